@@ -1,0 +1,218 @@
+# YADE driver: dry drained triaxial shear of a sphere packing, timed (a YADE script, not pendular).
+#
+#   yade -n -x -j THREADS benchmarks/yade_triaxial.py CONFIG.json
+#
+# (YADE 2023.02a, Debian package ``yade``: -n no GUI, -x exit when the script ends, -j OpenMP
+# threads; arguments after the script land in sys.argv[1:]). Exit status 1 on any error.
+# ``benchmarks/yade_runner.py`` calls this from Python. YADE is only a cross-check: pendular never
+# imports it.
+#
+# CONFIG.json (SI units, stresses compression positive, angles in degrees):
+#   spheres       sphere file, yade.export.textExt 'x_y_z_r' layout (dem.yade_io.write_spheres)
+#   box_lo/box_hi inner faces of the six walls [m] (default: the '# box_lo ... box_hi ...' line)
+#   young         FrictMat.young E [Pa]: kn = 2 E R1 R2 / (R1 + R2), E R against a wall
+#   poisson       FrictMat.poisson, read by Ip2_FrictMat_FrictMat_FrictPhys as ks / kn (0.3)
+#   friction_deg  sphere friction angle (walls: 0, frictionless)
+#   density       [kg/m^3];  damping: NewtonIntegrator.damping (Cundall local damping)
+#   dt            fixed time step [s]
+#   confining     lateral stress on the x and y walls [Pa]
+#   strain_rate   axial (z) compression rate [1/s], > 0 compresses
+#   steps, warmup_steps, record_every, output, history (optional, plot.saveDataTxt file)
+# Optional, with defaults: skin (pendular's Verlet skin [m], 0.3 R_min; YADE verletDist = skin / 2),
+#   stress_damping 0.25 (TriaxialStressController.stressDamping, YADE's default),
+#   strain_damping 0.0 (TriaxialStressController.strainDamping; YADE's default 0.99 ramps the
+#   axial rate up geometrically, 0 imposes it at once as pendular does),
+#   max_vel 1.0 m/s (TriaxialStressController.max_vel, YADE's default).
+#
+# Engine list, one step (YADE order, as pendular's shear phase):
+#   ForceResetter -> InsertionSortCollider -> InteractionLoop(Ig2 sphere-sphere & box-sphere ScGeom,
+#   Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack)
+#   -> TriaxialStressController (x, y servoed at -confining, z at strain rate -strain_rate)
+#   -> NewtonIntegrator(damping) [-> PyRunner recording the history]
+#
+# Output JSON: particles, steps, wall_time_s, particle_steps_per_s, threads, yade_version,
+# sigma_wall [sx, sy, sz] Pa (compression positive, force on each wall pair / current face
+# area), porosity, coordination (2 Nc / N over sphere-sphere contacts), unbalanced_force
+# (utils.unbalancedForce), and the settings used.
+
+import json
+import math
+import os
+import sys
+import time
+
+from yade import O, plot, utils, ymport
+from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
+                  Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
+                  Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack,
+                  NewtonIntegrator, PyRunner, Sphere, TriaxialStressController)
+import yade.config
+
+REQUIRED = ("spheres", "young", "poisson", "friction_deg", "density", "damping", "dt",
+            "confining", "strain_rate", "steps", "warmup_steps", "record_every", "output")
+
+
+def fail(message):
+    raise SystemExit("yade_triaxial.py: " + message)
+
+
+def load_config(path):
+    with open(path) as source:
+        config = json.load(source)
+    missing = [key for key in REQUIRED if key not in config]
+    if missing:
+        fail(f"{path}: missing keys {missing}")
+    for key in ("young", "density", "dt"):
+        if not config[key] > 0:
+            fail(f"{key} = {config[key]!r} must be > 0")
+    for key in ("steps", "warmup_steps", "record_every"):
+        if int(config[key]) != config[key] or config[key] < (1 if key != "warmup_steps" else 0):
+            fail(f"{key} = {config[key]!r} must be a positive integer")
+    if not 0 <= config["damping"] < 1:
+        fail(f"damping = {config['damping']!r} must lie in [0, 1)")
+    if config["confining"] < 0:
+        fail(f"confining = {config['confining']!r} Pa must be >= 0")
+    return config
+
+
+def box_from_file(path):
+    """The '# box_lo x y z box_hi x y z' line written by dem.yade_io.write_spheres, or None."""
+    with open(path) as source:
+        for line in source:
+            words = line.replace("#", " ").split()
+            if line.startswith("#") and len(words) == 8 and words[0] == "box_lo":
+                return [float(w) for w in words[1:4]], [float(w) for w in words[5:8]]
+    return None
+
+
+def build_scene(config):
+    box = (config.get("box_lo"), config.get("box_hi"))
+    if box[0] is None or box[1] is None:
+        box = box_from_file(config["spheres"])
+        if box is None:
+            fail("no box_lo/box_hi in the config nor in the sphere file")
+    lo, hi = [list(map(float, corner)) for corner in box]
+    if not all(h > l for l, h in zip(lo, hi)):
+        fail(f"box_hi {hi} must exceed box_lo {lo} on every axis")
+
+    E = float(config["young"])
+    sphere_mat = O.materials.append(FrictMat(
+        young=E, poisson=float(config["poisson"]), density=float(config["density"]),
+        frictionAngle=math.radians(float(config["friction_deg"])), label="spheres"))
+    # Same E as the spheres: Ig2_Box_Sphere_ScGeom gives the wall the sphere's radius, so
+    # kn_wall = E R (SPEC 2); friction angle 0 makes the walls frictionless (Ip2 takes the min).
+    wall_mat = O.materials.append(FrictMat(
+        young=E, poisson=float(config["poisson"]), density=float(config["density"]),
+        frictionAngle=0.0, label="walls"))
+
+    # aabbWalls puts the inner faces exactly on lo / hi and returns minX, maxX, minY, maxY,
+    # minZ, maxZ; appended first they get ids 0..5, TriaxialStressController's default ids.
+    thickness = 0.1 * min(h - l for l, h in zip(lo, hi))
+    walls = utils.aabbWalls([lo, hi], thickness=thickness, oversizeFactor=1.5, material=wall_mat)
+    wall_ids = O.bodies.append(walls)
+    spheres = ymport.textExt(config["spheres"], format="x_y_z_r", material=sphere_mat)
+    if not spheres:
+        fail(f"{config['spheres']}: no sphere read")
+    sphere_ids = O.bodies.append(spheres)
+    return lo, hi, thickness, wall_ids, sphere_ids
+
+
+def main(config_path):
+    config = load_config(config_path)
+    lo, hi, thickness, wall_ids, sphere_ids = build_scene(config)
+    radii = [O.bodies[i].shape.radius for i in sphere_ids]
+    skin = float(config.get("skin", 0.3 * min(radii)))
+    confining = float(config["confining"])
+    rate = float(config["strain_rate"])
+
+    triax = TriaxialStressController(
+        label="triax", internalCompaction=False, thickness=thickness,
+        wall_left_id=wall_ids[0], wall_right_id=wall_ids[1], wall_bottom_id=wall_ids[2],
+        wall_top_id=wall_ids[3], wall_back_id=wall_ids[4], wall_front_id=wall_ids[5],
+        # goal1/2/3 act on x/y/z; bit i of stressMask makes goal(i+1) a stress, else a strain
+        # rate; YADE's signs are tension positive, so compression is negative.
+        stressMask=0b011, goal1=-confining, goal2=-confining, goal3=-rate,
+        stressDamping=float(config.get("stress_damping", 0.25)),
+        strainDamping=float(config.get("strain_damping", 0.0)),
+        max_vel=float(config.get("max_vel", 1.0)))
+    O.engines = [
+        ForceResetter(),
+        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=0.5 * skin),
+        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+                        [Ip2_FrictMat_FrictMat_FrictPhys()],
+                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
+        triax,
+        NewtonIntegrator(damping=float(config["damping"])),
+    ]
+    O.dt = float(config["dt"])
+    depth0 = hi[2] - lo[2]
+    sphere_set = set(sphere_ids)
+
+    def wall_state():
+        """Inner box lengths [m] and wall stresses [Pa, compression positive]."""
+        p = [O.bodies[i].state.pos for i in wall_ids]
+        lengths = [p[2 * a + 1][a] - p[2 * a][a] - thickness for a in range(3)]
+        areas = [lengths[1] * lengths[2], lengths[0] * lengths[2], lengths[0] * lengths[1]]
+        sigma = [0.5 * (O.forces.f(wall_ids[2 * a + 1])[a] - O.forces.f(wall_ids[2 * a])[a])
+                 / areas[a] for a in range(3)]
+        return lengths, sigma
+
+    def record():
+        lengths, sigma = wall_state()
+        plot.addData(i=O.iter, t=O.time, eps_axial=1.0 - lengths[2] / depth0,
+                     sx=sigma[0], sy=sigma[1], sz=sigma[2], porosity=triax.porosity,
+                     unbalanced=utils.unbalancedForce())
+
+    history = config.get("history")
+    if history:
+        globals()["record_history"] = record
+        O.engines = O.engines + [PyRunner(iterPeriod=int(config["record_every"]),
+                                          command="record_history()")]
+
+    if int(config["warmup_steps"]) > 0:  # O.run(0) would run without end
+        O.run(int(config["warmup_steps"]), True)
+    steps = int(config["steps"])
+    start = time.perf_counter()
+    O.run(steps, True)
+    wall_time = time.perf_counter() - start
+
+    lengths, sigma = wall_state()
+    sphere_contacts = sum(1 for i in O.interactions
+                          if i.isReal and i.id1 in sphere_set and i.id2 in sphere_set)
+    n = len(sphere_ids)
+    result = {
+        "particles": n,
+        "steps": steps,
+        "wall_time_s": wall_time,
+        "particle_steps_per_s": n * steps / wall_time,
+        "threads": O.numThreads,
+        "yade_version": yade.config.version,
+        "sigma_wall": sigma,
+        "porosity": triax.porosity,
+        "coordination": 2.0 * sphere_contacts / n,
+        "unbalanced_force": utils.unbalancedForce(),
+        "axial_strain": 1.0 - lengths[2] / depth0,
+        "box_lengths": lengths,
+        "iterations": O.iter,
+        "time": O.time,
+        "dt": O.dt,
+        "verlet_dist": 0.5 * skin,
+        "stress_damping": triax.stressDamping,
+        "strain_damping": triax.strainDamping,
+        "max_vel": triax.max_vel,
+        "engines": [type(e).__name__ for e in O.engines],
+    }
+    if history:
+        record()  # the final state (PyRunner ran last at the previous multiple of record_every)
+        plot.saveDataTxt(history, vars=("i", "t", "eps_axial", "sx", "sy", "sz", "porosity",
+                                        "unbalanced"))
+    output = config["output"]
+    temporary = output + ".tmp"
+    with open(temporary, "w") as out:
+        json.dump(result, out, indent=1)
+    os.replace(temporary, output)
+
+
+if len(sys.argv) != 2:
+    fail("usage: yade -n -x [-j THREADS] yade_triaxial.py CONFIG.json")
+main(sys.argv[1])

@@ -1,0 +1,47 @@
+"""Liquid bridges between spheres: exact Young-Laplace solutions, tables, toroidal approximation.
+
+Units (SPEC section 1): R2 >= R1, r = R2/R1, u* = s R2/gamma, d* = D/R2, V* = V/R2**3,
+F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
+
+- solve_bridge(r, theta, u*, delta1): exact bridge from its filling angle (capillary.meniscus).
+- bridge_at_distance / rupture_distance / lowest_distance: suction-controlled (capillary.suction_control).
+- bridge_with_volume / rupture_distance_for_volume / volume_contour: volume-controlled (capillary.volume_control).
+- BridgeTable + lookup_suction, VolumeBridgeTable + lookup_volume: tables for Numba kernels.
+- write_yade / read_yade: YADE capillary files M(r=...) (capillary.yade_files).
+- toroidal_bridge: thesis Appendix A (capillary.toroidal).
+"""
+
+from capillary.meniscus import Bridge, solve_bridge
+from capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
+from capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
+from capillary.toroidal import ToroidalBridge, toroidal_bridge
+from capillary.validation import MAX_RADIUS_RATIO
+from capillary.volume_control import CONTACT_SUCTION_MAX, bridge_with_volume, rupture_distance_for_volume, volume_contour
+from capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
+from capillary.yade_files import YadeCapillaryFile, read_yade, write_yade
+
+__all__ = [
+    "Bridge",
+    "BridgeTable",
+    "CONTACT_SUCTION_MAX",
+    "FIELDS",
+    "MAX_RADIUS_RATIO",
+    "ToroidalBridge",
+    "VOLUME_FIELDS",
+    "VolumeBridgeTable",
+    "YADE_RADIUS_RATIOS",
+    "YadeCapillaryFile",
+    "bridge_at_distance",
+    "bridge_with_volume",
+    "cache_directory",
+    "lookup_suction",
+    "lookup_volume",
+    "lowest_distance",
+    "read_yade",
+    "rupture_distance",
+    "rupture_distance_for_volume",
+    "solve_bridge",
+    "toroidal_bridge",
+    "volume_contour",
+    "write_yade",
+]

@@ -1,0 +1,1 @@
+"""Soft-sphere discrete element engine (Numba): state, contacts, walls, integration."""

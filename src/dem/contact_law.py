@@ -1,0 +1,195 @@
+"""Linear elastic–frictional contact law (YADE's FrictMat / CundallStrack conventions, SPEC §2).
+
+Sphere–sphere: kn = 2 E R1 R2 / (R1 + R2), ks = shear_ratio * kn, Fn = kn * overlap (no tension),
+incremental shear spring rotated into the current contact plane, Coulomb cap |Fs| <= Fn tan(phi).
+Sphere–wall: frictionless, the wall acting as a virtual sphere of the same radius (kn = E R).
+"""
+
+import numba
+import numpy as np
+
+from .validate import check_positive, check_range
+
+
+@numba.njit(cache=True, parallel=True)
+def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j,
+                shear_force, normal, overlap, normal_force, force, torque_i, torque_j,
+                young, shear_ratio, tan_friction, dt):
+    """Evaluate every candidate pair; fill the per-pair arrays (force on j from i, torques).
+
+    The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
+    is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),
+    then incremented by -ks * (tangential relative velocity at the contact) * dt, the relative
+    velocity using the radii as lever arms (YADE's avoidGranularRatcheting), and finally capped
+    at Fn tan(phi), the elastic part being kept on the cap when sliding.
+    """
+    for k in numba.prange(len(pair_i)):
+        i = pair_i[k]
+        j = pair_j[k]
+        d0 = position[j, 0] - position[i, 0]
+        d1 = position[j, 1] - position[i, 1]
+        d2 = position[j, 2] - position[i, 2]
+        distance = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        ri = radius[i]
+        rj = radius[j]
+        gap_overlap = ri + rj - distance
+        overlap[k] = gap_overlap
+        if gap_overlap <= 0.0:
+            normal_force[k] = 0.0
+            for c in range(3):
+                shear_force[k, c] = 0.0
+                force[k, c] = 0.0
+                torque_i[k, c] = 0.0
+                torque_j[k, c] = 0.0
+            continue
+        n0 = d0 / distance
+        n1 = d1 / distance
+        n2 = d2 / distance
+        kn = 2.0 * young * ri * rj / (ri + rj)
+        ks = shear_ratio * kn
+        fs0 = shear_force[k, 0]
+        fs1 = shear_force[k, 1]
+        fs2 = shear_force[k, 2]
+        # rotate the shear force with the contact: tilt axis = n_old x n, then twist about n
+        o0 = normal[k, 0]
+        o1 = normal[k, 1]
+        o2 = normal[k, 2]
+        a0 = o1 * n2 - o2 * n1
+        a1 = o2 * n0 - o0 * n2
+        a2 = o0 * n1 - o1 * n0
+        fs0, fs1, fs2 = (fs0 - (fs1 * a2 - fs2 * a1), fs1 - (fs2 * a0 - fs0 * a2),
+                         fs2 - (fs0 * a1 - fs1 * a0))
+        spin = 0.5 * dt * (n0 * (angular_velocity[i, 0] + angular_velocity[j, 0])
+                           + n1 * (angular_velocity[i, 1] + angular_velocity[j, 1])
+                           + n2 * (angular_velocity[i, 2] + angular_velocity[j, 2]))
+        a0 = spin * n0
+        a1 = spin * n1
+        a2 = spin * n2
+        fs0, fs1, fs2 = (fs0 - (fs1 * a2 - fs2 * a1), fs1 - (fs2 * a0 - fs0 * a2),
+                         fs2 - (fs0 * a1 - fs1 * a0))
+        # relative velocity of j with respect to i at the contact point
+        wi0 = angular_velocity[i, 0]
+        wi1 = angular_velocity[i, 1]
+        wi2 = angular_velocity[i, 2]
+        wj0 = angular_velocity[j, 0]
+        wj1 = angular_velocity[j, 1]
+        wj2 = angular_velocity[j, 2]
+        v0 = velocity[j, 0] - velocity[i, 0] - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1)
+        v1 = velocity[j, 1] - velocity[i, 1] - rj * (wj2 * n0 - wj0 * n2) - ri * (wi2 * n0 - wi0 * n2)
+        v2 = velocity[j, 2] - velocity[i, 2] - rj * (wj0 * n1 - wj1 * n0) - ri * (wi0 * n1 - wi1 * n0)
+        vn = v0 * n0 + v1 * n1 + v2 * n2
+        fs0 -= ks * (v0 - vn * n0) * dt
+        fs1 -= ks * (v1 - vn * n1) * dt
+        fs2 -= ks * (v2 - vn * n2) * dt
+        fn = kn * gap_overlap
+        cap = fn * tan_friction
+        magnitude = np.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
+        if magnitude > cap:
+            scale = cap / magnitude
+            fs0 *= scale
+            fs1 *= scale
+            fs2 *= scale
+        shear_force[k, 0] = fs0
+        shear_force[k, 1] = fs1
+        shear_force[k, 2] = fs2
+        normal[k, 0] = n0
+        normal[k, 1] = n1
+        normal[k, 2] = n2
+        normal_force[k] = fn
+        force[k, 0] = fn * n0 + fs0
+        force[k, 1] = fn * n1 + fs1
+        force[k, 2] = fn * n2 + fs2
+        # torques of the shear force about each centre, applied at the middle of the overlap
+        t0 = n1 * fs2 - n2 * fs1
+        t1 = n2 * fs0 - n0 * fs2
+        t2 = n0 * fs1 - n1 * fs0
+        lever_i = -(ri - 0.5 * gap_overlap)
+        lever_j = -(rj - 0.5 * gap_overlap)
+        torque_i[k, 0] = lever_i * t0
+        torque_i[k, 1] = lever_i * t1
+        torque_i[k, 2] = lever_i * t2
+        torque_j[k, 0] = lever_j * t0
+        torque_j[k, 1] = lever_j * t1
+        torque_j[k, 2] = lever_j * t2
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_pair_forces(pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
+                       second_pair, force, torque):
+    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j."""
+    for p in numba.prange(len(row_start) - 1):
+        for c in range(3):
+            total_force = force[p, c]
+            total_torque = torque[p, c]
+            for k in range(row_start[p], row_start[p + 1]):
+                total_force -= pair_force[k, c]
+                total_torque += pair_torque_i[k, c]
+            for slot in range(second_start[p], second_start[p + 1]):
+                k = second_pair[slot]
+                total_force += pair_force[k, c]
+                total_torque += pair_torque_j[k, c]
+            force[p, c] = total_force
+            torque[p, c] = total_torque
+
+
+@numba.njit(cache=True)
+def wall_forces(position, radius, wall_position, young, force, wall_force, wall_stiffness,
+                wall_moment):
+    """Frictionless sphere–wall springs (kn = E R); add to ``force``, fill wall totals.
+
+    wall_force[w] is the compressive normal force the particles exert on wall w [N],
+    wall_stiffness[w] the sum of its contacts' kn [N/m] (used by the stress servo) and
+    wall_moment[w] the sum of (centre-to-wall distance) * force [N m] (Love–Weber, Eq. 3.41).
+    """
+    wall_force[:] = 0.0
+    wall_stiffness[:] = 0.0
+    wall_moment[:] = 0.0
+    for p in range(position.shape[0]):
+        r = radius[p]
+        kn = young * r
+        for axis in range(3):
+            low_overlap = r - (position[p, axis] - wall_position[2 * axis])
+            if low_overlap > 0.0:
+                push = kn * low_overlap
+                force[p, axis] += push
+                wall_force[2 * axis] += push
+                wall_stiffness[2 * axis] += kn
+                wall_moment[2 * axis] += (r - low_overlap) * push
+            high_overlap = r - (wall_position[2 * axis + 1] - position[p, axis])
+            if high_overlap > 0.0:
+                push = kn * high_overlap
+                force[p, axis] -= push
+                wall_force[2 * axis + 1] += push
+                wall_stiffness[2 * axis + 1] += kn
+                wall_moment[2 * axis + 1] += (r - high_overlap) * push
+
+
+class ContactForces:
+    """Sphere–sphere linear contacts for every candidate pair of ``sim.contacts``.
+
+    young [Pa], shear_ratio = ks/kn, friction [deg] (changeable between runs: ``friction_deg``).
+    """
+
+    def __init__(self, young, shear_ratio=0.3, friction_deg=18.0):
+        self.young = check_positive("young", young, "Pa")
+        self.shear_ratio = check_range("shear_ratio", shear_ratio, 0.0, 10.0)
+        self.friction_deg = friction_deg
+
+    @property
+    def friction_deg(self):
+        return self._friction_deg
+
+    @friction_deg.setter
+    def friction_deg(self, value):
+        self._friction_deg = check_range("friction", value, 0.0, 90.0, high_inclusive=False,
+                                         unit="deg")
+        self._tan_friction = float(np.tan(np.radians(self._friction_deg)))
+
+    def apply(self, sim):
+        p = sim.particles
+        c = sim.contacts
+        pair_forces(p.position, p.velocity, p.angular_velocity, p.radius, c.pair_i, c.pair_j,
+                    c.shear_force, c.normal, c.overlap, c.normal_force, c.force, c.torque_i,
+                    c.torque_j, self.young, self.shear_ratio, self._tan_friction, sim.dt)
+        gather_pair_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
+                           c.second_pair, p.force, p.torque)

@@ -1,0 +1,241 @@
+"""Verlet neighbour list built from a cell list, with per-pair contact history carried across rebuilds.
+
+Pairs are stored once (i < j) in CSR order: the pairs of particle i are
+``row_start[i]:row_start[i+1]``, sorted by j. ``second_start``/``second_pair`` index,
+for each particle, the pairs in which it is the second member, so that per-pair results
+can be gathered per particle without atomics (deterministic for any thread count).
+"""
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from .validate import check_positive
+
+
+@dataclass
+class Contacts:
+    """Candidate pairs and their per-pair state (K pairs).
+
+    pair_i, pair_j: (K,) int64 particle indices, i < j.
+    shear_force: (K, 3) elastic tangential force on j from i [N], the incremental spring history.
+    normal: (K, 3) unit vector i -> j at the last force evaluation (for rotating shear_force).
+    overlap: (K,) r_i + r_j - |x_j - x_i| at the last evaluation [m] (negative = gap).
+    normal_force: (K,) magnitude of the spring's normal force [N] (0 when apart).
+    force: (K, 3) total contact force on j from i [N]; torque_i, torque_j: (K, 3) [N m].
+    """
+
+    pair_i: np.ndarray
+    pair_j: np.ndarray
+    row_start: np.ndarray
+    second_start: np.ndarray
+    second_pair: np.ndarray
+    shear_force: np.ndarray
+    normal: np.ndarray
+    overlap: np.ndarray
+    normal_force: np.ndarray
+    force: np.ndarray
+    torque_i: np.ndarray
+    torque_j: np.ndarray
+
+    def __len__(self):
+        return len(self.pair_i)
+
+    def touching(self):
+        """Boolean mask of pairs in mechanical contact (overlap > 0)."""
+        return self.overlap > 0.0
+
+
+@numba.njit(cache=True)
+def _cell_grid(position, lo, hi, cell_size):
+    """Sort particles into a regular grid of cells of at least ``cell_size`` covering [lo, hi]."""
+    count = position.shape[0]
+    dims = np.empty(3, np.int64)
+    for axis in range(3):
+        dims[axis] = max(1, int((hi[axis] - lo[axis]) / cell_size))
+    cell_of = np.empty(count, np.int64)
+    for p in range(count):
+        index = 0
+        for axis in range(3):
+            width = (hi[axis] - lo[axis]) / dims[axis]
+            c = int((position[p, axis] - lo[axis]) / width)
+            c = min(max(c, 0), dims[axis] - 1)
+            index = index * dims[axis] + c
+        cell_of[p] = index
+    cell_count = dims[0] * dims[1] * dims[2]
+    cell_start = np.zeros(cell_count + 1, np.int64)
+    for p in range(count):
+        cell_start[cell_of[p] + 1] += 1
+    for c in range(cell_count):
+        cell_start[c + 1] += cell_start[c]
+    fill = cell_start[:-1].copy()
+    cell_particles = np.empty(count, np.int64)
+    for p in range(count):
+        cell_particles[fill[cell_of[p]]] = p
+        fill[cell_of[p]] += 1
+    return dims, cell_of, cell_start, cell_particles
+
+
+@numba.njit(cache=True)
+def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles, out):
+    """Write into ``out`` the sorted j > p within r_p + r_j + skin; return how many."""
+    found = 0
+    cell = cell_of[p]
+    cz = cell % dims[2]
+    cy = (cell // dims[2]) % dims[1]
+    cx = cell // (dims[1] * dims[2])
+    for dx in range(-1, 2):
+        x = cx + dx
+        if x < 0 or x >= dims[0]:
+            continue
+        for dy in range(-1, 2):
+            y = cy + dy
+            if y < 0 or y >= dims[1]:
+                continue
+            for dz in range(-1, 2):
+                z = cz + dz
+                if z < 0 or z >= dims[2]:
+                    continue
+                c = (x * dims[1] + y) * dims[2] + z
+                for slot in range(cell_start[c], cell_start[c + 1]):
+                    q = cell_particles[slot]
+                    if q <= p:
+                        continue
+                    reach = radius[p] + radius[q] + skin
+                    d0 = position[q, 0] - position[p, 0]
+                    d1 = position[q, 1] - position[p, 1]
+                    d2 = position[q, 2] - position[p, 2]
+                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                        # insertion keeps the row sorted by j
+                        k = found
+                        while k > 0 and out[k - 1] > q:
+                            out[k] = out[k - 1]
+                            k -= 1
+                        out[k] = q
+                        found += 1
+    return found
+
+
+@numba.njit(cache=True, parallel=True)
+def build_pairs(position, radius, lo, hi, skin):
+    """Half Verlet list (i < j, |x_i - x_j| < r_i + r_j + skin) as CSR arrays (row_start, pair_j)."""
+    count = position.shape[0]
+    cell_size = 2.0 * radius.max() + skin
+    dims, cell_of, cell_start, cell_particles = _cell_grid(position, lo, hi, cell_size)
+    max_row = 0
+    for c in range(len(cell_start) - 1):
+        max_row = max(max_row, cell_start[c + 1] - cell_start[c])
+    max_row *= 27
+    row_count = np.zeros(count, np.int64)
+    for p in numba.prange(count):
+        scratch = np.empty(max_row, np.int64)
+        row_count[p] = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start,
+                                     cell_particles, scratch)
+    row_start = np.zeros(count + 1, np.int64)
+    for p in range(count):
+        row_start[p + 1] = row_start[p] + row_count[p]
+    pair_j = np.empty(row_start[count], np.int64)
+    for p in numba.prange(count):
+        scratch = np.empty(max_row, np.int64)
+        found = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
+                              scratch)
+        pair_j[row_start[p]:row_start[p] + found] = scratch[:found]
+    return row_start, pair_j
+
+
+@numba.njit(cache=True)
+def second_index(row_start, pair_j, count):
+    """For each particle, the pair indices in which it is the second member (CSR)."""
+    second_start = np.zeros(count + 1, np.int64)
+    for k in range(len(pair_j)):
+        second_start[pair_j[k] + 1] += 1
+    for p in range(count):
+        second_start[p + 1] += second_start[p]
+    fill = second_start[:-1].copy()
+    second_pair = np.empty(len(pair_j), np.int64)
+    for i in range(count):
+        for k in range(row_start[i], row_start[i + 1]):
+            j = pair_j[k]
+            second_pair[fill[j]] = k
+            fill[j] += 1
+    return second_start, second_pair
+
+
+@numba.njit(cache=True, parallel=True)
+def carry_history(old_row_start, old_pair_j, old_values, new_row_start, new_pair_j, new_values):
+    """Copy per-pair rows of ``old_values`` to the same (i, j) pair in the new list; others stay 0."""
+    count = len(new_row_start) - 1
+    width = old_values.shape[1]
+    for i in numba.prange(count):
+        old = old_row_start[i]
+        old_end = old_row_start[i + 1]
+        for k in range(new_row_start[i], new_row_start[i + 1]):
+            j = new_pair_j[k]
+            while old < old_end and old_pair_j[old] < j:
+                old += 1
+            if old < old_end and old_pair_j[old] == j:
+                for c in range(width):
+                    new_values[k, c] = old_values[old, c]
+
+
+@numba.njit(cache=True, parallel=True)
+def max_travel(position, reference_position, radius, reference_radius):
+    """Largest displacement plus radius growth since the last rebuild [m]."""
+    count = position.shape[0]
+    travel = np.empty(count)
+    for p in numba.prange(count):
+        d0 = position[p, 0] - reference_position[p, 0]
+        d1 = position[p, 1] - reference_position[p, 1]
+        d2 = position[p, 2] - reference_position[p, 2]
+        travel[p] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) + max(radius[p] - reference_radius[p], 0.0)
+    return travel.max()
+
+
+def build_contacts(position, radius, lo, hi, skin, previous=None):
+    """Build the neighbour list; carry shear history and normals from ``previous`` if given."""
+    count = len(radius)
+    row_start, pair_j = build_pairs(position, radius, lo, hi, skin)
+    pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
+    second_start, second_pair = second_index(row_start, pair_j, count)
+    size = len(pair_j)
+    history = np.zeros((size, 6))
+    if previous is not None and len(previous):
+        old = np.concatenate([previous.shear_force, previous.normal], axis=1)
+        carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j, history)
+    return Contacts(
+        pair_i=pair_i, pair_j=pair_j, row_start=row_start,
+        second_start=second_start, second_pair=second_pair,
+        shear_force=np.ascontiguousarray(history[:, :3]),
+        normal=np.ascontiguousarray(history[:, 3:]),
+        overlap=np.full(size, -np.inf), normal_force=np.zeros(size),
+        force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)))
+
+
+class NeighborList:
+    """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2.
+
+    skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
+    """
+
+    def __init__(self, skin):
+        self.skin = check_positive("skin", skin, "m")
+        self.rebuilds = 0
+        self._reference_position = None
+        self._reference_radius = None
+
+    def rebuild(self, sim):
+        p = sim.particles
+        sim.contacts = build_contacts(p.position, p.radius, sim.walls.lo, sim.walls.hi, self.skin,
+                                      previous=sim.contacts)
+        self._reference_position = p.position.copy()
+        self._reference_radius = p.radius.copy()
+        self.rebuilds += 1
+
+    def apply(self, sim):
+        p = sim.particles
+        if (sim.contacts is None or self._reference_position is None
+                or len(self._reference_radius) != len(p.radius)
+                or max_travel(p.position, self._reference_position, p.radius,
+                              self._reference_radius) > 0.5 * self.skin):
+            self.rebuild(sim)

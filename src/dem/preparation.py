@@ -1,0 +1,249 @@
+"""Sample preparation (thesis Ch. 5.2.2, SPEC §3).
+
+1. A random non-overlapping cloud in a fixed frictionless box, friction ``prep_friction`` (0.5°).
+2. Radii grown homogeneously until the mean wall stress reaches ``prep_stress`` (5 kPa) and the
+   packing is in quasi-static equilibrium.
+3. The whole sample rescaled so that the radius is the nominal one. With linear springs
+   kn = E R, forces scale as R^2 and stresses are unchanged.
+4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
+   target lowered slowly to the confining stress, and equilibrium again.
+"""
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from .contact_law import ContactForces
+from .integrate import Integrator, pwave_timestep
+from .measure import coordination, porosity, unbalanced_force
+from .neighbors import NeighborList
+from .simulation import ForceReset, Simulation
+from .state import Particles, Walls
+from .validate import check_int, check_positive, check_range
+from .walls import StressServo, WallForces
+
+
+@numba.njit(cache=True)
+def _random_cloud(count, radius, lo, hi, seed, max_attempts):
+    """Random sequential insertion of ``count`` equal spheres in [lo, hi] without overlap."""
+    np.random.seed(seed)
+    cell = 2.0 * radius
+    dims = np.empty(3, np.int64)
+    for a in range(3):
+        dims[a] = max(1, int((hi[a] - lo[a] - 2.0 * radius) / cell))
+    # each cell holds at most one centre since its edge is >= the minimum centre distance
+    occupant = -np.ones(dims[0] * dims[1] * dims[2], np.int64)
+    position = np.empty((count, 3))
+    placed = 0
+    attempts = 0
+    while placed < count:
+        attempts += 1
+        if attempts > max_attempts:
+            return position[:placed]
+        x = np.empty(3)
+        c = np.empty(3, np.int64)
+        for a in range(3):
+            x[a] = lo[a] + radius + np.random.random() * (hi[a] - lo[a] - 2.0 * radius)
+            c[a] = min(int((x[a] - lo[a] - radius) / ((hi[a] - lo[a] - 2.0 * radius) / dims[a])),
+                       dims[a] - 1)
+        free = occupant[(c[0] * dims[1] + c[1]) * dims[2] + c[2]] < 0
+        for dx in range(-1, 2):
+            for dy in range(-1, 2):
+                for dz in range(-1, 2):
+                    nx = c[0] + dx
+                    ny = c[1] + dy
+                    nz = c[2] + dz
+                    if not free or nx < 0 or ny < 0 or nz < 0 or nx >= dims[0] \
+                            or ny >= dims[1] or nz >= dims[2]:
+                        continue
+                    q = occupant[(nx * dims[1] + ny) * dims[2] + nz]
+                    if q >= 0:
+                        d = x - position[q]
+                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cell * cell:
+                            free = False
+        if free:
+            position[placed] = x
+            occupant[(c[0] * dims[1] + c[1]) * dims[2] + c[2]] = placed
+            placed += 1
+    return position
+
+
+def random_cloud(count, radius, lo, hi, seed):
+    """``count`` non-overlapping spheres of ``radius`` [m] uniformly placed in the box [lo, hi]."""
+    count = check_int("particles", count, low=1)
+    radius = check_positive("radius", radius, "m")
+    position = _random_cloud(count, radius, np.asarray(lo, float), np.asarray(hi, float),
+                             check_int("seed", seed), 200 * count + 10000)
+    if len(position) < count:
+        raise ValueError(f"could place only {len(position)} of {count} spheres of radius "
+                         f"{radius:g} m without overlap; use a larger box or smaller radius")
+    return position
+
+
+class RadiusGrowth:
+    """Grow all radii by (1 + g) per step, g = max_rate * clip(1 - sigma_mean / target, -1, 1).
+
+    Runs after WallForces; masses follow the radii (constant density).
+    """
+
+    def __init__(self, target_stress, max_rate):
+        self.target_stress = check_positive("prep_stress", target_stress, "Pa")
+        self.max_rate = check_positive("growth max_rate", max_rate)
+
+    def apply(self, sim):
+        mean_stress = float(np.mean(sim.walls.stress()))
+        rate = self.max_rate * float(np.clip(1.0 - mean_stress / self.target_stress, -1.0, 1.0))
+        sim.particles.radius *= 1.0 + rate
+        sim.particles.update_mass()
+
+
+@dataclass
+class PrepareConfig:
+    """Sample and preparation parameters (SI, angles in degrees); defaults are thesis Table 5.2."""
+
+    particles: int = 10000
+    radius: float = 0.024e-3
+    porosity: float = 0.40
+    young: float = 1e6
+    shear_ratio: float = 0.3
+    friction_deg: float = 18.0
+    prep_friction_deg: float = 0.5
+    density: float = 2650.0
+    damping: float = 0.2
+    timestep_safety: float = 0.7
+    prep_stress: float = 5000.0
+    confining: float = 750.0
+    seed: int = 0
+    skin_factor: float = 0.3
+    equilibrium_unbalanced: float = 0.01
+    stress_tolerance: float = 0.01
+    unload_steps: int = 10000
+
+    def __post_init__(self):
+        self.particles = check_int("particles", self.particles, low=2)
+        self.radius = check_positive("radius", self.radius, "m")
+        self.porosity = check_range("porosity", self.porosity, 0.30, 0.60)
+        self.young = check_positive("young", self.young, "Pa")
+        self.shear_ratio = check_range("shear_ratio", self.shear_ratio, 0.0, 10.0)
+        self.friction_deg = check_range("friction", self.friction_deg, 0.0, 90.0,
+                                        high_inclusive=False, unit="deg")
+        self.prep_friction_deg = check_range("prep_friction", self.prep_friction_deg, 0.0, 90.0,
+                                             high_inclusive=False, unit="deg")
+        self.density = check_positive("density", self.density, "kg/m^3")
+        self.damping = check_range("damping", self.damping, 0.0, 1.0, high_inclusive=False)
+        self.timestep_safety = check_range("timestep_safety", self.timestep_safety, 0.0, 1.0,
+                                           low_inclusive=False)
+        self.prep_stress = check_positive("prep_stress", self.prep_stress, "Pa")
+        self.confining = check_range("confining", self.confining, 0.0, 1e7, unit="Pa")
+        self.seed = check_int("seed", self.seed)
+        self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
+        self.skin_factor = check_range("skin_factor", self.skin_factor, 0.0, 2.0,
+                                       low_inclusive=False)
+
+
+def timestep(particles, config):
+    """dt = timestep_safety * P-wave estimate (YADE's PWaveTimeStep) [s]."""
+    return config.timestep_safety * pwave_timestep(particles.radius, config.young, config.density)
+
+
+def equilibrated(config):
+    """Predicate: unbalanced force below threshold (and wall stresses within tolerance if servoed)."""
+
+    def done(sim):
+        if unbalanced_force(sim.particles, sim.contacts) > config.equilibrium_unbalanced:
+            return False
+        try:
+            servo = sim.operation(StressServo)
+        except KeyError:
+            return True
+        error = np.abs(sim.walls.stress() - servo.target)
+        return bool(np.all(error <= config.stress_tolerance * max(servo.target, 1e-12)))
+
+    return done
+
+
+def dry_operations(config, skin, friction_deg):
+    """The force pipeline of a dry scene: reset, neighbour list, contact law, wall springs."""
+    return [ForceReset(), NeighborList(skin),
+            ContactForces(config.young, config.shear_ratio, friction_deg), WallForces(config.young)]
+
+
+def rescale(sim, factor):
+    """Scale all lengths by ``factor`` (stresses unchanged: forces scale as factor^2)."""
+    p = sim.particles
+    p.position *= factor
+    p.radius *= factor
+    p.update_mass()
+    p.velocity[:] = 0.0
+    p.angular_velocity[:] = 0.0
+    sim.walls.position *= factor
+    sim.contacts.shear_force *= factor ** 2
+    sim.operation(NeighborList).rebuild(sim)
+
+
+def prepare_sample(config, *, progress=True, max_steps=2_000_000):
+    """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
+
+    The returned simulation's operations are the dry pipeline, the six-wall servo at the
+    confining stress and the integrator; ``report`` gives porosity, coordination and steps.
+    """
+    label = "prepare" if progress else None
+    solid = config.particles * 4.0 / 3.0 * np.pi * config.radius ** 3
+    edge = (solid / (1.0 - config.porosity)) ** (1.0 / 3.0)
+    # cloud at 60 % of the nominal radius (solid fraction ~0.13): sequential insertion is easy
+    cloud_radius = 0.6 * config.radius
+    lo = np.zeros(3)
+    hi = np.full(3, edge)
+    position = random_cloud(config.particles, cloud_radius, lo, hi, config.seed)
+    particles = Particles(position, np.full(config.particles, cloud_radius), config.density)
+    walls = Walls.box(lo, hi)
+    skin = config.skin_factor * config.radius
+    growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
+    sim = Simulation(particles, walls, timestep(particles, config),
+                     dry_operations(config, skin, config.prep_friction_deg)
+                     + [growth, Integrator(config.damping)])
+    done = equilibrated(config)
+
+    def grown(s):
+        stress = float(np.mean(s.walls.stress()))
+        return (abs(stress - config.prep_stress) <= 0.02 * config.prep_stress and done(s))
+
+    def status(s):
+        return {"sigma": f"{np.mean(s.walls.stress()):.0f}Pa",
+                "n": f"{porosity(s.particles, s.walls):.3f}",
+                "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"}
+
+    steps = {"growth": sim.run(max_steps, until=grown, check_every=200, progress=label and
+                               "grow radii", status=status)}
+    rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
+    growth_index = sim.operations.index(growth)
+    servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim, config))
+    sim.operations[growth_index] = servo
+    sim.dt = timestep(sim.particles, config)
+    sim.operation(ContactForces).friction_deg = config.friction_deg
+    steps["friction"] = sim.run(max_steps, until=done, check_every=200,
+                                progress=label and "set friction", status=status)
+    start = servo.target
+    stages = 20
+    for stage in range(1, stages + 1):
+        servo.target = start + (config.confining - start) * stage / stages
+        sim.run(config.unload_steps // stages)
+    steps["unload"] = config.unload_steps // stages * stages
+    steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
+                                   progress=label and "equilibrate", status=status)
+    report = {
+        "porosity": porosity(sim.particles, sim.walls),
+        "coordination": coordination(sim.contacts, len(sim.particles)),
+        "unbalanced_force": unbalanced_force(sim.particles, sim.contacts),
+        "sigma_wall": sim.walls.stress().tolist(),
+        "steps": steps,
+        "dt": sim.dt,
+        "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
+    }
+    return sim, report
+
+
+def _servo_speed(sim, config):
+    """Servo speed cap [m/s]: a wall may travel 1e-4 of the box per time step."""
+    return 1e-4 * float(np.mean(sim.walls.lengths())) / sim.dt

@@ -1,0 +1,112 @@
+"""Simulation state in contiguous arrays: particles and the six axis-aligned walls."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .validate import check_array, check_positive
+
+
+@dataclass
+class Particles:
+    """Spheres as a structure of arrays (SI units).
+
+    position, velocity, angular_velocity, force, torque: (N, 3) float64 [m, m/s, rad/s, N, N m];
+    radius, mass, inertia: (N,) float64 [m, kg, kg m^2]; density [kg/m^3].
+    """
+
+    position: np.ndarray
+    radius: np.ndarray
+    density: float
+    velocity: np.ndarray = None
+    angular_velocity: np.ndarray = None
+    mass: np.ndarray = field(init=False)
+    inertia: np.ndarray = field(init=False)
+    force: np.ndarray = field(init=False)
+    torque: np.ndarray = field(init=False)
+
+    def __post_init__(self):
+        self.position = check_array("position", self.position, (3,))
+        self.radius = check_array("radius", self.radius, positive=True)
+        if len(self.radius) != len(self.position):
+            raise ValueError(f"radius has {len(self.radius)} entries but position has {len(self.position)}")
+        self.density = check_positive("density", self.density, "kg/m^3")
+        count = len(self.radius)
+        self.velocity = (np.zeros((count, 3)) if self.velocity is None
+                         else check_array("velocity", self.velocity, (3,)))
+        self.angular_velocity = (np.zeros((count, 3)) if self.angular_velocity is None
+                                 else check_array("angular_velocity", self.angular_velocity, (3,)))
+        self.force = np.zeros((count, 3))
+        self.torque = np.zeros((count, 3))
+        self.mass = np.empty(count)
+        self.inertia = np.empty(count)
+        self.update_mass()
+
+    def __len__(self):
+        return len(self.radius)
+
+    def update_mass(self):
+        """Recompute mass (rho 4/3 pi R^3) and moment of inertia (2/5 m R^2) from the radii."""
+        np.multiply(self.density * 4.0 / 3.0 * np.pi, self.radius ** 3, out=self.mass)
+        np.multiply(0.4 * self.mass, self.radius ** 2, out=self.inertia)
+
+    def solid_volume(self):
+        """Total volume of the spheres [m^3]."""
+        return float(4.0 / 3.0 * np.pi * np.sum(self.radius ** 3))
+
+
+#: Wall k sits on axis k // 2; k % 2 == 0 is the low wall (normal +axis), 1 the high wall.
+WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
+
+
+@dataclass
+class Walls:
+    """Six frictionless axis-aligned planar walls bounding the box [lo, hi].
+
+    position: (6,) wall plane coordinate along its axis [m], ordered as WALL_NAMES;
+    velocity: (6,) outward-positive wall speed of the last step [m/s];
+    force: (6,) normal force the particles exert on each wall, compression positive [N];
+    stiffness: (6,) sum of the normal stiffnesses of the wall's contacts [N/m];
+    moment: (6,) sum over the wall's contacts of centre-to-wall distance * force [N m].
+    """
+
+    position: np.ndarray
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    force: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    stiffness: np.ndarray = field(default_factory=lambda: np.zeros(6))
+    moment: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+    @classmethod
+    def box(cls, lo, hi):
+        lo = check_array("box_lo", np.reshape(lo, (1, 3)), (3,))[0]
+        hi = check_array("box_hi", np.reshape(hi, (1, 3)), (3,))[0]
+        if (hi <= lo).any():
+            raise ValueError(f"box_hi {hi.tolist()} must exceed box_lo {lo.tolist()} on every axis")
+        return cls(position=np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], dtype=np.float64))
+
+    @property
+    def lo(self):
+        return self.position[0::2]
+
+    @property
+    def hi(self):
+        return self.position[1::2]
+
+    def lengths(self):
+        """Box edge lengths (3,) [m]."""
+        return self.position[1::2] - self.position[0::2]
+
+    def volume(self):
+        """Volume enclosed by the walls [m^3]."""
+        return float(np.prod(self.lengths()))
+
+    def areas(self):
+        """Area of each wall's face (6,) [m^2]: the product of the two other edge lengths."""
+        lengths = self.lengths()
+        face = np.array([lengths[1] * lengths[2], lengths[0] * lengths[2], lengths[0] * lengths[1]])
+        return np.repeat(face, 2)
+
+    def stress(self):
+        """Mean normal stress on each axis (3,) [Pa], compression positive: both walls' force / area."""
+        per_wall = self.force / self.areas()
+        return 0.5 * (per_wall[0::2] + per_wall[1::2])

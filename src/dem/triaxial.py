@@ -1,0 +1,102 @@
+"""Drained triaxial compression (thesis Ch. 5.2.3): lateral walls servoed, axial walls strained.
+
+Stresses are compression positive [Pa]; q = sigma_axial - sigma_lateral,
+p = (sigma_axial + 2 sigma_lateral) / 3; strains compression positive, volumetric strain
+positive in contraction (SPEC §1).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from homogenize import contact_stress, fabric_tensor
+
+from .measure import coordination, porosity, unbalanced_force
+from .record import HistoryRecorder
+from .validate import check_int, check_positive, check_range
+from .walls import ConstantStrainRate, StressServo
+
+
+@dataclass
+class ShearConfig:
+    """Shear-phase parameters. ``strain_rate`` [1/s] defaults to the one giving
+    ``inertial_number`` I = rate * 2R * sqrt(rho / confining)."""
+
+    confining: float = 750.0
+    max_strain: float = 0.25
+    inertial_number: float = 1e-3
+    strain_rate: float = None
+    records: int = 500
+
+    def __post_init__(self):
+        self.confining = check_positive("confining", self.confining, "Pa")
+        self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.9,
+                                      low_inclusive=False)
+        self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
+                                           low_inclusive=False)
+        if self.strain_rate is not None:
+            self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
+        self.records = check_int("records", self.records, low=2)
+
+    def rate(self, radius, density):
+        """Axial strain rate [1/s]: the given one, or the one of the target inertial number."""
+        if self.strain_rate is not None:
+            return self.strain_rate
+        return self.inertial_number / (2.0 * radius * np.sqrt(density / self.confining))
+
+
+def inertial_number(strain_rate, radius, density, pressure):
+    """I = strain_rate * d * sqrt(rho / p), d = 2R (GDR MiDi 2004)."""
+    return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
+
+
+def triaxial_quantities(axial, reference_volume):
+    """Recorded columns of the triaxial history (see the scenario's HDF5 layout)."""
+    return {
+        "step": lambda s: s.step,
+        "time": lambda s: s.time,
+        "axial_strain": lambda s: axial.strain(s.walls),
+        "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
+        "sigma_wall": lambda s: s.walls.stress(),
+        "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
+        "porosity": lambda s: porosity(s.particles, s.walls),
+        "coordination": lambda s: coordination(s.contacts, len(s.particles)),
+        "fabric": lambda s: fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0),
+        "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
+    }
+
+
+def start_shear(sim, config, radius, density):
+    """Replace the wall control of a prepared sample with the triaxial one; add a recorder.
+
+    Returns (recorder, steps to reach max_strain, strain rate).
+    """
+    servo = sim.operation(StressServo)
+    rate = config.rate(radius, density)
+    axial = ConstantStrainRate("z", rate, sim.walls.lengths()[2])
+    lateral = StressServo("xy", config.confining, servo.max_velocity, servo.gain, servo.memory)
+    index = sim.operations.index(servo)
+    sim.operations[index:index + 1] = [lateral, axial]
+    steps = int(np.ceil(config.max_strain / (rate * sim.dt)))
+    recorder = HistoryRecorder(max(1, steps // config.records),
+                               triaxial_quantities(axial, sim.walls.volume()))
+    recorder.record(sim)
+    sim.operations.append(recorder)
+    return recorder, steps, rate
+
+
+def summarize(history):
+    """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at peak."""
+    sigma = history["sigma_wall"]
+    lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
+    q = sigma[:, 2] - lateral
+    p = (sigma[:, 2] + 2.0 * lateral) / 3.0
+    peak = int(np.argmax(q))
+    return {
+        "peak_axial_stress": float(sigma[:, 2].max()),
+        "peak_q": float(q[peak]),
+        "p_at_peak": float(p[peak]),
+        "axial_strain_at_peak": float(history["axial_strain"][peak]),
+        "lateral_stress": float(np.mean(lateral)),
+        "peak_index": peak,
+    }

@@ -1,0 +1,40 @@
+"""Fabric tensors of contacts (Eq. 4.1) and bridges (Eq. 3.53), and their anisotropy."""
+
+import numba
+import numpy as np
+
+
+@numba.njit(cache=True)
+def _fabric_sum(normal, mask):
+    total = np.zeros((3, 3))
+    count = 0
+    for k in range(normal.shape[0]):
+        if not mask[k]:
+            continue
+        count += 1
+        for a in range(3):
+            for b in range(3):
+                total[a, b] += normal[k, a] * normal[k, b]
+    return total, count
+
+
+def fabric_tensor(normal, mask):
+    """F_ij = (1 / 2Nc) sum over both orientations of n_i n_j = (1/Nc) sum n_i n_j (Eq. 4.1).
+
+    normal: (K, 3) unit vectors, mask: (K,) bool selecting the contacts (or bridges, Eq. 3.53).
+    Returns zeros when nothing is selected.
+    """
+    total, count = _fabric_sum(normal, mask)
+    return total / count if count else total
+
+
+def fabric_anisotropy(fabric):
+    """a = 5/2 (F_z - F_x) / tr F from the principal values, largest minus smallest (Eq. 3.51).
+
+    For the axisymmetric triaxial the principal axes follow the box: F_z = F[2, 2] and
+    F_x = mean of F[0, 0], F[1, 1].
+    """
+    trace = np.trace(fabric)
+    if trace == 0.0:
+        return 0.0
+    return 2.5 * (fabric[2, 2] - 0.5 * (fabric[0, 0] + fabric[1, 1])) / trace
