@@ -37,7 +37,7 @@ def parse_args(argv=None):
     parser.add_argument("--friction", type=float, default=18.0, help="contact friction [deg]")
     parser.add_argument("--young", type=float, default=1e6, help="YADE young E [Pa], kn = E R")
     parser.add_argument("--damping", type=float, default=0.2, help="Cundall local damping")
-    parser.add_argument("--inertial-number", type=float, default=1e-3,
+    parser.add_argument("--inertial-number", type=float, default=3e-4,
                         help="target inertial number setting the strain rate")
     parser.add_argument("--strain-rate", type=float, default=None,
                         help="axial strain rate [1/s] (overrides --inertial-number)")

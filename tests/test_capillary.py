@@ -85,14 +85,16 @@ def test_zero_suction_rupture_distances_match_yade_generator():
 def test_bridge_at_distance_returns_the_stable_branch():
     radius_ratio, contact_angle, suction = 2.0, 20.0, 5.0
     rupture = capillary.rupture_distance(radius_ratio, contact_angle, suction)
-    bridges = [capillary.bridge_at_distance(radius_ratio, contact_angle, suction, d) for d in np.linspace(0, rupture, 6)]
-    for bridge, distance in zip(bridges, np.linspace(0.0, rupture, 6)):
+    distances = np.linspace(0.0, rupture, 6)
+    bridges = [capillary.bridge_at_distance(radius_ratio, contact_angle, suction, d) for d in distances]
+    for bridge, distance in zip(bridges, distances):
         assert bridge.distance == pytest.approx(distance, abs=1e-12)
     assert np.all(np.diff([b.delta1 for b in bridges]) < 0.0)  # separating: the filling angle shrinks
     assert min(b.volume for b in bridges) == bridges[-1].volume  # YADE's criterion: V >= V at rupture
     # at the same distance the other (unstable) solution has a smaller filling angle
     middle = capillary.bridge_at_distance(radius_ratio, contact_angle, suction, 0.5 * rupture)
-    smaller = [capillary.solve_bridge(radius_ratio, contact_angle, suction, a) for a in np.linspace(0.5, middle.delta1, 60)]
+    angles = np.linspace(0.5, middle.delta1, 60)
+    smaller = [capillary.solve_bridge(radius_ratio, contact_angle, suction, a) for a in angles]
     assert min(b.distance for b in smaller) < 0.5 * rupture < max(b.distance for b in smaller)
     with pytest.raises(ValueError, match="rupture distance"):
         capillary.bridge_at_distance(radius_ratio, contact_angle, suction, 1.01 * rupture)

@@ -16,7 +16,12 @@ from capillary.suction_control import bridge_at_distance, lowest_distance, ruptu
 from capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
 from capillary.toroidal import ToroidalBridge, toroidal_bridge
 from capillary.validation import MAX_RADIUS_RATIO
-from capillary.volume_control import CONTACT_SUCTION_MAX, bridge_with_volume, rupture_distance_for_volume, volume_contour
+from capillary.volume_control import (
+    CONTACT_SUCTION_MAX,
+    bridge_with_volume,
+    rupture_distance_for_volume,
+    volume_contour,
+)
 from capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
 from capillary.yade_files import YadeCapillaryFile, read_yade, write_yade
 

@@ -12,12 +12,15 @@ and the axial force through any cross-section is invariant (SPEC section 4),
     F / (2 pi gamma) = y cos(phi) + (s / 2 gamma) y**2
                      = R1 sin(delta1) sin(delta1 + theta) + (s R1**2 / 2 gamma) sin(delta1)**2.
 
-The invariant gives y(phi) in closed form, so the profile is a quadrature in the
-variable tau = artanh(sin phi) (phi increases monotonically along the meniscus while
-its mean curvature keeps the sign set by a non-negative suction). The meniscus starts
-on sphere 1 at phi0 = delta1 + theta - 90 deg and ends on sphere 2 at
-phi_end = 90 deg - theta - delta2, where its height equals R2 sin(delta2); that
-condition fixes delta2, and the length of the profile fixes the gap.
+The invariant gives y(phi) in closed form, so the profile is a quadrature. For s >= 0, phi
+increases monotonically along the meniscus and the variable is tau = artanh(sin phi)
+(Gauss–Legendre on the two panels sphere 1 - neck - sphere 2). For s < 0 (reached only by
+volume-controlled bridges) the meridian is an unduloid whose tangent angle can turn back at
+inflection points; it is parametrised by its phase v (y = (1 - k cos v) R1 / a, a = -s R1/gamma,
+k = sqrt(1 - 2 a f)) through tan(v/2) = eps sinh(sigma), which resolves thin necks. The
+meniscus starts on sphere 1 at phi0 = delta1 + theta - 90 deg and ends at the first point past
+the neck where it meets sphere 2 at the contact angle: phi_end = 90 deg - theta - delta2, height
+R2 sin(delta2). That fixes delta2; the length of the profile fixes the gap.
 
 All results are in YADE's dimensionless units (SPEC section 1): distance D/R2,
 volume V/R2**3, force F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS over the
@@ -75,38 +78,32 @@ def profile_height(phi, force_invariant, suction1):
 
 @numba.njit(cache=True)
 def end_tangent_angle(radius_ratio, theta, suction1, force_invariant):
-    """Tangent angle phi_end (rad) where the meniscus meets sphere 2 at the contact angle.
+    """Tangent angle phi_end (rad) where the meniscus meets sphere 2 at the contact angle, for u >= 0.
 
-    Solves y(phi) = r cos(phi + theta) on [0, 90 deg - theta], where the left side increases
-    and the right side decreases, by safeguarded Newton. Returns NaN if the meniscus cannot
-    reach sphere 2 (only possible for negative suction).
+    Root of y(phi) = r cos(phi + theta) on [0, 90 deg - theta]: the left side increases and the
+    right side decreases there, and at the neck (phi = 0) y <= sin(delta1) <= cos(theta) <=
+    r cos(theta), so the root exists and is unique. First guess: the closed-form root of
+    r sin(d2) sin(d2 + theta) + u r**2 sin(d2)**2 / 2 = f (the invariant on sphere 2); then
+    safeguarded Newton to machine precision.
     """
     lo = 0.0
     hi = 0.5 * math.pi - theta
-    if suction1 < 0.0:
-        # y(phi) exists while cos(phi)**2 + 2 u f > 0
-        hi = min(hi, math.acos(min(1.0, math.sqrt(-2.0 * suction1 * force_invariant))))
-    if profile_height(hi, force_invariant, suction1) - radius_ratio * math.cos(hi + theta) < 0.0:
-        return np.nan
-    # closed-form root of r sin(d2) sin(d2 + theta) + u r**2 sin(d2)**2 / 2 = f as first guess
     p = 0.5 * math.cos(theta) + 0.25 * suction1 * radius_ratio
     q = 0.5 * math.sin(theta)
     cos_arg = (p - force_invariant / radius_ratio) / math.hypot(p, q)
     delta2 = 0.5 * (math.acos(max(-1.0, min(1.0, cos_arg))) - math.atan2(q, p))
     phi = min(max(0.5 * math.pi - theta - delta2, lo), hi)
     for _ in range(60):
-        c = math.cos(phi)
-        s_root = math.sqrt(max(c * c + 2.0 * suction1 * force_invariant, 0.0))
-        y = 2.0 * force_invariant / (c + s_root)
-        g = y - radius_ratio * math.cos(phi + theta)
-        if g > 0.0:
+        y = profile_height(phi, force_invariant, suction1)
+        gap = y - radius_ratio * math.cos(phi + theta)
+        if gap > 0.0:
             hi = phi
         else:
             lo = phi
-        dg = radius_ratio * math.sin(phi + theta) + (y * math.sin(phi) / s_root if s_root > 0.0 else 0.0)
-        step = g / dg if dg > 0.0 else 0.0
-        new_phi = phi - step
-        if not (lo < new_phi < hi) or dg <= 0.0:
+        root = math.sqrt(math.cos(phi) ** 2 + 2.0 * suction1 * force_invariant)
+        slope = radius_ratio * math.sin(phi + theta) + y * math.sin(phi) / root  # >= 0 on the bracket
+        new_phi = phi - gap / slope if slope > 0.0 else 0.5 * (lo + hi)
+        if not lo < new_phi < hi:
             new_phi = 0.5 * (lo + hi)
         if abs(new_phi - phi) <= 1e-15 * max(1.0, abs(phi)) or hi - lo <= 1e-16:
             return new_phi
@@ -168,7 +165,7 @@ def _unduloid_point(sigma, suction_abs, force_invariant, k, one_minus_k, eps):
 def _unduloid_contact_gap(sigma, args):
     """y - r cos(phi + theta) at sigma: zero where the unduloid meets sphere 2 at the contact angle."""
     radius_ratio, theta, suction_abs, force_invariant, k, one_minus_k, eps = args
-    y, cos_phi, sin_phi, dx, dl = _unduloid_point(sigma, suction_abs, force_invariant, k, one_minus_k, eps)
+    y, cos_phi, sin_phi, _, _ = _unduloid_point(sigma, suction_abs, force_invariant, k, one_minus_k, eps)
     return y - radius_ratio * (cos_phi * math.cos(theta) - sin_phi * math.sin(theta))
 
 
@@ -203,8 +200,8 @@ def _unduloid_panel(sigma_a, sigma_b, suction_abs, force_invariant, k, one_minus
 def _unduloid_profile(radius_ratio, theta, suction1, force_invariant, delta1):
     """(phi_end, length, ∫ pi y**2 dx, area11, area33) in R1 units for negative suction, or NaNs.
 
-    Used when the meniscus has an inflection point (the tangent angle is not monotonic).
-    The end is the first point past the neck where the profile meets sphere 2 at the contact angle.
+    The end is the first point past the neck where the profile meets sphere 2 at the contact
+    angle; NaNs if there is none before the bulge, or if the invariant admits no unduloid.
     """
     nan = np.nan
     a = -suction1
@@ -236,20 +233,18 @@ def _unduloid_profile(radius_ratio, theta, suction1, force_invariant, delta1):
         _unduloid_contact_gap_at_v, args, 0.0, v_peak, _unduloid_contact_gap_at_v(0.0, args), gap_peak, 1e-15
     )
     sigma_end = math.asinh(math.tan(0.5 * v_end) / eps)
-    y, cos_phi, sin_phi, dx, dl = _unduloid_point(sigma_end, a, force_invariant, k, one_minus_k, eps)
+    _, cos_phi, sin_phi, _, _ = _unduloid_point(sigma_end, a, force_invariant, k, one_minus_k, eps)
     phi_end = math.atan2(sin_phi, cos_phi)
-    l1, v1, a1, b1 = _unduloid_panel(sigma0, 0.0, a, force_invariant, k, one_minus_k, eps, _GAUSS_NODES, _GAUSS_WEIGHTS)
-    l2, v2, a2, b2 = _unduloid_panel(0.0, sigma_end, a, force_invariant, k, one_minus_k, eps, _GAUSS_NODES, _GAUSS_WEIGHTS)
+    shape = (a, force_invariant, k, one_minus_k, eps, _GAUSS_NODES, _GAUSS_WEIGHTS)
+    l1, v1, a1, b1 = _unduloid_panel(sigma0, 0.0, *shape)
+    l2, v2, a2, b2 = _unduloid_panel(0.0, sigma_end, *shape)
     return phi_end, l1 + l2, v1 + v2, a1 + a2, b1 + b2
 
 
 @numba.njit(cache=True)
 def _tau_profile(radius_ratio, theta, suction1, force_invariant, delta1):
-    """(phi_end, length, ∫ pi y**2 dx, area11, area33) in R1 units while phi is monotonic, or NaNs."""
-    nan = np.nan
+    """(phi_end, length, ∫ pi y**2 dx, area11, area33) in R1 units for suction >= 0."""
     phi_end = end_tangent_angle(radius_ratio, theta, suction1, force_invariant)
-    if not phi_end == phi_end:
-        return nan, nan, nan, nan, nan
     delta2 = 0.5 * math.pi - theta - phi_end
     # tau = artanh(sin phi) = ln tan((phi + 90 deg)/2) at both ends of the profile
     tau_start = math.log(math.tan(0.5 * (delta1 + theta)))

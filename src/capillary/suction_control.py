@@ -120,7 +120,8 @@ def bridge_at_distance(radius_ratio, contact_angle, suction_star, distance_star)
             reason = f"the stable bridge would need a filling angle above 90 - contact_angle = {90 - contact_angle} deg"
         raise ValueError(
             f"distance_star = {distance_star} is outside the valid range [{low:.8g}, {distance_rupture:.8g}] "
-            f"for radius_ratio = {radius_ratio}, contact_angle = {contact_angle} deg, suction_star = {suction_star}: {reason}"
+            f"for radius_ratio = {radius_ratio}, contact_angle = {contact_angle} deg, "
+            f"suction_star = {suction_star}: {reason}"
         )
     return bridge_from_kernel(radius_ratio, contact_angle, suction_star, delta1)
 

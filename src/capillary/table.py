@@ -10,8 +10,8 @@ Grid, per radius ratio r (SPEC section 1 units):
   behave like sqrt(d*_rupture - d*)); the nodes also cluster near contact, where small
   volume-controlled bridges change fast.
 Each node holds the exact stable bridge (capillary.suction_control). Lookups interpolate the
-logarithms of the quantities bilinearly in (xi, z), and linearly in r between tabulated radius
-ratios (like YADE's capillary law, which interpolates the quantities themselves).
+logarithms of the quantities linearly in (r, xi, z), z relative to the interpolated rupture
+distance (YADE's capillary law interpolates the quantities themselves linearly in (r, u*, d*)).
 """
 
 import hashlib
@@ -51,7 +51,7 @@ def cache_key(kind, parameters):
 
 @numba.njit(cache=True)
 def _stable_bridge_fields(radius_ratio, theta, suction_star, delta1, out):
-    distance, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, suction_star, delta1)
+    _, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, suction_star, delta1)
     out[0] = force
     out[1] = volume
     out[2] = math.degrees(delta1)
@@ -108,7 +108,7 @@ def radius_ratio_bracket(radius_ratios, radius_ratio):
 
 
 @numba.njit(cache=True)
-def _grid_position(coordinate, step, n):
+def grid_position(coordinate, step, n):
     """Cell index and fraction for a coordinate on a uniform grid 0, step, ..., (n - 1) step."""
     s = coordinate / step
     i = min(int(s), n - 2)
@@ -132,18 +132,22 @@ def distance_fraction(coordinate):
 
 
 @numba.njit(cache=True)
-def interpolate_sheared(i_r, i_a, t_a, distance, distance_low, log_distance_rupture, grid, field):
-    """Bilinear value of grid[i_r, :, :, field] at axis cell (i_a, t_a) and distance D/R2.
+def along_axis(array, i_r, i_a, t_a):
+    """array[i_r, :] interpolated linearly at axis cell (i_a, t_a)."""
+    return (1.0 - t_a) * array[i_r, i_a] + t_a * array[i_r, i_a + 1]
 
-    The distance axis is distance_coordinate((d - d_low)/(d_rupture - d_low)), with d_low
-    interpolated linearly and ln d_rupture linearly along the first axis; clamped to [0, 1]
-    (rupture values beyond d_rupture, values at d_low below it).
-    """
-    n_z = grid.shape[2]
-    d_low = (1.0 - t_a) * distance_low[i_r, i_a] + t_a * distance_low[i_r, i_a + 1]
-    d_rupture = math.exp((1.0 - t_a) * log_distance_rupture[i_r, i_a] + t_a * log_distance_rupture[i_r, i_a + 1])
-    z = distance_coordinate((distance - d_low) / (d_rupture - d_low))
-    j, t_z = _grid_position(z, 1.0 / (n_z - 1), n_z)
+
+@numba.njit(cache=True)
+def distance_cell(distance, distance_low, distance_rupture, n_z):
+    """Cell (j, t) of the distance coordinate z for a gap D/R2, clamped to the tabulated range
+    (rupture values beyond d_rupture, values at d_low below it)."""
+    z = distance_coordinate((distance - distance_low) / (distance_rupture - distance_low))
+    return grid_position(z, 1.0 / (n_z - 1), n_z)
+
+
+@numba.njit(cache=True)
+def bilinear(grid, i_r, i_a, t_a, j, t_z, field):
+    """grid[i_r, :, :, field] interpolated bilinearly at axis cell (i_a, t_a) and distance cell (j, t_z)."""
     v00 = grid[i_r, i_a, j, field]
     v01 = grid[i_r, i_a, j + 1, field]
     v10 = grid[i_r, i_a + 1, j, field]
@@ -152,18 +156,22 @@ def interpolate_sheared(i_r, i_a, t_a, distance, distance_low, log_distance_rupt
 
 
 @numba.njit(cache=True)
-def _blend_radius_ratios(i_r, t_r, i_a, t_a, distance, distance_low, log_distance_rupture, log_values, field):
-    """exp of interpolate_sheared in the tables of radius ratios i_r and i_r + 1, blended with weight t_r."""
-    low = interpolate_sheared(i_r, i_a, t_a, distance, distance_low, log_distance_rupture, log_values, field)
-    if t_r == 0.0:
-        return math.exp(low)
-    high = interpolate_sheared(i_r + 1, i_a, t_a, distance, distance_low, log_distance_rupture, log_values, field)
+def _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, field):
+    low = bilinear(log_values, i_r, i_u, t_u, j, t_z, field)
+    high = bilinear(log_values, i_next, i_u, t_u, j, t_z, field)
     return math.exp((1.0 - t_r) * low + t_r * high)
 
 
 @numba.njit(cache=True)
 def lookup_suction(
-    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values, radius_ratio, suction_star, distance_star
+    radius_ratios,
+    suction_axis,
+    distance_low,
+    log_distance_rupture,
+    log_values,
+    radius_ratio,
+    suction_star,
+    distance_star,
 ):
     """Suction-controlled bridge from a BridgeTable's arrays(): r = R2/R1, u* = s R2/gamma, d* = D/R2.
 
@@ -171,9 +179,10 @@ def lookup_suction(
     in degrees (delta1 on the smaller sphere). exists is False beyond the rupture distance (then
     the other values are 0). Distances below the smallest tabulated one (contact, d* < 0) get the
     values there, as YADE does. Raises ValueError for r outside the table's radius ratios, u*
-    outside [0, suction_max] or non-finite input. The table holds logarithms of the (positive)
-    quantities and of the rupture distance, interpolated bilinearly, so that their power-law
-    dependence on u* at high suction is followed closely.
+    outside [0, suction_max] or non-finite input. The rupture distance and the quantities are
+    interpolated as logarithms (power laws in u* at high suction), linearly in (r, xi), and
+    the distance coordinate z is taken relative to the interpolated rupture distance, so every
+    radius ratio is read at the same stage of its family.
     """
     if not (math.isfinite(suction_star) and math.isfinite(distance_star) and math.isfinite(radius_ratio)):
         raise ValueError("lookup_suction: non-finite radius_ratio, suction_star or distance_star")
@@ -181,17 +190,20 @@ def lookup_suction(
     if not 0.0 <= suction_star <= suction_max:
         raise ValueError("lookup_suction: suction_star is outside the table range [0, suction_max]")
     i_r, t_r = radius_ratio_bracket(radius_ratios, radius_ratio)
-    i_u, t_u = _grid_position(math.log1p(suction_star / suction_scale), suction_step, log_values.shape[1])
-    i_next = min(i_r + 1, radius_ratios.size - 1)
-    log_rupture = (1.0 - t_u) * log_distance_rupture[i_r, i_u] + t_u * log_distance_rupture[i_r, i_u + 1]
-    log_next = (1.0 - t_u) * log_distance_rupture[i_next, i_u] + t_u * log_distance_rupture[i_next, i_u + 1]
-    if distance_star > math.exp((1.0 - t_r) * log_rupture + t_r * log_next):
+    i_next = i_r + 1 if t_r > 0.0 else i_r
+    i_u, t_u = grid_position(math.log1p(suction_star / suction_scale), suction_step, log_values.shape[1])
+    d_rupture = math.exp(
+        (1.0 - t_r) * along_axis(log_distance_rupture, i_r, i_u, t_u)
+        + t_r * along_axis(log_distance_rupture, i_next, i_u, t_u)
+    )
+    if distance_star > d_rupture:
         return False, 0.0, 0.0, 0.0, 0.0
-    args = (i_r, t_r, i_u, t_u, distance_star, distance_low, log_distance_rupture, log_values)
-    force = _blend_radius_ratios(*args, 0)
-    volume = _blend_radius_ratios(*args, 1)
-    delta1 = _blend_radius_ratios(*args, 2)
-    delta2 = _blend_radius_ratios(*args, 3)
+    d_low = (1.0 - t_r) * along_axis(distance_low, i_r, i_u, t_u) + t_r * along_axis(distance_low, i_next, i_u, t_u)
+    j, t_z = distance_cell(distance_star, d_low, d_rupture, log_values.shape[2])
+    force = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 0)
+    volume = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 1)
+    delta1 = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 2)
+    delta2 = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 3)
     return True, force, volume, delta1, delta2
 
 
@@ -209,7 +221,9 @@ class BridgeTable:
     Covered range: u* in [0, suction_max]; d* from max(0, d* at delta1 = 90 - theta) to rupture.
     """
 
-    def __init__(self, contact_angle, radius_ratios, suction_scale, suction_max, distance_low, distance_rupture, values):
+    def __init__(
+        self, contact_angle, radius_ratios, suction_scale, suction_max, distance_low, distance_rupture, values
+    ):
         self.contact_angle = float(contact_angle)
         self.radius_ratios = np.ascontiguousarray(radius_ratios, dtype=np.float64)
         self.suction_scale = float(suction_scale)
@@ -235,13 +249,24 @@ class BridgeTable:
 
     def parameters(self):
         """Build parameters (the cache key's content)."""
+        return self._parameters(
+            self.contact_angle,
+            self.radius_ratios,
+            self.n_suction,
+            self.n_distance,
+            self.suction_max,
+            self.suction_scale,
+        )
+
+    @staticmethod
+    def _parameters(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale):
         return {
-            "contact_angle": self.contact_angle,
-            "radius_ratios": [float(r) for r in self.radius_ratios],
-            "suction_scale": self.suction_scale,
-            "suction_max": self.suction_max,
-            "n_suction": self.n_suction,
-            "n_distance": self.n_distance,
+            "contact_angle": float(contact_angle),
+            "radius_ratios": [float(r) for r in radius_ratios],
+            "suction_scale": float(suction_scale),
+            "suction_max": float(suction_max),
+            "n_suction": int(n_suction),
+            "n_distance": int(n_distance),
         }
 
     @classmethod
@@ -278,14 +303,7 @@ class BridgeTable:
     def cached(cls, contact_angle=0.0, radius_ratios=YADE_RADIUS_RATIOS, n_suction=350, n_distance=80,
                suction_max=15000.0, suction_scale=0.1, directory=None):
         """Load the table with these parameters from the cache directory, building and saving it if absent."""
-        parameters = {
-            "contact_angle": float(contact_angle),
-            "radius_ratios": [float(r) for r in radius_ratios],
-            "suction_scale": float(suction_scale),
-            "suction_max": float(suction_max),
-            "n_suction": int(n_suction),
-            "n_distance": int(n_distance),
-        }
+        parameters = cls._parameters(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
         path = Path(directory or cache_directory()) / f"bridge_table_{cache_key('suction', parameters)}.h5"
         if path.exists():
             return cls.load(path)

@@ -21,7 +21,9 @@ def check_radius_ratio(radius_ratio, largest=MAX_RADIUS_RATIO):
     """r = R2/R1 in [1, largest]."""
     radius_ratio = finite_number("radius_ratio", radius_ratio, f"[1, {largest}]")
     if not 1.0 <= radius_ratio <= largest:
-        raise ValueError(f"radius_ratio = {radius_ratio} is outside the valid range [1, {largest}] (R2/R1 with R2 >= R1)")
+        raise ValueError(
+            f"radius_ratio = {radius_ratio} is outside the valid range [1, {largest}] (R2/R1 with R2 >= R1)"
+        )
     return radius_ratio
 
 
@@ -37,7 +39,9 @@ def check_suction(suction_star):
     """u* = s R2/gamma >= 0."""
     suction_star = finite_number("suction_star", suction_star, "[0, inf)")
     if suction_star < 0.0:
-        raise ValueError(f"suction_star = {suction_star} is outside the valid range [0, inf) (matric suction s R2/gamma)")
+        raise ValueError(
+            f"suction_star = {suction_star} is outside the valid range [0, inf) (matric suction s R2/gamma)"
+        )
     return suction_star
 
 

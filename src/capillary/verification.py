@@ -13,7 +13,6 @@ import math
 
 import numpy as np
 from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from capillary.meniscus import solve_bridge
 from capillary.suction_control import bridge_at_distance, rupture_point, stable_filling_angle
@@ -122,11 +121,13 @@ def table_interpolation_error(n_suction, n_distance, contact_angle=0.0, radius_r
     theta = math.radians(contact_angle)
     for _ in range(n_samples):
         suction = table.suction_scale * math.expm1(rng.uniform(0.0, math.log1p(suction_max / table.suction_scale)))
-        delta1_rupture, d_rupture = rupture_point(radius_ratio, theta, suction)
+        d_rupture = rupture_point(radius_ratio, theta, suction)[1]
         exact_low = solve_bridge(radius_ratio, contact_angle, suction, 90.0 - contact_angle).distance
         distance = rng.uniform(max(0.0, exact_low), 0.999 * d_rupture)
         exists, force, volume, delta1, _ = table.lookup(radius_ratio, suction, distance)
         exact = bridge_at_distance(radius_ratio, contact_angle, suction, distance)
+        if not exists:
+            raise AssertionError(f"the table finds no bridge at u* = {suction}, d* = {distance}")
         errors.append((force / exact.force - 1.0, volume / exact.volume - 1.0, delta1 / exact.delta1 - 1.0))
     return _summary(errors), seconds
 
@@ -147,11 +148,13 @@ def volume_table_interpolation_error(n_volume, n_distance, contact_angle=0.0, ra
     errors = []
     for _ in range(n_samples):
         volume = math.exp(rng.uniform(low, high))
-        contour = volume_contour(float(radius_ratio), math.radians(contact_angle), volume)
+        contour = volume_contour(radius_ratio, contact_angle, volume)
         distance = rng.uniform(contour.contact_distance, contour.rupture_distance - 1e-3 * (
             contour.rupture_distance - contour.contact_distance))
         exists, force, suction, delta1, _ = table.lookup(radius_ratio, volume, distance)
         exact = bridge_with_volume(radius_ratio, contact_angle, volume, distance)
+        if not exists:
+            raise AssertionError(f"the table finds no bridge at V* = {volume}, d* = {distance}")
         # the suction crosses zero along the family: its error is relative to max(|u*|, 1)
         errors.append((
             force / exact.force - 1.0,
@@ -228,7 +231,8 @@ def main():
     worst = solver_accuracy()
     print("## Solver against reference_bridge (largest relative difference)")
     for name, (error, where) in worst.items():
-        print(f"| {name} | {error:.2e} | theta={where[0]:.1f}, r={where[1]:.2f}, u*={where[2]:.3g}, delta1={where[3]:.2f} |")
+        theta, r, suction, delta1 = where
+        print(f"| {name} | {error:.2e} | theta={theta:.1f}, r={r:.2f}, u*={suction:.3g}, delta1={delta1:.2f} |")
     print("\n## Suction table, r = 1, theta = 0: relative error (max / rms) of F*, V*, delta1")
     for n_suction, n_distance in ((50, 20), (100, 40), (200, 80), (350, 80), (700, 160)):
         errors, seconds = table_interpolation_error(n_suction, n_distance)

@@ -10,7 +10,7 @@ suction turns negative (liquid pressure above the gas pressure, convex menisci) 
 so `suction` may come out negative here. The contour is traced by pseudo-arclength continuation
 in (asinh(u*/r), delta1). Its contact end is the stable suction-controlled bridge at contact
 (or at delta1 = 90 deg - theta where that comes first, large radius ratios), so the volumes
-covered are those of bridges formed at contact with a suction in [0, suction_max].
+covered are those of bridges formed at contact with a suction in [0, CONTACT_SUCTION_MAX].
 """
 
 from dataclasses import dataclass
@@ -27,15 +27,17 @@ from capillary.validation import check_contact_angle, check_distance, check_posi
 CONTACT_SUCTION_MAX = 15000.0
 """Largest u* at contact of the volume-controlled family (smallest volume covered)."""
 
-_STEP_FIRST, _STEP_MAX, _STEP_MIN = 0.01, 0.1, 1e-9
+_STEP_FIRST, _STEP_MAX, _STEP_MIN = 0.01, 0.1, 1e-6
+_MAX_POINTS = 3000
 _GRADIENT_STEP = 1e-6
 
 
 @dataclass(frozen=True)
 class VolumeContour:
-    """States of one volume-controlled bridge from contact to rupture.
+    """States of one volume-controlled bridge from contact to rupture (contact_angle in degrees).
 
     points: (n, 2) array of (asinh(u*/r), delta1 in rad) along the contour, distance increasing;
+    tangents, steps: points[k] is the projection onto the contour of points[k-1] + steps[k] tangents[k-1];
     distances: d* at the points (the last one is taken as the rupture distance);
     ends_at_peak: True when the distance peaked on the contour; False when the contour ends
     before, where the solver's family stops (delta1 reaching 90 - theta for large radius
@@ -45,9 +47,11 @@ class VolumeContour:
     """
 
     radius_ratio: float
-    theta: float
+    contact_angle: float
     volume: float
     points: np.ndarray
+    tangents: np.ndarray
+    steps: np.ndarray
     distances: np.ndarray
     ends_at_peak: bool
 
@@ -60,7 +64,8 @@ class VolumeContour:
         return float(self.distances[-1])
 
 
-def _suction(radius_ratio, nu):
+def suction_at(radius_ratio, nu):
+    """u* at the contour coordinate nu = asinh(u*/r)."""
     return radius_ratio * math.sinh(nu)
 
 
@@ -69,7 +74,7 @@ def _state(radius_ratio, theta, point):
     nu, delta1 = point
     if not 0.0 < delta1 <= 0.5 * math.pi - theta:
         return (math.nan,) * 6
-    return bridge_kernel(radius_ratio, theta, _suction(radius_ratio, nu), delta1)
+    return bridge_kernel(radius_ratio, theta, suction_at(radius_ratio, nu), delta1)
 
 
 def _gradients(radius_ratio, theta, point):
@@ -81,9 +86,13 @@ def _gradients(radius_ratio, theta, point):
         plus = np.array(_state(radius_ratio, theta, point + step)[:2])
         minus = np.array(_state(radius_ratio, theta, point - step)[:2])
         span = 2.0 * _GRADIENT_STEP
-        if np.isnan(plus[0]) or np.isnan(minus[0]):  # one-sided at the edge of the range (delta1 = 90 - theta)
+        if np.isnan(plus[0]) or np.isnan(minus[0]):  # one-sided at the edge of the range
             centre = np.array(_state(radius_ratio, theta, point)[:2])
-            plus, minus, span = (centre, minus, _GRADIENT_STEP) if np.isnan(plus[0]) else (plus, centre, _GRADIENT_STEP)
+            span = _GRADIENT_STEP
+            if np.isnan(plus[0]):
+                plus = centre
+            else:
+                minus = centre
         gradient[:, axis] = (plus - minus) / span
     return gradient
 
@@ -100,7 +109,7 @@ def _project(radius_ratio, theta, volume, guess):
             residual = _state(radius_ratio, theta, point)[1] - volume
             if not math.isfinite(residual):
                 break
-            if abs(residual) <= 1e-13 * volume:
+            if abs(residual) <= 1e-11 * volume:  # the kernel resolves V* to ~1e-13 relative
                 return point
             if refresh:
                 gradient = _gradients(radius_ratio, theta, point)[1]
@@ -124,7 +133,7 @@ def _contact_point(radius_ratio, theta, volume):
     """(nu, delta1) of the contact end: the stable bridge at contact holding this volume."""
 
     def contact_volume(nu):
-        suction = _suction(radius_ratio, nu)
+        suction = suction_at(radius_ratio, nu)
         return bridge_kernel(radius_ratio, theta, suction, contact_filling_angle(radius_ratio, theta, suction))[1]
 
     nu_max = math.asinh(CONTACT_SUCTION_MAX / radius_ratio)
@@ -136,16 +145,31 @@ def _contact_point(radius_ratio, theta, volume):
             f"suction_star in [0, {CONTACT_SUCTION_MAX}]"
         )
     nu = brentq(lambda x: contact_volume(x) - volume, 0.0, nu_max, xtol=1e-14, rtol=1e-14)
-    return np.array([nu, contact_filling_angle(radius_ratio, theta, _suction(radius_ratio, nu))])
+    return np.array([nu, contact_filling_angle(radius_ratio, theta, suction_at(radius_ratio, nu))])
+
+
+def volume_contour(radius_ratio, contact_angle, volume_star):
+    """VolumeContour of the bridge of volume V* = V/R2**3 (contact_angle in degrees; ranges as in
+    rupture_distance_for_volume)."""
+    radius_ratio = check_radius_ratio(radius_ratio)
+    contact_angle = check_contact_angle(contact_angle)
+    volume_star = check_positive("volume_star", volume_star)
+    return trace_contour(radius_ratio, contact_angle, volume_star)
 
 
 @functools.lru_cache(maxsize=256)
-def volume_contour(radius_ratio, theta, volume):
-    """Trace the volume-controlled bridge from contact to rupture (theta in rad); see VolumeContour."""
+def trace_contour(radius_ratio, contact_angle, volume):
+    """Trace the volume-controlled bridge from contact to rupture (validated input); see VolumeContour."""
+    theta = math.radians(contact_angle)
     point = _contact_point(radius_ratio, theta, volume)
-    tangent, distance_gradient = _tangent(radius_ratio, theta, point)
-    points = [point]
+    tangent = _tangent(radius_ratio, theta, point)[0]
+    points, tangents, steps = [point], [tangent], [0.0]
     distances = [_state(radius_ratio, theta, point)[0]]
+
+    def contour(ends_at_peak):
+        return VolumeContour(radius_ratio, contact_angle, volume, np.array(points), np.array(tangents),
+                             np.array(steps), np.array(distances), ends_at_peak)
+
     step = _STEP_FIRST
     while True:
         candidate = _project(radius_ratio, theta, volume, point + step * tangent)
@@ -154,54 +178,61 @@ def volume_contour(radius_ratio, theta, volume):
             turn = math.acos(min(1.0, new_tangent @ tangent))
         if candidate is None or turn > 0.1:
             step *= 0.5
-            if step < _STEP_MIN:
-                return VolumeContour(radius_ratio, theta, volume, np.array(points), np.array(distances), False)
+            if step < _STEP_MIN:  # a kink or the edge of the range: the family ends here
+                return contour(False)
             continue
         if new_distance_gradient @ new_tangent <= 0.0:  # the distance peaked within this step
             break
         point, tangent = candidate, new_tangent
         points.append(point)
+        tangents.append(tangent)
+        steps.append(step)
         distances.append(_state(radius_ratio, theta, point)[0])
         step = min(1.5 * step, _STEP_MAX)
-    # the rupture: largest distance on the contour between point and candidate
-    along = point.copy(), tangent.copy()
+        if len(points) == _MAX_POINTS:
+            return contour(False)
 
+    # the rupture: largest distance on the contour between point and candidate
     def negative_distance(s):
-        projected = _project(radius_ratio, theta, volume, along[0] + s * along[1])
+        projected = _project(radius_ratio, theta, volume, point + s * tangent)
         return -_state(radius_ratio, theta, projected)[0] if projected is not None else 1.0  # d* > -1 on the contour
 
     best = minimize_scalar(negative_distance, bounds=(0.0, step), method="bounded", options={"xatol": 1e-12})
-    rupture = _project(radius_ratio, theta, volume, along[0] + best.x * along[1])
+    rupture = _project(radius_ratio, theta, volume, point + best.x * tangent)
     points.append(rupture)
+    tangents.append(_tangent(radius_ratio, theta, rupture, tangent)[0])
+    steps.append(best.x)
     distances.append(_state(radius_ratio, theta, rupture)[0])
-    return VolumeContour(radius_ratio, theta, volume, np.array(points), np.array(distances), True)
+    return contour(True)
 
 
 def contour_point_at_distance(contour, distance_star):
-    """(nu, delta1) on the contour where d* = distance_star, in [contact distance, rupture distance]."""
+    """(nu, delta1) on the contour where d* = distance_star, in [contact distance, rupture distance].
+
+    Between traced points k-1 and k, the points projected from the predictor
+    points[k-1] + s tangents[k-1], s in [0, steps[k]], are searched for the distance.
+    """
     k = int(np.searchsorted(contour.distances, distance_star))
     k = min(max(k, 1), len(contour.distances) - 1)
-    start, end = contour.points[k - 1], contour.points[k]
     if distance_star <= contour.distances[k - 1]:
-        return start
+        return contour.points[k - 1]
     if distance_star >= contour.distances[k]:
-        return end
-    chord = end - start
-    length = float(np.hypot(*chord))
+        return contour.points[k]
+    start, tangent = contour.points[k - 1], contour.tangents[k - 1]
+    theta = math.radians(contour.contact_angle)
+
+    def point_at(s):
+        projected = _project(contour.radius_ratio, theta, contour.volume, start + s * tangent)
+        if projected is None:
+            raise ValueError(f"no volume-controlled bridge found near distance_star = {distance_star}")
+        return projected
 
     def residual(s):
-        projected = _project(contour.radius_ratio, contour.theta, contour.volume, start + s * chord / length)
-        return _state(contour.radius_ratio, contour.theta, projected)[0] - distance_star
+        return _state(contour.radius_ratio, theta, point_at(s))[0] - distance_star
 
-    s = brentq(residual, 0.0, length, xtol=1e-14 * max(1.0, length), rtol=1e-14)
-    return _project(contour.radius_ratio, contour.theta, contour.volume, start + s * chord / length)
-
-
-def _checked_contour(radius_ratio, contact_angle, volume_star):
-    radius_ratio = check_radius_ratio(radius_ratio)
-    contact_angle = check_contact_angle(contact_angle)
-    volume_star = check_positive("volume_star", volume_star)
-    return volume_contour(radius_ratio, math.radians(contact_angle), volume_star)
+    step = contour.steps[k]
+    s = brentq(residual, 0.0, step, xtol=1e-15 * max(1.0, step), rtol=1e-14)
+    return point_at(s)
 
 
 def rupture_distance_for_volume(radius_ratio, contact_angle, volume_star):
@@ -211,7 +242,7 @@ def rupture_distance_for_volume(radius_ratio, contact_angle, volume_star):
     volumes of bridges formed at contact with u* in [0, CONTACT_SUCTION_MAX]. Where the traced
     family ends before its distance peaks (VolumeContour.ends_at_peak), its last distance.
     """
-    return _checked_contour(radius_ratio, contact_angle, volume_star).rupture_distance
+    return volume_contour(radius_ratio, contact_angle, volume_star).rupture_distance
 
 
 def bridge_with_volume(radius_ratio, contact_angle, volume_star, distance_star):
@@ -222,7 +253,7 @@ def bridge_with_volume(radius_ratio, contact_angle, volume_star, distance_star):
     ValueError outside. The returned Bridge's suction may be negative (see module docstring).
     """
     distance_star = check_distance(distance_star)
-    contour = _checked_contour(radius_ratio, contact_angle, volume_star)
+    contour = volume_contour(radius_ratio, contact_angle, volume_star)
     if contour.contact_distance - 1e-12 <= distance_star < contour.contact_distance:
         distance_star = contour.contact_distance  # rounding of the contact distance (0 at contact)
     if not contour.contact_distance <= distance_star <= contour.rupture_distance:
@@ -233,8 +264,9 @@ def bridge_with_volume(radius_ratio, contact_angle, volume_star, distance_star):
             f"volume_star = {volume_star}: no volume-controlled bridge {beyond}"
         )
     nu, delta1 = contour_point_at_distance(contour, distance_star)
-    suction = _suction(contour.radius_ratio, nu)
-    distance, volume, force, delta2, nn11, nn33 = bridge_kernel(contour.radius_ratio, contour.theta, suction, delta1)
+    suction = suction_at(contour.radius_ratio, nu)
+    theta = math.radians(contour.contact_angle)
+    distance, volume, force, delta2, nn11, nn33 = bridge_kernel(contour.radius_ratio, theta, suction, delta1)
     return Bridge(
         radius_ratio=contour.radius_ratio,
         contact_angle=float(contact_angle),

@@ -4,8 +4,8 @@ Grid, per radius ratio r: ln V* uniform between the volumes of bridges formed at
 u* = CONTACT_SUCTION_MAX and u* = 0 (capillary.volume_control), and, for each volume,
 the distance coordinate z of capillary.table (z = 0 at the volume-controlled rupture, 1 at
 contact). Each node holds the exact bridge of capillary.volume_control.
-Lookups interpolate u* and the logarithms of the other quantities bilinearly in (ln V*, z),
-and linearly in r between tabulated radius ratios.
+Lookups interpolate u* and the logarithms of the other quantities linearly in (r, ln V*, z),
+z relative to the interpolated rupture distance.
 """
 
 from concurrent.futures import ProcessPoolExecutor
@@ -18,32 +18,34 @@ import numba
 import numpy as np
 
 from capillary.meniscus import bridge_kernel
+from capillary.suction_control import contact_filling_angle
 from capillary.table import (
     TABLE_FORMAT,
     YADE_RADIUS_RATIOS,
-    _grid_position,
+    along_axis,
+    bilinear,
     cache_directory,
     cache_key,
+    distance_cell,
     distance_fraction,
-    interpolate_sheared,
+    grid_position,
     radius_ratio_bracket,
 )
 from capillary.validation import check_contact_angle, check_radius_ratio
 from capillary.volume_control import (
     CONTACT_SUCTION_MAX,
-    _suction,
     contour_point_at_distance,
-    volume_contour,
+    suction_at,
+    trace_contour,
 )
 
 VOLUME_FIELDS = ("force", "suction", "delta1", "delta2", "nn11", "nn33")
 """Quantities stored at each node, last axis of `values`: F*, u*, delta1 and delta2 (degrees), nn11, nn33."""
 
 
-def contact_volume_range(radius_ratio, theta):
-    """(smallest, largest) V* of bridges formed at contact with u* in [0, CONTACT_SUCTION_MAX]; theta in rad."""
-    from capillary.suction_control import contact_filling_angle
-
+def contact_volume_range(radius_ratio, contact_angle):
+    """(smallest, largest) V* of bridges formed at contact with u* in [0, CONTACT_SUCTION_MAX]."""
+    theta = math.radians(contact_angle)
     volumes = []
     for suction in (CONTACT_SUCTION_MAX, 0.0):
         delta1 = contact_filling_angle(radius_ratio, theta, suction)
@@ -51,17 +53,18 @@ def contact_volume_range(radius_ratio, theta):
     return volumes[0], volumes[1]
 
 
-def build_volume_rows(radius_ratio, theta, n_volume, n_distance):
+def build_volume_rows(radius_ratio, contact_angle, n_volume, n_distance):
     """Nodes of one radius ratio: (ln V* bounds, distance_low (n_V,), distance_rupture (n_V,),
-    values (n_V, n_distance, 6)); theta in rad."""
-    smallest, largest = contact_volume_range(radius_ratio, theta)
+    values (n_V, n_distance, 6))."""
+    theta = math.radians(contact_angle)
+    smallest, largest = contact_volume_range(radius_ratio, contact_angle)
     # stay strictly inside the range so that the contact end is found by bracketing
     log_bounds = (math.log(smallest) + 1e-9, math.log(largest) - 1e-9)
     distance_low = np.empty(n_volume)
     distance_rupture = np.empty(n_volume)
     values = np.empty((n_volume, n_distance, len(VOLUME_FIELDS)))
     for m, log_volume in enumerate(np.linspace(*log_bounds, n_volume)):
-        contour = volume_contour(radius_ratio, theta, math.exp(log_volume))
+        contour = trace_contour(radius_ratio, contact_angle, math.exp(log_volume))
         distance_low[m] = contour.contact_distance
         distance_rupture[m] = contour.rupture_distance
         for j in range(n_distance):
@@ -73,10 +76,10 @@ def build_volume_rows(radius_ratio, theta, n_volume, n_distance):
                 fraction = distance_fraction(j / (n_distance - 1))
                 d = contour.contact_distance + (contour.rupture_distance - contour.contact_distance) * fraction
                 point = contour_point_at_distance(contour, d)
-            suction = _suction(radius_ratio, point[0])
+            suction = suction_at(radius_ratio, point[0])
             _, _, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, suction, point[1])
             values[m, j] = (force, suction, math.degrees(point[1]), math.degrees(delta2), nn11, nn33)
-        volume_contour.cache_clear()
+        trace_contour.cache_clear()
     return log_bounds, distance_low, distance_rupture, values
 
 
@@ -85,22 +88,15 @@ def _volume_position(volume_axes, i_r, log_volume, n_volume):
     low, high = volume_axes[i_r, 0], volume_axes[i_r, 1]
     if not low <= log_volume <= high:
         raise ValueError("lookup_volume: volume_star is outside the table range for this radius ratio")
-    return _grid_position(log_volume - low, (high - low) / (n_volume - 1), n_volume)
+    return grid_position(log_volume - low, (high - low) / (n_volume - 1), n_volume)
 
 
 @numba.njit(cache=True)
-def _log_rupture_distance(log_distance_rupture, i_r, i_v, t_v):
-    return (1.0 - t_v) * log_distance_rupture[i_r, i_v] + t_v * log_distance_rupture[i_r, i_v + 1]
-
-
-@numba.njit(cache=True)
-def _blend(i_r, i_v, t_v, i_next, i_w, t_w, t_r, distance, distance_low, log_distance_rupture, grid, field):
-    """Field interpolated in the tables of radius ratios i_r and i_next (weight t_r), each at its own volume cell."""
-    value = interpolate_sheared(i_r, i_v, t_v, distance, distance_low, log_distance_rupture, grid, field)
-    if t_r == 0.0:
-        return value
-    high = interpolate_sheared(i_next, i_w, t_w, distance, distance_low, log_distance_rupture, grid, field)
-    return (1.0 - t_r) * value + t_r * high
+def _interpolate(grid, i_r, i_v, t_v, i_next, i_w, t_w, t_r, j, t_z, field):
+    """grid field interpolated in the tables of radius ratios i_r and i_next, each at its own volume cell."""
+    low = bilinear(grid, i_r, i_v, t_v, j, t_z, field)
+    high = bilinear(grid, i_next, i_w, t_w, j, t_z, field)
+    return (1.0 - t_r) * low + t_r * high
 
 
 @numba.njit(cache=True)
@@ -114,7 +110,7 @@ def lookup_volume(
     rupture distance (then the other values are 0); distances below contact get the contact
     values. Raises ValueError for r outside the table's radius ratios, V* outside the volume
     range of either bracketing radius ratio, or non-finite input. The grid holds u* and the
-    logarithms of the other (positive) quantities.
+    logarithms of the other (positive) quantities; interpolation as in lookup_suction.
     """
     if not (math.isfinite(volume_star) and math.isfinite(distance_star) and math.isfinite(radius_ratio)):
         raise ValueError("lookup_volume: non-finite radius_ratio, volume_star or distance_star")
@@ -123,26 +119,27 @@ def lookup_volume(
     n_volume = grid.shape[1]
     log_volume = math.log(volume_star)
     i_r, t_r = radius_ratio_bracket(radius_ratios, radius_ratio)
+    i_next = i_r + 1 if t_r > 0.0 else i_r
     i_v, t_v = _volume_position(volume_axes, i_r, log_volume, n_volume)
-    log_rupture = _log_rupture_distance(log_distance_rupture, i_r, i_v, t_v)
-    i_next, i_w, t_w = i_r, i_v, t_v
-    if t_r > 0.0:
-        i_next = i_r + 1
-        i_w, t_w = _volume_position(volume_axes, i_next, log_volume, n_volume)
-        log_rupture = (1.0 - t_r) * log_rupture + t_r * _log_rupture_distance(log_distance_rupture, i_next, i_w, t_w)
-    if distance_star > math.exp(log_rupture):
+    i_w, t_w = _volume_position(volume_axes, i_next, log_volume, n_volume)
+    d_rupture = math.exp(
+        (1.0 - t_r) * along_axis(log_distance_rupture, i_r, i_v, t_v)
+        + t_r * along_axis(log_distance_rupture, i_next, i_w, t_w)
+    )
+    if distance_star > d_rupture:
         return False, 0.0, 0.0, 0.0, 0.0
-    args = (i_r, i_v, t_v, i_next, i_w, t_w, t_r, distance_star, distance_low, log_distance_rupture, grid)
-    force = math.exp(_blend(*args, 0))
-    suction = _blend(*args, 1)
-    delta1 = math.exp(_blend(*args, 2))
-    delta2 = math.exp(_blend(*args, 3))
+    d_low = (1.0 - t_r) * along_axis(distance_low, i_r, i_v, t_v) + t_r * along_axis(distance_low, i_next, i_w, t_w)
+    j, t_z = distance_cell(distance_star, d_low, d_rupture, grid.shape[2])
+    cells = (grid, i_r, i_v, t_v, i_next, i_w, t_w, t_r, j, t_z)
+    force = math.exp(_interpolate(*cells, 0))
+    suction = _interpolate(*cells, 1)
+    delta1 = math.exp(_interpolate(*cells, 2))
+    delta2 = math.exp(_interpolate(*cells, 3))
     return True, force, suction, delta1, delta2
 
 
 def _build_one_radius_ratio(job):
-    radius_ratio, theta, n_volume, n_distance = job
-    return build_volume_rows(radius_ratio, theta, n_volume, n_distance)
+    return build_volume_rows(*job)
 
 
 class VolumeBridgeTable:
@@ -196,8 +193,7 @@ class VolumeBridgeTable:
         for name, n in (("n_volume", n_volume), ("n_distance", n_distance)):
             if int(n) != n or n < 2:
                 raise ValueError(f"{name} = {n} is outside the valid range: an integer >= 2")
-        theta = math.radians(contact_angle)
-        jobs = [(float(r), theta, int(n_volume), int(n_distance)) for r in radius_ratios]
+        jobs = [(float(r), contact_angle, int(n_volume), int(n_distance)) for r in radius_ratios]
         workers = min(workers or os.cpu_count() or 1, len(jobs))
         if workers > 1:
             with ProcessPoolExecutor(workers) as pool:

@@ -70,7 +70,7 @@ def yade_rows(radius_ratio, theta, suction_values, n_distance):
             continue
         u = suction_values[k]
         delta1 = stable_filling_angle(radius_ratio, theta, u, d, delta1_rupture[k], distance_rupture[k])
-        distance, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, u, delta1)
+        _, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, u, delta1)
         row = rows[j, k]
         row[0] = distances[j]
         row[1] = u
@@ -96,7 +96,7 @@ def write_yade(folder, contact_angle, radius_ratios, suction_values, n_distance=
         raise ValueError("suction_values must be non-negative and strictly increasing")
     paths = []
     for radius_ratio in radius_ratios:
-        distances, rows = yade_rows(float(radius_ratio), math.radians(contact_angle), suction_values, int(n_distance))
+        rows = yade_rows(float(radius_ratio), math.radians(contact_angle), suction_values, int(n_distance))[1]
         lines = [f"{radius_ratio:g}", f"{int(n_distance)}"]
         for j in range(int(n_distance)):
             block = rows[j][~np.isnan(rows[j, :, 0])]

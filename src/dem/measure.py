@@ -37,3 +37,32 @@ def unbalanced_force(particles, contacts):
     Reads the forces of the last step (call after the force operations); inf without contacts.
     """
     return float(_unbalanced(particles.force, contacts.force, contacts.overlap))
+
+
+def kinetic_energy(particles):
+    """Translational plus rotational kinetic energy [J]."""
+    translation = 0.5 * np.sum(particles.mass * np.sum(particles.velocity ** 2, axis=1))
+    rotation = 0.5 * np.sum(particles.inertia * np.sum(particles.angular_velocity ** 2, axis=1))
+    return float(translation + rotation)
+
+
+def elastic_energy(particles, contacts, walls, young, shear_ratio):
+    """Energy stored in the linear springs [J]: pairs (normal and shear) and walls.
+
+    Uses the overlaps and shear forces of the last force evaluation; kn = 2 E R1 R2 / (R1 + R2),
+    ks = shear_ratio kn, wall kn = E R (SPEC §2).
+    """
+    touching = contacts.overlap > 0.0
+    ri = particles.radius[contacts.pair_i[touching]]
+    rj = particles.radius[contacts.pair_j[touching]]
+    kn = 2.0 * young * ri * rj / (ri + rj)
+    energy = 0.5 * np.sum(kn * contacts.overlap[touching] ** 2)
+    if shear_ratio > 0.0:
+        energy += 0.5 * np.sum(np.sum(contacts.shear_force[touching] ** 2, axis=1)
+                               / (shear_ratio * kn))
+    radius = particles.radius[:, None]
+    wall_overlap = np.concatenate([radius - (particles.position - walls.lo),
+                                   radius - (walls.hi - particles.position)], axis=1)
+    wall_overlap = np.maximum(wall_overlap, 0.0)
+    energy += 0.5 * np.sum(young * radius * wall_overlap ** 2)
+    return float(energy)

@@ -48,12 +48,25 @@ class Contacts:
 
 
 @numba.njit(cache=True)
-def _cell_grid(position, lo, hi, cell_size):
-    """Sort particles into a regular grid of cells of at least ``cell_size`` covering [lo, hi]."""
+def _cell_grid(position, cell_size):
+    """Sort particles into a regular grid of cells of at least ``cell_size`` covering them.
+
+    The grid spans the particles' bounding box and holds at most about 4 cells per particle,
+    so a sparse scene in a large box costs no more memory than a dense one.
+    """
     count = position.shape[0]
-    dims = np.empty(3, np.int64)
+    lo = np.empty(3)
+    hi = np.empty(3)
     for axis in range(3):
-        dims[axis] = max(1, int((hi[axis] - lo[axis]) / cell_size))
+        lo[axis] = position[:, axis].min()
+        hi[axis] = position[:, axis].max() + 1e-12 * cell_size
+    dims = np.empty(3, np.int64)
+    while True:
+        for axis in range(3):
+            dims[axis] = max(1, int((hi[axis] - lo[axis]) / cell_size))
+        if dims[0] * dims[1] * dims[2] <= 4 * count + 27:
+            break
+        cell_size *= 1.25
     cell_of = np.empty(count, np.int64)
     for p in range(count):
         index = 0
@@ -118,11 +131,11 @@ def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_par
 
 
 @numba.njit(cache=True, parallel=True)
-def build_pairs(position, radius, lo, hi, skin):
+def build_pairs(position, radius, skin):
     """Half Verlet list (i < j, |x_i - x_j| < r_i + r_j + skin) as CSR arrays (row_start, pair_j)."""
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
-    dims, cell_of, cell_start, cell_particles = _cell_grid(position, lo, hi, cell_size)
+    dims, cell_of, cell_start, cell_particles = _cell_grid(position, cell_size)
     max_row = 0
     for c in range(len(cell_start) - 1):
         max_row = max(max_row, cell_start[c + 1] - cell_start[c])
@@ -192,10 +205,10 @@ def max_travel(position, reference_position, radius, reference_radius):
     return travel.max()
 
 
-def build_contacts(position, radius, lo, hi, skin, previous=None):
+def build_contacts(position, radius, skin, previous=None):
     """Build the neighbour list; carry shear history and normals from ``previous`` if given."""
     count = len(radius)
-    row_start, pair_j = build_pairs(position, radius, lo, hi, skin)
+    row_start, pair_j = build_pairs(position, radius, skin)
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
     second_start, second_pair = second_index(row_start, pair_j, count)
     size = len(pair_j)
@@ -226,8 +239,7 @@ class NeighborList:
 
     def rebuild(self, sim):
         p = sim.particles
-        sim.contacts = build_contacts(p.position, p.radius, sim.walls.lo, sim.walls.hi, self.skin,
-                                      previous=sim.contacts)
+        sim.contacts = build_contacts(p.position, p.radius, self.skin, previous=sim.contacts)
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
         self.rebuilds += 1

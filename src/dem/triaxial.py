@@ -24,7 +24,7 @@ class ShearConfig:
 
     confining: float = 750.0
     max_strain: float = 0.25
-    inertial_number: float = 1e-3
+    inertial_number: float = 3e-4
     strain_rate: float = None
     records: int = 500
 
@@ -78,10 +78,12 @@ def start_shear(sim, config, radius, density):
     index = sim.operations.index(servo)
     sim.operations[index:index + 1] = [lateral, axial]
     steps = int(np.ceil(config.max_strain / (rate * sim.dt)))
-    recorder = HistoryRecorder(max(1, steps // config.records),
+    period = max(1, steps // config.records)
+    steps = -(-steps // period) * period     # whole periods: the last step is recorded
+    recorder = HistoryRecorder(period,
                                triaxial_quantities(axial, sim.walls.volume()))
     recorder.record(sim)
-    sim.operations.append(recorder)
+    sim.writers.append(recorder)
     return recorder, steps, rate
 
 

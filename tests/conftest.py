@@ -1,0 +1,40 @@
+"""Shared fixtures: small scenes built with the public API."""
+
+import numpy as np
+import pytest
+
+from dem.contact_law import ContactForces
+from dem.integrate import Integrator
+from dem.neighbors import NeighborList
+from dem.preparation import PrepareConfig, prepare_sample
+from dem.simulation import ForceReset, Simulation
+from dem.state import Particles, Walls
+from dem.walls import WallForces
+
+RADIUS = 1e-3
+DENSITY = 2650.0
+YOUNG = 1e6
+
+
+def two_body_scene(positions, velocities, radius=RADIUS, young=YOUNG, friction_deg=0.0,
+                   damping=0.0, dt=None, extra=(), box=1.0):
+    """Spheres of ``radius`` (scalar or one per sphere) in a box [-box, box]^3 (walls out of
+    reach unless placed near them) with the standard dry pipeline."""
+    radii = np.broadcast_to(np.asarray(radius, float), (len(positions),))
+    particles = Particles(np.array(positions, float), radii, DENSITY,
+                          velocity=np.array(velocities, float))
+    walls = Walls.box([-box] * 3, [box] * 3)
+    if dt is None:
+        dt = 0.01 * np.sqrt(particles.mass.min() / (young * radii.min()))
+    operations = [ForceReset(), NeighborList(0.2 * radii.min()),
+                  ContactForces(young, 0.3, friction_deg), WallForces(young), *extra,
+                  Integrator(damping)]
+    return Simulation(particles, walls, dt, operations)
+
+
+@pytest.fixture(scope="session")
+def small_sample():
+    """A 300-sphere sample prepared as in thesis Ch. 5.2.2 and held at 750 Pa (seed 1)."""
+    config = PrepareConfig(particles=300, confining=750.0, seed=1, unload_steps=2000)
+    sim, report = prepare_sample(config, progress=False)
+    return config, sim, report

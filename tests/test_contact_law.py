@@ -1,0 +1,99 @@
+"""Two-body tests of the linear contact law against closed forms."""
+
+import numpy as np
+import pytest
+
+from conftest import RADIUS, YOUNG, two_body_scene
+
+
+class CountContactSteps:
+    """Test operation: count the steps during which the first pair overlaps."""
+
+    steps = 0
+
+    def apply(self, sim):
+        self.steps += int(sim.contacts.overlap[0] > 0)
+
+
+def test_head_on_collision_duration_and_restitution():
+    """Undamped linear spring: contact lasts pi sqrt(m_eff / kn), restitution is exactly 1."""
+    speed = 0.01
+    sim = two_body_scene([[-1.001 * RADIUS, 0, 0], [1.001 * RADIUS, 0, 0]],
+                         [[speed, 0, 0], [-speed, 0, 0]])
+    mass = sim.particles.mass[0]
+    kn = YOUNG * RADIUS  # 2 E R R / (2 R)
+    expected = np.pi * np.sqrt(0.5 * mass / kn)
+    counter = CountContactSteps()
+    sim.operations.append(counter)
+    sim.run(int(3 * expected / sim.dt) + int(0.01 * RADIUS / (speed * sim.dt)))
+    duration = counter.steps * sim.dt
+    assert duration == pytest.approx(expected, rel=0.01)
+    relative_after = sim.particles.velocity[1, 0] - sim.particles.velocity[0, 0]
+    assert relative_after == pytest.approx(2 * speed, rel=1e-3)
+    assert np.abs(sim.particles.angular_velocity).max() == 0.0
+
+
+def test_damped_collision_loses_energy():
+    """Cundall damping 0.2 must make the rebound slower than the impact."""
+    speed = 0.01
+    sim = two_body_scene([[-1.001 * RADIUS, 0, 0], [1.001 * RADIUS, 0, 0]],
+                         [[speed, 0, 0], [-speed, 0, 0]], damping=0.2)
+    sim.run(4000)
+    rebound = sim.particles.velocity[1, 0] - sim.particles.velocity[0, 0]
+    assert 0 < rebound < 2 * speed * 0.95
+
+
+class PushOnSphere:
+    """Test operation: constant external force on particle 1 (normal and tangential)."""
+
+    def __init__(self, force):
+        self.force = np.asarray(force, float)
+
+    def apply(self, sim):
+        sim.particles.force[1] += self.force
+
+
+@pytest.mark.parametrize("ratio", [0.8, 1.5])
+def test_sliding_at_the_coulomb_limit(ratio):
+    """A sphere pressed on a far larger one (locally a plane) and pushed sideways, rotation
+    blocked: it sticks with |Fs| = Ft below mu Fn, and slides at (Ft - mu Fn) / m above."""
+    friction_deg = 20.0
+    mu = np.tan(np.radians(friction_deg))
+    big = 1e4 * RADIUS
+    normal_push = 1e-3
+    tangential = ratio * mu * normal_push
+    kn = 2 * YOUNG * big * RADIUS / (big + RADIUS)
+    overlap = normal_push / kn
+    sliding = ratio > 1
+    sim = two_body_scene([[0, 0, 0], [0, 0, big + RADIUS - overlap]], [[0, 0, 0], [0, 0, 0]],
+                         radius=[big, RADIUS], friction_deg=friction_deg, box=10 * big,
+                         damping=0.0 if sliding else 0.2,
+                         extra=[PushOnSphere([tangential, 0.0, -normal_push])])
+    sim.particles.inertia[:] *= 1e12   # no rotation: pure sliding
+    sim.run(2000 if sliding else 40000)
+    shear = np.linalg.norm(sim.contacts.shear_force[0])
+    if not sliding:
+        assert shear == pytest.approx(tangential, rel=1e-4)
+        assert abs(sim.particles.velocity[1, 0]) < 1e-6 * np.sqrt(normal_push * overlap
+                                                                  / sim.particles.mass[1])
+        return
+    x0, v0 = sim.particles.position[1, 0], sim.particles.velocity[1, 0]
+    steps = 2000
+    sim.run(steps)
+    acceleration = (tangential - mu * normal_push) / sim.particles.mass[1]
+    measured = (sim.particles.velocity[1, 0] - v0) / (steps * sim.dt)
+    assert measured == pytest.approx(acceleration, rel=1e-3)
+    assert sim.particles.position[1, 0] > x0
+    shear = np.linalg.norm(sim.contacts.shear_force[0])
+    assert shear == pytest.approx(mu * sim.contacts.normal_force[0], rel=1e-9)
+
+
+def test_wall_contact_stiffness_is_young_times_radius():
+    """A sphere resting with overlap d on a wall feels E R d and the wall records it."""
+    overlap = 1e-6
+    sim = two_body_scene([[0, 0, -1.0 + RADIUS - overlap]], [[0, 0, 0]])
+    sim.advance()
+    expected = YOUNG * RADIUS * overlap
+    assert sim.walls.force[4] == pytest.approx(expected, rel=1e-9)
+    assert sim.walls.stiffness[4] == pytest.approx(YOUNG * RADIUS)
+    assert np.count_nonzero(sim.walls.force) == 1

@@ -1,0 +1,80 @@
+"""Energy conservation of an undamped, frictionless packing with walls."""
+
+import numpy as np
+
+from dem.measure import elastic_energy, kinetic_energy
+from dem.preparation import random_cloud
+from dem.simulation import Simulation
+from dem.state import Particles, Walls
+from dem.contact_law import ContactForces
+from dem.integrate import Integrator
+from dem.neighbors import NeighborList
+from dem.simulation import ForceReset
+from dem.walls import WallForces
+
+
+class SpringEnergyProbe:
+    """Test operation placed before the integrator: spring energy at x(t), v(t - dt/2)."""
+
+    def __init__(self, young):
+        self.young = young
+
+    def apply(self, sim):
+        self.energy = elastic_energy(sim.particles, sim.contacts, sim.walls, self.young, 0.3)
+        self.velocity_before = sim.particles.velocity.copy()
+
+
+def energy_error(timestep_factor, steps=10000):
+    """Largest relative deviation of the total energy of an undamped frictionless packing."""
+    radius, young, density = 1e-3, 1e6, 2650.0
+    edge = 0.02
+    position = random_cloud(500, radius, np.zeros(3), np.full(3, edge), seed=2)
+    rng = np.random.default_rng(5)
+    # radii 10 % larger than placed: the packing starts overlapped and loaded
+    particles = Particles(position, np.full(500, 1.1 * radius), density,
+                          velocity=rng.normal(scale=0.05, size=(500, 3)))
+    walls = Walls.box(np.zeros(3), np.full(3, edge))
+    dt = timestep_factor * np.sqrt(particles.mass[0] / (young * radius))
+    probe = SpringEnergyProbe(young)
+    sim = Simulation(particles, walls, dt, [ForceReset(), NeighborList(0.3 * radius),
+                                            ContactForces(young, 0.3, 0.0), WallForces(young),
+                                            probe, Integrator(damping=0.0)])
+
+    def total():
+        # leapfrog: springs at x(t), velocities at t -/+ dt/2; v(t) is their mean
+        on_step = 0.5 * (probe.velocity_before + sim.particles.velocity)
+        return 0.5 * np.sum(sim.particles.mass * np.sum(on_step ** 2, axis=1)) + probe.energy
+
+    sim.run(1)
+    start = total()
+    energies = []
+    for _ in range(20):
+        sim.run(steps // 20)
+        energies.append(total())
+    assert np.count_nonzero(sim.contacts.overlap > 0) > 100
+    assert probe.energy > 0.1 * start
+    return np.abs(np.array(energies) / start - 1.0).max()
+
+
+def test_total_energy_is_conserved_without_damping():
+    """Leapfrog with no damping and no friction conserves kinetic + spring energy: the error is
+    bounded (no drift) and second order in dt."""
+    coarse = energy_error(0.05, steps=10000)
+    fine = energy_error(0.025, steps=20000)
+    assert coarse < 1e-3
+    assert coarse / fine > 3.0
+
+
+def test_damping_dissipates_energy():
+    radius, young = 1e-3, 1e6
+    position = random_cloud(200, radius, np.zeros(3), np.full(3, 0.02), seed=3)
+    rng = np.random.default_rng(6)
+    particles = Particles(position, np.full(200, radius), 2650.0,
+                          velocity=rng.normal(scale=0.05, size=(200, 3)))
+    walls = Walls.box(np.zeros(3), np.full(3, 0.02))
+    sim = Simulation(particles, walls, 0.05 * np.sqrt(particles.mass[0] / (young * radius)),
+                     [ForceReset(), NeighborList(0.3 * radius), ContactForces(young, 0.3, 20.0),
+                      WallForces(young), Integrator(damping=0.2)])
+    start = kinetic_energy(sim.particles)
+    sim.run(5000)
+    assert kinetic_energy(sim.particles) < 0.8 * start

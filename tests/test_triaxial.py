@@ -1,0 +1,133 @@
+"""Servo, Love–Weber bookkeeping, determinism and the triaxial scenario on small samples."""
+
+import copy
+import json
+import os
+import subprocess
+import sys
+
+import h5py
+import numba
+import numpy as np
+import pytest
+
+from dem.preparation import PrepareConfig, prepare_sample
+from dem.triaxial import ShearConfig, start_shear, summarize
+from homogenize import contact_stress
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def test_prepared_sample_is_static_at_the_confining_stress(small_sample):
+    config, sim, report = small_sample
+    assert report["unbalanced_force"] <= config.equilibrium_unbalanced
+    assert np.allclose(sim.walls.stress(), config.confining, rtol=config.stress_tolerance)
+    assert 0.33 < report["porosity"] < 0.47
+    assert report["coordination"] > 3.5
+
+
+def test_love_weber_contact_stress_equals_wall_stress_in_equilibrium(small_sample):
+    """Eq. 3.41 over sphere and wall contacts equals the wall stresses of a static packing."""
+    _, sim, _ = small_sample
+    sim = copy.deepcopy(sim)
+    sim.run(20000, until=lambda s: _unbalanced(s) < 1e-4, check_every=500)
+    stress = contact_stress(sim.particles, sim.contacts, sim.walls)
+    walls = sim.walls.stress()
+    assert np.allclose(np.diag(stress), walls, rtol=2e-3)
+    # full tensor against the boundary traction (1/V) sum x_c (x) f_wall, x_c on the wall planes
+    boundary = np.zeros((3, 3))
+    position, radius = sim.particles.position, sim.particles.radius
+    for w, plane in enumerate(sim.walls.position):
+        axis, outward = w // 2, (1.0 if w % 2 else -1.0)
+        overlap = radius - outward * (plane - position[:, axis])
+        touching = overlap > 0
+        contact_point = position[touching].copy()
+        contact_point[:, axis] = plane
+        force_on_wall = np.zeros((touching.sum(), 3))
+        force_on_wall[:, axis] = outward * 1e6 * radius[touching] * overlap[touching]
+        boundary += contact_point.T @ force_on_wall
+    boundary /= sim.walls.volume()
+    assert np.allclose(stress, boundary, atol=2e-3 * walls.mean())
+
+
+def _unbalanced(sim):
+    from dem.measure import unbalanced_force
+    return unbalanced_force(sim.particles, sim.contacts)
+
+
+def test_servo_holds_lateral_stress_within_one_percent_in_shear(small_sample):
+    config, sim, _ = small_sample
+    sim = copy.deepcopy(sim)
+    shear = ShearConfig(confining=config.confining, max_strain=0.05, inertial_number=1e-3,
+                        records=50)
+    recorder, steps, _ = start_shear(sim, shear, config.radius, config.density)
+    sim.run(steps)
+    history = recorder.arrays()
+    lateral = history["sigma_wall"][5:, :2]    # past the first 0.5 % of strain
+    assert np.abs(lateral / config.confining - 1).mean() < 0.01
+    assert np.abs(lateral / config.confining - 1).max() < 0.03
+    result = summarize(history)
+    assert result["peak_q"] > 0.5 * config.confining     # the sample carries deviatoric load
+    assert history["axial_strain"][-1] == pytest.approx(0.05, rel=0.01)
+
+
+def test_same_seed_gives_identical_samples_for_any_thread_count():
+    config = PrepareConfig(particles=150, confining=750.0, seed=7, unload_steps=400)
+    first, _ = prepare_sample(config, progress=False)
+    again, _ = prepare_sample(config, progress=False)
+    assert np.array_equal(first.particles.position, again.particles.position)
+    other = PrepareConfig(particles=150, confining=750.0, seed=8, unload_steps=400)
+    different, _ = prepare_sample(other, progress=False)
+    assert not np.allclose(first.particles.position[:10], different.particles.position[:10])
+    if numba.config.NUMBA_NUM_THREADS > 1:
+        for sim in (first, again):
+            sim.threads = numba.config.NUMBA_NUM_THREADS if sim is first else 1
+            sim.run(300)
+        assert np.array_equal(first.particles.position, again.particles.position)
+        assert np.array_equal(first.contacts.shear_force, again.contacts.shear_force)
+
+
+def test_triaxial_scenario_writes_its_outputs(tmp_path):
+    out = tmp_path / "run"
+    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), "--particles",
+               "200", "--max-strain", "0.01", "--inertial-number", "2e-3", "--quiet",
+               "--out", str(out)]
+    subprocess.run(command, check=True, capture_output=True, text=True)
+    summary = json.loads((out / "summary.json").read_text())
+    for key in ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
+                "lateral_stress", "initial_porosity", "wall_time_s", "steps",
+                "particle_steps_per_s"):
+        assert np.isfinite(summary[key]), key
+    with h5py.File(out / "history.h5") as handle:
+        history = handle["history"]
+        rows = len(history["step"])
+        assert rows > 10
+        shapes = {"sigma_wall": (rows, 3), "sigma_contact": (rows, 3, 3), "fabric": (rows, 3, 3),
+                  "axial_strain": (rows,), "volumetric_strain": (rows,), "porosity": (rows,),
+                  "coordination": (rows,), "unbalanced_force": (rows,), "time": (rows,)}
+        for name, shape in shapes.items():
+            assert history[name].shape == shape, name
+        assert handle.attrs["particles"] == 200
+        assert handle.attrs["confining"] == 750.0
+        fabric = history["fabric"][0]
+        assert np.trace(fabric) == pytest.approx(1.0)
+    assert (out / "triaxial.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--particles", "-5"], "particles"),
+    (["--radius", "-1e-5"], "radius"),
+    (["--radius", "0"], "radius"),
+    (["--porosity", "0.7"], "porosity"),
+    (["--friction", "95"], "friction"),
+    (["--confining", "nan"], "confining"),
+    (["--max-strain", "inf"], "max_strain"),
+    (["--suction", "30000"], "not yet supported"),
+    (["--bogus"], "unrecognized arguments"),
+])
+def test_triaxial_scenario_refuses_bad_input(arguments, message):
+    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), *arguments,
+               "--out", os.devnull]
+    result = subprocess.run(command, capture_output=True, text=True)
+    assert result.returncode != 0
+    assert message in result.stderr
