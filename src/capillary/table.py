@@ -43,6 +43,15 @@ def cache_directory():
     return Path(os.environ.get("PENDULAR_CACHE", Path.home() / ".cache" / "pendular"))
 
 
+def save_atomically(table, path):
+    """table.save to path through a temporary file, so that concurrent runs never read a partial table."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    partial = path.with_name(f"{path.name}.{os.getpid()}.partial")
+    table.save(partial)
+    os.replace(partial, path)
+
+
 def cache_key(kind, parameters):
     """Short hash of a table's kind and build parameters."""
     text = json.dumps({"kind": kind, "format": TABLE_FORMAT, **parameters}, sort_keys=True)
@@ -308,8 +317,7 @@ class BridgeTable:
         if path.exists():
             return cls.load(path)
         table = cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        table.save(path)
+        save_atomically(table, path)
         return table
 
     def arrays(self):

@@ -30,6 +30,7 @@ from capillary.table import (
     distance_fraction,
     grid_position,
     radius_ratio_bracket,
+    save_atomically,
 )
 from capillary.validation import check_contact_angle, check_radius_ratio
 from capillary.volume_control import (
@@ -217,8 +218,7 @@ class VolumeBridgeTable:
         if path.exists():
             return cls.load(path)
         table = cls.build(contact_angle, radius_ratios, n_volume, n_distance)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        table.save(path)
+        save_atomically(table, path)
         return table
 
     def arrays(self):

@@ -169,6 +169,17 @@ def dry_operations(config, skin, friction_deg):
             ContactForces(config.young, config.shear_ratio, friction_deg), WallForces(config.young)]
 
 
+def servoed_simulation(particles, walls, config, target, threads=None):
+    """A static sample's simulation: dry pipeline at the test friction, six walls servoed at
+    ``target`` [Pa], integrator. Used to continue from a saved sample."""
+    sim = Simulation(particles, walls, timestep(particles, config),
+                     dry_operations(config, config.skin_factor * float(np.mean(particles.radius)),
+                                    config.friction_deg), threads=threads)
+    sim.operations += [StressServo("xyz", target, max_velocity=_servo_speed(sim, config)),
+                       Integrator(config.damping)]
+    return sim
+
+
 def rescale(sim, factor):
     """Scale all lengths by ``factor`` (stresses unchanged: forces scale as factor^2)."""
     p = sim.particles
@@ -182,7 +193,7 @@ def rescale(sim, factor):
     sim.operation(NeighborList).rebuild(sim)
 
 
-def prepare_sample(config, *, progress=True, max_steps=2_000_000):
+def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
 
     The returned simulation's operations are the dry pipeline, the six-wall servo at the
@@ -202,7 +213,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000):
     growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
     sim = Simulation(particles, walls, timestep(particles, config),
                      dry_operations(config, skin, config.prep_friction_deg)
-                     + [growth, Integrator(config.damping)])
+                     + [growth, Integrator(config.damping)], threads=threads)
     done = equilibrated(config)
 
     def grown(s):

@@ -1,0 +1,122 @@
+"""Shear-phase speed of the dry triaxial: pendular against YADE on the same sample, same run.
+
+    python benchmarks/bench_triaxial.py [--sizes 1000,10000] [--threads 1,2] [--steps 3000]
+        [--no-yade] [--out benchmarks/results_triaxial.json]
+
+For each size, a sample is prepared with pendular (thesis Ch. 5.2.2, 750 Pa; cached under
+.cache/), sheared with x, y servoed and z strained, and timed in particle-steps per second after
+a warm-up. The same packing is exported as a YADE sphere file and sheared by YADE 2023
+(benchmarks/yade_triaxial.py) with the equivalent engine list, time step and strain rate.
+Prints a table of particle-steps/s and the ratio pendular / YADE for each thread count.
+"""
+
+import argparse
+import copy
+import json
+import os
+import sys
+import tempfile
+import time
+
+import numba
+import numpy as np
+
+from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
+from dem.sample import load_sample, save_sample
+from dem.triaxial import ShearConfig, start_shear
+from dem.yade_io import write_spheres
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from yade_runner import find_yade, run_yade_triaxial  # noqa: E402
+
+CACHE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".cache")
+
+
+def sample(count, confining):
+    """Prepared sample of ``count`` spheres at ``confining`` Pa (prepared once, then cached)."""
+    config = PrepareConfig(particles=count, confining=confining)
+    path = os.path.join(CACHE, f"sample_{count}_{confining:g}.h5")
+    if not os.path.exists(path):
+        os.makedirs(CACHE, exist_ok=True)
+        started = time.perf_counter()
+        sim, report = prepare_sample(config, progress=True)
+        report["preparation_wall_time_s"] = time.perf_counter() - started
+        save_sample(path, sim, report)
+    particles, walls, report, _ = load_sample(path)
+    return config, particles, walls, report
+
+
+def time_pendular(config, particles, walls, threads, steps, warmup):
+    sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
+                             config.confining, threads=threads)
+    shear = ShearConfig(confining=config.confining, max_strain=0.25)
+    _, _, rate = start_shear(sim, shear, config.radius, config.density)
+    sim.writers.clear()     # time the physics, as the YADE run (which records nothing)
+    sim.run(warmup)
+    started = time.perf_counter()
+    sim.run(steps)
+    elapsed = time.perf_counter() - started
+    return {"particle_steps_per_s": len(particles) * steps / elapsed, "wall_time_s": elapsed,
+            "sigma_wall": sim.walls.stress().tolist()}, sim.dt, rate
+
+
+def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
+    with tempfile.TemporaryDirectory() as folder:
+        spheres = os.path.join(folder, "spheres.txt")
+        write_spheres(spheres, particles.position, particles.radius, walls.lo, walls.hi)
+        result = run_yade_triaxial({
+            "spheres": spheres, "box_lo": walls.lo.tolist(), "box_hi": walls.hi.tolist(),
+            "young": config.young, "poisson": config.shear_ratio,
+            "friction_deg": config.friction_deg, "density": config.density,
+            "damping": config.damping, "dt": dt, "confining": config.confining,
+            "strain_rate": rate, "steps": steps, "warmup_steps": warmup,
+            "record_every": steps, "skin": config.skin_factor * config.radius}, threads=threads)
+    return result
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="1000,10000")
+    parser.add_argument("--threads", default="1,2")
+    parser.add_argument("--steps", type=int, default=3000)
+    parser.add_argument("--warmup", type=int, default=300)
+    parser.add_argument("--confining", type=float, default=750.0)
+    parser.add_argument("--no-yade", action="store_true")
+    parser.add_argument("--out", default=None, help="JSON file for the results")
+    args = parser.parse_args(argv)
+    sizes = [int(s) for s in args.sizes.split(",")]
+    threads = [int(t) for t in args.threads.split(",")]
+    use_yade = not args.no_yade
+    if use_yade:
+        find_yade()
+    rows = []
+    for count in sizes:
+        config, particles, walls, report = sample(count, args.confining)
+        for thread_count in threads:
+            ours, dt, rate = time_pendular(config, particles, walls, thread_count, args.steps,
+                                           args.warmup)
+            row = {"particles": count, "threads": thread_count,
+                   "pendular": ours["particle_steps_per_s"], "dt": dt, "strain_rate": rate,
+                   "porosity": report["porosity"]}
+            if use_yade:
+                yade = time_yade(config, particles, walls, thread_count, args.steps,
+                                 args.warmup, dt, rate)
+                row["yade"] = yade["particle_steps_per_s"]
+                row["ratio"] = row["pendular"] / row["yade"]
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    print(f"\n{'particles':>9} {'threads':>7} {'pendular [Mps/s]':>17} {'YADE [Mps/s]':>13} "
+          f"{'ratio':>6}")
+    for row in rows:
+        yade = f"{row['yade'] / 1e6:13.2f}" if "yade" in row else f"{'-':>13}"
+        ratio = f"{row['ratio']:6.2f}" if "ratio" in row else f"{'-':>6}"
+        print(f"{row['particles']:9d} {row['threads']:7d} {row['pendular'] / 1e6:17.2f} "
+              f"{yade} {ratio}")
+    if args.out:
+        with open(args.out, "w") as handle:
+            json.dump({"rows": rows, "numba_threads_available": numba.config.NUMBA_NUM_THREADS,
+                       "cpu_count": os.cpu_count()}, handle, indent=2)
+
+
+if __name__ == "__main__":
+    main()
