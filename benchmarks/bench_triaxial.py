@@ -49,6 +49,7 @@ def sample(count, confining):
 def time_pendular(config, particles, walls, threads, steps, warmup):
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
                              config.confining, threads=threads)
+    sim.run(warmup)         # settle the loaded packing (saved without its shear history)
     shear = ShearConfig(confining=config.confining, max_strain=0.25)
     _, _, rate = start_shear(sim, shear, config.radius, config.density)
     sim.writers.clear()     # time the physics, as the YADE run (which records nothing)

@@ -118,18 +118,28 @@ def gather_pair_forces(pair_force, pair_torque_i, pair_torque_j, row_start, seco
                        second_pair, force, torque):
     """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j."""
     for p in numba.prange(len(row_start) - 1):
-        for c in range(3):
-            total_force = force[p, c]
-            total_torque = torque[p, c]
-            for k in range(row_start[p], row_start[p + 1]):
-                total_force -= pair_force[k, c]
-                total_torque += pair_torque_i[k, c]
-            for slot in range(second_start[p], second_start[p + 1]):
-                k = second_pair[slot]
-                total_force += pair_force[k, c]
-                total_torque += pair_torque_j[k, c]
-            force[p, c] = total_force
-            torque[p, c] = total_torque
+        f0 = f1 = f2 = t0 = t1 = t2 = 0.0
+        for k in range(row_start[p], row_start[p + 1]):
+            f0 -= pair_force[k, 0]
+            f1 -= pair_force[k, 1]
+            f2 -= pair_force[k, 2]
+            t0 += pair_torque_i[k, 0]
+            t1 += pair_torque_i[k, 1]
+            t2 += pair_torque_i[k, 2]
+        for slot in range(second_start[p], second_start[p + 1]):
+            k = second_pair[slot]
+            f0 += pair_force[k, 0]
+            f1 += pair_force[k, 1]
+            f2 += pair_force[k, 2]
+            t0 += pair_torque_j[k, 0]
+            t1 += pair_torque_j[k, 1]
+            t2 += pair_torque_j[k, 2]
+        force[p, 0] += f0
+        force[p, 1] += f1
+        force[p, 2] += f2
+        torque[p, 0] += t0
+        torque[p, 1] += t1
+        torque[p, 2] += t2
 
 
 @numba.njit(cache=True)

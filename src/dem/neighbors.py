@@ -4,14 +4,19 @@ Pairs are stored once (i < j) in CSR order: the pairs of particle i are
 ``row_start[i]:row_start[i+1]``, sorted by j. ``second_start``/``second_pair`` index,
 for each particle, the pairs in which it is the second member, so that per-pair results
 can be gathered per particle without atomics (deterministic for any thread count).
+
+Operations may keep their own per-pair state in ``Contacts.extra`` (name -> array with one row
+per pair, any dtype and trailing shape); ``build_contacts`` carries every such array to the same
+(i, j) pair across rebuilds, as it does for the shear history. ``NeighborList`` can reach beyond
+touching by an ``interaction_range`` (for interactions acting across a gap, e.g. liquid bridges).
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
 
-from .validate import check_positive
+from .validate import check_positive, check_range
 
 
 @dataclass
@@ -24,6 +29,8 @@ class Contacts:
     overlap: (K,) r_i + r_j - |x_j - x_i| at the last evaluation [m] (negative = gap).
     normal_force: (K,) magnitude of the spring's normal force [N] (0 when apart).
     force: (K, 3) total contact force on j from i [N]; torque_i, torque_j: (K, 3) [N m].
+    extra: name -> (K, ...) per-pair state owned by other operations (e.g. capillary bridges),
+    carried to the same pair by ``build_contacts``; absent pairs start at 0.
     """
 
     pair_i: np.ndarray
@@ -38,6 +45,7 @@ class Contacts:
     force: np.ndarray
     torque_i: np.ndarray
     torque_j: np.ndarray
+    extra: dict = field(default_factory=dict)
 
     def __len__(self):
         return len(self.pair_i)
@@ -192,21 +200,56 @@ def carry_history(old_row_start, old_pair_j, old_values, new_row_start, new_pair
                     new_values[k, c] = old_values[old, c]
 
 
-@numba.njit(cache=True, parallel=True)
-def max_travel(position, reference_position, radius, reference_radius):
-    """Largest displacement plus radius growth since the last rebuild [m]."""
-    count = position.shape[0]
-    travel = np.empty(count)
-    for p in numba.prange(count):
+@numba.njit(cache=True)
+def moved_beyond(position, reference_position, radius, reference_radius, limit):
+    """True when some particle's displacement plus radius growth since the last rebuild exceeds
+    ``limit`` [m]."""
+    limit_squared = limit * limit
+    for p in range(position.shape[0]):
+        growth = max(radius[p] - reference_radius[p], 0.0)
         d0 = position[p, 0] - reference_position[p, 0]
         d1 = position[p, 1] - reference_position[p, 1]
         d2 = position[p, 2] - reference_position[p, 2]
-        travel[p] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) + max(radius[p] - reference_radius[p], 0.0)
-    return travel.max()
+        if growth == 0.0:
+            if d0 * d0 + d1 * d1 + d2 * d2 > limit_squared:
+                return True
+        elif np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) + growth > limit:
+            return True
+    return False
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_pair_vectors(pair_vector, row_start, second_start, second_pair, out):
+    """Add a per-pair vector (K, w) to particles (N, w): -v to the first member i, +v to j.
+
+    For a pair force stored as "force on j from i" this applies action and reaction. Each
+    particle sums its own pairs in a fixed order: deterministic without atomics.
+    """
+    width = pair_vector.shape[1]
+    for p in numba.prange(len(row_start) - 1):
+        for k in range(row_start[p], row_start[p + 1]):
+            for c in range(width):
+                out[p, c] -= pair_vector[k, c]
+        for slot in range(second_start[p], second_start[p + 1]):
+            k = second_pair[slot]
+            for c in range(width):
+                out[p, c] += pair_vector[k, c]
+
+
+def carry_pair_array(previous, values, row_start, pair_j):
+    """``values`` (one row per pair of ``previous``) moved to the pairs of a new list
+    (``row_start``, ``pair_j``); pairs absent before get zeros. Any dtype and trailing shape."""
+    carried = np.zeros((len(pair_j),) + values.shape[1:], dtype=values.dtype)
+    if len(previous) and len(pair_j):
+        old = np.ascontiguousarray(values).reshape(len(values), -1)
+        carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j,
+                      carried.reshape(len(pair_j), -1))
+    return carried
 
 
 def build_contacts(position, radius, skin, previous=None):
-    """Build the neighbour list; carry shear history and normals from ``previous`` if given."""
+    """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals and
+    every ``extra`` per-pair array from ``previous`` if given."""
     count = len(radius)
     row_start, pair_j = build_pairs(position, radius, skin)
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
@@ -216,30 +259,49 @@ def build_contacts(position, radius, skin, previous=None):
     if previous is not None and len(previous):
         old = np.concatenate([previous.shear_force, previous.normal], axis=1)
         carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j, history)
+    extra = {}
+    if previous is not None:
+        for name, values in previous.extra.items():
+            extra[name] = carry_pair_array(previous, values, row_start, pair_j)
     return Contacts(
         pair_i=pair_i, pair_j=pair_j, row_start=row_start,
         second_start=second_start, second_pair=second_pair,
         shear_force=np.ascontiguousarray(history[:, :3]),
         normal=np.ascontiguousarray(history[:, 3:]),
         overlap=np.full(size, -np.inf), normal_force=np.zeros(size),
-        force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)))
+        force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)),
+        extra=extra)
 
 
 class NeighborList:
     """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2.
 
     skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
+    interaction_range [m]: largest gap across which some operation still needs a pair (0 for
+    contacts only). The list holds pairs with gap < interaction_range + skin, so every pair
+    with gap < interaction_range is in it until the next rebuild. Changing it forces a rebuild.
     """
 
-    def __init__(self, skin):
+    def __init__(self, skin, interaction_range=0.0):
         self.skin = check_positive("skin", skin, "m")
         self.rebuilds = 0
         self._reference_position = None
         self._reference_radius = None
+        self.interaction_range = interaction_range
+
+    @property
+    def interaction_range(self):
+        return self._interaction_range
+
+    @interaction_range.setter
+    def interaction_range(self, value):
+        self._interaction_range = check_range("interaction_range", value, 0.0, unit="m")
+        self._reference_position = None     # rebuild with the new reach at the next step
 
     def rebuild(self, sim):
         p = sim.particles
-        sim.contacts = build_contacts(p.position, p.radius, self.skin, previous=sim.contacts)
+        sim.contacts = build_contacts(p.position, p.radius, self.skin + self.interaction_range,
+                                      previous=sim.contacts)
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
         self.rebuilds += 1
@@ -248,6 +310,6 @@ class NeighborList:
         p = sim.particles
         if (sim.contacts is None or self._reference_position is None
                 or len(self._reference_radius) != len(p.radius)
-                or max_travel(p.position, self._reference_position, p.radius,
-                              self._reference_radius) > 0.5 * self.skin):
+                or moved_beyond(p.position, self._reference_position, p.radius,
+                                self._reference_radius, 0.5 * self.skin)):
             self.rebuild(sim)

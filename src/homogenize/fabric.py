@@ -38,3 +38,24 @@ def fabric_anisotropy(fabric):
     if trace == 0.0:
         return 0.0
     return 2.5 * (fabric[2, 2] - 0.5 * (fabric[0, 0] + fabric[1, 1])) / trace
+
+
+def principal_anisotropy(tensor):
+    """a = 5/2 (T_z - T_x) / tr T from the principal values of a symmetric 3x3 tensor.
+
+    The form of Eq. 3.51 (fabric), Eq. 3.54 (bridge fabric) and Eq. 4.5 (capillary stress).
+    T_z is the principal value whose principal axis is closest to the z axis (the axial
+    direction of the packings and of the triaxial box), T_x the mean of the other two, so that
+    a < 0 when the largest principal value lies in the x-y plane (the thesis's BCC with l' = 2.1).
+    Returns NaN when tr T = 0 (no bridges: the anisotropy is undefined).
+    """
+    tensor = np.asarray(tensor, dtype=float)
+    if tensor.shape != (3, 3):
+        raise ValueError(f"tensor has shape {tensor.shape}; expected (3, 3)")
+    trace = np.trace(tensor)
+    if trace == 0.0:
+        return np.nan
+    values, vectors = np.linalg.eigh(0.5 * (tensor + tensor.T))
+    axial = int(np.argmax(np.abs(vectors[2])))
+    lateral = np.delete(values, axial).mean()
+    return 2.5 * (values[axial] - lateral) / trace
