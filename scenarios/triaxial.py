@@ -2,9 +2,17 @@
 
     python scenarios/triaxial.py [--particles N] [--confining PA] [--suction PA]
         [--contact-angle DEG] [--max-strain X] [--seed S] [--out DIR]
+        [--bridges exact|toroidal] [--surface-tension N/M] [--persist-bridges]
 
 Writes DIR/history.h5 (group ``history``, one row per record; file attributes hold every input),
 DIR/summary.json and DIR/triaxial.png. Stresses compression positive [Pa].
+
+Wet test (--suction > 0, thesis Ch. 5.2): the sample is prepared dry, then capillary bridges
+(capillary.coupling.CapillaryBridges, suction-controlled, formed at every contact) are added at
+the confining stress and the sample is let to equilibrate with them (six walls servoed) before
+the shear. The history then also holds saturation, suction [Pa], sigma_capillary (Love–Weber
+stress of the capillary forces, tensile negative), bridges and pendular_overlaps. Without
+--suction the scene is dry and never imports the capillary package.
 """
 
 import argparse
@@ -17,7 +25,8 @@ import time
 import numba
 import numpy as np
 
-from dem.preparation import PrepareConfig, prepare_sample
+from dem.preparation import PrepareConfig, equilibrated, prepare_sample
+from dem.measure import porosity
 from dem.record import write_history
 from dem.triaxial import ShearConfig, inertial_number, start_shear, summarize
 
@@ -27,7 +36,18 @@ def parse_args(argv=None):
     parser.add_argument("--particles", type=int, default=10000, help="number of spheres")
     parser.add_argument("--confining", type=float, default=750.0, help="lateral stress [Pa]")
     parser.add_argument("--suction", type=float, default=0.0, help="matric suction [Pa]")
-    parser.add_argument("--contact-angle", type=float, default=None, help="wetting angle [deg]")
+    parser.add_argument("--contact-angle", type=float, default=None,
+                        help="wetting angle [deg] (wet test; default 0)")
+    parser.add_argument("--bridges", choices=("exact", "toroidal"), default=None,
+                        help="bridge model of the wet test: exact Young-Laplace tables "
+                             "(default) or the toroidal approximation (equal spheres)")
+    parser.add_argument("--surface-tension", type=float, default=None,
+                        help="liquid surface tension [N/m] (wet test; default 0.073)")
+    parser.add_argument("--persist-bridges", action="store_true",
+                        help="bridges live up to their rupture distance instead of breaking "
+                             "when contact is lost")
+    parser.add_argument("--wet-steps", type=int, default=200000,
+                        help="most steps to equilibrate the wetted sample before the shear")
     parser.add_argument("--max-strain", type=float, default=0.25, help="final axial strain")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
@@ -47,9 +67,18 @@ def parse_args(argv=None):
     parser.add_argument("--threads", type=int, default=None, help="Numba threads")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
     args = parser.parse_args(argv)
-    if args.suction != 0.0 or args.contact_angle is not None:
-        parser.error("--suction and --contact-angle are not yet supported "
-                     "(capillary bridges come with the capillary issue); run dry with --suction 0")
+    if not math.isfinite(args.suction) or args.suction < 0.0:
+        parser.error(f"--suction {args.suction} Pa is outside the valid range [0, inf) "
+                     "(0: dry)")
+    if args.wet_steps < 0:
+        parser.error(f"--wet-steps {args.wet_steps} is outside the valid range [0, inf)")
+    wet_only = {"--contact-angle": args.contact_angle is not None,
+                "--bridges": args.bridges is not None,
+                "--surface-tension": args.surface_tension is not None,
+                "--persist-bridges": args.persist_bridges}
+    if args.suction == 0.0 and any(wet_only.values()):
+        parser.error(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet test: "
+                     "give --suction > 0")
     if args.threads is not None:
         if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
             parser.error(f"--threads {args.threads} is outside the valid range "
@@ -69,6 +98,7 @@ def main(argv=None):
         shear = ShearConfig(confining=args.confining, max_strain=args.max_strain,
                             inertial_number=args.inertial_number, strain_rate=args.strain_rate,
                             records=args.records)
+        bridges = wet_bridges(args, prepare.radius) if args.suction > 0.0 else None
     except ValueError as error:
         sys.exit(f"triaxial.py: error: {error}")
     os.makedirs(args.out, exist_ok=True)
@@ -76,6 +106,7 @@ def main(argv=None):
     started = time.perf_counter()
     sim, preparation = prepare_sample(prepare, progress=progress)
     prepared = time.perf_counter()
+    wetting = wet_sample(sim, bridges, prepare, args.wet_steps, progress) if bridges else {}
     recorder, steps, rate = start_shear(sim, shear, prepare.radius, prepare.density)
 
     def status(s):
@@ -106,20 +137,51 @@ def main(argv=None):
         "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
         "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
         "threads": numba.get_num_threads(),
+        **wetting,
     })
     attributes = {k: v for k, v in vars(args).items() if v is not None}
     attributes.update({"timestep": preparation["timestep"], "dt": sim.dt, "strain_rate": rate,
                        "density": prepare.density, "shear_ratio": prepare.shear_ratio,
                        "prep_friction": prepare.prep_friction_deg,
                        "prep_stress": prepare.prep_stress})
+    if bridges is not None:
+        attributes.update({"bridges": bridges.model, "contact_angle": bridges.contact_angle,
+                           "surface_tension": bridges.surface_tension,
+                           "persist_bridges": bridges.persist})
     write_history(os.path.join(args.out, "history.h5"), history, attributes)
     with open(os.path.join(args.out, "summary.json"), "w") as handle:
         json.dump(summary, handle, indent=2)
     plot_history(history, os.path.join(args.out, "triaxial.png"))
-    print(json.dumps({k: summary[k] for k in ("peak_axial_stress", "peak_q", "p_at_peak",
-                                              "axial_strain_at_peak", "initial_porosity",
-                                              "wall_time_s", "particle_steps_per_s")}, indent=2))
+    shown = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
+             "initial_porosity", "saturation_at_peak", "wall_time_s", "particle_steps_per_s")
+    print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
     return summary
+
+
+def wet_bridges(args, radius):
+    """The capillary operation of the wet test, its input checked against the sample's radius
+    (imported here: a dry test never loads the capillary package)."""
+    from capillary.coupling import CapillaryBridges
+
+    bridges = CapillaryBridges(
+        args.suction, surface_tension=0.073 if args.surface_tension is None else args.surface_tension,
+        contact_angle=args.contact_angle or 0.0, model=args.bridges or "exact",
+        persist=args.persist_bridges)
+    bridges.load_tables(radius, radius)
+    return bridges
+
+
+def wet_sample(sim, bridges, prepare, max_steps, progress):
+    """Add the bridges to the dry sample held at the confining stress and run until it is
+    static again (unbalanced force and wall stresses as in the preparation)."""
+    bridges.insert(sim)
+    started = time.perf_counter()
+    steps = sim.run(max_steps, until=equilibrated(prepare), check_every=200,
+                    progress="wet" if progress else None)
+    return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
+            "initial_saturation": bridges.saturation(sim),
+            "initial_bridges": bridges.count(sim),
+            "wet_porosity": porosity(sim.particles, sim.walls)}
 
 
 def plot_history(history, path):

@@ -112,14 +112,75 @@ def _apply_across_gap(k, position, i, j, magnitude, pair_force):
 
 
 @numba.njit(cache=True, parallel=True)
+def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filling_i, filling_j,
+                    suction, surface_tension, radius_ratios, suction_axis, distance_low,
+                    log_distance_rupture, log_values):
+    """Suction-controlled bridges that exist exactly while the spheres touch (thesis Ch. 5.2.2).
+
+    A pair that starts touching gets its bridge from the table at d* = 0 (force, volume and
+    filling angles depend only on the radii then); a pair that stops touching loses it. In
+    steady state this pass only reads overlap and state. overlap: the contact law's, this step.
+    """
+    for k in numba.prange(len(pair_i)):
+        touching = overlap[k] > 0.0
+        if touching == (state[k] == AT_CONTACT):   # no change: the (predictable) common case
+            continue
+        if touching:
+            i = pair_i[k]
+            j = pair_j[k]
+            larger = max(radius[i], radius[j])
+            _, force_star, volume_star, delta1, delta2 = lookup_suction(
+                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                larger / min(radius[i], radius[j]), suction * larger / surface_tension, 0.0)
+            _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
+                   force, filling_i, filling_j)
+            volume[k] = volume_star * larger * larger * larger
+            state[k] = AT_CONTACT
+        else:
+            state[k] = NO_BRIDGE
+            volume[k] = 0.0
+            force[k] = 0.0
+            filling_i[k] = 0.0
+            filling_j[k] = 0.0
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_contact_bridges(force, normal, row_start, second_start, second_pair, out):
+    """Add bridge forces of magnitude ``force`` (0 where no bridge) along the contact normals
+    (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction).
+
+    Branch-free (a pair without bridge adds 0 x its normal); each particle sums its own pairs
+    in a fixed order, as dem.neighbors.gather_pair_vectors: deterministic without atomics.
+    """
+    for p in numba.prange(len(row_start) - 1):
+        f0 = f1 = f2 = 0.0
+        for k in range(row_start[p], row_start[p + 1]):
+            f = force[k]
+            f0 += f * normal[k, 0]
+            f1 += f * normal[k, 1]
+            f2 += f * normal[k, 2]
+        for slot in range(second_start[p], second_start[p + 1]):
+            k = second_pair[slot]
+            f = force[k]
+            f0 -= f * normal[k, 0]
+            f1 -= f * normal[k, 1]
+            f2 -= f * normal[k, 2]
+        out[p, 0] += f0
+        out[p, 1] += f1
+        out[p, 2] += f2
+
+
+@numba.njit(cache=True, parallel=True)
 def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
                     filling_i, filling_j, pair_force, persist, suction, surface_tension,
                     radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values):
     """Suction-controlled bridges (thesis Table 5.1), one pass over the pairs.
 
     overlap and normal: the contact law's values of this step (normal is current for touching
-    pairs). suction [Pa], surface_tension [N/m]; the last five arguments are a BridgeTable's
-    arrays(). Fills the per-pair state and pair_force (force on j from i) [N].
+    pairs). With ``persist`` a bridge lives across a gap while the table has a solution there,
+    else it breaks with the contact. suction [Pa], surface_tension [N/m]; the last five
+    arguments are a BridgeTable's arrays(). Fills the per-pair state and pair_force (force on
+    j from i) [N].
     """
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
@@ -296,6 +357,7 @@ class CapillaryBridges:
         self.volume_table = None
         self.required_range = 0.0
         self.pair_force = np.zeros((0, 3))
+        self._table_arrays = None
         self._contacts = None
         self._bridges = 0
         self._radius_bounds = None
@@ -311,15 +373,17 @@ class CapillaryBridges:
             raise ValueError("CapillaryBridges must follow a ContactForces operation: the "
                              "simulation has none")
         sim.operations.insert(max(indices) + 1, self)
-        self.prepare(sim.particles)
+        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
         if self.persist:
             neighbors = sim.operation(NeighborList)
             neighbors.interaction_range = max(neighbors.interaction_range, self.required_range)
         return self
 
-    def prepare(self, particles):
-        """Check the suction range against the radii and load (or build) the tables."""
-        low, high = float(particles.radius.min()), float(particles.radius.max())
+    def load_tables(self, low, high):
+        """Check the input against spheres of radii in [low, high] [m] and load (or build and
+        cache) the tables; ValueError naming the parameter when out of range."""
+        low = check_positive("smallest radius", low, "m")
+        high = check_range("largest radius", high, low, unit="m")
         if self._radius_bounds == (low, high):
             return
         ratio = high / low
@@ -345,6 +409,7 @@ class CapillaryBridges:
         if self.control == "volume":
             self.volume_table = VolumeBridgeTable.cached(
                 self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
+        self._table_arrays = self.suction_table.arrays()
         self.required_range = self._rupture_range(low, high)
         self._radius_bounds = (low, high)
 
@@ -390,34 +455,47 @@ class CapillaryBridges:
                 f"{sim.operation(NeighborList).interaction_range:g} m plus skin) is shorter than "
                 f"the rupture distance ({self.required_range:g} m); use CapillaryBridges.insert(sim) "
                 f"or set NeighborList.interaction_range >= {self.required_range:g}")
-        self.pair_force = np.zeros((len(contacts), 3))
+        self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
         self._contacts = contacts
 
+    def _sync(self, sim):
+        """Tables and per-pair arrays for the current radii and neighbour list."""
+        if sim.contacts is self._contacts:
+            return
+        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
+        reach = sim.operation(NeighborList).interaction_range
+        if self.persist and reach < self.required_range:
+            raise ValueError(
+                f"NeighborList.interaction_range = {reach:g} m is below the largest rupture "
+                f"distance {self.required_range:g} m of persisting bridges: bridges could be "
+                f"missed; use CapillaryBridges.insert(sim) or raise it")
+        self._attach(sim)
+
     def apply(self, sim):
-        if sim.contacts is not self._contacts:
-            self.prepare(sim.particles)
-            if self.persist and sim.operation(NeighborList).interaction_range < self.required_range:
-                raise ValueError(
-                    f"NeighborList.interaction_range = "
-                    f"{sim.operation(NeighborList).interaction_range:g} m is below the largest "
-                    f"rupture distance {self.required_range:g} m of persisting bridges: bridges "
-                    f"could be missed; use CapillaryBridges.insert(sim) or raise it")
-            self._attach(sim)
+        self._sync(sim)
         p = sim.particles
         c = sim.contacts
         extra = c.extra
+        if self.control == "suction" and not self.persist:
+            contact_bridges(p.radius, c.pair_i, c.pair_j, c.overlap, extra["bridge"],
+                            extra["bridge_volume"], extra["bridge_force"],
+                            extra["filling_angle_i"], extra["filling_angle_j"], self.suction,
+                            self.surface_tension, *self._table_arrays)
+            gather_contact_bridges(extra["bridge_force"], c.normal, c.row_start, c.second_start,
+                                   c.second_pair, p.force)
+            return
         if self.control == "suction":
             suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
                             extra["bridge"], extra["bridge_volume"], extra["bridge_force"],
                             extra["filling_angle_i"], extra["filling_angle_j"], self.pair_force,
                             self.persist, self.suction, self.surface_tension,
-                            *self.suction_table.arrays())
+                            *self._table_arrays)
         else:
             volume_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
                            extra["bridge"], extra["bridge_volume"], extra["bridge_force"],
                            extra["filling_angle_i"], extra["filling_angle_j"],
                            extra["bridge_suction"], self.pair_force, self.suction,
-                           self.surface_tension, self.suction_table.arrays(),
+                           self.surface_tension, self._table_arrays,
                            self.volume_table.arrays())
         gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
         if self.persist:
@@ -428,18 +506,25 @@ class CapillaryBridges:
         """Boolean mask of the pairs holding a bridge."""
         return contacts.extra["bridge"] != NO_BRIDGE
 
+    def count(self, sim):
+        """Number of bridges."""
+        self._sync(sim)
+        return int(np.count_nonzero(sim.contacts.extra["bridge"]))
+
     def water_volume(self, contacts):
         """Total liquid volume of the bridges [m^3]."""
         return float(np.sum(contacts.extra["bridge_volume"]))
 
     def saturation(self, sim):
         """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume - solid volume."""
+        self._sync(sim)
         voids = sim.walls.volume() - sim.particles.solid_volume()
         return self.water_volume(sim.contacts) / voids
 
     def mean_suction(self, sim):
         """The imposed suction [Pa] (suction control) or the bridges' mean suction (volume
         control; NaN without bridges)."""
+        self._sync(sim)
         if self.control == "suction":
             return self.suction
         mask = self.bridges(sim.contacts)
@@ -450,13 +535,23 @@ class CapillaryBridges:
         sign convention of homogenize.contact_stress (l = x_j - x_i, f on j from i,
         compression positive): attractive bridges give a negative (tensile) stress, and in
         static equilibrium sigma_wall = sigma_contact + sigma_capillary."""
+        self._sync(sim)
         c = sim.contacts
-        total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, self.pair_force,
-                                self.bridges(c))
+        total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j,
+                                self.pair_forces(sim), self.bridges(c))
         return total / sim.walls.volume()
+
+    def pair_forces(self, sim):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
+        self._sync(sim)
+        if self.persist:
+            return self.pair_force
+        c = sim.contacts
+        return -c.extra["bridge_force"][:, None] * c.normal
 
     def pendular_overlaps(self, sim):
         """Number of pairs of overlapping menisci on a same particle, summed over particles."""
+        self._sync(sim)
         c = sim.contacts
         e = c.extra
         return int(np.sum(pendular_overlap_counts(
@@ -469,6 +564,6 @@ class CapillaryBridges:
             "saturation": self.saturation,
             "suction": self.mean_suction,
             "sigma_capillary": self.capillary_stress,
-            "bridges": lambda sim: int(np.count_nonzero(sim.contacts.extra["bridge"])),
+            "bridges": self.count,
             "pendular_overlaps": self.pendular_overlaps,
         }

@@ -33,8 +33,11 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j,
         ri = radius[i]
         rj = radius[j]
         gap_overlap = ri + rj - distance
+        was_touching = overlap[k] > 0.0
         overlap[k] = gap_overlap
         if gap_overlap <= 0.0:
+            if not was_touching:
+                continue    # the pair's arrays are still zero from when it separated
             normal_force[k] = 0.0
             for c in range(3):
                 shear_force[k, c] = 0.0

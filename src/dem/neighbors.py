@@ -220,20 +220,26 @@ def moved_beyond(position, reference_position, radius, reference_radius, limit):
 
 @numba.njit(cache=True, parallel=True)
 def gather_pair_vectors(pair_vector, row_start, second_start, second_pair, out):
-    """Add a per-pair vector (K, w) to particles (N, w): -v to the first member i, +v to j.
+    """Add a per-pair 3-vector (K, 3) to particles (N, 3): -v to the first member i, +v to j.
 
-    For a pair force stored as "force on j from i" this applies action and reaction. Each
-    particle sums its own pairs in a fixed order: deterministic without atomics.
+    For a central pair force stored as "force on j from i" this applies action and reaction
+    (gather_pair_forces of the contact law does the same with torques). Each particle sums its
+    own pairs in a fixed order: deterministic for any thread count, without atomics.
     """
-    width = pair_vector.shape[1]
     for p in numba.prange(len(row_start) - 1):
+        v0 = v1 = v2 = 0.0
         for k in range(row_start[p], row_start[p + 1]):
-            for c in range(width):
-                out[p, c] -= pair_vector[k, c]
+            v0 -= pair_vector[k, 0]
+            v1 -= pair_vector[k, 1]
+            v2 -= pair_vector[k, 2]
         for slot in range(second_start[p], second_start[p + 1]):
             k = second_pair[slot]
-            for c in range(width):
-                out[p, c] += pair_vector[k, c]
+            v0 += pair_vector[k, 0]
+            v1 += pair_vector[k, 1]
+            v2 += pair_vector[k, 2]
+        out[p, 0] += v0
+        out[p, 1] += v1
+        out[p, 2] += v2
 
 
 def carry_pair_array(previous, values, row_start, pair_j):

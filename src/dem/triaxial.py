@@ -50,9 +50,11 @@ def inertial_number(strain_rate, radius, density, pressure):
     return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
 
 
-def triaxial_quantities(axial, reference_volume):
-    """Recorded columns of the triaxial history (see the scenario's HDF5 layout)."""
-    return {
+def triaxial_quantities(axial, reference_volume, operations=()):
+    """Recorded columns of the triaxial history (see the scenario's HDF5 layout), plus those of
+    every operation that offers ``quantities()`` (name -> function of sim; e.g. the capillary
+    bridges' saturation, suction, sigma_capillary, bridges, pendular_overlaps)."""
+    columns = {
         "step": lambda s: s.step,
         "time": lambda s: s.time,
         "axial_strain": lambda s: axial.strain(s.walls),
@@ -64,6 +66,10 @@ def triaxial_quantities(axial, reference_volume):
         "fabric": lambda s: fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0),
         "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
     }
+    for op in operations:
+        if hasattr(op, "quantities"):
+            columns.update(op.quantities())
+    return columns
 
 
 def start_shear(sim, config, radius, density):
@@ -80,21 +86,22 @@ def start_shear(sim, config, radius, density):
     steps = int(np.ceil(config.max_strain / (rate * sim.dt)))
     period = max(1, steps // config.records)
     steps = -(-steps // period) * period     # whole periods: the last step is recorded
-    recorder = HistoryRecorder(period,
-                               triaxial_quantities(axial, sim.walls.volume()))
+    recorder = HistoryRecorder(period, triaxial_quantities(axial, sim.walls.volume(),
+                                                           sim.operations))
     recorder.record(sim)
     sim.writers.append(recorder)
     return recorder, steps, rate
 
 
 def summarize(history):
-    """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at peak."""
+    """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at peak
+    (and the degree of saturation there when the history records one)."""
     sigma = history["sigma_wall"]
     lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
     q = sigma[:, 2] - lateral
     p = (sigma[:, 2] + 2.0 * lateral) / 3.0
     peak = int(np.argmax(q))
-    return {
+    summary = {
         "peak_axial_stress": float(sigma[:, 2].max()),
         "peak_q": float(q[peak]),
         "p_at_peak": float(p[peak]),
@@ -102,3 +109,6 @@ def summarize(history):
         "lateral_stress": float(np.mean(lateral)),
         "peak_index": peak,
     }
+    if "saturation" in history:
+        summary["saturation_at_peak"] = float(history["saturation"][peak])
+    return summary

@@ -1,6 +1,55 @@
-"""Micromechanical effective stress (thesis Eqs. 3.41-3.57) and regular packings (Chapter 4)."""
+"""Micromechanical effective stress (thesis Eqs. 3.41-3.57) and regular packings (Chapter 4).
 
+- contact_stress: Love-Weber stress of the contact forces (Eq. 3.41).
+- fabric_tensor, fabric_anisotropy, principal_anisotropy: fabric (Eqs. 4.1, 3.51, 3.53-3.54).
+- bridge_tensors: per-bridge A_ij, B'_ij (Eqs. 3.48-3.49), their rotation onto the bridge normal
+  and the discrete sums chi_ij, B_ij, psi_ij, sigma'_ij, a_psi (Eqs. 3.43-3.46, 4.5).
+- harmonic: the continuous forms (Eqs. 3.50, 3.55-3.57).
+- regular_packing, packing_state: SCP, BCC, FCP and their pendular states (Tables 4.1-4.4).
+"""
+
+from .bridge_tensors import (
+    capillary_stress,
+    capillary_stress_anisotropy,
+    contact_line_integral,
+    effective_stress,
+    effective_stress_parameter,
+    rotate_to_normal,
+    rotation_onto,
+    surface_tension_stress,
+    wetted_cap_integral,
+)
 from .contact_stress import contact_stress
-from .fabric import fabric_anisotropy, fabric_tensor
+from .fabric import fabric_anisotropy, fabric_tensor, principal_anisotropy
+from .harmonic import (
+    fabric_density,
+    harmonic_effective_stress_parameter,
+    harmonic_surface_tension_stress,
+    thesis_rotation,
+)
+from .packing_state import PackingState, packing_state
+from .regular_packing import RegularPacking, regular_packing
 
-__all__ = ["contact_stress", "fabric_anisotropy", "fabric_tensor"]
+__all__ = [
+    "PackingState",
+    "RegularPacking",
+    "capillary_stress",
+    "capillary_stress_anisotropy",
+    "contact_line_integral",
+    "contact_stress",
+    "effective_stress",
+    "effective_stress_parameter",
+    "fabric_anisotropy",
+    "fabric_density",
+    "fabric_tensor",
+    "harmonic_effective_stress_parameter",
+    "harmonic_surface_tension_stress",
+    "packing_state",
+    "principal_anisotropy",
+    "regular_packing",
+    "rotate_to_normal",
+    "rotation_onto",
+    "surface_tension_stress",
+    "thesis_rotation",
+    "wetted_cap_integral",
+]

@@ -21,12 +21,12 @@ Only positive suctions are accepted (thesis section 3.4.1: R1 < R2, water in ten
 """
 
 from dataclasses import dataclass
-import math
 
 import numpy as np
 from scipy.optimize import brentq
 
 import capillary
+from capillary.validation import check_contact_angle, check_filling_angle
 
 METHODS = ("exact", "toroidal")
 
@@ -104,7 +104,8 @@ def bridge_from_filling_angle(method, filling_angle, contact_angle, separation):
     check_method(method)
     if method == "toroidal":
         return _positive(_toroidal(filling_angle, contact_angle, separation), method, contact_angle, separation)
-    capillary.solve_bridge(1.0, contact_angle, 0.0, filling_angle)  # checks the angles
+    contact_angle = check_contact_angle(contact_angle)
+    filling_angle = check_filling_angle(filling_angle, contact_angle)
 
     def gap_excess(suction_star):
         return capillary.solve_bridge(1.0, contact_angle, suction_star, filling_angle).distance - separation

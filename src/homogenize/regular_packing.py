@@ -95,12 +95,10 @@ def _contact_normals(cell_size, basis, contact_distance):
     return np.array(normals)
 
 
-def _is_first_orientation(normal):
-    """True for the one of n and -n whose first nonzero component is positive."""
-    for component in normal:
-        if abs(component) > 1e-12:
-            return component > 0.0
-    raise ValueError("zero normal")
+def _first_orientation(normals):
+    """Mask selecting, of each pair n, -n, the one whose first nonzero component is positive."""
+    leading = np.argmax(np.abs(normals) > 1e-12, axis=1)
+    return normals[np.arange(len(normals)), leading] > 0.0
 
 
 def _smallest_angle(normals):
@@ -145,8 +143,7 @@ def regular_packing(kind, l_prime=None, separation=0.0):
     normals = _contact_normals(cell_size, basis, 2.0 * scale)
     cell_volume = float(np.prod(cell_size))
     porosity = 1.0 - len(basis) * (4.0 * math.pi / 3.0) / cell_volume
-    first = np.array([_is_first_orientation(n) for n in normals])
-    bridge_normals = np.tile(normals[first], (len(basis), 1))
+    bridge_normals = np.tile(normals[_first_orientation(normals)], (len(basis), 1))
     fabric = fabric_tensor(normals, np.ones(len(normals), dtype=bool))
     return RegularPacking(
         kind=kind,
