@@ -1,0 +1,233 @@
+"""ParaView time series of a simulation (meshio .vtu files indexed by .pvd collections).
+
+``VtkWriter(folder, period)`` is a writer: on its first call and then every ``period`` steps it
+writes, each file under a temporary name then renamed (a killed run never leaves a truncated
+file), three series indexed by ParaView collection files whose ``timestep`` is the simulation
+time [s]:
+
+``particles.pvd`` / ``particles_NNNNNN.vtu`` (NNNNNN: the step), one VTK vertex per sphere,
+point data (SI units):
+    id                 particle index
+    radius             [m] (ParaView: Glyph, sphere, Scale Array = radius, scale factor 1)
+    velocity           (3) [m/s]
+    angular_velocity   (3) [rad/s]
+    contact_force      [N] sum over the particle's sphere–sphere contacts of the magnitude of
+                       the mechanical contact force (normal + shear, ``contacts.force``); wall
+                       contacts and capillary forces are not included
+    coordination       number of touching sphere–sphere pairs (overlap > 0)
+    bridges            number of liquid bridges (pairs with ``contacts.extra["bridge"]`` set;
+                       0 in a dry scene)
+
+``walls.pvd`` / ``walls_NNNNNN.vtu``: the six walls as quads spanning the box, cell data
+    wall               index 0..5 (x-, x+, y-, y+, z-, z+; ``dem.state.WALL_NAMES``)
+    normal_stress      [Pa] force / area, compression positive
+    force              [N] normal force of the particles on the wall, compression positive
+    velocity           [m/s] outward wall speed of the last step
+
+``bridges.pvd`` / ``bridges_NNNNNN.vtu``: one line per liquid bridge between the two centres,
+cell data from the per-pair arrays of ``sim.contacts.extra`` that are present:
+    force              [N] from "bridge_force" (magnitude, attractive)
+    volume             [m^3] from "bridge_volume"
+    delta1, delta2     [deg] filling angles on the smaller / larger sphere, from "delta1" and
+                       "delta2", or else from the capillary operation's "filling_angle_i" /
+                       "filling_angle_j" (sorted by radius)
+A scene without bridges gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
+file without cells back; ParaView and VTK can.
+"""
+
+import os
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+from .validate import check_int
+
+#: The series written, each a .pvd collection of .vtu files.
+SERIES = ("particles", "walls", "bridges")
+
+
+def _replace_atomically(path, write):
+    """Call ``write(temporary)`` then rename the temporary file to ``path``."""
+    folder, name = os.path.split(path)
+    temporary = os.path.join(folder, f".{name}.tmp{os.getpid()}")
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
+
+
+def write_vtu(path, mesh, compression="zlib"):
+    """Write a meshio mesh as VTK XML unstructured grid, atomically. Meshes without cells are
+    written uncompressed (VTK's empty compressed arrays are not read back by every reader)."""
+    if not any(len(block.data) for block in mesh.cells):
+        compression = None
+    _replace_atomically(path, lambda temporary: meshio.write(
+        temporary, mesh, file_format="vtu", compression=compression))
+
+
+def write_pvd(path, frames):
+    """Write a ParaView collection file listing ``frames`` [(time [s], file name)], atomically."""
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             "  <Collection>"]
+    lines += [f'    <DataSet timestep="{float(time)!r}" group="" part="0" file={quoteattr(name)}/>'
+              for time, name in frames]
+    lines += ["  </Collection>", "</VTKFile>", ""]
+
+    def write(temporary):
+        with open(temporary, "w") as handle:
+            handle.write("\n".join(lines))
+
+    _replace_atomically(path, write)
+
+
+def _contacts_per_particle(contacts, count):
+    """(coordination, sum of contact-force magnitudes [N], bridges) per particle (N,) each."""
+    if contacts is None or len(contacts) == 0:
+        zeros = np.zeros(count, np.int64)
+        return zeros, np.zeros(count), zeros.copy()
+    touching = contacts.overlap > 0.0
+    first = contacts.pair_i[touching]
+    second = contacts.pair_j[touching]
+    coordination = (np.bincount(first, minlength=count) + np.bincount(second, minlength=count))
+    magnitude = np.linalg.norm(contacts.force[touching], axis=1)
+    contact_force = (np.bincount(first, weights=magnitude, minlength=count)
+                     + np.bincount(second, weights=magnitude, minlength=count))
+    bridges = np.zeros(count, np.int64)
+    if "bridge" in contacts.extra:
+        mask = contacts.extra["bridge"] != 0
+        bridges = (np.bincount(contacts.pair_i[mask], minlength=count)
+                   + np.bincount(contacts.pair_j[mask], minlength=count))
+    return coordination, contact_force, bridges
+
+
+def particle_mesh(sim):
+    """One vertex per sphere with the point data listed in the module docstring."""
+    p = sim.particles
+    count = len(p)
+    coordination, contact_force, bridges = _contacts_per_particle(sim.contacts, count)
+    return meshio.Mesh(
+        np.array(p.position), [("vertex", np.arange(count, dtype=np.int64)[:, None])],
+        point_data={"id": np.arange(count, dtype=np.int64), "radius": np.array(p.radius),
+                    "velocity": np.array(p.velocity),
+                    "angular_velocity": np.array(p.angular_velocity),
+                    "contact_force": contact_force, "coordination": coordination,
+                    "bridges": bridges})
+
+
+def wall_mesh(walls):
+    """The six walls as quads (4 points each, wall w's points are 4w..4w+3) spanning the box."""
+    lo = walls.position[0::2]
+    hi = walls.position[1::2]
+    corners = np.array([[0, 0], [1, 0], [1, 1], [0, 1]])
+    points = np.empty((24, 3))
+    for w in range(6):
+        axis = w // 2
+        u, v = [a for a in range(3) if a != axis]
+        block = points[4 * w:4 * w + 4]
+        block[:, axis] = walls.position[w]
+        block[:, u] = np.where(corners[:, 0] == 0, lo[u], hi[u])
+        block[:, v] = np.where(corners[:, 1] == 0, lo[v], hi[v])
+    quads = np.arange(24, dtype=np.int64).reshape(6, 4)
+    return meshio.Mesh(points, [("quad", quads)], cell_data={
+        "wall": [np.arange(6, dtype=np.int64)],
+        "normal_stress": [walls.force / walls.areas()],
+        "force": [np.array(walls.force)],
+        "velocity": [np.array(walls.velocity)]})
+
+
+def _filling_angles(sim, mask):
+    """(delta1, delta2) [deg] of the bridges of ``mask`` (smaller / larger sphere), or None."""
+    extra = sim.contacts.extra
+    if "delta1" in extra and "delta2" in extra:
+        return extra["delta1"][mask], extra["delta2"][mask]
+    if "filling_angle_i" in extra and "filling_angle_j" in extra:
+        radius = sim.particles.radius
+        on_i = extra["filling_angle_i"][mask]
+        on_j = extra["filling_angle_j"][mask]
+        i_smaller = radius[sim.contacts.pair_i[mask]] <= radius[sim.contacts.pair_j[mask]]
+        return np.where(i_smaller, on_i, on_j), np.where(i_smaller, on_j, on_i)
+    return None
+
+
+def bridge_mesh(sim):
+    """One line per liquid bridge (centre to centre) with the cell data of the module
+    docstring; no points and no cells when there is no bridge."""
+    contacts = sim.contacts
+    if contacts is None or "bridge" not in contacts.extra:
+        mask = np.zeros(0 if contacts is None else len(contacts), bool)
+    else:
+        mask = contacts.extra["bridge"] != 0
+    count = int(np.count_nonzero(mask))
+    if count:
+        position = sim.particles.position
+        points = np.concatenate([position[contacts.pair_i[mask]],
+                                 position[contacts.pair_j[mask]]])
+    else:
+        points = np.zeros((0, 3))
+    lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
+    data = {}
+    extra = contacts.extra if contacts is not None else {}
+    for name, key in (("force", "bridge_force"), ("volume", "bridge_volume")):
+        if key in extra:
+            data[name] = [np.asarray(extra[key][mask], np.float64)]
+    angles = _filling_angles(sim, mask) if contacts is not None else None
+    if angles is not None:
+        data["delta1"] = [np.asarray(angles[0], np.float64)]
+        data["delta2"] = [np.asarray(angles[1], np.float64)]
+    return meshio.Mesh(points, [("line", lines)], cell_data=data)
+
+
+class VtkWriter:
+    """Writer of the particle, wall and bridge series (module docstring) into ``folder``.
+
+    Writes on its first call and then whenever ``sim.step % period == 0``; the .pvd index files
+    are rewritten with every frame (so that a killed run leaves a usable series) and by
+    ``close()``. ``frames`` lists (step, time [s]) of the frames written. ``compression``:
+    "zlib" (default) or None (larger files, about 10x faster to write).
+    """
+
+    def __init__(self, folder, period, compression="zlib"):
+        self.folder = os.fspath(folder)
+        self.period = check_int("vtk period", period, low=1)
+        if compression not in ("zlib", "lzma", None):
+            raise ValueError(f"compression = {compression!r} is not one of 'zlib', 'lzma', None")
+        self.compression = compression
+        self.frames = []
+        os.makedirs(self.folder, exist_ok=True)
+
+    def apply(self, sim):
+        if not self.frames or sim.step % self.period == 0:
+            self.write(sim)
+
+    def write(self, sim):
+        """Write the frame of the current step (once per step) and update the index files."""
+        if self.frames and self.frames[-1][0] == sim.step:
+            return
+        meshes = {"particles": particle_mesh(sim), "walls": wall_mesh(sim.walls),
+                  "bridges": bridge_mesh(sim)}
+        for series, mesh in meshes.items():
+            write_vtu(os.path.join(self.folder, self.file_name(series, sim.step)), mesh,
+                      self.compression)
+        self.frames.append((int(sim.step), float(sim.time)))
+        self.close()
+
+    def file_name(self, series, step):
+        """Name of the .vtu file of ``series`` at ``step`` (relative to the folder)."""
+        return f"{series}_{step:06d}.vtu"
+
+    def close(self, sim=None):
+        """Write the .pvd index files; with ``sim``, first write its current state if not yet
+        written (call at the end of a run)."""
+        if sim is not None and (not self.frames or self.frames[-1][0] != sim.step):
+            self.write(sim)
+            return
+        for series in SERIES:
+            write_pvd(os.path.join(self.folder, f"{series}.pvd"),
+                      [(time, self.file_name(series, step)) for step, time in self.frames])
+
+    finish = close

@@ -1,0 +1,327 @@
+"""Capillary bridges in the DEM (capillary.coupling): pair laws against the exact solver and
+the tables, force bookkeeping, saturation, neighbour-list reach, the wet triaxial scenario."""
+
+import copy
+import json
+import math
+import os
+import subprocess
+import sys
+
+import h5py
+import numba
+import numpy as np
+import pytest
+
+import capillary
+from capillary.coupling import CapillaryBridges, pendular_overlap_counts
+from conftest import two_body_scene
+from dem.neighbors import NeighborList, build_contacts
+from homogenize import contact_stress
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GAMMA = 0.073
+YOUNG = 1e6
+
+
+class PrescribedGap:
+    """Replaces the integrator: sphere 1 on the x axis at a gap growing by ``rate`` per step."""
+
+    def __init__(self, start, rate):
+        self.start = start
+        self.rate = rate
+
+    def apply(self, sim):
+        p = sim.particles
+        p.position[1] = [p.radius[0] + p.radius[1] + self.start + self.rate * (sim.step + 1), 0, 0]
+        p.velocity[:] = 0.0
+
+
+def pull_apart(bridges, radii, rate, max_steps=20000):
+    """Two spheres touching, then separated at ``rate`` [m/step]; rows of (gap, force on
+    sphere 1 along x, bridge state, volume) after each step, until the bridge breaks."""
+    sim = two_body_scene([[0, 0, 0], [sum(radii) - 2 * rate, 0, 0]], np.zeros((2, 3)),
+                         radius=radii)
+    sim.operations[-1] = PrescribedGap(-2 * rate, rate)
+    bridges.insert(sim)
+    rows = []
+    for _ in range(max_steps):
+        sim.advance()
+        extra = sim.contacts.extra
+        rows.append((-sim.contacts.overlap[0], sim.particles.force[1, 0], extra["bridge"][0],
+                     extra["bridge_volume"][0]))
+        if rows[-1][0] > 0 and extra["bridge"][0] == 0:
+            break
+    return sim, np.array(rows)
+
+
+def test_pulled_pair_follows_the_exact_force_distance_curve_and_ruptures_where_the_table_ends():
+    """Suction control with persist: unequal spheres (r = 1.5) separated slowly."""
+    radii = (1e-3, 1.5e-3)
+    suction = 2000.0
+    u_star = suction * radii[1] / GAMMA
+    bridges = CapillaryBridges(suction, GAMMA, persist=True)
+    sim, rows = pull_apart(bridges, radii, rate=2e-7)
+    apart = rows[:, 0] > 0
+    alive = rows[:, 2] > 0
+    # the force on sphere 1 is the bridge's, pulling it back toward sphere 0 (-x)
+    for gap, force, _, _ in rows[apart & alive][::15]:
+        exact = capillary.bridge_at_distance(1.5, 0.0, u_star, gap / radii[1])
+        assert -force / (2 * math.pi * GAMMA * radii[1]) == pytest.approx(exact.force, rel=3e-3)
+    # while touching: the table's contact value on top of the spring (kn = 2 E R1 R2/(R1+R2))
+    touching = rows[~apart][-1]
+    kn = 2 * YOUNG * radii[0] * radii[1] / sum(radii)
+    contact = capillary.bridge_at_distance(1.5, 0.0, u_star, 0.0)
+    assert touching[1] == pytest.approx(
+        kn * -touching[0] - contact.force * 2 * math.pi * GAMMA * radii[1], rel=1e-3)
+    # rupture between the last gap with a bridge and the first without
+    rupture = capillary.rupture_distance(1.5, 0.0, u_star) * radii[1]
+    last_alive, first_broken = rows[alive, 0][-1], rows[-1, 0]
+    assert last_alive <= rupture * (1 + 2e-3)
+    assert first_broken >= rupture * (1 - 2e-3)
+    assert rows[-1, 1] == 0.0
+    assert bridges.required_range >= rupture
+
+
+def test_bridge_breaks_with_contact_by_default():
+    radii = (1e-3, 1e-3)
+    bridges = CapillaryBridges(2000.0, GAMMA)
+    sim, rows = pull_apart(bridges, radii, rate=2e-7, max_steps=50)
+    assert rows[0, 2] == 1 and rows[0, 0] < 0
+    first_gap = np.argmax(rows[:, 0] > 0)
+    assert rows[first_gap, 2] == 0 and rows[first_gap, 1] == 0.0
+    assert sim.operation(NeighborList).interaction_range == 0.0
+
+
+def test_volume_controlled_pair_keeps_its_volume_and_ruptures_near_lian():
+    """Constant water content: the volume formed at contact (at 2 kPa) is kept; rupture at the
+    exact volume-controlled distance, close to Lian et al.'s (1 + theta/2) V^(1/3)."""
+    radius = 1e-3
+    bridges = CapillaryBridges(2000.0, GAMMA, control="volume")
+    sim, rows = pull_apart(bridges, (radius, radius), rate=2e-7)
+    alive = rows[:, 2] > 0
+    volume = rows[0, 3]
+    contact = capillary.bridge_at_distance(1.0, 0.0, 2000.0 * radius / GAMMA, 0.0)
+    assert volume == pytest.approx(contact.volume * radius ** 3, rel=2e-3)
+    assert np.all(rows[alive, 3] == volume)
+    rupture_gap = rows[alive, 0][-1]
+    exact = capillary.rupture_distance_for_volume(1.0, 0.0, volume / radius ** 3) * radius
+    assert rupture_gap == pytest.approx(exact, abs=2e-7, rel=5e-3)
+    assert rupture_gap == pytest.approx(volume ** (1 / 3), rel=0.03)     # Lian, theta = 0
+    # the suction of the bridge falls as it stretches (volume control)
+    extra = sim.contacts.extra
+    assert "bridge_suction" in extra
+
+
+def test_touching_pair_at_rest_has_the_capillary_equilibrium_overlap():
+    """The capillary force acts on top of the contact spring: overlap = F_cap / kn."""
+    radius = 1e-3
+    sim = two_body_scene([[0, 0, 0], [2 * radius - 1e-7, 0, 0]], np.zeros((2, 3)), damping=0.5)
+    bridges = CapillaryBridges(1000.0, GAMMA).insert(sim)
+    sim.run(15000)
+    force = sim.contacts.extra["bridge_force"][0]
+    table = bridges.suction_table.lookup(1.0, 1000.0 * radius / GAMMA, 0.0)
+    assert force == pytest.approx(table[1] * 2 * math.pi * GAMMA * radius, rel=1e-12)
+    assert sim.contacts.overlap[0] == pytest.approx(force / (YOUNG * radius), rel=1e-4)
+    assert np.abs(sim.particles.force).max() < 1e-4 * force
+    # the mechanical contact force alone is stored in contacts.force (Eq. 3.41 uses it)
+    assert sim.contacts.normal_force[0] == pytest.approx(force, rel=1e-4)
+
+
+def test_toroidal_bridges_use_appendix_a_and_need_equal_spheres():
+    radius = 1e-3
+    sim = two_body_scene([[0, 0, 0], [2 * radius - 1e-7, 0, 0]], np.zeros((2, 3)))
+    bridges = CapillaryBridges(1000.0, GAMMA, contact_angle=20.0, model="toroidal").insert(sim)
+    sim.advance()
+    extra = sim.contacts.extra
+    alpha = extra["filling_angle_i"][0]
+    exact = capillary.toroidal_bridge(alpha, 20.0, 0.0)
+    assert exact.suction_star == pytest.approx(1000.0 * radius / GAMMA, rel=1e-3)
+    assert extra["bridge_force"][0] == pytest.approx(exact.force * 2 * math.pi * GAMMA * radius,
+                                                     rel=1e-3)
+    assert extra["bridge_volume"][0] == pytest.approx(exact.volume * radius ** 3, rel=1e-3)
+    unequal = two_body_scene([[0, 0, 0], [2.1e-3, 0, 0]], np.zeros((2, 3)), radius=[1e-3, 1.1e-3])
+    with pytest.raises(ValueError, match="equal spheres"):
+        CapillaryBridges(1000.0, model="toroidal").insert(unequal)
+
+
+@pytest.fixture(scope="module")
+def wet_sample(small_sample):
+    """The 300-sphere sample wetted at 30 kPa and run 300 steps (bridges formed, rebuilds)."""
+    _, sim, _ = small_sample
+    sim = copy.deepcopy(sim)
+    bridges = CapillaryBridges(30000.0, GAMMA).insert(sim)
+    sim.run(300)
+    return sim, bridges
+
+
+def test_saturation_bridges_and_pendular_overlaps_against_hand_sums(wet_sample):
+    sim, bridges = wet_sample
+    c = sim.contacts
+    p = sim.particles
+    touching = np.nonzero(c.overlap > 0)[0]
+    assert bridges.count(sim) == len(touching) > 0
+    water = 0.0
+    for k in touching:
+        larger = max(p.radius[c.pair_i[k]], p.radius[c.pair_j[k]])
+        ratio = larger / min(p.radius[c.pair_i[k]], p.radius[c.pair_j[k]])
+        _, _, volume_star, _, _ = bridges.suction_table.lookup(ratio, 30000.0 * larger / GAMMA, 0.0)
+        water += volume_star * larger ** 3
+    voids = np.prod(sim.walls.lengths()) - np.sum(4 / 3 * np.pi * p.radius ** 3)
+    assert bridges.saturation(sim) == pytest.approx(water / voids, rel=1e-12)
+    # pendular limit: brute force over the caps of every particle
+    caps = {n: [] for n in range(len(p.radius))}
+    for k in touching:
+        i, j = c.pair_i[k], c.pair_j[k]
+        branch = p.position[j] - p.position[i]
+        branch /= np.linalg.norm(branch)
+        caps[i].append((branch, c.extra["filling_angle_i"][k]))
+        caps[j].append((-branch, c.extra["filling_angle_j"][k]))
+    expected = 0
+    for items in caps.values():
+        for a in range(len(items)):
+            for b in range(a + 1, len(items)):
+                separation = math.degrees(math.acos(np.clip(items[a][0] @ items[b][0], -1, 1)))
+                expected += separation < items[a][1] + items[b][1]
+    assert bridges.pendular_overlaps(sim) == expected
+    # a case that does overlap: three spheres in a tight triangle with large menisci
+    position = np.array([[0.0, 0, 0], [2.0, 0, 0], [1.0, math.sqrt(3), 0]])
+    contacts = build_contacts(position, np.full(3, 1.0), 0.1)
+    state = np.ones(len(contacts), np.int8)
+    wide = np.full(len(contacts), 31.0)    # caps 60 deg apart: 31 + 31 > 60
+    assert pendular_overlap_counts(position, contacts.row_start, contacts.second_start,
+                                   contacts.second_pair, contacts.pair_i, contacts.pair_j,
+                                   state, wide, wide).sum() == 3
+
+
+def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_sample):
+    """Static equilibrium: sigma_wall = sigma_contact (Eq. 3.41) + sigma_capillary."""
+    sim, bridges = wet_sample
+    sim = copy.deepcopy(sim)
+    bridges = sim.operation(CapillaryBridges)
+    from dem.measure import unbalanced_force
+    sim.run(30000, until=lambda s: unbalanced_force(s.particles, s.contacts) < 2e-4,
+            check_every=500)
+    capillary_stress = bridges.capillary_stress(sim)
+    total = contact_stress(sim.particles, sim.contacts, sim.walls) + capillary_stress
+    walls = sim.walls.stress()
+    assert np.all(np.diag(capillary_stress) < -2 * walls.mean())   # tensile, large at 30 kPa
+    assert np.allclose(np.diag(total), walls, rtol=2e-2)
+
+
+def test_bridges_survive_rebuilds_and_thread_count_does_not_change_results(wet_sample):
+    sim, _ = wet_sample
+    neighbor_list = sim.operation(NeighborList)
+    assert neighbor_list.rebuilds >= 1     # the bridges went through rebuilds
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one Numba thread only")
+    runs = []
+    for threads in (1, numba.config.NUMBA_NUM_THREADS):
+        copied = copy.deepcopy(sim)
+        copied.threads = threads
+        copied.run(200)
+        runs.append(copied)
+    assert np.array_equal(runs[0].particles.position, runs[1].particles.position)
+    assert np.array_equal(runs[0].contacts.extra["bridge_force"],
+                          runs[1].contacts.extra["bridge_force"])
+
+
+def test_extra_pair_arrays_are_carried_to_the_same_pair():
+    rng = np.random.default_rng(5)
+    position = rng.random((300, 3))
+    radius = np.full(300, 0.04)
+    old = build_contacts(position, radius, 0.01)
+    old.extra["flag"] = rng.integers(0, 3, len(old)).astype(np.int8)
+    old.extra["vector"] = rng.random((len(old), 3))
+    moved = position + rng.normal(scale=0.005, size=position.shape)
+    new = build_contacts(moved, radius, 0.01, previous=old)
+    old_rows = {(i, j): k for k, (i, j) in enumerate(zip(old.pair_i, old.pair_j))}
+    assert new.extra["flag"].dtype == np.int8 and new.extra["vector"].shape == (len(new), 3)
+    for k, (i, j) in enumerate(zip(new.pair_i, new.pair_j)):
+        if (i, j) in old_rows:
+            assert new.extra["flag"][k] == old.extra["flag"][old_rows[i, j]]
+            assert np.array_equal(new.extra["vector"][k], old.extra["vector"][old_rows[i, j]])
+        else:
+            assert new.extra["flag"][k] == 0 and not new.extra["vector"][k].any()
+
+
+def test_a_neighbour_list_too_short_for_persisting_bridges_is_refused():
+    radii = (1e-3, 1e-3)
+    sim = two_body_scene([[0, 0, 0], [2e-3 - 1e-7, 0, 0]], np.zeros((2, 3)), radius=radii)
+    bridges = CapillaryBridges(2000.0, GAMMA, persist=True).insert(sim)
+    reach = sim.operation(NeighborList).interaction_range
+    assert reach == bridges.required_range > 0
+    sim.operation(NeighborList).interaction_range = 0.0
+    with pytest.raises(ValueError, match="interaction_range"):
+        sim.advance()
+
+
+@pytest.mark.parametrize("arguments, message", [
+    ({"suction": -5.0}, "suction"),
+    ({"suction": 1000.0, "contact_angle": 90.0}, "contact_angle"),
+    ({"suction": 1000.0, "contact_angle": 120.0}, "contact_angle"),
+    ({"suction": 1000.0, "surface_tension": 0.0}, "surface_tension"),
+    ({"suction": 1000.0, "model": "cylinder"}, "model"),
+    ({"suction": 1000.0, "control": "flux"}, "control"),
+])
+def test_bad_bridge_parameters_are_refused(arguments, message):
+    with pytest.raises(ValueError, match=message):
+        CapillaryBridges(**arguments)
+
+
+def test_suction_beyond_the_table_is_refused():
+    bridges = CapillaryBridges(1e9, GAMMA)
+    with pytest.raises(ValueError, match="suction = 1e\\+09 Pa is outside the valid range"):
+        bridges.load_tables(2.4e-5, 2.4e-5)
+
+
+def test_dry_scenario_never_imports_capillary(tmp_path):
+    code = ("import runpy, sys; sys.argv = ['triaxial.py', '--particles', '60', '--max-strain', "
+            f"'0.002', '--inertial-number', '2e-3', '--quiet', '--out', {str(tmp_path)!r}]; "
+            f"runpy.run_path({os.path.join(ROOT, 'scenarios', 'triaxial.py')!r}, "
+            "run_name='__main__'); "
+            "loaded = sorted(m for m in sys.modules if m.split('.')[0] == 'capillary'); "
+            "print('CAPILLARY', loaded)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    loaded = done.stdout[done.stdout.index("CAPILLARY"):].strip()
+    assert loaded == "CAPILLARY []", (
+        f"a dry triaxial run loaded the capillary package ({loaded}); the dry path imports "
+        "dem.*, homogenize.contact_stress and homogenize.fabric, none of which may import "
+        "capillary at module level (homogenize/__init__.py loads every submodule)")
+
+
+def test_wet_triaxial_scenario_writes_the_capillary_history(tmp_path):
+    out = tmp_path / "wet"
+    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), "--particles",
+               "200", "--max-strain", "0.01", "--inertial-number", "2e-3", "--suction", "30000",
+               "--quiet", "--out", str(out)]
+    subprocess.run(command, check=True, capture_output=True, text=True)
+    summary = json.loads((out / "summary.json").read_text())
+    assert 0.0 < summary["saturation_at_peak"] < 0.1
+    assert summary["initial_bridges"] > 0
+    with h5py.File(out / "history.h5") as handle:
+        history = handle["history"]
+        rows = len(history["step"])
+        for name, shape in {"saturation": (rows,), "suction": (rows,), "bridges": (rows,),
+                            "pendular_overlaps": (rows,), "sigma_capillary": (rows, 3, 3)}.items():
+            assert history[name].shape == shape, name
+        assert np.all(history["suction"][:] == 30000.0)
+        assert np.all(history["bridges"][:] > 0)
+        first = np.diag(history["sigma_contact"][0] + history["sigma_capillary"][0])
+        assert np.allclose(first, history["sigma_wall"][0], rtol=0.05)   # wetted, static
+        assert handle.attrs["suction"] == 30000.0 and handle.attrs["bridges"] == "exact"
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--suction", "-5"], "--suction"),
+    (["--suction", "30000", "--contact-angle", "95"], "contact_angle"),
+    (["--suction", "1e9"], "suction = 1e+09 Pa is outside the valid range"),
+    (["--contact-angle", "10"], "--suction > 0"),
+    (["--suction", "30000", "--bridges", "cylinder"], "invalid choice"),
+])
+def test_wet_scenario_refuses_bad_input(arguments, message):
+    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), *arguments,
+               "--out", os.devnull]
+    result = subprocess.run(command, capture_output=True, text=True)
+    assert result.returncode != 0
+    assert message in result.stderr
