@@ -34,7 +34,8 @@ def find_yade():
 def run_yade_triaxial(config, threads=1, timeout=None, yade=None, env=None):
     """Run ``yade -n -x -j threads yade_triaxial.py CONFIG.json``; return its result dict.
 
-    config: the driver's configuration (see the header of ``yade_triaxial.py``); ``output``
+    config: the driver's configuration (see the header of ``yade_triaxial.py``; a
+    ``capillary`` entry runs the wet test with YADE's capillary law); ``output``
     defaults to a file in a temporary folder, and relative paths are taken from the current
     folder. threads: OpenMP threads (>= 1). timeout: seconds, None for no limit. yade: the
     executable (default: the first of ``yade``, ``yadedaily`` on PATH). env: extra environment
@@ -50,6 +51,9 @@ def run_yade_triaxial(config, threads=1, timeout=None, yade=None, env=None):
         for key in ("spheres", "history", "output"):
             if config.get(key):
                 config[key] = os.path.abspath(config[key])
+        if config.get("capillary"):
+            config["capillary"] = dict(config["capillary"])
+            config["capillary"]["files"] = os.path.abspath(config["capillary"]["files"])
         output = config.setdefault("output", os.path.join(folder, "result.json"))
         config_path = os.path.join(folder, "config.json")
         with open(config_path, "w") as out:

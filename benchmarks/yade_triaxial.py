@@ -23,17 +23,29 @@
 #   strain_damping 0.0 (TriaxialStressController.strainDamping; YADE's default 0.99 ramps the
 #   axial rate up geometrically, 0 imposes it at once as pendular does),
 #   max_vel 1.0 m/s (TriaxialStressController.max_vel, YADE's default).
+#   capillary (optional, wet test): {"suction": s [Pa], "files": folder holding the capillary
+#     files M(r=1) ... M(r=10) (capillary.write_yade), "surface_tension": 0.073 N/m,
+#     "persist": false, "detection_factor": 1.0}. Adds YADE's capillary law
+#     (Law2_ScGeom_CapillaryPhys_Capillarity, Scholtes et al. 2009) after the InteractionLoop with
+#     Ip2_FrictMat_FrictMat_CapillaryPhys; menisci form at contact (createDistantMeniscii=False)
+#     and, by default, vanish with the interaction when contact is lost (CundallStrack erases
+#     it). persist: bridges live to their rupture distance (neverErase=True, interactions
+#     detected within detection_factor times the radii: aabbEnlargeFactor and
+#     interactionDetectionFactor). The law reads its files from the working directory, so
+#     the driver changes into ``files``.
 #
 # Engine list, one step (YADE order, as pendular's shear phase):
 #   ForceResetter -> InsertionSortCollider -> InteractionLoop(Ig2 sphere-sphere & box-sphere ScGeom,
 #   Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack)
+#   [-> Law2_ScGeom_CapillaryPhys_Capillarity (wet test)]
 #   -> TriaxialStressController (x, y servoed at -confining, z at strain rate -strain_rate)
 #   -> NewtonIntegrator(damping) [-> PyRunner recording the history]
 #
 # Output JSON: particles, steps, wall_time_s, particle_steps_per_s, threads, yade_version,
 # sigma_wall [sx, sy, sz] Pa (compression positive, force on each wall pair / current face
 # area), porosity, coordination (2 Nc / N over sphere-sphere contacts), unbalanced_force
-# (utils.unbalancedForce), and the settings used.
+# (utils.unbalancedForce), and the settings used; wet test: menisci (count), water_volume [m^3]
+# and saturation (water / (box volume - solid volume)).
 
 import json
 import math
@@ -44,7 +56,8 @@ import time
 from yade import O, plot, utils, ymport
 from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
                   Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
-                  Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack,
+                  Ip2_FrictMat_FrictMat_CapillaryPhys, Ip2_FrictMat_FrictMat_FrictPhys,
+                  Law2_ScGeom_CapillaryPhys_Capillarity, Law2_ScGeom_FrictPhys_CundallStrack,
                   NewtonIntegrator, PyRunner, Sphere, TriaxialStressController)
 import yade.config
 
@@ -73,6 +86,28 @@ def load_config(path):
     if config["confining"] < 0:
         fail(f"confining = {config['confining']!r} Pa must be >= 0")
     return config
+
+
+def capillary_settings(wet):
+    """The 'capillary' entry of the config, checked, with defaults."""
+    settings = {"surface_tension": 0.073, "persist": False, "detection_factor": 1.0, **wet}
+    for key in ("suction", "files"):
+        if key not in settings:
+            fail(f"capillary: missing key {key!r}")
+    if not settings["suction"] >= 0:
+        fail(f"capillary suction = {settings['suction']!r} Pa must be >= 0")
+    if not settings["surface_tension"] > 0:
+        fail(f"capillary surface_tension = {settings['surface_tension']!r} N/m must be > 0")
+    if not settings["detection_factor"] >= 1:
+        fail(f"capillary detection_factor = {settings['detection_factor']!r} must be >= 1")
+    missing = [name for name in ("M(r=1)", "M(r=10)")
+               if not os.path.exists(os.path.join(settings["files"], name))]
+    if missing:  # YADE would silently run with zero capillary forces
+        fail(f"capillary files {missing} not found in {settings['files']!r}")
+    settings["files"] = os.path.abspath(settings["files"])
+    settings["suction"] = float(settings["suction"])
+    settings["persist"] = bool(settings["persist"])
+    return settings
 
 
 def box_from_file(path):
@@ -119,6 +154,9 @@ def build_scene(config):
 
 def main(config_path):
     config = load_config(config_path)
+    for key in ("spheres", "output", "history"):  # the wet test changes the working directory
+        if config.get(key):
+            config[key] = os.path.abspath(config[key])
     lo, hi, thickness, wall_ids, sphere_ids = build_scene(config)
     radii = [O.bodies[i].shape.radius for i in sphere_ids]
     skin = float(config.get("skin", 0.3 * min(radii)))
@@ -135,15 +173,35 @@ def main(config_path):
         stressDamping=float(config.get("stress_damping", 0.25)),
         strainDamping=float(config.get("strain_damping", 0.0)),
         max_vel=float(config.get("max_vel", 1.0)))
-    O.engines = [
-        ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=0.5 * skin),
-        InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
-                        [Ip2_FrictMat_FrictMat_FrictPhys()],
-                        [Law2_ScGeom_FrictPhys_CundallStrack()]),
-        triax,
-        NewtonIntegrator(damping=float(config["damping"])),
-    ]
+    wet = config.get("capillary")
+    if wet:
+        wet = capillary_settings(wet)
+        os.chdir(wet["files"])  # Law2_ScGeom_CapillaryPhys_Capillarity reads M(r=...) from here
+        factor = wet["detection_factor"]
+        O.engines = [
+            ForceResetter(),
+            InsertionSortCollider([Bo1_Sphere_Aabb(aabbEnlargeFactor=factor), Bo1_Box_Aabb()],
+                                  verletDist=0.5 * skin),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(interactionDetectionFactor=factor),
+                             Ig2_Box_Sphere_ScGeom()],
+                            [Ip2_FrictMat_FrictMat_CapillaryPhys()],
+                            [Law2_ScGeom_FrictPhys_CundallStrack(neverErase=wet["persist"])]),
+            Law2_ScGeom_CapillaryPhys_Capillarity(
+                capillaryPressure=wet["suction"], surfaceTension=wet["surface_tension"],
+                createDistantMeniscii=False, label="capillary"),
+            triax,
+            NewtonIntegrator(damping=float(config["damping"])),
+        ]
+    else:
+        O.engines = [
+            ForceResetter(),
+            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=0.5 * skin),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+                            [Ip2_FrictMat_FrictMat_FrictPhys()],
+                            [Law2_ScGeom_FrictPhys_CundallStrack()]),
+            triax,
+            NewtonIntegrator(damping=float(config["damping"])),
+        ]
     O.dt = float(config["dt"])
     depth0 = hi[2] - lo[2]
     sphere_set = set(sphere_ids)
@@ -202,6 +260,14 @@ def main(config_path):
         "max_vel": triax.max_vel,
         "engines": [type(e).__name__ for e in O.engines],
     }
+    if wet:
+        menisci = [i.phys for i in O.interactions
+                   if i.isReal and i.id1 in sphere_set and i.id2 in sphere_set and i.phys.meniscus]
+        water = sum(phys.vMeniscus for phys in menisci)
+        solid = sum(4.0 / 3.0 * math.pi * r ** 3 for r in radii)
+        result.update({"menisci": len(menisci), "water_volume": water,
+                       "saturation": water / (lengths[0] * lengths[1] * lengths[2] - solid),
+                       "capillary": {k: v for k, v in wet.items()}})
     if history:
         record()  # the final state (PyRunner ran last at the previous multiple of record_every)
         plot.saveDataTxt(history, vars=("i", "t", "eps_axial", "sx", "sy", "sz", "porosity",

@@ -163,10 +163,10 @@ def wet_bridges(args, radius):
     (imported here: a dry test never loads the capillary package)."""
     from capillary.coupling import CapillaryBridges
 
-    bridges = CapillaryBridges(
-        args.suction, surface_tension=0.073 if args.surface_tension is None else args.surface_tension,
-        contact_angle=args.contact_angle or 0.0, model=args.bridges or "exact",
-        persist=args.persist_bridges)
+    surface_tension = 0.073 if args.surface_tension is None else args.surface_tension
+    bridges = CapillaryBridges(args.suction, surface_tension=surface_tension,
+                               contact_angle=args.contact_angle or 0.0,
+                               model=args.bridges or "exact", persist=args.persist_bridges)
     bridges.load_tables(radius, radius)
     return bridges
 

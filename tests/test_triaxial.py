@@ -122,7 +122,7 @@ def test_triaxial_scenario_writes_its_outputs(tmp_path):
     (["--friction", "95"], "friction"),
     (["--confining", "nan"], "confining"),
     (["--max-strain", "inf"], "max_strain"),
-    (["--suction", "30000"], "not yet supported"),
+    (["--suction", "-5"], "suction"),
     (["--bogus"], "unrecognized arguments"),
 ])
 def test_triaxial_scenario_refuses_bad_input(arguments, message):

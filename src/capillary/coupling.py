@@ -21,11 +21,12 @@ gathered by ``dem.neighbors.gather_pair_vectors``.
 
 The capillary force is added on top of the mechanical contact force and does not enter the
 Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack caps the shear
-force with ``phys->normalForce`` (the spring's force only), and Law2_ScGeom_CapillaryPhys_Capillarity
-adds fCap separately through ``scene->forces.addForce`` (YADE 2023 sources,
-pkg/dem/ElasticContactLaw.cpp and pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bridges
-(YADE's capillary law skips pairs of different shapes), and ``contacts.force`` stays the
-mechanical force, so that homogenize.contact_stress is Eq. 3.41's contact stress.
+force with ``phys->normalForce`` (the spring's force only), and
+Law2_ScGeom_CapillaryPhys_Capillarity adds fCap separately through ``scene->forces.addForce``
+(YADE 2023 sources, pkg/dem/ElasticContactLaw.cpp and
+pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bridges (YADE's
+capillary law skips pairs of different shapes), and ``contacts.force`` stays the mechanical
+force, so that homogenize.contact_stress is Eq. 3.41's contact stress.
 
 Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
 d* = max(gap, 0) / R2 (overlaps read the table's contact values, as YADE does), F = F* 2 pi gamma
@@ -178,15 +179,16 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 
 @numba.njit(cache=True, parallel=True)
 def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
-                    filling_i, filling_j, pair_force, persist, suction, surface_tension,
-                    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values):
-    """Suction-controlled bridges (thesis Table 5.1), one pass over the pairs.
+                    filling_i, filling_j, pair_force, suction, surface_tension, radius_ratios,
+                    suction_axis, distance_low, log_distance_rupture, log_values):
+    """Suction-controlled bridges that persist across gaps (thesis Table 5.1, ``persist``).
 
-    overlap and normal: the contact law's values of this step (normal is current for touching
-    pairs). With ``persist`` a bridge lives across a gap while the table has a solution there,
-    else it breaks with the contact. suction [Pa], surface_tension [N/m]; the last five
-    arguments are a BridgeTable's arrays(). Fills the per-pair state and pair_force (force on
-    j from i) [N].
+    A bridge forms when the spheres touch and lives while the table has a bridge at the gap
+    (d* = gap / R2 up to the rupture distance at u* = s R2 / gamma). At contact its values are
+    cached (looked up once per contact); across a gap it is looked up each step and pulls along
+    the current branch vector. overlap and normal: the contact law's values of this step.
+    suction [Pa], surface_tension [N/m]; the last five arguments are a BridgeTable's arrays().
+    Fills the per-pair state and pair_force (force on j from i) [N].
     """
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
@@ -202,7 +204,7 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
                 volume[k] = volume_star * larger * larger * larger
                 state[k] = AT_CONTACT
             _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
-        elif persist and state[k] != NO_BRIDGE:
+        elif state[k] != NO_BRIDGE:
             larger = max(radius[i], radius[j])
             exists, force_star, volume_star, delta1, delta2 = lookup_suction(
                 radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
@@ -216,8 +218,6 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
                 _apply_across_gap(k, position, i, j, force[k], pair_force)
             else:
                 _clear(k, state, volume, force, filling_i, filling_j, pair_force)
-        elif state[k] != NO_BRIDGE:
-            _clear(k, state, volume, force, filling_i, filling_j, pair_force)
         else:
             pair_force[k, 0] = 0.0
             pair_force[k, 1] = 0.0
@@ -338,7 +338,8 @@ class CapillaryBridges:
     control: "suction" (default, thesis Ch. 5) or "volume" (each bridge keeps its volume);
     persist: suction control only: bridges live up to the rupture distance instead of breaking
         when contact is lost (volume-controlled bridges always persist up to rupture);
-    table_options: passed to BridgeTable.cached / VolumeBridgeTable.cached (resolution).
+    table_options: keyword arguments of BridgeTable.cached (model 'exact') or
+        capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
 
     Use ``insert(sim)`` to place it after the contact and wall forces and, for bridges across
     gaps, widen the neighbour list's reach. Radii must not change while bridges exist.
@@ -411,7 +412,8 @@ class CapillaryBridges:
                 f"suction = {self.suction:g} Pa is outside the valid range [0, "
                 f"{self.suction_table.suction_max * self.surface_tension / high:g}] Pa for these "
                 f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
-                f"{self.surface_tension:g} N/m) exceeds the table's {self.suction_table.suction_max:g}")
+                f"{self.surface_tension:g} N/m) exceeds the table's "
+                f"{self.suction_table.suction_max:g}")
         if self.control == "volume":
             self.volume_table = VolumeBridgeTable.cached(
                 self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
@@ -459,8 +461,9 @@ class CapillaryBridges:
                 f"{self._bridges - carried} liquid bridge(s) left the neighbour list at a "
                 f"rebuild: its reach (NeighborList.interaction_range = "
                 f"{sim.operation(NeighborList).interaction_range:g} m plus skin) is shorter than "
-                f"the rupture distance ({self.required_range:g} m); use CapillaryBridges.insert(sim) "
-                f"or set NeighborList.interaction_range >= {self.required_range:g}")
+                f"the rupture distance ({self.required_range:g} m); use "
+                f"CapillaryBridges.insert(sim) or set NeighborList.interaction_range >= "
+                f"{self.required_range:g}")
         self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
         self._contacts = contacts
 
@@ -494,8 +497,7 @@ class CapillaryBridges:
             suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
                             extra["bridge"], extra["bridge_volume"], extra["bridge_force"],
                             extra["filling_angle_i"], extra["filling_angle_j"], self.pair_force,
-                            self.persist, self.suction, self.surface_tension,
-                            *self._table_arrays)
+                            self.suction, self.surface_tension, *self._table_arrays)
         else:
             volume_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
                            extra["bridge"], extra["bridge_volume"], extra["bridge_force"],
@@ -522,7 +524,8 @@ class CapillaryBridges:
         return float(np.sum(contacts.extra["bridge_volume"]))
 
     def saturation(self, sim):
-        """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume - solid volume."""
+        """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume minus the
+        solid volume."""
         self._sync(sim)
         voids = sim.walls.volume() - sim.particles.solid_volume()
         return self.water_volume(sim.contacts) / voids
@@ -534,7 +537,9 @@ class CapillaryBridges:
         if self.control == "suction":
             return self.suction
         mask = self.bridges(sim.contacts)
-        return float(np.mean(sim.contacts.extra["bridge_suction"][mask])) if mask.any() else math.nan
+        if not mask.any():
+            return math.nan
+        return float(np.mean(sim.contacts.extra["bridge_suction"][mask]))
 
     def capillary_stress(self, sim):
         """Love–Weber stress of the capillary forces (1/V) sum l_i f^cap_j [Pa] (3x3), with the

@@ -2,19 +2,10 @@
 
 import math
 
+from dem.validate import check_positive, finite_number  # noqa: F401  (shared checks)
+
 MAX_RADIUS_RATIO = 20.0
 """Largest R2/R1 the exact solver accepts (its accuracy is verified up to this value)."""
-
-
-def finite_number(name, value, valid_range):
-    """value as a float; ValueError naming the parameter, value and valid range unless finite."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} is not a number; valid range {valid_range}") from None
-    if not math.isfinite(number):
-        raise ValueError(f"{name} = {number} is not finite; valid range {valid_range}")
-    return number
 
 
 def check_radius_ratio(radius_ratio, largest=MAX_RADIUS_RATIO):
@@ -54,14 +45,6 @@ def check_filling_angle(filling_angle, contact_angle):
             f"(0 < delta1 <= 90 - contact_angle)"
         )
     return filling_angle
-
-
-def check_positive(name, value):
-    """A finite value > 0."""
-    value = finite_number(name, value, "(0, inf)")
-    if value <= 0.0:
-        raise ValueError(f"{name} = {value} is outside the valid range (0, inf)")
-    return value
 
 
 def check_distance(distance_star):

@@ -82,6 +82,11 @@ def start_shear(sim, config, radius, density):
     axial = ConstantStrainRate("z", rate, sim.walls.lengths()[2])
     lateral = StressServo("xy", config.confining, servo.max_velocity, servo.gain, servo.memory)
     index = sim.operations.index(servo)
+    if sim.contacts is None:
+        # a sample just loaded from disk: evaluate its forces once (the operations before the
+        # wall control move nothing) so that the first record sees its contacts
+        for op in sim.operations[:index]:
+            op.apply(sim)
     sim.operations[index:index + 1] = [lateral, axial]
     steps = int(np.ceil(config.max_strain / (rate * sim.dt)))
     period = max(1, steps // config.records)

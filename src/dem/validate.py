@@ -16,6 +16,18 @@ def check_finite(name, value):
     return number
 
 
+def finite_number(name, value, valid_range):
+    """``value`` as a float; ValueError naming the parameter, value and ``valid_range`` (text)
+    unless it is a finite number."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} = {value!r} is not a number; valid range {valid_range}") from None
+    if not math.isfinite(number):
+        raise ValueError(f"{name} = {number} is not finite; valid range {valid_range}")
+    return number
+
+
 def check_range(name, value, low=-math.inf, high=math.inf, *, low_inclusive=True,
                 high_inclusive=True, unit=""):
     """Return ``value`` as float after checking it lies in [low, high] (bounds open or closed)."""

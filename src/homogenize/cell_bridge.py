@@ -25,8 +25,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-import capillary
-from capillary.validation import check_contact_angle, check_filling_angle
 
 METHODS = ("exact", "toroidal")
 
@@ -49,6 +47,12 @@ class CellBridge:
     volume: float
     force: float
     filling_angle: float
+
+
+def check_contact_angle(contact_angle):
+    """The contact angle [deg], checked by the capillary package (loaded on first use)."""
+    import capillary  # lazy: dry scenes never load the capillary package
+    return capillary.validation.check_contact_angle(contact_angle)
 
 
 def check_method(method):
@@ -77,12 +81,14 @@ def _from_exact(bridge):
 
 
 def _toroidal(filling_angle, contact_angle, separation):
+    import capillary  # lazy: dry scenes never load the capillary package
     bridge = capillary.toroidal_bridge(filling_angle, contact_angle, separation)
     return CellBridge(bridge.suction_star, bridge.volume, bridge.force, float(filling_angle))
 
 
 def _toroidal_lowest_angle(contact_angle, separation):
     """Smallest alpha [deg] with a positive toroidal neck radius (Eq. A.2) at this gap."""
+    import capillary  # lazy: dry scenes never load the capillary package
     def neck_ok(alpha):
         try:
             capillary.toroidal_bridge(alpha, contact_angle, separation)
@@ -101,11 +107,12 @@ def _toroidal_lowest_angle(contact_angle, separation):
 
 def bridge_from_filling_angle(method, filling_angle, contact_angle, separation):
     """CellBridge with filling angle alpha [deg] spanning the gap H/R = separation."""
+    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "toroidal":
         return _positive(_toroidal(filling_angle, contact_angle, separation), method, contact_angle, separation)
-    contact_angle = check_contact_angle(contact_angle)
-    filling_angle = check_filling_angle(filling_angle, contact_angle)
+    contact_angle = capillary.validation.check_contact_angle(contact_angle)
+    filling_angle = capillary.validation.check_filling_angle(filling_angle, contact_angle)
 
     def gap_excess(suction_star):
         return capillary.solve_bridge(1.0, contact_angle, suction_star, filling_angle).distance - separation
@@ -127,6 +134,7 @@ def bridge_from_filling_angle(method, filling_angle, contact_angle, separation):
 
 def bridge_from_suction(method, suction_star, contact_angle, separation):
     """CellBridge at suction u* = s R/gamma > 0 spanning the gap: the larger bridge."""
+    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "exact":
         return _from_exact(capillary.bridge_at_distance(1.0, contact_angle, suction_star, separation))
@@ -150,6 +158,7 @@ def bridge_from_suction(method, suction_star, contact_angle, separation):
 
 def bridge_from_volume(method, volume_star, contact_angle, separation):
     """CellBridge holding V* = V/R^3 > 0 at the gap (exact: volume-controlled; toroidal: root in alpha)."""
+    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "exact":
         bridge = _from_exact(capillary.bridge_with_volume(1.0, contact_angle, volume_star, separation))

@@ -23,7 +23,7 @@ polynomial integrands from order 4 on.
 
 import numpy as np
 
-from capillary.validation import finite_number
+from dem.validate import finite_number
 from homogenize.bridge_tensors import contact_line_integral, wetted_cap_integral
 
 ANISOTROPY_RANGE = (-0.5, 1.0)

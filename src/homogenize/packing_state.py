@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from capillary.validation import check_contact_angle, check_positive, finite_number
+from dem.validate import check_positive, finite_number
 from homogenize import cell_bridge
 from homogenize.bridge_tensors import (
     capillary_stress,
@@ -113,7 +113,7 @@ def packing_state(packing, *, radius, contact_angle, surface_tension, saturation
     radius = check_positive("radius", radius)
     surface_tension = check_positive("surface_tension", surface_tension)
     specific_gravity = check_positive("specific_gravity", specific_gravity)
-    contact_angle = check_contact_angle(contact_angle)
+    contact_angle = cell_bridge.check_contact_angle(contact_angle)
     method = cell_bridge.check_method(method)
     name, value = _state_input(saturation, suction, water_content, filling_angle)
 

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from capillary.validation import finite_number
+from dem.validate import finite_number
 from homogenize.fabric import fabric_tensor, principal_anisotropy
 
 KINDS = ("scp", "bcc", "fcp")
