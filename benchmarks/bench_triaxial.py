@@ -47,8 +47,11 @@ def sample(count, confining):
 
 
 def time_pendular(config, particles, walls, threads, steps, warmup):
+    """Shear-phase speed with ``threads`` Numba threads available; the Simulation's own policy
+    decides how many it uses (one below dem.simulation.SERIAL_BELOW particles)."""
+    numba.set_num_threads(threads)
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
-                             config.confining, threads=threads)
+                             config.confining)
     sim.run(warmup)         # settle the loaded packing (saved without its shear history)
     shear = ShearConfig(confining=config.confining, max_strain=0.25)
     _, _, rate = start_shear(sim, shear, config.radius, config.density)
@@ -58,7 +61,7 @@ def time_pendular(config, particles, walls, threads, steps, warmup):
     sim.run(steps)
     elapsed = time.perf_counter() - started
     return {"particle_steps_per_s": len(particles) * steps / elapsed, "wall_time_s": elapsed,
-            "sigma_wall": sim.walls.stress().tolist()}, sim.dt, rate
+            "sigma_wall": sim.walls.stress().tolist(), "threads_used": sim.threads}, sim.dt, rate
 
 
 def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
@@ -97,6 +100,7 @@ def main(argv=None):
             ours, dt, rate = time_pendular(config, particles, walls, thread_count, args.steps,
                                            args.warmup)
             row = {"particles": count, "threads": thread_count,
+                   "threads_used": ours["threads_used"],
                    "pendular": ours["particle_steps_per_s"], "dt": dt, "strain_rate": rate,
                    "porosity": report["porosity"]}
             if use_yade:
@@ -106,13 +110,13 @@ def main(argv=None):
                 row["ratio"] = row["pendular"] / row["yade"]
             rows.append(row)
             print(json.dumps(row), flush=True)
-    print(f"\n{'particles':>9} {'threads':>7} {'pendular [Mps/s]':>17} {'YADE [Mps/s]':>13} "
-          f"{'ratio':>6}")
+    print(f"\n{'particles':>9} {'threads':>7} {'used':>4} {'pendular [Mps/s]':>17} "
+          f"{'YADE [Mps/s]':>13} {'ratio':>6}")
     for row in rows:
         yade = f"{row['yade'] / 1e6:13.2f}" if "yade" in row else f"{'-':>13}"
         ratio = f"{row['ratio']:6.2f}" if "ratio" in row else f"{'-':>6}"
-        print(f"{row['particles']:9d} {row['threads']:7d} {row['pendular'] / 1e6:17.2f} "
-              f"{yade} {ratio}")
+        print(f"{row['particles']:9d} {row['threads']:7d} {row['threads_used']:4d} "
+              f"{row['pendular'] / 1e6:17.2f} {yade} {ratio}")
     if args.out:
         with open(args.out, "w") as handle:
             json.dump({"rows": rows, "numba_threads_available": numba.config.NUMBA_NUM_THREADS,
