@@ -31,6 +31,16 @@ def find_yade():
                        "YADE cross-checks")
 
 
+def yade_environment(extra=None):
+    """os.environ for a YADE subprocess: without VIRTUAL_ENV, PYTHONPATH and PYTHONHOME, which
+    make YADE's system Python load a virtual environment's packages (numpy, matplotlib) built
+    for another interpreter; plus ``extra`` variables."""
+    environment = {key: value for key, value in os.environ.items()
+                   if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
+    environment.update(extra or {})
+    return environment
+
+
 def run_yade_triaxial(config, threads=1, timeout=None, yade=None, env=None):
     """Run ``yade -n -x -j threads yade_triaxial.py CONFIG.json``; return its result dict.
 
@@ -61,7 +71,7 @@ def run_yade_triaxial(config, threads=1, timeout=None, yade=None, env=None):
         command = [executable, "-n", "-x", "-j", str(int(threads)), DRIVER, config_path]
         try:
             done = subprocess.run(command, cwd=folder, capture_output=True, text=True,
-                                  timeout=timeout, env={**os.environ, **(env or {})})
+                                  timeout=timeout, env=yade_environment(env))
         except subprocess.TimeoutExpired:
             raise RuntimeError(f"YADE ran past {timeout} s: {' '.join(command)}") from None
         if done.returncode != 0 or not os.path.exists(output):

@@ -11,8 +11,13 @@ Wet test (--suction > 0, thesis Ch. 5.2): the sample is prepared dry, then capil
 (capillary.coupling.CapillaryBridges, suction-controlled, formed at every contact) are added at
 the confining stress and the sample is let to equilibrate with them (six walls servoed) before
 the shear. The history then also holds saturation, suction [Pa], sigma_capillary (Love–Weber
-stress of the capillary forces, tensile negative), bridges and pendular_overlaps. Without
---suction the scene is dry and never imports the capillary package.
+stress of the capillary forces, tensile negative), bridges, pendular_overlaps and, at every
+record, the effective stress homogenised from the bridges (homogenize.on_the_fly): chi
+(Eq. 3.44), B [Pa] (Eq. 3.45), psi = chi s + B [Pa] (Eq. 3.46, positive), sigma_effective
+= diag(sigma_wall) + psi [Pa] (Eq. 3.43, u_a = 0), fabric_bridges (Eq. 3.53), anisotropy_bridges
+(Eq. 3.54) and a_psi (Eq. 4.5); summary.json adds peak_q_effective and p_effective_at_peak (q'
+and p' at the peak of q). Every history has the contact fabric and its anisotropy (Eq. 3.51).
+Without --suction the scene is dry and never imports the capillary package.
 """
 
 import argparse
@@ -153,7 +158,8 @@ def main(argv=None):
         json.dump(summary, handle, indent=2)
     plot_history(history, os.path.join(args.out, "triaxial.png"))
     shown = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
-             "initial_porosity", "saturation_at_peak", "wall_time_s", "particle_steps_per_s")
+             "peak_q_effective", "p_effective_at_peak", "initial_porosity",
+             "saturation_at_peak", "wall_time_s", "particle_steps_per_s")
     print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
     return summary
 

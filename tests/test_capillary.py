@@ -3,6 +3,7 @@
 import json
 import math
 import shutil
+import os
 import subprocess
 
 import numba
@@ -310,8 +311,9 @@ def test_yade_reads_the_files_and_reproduces_the_exact_bridges(tmp_path):
     table = capillary.BridgeTable.build(0.0, n_suction=60, n_distance=4, suction_max=200.0)
     table.write_yade(tmp_path, n_distance=60)
     (tmp_path / "two_spheres.py").write_text(YADE_TWO_SPHERES)
+    environment = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
     run = subprocess.run(["yade", "-n", "-x", "two_spheres.py"], cwd=tmp_path, capture_output=True, text=True,
-                         timeout=120)
+                         timeout=120, env=environment)
     result = next(line for line in run.stdout.splitlines() if line.startswith("RESULT"))
     for distance, force, volume in json.loads(result[len("RESULT"):]):
         exact = capillary.bridge_at_distance(2.0, 0.0, 10.0, distance)

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from homogenize import contact_stress, fabric_tensor
+from homogenize import contact_stress, fabric_tensor, principal_anisotropy
+from homogenize.on_the_fly import capillary_quantities
 
 from .measure import coordination, porosity, unbalanced_force
 from .record import HistoryRecorder
@@ -50,10 +51,17 @@ def inertial_number(strain_rate, radius, density, pressure):
     return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
 
 
+def _contact_fabric(sim):
+    return fabric_tensor(sim.contacts.normal, sim.contacts.overlap > 0.0)
+
+
 def triaxial_quantities(axial, reference_volume, operations=()):
     """Recorded columns of the triaxial history (see the scenario's HDF5 layout), plus those of
     every operation that offers ``quantities()`` (name -> function of sim; e.g. the capillary
-    bridges' saturation, suction, sigma_capillary, bridges, pendular_overlaps)."""
+    bridges' saturation, suction, sigma_capillary, bridges, pendular_overlaps) and, when the
+    scene has capillary bridges, the homogenised capillary state
+    (homogenize.on_the_fly.CapillaryHomogenization: chi, B, psi, sigma_effective,
+    fabric_bridges, anisotropy_bridges, a_psi). A dry scene records no capillary column."""
     columns = {
         "step": lambda s: s.step,
         "time": lambda s: s.time,
@@ -63,12 +71,14 @@ def triaxial_quantities(axial, reference_volume, operations=()):
         "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
         "porosity": lambda s: porosity(s.particles, s.walls),
         "coordination": lambda s: coordination(s.contacts, len(s.particles)),
-        "fabric": lambda s: fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0),
+        "fabric": _contact_fabric,
+        "anisotropy": lambda s: principal_anisotropy(_contact_fabric(s)),   # Eq. 3.51
         "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
     }
     for op in operations:
         if hasattr(op, "quantities"):
             columns.update(op.quantities())
+    columns.update(capillary_quantities(operations))
     return columns
 
 
@@ -100,7 +110,10 @@ def start_shear(sim, config, radius, density):
 
 def summarize(history):
     """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at peak
-    (and the degree of saturation there when the history records one)."""
+    (and the degree of saturation there when the history records one). A wet history adds
+    ``peak_q_effective`` and ``p_effective_at_peak``: q' = sigma'_z - (sigma'_x + sigma'_y)/2
+    and p' = tr sigma' / 3 of the effective stress (Eq. 3.43) at the peak of q (the wall
+    stresses' peak, not the largest q')."""
     sigma = history["sigma_wall"]
     lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
     q = sigma[:, 2] - lateral
@@ -116,4 +129,8 @@ def summarize(history):
     }
     if "saturation" in history:
         summary["saturation_at_peak"] = float(history["saturation"][peak])
+    if "sigma_effective" in history:
+        effective = np.diagonal(history["sigma_effective"][peak])
+        summary["peak_q_effective"] = float(effective[2] - 0.5 * (effective[0] + effective[1]))
+        summary["p_effective_at_peak"] = float(effective.mean())
     return summary

@@ -5,6 +5,8 @@
 - bridge_tensors: per-bridge A_ij, B'_ij (Eqs. 3.48-3.49), their rotation onto the bridge normal
   and the discrete sums chi_ij, B_ij, psi_ij, sigma'_ij, a_psi (Eqs. 3.43-3.46, 4.5).
 - harmonic: the continuous forms (Eqs. 3.50, 3.55-3.57).
+- on_the_fly: the same discrete sums over the bridges of a live DEM state, for the recorders
+  (homogenize_bridges, CapillaryHomogenization; capillary_quantities for the triaxial history).
 - regular_packing, packing_state: SCP, BCC, FCP and their pendular states (Tables 4.1-4.4).
 """
 
@@ -27,12 +29,23 @@ from .harmonic import (
     harmonic_surface_tension_stress,
     thesis_rotation,
 )
+from .on_the_fly import (
+    BridgeStress,
+    CapillaryHomogenization,
+    bridges_in_region,
+    capillary_quantities,
+    homogenize_bridges,
+)
 from .packing_state import PackingState, packing_state
 from .regular_packing import RegularPacking, regular_packing
 
 __all__ = [
+    "BridgeStress",
+    "CapillaryHomogenization",
     "PackingState",
     "RegularPacking",
+    "bridges_in_region",
+    "capillary_quantities",
     "capillary_stress",
     "capillary_stress_anisotropy",
     "contact_line_integral",
@@ -44,6 +57,7 @@ __all__ = [
     "fabric_tensor",
     "harmonic_effective_stress_parameter",
     "harmonic_surface_tension_stress",
+    "homogenize_bridges",
     "packing_state",
     "principal_anisotropy",
     "regular_packing",

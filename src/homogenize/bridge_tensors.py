@@ -111,8 +111,25 @@ def rotate_to_normal(local_tensor, normal):
     return np.einsum("kia,kab,kjb->kij", rotation, local_tensor, rotation, optimize=True)
 
 
+_OFF_DIAGONAL = [1, 2, 3, 5, 6, 7]
+"""Flat indices of the off-diagonal entries of a 3x3 tensor."""
+
+
 def _rotated_sum(local_tensor, normal):
-    """sum_k M_k X_k M_k^T (3, 3)."""
+    """sum_k M_k X_k M_k^T (3, 3), M_k e_z = normal_k.
+
+    For axisymmetric X_k = diag(a_k, a_k, c_k) (A and B' of every bridge) the rotated tensor is
+    a_k I + (c_k - a_k) n_k n_k^T whatever M_k does about the normal, and the sum is the weighted
+    outer product (sum a_k) I + sum (c_k - a_k) n_k n_k^T: O(K) without building the rotations
+    (about 30 times faster than the einsum for the live DEM state's bridges). Other tensors
+    take the general path.
+    """
+    local_tensor = np.asarray(local_tensor, dtype=float)
+    flat = local_tensor.reshape(len(local_tensor), 9)
+    if np.array_equal(flat[:, 0], flat[:, 4]) and not np.any(flat[:, _OFF_DIAGONAL]):
+        normal = np.asarray(normal, dtype=float)
+        lateral = flat[:, 0]
+        return lateral.sum() * np.eye(3) + (normal * (flat[:, 8] - lateral)[:, None]).T @ normal
     rotation = rotation_onto(normal)
     return np.einsum("kia,kab,kjb->ij", rotation, local_tensor, rotation, optimize=True)
 

@@ -1,0 +1,264 @@
+"""Effective stress of the live DEM state (thesis Eqs. 3.43-3.46, 3.51-3.54, 4.5), when a recorder asks.
+
+The discrete sums of homogenize.bridge_tensors taken over the liquid bridges of a simulation:
+the per-pair arrays that capillary.coupling.CapillaryBridges keeps in ``sim.contacts.extra``
+(``bridge`` != 0 marks a bridge; ``bridge_volume`` [m^3]; ``filling_angle_i`` and
+``filling_angle_j`` [deg], the caps on particles pair_i and pair_j, each with its own radius).
+Each bridge's normal is its current branch vector x_j - x_i, unit (valid for bridges at contact
+and across a gap alike; ``contacts.normal`` is the contact law's and lags for gap pairs).
+
+    chi_ij    = (V_w / V) delta_ij + (1/V) sum_bridges [Rot A(R_i, delta_i) + Rot A(R_j, delta_j)]  (Eq. 3.44)
+    B_ij      = (1/V) sum_bridges [Rot B'(R_i, delta_i) + Rot B'(R_j, delta_j)]                      (Eq. 3.45)
+    psi_ij    = chi_ij s + B_ij                                                                     (Eq. 3.46)
+    sigma'_ij = (sigma_ij - u_a delta_ij) + psi_ij                                                  (Eq. 3.43)
+    F^LB_ij   = (1/N_LB) sum_bridges n_i n_j, a_LB = 5/2 (F_z - F_x) / tr F                        (Eqs. 3.53-3.54)
+    a_psi     = 5/2 (psi_z - psi_x) / tr psi                                                        (Eq. 4.5)
+
+with V_w the water volume (sum of the bridge volumes, V_w / V = n Sr) and V the volume
+homogenised over (the box inside the walls for a recorder). In the triaxial the total stress
+sigma_ij is the wall stress diag(sigma_x, sigma_y, sigma_z) and u_a = 0. SI units, angles in
+degrees, stresses compression positive.
+
+Sign of B (Eq. 3.45 with SPEC section 5's Eq. 3.49). In Love-Weber form, compression positive,
+forces f acting on a particle at points x of its surface (x from its centre) contribute
+-(1/V) sum x_i f_j to the stress: a force pushing the particle inward is compressive. A bridge
+acts on each of its particles through the water pressure u_w = -s on the wetted cap (the force
+s n dGamma pulls the surface outward: contribution -(s/V) A_ij) and through the surface tension
+gamma e dl along the contact line, e pointing along the liquid-gas interface, i.e. toward the
+other particle (attraction: contribution -(1/V) B'_ij); the water itself adds u_w n Sr delta_ij.
+The total stress is then sigma = sigma' - chi s - B, i.e. Eq. 3.43 with a plus sign for
+both terms, provided B'_ij = ∫ R gamma n_i e_j dl with e the direction of the surface-tension
+force ON the particle. That is how Eq. 3.49 reads: in the bridge frame n_z = cos(alpha) and
+e_z = sin(alpha + theta) > 0 at the contact line, so B'_zz = pi R^2 gamma sin(2 alpha)
+sin(alpha + theta) > 0, compressive along the bridge like the suction term, while
+B'_xx = B'_yy = -pi R^2 gamma sin^2(alpha) cos(alpha + theta) < 0 (the lateral pull of the
+meniscus ring, e_x = -cos(alpha + theta) at azimuth 0). Hence psi is positive at theta = 0 and
+s > 0 (tr B = 0 there: B is deviatoric and vanishes for an isotropic bridge fabric), and the
+capillary terms add to the net stress: sigma' = sigma_net + psi.
+
+Volume-controlled bridges carry their own suction (``bridge_suction``): psi is then the sum of
+each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
+bridge has the suction s; chi is Eq. 3.44 either way.
+
+A dry scene never needs this module's capillary half: ``capillary_quantities`` looks for a
+bridge operation among the operations without importing the capillary package.
+"""
+
+from dataclasses import dataclass
+import sys
+
+import numpy as np
+
+from dem.validate import check_positive
+from homogenize.bridge_tensors import (
+    _rotated_sum,
+    capillary_stress,
+    capillary_stress_anisotropy,
+    effective_stress_parameter,
+    surface_tension_stress,
+    wetted_cap_integral,
+)
+from homogenize.fabric import fabric_tensor, principal_anisotropy
+
+NO_BRIDGE = 0
+"""Value of ``contacts.extra["bridge"]`` for a pair without a bridge (capillary.coupling)."""
+
+
+@dataclass(frozen=True)
+class BridgeStress:
+    """Homogenised capillary state of the bridges in a volume.
+
+    bridges: number of bridges counted (N_LB); water_volume: V_w [m^3]; volume: V [m^3];
+    chi: chi_ij (3, 3), dimensionless (Eq. 3.44); B: B_ij (3, 3) [Pa] (Eq. 3.45);
+    psi: psi_ij (3, 3) [Pa] (Eq. 3.46); fabric: bridge fabric F^LB_ij (3, 3) (Eq. 3.53, zeros
+    without bridges); anisotropy: a_LB (Eq. 3.54); a_psi (Eq. 4.5) (both NaN without bridges).
+    """
+
+    bridges: int
+    water_volume: float
+    volume: float
+    chi: np.ndarray
+    B: np.ndarray
+    psi: np.ndarray
+    fabric: np.ndarray
+    anisotropy: float
+    a_psi: float
+
+
+def bridge_mask(contacts):
+    """(K,) bool: the pairs holding a liquid bridge (none if no bridge operation ran)."""
+    state = contacts.extra.get("bridge")
+    if state is None:
+        return np.zeros(len(contacts), dtype=bool)
+    return state != NO_BRIDGE
+
+
+def _branch(particles, contacts, index):
+    """Centre distances (B,) and unit branch vectors i -> j (B, 3) of the pairs ``index``."""
+    branch = particles.position[contacts.pair_j[index]] - particles.position[contacts.pair_i[index]]
+    distance = np.sqrt(np.einsum("ka,ka->k", branch, branch))
+    return distance, branch / distance[:, None]
+
+
+def bridges_in_region(particles, contacts, lo, hi):
+    """(K,) bool: the bridges whose centre lies in the half-open box [lo, hi) [m].
+
+    The bridge centre is the middle of the gap (or overlap) on the branch vector,
+    x_i + (d + R_i - R_j)/2 n (the contact point at touching; the midpoint for equal spheres).
+    Selecting bridges by their centre counts each bridge of a periodic packing once per cell.
+    """
+    lo = np.asarray(lo, dtype=float)
+    hi = np.asarray(hi, dtype=float)
+    if lo.shape != (3,) or hi.shape != (3,) or not np.all(hi > lo):
+        raise ValueError(f"region [lo, hi) = [{lo.tolist()}, {hi.tolist()}) is not a box: "
+                         "expected lo, hi of shape (3,) with hi > lo")
+    mask = bridge_mask(contacts)
+    index = np.flatnonzero(mask)
+    distance, normal = _branch(particles, contacts, index)
+    radius = particles.radius
+    reach = 0.5 * (distance + radius[contacts.pair_i[index]] - radius[contacts.pair_j[index]])
+    centre = particles.position[contacts.pair_i[index]] + reach[:, None] * normal
+    mask[index] = np.all((centre >= lo) & (centre < hi), axis=1)
+    return mask
+
+
+def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, surface_tension,
+                       mask=None):
+    """chi, B, psi, bridge fabric and anisotropies of the bridges of a DEM state (Eqs. 3.44-3.46,
+    3.53-3.54, 4.5) over the volume V [m^3]; a BridgeStress.
+
+    suction: s = u_a - u_w [Pa], a scalar (suction control) or one value per pair (K,)
+    (volume control: each bridge's own suction); contact_angle [deg]; surface_tension [N/m];
+    mask: (K,) bool, the pairs counted (default: every bridge); it must select bridges only.
+    """
+    volume = check_positive("volume", volume, "m^3")
+    bridges = bridge_mask(contacts)
+    if mask is None:
+        mask = bridges
+    else:
+        mask = np.asarray(mask, dtype=bool)
+        if mask.shape != bridges.shape:
+            raise ValueError(f"mask has shape {mask.shape}; expected ({len(contacts)},), one per pair")
+        if np.any(mask & ~bridges):
+            raise ValueError(f"mask selects {int(np.count_nonzero(mask & ~bridges))} pair(s) "
+                             "without a bridge; valid: a subset of the bridges")
+    index = np.flatnonzero(mask)
+    extra = contacts.extra
+    _, normal = _branch(particles, contacts, index)
+    radius_i = particles.radius[contacts.pair_i[index]]
+    radius_j = particles.radius[contacts.pair_j[index]]
+    filling_i = extra["filling_angle_i"][index] if len(index) else np.zeros(0)
+    filling_j = extra["filling_angle_j"][index] if len(index) else np.zeros(0)
+    bridge_volume = extra["bridge_volume"][index] if len(index) else np.zeros(0)
+    water_volume = float(np.sum(bridge_volume))
+    caps = (normal, radius_i, radius_j, filling_i, filling_j)
+    chi = effective_stress_parameter(*caps, water_volume, volume)
+    tension = surface_tension_stress(*caps, contact_angle, surface_tension, volume)
+    if np.ndim(suction) == 0:
+        psi = capillary_stress(chi, tension, float(suction))
+    else:
+        suction = np.asarray(suction, dtype=float)
+        if suction.shape != bridges.shape:
+            raise ValueError(f"suction has shape {suction.shape}; expected a scalar or "
+                             f"({len(contacts)},), one per pair")
+        own = suction[index]
+        weighted = own[:, None, None] * (wetted_cap_integral(radius_i, filling_i)
+                                         + wetted_cap_integral(radius_j, filling_j))
+        psi = (float(np.sum(own * bridge_volume)) * np.eye(3)
+               + _rotated_sum(weighted, normal)) / volume + tension
+    fabric = fabric_tensor(normal, np.ones(len(index), dtype=bool))
+    return BridgeStress(
+        bridges=len(index),
+        water_volume=water_volume,
+        volume=volume,
+        chi=chi,
+        B=tension,
+        psi=psi,
+        fabric=fabric,
+        anisotropy=principal_anisotropy(fabric),
+        a_psi=capillary_stress_anisotropy(psi),
+    )
+
+
+class CapillaryHomogenization:
+    """The homogenised capillary state of a wet scene, evaluated when a recorder asks.
+
+    bridges: the scene's capillary.coupling.CapillaryBridges operation (its suction, contact
+    angle and surface tension, and the per-pair arrays it keeps in ``sim.contacts.extra``).
+    The volume is the box inside the walls; the total stress of Eq. 3.43 is the wall stress
+    diag(sigma_x, sigma_y, sigma_z), u_a = 0. One evaluation serves every column of a record
+    (cached for the state's step and contact list).
+    """
+
+    def __init__(self, bridges):
+        self.bridges = bridges
+        self._step = None
+        self._contacts = None
+        self._state = None
+
+    def evaluate(self, sim):
+        """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state."""
+        if (sim.step, sim.time) != self._step or sim.contacts is not self._contacts:
+            op = self.bridges
+            suction = (sim.contacts.extra["bridge_suction"]
+                       if op.control == "volume" and "bridge_suction" in sim.contacts.extra
+                       else op.suction)
+            state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
+                                       suction=suction, contact_angle=op.contact_angle,
+                                       surface_tension=op.surface_tension)
+            effective = np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
+            self._step, self._contacts = (sim.step, sim.time), sim.contacts
+            self._state = (state, effective)
+        return self._state
+
+    def chi(self, sim):
+        return self.evaluate(sim)[0].chi
+
+    def B(self, sim):
+        return self.evaluate(sim)[0].B
+
+    def psi(self, sim):
+        return self.evaluate(sim)[0].psi
+
+    def sigma_effective(self, sim):
+        return self.evaluate(sim)[1]
+
+    def fabric_bridges(self, sim):
+        return self.evaluate(sim)[0].fabric
+
+    def anisotropy_bridges(self, sim):
+        return self.evaluate(sim)[0].anisotropy
+
+    def a_psi(self, sim):
+        return self.evaluate(sim)[0].a_psi
+
+    def quantities(self):
+        """Recorded columns (bound methods, so that a deep-copied recorder follows its copy)."""
+        return {
+            "chi": self.chi,
+            "B": self.B,
+            "psi": self.psi,
+            "sigma_effective": self.sigma_effective,
+            "fabric_bridges": self.fabric_bridges,
+            "anisotropy_bridges": self.anisotropy_bridges,
+            "a_psi": self.a_psi,
+        }
+
+
+def capillary_quantities(operations):
+    """History columns of the homogenised capillary state (CapillaryHomogenization) for the
+    bridge operation among ``operations``; {} for a dry scene.
+
+    A scene with bridges has imported capillary.coupling to build them, so a dry scene is
+    recognised without importing the capillary package (SPEC: a dry test never touches it).
+    """
+    coupling = sys.modules.get("capillary.coupling")
+    if coupling is None:
+        return {}
+    found = [op for op in operations if isinstance(op, coupling.CapillaryBridges)]
+    if not found:
+        return {}
+    if len(found) > 1:
+        raise ValueError(f"{len(found)} CapillaryBridges operations in the simulation; the "
+                         "homogenisation expects one")
+    return CapillaryHomogenization(found[0]).quantities()
