@@ -32,9 +32,10 @@ force ON the particle. That is how Eq. 3.49 reads: in the bridge frame n_z = cos
 e_z = sin(alpha + theta) > 0 at the contact line, so B'_zz = pi R^2 gamma sin(2 alpha)
 sin(alpha + theta) > 0, compressive along the bridge like the suction term, while
 B'_xx = B'_yy = -pi R^2 gamma sin^2(alpha) cos(alpha + theta) < 0 (the lateral pull of the
-meniscus ring, e_x = -cos(alpha + theta) at azimuth 0). Hence psi is positive at theta = 0 and
-s > 0 (tr B = 0 there: B is deviatoric and vanishes for an isotropic bridge fabric), and the
-capillary terms add to the net stress: sigma' = sigma_net + psi.
+meniscus ring, e_x = -cos(alpha + theta) at azimuth 0). Hence, at theta = 0 and s > 0, tr B = 0
+(B is deviatoric and vanishes for an isotropic bridge fabric), chi s is positive definite, the
+diagonal of psi is positive for the near-isotropic bridge fabrics of packings and triaxial
+samples, and the capillary terms add to the net stress: sigma' = sigma_net + psi.
 
 Volume-controlled bridges carry their own suction (``bridge_suction``): psi is then the sum of
 each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
