@@ -3,9 +3,23 @@
     python scenarios/triaxial.py [--particles N] [--confining PA] [--suction PA]
         [--contact-angle DEG] [--max-strain X] [--seed S] [--out DIR]
         [--bridges exact|toroidal] [--surface-tension N/M] [--persist-bridges]
+        [--vtk-every N] [--checkpoint-every N]
+    python scenarios/triaxial.py --resume DIR [--quiet] [--threads T]
 
 Writes DIR/history.h5 (group ``history``, one row per record; file attributes hold every input),
-DIR/summary.json and DIR/triaxial.png. Stresses compression positive [Pa].
+DIR/summary.json and DIR/triaxial.png. Stresses compression positive [Pa]. Also:
+
+- DIR/vtk/{particles,walls,bridges}.pvd: ParaView series of the shear (dem.vtk.VtkWriter), a
+  frame every --vtk-every steps (default: about 50 frames; 0: none), the last state included.
+- DIR/plots/: q_p.png (q/p), volumetric_strain.png and, wet, capillary_stress.png (diagonals of
+  psi and of sigma_capillary) against axial strain.
+- DIR/sample.h5: the prepared (and wetted) sample at the start of the shear, with the run's
+  arguments, preparation report and wetting results (dem.sample.save_sample, ``config``).
+- DIR/checkpoint.h5 with --checkpoint-every N: a checkpoint (dem.checkpoint) at the start of the
+  shear and every N steps, written atomically; its extra_state holds the phase ("shear"), the
+  shear's steps, start step, the arguments and the elapsed times. ``--resume DIR`` rebuilds the
+  same simulation from DIR/sample.h5 with the arguments stored there, loads the checkpoint and
+  runs the remaining steps: history.h5 is the one of an uninterrupted run, bit for bit.
 
 Wet test (--suction > 0, thesis Ch. 5.2): the sample is prepared dry, then capillary bridges
 (capillary.coupling.CapillaryBridges, suction-controlled, formed at every contact) are added at
@@ -30,10 +44,21 @@ import time
 import numba
 import numpy as np
 
-from dem.preparation import PrepareConfig, equilibrated, prepare_sample
+from dem.checkpoint import CheckpointWriter, load_checkpoint
+from dem.preparation import PrepareConfig, equilibrated, prepare_sample, servoed_simulation
 from dem.measure import porosity
 from dem.record import write_history
+from dem.sample import load_sample, save_sample
+from dem.vtk import VtkWriter
 from dem.triaxial import ShearConfig, inertial_number, start_shear, summarize
+
+
+#: Default number of ParaView frames over the shear.
+VTK_FRAMES = 50
+#: Arguments that a resumed run takes from its own command line, not from the stored run.
+RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after")
+#: Exit status of a run stopped by --stop-after (as a shell reports an interrupted command).
+INTERRUPTED = 130
 
 
 def parse_args(argv=None):
@@ -71,7 +96,31 @@ def parse_args(argv=None):
     parser.add_argument("--records", type=int, default=500, help="history rows over the test")
     parser.add_argument("--threads", type=int, default=None, help="Numba threads")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--vtk-every", type=int, default=None,
+                        help="steps between ParaView frames of the shear (default: about "
+                             f"{VTK_FRAMES} frames; 0: no ParaView output)")
+    parser.add_argument("--checkpoint-every", type=int, default=0,
+                        help="steps between checkpoints DIR/checkpoint.h5 of the shear (0: none)")
+    parser.add_argument("--resume", metavar="DIR", default=None,
+                        help="continue the interrupted run of DIR from its checkpoint, with the "
+                             "arguments stored there (only --quiet and --threads may be added)")
+    # tests: stop the shear after this many steps as an interruption would (exit status 130)
+    parser.add_argument("--stop-after", type=int, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.vtk_every is not None and args.vtk_every < 0:
+        parser.error(f"--vtk-every {args.vtk_every} is outside the valid range [0, inf)")
+    if args.checkpoint_every < 0:
+        parser.error(f"--checkpoint-every {args.checkpoint_every} is outside the valid range "
+                     "[0, inf)")
+    if args.stop_after is not None and args.stop_after < 0:
+        parser.error(f"--stop-after {args.stop_after} is outside the valid range [0, inf)")
+    if args.resume is not None:
+        given = [name for name, value in vars(args).items()
+                 if name not in RESUME_OPTIONS and value != parser.get_default(name)]
+        if given:
+            parser.error(f"--resume takes the run's arguments from {args.resume}; "
+                         f"{', '.join('--' + n.replace('_', '-') for n in given)} cannot be "
+                         "changed (only --quiet and --threads may be added)")
     if not math.isfinite(args.suction) or args.suction < 0.0:
         parser.error(f"--suction {args.suction} Pa is outside the valid range [0, inf) "
                      "(0: dry)")
@@ -94,16 +143,10 @@ def parse_args(argv=None):
 
 def main(argv=None):
     args = parse_args(argv)
+    if args.resume is not None:
+        return resume(args)
     try:
-        prepare = PrepareConfig(particles=args.particles, radius=args.radius,
-                                porosity=args.porosity, young=args.young,
-                                friction_deg=args.friction, damping=args.damping,
-                                timestep_safety=args.timestep_safety, confining=args.confining,
-                                seed=args.seed)
-        shear = ShearConfig(confining=args.confining, max_strain=args.max_strain,
-                            inertial_number=args.inertial_number, strain_rate=args.strain_rate,
-                            records=args.records)
-        bridges = wet_bridges(args, prepare.radius) if args.suction > 0.0 else None
+        prepare, shear, bridges = configs(args)
     except ValueError as error:
         sys.exit(f"triaxial.py: error: {error}")
     os.makedirs(args.out, exist_ok=True)
@@ -112,56 +155,177 @@ def main(argv=None):
     sim, preparation = prepare_sample(prepare, progress=progress)
     prepared = time.perf_counter()
     wetting = wet_sample(sim, bridges, prepare, args.wet_steps, progress) if bridges else {}
-    recorder, steps, rate = start_shear(sim, shear, prepare.radius, prepare.density)
+    before_shear = {"arguments": vars(args), "preparation": preparation, "wetting": wetting,
+                    "preparation_time_s": prepared - started,
+                    "pre_shear_time_s": time.perf_counter() - started}
+    before_shear = json.loads(json.dumps(before_shear, default=_plain))
+    # the sample the shear starts from: a resumed run rebuilds its simulation from it
+    save_sample(os.path.join(args.out, "sample.h5"), sim, preparation, before_shear)
+    run = Shear(sim, args, prepare, shear, before_shear)
+    if run.checkpoint is not None:
+        run.checkpoint.write(sim)
+    return run.finish()
 
-    def status(s):
-        sigma = s.walls.stress()
-        lateral = 0.5 * (sigma[0] + sigma[1])
-        return {"strain": f"{recorder.last('axial_strain'):.3f}",
-                "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral:.0f}Pa",
-                "q/p": f"{3 * (sigma[2] - lateral) / (sigma[2] + 2 * lateral):.2f}"}
 
-    shear_start = time.perf_counter()
-    sim.run(steps, progress="shear" if progress else None, status=status)
-    shear_time = time.perf_counter() - shear_start
-    history = recorder.arrays()
-    summary = summarize(history)
-    summary.update({
-        "initial_porosity": preparation["porosity"],
-        "initial_coordination": preparation["coordination"],
-        "wall_time_s": time.perf_counter() - started,
-        "preparation_time_s": prepared - started,
-        "shear_time_s": shear_time,
-        "steps": steps,
-        "preparation_steps": preparation["steps"],
-        "particle_steps_per_s": len(sim.particles) * steps / shear_time,
-        "dt": sim.dt,
-        "strain_rate": rate,
-        "inertial_number": inertial_number(rate, prepare.radius, prepare.density,
-                                           args.confining),
-        "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
-        "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
-        "threads": numba.get_num_threads(),
-        **wetting,
-    })
-    attributes = {k: v for k, v in vars(args).items() if v is not None}
-    attributes.update({"timestep": preparation["timestep"], "dt": sim.dt, "strain_rate": rate,
-                       "density": prepare.density, "shear_ratio": prepare.shear_ratio,
-                       "prep_friction": prepare.prep_friction_deg,
-                       "prep_stress": prepare.prep_stress})
+def resume(args):
+    """Continue the run of ``args.resume`` from its checkpoint (module docstring)."""
+    folder = args.resume
+    checkpoint = os.path.join(folder, "checkpoint.h5")
+    for path in (os.path.join(folder, "sample.h5"), checkpoint):
+        if not os.path.exists(path):
+            sys.exit(f"triaxial.py: error: --resume {folder}: {path} is missing (was the run "
+                     "started with --checkpoint-every N > 0?)")
+    particles, walls, _, before_shear = load_sample(os.path.join(folder, "sample.h5"))
+    stored = dict(before_shear["arguments"])
+    stored.update({name: getattr(args, name) for name in RESUME_OPTIONS})
+    stored["out"] = folder
+    stored["resume"] = None
+    args = argparse.Namespace(**stored)
+    if args.threads is not None:
+        numba.set_num_threads(args.threads)
+    prepare, shear, bridges = configs(args)
+    sim = servoed_simulation(particles, walls, prepare, prepare.confining)
     if bridges is not None:
-        attributes.update({"bridges": bridges.model, "contact_angle": bridges.contact_angle,
-                           "surface_tension": bridges.surface_tension,
-                           "persist_bridges": bridges.persist})
-    write_history(os.path.join(args.out, "history.h5"), history, attributes)
-    with open(os.path.join(args.out, "summary.json"), "w") as handle:
-        json.dump(summary, handle, indent=2)
-    plot_history(history, os.path.join(args.out, "triaxial.png"))
-    shown = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
-             "peak_q_effective", "p_effective_at_peak", "initial_porosity",
-             "saturation_at_peak", "wall_time_s", "particle_steps_per_s")
-    print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
-    return summary
+        bridges.insert(sim)
+    run = Shear(sim, args, prepare, shear, before_shear)
+    state = load_checkpoint(checkpoint, sim)
+    if state.get("phase") != "shear" or state["steps"] != run.steps:
+        sys.exit(f"triaxial.py: error: {checkpoint} does not belong to this run's shear")
+    run.resumed(state)
+    return run.finish()
+
+
+def configs(args):
+    """(PrepareConfig, ShearConfig, capillary operation or None) of the arguments."""
+    prepare = PrepareConfig(particles=args.particles, radius=args.radius,
+                            porosity=args.porosity, young=args.young,
+                            friction_deg=args.friction, damping=args.damping,
+                            timestep_safety=args.timestep_safety, confining=args.confining,
+                            seed=args.seed)
+    shear = ShearConfig(confining=args.confining, max_strain=args.max_strain,
+                        inertial_number=args.inertial_number, strain_rate=args.strain_rate,
+                        records=args.records)
+    bridges = wet_bridges(args, prepare.radius) if args.suction > 0.0 else None
+    return prepare, shear, bridges
+
+
+def _plain(value):
+    """JSON form of NumPy scalars and arrays."""
+    return value.tolist() if hasattr(value, "tolist") else str(value)
+
+
+class Shear:
+    """The shear phase of a prepared sample: triaxial wall control, recorder, then (as asked)
+    the ParaView writer and the checkpoint writer, always in this order, so that a resumed run
+    builds the same simulation; ``finish()`` runs the remaining steps and writes the outputs."""
+
+    def __init__(self, sim, args, prepare, shear, before_shear):
+        self.sim, self.args, self.prepare, self.before_shear = sim, args, prepare, before_shear
+        self.recorder, self.steps, self.rate = start_shear(sim, shear, prepare.radius,
+                                                           prepare.density)
+        self.start_step = sim.step
+        self.shear_time = 0.0        # seconds spent shearing by earlier (interrupted) runs
+        self.vtk_period = (max(1, self.steps // VTK_FRAMES) if args.vtk_every is None
+                           else args.vtk_every)
+        self.vtk = None
+        if self.vtk_period > 0:
+            self.vtk = VtkWriter(os.path.join(args.out, "vtk"), self.vtk_period)
+            sim.writers.append(self.vtk)
+        self.checkpoint = None
+        if args.checkpoint_every > 0:
+            self.checkpoint = CheckpointWriter(os.path.join(args.out, "checkpoint.h5"),
+                                               args.checkpoint_every, self.extra_state)
+            sim.writers.append(self.checkpoint)
+        self._clock = time.perf_counter()
+
+    def extra_state(self, sim):
+        """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
+        return {"phase": "shear", "steps": self.steps, "start_step": self.start_step,
+                "shear_time_s": self.shear_time + time.perf_counter() - self._clock,
+                "arguments": self.before_shear["arguments"]}
+
+    def resumed(self, state):
+        """Take the progress of the checkpoint loaded into the simulation."""
+        self.start_step = state["start_step"]
+        self.shear_time = state["shear_time_s"]
+        self._clock = time.perf_counter()
+
+    def finish(self):
+        """Run the rest of the shear (or stop early at --stop-after) and write the outputs."""
+        sim, args, recorder = self.sim, self.args, self.recorder
+        remaining = self.steps - (sim.step - self.start_step)
+        stop = args.stop_after is not None and args.stop_after < remaining
+
+        def status(s):
+            sigma = s.walls.stress()
+            lateral = 0.5 * (sigma[0] + sigma[1])
+            return {"strain": f"{recorder.last('axial_strain'):.3f}",
+                    "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral:.0f}Pa",
+                    "q/p": f"{3 * (sigma[2] - lateral) / (sigma[2] + 2 * lateral):.2f}"}
+
+        self._clock = time.perf_counter()
+        try:
+            sim.run(args.stop_after if stop else remaining,
+                    progress=None if args.quiet else "shear", status=status)
+        except KeyboardInterrupt:
+            stop = True
+        if stop:             # as an interruption: the last checkpoint is where a resume starts
+            if self.checkpoint is not None:
+                print(f"triaxial.py: interrupted at step {sim.step}; continue with "
+                      f"--resume {args.out}", file=sys.stderr)
+            sys.exit(INTERRUPTED)
+        if self.vtk is not None:
+            self.vtk.close(sim)
+        self.shear_time += time.perf_counter() - self._clock
+        return self.write_outputs()
+
+    def write_outputs(self):
+        sim, args, prepare, rate = self.sim, self.args, self.prepare, self.rate
+        preparation = self.before_shear["preparation"]
+        history = self.recorder.arrays()
+        summary = summarize(history)
+        summary.update({
+            "initial_porosity": preparation["porosity"],
+            "initial_coordination": preparation["coordination"],
+            "wall_time_s": self.before_shear["pre_shear_time_s"] + self.shear_time,
+            "preparation_time_s": self.before_shear["preparation_time_s"],
+            "shear_time_s": self.shear_time,
+            "steps": self.steps,
+            "preparation_steps": preparation["steps"],
+            "particle_steps_per_s": len(sim.particles) * self.steps / self.shear_time,
+            "dt": sim.dt,
+            "strain_rate": rate,
+            "inertial_number": inertial_number(rate, prepare.radius, prepare.density,
+                                               args.confining),
+            "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
+            "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
+            "threads": numba.get_num_threads(),
+            **self.before_shear["wetting"],
+        })
+        attributes = {k: v for k, v in vars(args).items()
+                      if v is not None and k not in ("resume", "stop_after")}
+        attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
+                           "strain_rate": rate, "density": prepare.density,
+                           "shear_ratio": prepare.shear_ratio,
+                           "prep_friction": prepare.prep_friction_deg,
+                           "prep_stress": prepare.prep_stress, "vtk_every": self.vtk_period})
+        if args.suction > 0.0:
+            from capillary.coupling import CapillaryBridges   # a dry scene never loads it
+
+            bridges = sim.operation(CapillaryBridges)
+            attributes.update({"bridges": bridges.model, "contact_angle": bridges.contact_angle,
+                               "surface_tension": bridges.surface_tension,
+                               "persist_bridges": bridges.persist})
+        write_history(os.path.join(args.out, "history.h5"), history, attributes)
+        with open(os.path.join(args.out, "summary.json"), "w") as handle:
+            json.dump(summary, handle, indent=2)
+        plot_history(history, os.path.join(args.out, "triaxial.png"))
+        write_plots(history, os.path.join(args.out, "plots"))
+        shown = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
+                 "peak_q_effective", "p_effective_at_peak", "initial_porosity",
+                 "saturation_at_peak", "wall_time_s", "particle_steps_per_s")
+        print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
+        return summary
 
 
 def wet_bridges(args, radius):
@@ -190,11 +354,67 @@ def wet_sample(sim, bridges, prepare, max_steps, progress):
             "wet_porosity": porosity(sim.particles, sim.walls)}
 
 
-def plot_history(history, path):
-    """q/p and volumetric strain against axial strain (thesis Fig. 5.3)."""
+def _pyplot():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    return plt
+
+
+def _diagonals(values):
+    """(rows, 3) diagonal of a (rows, 3, 3) tensor history, or a (rows, 3) one as it is."""
+    values = np.asarray(values)
+    return np.diagonal(values, axis1=1, axis2=2) if values.ndim == 3 else values
+
+
+def write_plots(history, folder):
+    """The plots of a run into ``folder``: q_p.png (q/p), volumetric_strain.png and, when the
+    history has capillary columns, capillary_stress.png (diagonal components of psi, Eq. 3.46,
+    and of sigma_capillary, [Pa]), each against axial strain. Returns the paths written."""
+    plt = _pyplot()
+    os.makedirs(folder, exist_ok=True)
+    sigma = history["sigma_wall"]
+    lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
+    p = (sigma[:, 2] + 2 * lateral) / 3
+    strain = history["axial_strain"]
+    curves = {"q_p.png": ("q/p", [("q/p", (sigma[:, 2] - lateral)
+                                   / np.where(p > 0, p, math.nan))]),
+              "volumetric_strain.png": ("volumetric strain (contraction +)",
+                                        [(None, history["volumetric_strain"])])}
+    paths = []
+    for name, (label, series) in curves.items():
+        figure, axes = plt.subplots(figsize=(6, 4))
+        for legend, values in series:
+            axes.plot(strain, values, label=legend)
+        axes.set_xlabel("axial strain")
+        axes.set_ylabel(label)
+        figure.tight_layout()
+        paths.append(os.path.join(folder, name))
+        figure.savefig(paths[-1], dpi=120)
+        plt.close(figure)
+    capillary = [(key, title) for key, title in
+                 (("psi", "psi = chi s + B [Pa] (Eq. 3.46)"),
+                  ("sigma_capillary", "sigma_capillary [Pa] (tensile negative)"))
+                 if key in history]
+    if capillary:
+        figure, panels = plt.subplots(len(capillary), 1, figsize=(6, 3.5 * len(capillary)),
+                                      sharex=True, squeeze=False)
+        for axes, (key, title) in zip(panels[:, 0], capillary):
+            for axis, values in zip("xyz", _diagonals(history[key]).T):
+                axes.plot(strain, values, label=f"{key}_{axis}{axis}")
+            axes.set_ylabel(title)
+            axes.legend()
+        panels[-1, 0].set_xlabel("axial strain")
+        figure.tight_layout()
+        paths.append(os.path.join(folder, "capillary_stress.png"))
+        figure.savefig(paths[-1], dpi=120)
+        plt.close(figure)
+    return paths
+
+
+def plot_history(history, path):
+    """q/p and volumetric strain against axial strain (thesis Fig. 5.3), one figure."""
+    plt = _pyplot()
 
     sigma = history["sigma_wall"]
     lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
