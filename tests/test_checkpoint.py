@@ -199,7 +199,7 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     code = (f"import sys; sys.path.insert(0, {TESTS!r}); import test_checkpoint; "
             f"test_checkpoint.checkpoint_forever({path!r})")
     child = subprocess.Popen([sys.executable, "-c", code])
-    temporary = f"{path}.tmp{child.pid}"
+    temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # dem.atomic.replacing
     try:
         deadline = time.monotonic() + 60.0
         while not os.path.exists(path):

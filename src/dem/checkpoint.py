@@ -36,6 +36,7 @@ import pickle
 import h5py
 import numpy as np
 
+from .atomic import replacing
 from .neighbors import Contacts
 from .validate import check_int
 
@@ -136,14 +137,6 @@ def _write_group(handle, name, arrays, scalars=None):
     return group
 
 
-def _fsync(path):
-    descriptor = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(descriptor)
-    finally:
-        os.close(descriptor)
-
-
 def save_checkpoint(path, sim, extra_state=None):
     """Write the complete state of ``sim`` to ``path`` atomically (module docstring).
 
@@ -169,38 +162,28 @@ def save_checkpoint(path, sim, extra_state=None):
     _Pickler(buffer, references).dump(tree)
     blob = np.frombuffer(buffer.getbuffer(), np.uint8)
 
-    temporary = f"{path}.tmp{os.getpid()}"
-    try:
-        with h5py.File(temporary, "w") as handle:
-            handle.attrs.update({
-                "format": FORMAT, "version": VERSION, "step": int(sim.step),
-                "time": float(sim.time), "dt": float(sim.dt),
-                "operations": json.dumps([_type_name(op) for op in sim.operations]),
-                "writers": json.dumps([_type_name(op) for op in sim.writers]),
-                "skipped": json.dumps(skipped), "has_contacts": contacts is not None})
-            _write_group(handle, "particles", particle_arrays, particle_scalars)
-            _write_group(handle, "walls", wall_arrays, wall_scalars)
-            if contacts is not None:
-                arrays = {k: v for k, v in vars(contacts).items() if k != "extra"}
-                for key, value in arrays.items():
-                    if not isinstance(value, np.ndarray):
-                        raise TypeError(f"cannot checkpoint contacts.{key} of type "
-                                        f"{type(value).__name__}: only arrays are supported")
-                group = _write_group(handle, "contacts", arrays)
-                for key, value in contacts.extra.items():
-                    if not isinstance(value, np.ndarray):
-                        raise TypeError(f"cannot checkpoint contacts.extra[{key!r}] of type "
-                                        f"{type(value).__name__}: only arrays are supported")
-                _write_group(group, "extra", contacts.extra)
-            handle.create_dataset("state", data=blob)
-        _fsync(temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-        raise
-    if os.name == "posix":
-        _fsync(os.path.dirname(os.path.abspath(path)))    # make the rename itself durable
+    with replacing(path, durable=True) as temporary, h5py.File(temporary, "w") as handle:
+        handle.attrs.update({
+            "format": FORMAT, "version": VERSION, "step": int(sim.step),
+            "time": float(sim.time), "dt": float(sim.dt),
+            "operations": json.dumps([_type_name(op) for op in sim.operations]),
+            "writers": json.dumps([_type_name(op) for op in sim.writers]),
+            "skipped": json.dumps(skipped), "has_contacts": contacts is not None})
+        _write_group(handle, "particles", particle_arrays, particle_scalars)
+        _write_group(handle, "walls", wall_arrays, wall_scalars)
+        if contacts is not None:
+            arrays = {k: v for k, v in vars(contacts).items() if k != "extra"}
+            for key, value in arrays.items():
+                if not isinstance(value, np.ndarray):
+                    raise TypeError(f"cannot checkpoint contacts.{key} of type "
+                                    f"{type(value).__name__}: only arrays are supported")
+            group = _write_group(handle, "contacts", arrays)
+            for key, value in contacts.extra.items():
+                if not isinstance(value, np.ndarray):
+                    raise TypeError(f"cannot checkpoint contacts.extra[{key!r}] of type "
+                                    f"{type(value).__name__}: only arrays are supported")
+            _write_group(group, "extra", contacts.extra)
+        handle.create_dataset("state", data=blob)
     return skipped
 
 

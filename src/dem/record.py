@@ -1,10 +1,9 @@
 """Recorders: operations that sample the state every ``period`` steps into named columns."""
 
-import os
-
 import h5py
 import numpy as np
 
+from .atomic import replacing
 from .validate import check_int
 
 
@@ -46,11 +45,9 @@ def write_history(path, columns, attributes, group="history"):
     The file is written under a temporary name then renamed, so a killed run never leaves a
     truncated HDF5 file at ``path``. Attribute values that HDF5 cannot hold are stored as text.
     """
-    temporary = f"{path}.tmp{os.getpid()}"
-    with h5py.File(temporary, "w") as handle:
+    with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
         for key, value in attributes.items():
             handle.attrs[key] = value if isinstance(value, (int, float, str, bool)) else str(value)
         data = handle.create_group(group)
         for name, values in columns.items():
             data.create_dataset(name, data=values)
-    os.replace(temporary, path)

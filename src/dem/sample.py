@@ -1,18 +1,17 @@
 """Save and load a prepared sample (positions, radii, walls, velocities) as HDF5."""
 
 import json
-import os
 
 import h5py
 import numpy as np
 
+from .atomic import replacing
 from .state import Particles, Walls
 
 
 def save_sample(path, sim, report=None, config=None):
     """Write the particles and walls of ``sim`` (and the preparation report/config) atomically."""
-    temporary = f"{path}.tmp{os.getpid()}"
-    with h5py.File(temporary, "w") as handle:
+    with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
         p = sim.particles
         for name in ("position", "radius", "velocity", "angular_velocity"):
             handle.create_dataset(name, data=getattr(p, name))
@@ -20,7 +19,6 @@ def save_sample(path, sim, report=None, config=None):
         handle.attrs["density"] = p.density
         handle.attrs["report"] = json.dumps(report or {})
         handle.attrs["config"] = json.dumps(config or {})
-    os.replace(temporary, path)
 
 
 def load_sample(path):

@@ -41,23 +41,11 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
+from .atomic import replacing
 from .validate import check_int
 
 #: The series written, each a .pvd collection of .vtu files.
 SERIES = ("particles", "walls", "bridges")
-
-
-def _replace_atomically(path, write):
-    """Call ``write(temporary)`` then rename the temporary file to ``path``."""
-    folder, name = os.path.split(path)
-    temporary = os.path.join(folder, f".{name}.tmp{os.getpid()}")
-    try:
-        write(temporary)
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-        raise
 
 
 def write_vtu(path, mesh, compression="zlib"):
@@ -65,8 +53,8 @@ def write_vtu(path, mesh, compression="zlib"):
     written uncompressed (VTK's empty compressed arrays are not read back by every reader)."""
     if not any(len(block.data) for block in mesh.cells):
         compression = None
-    _replace_atomically(path, lambda temporary: meshio.write(
-        temporary, mesh, file_format="vtu", compression=compression))
+    with replacing(path) as temporary:
+        meshio.write(temporary, mesh, file_format="vtu", compression=compression)
 
 
 def write_pvd(path, frames):
@@ -77,12 +65,8 @@ def write_pvd(path, frames):
     lines += [f'    <DataSet timestep="{float(time)!r}" group="" part="0" file={quoteattr(name)}/>'
               for time, name in frames]
     lines += ["  </Collection>", "</VTKFile>", ""]
-
-    def write(temporary):
-        with open(temporary, "w") as handle:
-            handle.write("\n".join(lines))
-
-    _replace_atomically(path, write)
+    with replacing(path) as temporary, open(temporary, "w") as handle:
+        handle.write("\n".join(lines))
 
 
 def _contacts_per_particle(contacts, count):

@@ -25,9 +25,10 @@ import bz2
 import gzip
 import math
 import os
-import tempfile
 
 import numpy as np
+
+from .atomic import replacing
 
 SPHERE_FORMAT = "x_y_z_r"
 _BOX_TAGS = ("box_lo", "box_hi")
@@ -95,18 +96,8 @@ def write_spheres(path, positions, radii, box_lo=None, box_hi=None):
     lines.extend("\t".join(map(_number, (*x, r))) + "\n" for x, r in zip(position, radius))
 
     path = os.fspath(path)
-    folder = os.path.dirname(os.path.abspath(path))
-    handle, temporary = tempfile.mkstemp(prefix=".tmp-", suffix=".txt", dir=folder)
-    try:
-        with os.fdopen(handle, "w") as out:
-            out.writelines(lines)
-            out.flush()
-            os.fsync(out.fileno())
-        os.replace(temporary, path)
-    except BaseException:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
-        raise
+    with replacing(path) as temporary, open(temporary, "w") as out:
+        out.writelines(lines)
     return position.shape[0]
 
 
