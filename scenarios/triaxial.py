@@ -3,7 +3,7 @@
     python scenarios/triaxial.py [--particles N] [--confining PA] [--suction PA]
         [--contact-angle DEG] [--max-strain X] [--seed S] [--out DIR]
         [--bridges exact|toroidal] [--surface-tension N/M] [--persist-bridges]
-        [--vtk-every N] [--checkpoint-every N]
+        [--vtk-every N] [--checkpoint-every N] [--sample PATH]
     python scenarios/triaxial.py --resume DIR [--quiet] [--threads T]
 
 Writes DIR/history.h5 (group ``history``, one row per record; file attributes hold every input),
@@ -20,6 +20,11 @@ DIR/summary.json and DIR/triaxial.png. Stresses compression positive [Pa]. Also:
   shear's steps, start step, the arguments and the elapsed times. ``--resume DIR`` rebuilds the
   same simulation from DIR/sample.h5 with the arguments stored there, loads the checkpoint and
   runs the remaining steps: history.h5 is the one of an uninterrupted run, bit for bit.
+
+--sample PATH starts from a sample prepared earlier (dem.sample.save_sample, e.g. a campaign's
+DIR/samples/) instead of preparing one: it is servoed at --confining and let to equilibrate
+(at most --wet-steps steps; its contacts' shear forces are not stored) before the wetting or the
+shear; the other sample arguments (--particles, --radius, ...) must describe the same sample.
 
 Wet test (--suction > 0, thesis Ch. 5.2): the sample is prepared dry, then capillary bridges
 (capillary.coupling.CapillaryBridges, suction-controlled, formed at every contact) are added at
@@ -46,7 +51,7 @@ import numpy as np
 
 from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.preparation import PrepareConfig, equilibrated, prepare_sample, servoed_simulation
-from dem.measure import porosity
+from dem.measure import coordination, porosity
 from dem.record import write_history
 from dem.sample import load_sample, save_sample
 from dem.vtk import VtkWriter
@@ -101,6 +106,9 @@ def parse_args(argv=None):
                              f"{VTK_FRAMES} frames; 0: no ParaView output)")
     parser.add_argument("--checkpoint-every", type=int, default=0,
                         help="steps between checkpoints DIR/checkpoint.h5 of the shear (0: none)")
+    parser.add_argument("--sample", metavar="PATH", default=None,
+                        help="start from this prepared sample (dem.sample.save_sample) instead "
+                             "of preparing one")
     parser.add_argument("--resume", metavar="DIR", default=None,
                         help="continue the interrupted run of DIR from its checkpoint, with the "
                              "arguments stored there (only --quiet and --threads may be added)")
@@ -152,7 +160,10 @@ def main(argv=None):
     os.makedirs(args.out, exist_ok=True)
     progress = not args.quiet
     started = time.perf_counter()
-    sim, preparation = prepare_sample(prepare, progress=progress)
+    if args.sample is not None:
+        sim, preparation = saved_sample(args.sample, prepare, args.wet_steps, progress)
+    else:
+        sim, preparation = prepare_sample(prepare, progress=progress)
     prepared = time.perf_counter()
     wetting = wet_sample(sim, bridges, prepare, args.wet_steps, progress) if bridges else {}
     before_shear = {"arguments": vars(args), "preparation": preparation, "wetting": wetting,
@@ -193,6 +204,32 @@ def resume(args):
         sys.exit(f"triaxial.py: error: {checkpoint} does not belong to this run's shear")
     run.resumed(state)
     return run.finish()
+
+
+def saved_sample(path, prepare, max_steps, progress):
+    """(Simulation, preparation report) of the sample saved at ``path``, servoed at the
+    confining stress of ``prepare`` and run until static (at most ``max_steps`` steps)."""
+    if not os.path.exists(path):
+        sys.exit(f"triaxial.py: error: --sample {path}: no such file")
+    particles, walls, report, _ = load_sample(path)
+    if len(particles) != prepare.particles:
+        sys.exit(f"triaxial.py: error: --sample {path} has {len(particles)} particles, "
+                 f"--particles says {prepare.particles}")
+    sim = servoed_simulation(particles, walls, prepare, prepare.confining)
+    started = time.perf_counter()
+    steps = sim.run(max_steps, until=equilibrated(prepare), check_every=200,
+                    progress="equilibrate sample" if progress else None)
+    report = dict(report)
+    report.update({"sample": os.path.abspath(path), "sample_equilibration_steps": steps,
+                   "sample_equilibration_time_s": time.perf_counter() - started,
+                   "porosity": porosity(sim.particles, sim.walls),
+                   "coordination": coordination(sim.contacts, len(sim.particles)),
+                   "sigma_wall": sim.walls.stress().tolist()})
+    if "steps" not in report:
+        report["steps"] = steps
+    if "timestep" not in report:
+        report["timestep"] = f"{prepare.timestep_safety} x P-wave time step min R / sqrt(E / rho)"
+    return sim, report
 
 
 def configs(args):
