@@ -39,11 +39,6 @@ def pwave_timestep(radius, young, density):
     return float(np.min(radius) / np.sqrt(young / density))
 
 
-def oscillator_timestep(mass, radius, young):
-    """Single-spring estimate min sqrt(m / kn) [s], kn = E R for equal spheres (SPEC §2)."""
-    return float(np.min(np.sqrt(mass / (young * radius))))
-
-
 class Integrator:
     """Leapfrog with Cundall local damping ``damping`` (YADE NewtonIntegrator, default 0.2)."""
 
