@@ -118,6 +118,21 @@ def _apply_across_gap(k, position, i, j, magnitude, pair_force):
     _apply_along(k, magnitude, d0 * inverse, d1 * inverse, d2 * inverse, pair_force)
 
 
+@numba.njit(cache=True, inline="always")
+def _form_at_contact(k, radius_i, radius_j, state, volume, force, filling_i, filling_j, suction,
+                     surface_tension, radius_ratios, suction_axis, distance_low,
+                     log_distance_rupture, log_values):
+    """Give pair k the suction-controlled bridge of touching spheres (table at d* = 0)."""
+    larger = max(radius_i, radius_j)
+    _, force_star, volume_star, delta1, delta2 = lookup_suction(
+        radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+        larger / min(radius_i, radius_j), suction * larger / surface_tension, 0.0)
+    _store(k, radius_i, radius_j, force_star, delta1, delta2, surface_tension, force, filling_i,
+           filling_j)
+    volume[k] = volume_star * larger * larger * larger
+    state[k] = AT_CONTACT
+
+
 @numba.njit(cache=True, parallel=True)
 def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filling_i, filling_j,
                     suction, surface_tension, radius_ratios, suction_axis, distance_low,
@@ -133,16 +148,9 @@ def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filli
         if touching == (state[k] == AT_CONTACT):   # no change: the (predictable) common case
             continue
         if touching:
-            i = pair_i[k]
-            j = pair_j[k]
-            larger = max(radius[i], radius[j])
-            _, force_star, volume_star, delta1, delta2 = lookup_suction(
-                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
-                larger / min(radius[i], radius[j]), suction * larger / surface_tension, 0.0)
-            _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
-                   force, filling_i, filling_j)
-            volume[k] = volume_star * larger * larger * larger
-            state[k] = AT_CONTACT
+            _form_at_contact(k, radius[pair_i[k]], radius[pair_j[k]], state, volume, force,
+                             filling_i, filling_j, suction, surface_tension, radius_ratios,
+                             suction_axis, distance_low, log_distance_rupture, log_values)
         else:
             state[k] = NO_BRIDGE
             volume[k] = 0.0
@@ -195,14 +203,9 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
         j = pair_j[k]
         if overlap[k] > 0.0:
             if state[k] != AT_CONTACT:
-                larger = max(radius[i], radius[j])
-                _, force_star, volume_star, delta1, delta2 = lookup_suction(
-                    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
-                    larger / min(radius[i], radius[j]), suction * larger / surface_tension, 0.0)
-                _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
-                       force, filling_i, filling_j)
-                volume[k] = volume_star * larger * larger * larger
-                state[k] = AT_CONTACT
+                _form_at_contact(k, radius[i], radius[j], state, volume, force, filling_i,
+                                 filling_j, suction, surface_tension, radius_ratios,
+                                 suction_axis, distance_low, log_distance_rupture, log_values)
             _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
         elif state[k] != NO_BRIDGE:
             larger = max(radius[i], radius[j])
