@@ -23,7 +23,6 @@ import sys
 import tempfile
 import time
 
-import numba
 import numpy as np
 
 import capillary
@@ -34,7 +33,7 @@ from dem.triaxial import ShearConfig, start_shear
 from dem.yade_io import write_spheres
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_triaxial import CACHE, sample  # noqa: E402
+from bench_triaxial import CACHE, sample, write_results  # noqa: E402
 from yade_runner import find_yade, run_yade_triaxial  # noqa: E402
 
 SURFACE_TENSION = 0.073
@@ -170,9 +169,7 @@ def main(argv=None):
               f"{cell('yade_wet', 9, 1e-6)} {cell('yade_wet_over_dry_cost', 12)} "
               f"{cell('ours_over_yade_wet', 13)}")
     if args.out:
-        with open(args.out, "w") as handle:
-            json.dump({"rows": rows, "numba_threads_available": numba.config.NUMBA_NUM_THREADS,
-                       "cpu_count": os.cpu_count()}, handle, indent=2)
+        write_results(args.out, rows)
 
 
 if __name__ == "__main__":

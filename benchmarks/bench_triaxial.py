@@ -19,7 +19,6 @@ import tempfile
 import time
 
 import numba
-import numpy as np
 
 from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from dem.sample import load_sample, save_sample
@@ -78,6 +77,13 @@ def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
     return result
 
 
+def write_results(path, rows):
+    """Benchmark rows and the machine's thread counts as JSON."""
+    with open(path, "w") as handle:
+        json.dump({"rows": rows, "numba_threads_available": numba.config.NUMBA_NUM_THREADS,
+                   "cpu_count": os.cpu_count()}, handle, indent=2)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--sizes", default="1000,10000")
@@ -118,9 +124,7 @@ def main(argv=None):
         print(f"{row['particles']:9d} {row['threads']:7d} {row['threads_used']:4d} "
               f"{row['pendular'] / 1e6:17.2f} {yade} {ratio}")
     if args.out:
-        with open(args.out, "w") as handle:
-            json.dump({"rows": rows, "numba_threads_available": numba.config.NUMBA_NUM_THREADS,
-                       "cpu_count": os.cpu_count()}, handle, indent=2)
+        write_results(args.out, rows)
 
 
 if __name__ == "__main__":

@@ -58,7 +58,7 @@ from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Bo
                   Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                   Ip2_FrictMat_FrictMat_CapillaryPhys, Ip2_FrictMat_FrictMat_FrictPhys,
                   Law2_ScGeom_CapillaryPhys_Capillarity, Law2_ScGeom_FrictPhys_CundallStrack,
-                  NewtonIntegrator, PyRunner, Sphere, TriaxialStressController)
+                  NewtonIntegrator, PyRunner, TriaxialStressController)
 import yade.config
 
 REQUIRED = ("spheres", "young", "poisson", "friction_deg", "density", "damping", "dt",

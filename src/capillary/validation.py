@@ -1,7 +1,5 @@
 """Input checks for the capillary package: each names the parameter, its value and the valid range."""
 
-import math
-
 from dem.validate import check_positive, finite_number  # noqa: F401  (shared checks)
 
 MAX_RADIUS_RATIO = 20.0

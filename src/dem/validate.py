@@ -5,17 +5,6 @@ import math
 import numpy as np
 
 
-def check_finite(name, value):
-    """Return ``value`` as float after checking it is a finite number."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return number
-
-
 def finite_number(name, value, valid_range):
     """``value`` as a float; ValueError naming the parameter, value and ``valid_range`` (text)
     unless it is a finite number."""
@@ -31,15 +20,15 @@ def finite_number(name, value, valid_range):
 def check_range(name, value, low=-math.inf, high=math.inf, *, low_inclusive=True,
                 high_inclusive=True, unit=""):
     """Return ``value`` as float after checking it lies in [low, high] (bounds open or closed)."""
-    number = check_finite(name, value)
+    left = "[" if low_inclusive else "("
+    right = "]" if high_inclusive else ")"
+    suffix = f" {unit}" if unit else ""
+    valid_range = f"{left}{low:g}, {high:g}{right}{suffix}"
+    number = finite_number(name, value, valid_range)
     too_low = number < low if low_inclusive else number <= low
     too_high = number > high if high_inclusive else number >= high
     if too_low or too_high:
-        left = "[" if low_inclusive else "("
-        right = "]" if high_inclusive else ")"
-        suffix = f" {unit}" if unit else ""
-        raise ValueError(
-            f"{name} = {value!r}{suffix} is outside the valid range {left}{low:g}, {high:g}{right}{suffix}")
+        raise ValueError(f"{name} = {value!r}{suffix} is outside the valid range {valid_range}")
     return number
 
 
