@@ -2,22 +2,28 @@
 
     python scenarios/chapter5.py [--particles N] [--suctions 0,15000,30000,300000]
         [--confining 250,500,750,1000] [--jobs J] [--out DIR]
-        [--seed S] [--max-strain X] [--inertial-number I]
+        [--seed S] [--max-strain X] [--inertial-number I] [--scheduler ADDRESS]
 
 One sample is prepared per confining stress (dem.preparation.prepare_sample: radius growth to
 5 kPa, then unloaded to the test value, the same seed for all) and saved as
 DIR/samples/c{confining}.h5. Every (suction, confining) test (dry when the suction is 0) then
 starts from its sample (scenarios/triaxial.py --sample) in DIR/runs/s{suction}_c{confining}/,
 with the outputs of scenarios/triaxial.py (history.h5, summary.json, plots, vtk, sample.h5,
-log.txt). Preparations and tests run in --jobs parallel processes, one Numba thread each when
-J > 1.
+log.txt with the run's progress bar). Preparations and tests run in --jobs parallel processes,
+or on the Dask cluster of --scheduler (dask.distributed's concurrent.futures executor; its
+workers must see the same file system, this repository and DIR, and should run one thread
+each: ``dask worker ADDRESS --nthreads 1``), one Numba thread per run. The campaign's progress
+bar shows each running run's progress. Run again with the same DIR, a campaign reuses its
+samples and the runs that finished with the same arguments (an interrupted campaign goes on
+where it stopped; delete a run's folder to redo it).
 
 DIR/campaign.json: ``runs`` (suction, confining, peak_axial_stress, peak_q, p_at_peak,
 saturation_at_peak, peak_q_effective, p_effective_at_peak; a dry run's effective values are its
 net ones) and ``envelopes`` keyed by suction (str), each {phi_deg, cohesion} fitted to (p, q) at
 peak and {phi_eff_deg, cohesion_eff} to (p', q') at peak (Eq. 3.43; dem.envelope), where a
 suction has at least two confining stresses. DIR/report.md compares with thesis Table 5.3 and
-Fig. 5.5; DIR/plots/envelopes.png shows the failure points in net and effective stress.
+Fig. 5.5. DIR/plots/ (chapter5_figures): envelopes.png (Figs. 5.4, 5.6), q_ev.png (5.3),
+q_p_effective.png (5.7), polar_psi.png (5.5), polar_fabric.png, anisotropy.png (5.8).
 """
 
 import argparse
@@ -27,6 +33,7 @@ import json
 import math
 import multiprocessing
 import os
+import re
 import sys
 import traceback
 
@@ -34,12 +41,13 @@ import h5py
 import numpy as np
 from tqdm import tqdm
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from dem.atomic import replacing
+from dem.envelope import mohr_coulomb_fit
 
-import triaxial  # noqa: E402  (scenarios/triaxial.py)
-from dem.envelope import mohr_coulomb_fit  # noqa: E402
-from dem.preparation import prepare_sample  # noqa: E402
-from dem.sample import save_sample  # noqa: E402
+#: This folder: scenarios/triaxial.py and chapter5_figures.py.
+SCENARIOS = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, SCENARIOS)
+from chapter5_figures import campaign_figures  # noqa: E402
 
 #: Thesis Table 5.3: axial stress at peak [Pa], keyed (suction [Pa], lateral stress [Pa]).
 TABLE_5_3 = {
@@ -54,6 +62,11 @@ FIG_5_5 = {15000: 0.055, 30000: 0.022, 300000: 0.0005}
 DRY_FRICTION_DEG = 25.0
 #: Strain at which Sr is also reported (Fig. 5.5's horizontal axis ends there).
 LATE_STRAIN = 0.20
+#: triaxial.py arguments that do not change a run's result (a finished run is reused whatever
+#: they were).
+RESULT_NEUTRAL = ("out", "quiet", "threads", "resume", "stop_after", "sample")
+#: Seconds between updates of the campaign's progress bar.
+PROGRESS_PERIOD = 5.0
 
 
 def _values(text, name):
@@ -79,6 +92,9 @@ def parse_args(argv=None):
     parser.add_argument("--max-strain", type=float, default=0.25, help="final axial strain")
     parser.add_argument("--inertial-number", type=float, default=3e-4,
                         help="target inertial number setting the strain rate")
+    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                        help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
+                             "instead of --jobs local processes")
     args = parser.parse_args(argv)
     try:
         args.suctions = _values(args.suctions, "suctions")
@@ -113,36 +129,56 @@ def run_folder(out, suction, confining):
 
 
 def _common(args):
-    return ["--particles", str(args.particles), "--seed", str(args.seed),
-            "--max-strain", repr(args.max_strain),
-            "--inertial-number", repr(args.inertial_number), "--quiet"]
+    """triaxial.py arguments shared by every sample and run of the campaign."""
+    common = ["--particles", str(args.particles), "--seed", str(args.seed),
+              "--max-strain", repr(args.max_strain),
+              "--inertial-number", repr(args.inertial_number)]
+    if args.jobs > 1 or args.scheduler is not None:
+        common += ["--threads", "1"]          # one core per run
+    return common
 
 
-def _single_thread():
-    """Worker initializer: one Numba thread per process."""
-    import numba
-    numba.set_num_threads(1)
+def _triaxial():
+    """scenarios/triaxial.py as a module, imported where the function runs (a Dask worker has
+    the scenarios folder of the same file system, not on its path)."""
+    if SCENARIOS not in sys.path:
+        sys.path.insert(0, SCENARIOS)
+    import triaxial
+    return triaxial
 
 
 def prepare_one(argv, path):
     """Worker: prepare the sample of triaxial.py's arguments ``argv`` and save it at ``path``."""
-    args = triaxial.parse_args(argv)
-    prepare, _, _ = triaxial.configs(args)
-    sim, report = prepare_sample(prepare, progress=False)
-    config = json.loads(json.dumps({"arguments": vars(args)}, default=triaxial._plain))
-    save_sample(path, sim, report, config)
-    return path
+    return _triaxial().prepare_and_save(argv + ["--quiet"], path)
 
 
 def run_one(argv, folder):
-    """Worker: one triaxial test (triaxial.main) into ``folder``, its output in log.txt."""
+    """Worker: one triaxial test (triaxial.main) into ``folder``; its output, progress bar
+    included, goes to ``folder``/log.txt."""
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
         try:
-            return triaxial.main(argv + ["--out", folder])
+            return _triaxial().main(argv + ["--out", folder])
         except SystemExit as stop:
             raise RuntimeError(f"triaxial.py {' '.join(argv)} stopped: {stop.code}") from None
+
+
+def finished_summary(argv, folder):
+    """summary.json of a run of ``folder`` that ended with the arguments ``argv`` (up to those
+    that do not change its result), or None: a campaign run again reuses its finished runs."""
+    if not all(os.path.exists(os.path.join(folder, name))
+               for name in ("summary.json", "sample.h5", "history.h5")):
+        return None
+    with h5py.File(os.path.join(folder, "sample.h5"), "r") as handle:
+        stored = json.loads(handle.attrs["config"]).get("arguments", {})
+    wanted = json.loads(json.dumps(vars(_triaxial().parse_args(argv + ["--out", folder])),
+                                   default=str))
+    if any(stored.get(key, value) != value for key, value in wanted.items()
+           if key not in RESULT_NEUTRAL):
+        return None
+    with open(os.path.join(folder, "summary.json")) as handle:
+        return json.load(handle)
 
 
 def saturation_at(folder, strain):
@@ -183,7 +219,9 @@ def _fmt(value, spec=".0f", scale=1.0):
     return "" if value is None else format(value * scale, spec)
 
 
-def write_report(path, runs, fits, args):
+def write_report(path, runs, fits, args, figures, out):
+    """DIR/report.md: every Table 5.3 cell and Sr beside the thesis's, the envelopes, the runs
+    and the ``figures`` ({name: path}, linked relative to ``out``)."""
     rows = {(r["suction"], r["confining"]): r for r in runs}
     suctions = sorted({r["suction"] for r in runs} | {s for s, _ in TABLE_5_3})
     confining = sorted({r["confining"] for r in runs} | {c for _, c in TABLE_5_3})
@@ -217,11 +255,15 @@ def write_report(path, runs, fits, args):
     lines += ["", "## Failure envelopes (Mohr–Coulomb in p–q)", "",
               f"Thesis: dry friction angle {DRY_FRICTION_DEG:.0f} deg; with the effective stress "
               "of Eq. 3.43 every suction should fall on the dry line (Fig. 5.6b).", "",
-              "| suction [Pa] | phi net [deg] | c net [Pa] | phi' [deg] | c' [Pa] |",
-              "|---:|---:|---:|---:|---:|"]
+              "| suction [Pa] | phi net [deg] | c net [Pa] | phi' [deg] | c' [Pa] | "
+              "phi' - phi dry [deg] |", "|---:|---:|---:|---:|---:|---:|"]
+    dry_phi = fits.get(label(0.0), {}).get("phi_deg")
     for key, fit in fits.items():
+        offset = (None if dry_phi is None or fit["phi_eff_deg"] is None
+                  else fit["phi_eff_deg"] - dry_phi)
         lines.append(f"| {key} | {_fmt(fit['phi_deg'], '.2f')} | {_fmt(fit['cohesion'], '.1f')} "
-                     f"| {_fmt(fit['phi_eff_deg'], '.2f')} | {_fmt(fit['cohesion_eff'], '.1f')} |")
+                     f"| {_fmt(fit['phi_eff_deg'], '.2f')} | {_fmt(fit['cohesion_eff'], '.1f')} "
+                     f"| {_fmt(offset, '+.2f')} |")
         for error in fit.get("errors", []):
             lines.append(f"| {key} | fit failed: {error} | | | |")
     if not fits:
@@ -233,130 +275,132 @@ def write_report(path, runs, fits, args):
         lines.append(f"| {label(r['suction'])} | {label(r['confining'])} | {r['peak_q']:.0f} | "
                      f"{r['p_at_peak']:.0f} | {r['peak_q_effective']:.0f} | "
                      f"{r['p_effective_at_peak']:.0f} | {r['folder']} |")
-    lines += ["", "## Figures", "", "![p-q failure envelopes](plots/envelopes.png)", ""]
-    lines += [f"- {r['folder']}/plots/q_p.png" for r in runs]
-    with open(path, "w") as handle:
+    lines += ["", "## Figures", ""]
+    lines += [f"![{name}]({os.path.relpath(figure, out)})" for name, figure in figures.items()]
+    lines += ["", "Each run's own plots: " + ", ".join(f"{r['folder']}/plots" for r in runs)]
+    with replacing(path) as temporary, open(temporary, "w") as handle:
         handle.write("\n".join(lines) + "\n")
 
 
-def plot_envelopes(path, runs, fits):
-    """Failure points (p, q) and (p', q') with each suction's fit and the dry line."""
-    plt = triaxial._pyplot()
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    figure, panels = plt.subplots(1, 2, figsize=(11, 4.5))
-    p_max = max(max(r["p_at_peak"], r["p_effective_at_peak"]) for r in runs) * 1.1
-    dry = fits.get("0")
-    for axes, (pk, qk, phik, ck, title) in zip(panels, (
-            ("p_at_peak", "peak_q", "phi_deg", "cohesion", "net stress"),
-            ("p_effective_at_peak", "peak_q_effective", "phi_eff_deg", "cohesion_eff",
-             "effective stress (Eq. 3.43)"))):
-        for index, suction in enumerate(sorted({r["suction"] for r in runs})):
-            rows = [r for r in runs if r["suction"] == suction]
-            color = f"C{index}"
-            axes.plot([r[pk] for r in rows], [r[qk] for r in rows], "o", color=color,
-                      label=f"s = {label(suction)} Pa")
-            fit = fits.get(label(suction))
-            if fit and fit[phik] is not None and suction != 0:
-                axes.plot(*_line(fit[phik], fit[ck], p_max), "--", color=color, lw=1)
-        if dry and dry["phi_deg"] is not None:
-            axes.plot(*_line(dry["phi_deg"], dry["cohesion"], p_max), "k-", lw=1.5,
-                      label=f"dry line, phi = {dry['phi_deg']:.1f} deg")
-        axes.set_xlim(0, p_max)
-        axes.set_ylim(bottom=0)
-        axes.set_xlabel("p' [Pa]" if "effective" in pk else "p [Pa]")
-        axes.set_ylabel("q' [Pa]" if "effective" in pk else "q [Pa]")
-        axes.set_title(title)
-        axes.legend(fontsize=8)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+@contextlib.contextmanager
+def executor(jobs, scheduler):
+    """Where the runs go: None (here, one after the other), a spawn process pool of ``jobs``
+    workers, or the concurrent.futures executor of the Dask cluster at ``scheduler``."""
+    if scheduler is not None:
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            sys.exit("chapter5.py: error: --scheduler needs dask.distributed: "
+                     "pip install 'pendular[dask]'")
+        with Client(scheduler) as client:
+            pool = client.get_executor(pure=False)
+            try:
+                yield pool
+            finally:
+                pool.shutdown()
+    elif jobs == 1:
+        yield None
+    else:
+        # fresh interpreters (no fork of a running Numba threading layer)
+        with concurrent.futures.ProcessPoolExecutor(
+                jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+            yield pool
 
 
-def _line(phi_deg, cohesion, p_max):
-    """p and q of the Mohr–Coulomb line q = M p + q0 (dem.envelope) over [0, p_max]."""
-    sin_phi = math.sin(math.radians(phi_deg))
-    slope = 6 * sin_phi / (3 - sin_phi)
-    q0 = cohesion * 6 * math.cos(math.radians(phi_deg)) / (3 - sin_phi)
-    p = np.array([0.0, p_max])
-    return p, slope * p + q0
+def run_progress(folder):
+    """The last progress a run's log.txt shows ('shear 42%'), or '' before it starts."""
+    try:
+        with open(os.path.join(folder, "log.txt"), "rb") as handle:
+            handle.seek(0, os.SEEK_END)
+            handle.seek(max(0, handle.tell() - 4096))
+            tail = handle.read().decode(errors="replace")
+    except OSError:
+        return ""
+    for line in reversed(re.split(r"[\r\n]+", tail)):
+        match = re.match(r"\s*(\w[\w ]*?):\s*(\d+)%", line)
+        if match:
+            return f"{match.group(1)} {match.group(2)}%"
+    return ""
 
 
-def _executor(jobs):
-    if jobs == 1:
-        return None
-    # fresh interpreters (no fork of a running Numba threading layer), one thread each
-    return concurrent.futures.ProcessPoolExecutor(
-        jobs, mp_context=multiprocessing.get_context("spawn"), initializer=_single_thread)
-
-
-def _map(executor, function, tasks, description):
-    """Run ``function(*task)`` for every task (in the pool or here), with a progress bar;
+def _map(pool, function, tasks, description):
+    """Run ``function(*task)`` for every task (in ``pool`` or here) with a progress bar whose
+    status shows each running run's own progress (tasks whose last item is a run folder);
     returns the results in the order of ``tasks``."""
     results = [None] * len(tasks)
-    bar = tqdm(total=len(tasks), desc=description, unit="run")
-    try:
-        if executor is None:
+    if not tasks:
+        return results
+    with tqdm(total=len(tasks), desc=description, unit="run") as bar:
+        if pool is None:
             for index, task in enumerate(tasks):
+                bar.set_postfix_str(os.path.basename(task[-1]))
                 results[index] = function(*task)
                 bar.update()
-        else:
-            futures = {executor.submit(function, *task): i for i, task in enumerate(tasks)}
-            for future in concurrent.futures.as_completed(futures):
-                results[futures[future]] = future.result()
+            return results
+        pending = {pool.submit(function, *task): i for i, task in enumerate(tasks)}
+        while pending:
+            done, _ = concurrent.futures.wait(pending, timeout=PROGRESS_PERIOD,
+                                              return_when=concurrent.futures.FIRST_COMPLETED)
+            for future in done:
+                results[pending.pop(future)] = future.result()
                 bar.update()
-    finally:
-        bar.close()
+            running = (tasks[i][-1] for i in sorted(pending.values()))
+            bar.set_postfix_str(", ".join(f"{os.path.basename(f)} {p}" for f in running
+                                          for p in [run_progress(f)] if p))
     return results
+
+
+def run_row(suction, lateral, summary, folder, out):
+    """The campaign.json row of one run (module docstring)."""
+    wet = suction > 0
+    return {"suction": suction, "confining": lateral,
+            "peak_axial_stress": summary["peak_axial_stress"],
+            "peak_q": summary["peak_q"], "p_at_peak": summary["p_at_peak"],
+            "saturation_at_peak": summary.get("saturation_at_peak", 0.0 if not wet else None),
+            "peak_q_effective": summary["peak_q_effective"] if wet else summary["peak_q"],
+            "p_effective_at_peak": (summary["p_effective_at_peak"] if wet
+                                    else summary["p_at_peak"]),
+            "axial_strain_at_peak": summary["axial_strain_at_peak"],
+            "saturation_at_20_percent": saturation_at(folder, LATE_STRAIN) if wet else None,
+            "folder": os.path.relpath(folder, out)}
 
 
 def main(argv=None):
     args = parse_args(argv)
-    out = args.out
+    out = os.path.abspath(args.out)       # workers elsewhere see the same paths
     os.makedirs(os.path.join(out, "samples"), exist_ok=True)
     common = _common(args)
-    if args.jobs > 1:
-        os.environ["NUMBA_NUM_THREADS"] = "1"   # the spawned workers' Numba
-    executor = _executor(args.jobs)
-    try:
-        preparations = [(common + ["--confining", repr(c)], sample_path(out, c))
-                        for c in args.confining]
-        _map(executor, prepare_one, preparations, "prepare")
-        tests = [(s, c) for s in args.suctions for c in args.confining]
-        tasks = []
-        for suction, lateral in tests:
-            argv_run = common + ["--confining", repr(lateral), "--sample",
-                                 sample_path(out, lateral)]
-            if suction > 0:
-                argv_run += ["--suction", repr(suction)]
-            tasks.append((argv_run, run_folder(out, suction, lateral)))
-        summaries = _map(executor, run_one, tasks, "triaxial")
-    finally:
-        if executor is not None:
-            executor.shutdown()
-    runs = []
-    for (suction, lateral), summary, (_, folder) in zip(tests, summaries, tasks):
-        wet = suction > 0
-        row = {"suction": suction, "confining": lateral,
-               "peak_axial_stress": summary["peak_axial_stress"],
-               "peak_q": summary["peak_q"], "p_at_peak": summary["p_at_peak"],
-               "saturation_at_peak": summary.get("saturation_at_peak", 0.0 if not wet else None),
-               "peak_q_effective": summary["peak_q_effective"] if wet else summary["peak_q"],
-               "p_effective_at_peak": (summary["p_effective_at_peak"] if wet
-                                       else summary["p_at_peak"]),
-               "axial_strain_at_peak": summary["axial_strain_at_peak"],
-               "saturation_at_20_percent": saturation_at(folder, LATE_STRAIN) if wet else None,
-               "folder": os.path.relpath(folder, out)}
-        runs.append(row)
+    preparations = [(common + ["--confining", repr(c)], sample_path(out, c))
+                    for c in args.confining if not os.path.exists(sample_path(out, c))]
+    tests = [(s, c) for s in args.suctions for c in args.confining]
+    summaries, tasks, keys = {}, [], []
+    for suction, lateral in tests:
+        folder = run_folder(out, suction, lateral)
+        argv_run = common + ["--confining", repr(lateral), "--sample", sample_path(out, lateral)]
+        if suction > 0:
+            argv_run += ["--suction", repr(suction)]
+        summaries[(suction, lateral)] = finished_summary(argv_run, folder)
+        if summaries[(suction, lateral)] is None:
+            tasks.append((argv_run, folder))
+            keys.append((suction, lateral))
+    if len(keys) < len(tests):
+        print(f"chapter5.py: {len(tests) - len(keys)} finished runs in {out} reused, "
+              f"{len(keys)} to run")
+    with executor(args.jobs, args.scheduler) as pool:
+        _map(pool, prepare_one, preparations, "prepare")
+        summaries.update(zip(keys, _map(pool, run_one, tasks, "triaxial")))
+    runs = [run_row(s, c, summaries[(s, c)], run_folder(out, s, c), out) for s, c in tests]
     fits = envelopes(runs)
     campaign = {"arguments": vars(args), "runs": runs, "envelopes": fits,
                 "thesis": {"table_5_3": [{"suction": s, "confining": c, "peak_axial_stress": v}
                                          for (s, c), v in TABLE_5_3.items()],
                            "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
                            "dry_friction_deg": DRY_FRICTION_DEG}}
-    with open(os.path.join(out, "campaign.json"), "w") as handle:
+    with replacing(os.path.join(out, "campaign.json")) as temporary, \
+            open(temporary, "w") as handle:
         json.dump(campaign, handle, indent=2)
-    plot_envelopes(os.path.join(out, "plots", "envelopes.png"), runs, fits)
-    write_report(os.path.join(out, "report.md"), runs, fits, args)
+    figures = campaign_figures(out, runs, fits, label, LATE_STRAIN)
+    write_report(os.path.join(out, "report.md"), runs, fits, args, figures, out)
     print(f"chapter5.py: {len(runs)} runs; {os.path.join(out, 'campaign.json')}, "
           f"{os.path.join(out, 'report.md')}")
     return campaign

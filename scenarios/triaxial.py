@@ -4,6 +4,8 @@
         [--contact-angle DEG] [--max-strain X] [--seed S] [--out DIR]
         [--bridges exact|toroidal] [--surface-tension N/M] [--persist-bridges]
         [--vtk-every N] [--checkpoint-every N] [--sample PATH]
+        [--timestep-safety F] [--inertial-number I | --strain-rate R] [--damping L]
+        [--skin-factor F] [--table-resolution NS,ND] [--records N] [--threads T] [--quiet]
     python scenarios/triaxial.py --resume DIR [--quiet] [--threads T]
 
 Writes DIR/history.h5 (group ``history``, one row per record; file attributes hold every input),
@@ -98,6 +100,11 @@ def parse_args(argv=None):
                         help="axial strain rate [1/s] (overrides --inertial-number)")
     parser.add_argument("--timestep-safety", type=float, default=0.7,
                         help="time step as a fraction of the P-wave estimate")
+    parser.add_argument("--skin-factor", type=float, default=0.3,
+                        help="Verlet skin of the neighbour list / radius (0, 2]")
+    parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
+                        help="bridge table nodes in suction and in distance (exact default "
+                             "350,80; toroidal 64,80)")
     parser.add_argument("--records", type=int, default=500, help="history rows over the test")
     parser.add_argument("--threads", type=int, default=None, help="Numba threads")
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -134,7 +141,16 @@ def parse_args(argv=None):
                      "(0: dry)")
     if args.wet_steps < 0:
         parser.error(f"--wet-steps {args.wet_steps} is outside the valid range [0, inf)")
+    if args.table_resolution is not None:
+        try:
+            nodes = [int(v) for v in args.table_resolution.split(",")]
+        except ValueError:
+            nodes = []
+        if len(nodes) != 2 or min(nodes) < 4:
+            parser.error(f"--table-resolution {args.table_resolution!r}: two integers NS,ND, "
+                         "each in [4, inf), expected")
     wet_only = {"--contact-angle": args.contact_angle is not None,
+                "--table-resolution": args.table_resolution is not None,
                 "--bridges": args.bridges is not None,
                 "--surface-tension": args.surface_tension is not None,
                 "--persist-bridges": args.persist_bridges}
@@ -206,6 +222,17 @@ def resume(args):
     return run.finish()
 
 
+def prepare_and_save(argv, path):
+    """Prepare the sample of the arguments ``argv`` (no shear) and save it at ``path`` for
+    --sample; returns ``path``."""
+    args = parse_args(argv)
+    prepare, _, _ = configs(args)
+    sim, report = prepare_sample(prepare, progress=not args.quiet)
+    config = json.loads(json.dumps({"arguments": vars(args)}, default=_plain))
+    save_sample(path, sim, report, config)
+    return path
+
+
 def saved_sample(path, prepare, max_steps, progress):
     """(Simulation, preparation report) of the sample saved at ``path``, servoed at the
     confining stress of ``prepare`` and run until static (at most ``max_steps`` steps)."""
@@ -238,7 +265,7 @@ def configs(args):
                             porosity=args.porosity, young=args.young,
                             friction_deg=args.friction, damping=args.damping,
                             timestep_safety=args.timestep_safety, confining=args.confining,
-                            seed=args.seed)
+                            seed=args.seed, skin_factor=getattr(args, "skin_factor", 0.3))
     shear = ShearConfig(confining=args.confining, max_strain=args.max_strain,
                         inertial_number=args.inertial_number, strain_rate=args.strain_rate,
                         records=args.records)
@@ -371,9 +398,13 @@ def wet_bridges(args, radius):
     from capillary.coupling import CapillaryBridges
 
     surface_tension = 0.073 if args.surface_tension is None else args.surface_tension
+    resolution = getattr(args, "table_resolution", None)     # absent from older runs' arguments
+    table_options = (None if resolution is None else
+                     dict(zip(("n_suction", "n_distance"), map(int, resolution.split(",")))))
     bridges = CapillaryBridges(args.suction, surface_tension=surface_tension,
                                contact_angle=args.contact_angle or 0.0,
-                               model=args.bridges or "exact", persist=args.persist_bridges)
+                               model=args.bridges or "exact", persist=args.persist_bridges,
+                               table_options=table_options)
     bridges.load_tables(radius, radius)
     return bridges
 

@@ -6,6 +6,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -71,3 +72,55 @@ def test_report_and_plot(campaign):
     assert "| 300000 | 750 |  | 8289 |" in report                 # thesis cell we did not run
     assert "2.20" in report                                       # Fig. 5.5 at 30 kPa
     assert (out / "plots" / "envelopes.png").stat().st_size > 0
+
+
+def test_campaign_figures(campaign):
+    out, _ = campaign
+    for name in ("q_ev", "q_p_effective", "polar_psi", "polar_fabric", "anisotropy"):
+        path = out / "plots" / f"{name}.png"
+        assert path.stat().st_size > 0, path
+        assert f"plots/{name}.png" in (out / "report.md").read_text()
+
+
+def test_directional_value_of_a_tensor_is_its_quadratic_form():
+    sys.path.insert(0, os.path.dirname(SCENARIO))
+    from chapter5_figures import directional
+
+    tensor = np.array([[2.0, 0.0, 0.5], [0.0, 7.0, 0.0], [0.5, 0.0, 3.0]])
+    angles = np.linspace(0.0, 2 * np.pi, 13)
+    normals = np.stack([np.sin(angles), np.zeros_like(angles), np.cos(angles)], axis=1)
+    expected = np.einsum("ai,ij,aj->a", normals, tensor, normals)
+    assert np.allclose(directional(tensor, angles), expected, rtol=1e-14)
+    assert directional(tensor, np.array([0.0]))[0] == 3.0          # axial direction: T_zz
+
+
+def test_rerun_reuses_finished_runs(campaign):
+    out, data = campaign
+    stamps = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/history.h5")}
+    result = subprocess.run([sys.executable, SCENARIO, "--particles", "120", "--suctions",
+                             "0,30000", "--confining", "500,1000", "--max-strain", "0.01",
+                             "--inertial-number", "3e-3", "--jobs", "2", "--out", str(out)],
+                            check=True, capture_output=True, text=True, timeout=120)
+    assert "4 finished runs" in result.stdout
+    assert {p: p.stat().st_mtime_ns for p in stamps} == stamps        # nothing re-run
+    with open(out / "campaign.json") as handle:
+        assert json.load(handle)["runs"] == data["runs"]
+
+
+def test_campaign_on_a_dask_cluster(tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        subprocess.run([sys.executable, SCENARIO, "--particles", "120", "--suctions", "30000",
+                        "--confining", "500,1000", "--max-strain", "0.01",
+                        "--inertial-number", "3e-3", "--scheduler", cluster.scheduler_address,
+                        "--out", str(out)], check=True, capture_output=True, text=True,
+                       timeout=300)
+    with open(out / "campaign.json") as handle:
+        runs = json.load(handle)["runs"]
+    assert sorted(r["confining"] for r in runs) == [500, 1000]
+    for run in runs:
+        assert run["peak_axial_stress"] > run["confining"]
+        assert 0.0 < run["saturation_at_peak"] < 1.0
+        assert (out / run["folder"] / "history.h5").exists()
