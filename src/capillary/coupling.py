@@ -57,7 +57,8 @@ import numba
 import numpy as np
 
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable, lookup_suction
-from capillary.validation import check_contact_angle
+from capillary.validation import (check_bridge_stiffness, check_contact_angle,
+                                  check_pendular_suction)
 from capillary.volume_table import VolumeBridgeTable, lookup_volume
 from dem.contact_law import ContactForces
 from dem.neighbors import NeighborList, gather_pair_vectors
@@ -382,6 +383,9 @@ class CapillaryBridges:
         if not indices:
             raise ValueError("CapillaryBridges must follow a ContactForces operation: the "
                              "simulation has none")
+        for contact_law in (op for op in sim.operations if isinstance(op, ContactForces)):
+            check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
+                                   self.surface_tension)
         sim.operations.insert(max(indices) + 1, self)
         self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
         if self.persist:
@@ -417,6 +421,7 @@ class CapillaryBridges:
                 f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
                 f"{self.surface_tension:g} N/m) exceeds the table's "
                 f"{self.suction_table.suction_max:g}")
+        check_pendular_suction(self.suction_table, self.suction, low, self.surface_tension)
         if self.control == "volume":
             self.volume_table = VolumeBridgeTable.cached(
                 self.contact_angle, radius_ratios=self.suction_table.radius_ratios)

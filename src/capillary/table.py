@@ -27,6 +27,8 @@ import numpy as np
 from capillary.meniscus import bridge_kernel
 from capillary.suction_control import rupture_point, stable_filling_angle
 from capillary.validation import check_contact_angle, check_positive, check_radius_ratio
+from dem.atomic import replacing
+from dem.validate import reading
 
 YADE_RADIUS_RATIOS = (1.0, 1.1, 1.25, 1.5, 1.75, 2.0, 3.0, 4.0, 5.0, 10.0)
 """Radius ratios of YADE's capillary files M(r=1) ... M(r=10)."""
@@ -44,12 +46,11 @@ def cache_directory():
 
 
 def save_atomically(table, path):
-    """table.save to path through a temporary file, so that concurrent runs never read a partial table."""
+    """table.save to path (atomic: concurrent runs never read a partial table), creating its
+    folder."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    partial = path.with_name(f"{path.name}.{os.getpid()}.partial")
-    table.save(partial)
-    os.replace(partial, path)
+    table.save(path)
 
 
 def cache_key(kind, parameters):
@@ -315,7 +316,10 @@ class BridgeTable:
         parameters = cls._parameters(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
         path = Path(directory or cache_directory()) / f"bridge_table_{cache_key('suction', parameters)}.h5"
         if path.exists():
-            return cls.load(path)
+            try:
+                return cls.load(path)
+            except ValueError:      # a corrupt or foreign file in the cache: build it again
+                pass
         table = cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
         save_atomically(table, path)
         return table
@@ -332,8 +336,8 @@ class BridgeTable:
         return lookup_suction(*self.arrays(), float(radius_ratio), float(suction_star), float(distance_star))
 
     def save(self, path):
-        """Write the table to an HDF5 file."""
-        with h5py.File(path, "w") as h5:
+        """Write the table to an HDF5 file, atomically (dem.atomic.replacing)."""
+        with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
             h5.attrs["kind"] = "suction"
             h5.attrs["format"] = TABLE_FORMAT
             h5.attrs["contact_angle_deg"] = self.contact_angle
@@ -348,7 +352,7 @@ class BridgeTable:
     @classmethod
     def load(cls, path):
         """Read a table written by save()."""
-        with h5py.File(path, "r") as h5:
+        with reading(path, "suction-controlled bridge table"), h5py.File(path, "r") as h5:
             if h5.attrs.get("kind") != "suction" or h5.attrs.get("format") != TABLE_FORMAT:
                 raise ValueError(f"{path} is not a suction-controlled bridge table of format {TABLE_FORMAT}")
             return cls(

@@ -33,6 +33,8 @@ from capillary.table import (
     save_atomically,
 )
 from capillary.validation import check_contact_angle, check_radius_ratio
+from dem.atomic import replacing
+from dem.validate import reading
 from capillary.volume_control import (
     CONTACT_SUCTION_MAX,
     contour_point_at_distance,
@@ -216,7 +218,10 @@ class VolumeBridgeTable:
         key = cache_key("volume", cls._parameters(contact_angle, radius_ratios, n_volume, n_distance))
         path = Path(directory or cache_directory()) / f"volume_bridge_table_{key}.h5"
         if path.exists():
-            return cls.load(path)
+            try:
+                return cls.load(path)
+            except ValueError:      # a corrupt or foreign file in the cache: build it again
+                pass
         table = cls.build(contact_angle, radius_ratios, n_volume, n_distance)
         save_atomically(table, path)
         return table
@@ -232,8 +237,8 @@ class VolumeBridgeTable:
         return lookup_volume(*self.arrays(), float(radius_ratio), float(volume_star), float(distance_star))
 
     def save(self, path):
-        """Write the table to an HDF5 file."""
-        with h5py.File(path, "w") as h5:
+        """Write the table to an HDF5 file, atomically (dem.atomic.replacing)."""
+        with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
             h5.attrs["kind"] = "volume"
             h5.attrs["format"] = TABLE_FORMAT
             h5.attrs["contact_angle_deg"] = self.contact_angle
@@ -247,7 +252,7 @@ class VolumeBridgeTable:
     @classmethod
     def load(cls, path):
         """Read a table written by save()."""
-        with h5py.File(path, "r") as h5:
+        with reading(path, "volume-controlled bridge table"), h5py.File(path, "r") as h5:
             if h5.attrs.get("kind") != "volume" or h5.attrs.get("format") != TABLE_FORMAT:
                 raise ValueError(f"{path} is not a volume-controlled bridge table of format {TABLE_FORMAT}")
             return cls(

@@ -23,6 +23,8 @@ import numpy as np
 
 from capillary.meniscus import bridge_kernel
 from capillary.suction_control import rupture_point, stable_filling_angle
+from dem.atomic import replacing
+from dem.validate import reading
 
 COLUMNS = ("distance", "suction", "volume", "force", "delta1", "delta2", "nn11", "nn33")
 
@@ -103,25 +105,32 @@ def write_yade(folder, contact_angle, radius_ratios, suction_values, n_distance=
             lines.append("\t".join([str(len(block))] + ["0"] * 7))
             lines.extend("\t".join(f"{x:.12g}" for x in row) for row in block)
         path = folder / yade_file_name(radius_ratio)
-        path.write_text("\n".join(lines) + "\n")
+        with replacing(path) as temporary:
+            Path(temporary).write_text("\n".join(lines) + "\n")
         paths.append(path)
     return paths
 
 
 def read_capillary_file(path):
-    """Parse one capillary file as YADE does (whitespace-separated numbers)."""
-    numbers = Path(path).read_text().split("\n")
-    radius_ratio = float(numbers[0].split()[0])
-    n_blocks = int(float(numbers[1].split()[0]))
-    blocks = []
-    line = 2
-    for _ in range(n_blocks):
-        n_rows = int(float(numbers[line].split()[0]))
-        if n_rows <= 0:
-            raise ValueError(f"{path}: block {len(blocks)} has {n_rows} rows; YADE needs at least one")
-        rows = np.array([[float(x) for x in numbers[line + 1 + i].split()[:8]] for i in range(n_rows)])
-        blocks.append(rows)
-        line += 1 + n_rows
+    """Parse one capillary file as YADE does (whitespace-separated numbers); ValueError naming
+    the path for a truncated or corrupt file."""
+    with reading(path, "YADE capillary file"):
+        numbers = Path(path).read_text().split("\n")
+        radius_ratio = float(numbers[0].split()[0])
+        n_blocks = int(float(numbers[1].split()[0]))
+        blocks = []
+        line = 2
+        for _ in range(n_blocks):
+            n_rows = int(float(numbers[line].split()[0]))
+            if n_rows <= 0:
+                raise ValueError(f"{path}: block {len(blocks)} has {n_rows} rows; YADE needs at least one")
+            rows = [[float(x) for x in numbers[line + 1 + i].split()[:8]] for i in range(n_rows)]
+            if any(len(row) != 8 for row in rows) or not np.all(np.isfinite(rows)):
+                raise ValueError(f"path = {str(path)!r} is not a readable YADE capillary file: block "
+                                 f"{len(blocks)} is not {n_rows} rows of 8 finite numbers")
+            rows = np.array(rows)
+            blocks.append(rows)
+            line += 1 + n_rows
     return YadeCapillaryFile(radius_ratio, tuple(blocks))
 
 

@@ -38,7 +38,7 @@ import numpy as np
 
 from .atomic import replacing
 from .neighbors import Contacts
-from .validate import check_int
+from .validate import check_int, reading
 
 FORMAT = "pendular-checkpoint"
 VERSION = 1
@@ -211,7 +211,7 @@ def load_checkpoint(path, sim):
     keep the values of ``sim``'s own operations.
     """
     path = os.fspath(path)
-    with h5py.File(path, "r") as handle:
+    with reading(path, "pendular checkpoint"), h5py.File(path, "r") as handle:
         if handle.attrs.get("format") != FORMAT:
             raise ValueError(f"{path!r} is not a pendular checkpoint")
         if int(handle.attrs["version"]) != VERSION:

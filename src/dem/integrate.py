@@ -3,7 +3,7 @@
 import numba
 import numpy as np
 
-from .validate import check_range
+from .validate import check_array, check_positive, check_range
 
 
 @numba.njit(cache=True, inline="always")
@@ -36,6 +36,9 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
 
 def pwave_timestep(radius, young, density):
     """YADE's P-wave estimate min R / sqrt(E / rho) [s] (to be multiplied by a safety factor)."""
+    radius = check_array("radius", np.atleast_1d(radius), positive=True)
+    young = check_positive("young", young, "Pa")
+    density = check_positive("density", density, "kg/m^3")
     return float(np.min(radius) / np.sqrt(young / density))
 
 

@@ -255,7 +255,13 @@ def carry_pair_array(previous, values, row_start, pair_j):
 
 def build_contacts(position, radius, skin, previous=None):
     """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals and
-    every ``extra`` per-pair array from ``previous`` if given."""
+    every ``extra`` per-pair array from ``previous`` if given. FloatingPointError if a position
+    is not finite (a diverged simulation would otherwise get a meaningless list)."""
+    if not np.isfinite(position).all():
+        particle = int(np.argwhere(~np.isfinite(position))[0, 0])
+        raise FloatingPointError(
+            f"position of particle {particle} = {position[particle].tolist()} is not finite: the "
+            "simulation diverged (lower the time step, e.g. timestep_safety, or check the forces)")
     count = len(radius)
     row_start, pair_j = build_pairs(position, radius, skin)
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))

@@ -69,15 +69,57 @@ def _random_cloud(count, radius, lo, hi, seed, max_attempts):
     return position
 
 
+@numba.njit(cache=True)
+def _random_cloud_pairwise(count, radius, lo, hi, seed, max_attempts):
+    """Random sequential insertion testing every placed sphere (O(count^2), small counts)."""
+    np.random.seed(seed)
+    position = np.empty((count, 3))
+    placed = 0
+    for _ in range(max_attempts):
+        x = np.empty(3)
+        for a in range(3):
+            x[a] = lo[a] + radius + np.random.random() * (hi[a] - lo[a] - 2.0 * radius)
+        free = True
+        for q in range(placed):
+            d = x - position[q]
+            if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < 4.0 * radius * radius:
+                free = False
+                break
+        if free:
+            position[placed] = x
+            placed += 1
+            if placed == count:
+                break
+    return position[:placed]
+
+
+#: Largest count for which random_cloud falls back to pairwise insertion.
+PAIRWISE_CLOUD_MAX = 2000
+
+
 def random_cloud(count, radius, lo, hi, seed):
-    """``count`` non-overlapping spheres of ``radius`` [m] uniformly placed in the box [lo, hi]."""
+    """``count`` non-overlapping spheres of ``radius`` [m] uniformly placed in the box [lo, hi].
+
+    Cell-list insertion admits one centre per cell, which in a box only a few diameters wide
+    leaves room for fewer spheres than fit; small counts that it cannot place are placed by
+    pairwise insertion instead (the cell-list result is kept whenever it succeeds)."""
     count = check_int("particles", count, low=1)
     radius = check_positive("radius", radius, "m")
-    position = _random_cloud(count, radius, np.asarray(lo, float), np.asarray(hi, float),
-                             check_int("seed", seed), 200 * count + 10000)
+    box = Walls.box(lo, hi)
+    lo, hi = np.ascontiguousarray(box.lo), np.ascontiguousarray(box.hi)
+    if np.any(hi - lo <= 2.0 * radius):
+        raise ValueError(f"radius = {radius:g} m is outside the valid range (0, "
+                         f"{0.5 * float(np.min(hi - lo)):g}] m for a box of edges "
+                         f"{(hi - lo).tolist()} m")
+    seed = check_int("seed", seed)
+    position = _random_cloud(count, radius, lo, hi, seed, 200 * count + 10000)
+    if len(position) < count and count <= PAIRWISE_CLOUD_MAX:
+        position = _random_cloud_pairwise(count, radius, lo, hi, seed, 200 * count + 10000)
     if len(position) < count:
-        raise ValueError(f"could place only {len(position)} of {count} spheres of radius "
-                         f"{radius:g} m without overlap; use a larger box or smaller radius")
+        raise ValueError(f"particles = {count} is outside the valid range [1, {len(position)}] "
+                         f"for spheres of radius {radius:g} m in this box: only "
+                         f"{len(position)} could be placed without overlap; use a larger box "
+                         "or a smaller radius")
     return position
 
 
@@ -96,6 +138,23 @@ class RadiusGrowth:
         rate = self.max_rate * float(np.clip(1.0 - mean_stress / self.target_stress, -1.0, 1.0))
         sim.particles.radius *= 1.0 + rate
         sim.particles.update_mass()
+
+
+#: Largest stress / young of a sample: linear springs kn = E R hold a stress sigma with
+#: overlaps of about 8 sigma / E times the radius at the most loaded contact (measured on
+#: prepared samples), so 0.02 keeps every overlap below about 16 % of the radius.
+MAX_STRESS_OVER_YOUNG = 0.02
+
+
+def check_soft_contacts(name, stress, young):
+    """ValueError naming ``name`` (a stress [Pa]) and ``young`` [Pa] when stress / young
+    exceeds MAX_STRESS_OVER_YOUNG (overlaps too large for the linear contact model)."""
+    if stress > MAX_STRESS_OVER_YOUNG * young:
+        raise ValueError(
+            f"{name} = {stress:g} Pa is outside the valid range [0, {MAX_STRESS_OVER_YOUNG * young:g}]"
+            f" Pa for young = {young:g} Pa: stress / young must stay below "
+            f"{MAX_STRESS_OVER_YOUNG:g} (overlaps of about 8 stress / young times the radius); "
+            f"lower {name} or raise young to at least {stress / MAX_STRESS_OVER_YOUNG:g} Pa")
 
 
 @dataclass
@@ -140,6 +199,11 @@ class PrepareConfig:
         self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
         self.skin_factor = check_range("skin_factor", self.skin_factor, 0.0, 2.0,
                                        low_inclusive=False)
+        for name in ("prep_stress", "confining"):
+            check_soft_contacts(name, getattr(self, name), self.young)
+        self.equilibrium_unbalanced = check_positive("equilibrium_unbalanced",
+                                                     self.equilibrium_unbalanced)
+        self.stress_tolerance = check_positive("stress_tolerance", self.stress_tolerance)
 
 
 def timestep(particles, config):
@@ -199,6 +263,9 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     The returned simulation's operations are the dry pipeline, the six-wall servo at the
     confining stress and the integrator; ``report`` gives porosity, coordination and steps.
     """
+    if not isinstance(config, PrepareConfig):
+        raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
+    max_steps = check_int("max_steps", max_steps, low=1)
     label = "prepare" if progress else None
     solid = config.particles * 4.0 / 3.0 * np.pi * config.radius ** 3
     edge = (solid / (1.0 - config.porosity)) ** (1.0 / 3.0)

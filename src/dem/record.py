@@ -17,6 +17,9 @@ class HistoryRecorder:
     def __init__(self, period, quantities):
         self.period = check_int("record period", period, low=1)
         self.quantities = dict(quantities)
+        for name, quantity in self.quantities.items():
+            if not callable(quantity):
+                raise TypeError(f"quantities[{name!r}] = {quantity!r} is not a function of sim")
         self.rows = {name: [] for name in self.quantities}
 
     def apply(self, sim):

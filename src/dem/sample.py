@@ -7,6 +7,7 @@ import numpy as np
 
 from .atomic import replacing
 from .state import Particles, Walls
+from .validate import reading
 
 
 def save_sample(path, sim, report=None, config=None):
@@ -22,8 +23,10 @@ def save_sample(path, sim, report=None, config=None):
 
 
 def load_sample(path):
-    """Read a sample written by ``save_sample``: (Particles, Walls, report dict, config dict)."""
-    with h5py.File(path, "r") as handle:
+    """Read a sample written by ``save_sample``: (Particles, Walls, report dict, config dict).
+
+    ValueError naming the path for a corrupt or foreign file or invalid contents."""
+    with reading(path, "pendular sample (dem.sample.save_sample)"), h5py.File(path, "r") as handle:
         particles = Particles(handle["position"][:], handle["radius"][:],
                               float(handle.attrs["density"]), velocity=handle["velocity"][:],
                               angular_velocity=handle["angular_velocity"][:])

@@ -13,6 +13,7 @@ import time
 import numba
 from tqdm import tqdm
 
+from .state import Particles, Walls
 from .validate import check_int, check_positive
 
 
@@ -38,6 +39,13 @@ class Simulation:
     """
 
     def __init__(self, particles, walls, dt, operations=(), writers=(), threads=None):
+        for name, value, kind in (("particles", particles, Particles), ("walls", walls, Walls)):
+            if not isinstance(value, kind):
+                raise TypeError(f"{name} must be a dem.state.{kind.__name__}, got "
+                                f"{type(value).__name__}")
+        for op in (*operations, *writers):
+            if not callable(getattr(op, "apply", None)):
+                raise TypeError(f"operation {op!r} has no apply(sim) method")
         self.particles = particles
         self.walls = walls
         self.dt = check_positive("dt", dt, "s")

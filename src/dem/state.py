@@ -27,15 +27,16 @@ class Particles:
 
     def __post_init__(self):
         self.position = check_array("position", self.position, (3,))
-        self.radius = check_array("radius", self.radius, positive=True)
-        if len(self.radius) != len(self.position):
-            raise ValueError(f"radius has {len(self.radius)} entries but position has {len(self.position)}")
+        if len(self.position) == 0:
+            raise ValueError("position holds no sphere: valid range at least 1 particle")
+        self.radius = check_array("radius", self.radius, positive=True, length=len(self.position))
         self.density = check_positive("density", self.density, "kg/m^3")
         count = len(self.radius)
         self.velocity = (np.zeros((count, 3)) if self.velocity is None
-                         else check_array("velocity", self.velocity, (3,)))
+                         else check_array("velocity", self.velocity, (3,), length=count))
         self.angular_velocity = (np.zeros((count, 3)) if self.angular_velocity is None
-                                 else check_array("angular_velocity", self.angular_velocity, (3,)))
+                                 else check_array("angular_velocity", self.angular_velocity, (3,),
+                                                  length=count))
         self.force = np.zeros((count, 3))
         self.torque = np.zeros((count, 3))
         self.mass = np.empty(count)
@@ -75,6 +76,14 @@ class Walls:
     force: np.ndarray = field(default_factory=lambda: np.zeros(6))
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(6))
     moment: np.ndarray = field(default_factory=lambda: np.zeros(6))
+
+    def __post_init__(self):
+        for name in ("position", "velocity", "force", "stiffness", "moment"):
+            setattr(self, name, check_array(f"walls {name}", getattr(self, name), length=6))
+        lo, hi = self.position[0::2], self.position[1::2]
+        if (hi <= lo).any():
+            raise ValueError(f"walls position = {self.position.tolist()} m: each high wall must "
+                             f"lie above its low wall (valid range hi > lo on every axis)")
 
     @classmethod
     def box(cls, lo, hi):

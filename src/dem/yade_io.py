@@ -29,6 +29,7 @@ import os
 import numpy as np
 
 from .atomic import replacing
+from .validate import reading
 
 SPHERE_FORMAT = "x_y_z_r"
 _BOX_TAGS = ("box_lo", "box_hi")
@@ -137,7 +138,7 @@ def read_spheres(path):
     path = os.fspath(path)
     rows = []
     box_lo = box_hi = None
-    with open(path) as source:
+    with reading(path, "YADE x_y_z_r sphere file"), open(path) as source:
         for lineno, line in enumerate(source, start=1):
             words = line.split()
             if not words:
@@ -194,7 +195,7 @@ def _read_plot_file(path):
     comments = []
     names = None
     rows = []
-    with _open_text(path) as source:
+    with reading(path, "yade.plot.saveDataTxt file"), _open_text(path) as source:
         for lineno, line in enumerate(source, start=1):
             text = line.rstrip("\r\n")
             if not text.strip():

@@ -33,6 +33,7 @@ vectorised numpy (about 10 ms for 30,000 bridges).
 
 import numpy as np
 
+from dem.validate import check_values
 from homogenize.fabric import principal_anisotropy
 
 
@@ -58,8 +59,10 @@ def wetted_cap_integral(radius, filling_angle):
     cap area, and A = (4/3) pi R^3 I for the whole sphere (a = 180 deg, the saturated limit).
     radius [m] and filling_angle [deg] broadcast; returns shape (..., 3, 3).
     """
+    radius = check_values("radius", radius, 0.0, low_inclusive=False, unit="m")
+    filling_angle = check_values("filling_angle", filling_angle, 0.0, 180.0, unit="deg")
     versine = _versine(filling_angle)
-    scale = np.pi * np.asarray(radius, float) ** 3 / 3.0
+    scale = np.pi * radius ** 3 / 3.0
     lateral = scale * versine**2 * (3.0 - versine)  # (1 - c)^2 (2 + c), c = 1 - versine
     axial = scale * 2.0 * versine * (3.0 - 3.0 * versine + versine**2)  # 2 (1 - c)(1 + c + c^2)
     return _axisymmetric(lateral, axial)
@@ -72,9 +75,13 @@ def contact_line_integral(radius, filling_angle, contact_angle, surface_tension)
     radius [m], filling_angle and contact_angle [deg], surface_tension [N/m] broadcast;
     returns shape (..., 3, 3).
     """
-    alpha = np.radians(filling_angle)
-    wetting = alpha + np.radians(contact_angle)
-    scale = np.pi * np.asarray(radius, float) ** 2 * surface_tension
+    radius = check_values("radius", radius, 0.0, low_inclusive=False, unit="m")
+    alpha = np.radians(check_values("filling_angle", filling_angle, 0.0, 180.0, unit="deg"))
+    wetting = alpha + np.radians(check_values("contact_angle", contact_angle, 0.0, 90.0,
+                                              high_inclusive=False, unit="deg"))
+    surface_tension = check_values("surface_tension", surface_tension, 0.0, low_inclusive=False,
+                                   unit="N/m")
+    scale = np.pi * radius ** 2 * surface_tension
     lateral = -scale * np.sin(alpha) ** 2 * np.cos(wetting)
     axial = scale * np.sin(2.0 * alpha) * np.sin(wetting)
     return _axisymmetric(lateral, axial)
@@ -183,7 +190,7 @@ def surface_tension_stress(normal, radius_1, radius_2, filling_angle_1, filling_
 
 def capillary_stress(chi, tension_stress, suction):
     """psi_ij = chi_ij s + B_ij [Pa] (Eq. 3.46); tension_stress = B_ij [Pa], suction s = u_a - u_w [Pa]."""
-    return np.asarray(chi) * suction + np.asarray(tension_stress)
+    return np.asarray(chi) * check_values("suction", suction, unit="Pa") + np.asarray(tension_stress)
 
 
 def effective_stress(total_stress, chi, tension_stress, suction, air_pressure=0.0):

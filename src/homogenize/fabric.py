@@ -24,6 +24,11 @@ def fabric_tensor(normal, mask):
     normal: (K, 3) unit vectors, mask: (K,) bool selecting the contacts (or bridges, Eq. 3.53).
     Returns zeros when nothing is selected.
     """
+    normal = np.asarray(normal)
+    mask = np.asarray(mask)
+    if normal.ndim != 2 or normal.shape[1] != 3 or mask.shape != (len(normal),):
+        raise ValueError(f"normal must have shape (K, 3) and mask shape (K,), got normal "
+                         f"{normal.shape} and mask {mask.shape}")
     total, count = _fabric_sum(normal, mask)
     return total / count if count else total
 
