@@ -1,0 +1,160 @@
+"""scenarios/direct_tension.py and dem.tension: wetting to a water content, grips, strength."""
+
+import copy
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from capillary.table import BridgeTable
+from dem.preparation import prepare_sample
+from dem.state import Particles, Walls
+from dem.tension import Grip, formation_suction, grip_members
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scenarios"))
+import direct_tension  # noqa: E402
+
+GAMMA = 0.074
+WATER = 0.0104       # Kim's middle water content (fraction)
+TINY = ["--particles", "200", "--max-strain", "0.03", "--vtk-frames", "0", "--quiet"]
+
+
+@pytest.fixture(scope="module")
+def table():
+    return BridgeTable.cached(0.0, radius_ratios=(1.0,))
+
+
+@pytest.fixture(scope="module")
+def args():
+    return direct_tension.parse_args(TINY)
+
+
+@pytest.fixture(scope="module")
+def dry(args):
+    """200 spheres of R = 0.11 mm held at 100 Pa (growth friction 10 deg)."""
+    sim, _ = prepare_sample(direct_tension.prepare_config(args, 10.0), progress=False)
+    return sim
+
+
+@pytest.fixture(scope="module")
+def wetted(dry, args):
+    return direct_tension.wet(dry, args, WATER, progress=False)
+
+
+def test_formation_suction_holds_the_target_volume(table):
+    """Bisection against an independent sum of table volumes, over two sphere sizes."""
+    radius_i = np.array([1e-4] * 30 + [2e-4] * 10)
+    radius_j = radius_i.copy()
+
+    def held(suction):
+        return sum(table.lookup(1.0, suction * r / GAMMA, 0.0)[2] * r ** 3 for r in radius_i)
+
+    for target in (0.02 * 30 * 1e-12 + 0.02 * 10 * 8e-12, 0.1 * 40 * 1e-12):
+        suction = formation_suction(table, radius_i, radius_j, target, GAMMA)
+        assert held(suction) == pytest.approx(target, rel=1e-5)
+    # more water than bridges at vanishing suction can hold, or none
+    with pytest.raises(ValueError, match="water volume"):
+        formation_suction(table, radius_i, radius_j, 1.0 * 40 * 8e-12, GAMMA)
+    with pytest.raises(ValueError, match="water volume"):
+        formation_suction(table, radius_i, radius_j, 0.0, GAMMA)
+
+
+def test_wetting_reaches_the_water_content(wetted, dry, args):
+    sim, bridges, report = wetted
+    water = bridges.water_volume(sim.contacts) / (args.specific_gravity
+                                                  * sim.particles.solid_volume())
+    assert water == pytest.approx(WATER, rel=direct_tension.WATER_TOLERANCE)
+    assert report["water_content"] == pytest.approx(water)
+    # the bridges outnumber the dry contacts: the settling under the bridges made new ones
+    assert bridges.count(sim) >= np.count_nonzero(dry.contacts.overlap > 0.0)
+
+
+def _force_on_upper_part(sim, bridges, height):
+    """z force on the particles above ``height`` from those below: contact + capillary forces
+    of the pairs that cross the plane (pair arrays hold the force on j from i)."""
+    contacts = sim.contacts
+    position = sim.particles.position
+    below_i = position[contacts.pair_i, 2] < height
+    below_j = position[contacts.pair_j, 2] < height
+    across = below_i != below_j
+    force_z = (contacts.force + bridges.pair_forces(sim))[across, 2]
+    return float(np.sum(np.where(below_i[across], force_z, -force_z)))
+
+
+def test_grip_pull_equals_the_force_across_a_plane(wetted, args, tmp_path):
+    """Pull 1 %, hold the grips still until static: both grips' pull equals the tension
+    carried across the mid-height plane by contact and capillary forces."""
+    sim = copy.deepcopy(wetted[0])
+    bridges = sim.operation(type(wetted[1]))
+    pull = direct_tension.Pull(sim, bridges, args, str(tmp_path))
+    sim.run(int(0.01 / (pull.rate * sim.dt)))
+    pull.extension.rate = 0.0
+    sim.run(20000, until=lambda s: direct_tension.unbalanced_force(s.particles, s.contacts)
+            < 1e-3, check_every=200)
+    walls = sim.walls
+    tension = -_force_on_upper_part(sim, bridges, 0.5 * (walls.lo[2] + walls.hi[2]))
+    assert tension > 0.0
+    for grip in pull.grips:
+        assert grip.pull == pytest.approx(tension, rel=0.02)
+
+
+def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wetted, args,
+                                                                        table, tmp_path):
+    """Rumpf (1962): sigma_t = (1 - n) k F / (pi d^2), k bridges per particle, F the force of
+    a bridge at contact (computed here from the table, not by the scenario)."""
+    _, dry_history = direct_tension.Pull(copy.deepcopy(dry), None, args,
+                                         str(tmp_path / "dry")).run(None)
+    sim = copy.deepcopy(wetted[0])
+    bridges = sim.operation(type(wetted[1]))
+    count = bridges.count(sim)
+    particles = sim.particles
+    radius = float(particles.radius[0])
+    porosity = 1.0 - particles.solid_volume() / sim.walls.volume()
+    force = (table.lookup(1.0, bridges.suction * radius / GAMMA, 0.0)[1]
+             * 2.0 * math.pi * GAMMA * radius)
+    rumpf = (1.0 - porosity) * (2.0 * count / len(particles)) * force / (math.pi * 4 * radius ** 2)
+    _, history = direct_tension.Pull(sim, bridges, args, str(tmp_path / "wet")).run(None)
+    wet_strength = float(np.max(history["tensile_stress"]))
+    dry_strength = float(np.max(dry_history["tensile_stress"]))
+    assert dry_strength < 0.01 * rumpf
+    assert 0.2 * rumpf < wet_strength < 1.0 * rumpf
+    # quasi-static: the thesis's criterion on the unbalanced force, on average up to the peak
+    peak = int(np.argmax(history["tensile_stress"]))
+    assert np.mean(history["unbalanced_force"][1:peak + 1]) < 0.02
+
+
+@pytest.mark.parametrize("arguments, message", [
+    (["--void-ratio", "0.3"], "--void-ratio = 0.3 is outside the valid range"),
+    (["--water-content", "9"], "--water-content = 9 % is outside the valid range (0, 5.28] %"),
+    (["--water-content", "0,1"], "--water-content = 0 % is outside"),
+    (["--contact-angle", "95"], "--contact-angle = 95.0 deg is outside"),
+    (["--particles", "10"], "--particles = 10 is outside"),
+    (["--residual", "1.5"], "--residual = 1.5 is outside"),
+    (["--void-ratio", "0.7,x"], "--void-ratio = '0.7,x' is not a comma-separated list"),
+])
+def test_bad_inputs_are_refused_by_name(arguments, message, capsys):
+    with pytest.raises(SystemExit):
+        direct_tension.parse_args(TINY + arguments)
+    assert message in capsys.readouterr().err
+
+
+def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
+    dense = copy.copy(args)
+    dense.particles = 100
+    with pytest.raises(ValueError, match=r"--void-ratio = 0.52 is outside the valid range"):
+        direct_tension.prepare_void_ratio(dense, 0.52, progress=False)
+
+
+def test_grips_take_every_particle_touching_their_wall():
+    particles = Particles(np.array([[0.5, 0.5, 0.1], [0.5, 0.5, 0.25], [0.5, 0.5, 0.9]]),
+                          np.full(3, 0.1), 2650.0)
+    walls = Walls.box([0, 0, 0], [1, 1, 1])
+    assert grip_members(particles.position, particles.radius, walls, 4, 0.3).tolist() == [0, 1]
+    assert grip_members(particles.position, particles.radius, walls, 5, 0.3).tolist() == [2]
+    with pytest.raises(ValueError, match="grip depth"):
+        grip_members(particles.position, particles.radius, walls, 4, 0.05)
+    with pytest.raises(ValueError, match="no particles"):
+        Grip(4, [])
