@@ -18,6 +18,8 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
+from dem.atomic import write_text
+from dem.figures import pyplot, save_figure
 from homogenize import packing_state, regular_packing
 from homogenize.cell_bridge import largest_filling_angle
 
@@ -387,9 +389,7 @@ def fig_4_19(plt, out, points):
 
 
 def save(fig, out, name):
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, name), dpi=120)
-    fig.clf()
+    save_figure(fig, os.path.join(out, name))
     print(f"  wrote {name}", flush=True)
 
 
@@ -401,13 +401,9 @@ def main(argv=None):
                 kim_comparison()]
     text = "\n\n".join("\n".join(lines) for lines in sections)
     print(text, flush=True)
-    with open(os.path.join(args.out, "chapter4_tables.txt"), "w") as handle:
-        handle.write(text + "\n")
+    write_text(os.path.join(args.out, "chapter4_tables.txt"), text + "\n")
 
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig_4_6(plt, args.out)
     fig_4_7(plt, args.out, args.points)
     fig_4_8(plt, args.out, args.points)

@@ -41,7 +41,7 @@ import h5py
 import numpy as np
 from tqdm import tqdm
 
-from dem.atomic import replacing
+from dem.atomic import write_json, write_text
 from dem.envelope import mohr_coulomb_fit
 
 #: This folder: scenarios/triaxial.py and chapter5_figures.py.
@@ -278,8 +278,7 @@ def write_report(path, runs, fits, args, figures, out):
     lines += ["", "## Figures", ""]
     lines += [f"![{name}]({os.path.relpath(figure, out)})" for name, figure in figures.items()]
     lines += ["", "Each run's own plots: " + ", ".join(f"{r['folder']}/plots" for r in runs)]
-    with replacing(path) as temporary, open(temporary, "w") as handle:
-        handle.write("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
 
 
 @contextlib.contextmanager
@@ -396,9 +395,7 @@ def main(argv=None):
                                          for (s, c), v in TABLE_5_3.items()],
                            "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
                            "dry_friction_deg": DRY_FRICTION_DEG}}
-    with replacing(os.path.join(out, "campaign.json")) as temporary, \
-            open(temporary, "w") as handle:
-        json.dump(campaign, handle, indent=2)
+    write_json(os.path.join(out, "campaign.json"), campaign)
     figures = campaign_figures(out, runs, fits, label, LATE_STRAIN)
     write_report(os.path.join(out, "report.md"), runs, fits, args, figures, out)
     print(f"chapter5.py: {len(runs)} runs; {os.path.join(out, 'campaign.json')}, "

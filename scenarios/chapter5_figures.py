@@ -11,18 +11,12 @@ import os
 import h5py
 import numpy as np
 
+from dem.figures import pyplot, save_figure
 from homogenize.fabric import principal_anisotropy
 
 #: History columns the figures use (the rest of a history is not read).
 COLUMNS = ("axial_strain", "volumetric_strain", "sigma_wall", "sigma_effective", "psi",
            "fabric", "fabric_bridges", "saturation")
-
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
 
 
 def load_histories(out, runs):
@@ -62,18 +56,10 @@ def _suction_label(suction):
     return "dry" if suction == 0 else f"s = {suction / 1000:g} kPa"
 
 
-def _save(figure, path):
-    os.makedirs(os.path.dirname(path) or ".", exist_ok=True)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    _pyplot().close(figure)
-    return path
-
-
 def plot_curves(path, histories, confining):
     """Fig. 5.3: (a) deviatoric stress q [kPa] and (b) volumetric strain against axial strain,
     one curve per suction at lateral stress ``confining``."""
-    plt = _pyplot()
+    plt = pyplot()
     figure, (top, bottom) = plt.subplots(2, 1, figsize=(6.5, 7), sharex=True)
     for (suction, lateral), history in sorted(histories.items()):
         if lateral != confining:
@@ -86,14 +72,14 @@ def plot_curves(path, histories, confining):
     top.legend(fontsize=8)
     bottom.set_ylabel("volumetric strain (contraction +)")
     bottom.set_xlabel("axial strain")
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def plot_effective_curves(path, histories, confining):
     """Fig. 5.7: q/p in net stress and q'/p' in effective stress (Eq. 3.43) against axial
     strain at lateral stress ``confining``; with Eq. 3.43 the wet curves should merge with the
     dry one."""
-    plt = _pyplot()
+    plt = pyplot()
     figure, axes = plt.subplots(figsize=(6.5, 4.5))
     for index, ((suction, lateral), history) in enumerate(sorted(histories.items())):
         if lateral != confining:
@@ -111,7 +97,7 @@ def plot_effective_curves(path, histories, confining):
     axes.set_ylabel("q/p, q'/p'")
     axes.set_title(f"lateral stress {confining:g} Pa (thesis Fig. 5.7)")
     axes.legend(fontsize=7)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def directional(tensor, angles):
@@ -130,7 +116,7 @@ def record_at(history, strain):
 def plot_polar(path, series, title, unit):
     """A polar diagram (axial direction up) of n . T . n in the x–z plane for each
     (label, tensor) of ``series``; ``unit`` labels the radial axis."""
-    plt = _pyplot()
+    plt = pyplot()
     angles = np.linspace(0.0, 2 * math.pi, 361)
     figure = plt.figure(figsize=(5.5, 5.5))
     axes = figure.add_subplot(projection="polar")
@@ -139,7 +125,7 @@ def plot_polar(path, series, title, unit):
         axes.plot(angles, directional(tensor, angles), label=name)
     axes.set_title(f"{title}\n[{unit}], axial direction up", fontsize=10)
     axes.legend(fontsize=7, loc="lower left", bbox_to_anchor=(-0.1, -0.15))
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def polar_figures(folder, histories, confining, strain):
@@ -168,7 +154,7 @@ def polar_figures(folder, histories, confining, strain):
 def plot_anisotropy(path, history, suction, confining):
     """Fig. 5.8: anisotropy factor a = 5/2 (T_z - T_x) / tr T of the effective stress (Eq. 3.43)
     and of the capillary stress psi (Eq. 4.5) against axial strain."""
-    plt = _pyplot()
+    plt = pyplot()
     figure, axes = plt.subplots(figsize=(6.5, 4.5))
     strain = history["axial_strain"]
     for key, name in (("sigma_effective", "effective stress"), ("psi", "capillary stress")):
@@ -178,7 +164,7 @@ def plot_anisotropy(path, history, suction, confining):
     axes.set_title(f"{_suction_label(suction)}, lateral stress {confining:g} Pa "
                    "(thesis Fig. 5.8)")
     axes.legend()
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def _line(phi_deg, cohesion, p_max):
@@ -193,7 +179,7 @@ def _line(phi_deg, cohesion, p_max):
 def plot_envelopes(path, runs, fits, label):
     """Figs. 5.4 and 5.6: failure points (p, q) and (p', q') with each suction's fit and the
     dry line; ``label(suction)`` is the key of ``fits``."""
-    plt = _pyplot()
+    plt = pyplot()
     figure, panels = plt.subplots(1, 2, figsize=(11, 4.5))
     p_max = max(max(r["p_at_peak"], r["p_effective_at_peak"]) for r in runs) * 1.1
     dry = fits.get(label(0.0))
@@ -218,7 +204,7 @@ def plot_envelopes(path, runs, fits, label):
         axes.set_ylabel("q' [Pa]" if "effective" in pk else "q [Pa]")
         axes.set_title(title)
         axes.legend(fontsize=8)
-    return _save(figure, path)
+    return save_figure(figure, path)
 
 
 def campaign_figures(out, runs, fits, label, strain=0.20):

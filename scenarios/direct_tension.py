@@ -44,7 +44,6 @@ cases/<case>/vtk/*.pvd.
 
 import argparse
 import copy
-import json
 import math
 import os
 import sys
@@ -56,6 +55,8 @@ import numpy as np
 from capillary.coupling import CapillaryBridges, table_radius_ratios
 from capillary.table import BridgeTable
 from chapter4 import KIM_2001, KIM_PACKINGS, KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
+from dem.atomic import write_json, write_text
+from dem.figures import pyplot, save_figure
 from dem.measure import coordination, unbalanced_force
 from dem.preparation import PrepareConfig, equilibrated, prepare_sample
 from dem.record import HistoryRecorder, write_history
@@ -440,37 +441,24 @@ def run_case(dry, preparation, args, void_ratio, water_content):
     return summary, history
 
 
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def plot_curves(histories, folder):
     """Tensile stress against axial extension, one figure per case and one with all."""
-    plt = _pyplot()
-    os.makedirs(folder, exist_ok=True)
+    plt = pyplot()
     every, all_axes = plt.subplots(figsize=(6, 4))
     for name, history in histories.items():
         figure, axes = plt.subplots(figsize=(6, 4))
         for target in (axes, all_axes):
             target.plot(-100.0 * history["axial_strain"], history["tensile_stress"], label=name)
         axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]", title=name)
-        figure.tight_layout()
-        figure.savefig(os.path.join(folder, f"tension_{name}.png"), dpi=120)
-        plt.close(figure)
+        save_figure(figure, os.path.join(folder, f"tension_{name}.png"))
     all_axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]")
     all_axes.legend(fontsize=7)
-    every.tight_layout()
-    every.savefig(os.path.join(folder, "tension_all.png"), dpi=120)
-    plt.close(every)
+    save_figure(every, os.path.join(folder, "tension_all.png"))
 
 
 def plot_strength(summaries, args, path):
     """Tensile strength against water content: DEM, Kim (2001) and packing_state's curve."""
-    plt = _pyplot()
-    figure, axes = plt.subplots(figsize=(6, 4.5))
+    figure, axes = pyplot().subplots(figsize=(6, 4.5))
     void_ratios = sorted({s["void_ratio_target"] for s in summaries}, reverse=True)
     for colour, e in zip(("C0", "C3", "C2", "C1"), void_ratios):
         mine = [s for s in summaries if s["void_ratio_target"] == e]
@@ -487,9 +475,7 @@ def plot_strength(summaries, args, path):
     axes.set(xlabel="gravimetric water content w [%]", ylabel="tensile strength [Pa]",
              xlim=(0, None), ylim=(0, None))
     axes.legend(fontsize=7)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path)
 
 
 def _percent(value):
@@ -517,8 +503,7 @@ def write_report(summaries, args, path):
             f"| {s['tensile_strength_pa']:.1f} | {kim} | {s['packing_state_pa']:.1f} "
             f"| {_percent(s['relative_difference_to_kim'])} "
             f"| {_percent(s['relative_difference_to_packing_state'])} |")
-    with open(path, "w") as handle:
-        handle.write("\n".join(lines) + "\n")
+    write_text(path, "\n".join(lines) + "\n")
     return lines
 
 
@@ -549,8 +534,7 @@ def main(argv=None):
               "samples": {str(e): {k: v for k, v in r.items() if k != "sigma_wall"}
                           for e, r in samples.items()},
               "cases": summaries, "wall_time_s": time.perf_counter() - started}
-    with open(os.path.join(args.out, "tension.json"), "w") as handle:
-        json.dump(output, handle, indent=2, default=float)
+    write_json(os.path.join(args.out, "tension.json"), output, default=float)
     plot_curves(histories, os.path.join(args.out, "plots"))
     plot_strength(summaries, args, os.path.join(args.out, "plots", "strength_vs_water.png"))
     print("\n".join(write_report(summaries, args, os.path.join(args.out, "report.md"))))

@@ -39,7 +39,8 @@ import numba
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import triaxial  # noqa: E402  (scenarios/triaxial.py)
-from dem.atomic import replacing  # noqa: E402
+from dem.atomic import write_json, write_text  # noqa: E402
+from dem.figures import pyplot, save_figure  # noqa: E402
 
 SUCTION = 30000.0
 CONFINING = 750.0
@@ -127,8 +128,7 @@ def run(args, name, settings, particles):
               "stress_ratio_at_peak": (summary["peak_q_effective"]
                                        / summary["p_effective_at_peak"]),
               "axial_strain_at_peak": summary["axial_strain_at_peak"]}
-    with replacing(timing_path) as temporary, open(temporary, "w") as handle:
-        json.dump(result, handle, indent=2)
+    write_json(timing_path, result)
     return result
 
 
@@ -243,14 +243,12 @@ def write_markdown(path, args, reference, rows):
               "the scatter between runs of a chaotic system: any change of the order of "
               "floating-point sums makes the runs drift apart after the peak; their errors are "
               "the noise floor against which the other knobs are read.", ""]
-    with replacing(path) as temporary, open(temporary, "w") as handle:
-        handle.write("\n".join(lines))
+    write_text(path, "\n".join(lines) + "\n")
 
 
 def plot(path, rows):
     """CPU time against error, one series per knob."""
-    plt = triaxial._pyplot()
-    figure, axes = plt.subplots(figsize=(7, 5))
+    figure, axes = pyplot().subplots(figsize=(7, 5))
     for index, knob in enumerate(dict.fromkeys(r["knob"] for r in rows)):
         chosen = [r for r in rows if r["knob"] == knob]
         axes.plot([r["cpu_time_s"] for r in chosen], [100 * max(r["error"], 1e-4) for r in chosen],
@@ -264,9 +262,7 @@ def plot(path, rows):
     axes.set_xlabel("CPU time, wetting and shear [s]")
     axes.set_ylabel("largest relative error [%]")
     axes.legend(fontsize=7)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path)
 
 
 def main(argv=None):
@@ -277,8 +273,7 @@ def main(argv=None):
     data = {"arguments": vars(args), "suction": SUCTION, "confining": CONFINING,
             "reference": reference, "rows": rows}
     paths = {name: os.path.join(args.out, f"tradeoff.{name}") for name in ("json", "md", "png")}
-    with replacing(paths["json"]) as temporary, open(temporary, "w") as handle:
-        json.dump(data, handle, indent=2)
+    write_json(paths["json"], data)
     write_markdown(paths["md"], args, reference, rows)
     plot(paths["png"], rows)
     if args.docs is not None:

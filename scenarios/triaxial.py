@@ -51,7 +51,9 @@ import time
 import numba
 import numpy as np
 
+from dem.atomic import write_json
 from dem.checkpoint import CheckpointWriter, load_checkpoint
+from dem.figures import pyplot, save_figure
 from dem.preparation import PrepareConfig, equilibrated, prepare_sample, servoed_simulation
 from dem.measure import coordination, porosity
 from dem.record import write_history
@@ -381,8 +383,7 @@ class Shear:
                                "surface_tension": bridges.surface_tension,
                                "persist_bridges": bridges.persist})
         write_history(os.path.join(args.out, "history.h5"), history, attributes)
-        with open(os.path.join(args.out, "summary.json"), "w") as handle:
-            json.dump(summary, handle, indent=2)
+        write_json(os.path.join(args.out, "summary.json"), summary)
         plot_history(history, os.path.join(args.out, "triaxial.png"))
         write_plots(history, os.path.join(args.out, "plots"))
         shown = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
@@ -422,13 +423,6 @@ def wet_sample(sim, bridges, prepare, max_steps, progress):
             "wet_porosity": porosity(sim.particles, sim.walls)}
 
 
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
-
-
 def _diagonals(values):
     """(rows, 3) diagonal of a (rows, 3, 3) tensor history, or a (rows, 3) one as it is."""
     values = np.asarray(values)
@@ -439,8 +433,7 @@ def write_plots(history, folder):
     """The plots of a run into ``folder``: q_p.png (q/p), volumetric_strain.png and, when the
     history has capillary columns, capillary_stress.png (diagonal components of psi, Eq. 3.46,
     and of sigma_capillary, [Pa]), each against axial strain. Returns the paths written."""
-    plt = _pyplot()
-    os.makedirs(folder, exist_ok=True)
+    plt = pyplot()
     sigma = history["sigma_wall"]
     lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
     p = (sigma[:, 2] + 2 * lateral) / 3
@@ -456,10 +449,7 @@ def write_plots(history, folder):
             axes.plot(strain, values, label=legend)
         axes.set_xlabel("axial strain")
         axes.set_ylabel(label)
-        figure.tight_layout()
-        paths.append(os.path.join(folder, name))
-        figure.savefig(paths[-1], dpi=120)
-        plt.close(figure)
+        paths.append(save_figure(figure, os.path.join(folder, name)))
     capillary = [(key, title) for key, title in
                  (("psi", "psi = chi s + B [Pa] (Eq. 3.46)"),
                   ("sigma_capillary", "sigma_capillary [Pa] (tensile negative)"))
@@ -473,30 +463,23 @@ def write_plots(history, folder):
             axes.set_ylabel(title)
             axes.legend()
         panels[-1, 0].set_xlabel("axial strain")
-        figure.tight_layout()
-        paths.append(os.path.join(folder, "capillary_stress.png"))
-        figure.savefig(paths[-1], dpi=120)
-        plt.close(figure)
+        paths.append(save_figure(figure, os.path.join(folder, "capillary_stress.png")))
     return paths
 
 
 def plot_history(history, path):
     """q/p and volumetric strain against axial strain (thesis Fig. 5.3), one figure."""
-    plt = _pyplot()
-
     sigma = history["sigma_wall"]
     lateral = 0.5 * (sigma[:, 0] + sigma[:, 1])
     p = (sigma[:, 2] + 2 * lateral) / 3
     strain = history["axial_strain"]
-    figure, (top, bottom) = plt.subplots(2, 1, figsize=(6, 7), sharex=True)
+    figure, (top, bottom) = pyplot().subplots(2, 1, figsize=(6, 7), sharex=True)
     top.plot(strain, (sigma[:, 2] - lateral) / np.where(p > 0, p, math.nan))
     top.set_ylabel("q/p")
     bottom.plot(strain, history["volumetric_strain"])
     bottom.set_ylabel("volumetric strain (contraction +)")
     bottom.set_xlabel("axial strain")
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    save_figure(figure, path)
 
 
 if __name__ == "__main__":

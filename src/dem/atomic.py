@@ -1,6 +1,7 @@
 """Atomic file replacement: a killed run leaves either the old file or the new one, never a
 truncated one."""
 
+import json
 import os
 from contextlib import contextmanager
 
@@ -31,3 +32,17 @@ def replacing(path, durable=False):
         raise
     if durable and os.name == "posix":
         _fsync(folder)
+
+
+def write_text(path, text):
+    """Write ``text`` to ``path`` atomically."""
+    with replacing(path) as temporary, open(temporary, "w") as handle:
+        handle.write(text)
+
+
+def write_json(path, data, **options):
+    """Write ``data`` as JSON (json.dump ``options``, indent 2 by default) to ``path``
+    atomically."""
+    options.setdefault("indent", 2)
+    with replacing(path) as temporary, open(temporary, "w") as handle:
+        json.dump(data, handle, **options)
