@@ -1,7 +1,10 @@
 """Run the YADE triaxial driver (``benchmarks/yade_triaxial.py``) from Python and read its result.
 
-YADE is an optional, external cross-check: nothing in pendular imports it. ``run_yade_triaxial``
-needs a ``yade`` executable on PATH (Debian/Ubuntu package ``yade``, tested with 2023.02a).
+YADE is an optional, external cross-check: nothing in pendular imports it. The benchmarks
+(bench_triaxial.py, bench_capillary.py) and scenarios/yade_crosscheck.py import this module by
+path: it stays here, outside the installed packages, with the driver it runs.
+``run_yade_triaxial`` needs a ``yade`` executable on PATH (Debian/Ubuntu package ``yade``,
+tested with 2023.02a).
 
 Self-check (about a minute on two cores): ``python benchmarks/yade_runner.py [N]`` writes a random
 packing of N spheres (default 1000, R = 0.024 mm), times it with 1 and 2 threads, prints both.

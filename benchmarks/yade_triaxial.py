@@ -22,7 +22,10 @@
 #   stress_damping 0.25 (TriaxialStressController.stressDamping, YADE's default),
 #   strain_damping 0.0 (TriaxialStressController.strainDamping; YADE's default 0.99 ramps the
 #   axial rate up geometrically, 0 imposes it at once as pendular does),
-#   max_vel 1.0 m/s (TriaxialStressController.max_vel, YADE's default).
+#   max_vel 1.0 m/s (TriaxialStressController.max_vel, YADE's default; YADE scales it per axis
+#   by 3 L_a / (L_x + L_y + L_z)), stiffness_update_interval 10
+#   (TriaxialStressController.stiffnessUpdateInterval, YADE's default; the wall stiffness is
+#   also refreshed at each of the first 100 iterations).
 #   capillary (optional, wet test): {"suction": s [Pa], "files": folder holding the capillary
 #     files M(r=1) ... M(r=10) (capillary.write_yade), "surface_tension": 0.073 N/m,
 #     "persist": false, "detection_factor": 1.0}. Adds YADE's capillary law
@@ -40,6 +43,11 @@
 #   [-> Law2_ScGeom_CapillaryPhys_Capillarity (wet test)]
 #   -> TriaxialStressController (x, y servoed at -confining, z at strain rate -strain_rate)
 #   -> NewtonIntegrator(damping) [-> PyRunner recording the history]
+#
+# History (plot.saveDataTxt columns, a row every record_every iterations, from iteration 0 (its
+# wall forces are those of the initial packing) if record_initial (default false), and the final
+# state): i, t, eps_axial (1 - L_z / L_z0), sx, sy, sz [Pa], lx, ly, lz (inner box lengths [m]),
+# porosity, unbalanced; the wet test adds saturation and menisci (as in the output JSON).
 #
 # Output JSON: particles, steps, wall_time_s, particle_steps_per_s, threads, yade_version,
 # sigma_wall [sx, sy, sz] Pa (compression positive, force on each wall pair / current face
@@ -172,7 +180,8 @@ def main(config_path):
         stressMask=0b011, goal1=-confining, goal2=-confining, goal3=-rate,
         stressDamping=float(config.get("stress_damping", 0.25)),
         strainDamping=float(config.get("strain_damping", 0.0)),
-        max_vel=float(config.get("max_vel", 1.0)))
+        max_vel=float(config.get("max_vel", 1.0)),
+        stiffnessUpdateInterval=int(config.get("stiffness_update_interval", 10)))
     wet = config.get("capillary")
     if wet:
         wet = capillary_settings(wet)
@@ -215,16 +224,32 @@ def main(config_path):
                  / areas[a] for a in range(3)]
         return lengths, sigma
 
+    solid = sum(4.0 / 3.0 * math.pi * r ** 3 for r in radii)
+
+    def wet_state(lengths):
+        """Menisci between spheres, their water volume [m^3] and the degree of saturation."""
+        volumes = [i.phys.vMeniscus for i in O.interactions
+                   if i.isReal and i.id1 in sphere_set and i.id2 in sphere_set and i.phys.meniscus]
+        water = sum(volumes)
+        return {"menisci": len(volumes), "water_volume": water,
+                "saturation": water / (lengths[0] * lengths[1] * lengths[2] - solid)}
+
     def record():
         lengths, sigma = wall_state()
-        plot.addData(i=O.iter, t=O.time, eps_axial=1.0 - lengths[2] / depth0,
-                     sx=sigma[0], sy=sigma[1], sz=sigma[2], porosity=triax.porosity,
-                     unbalanced=utils.unbalancedForce())
+        row = {"i": O.iter, "t": O.time, "eps_axial": 1.0 - lengths[2] / depth0,
+               "sx": sigma[0], "sy": sigma[1], "sz": sigma[2], "lx": lengths[0],
+               "ly": lengths[1], "lz": lengths[2], "porosity": triax.porosity,
+               "unbalanced": utils.unbalancedForce()}
+        if wet:
+            state = wet_state(lengths)
+            row.update(saturation=state["saturation"], menisci=state["menisci"])
+        plot.addData(**row)
 
     history = config.get("history")
     if history:
         globals()["record_history"] = record
         O.engines = O.engines + [PyRunner(iterPeriod=int(config["record_every"]),
+                                          initRun=bool(config.get("record_initial", False)),
                                           command="record_history()")]
 
     if int(config["warmup_steps"]) > 0:  # O.run(0) would run without end
@@ -258,20 +283,16 @@ def main(config_path):
         "stress_damping": triax.stressDamping,
         "strain_damping": triax.strainDamping,
         "max_vel": triax.max_vel,
+        "stiffness_update_interval": triax.stiffnessUpdateInterval,
         "engines": [type(e).__name__ for e in O.engines],
     }
     if wet:
-        menisci = [i.phys for i in O.interactions
-                   if i.isReal and i.id1 in sphere_set and i.id2 in sphere_set and i.phys.meniscus]
-        water = sum(phys.vMeniscus for phys in menisci)
-        solid = sum(4.0 / 3.0 * math.pi * r ** 3 for r in radii)
-        result.update({"menisci": len(menisci), "water_volume": water,
-                       "saturation": water / (lengths[0] * lengths[1] * lengths[2] - solid),
-                       "capillary": {k: v for k, v in wet.items()}})
+        result.update(wet_state(lengths), capillary=dict(wet))
     if history:
         record()  # the final state (PyRunner ran last at the previous multiple of record_every)
-        plot.saveDataTxt(history, vars=("i", "t", "eps_axial", "sx", "sy", "sz", "porosity",
-                                        "unbalanced"))
+        columns = ("i", "t", "eps_axial", "sx", "sy", "sz", "lx", "ly", "lz", "porosity",
+                   "unbalanced") + (("saturation", "menisci") if wet else ())
+        plot.saveDataTxt(history, vars=columns)
     output = config["output"]
     temporary = output + ".tmp"
     with open(temporary, "w") as out:

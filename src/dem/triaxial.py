@@ -21,13 +21,27 @@ from .walls import ConstantStrainRate, StressServo
 @dataclass
 class ShearConfig:
     """Shear-phase parameters. ``strain_rate`` [1/s] defaults to the one giving
-    ``inertial_number`` I = rate * 2R * sqrt(rho / confining)."""
+    ``inertial_number`` I = rate * 2R * sqrt(rho / confining).
+
+    Wall control options, pendular's choice by default; ``YADE_CHOICES`` holds YADE's
+    (TriaxialStressController, docs/yade_crosscheck.md):
+    rate_on_current_length: the axial rate acts on the current height (true strain rate)
+        instead of the initial one (engineering strain rate);
+    servo_max_velocity: speed cap of the lateral walls [m/s] (None: the one of the preparation
+        servo); servo_scale_max_velocity: scale it per axis by 3 L_a / (L_x + L_y + L_z);
+    servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
+        the first 100) instead of every step.
+    """
 
     confining: float = 750.0
     max_strain: float = 0.25
     inertial_number: float = 3e-4
     strain_rate: float = None
     records: int = 500
+    rate_on_current_length: bool = False
+    servo_max_velocity: float = None
+    servo_scale_max_velocity: bool = False
+    servo_stiffness_every: int = 1
 
     def __post_init__(self):
         self.confining = check_positive("confining", self.confining, "Pa")
@@ -38,12 +52,22 @@ class ShearConfig:
         if self.strain_rate is not None:
             self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
         self.records = check_int("records", self.records, low=2)
+        if self.servo_max_velocity is not None:
+            self.servo_max_velocity = check_positive("servo_max_velocity",
+                                                     self.servo_max_velocity, "m/s")
+        self.servo_stiffness_every = check_int("servo_stiffness_every",
+                                               self.servo_stiffness_every, low=1)
 
     def rate(self, radius, density):
         """Axial strain rate [1/s]: the given one, or the one of the target inertial number."""
         if self.strain_rate is not None:
             return self.strain_rate
         return self.inertial_number / (2.0 * radius * np.sqrt(density / self.confining))
+
+
+#: ShearConfig options that reproduce YADE's TriaxialStressController (stiffnessUpdateInterval 10).
+YADE_CHOICES = {"rate_on_current_length": True, "servo_scale_max_velocity": True,
+                "servo_stiffness_every": 10}
 
 
 def inertial_number(strain_rate, radius, density, pressure):
@@ -89,8 +113,13 @@ def start_shear(sim, config, radius, density):
     """
     servo = sim.operation(StressServo)
     rate = config.rate(radius, density)
-    axial = ConstantStrainRate("z", rate, sim.walls.lengths()[2])
-    lateral = StressServo("xy", config.confining, servo.max_velocity, servo.gain, servo.memory)
+    axial = ConstantStrainRate("z", rate, sim.walls.lengths()[2],
+                               on_current_length=config.rate_on_current_length)
+    max_velocity = (servo.max_velocity if config.servo_max_velocity is None
+                    else config.servo_max_velocity)
+    lateral = StressServo("xy", config.confining, max_velocity, servo.gain, servo.memory,
+                          scale_max_velocity=config.servo_scale_max_velocity,
+                          stiffness_every=config.servo_stiffness_every)
     index = sim.operations.index(servo)
     if sim.contacts is None:
         # a sample just loaded from disk: evaluate its forces once (the operations before the
@@ -98,7 +127,7 @@ def start_shear(sim, config, radius, density):
         for op in sim.operations[:index]:
             op.apply(sim)
     sim.operations[index:index + 1] = [lateral, axial]
-    steps = int(np.ceil(config.max_strain / (rate * sim.dt)))
+    steps = axial.steps_to(config.max_strain, sim.dt)
     period = max(1, steps // config.records)
     steps = -(-steps // period) * period     # whole periods: the last step is recorded
     recorder = HistoryRecorder(period, triaxial_quantities(axial, sim.walls.volume(),

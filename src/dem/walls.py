@@ -6,7 +6,7 @@ A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, 
 import numpy as np
 
 from .contact_law import wall_forces
-from .validate import check_positive, check_range
+from .validate import check_int, check_positive, check_range
 
 AXES = {"x": 0, "y": 1, "z": 2}
 
@@ -42,27 +42,54 @@ class StressServo:
     """Hold the normal stress of the walls of ``axes`` at ``target`` [Pa, compression positive].
 
     Each step every wall moves outward by
-        shift_n = gain * clip((F_wall - target A) / K_wall, +-max_velocity dt) + memory * shift_n-1,
-    K_wall being the sum of its contacts' normal stiffness; a wall without contacts moves inward
-    at max_velocity. This is YADE's TriaxialStressController law, where gain = 1 - stressDamping
-    (0.75) and memory = 0.8; the memory term lets a wall follow a dilating sample with a steady
-    stress error (1 - memory) / gain times that of a memoryless servo.
+        shift_n = gain * clip((F_wall - target A) / K_wall, +-cap) + memory * shift_n-1,
+    K_wall being the sum of its contacts' normal stiffness and cap = max_velocity dt [m]; a
+    wall without contacts moves inward by the cap. This is YADE's TriaxialStressController law,
+    where gain = 1 - stressDamping (0.75) and memory = 0.8; the memory term lets a wall follow a
+    dilating sample with a steady stress error (1 - memory) / gain times that of a memoryless
+    servo. Two of YADE's choices are options (defaults: pendular's):
+
+    scale_max_velocity: the cap of axis a is max_velocity * 3 L_a / (L_x + L_y + L_z) (YADE's
+        max_vel1/2/3) instead of max_velocity;
+    stiffness_every: K_wall is refreshed every ``stiffness_every`` calls of the servo and at
+        each of its first 100 calls (YADE's stiffnessUpdateInterval, 10) instead of every step.
     """
 
-    def __init__(self, axes, target, max_velocity, gain=0.75, memory=0.8):
-        self.walls = tuple(w for axis in _axes(axes) for w in (2 * axis, 2 * axis + 1))
+    #: Calls during which the stiffness is refreshed every step (YADE: scene->iter < 100).
+    STIFFNESS_WARMUP = 100
+
+    def __init__(self, axes, target, max_velocity, gain=0.75, memory=0.8,
+                 scale_max_velocity=False, stiffness_every=1):
+        self.axes = _axes(axes)
+        self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
         self.target = check_range("target stress", target, 0.0, unit="Pa")
         self.max_velocity = check_positive("max_velocity", max_velocity, "m/s")
         self.gain = check_range("servo gain", gain, 0.0, 1.0, low_inclusive=False)
         self.memory = check_range("servo memory", memory, 0.0, 1.0, high_inclusive=False)
+        self.scale_max_velocity = bool(scale_max_velocity)
+        self.stiffness_every = check_int("servo stiffness_every", stiffness_every, low=1)
         self.previous = np.zeros(len(self.walls))
+        self.stiffness = np.zeros(len(self.walls))
+        self.calls = 0
+
+    def _step_caps(self, walls, dt):
+        """Largest wall shift of this step per servoed wall [m]."""
+        if not self.scale_max_velocity:
+            return np.full(len(self.walls), self.max_velocity * dt)
+        lengths = walls.lengths()
+        scale = 3.0 * lengths / lengths.sum()
+        return np.array([self.max_velocity * dt * scale[w // 2] for w in self.walls])
 
     def apply(self, sim):
         walls = sim.walls
         areas = walls.areas()
-        step_cap = self.max_velocity * sim.dt
+        step_caps = self._step_caps(walls, sim.dt)
+        if self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0:
+            self.stiffness[:] = walls.stiffness[list(self.walls)]
+        self.calls += 1
         for slot, w in enumerate(self.walls):
-            stiffness = walls.stiffness[w]
+            stiffness = self.stiffness[slot]
+            step_cap = step_caps[slot]
             if stiffness > 0.0:
                 shift = (walls.force[w] - self.target * areas[w]) / stiffness
                 shift = min(max(shift, -step_cap), step_cap)
@@ -73,21 +100,41 @@ class StressServo:
 
 
 class ConstantStrainRate:
-    """Drive the two walls of ``axis`` at a constant engineering strain rate [1/s].
+    """Drive the two walls of ``axis`` at a constant strain rate [1/s].
 
     rate > 0 compresses: each wall moves inward at rate * L0 / 2, L0 being the box length on
-    that axis when the operation is attached (the reference of ``axial_strain``).
+    that axis when the operation is attached (the reference of ``axial_strain``), so that the
+    engineering strain grows at ``rate``. With ``on_current_length`` the speed is rate * L / 2,
+    L the current length (YADE's TriaxialStressController: the true strain rate is ``rate``).
     """
 
-    def __init__(self, axis, rate, reference_length):
+    def __init__(self, axis, rate, reference_length, on_current_length=False):
         (self.axis,) = _axes(axis)
         self.rate = check_range("strain_rate", rate, -1e6, 1e6, unit="1/s")
         self.reference_length = check_positive("reference_length", reference_length, "m")
+        self.on_current_length = bool(on_current_length)
 
     def strain(self, walls):
         """Engineering strain of the axis, compression positive."""
         return 1.0 - walls.lengths()[self.axis] / self.reference_length
 
+    def steps_to(self, strain, dt):
+        """Steps [-] of ``dt`` [s] to reach the engineering ``strain`` from the reference length
+        (the rate must have the strain's sign; on the current length the length shrinks by a
+        factor 1 - rate dt per step)."""
+        if self.rate == 0.0 or strain / self.rate <= 0.0:
+            raise ValueError(f"strain = {strain!r} cannot be reached at strain_rate = "
+                             f"{self.rate!r} 1/s: they must be non-zero and of the same sign")
+        if not self.on_current_length:
+            return int(np.ceil(strain / (self.rate * dt)))
+        factor = 1.0 - self.rate * dt
+        if not 0.0 < factor < 1.0 or strain >= 1.0:
+            raise ValueError(f"strain_rate * dt = {self.rate * dt!r} must lie in (0, 1) and "
+                             f"strain = {strain!r} below 1 on the current length")
+        return int(np.ceil(np.log1p(-strain) / np.log(factor)))
+
     def apply(self, sim):
-        shift = -0.5 * self.rate * self.reference_length * sim.dt
+        length = (sim.walls.lengths()[self.axis] if self.on_current_length
+                  else self.reference_length)
+        shift = -0.5 * self.rate * length * sim.dt
         move_walls(sim.walls, (2 * self.axis, 2 * self.axis + 1), (shift, shift), sim.dt)
