@@ -92,6 +92,9 @@ def parse_args(argv=None):
     parser.add_argument("--max-strain", type=float, default=0.25, help="final axial strain")
     parser.add_argument("--inertial-number", type=float, default=3e-4,
                         help="target inertial number setting the strain rate")
+    parser.add_argument("--prep-friction", type=float, default=0.5,
+                        help="contact friction during the radius growth [deg] (thesis 0.5; "
+                             "higher gives looser samples)")
     parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
                         help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
                              "instead of --jobs local processes")
@@ -132,7 +135,8 @@ def _common(args):
     """triaxial.py arguments shared by every sample and run of the campaign."""
     common = ["--particles", str(args.particles), "--seed", str(args.seed),
               "--max-strain", repr(args.max_strain),
-              "--inertial-number", repr(args.inertial_number)]
+              "--inertial-number", repr(args.inertial_number),
+              "--prep-friction", repr(args.prep_friction)]
     if args.jobs > 1 or args.scheduler is not None:
         common += ["--threads", "1"]          # one core per run
     return common
@@ -164,18 +168,28 @@ def run_one(argv, folder):
             raise RuntimeError(f"triaxial.py {' '.join(argv)} stopped: {stop.code}") from None
 
 
-def finished_summary(argv, folder):
-    """summary.json of a run of ``folder`` that ended with the arguments ``argv`` (up to those
-    that do not change its result), or None: a campaign run again reuses its finished runs."""
-    if not all(os.path.exists(os.path.join(folder, name))
-               for name in ("summary.json", "sample.h5", "history.h5")):
-        return None
-    with h5py.File(os.path.join(folder, "sample.h5"), "r") as handle:
+def made_with(path, argv):
+    """Whether the sample file ``path`` (dem.sample.save_sample, its config holding the
+    triaxial.py arguments) was made with the arguments ``argv``, up to those that do not change
+    a result (RESULT_NEUTRAL)."""
+    if not os.path.exists(path):
+        return False
+    with h5py.File(path, "r") as handle:
         stored = json.loads(handle.attrs["config"]).get("arguments", {})
-    wanted = json.loads(json.dumps(vars(_triaxial().parse_args(argv + ["--out", folder])),
-                                   default=str))
-    if any(stored.get(key, value) != value for key, value in wanted.items()
-           if key not in RESULT_NEUTRAL):
+    triaxial = _triaxial()
+    wanted, default = (json.loads(json.dumps(vars(triaxial.parse_args(a)), default=str))
+                       for a in (argv, []))
+    # an option newer than the stored file was at its default value there
+    return all(stored.get(key, default[key]) == value for key, value in wanted.items()
+               if key not in RESULT_NEUTRAL)
+
+
+def finished_summary(argv, folder):
+    """summary.json of a run of ``folder`` that ended with the arguments ``argv``, or None: a
+    campaign run again reuses its finished runs."""
+    if not (os.path.exists(os.path.join(folder, "summary.json"))
+            and os.path.exists(os.path.join(folder, "history.h5"))
+            and made_with(os.path.join(folder, "sample.h5"), argv)):
         return None
     with open(os.path.join(folder, "summary.json")) as handle:
         return json.load(handle)
@@ -370,7 +384,8 @@ def main(argv=None):
     os.makedirs(os.path.join(out, "samples"), exist_ok=True)
     common = _common(args)
     preparations = [(common + ["--confining", repr(c)], sample_path(out, c))
-                    for c in args.confining if not os.path.exists(sample_path(out, c))]
+                    for c in args.confining
+                    if not made_with(sample_path(out, c), common + ["--confining", repr(c)])]
     tests = [(s, c) for s in args.suctions for c in args.confining]
     summaries, tasks, keys = {}, [], []
     for suction, lateral in tests:

@@ -94,6 +94,9 @@ def parse_args(argv=None):
     parser.add_argument("--porosity", type=float, default=0.40,
                         help="porosity of the initial cloud box (0.30-0.60)")
     parser.add_argument("--friction", type=float, default=18.0, help="contact friction [deg]")
+    parser.add_argument("--prep-friction", type=float, default=0.5,
+                        help="contact friction during the radius growth [deg] (thesis 0.5; "
+                             "higher gives a looser sample)")
     parser.add_argument("--young", type=float, default=1e6, help="YADE young E [Pa], kn = E R")
     parser.add_argument("--damping", type=float, default=0.2, help="Cundall local damping")
     parser.add_argument("--inertial-number", type=float, default=3e-4,
@@ -266,6 +269,7 @@ def configs(args):
     prepare = PrepareConfig(particles=args.particles, radius=args.radius,
                             porosity=args.porosity, young=args.young,
                             friction_deg=args.friction, damping=args.damping,
+                            prep_friction_deg=getattr(args, "prep_friction", 0.5),
                             timestep_safety=args.timestep_safety, confining=args.confining,
                             seed=args.seed, skin_factor=getattr(args, "skin_factor", 0.3))
     shear = ShearConfig(confining=args.confining, max_strain=args.max_strain,
