@@ -64,6 +64,8 @@ QUICK_KNOBS = {"timestep_safety": [0.5, 0.7, 0.9], "inertial_number": [3e-4, 1e-
                "table_resolution": ["50,20", "100,40", "350,80"]}
 #: Error bounds of the recommendations.
 PAPER_ERROR, QUICK_ERROR = 0.02, 0.10
+#: The uses recommended for, and their error bounds.
+USES = {"paper figure": PAPER_ERROR, "quick look": QUICK_ERROR}
 
 
 def parse_args(argv=None):
@@ -178,14 +180,23 @@ def measure(args):
             print(f"tradeoff.py: {knob} = {value}", file=sys.stderr, flush=True)
             result = run(args, name, settings, particles)
             rows.append({"knob": knob, "value": value, **result, **errors(result, reference)})
+    for use, bound in USES.items():
+        settings = dict(DEFAULTS)
+        settings.update({knob: row["value"] for knob, row in recommendation(rows, bound).items()
+                         if knob in settings})
+        print(f"tradeoff.py: combined settings for a {use}: {settings}", file=sys.stderr,
+              flush=True)
+        result = run(args, f"combined_{use.replace(' ', '_')}", settings, args.particles)
+        rows.append({"knob": "combined", "value": use, **result, **errors(result, reference)})
     return reference, rows
 
 
 def recommendation(rows, bound):
-    """Per knob, the cheapest setting (CPU time) whose error is within ``bound``."""
+    """Per knob (the combined rows aside), the cheapest setting (CPU time) whose error is within
+    ``bound``."""
     chosen = {}
     for row in rows:
-        if row["error"] <= bound:
+        if row["error"] <= bound and row["knob"] != "combined":
             best = chosen.get(row["knob"])
             if best is None or row["cpu_time_s"] < best["cpu_time_s"]:
                 chosen[row["knob"]] = row
@@ -214,7 +225,9 @@ def write_markdown(path, args, reference, rows):
         f"peak q = {reference['peak_q']:.1f} Pa, Sr at peak = "
         f"{100 * reference['saturation_at_peak']:.3f} %, q'/p' at peak = "
         f"{reference['stress_ratio_at_peak']:.4f}; it took {reference['cpu_time_s']:.0f} s of "
-        "CPU. Times cover wetting and shear, not the sample's preparation.", "",
+        "CPU. Times cover wetting and shear, not the sample's preparation; CPU time (the run's "
+        "process time) is the speed measure, wall time also counts whatever else the machine "
+        "was running.", "",
         "![time against error](tradeoff.png)", "",
         "| knob | value | CPU [s] | wall [s] | M particle-steps/s | peak q error | "
         "Sr error | q'/p' error | error |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -227,10 +240,15 @@ def write_markdown(path, args, reference, rows):
               f"Fastest single-knob run within {PAPER_ERROR:.0%} of the reference on peak q: "
               f"{best['knob']} = {best['value']}, {speedup:.2f} x faster than the defaults "
               f"({best['cpu_time_s']:.1f} s against {default['cpu_time_s']:.1f} s of CPU).", ""]
-    for title, bound in (("Paper figure", PAPER_ERROR), ("Quick look", QUICK_ERROR)):
+    for use, bound in USES.items():
         chosen = recommendation(rows, bound)
-        lines += [f"**{title}** (each knob's cheapest setting with all three errors within "
-                  f"{bound:.0%}):", ""]
+        together = next(r for r in rows if r["knob"] == "combined" and r["value"] == use)
+        lines += [f"**{use.capitalize()}** (each knob's cheapest setting with all three errors "
+                  f"within {bound:.0%}); all of them together (sample size aside): peak q "
+                  f"error {100 * together['peak_q_error']:.2f} %, largest error "
+                  f"{100 * together['error']:.2f} %, {together['cpu_time_s']:.1f} s of CPU, "
+                  f"{default['cpu_time_s'] / together['cpu_time_s']:.1f} x faster than the "
+                  "defaults:", ""]
         for knob in KNOBS:
             if knob in chosen:
                 row = chosen[knob]
@@ -239,10 +257,14 @@ def write_markdown(path, args, reference, rows):
             elif any(r["knob"] == knob for r in rows):
                 lines.append(f"- {knob}: no setting within {bound:.0%} (keep the reference's)")
         lines.append("")
-    lines += ["Knobs that leave the physics unchanged (records, skin) and the sample size show "
-              "the scatter between runs of a chaotic system: any change of the order of "
-              "floating-point sums makes the runs drift apart after the peak; their errors are "
-              "the noise floor against which the other knobs are read.", ""]
+    lines += ["Reading the table: the skin and the record interval leave the dynamics unchanged "
+              "(skins 0.3-1.0 give bit-identical runs; 0.1 rebuilds the neighbour list in "
+              "another order, so floating-point sums differ and the chaotic trajectories drift "
+              "apart after the peak). Their rows, and the default run itself (about 1-2 % from "
+              "the reference), show the run-to-run scatter: differences below it are noise, "
+              "not an error of the knob. The sample size changes the sample itself (smaller "
+              "samples prepared by the same procedure are looser, with proportionally more "
+              "wall layers), so its errors are a size effect, not a numerical one.", ""]
     write_text(path, "\n".join(lines) + "\n")
 
 

@@ -25,10 +25,11 @@ def tradeoff(tmp_path_factory):
 def test_rows_cover_the_quick_knobs(tradeoff):
     _, data = tradeoff
     sys.path.insert(0, os.path.dirname(SCENARIO))
-    from tradeoff import QUICK_KNOBS
+    from tradeoff import QUICK_KNOBS, USES
 
     assert [(r["knob"], r["value"]) for r in data["rows"]] == [
-        (knob, value) for knob, values in QUICK_KNOBS.items() for value in values]
+        (knob, value) for knob, values in QUICK_KNOBS.items() for value in values] + [
+        ("combined", use) for use in USES]
     for row in data["rows"]:
         assert row["wall_time_s"] > 0 and row["cpu_time_s"] > 0
         for key in ("peak_q_error", "saturation_error", "stress_ratio_error"):
@@ -54,6 +55,19 @@ def test_default_run_is_shared_between_knobs(tradeoff):
                  ("table_resolution", "350,80"))]
     assert len(defaults) == 3
     assert len({(r["peak_q"], r["cpu_time_s"]) for r in defaults}) == 1   # one run, reused
+
+
+def test_combined_rows_take_each_knobs_cheapest_setting_within_the_bound(tradeoff):
+    _, data = tradeoff
+    from tradeoff import USES
+
+    knobs = [r for r in data["rows"] if r["knob"] != "combined"]
+    for use, bound in USES.items():
+        combined = next(r for r in data["rows"] if r["knob"] == "combined" and r["value"] == use)
+        for knob, setting in combined["settings"].items():
+            rows = [r for r in knobs if r["knob"] == knob and r["error"] <= bound]
+            if rows:
+                assert setting == min(rows, key=lambda r: r["cpu_time_s"])["value"], knob
 
 
 def test_report_and_plot(tradeoff):
