@@ -381,8 +381,18 @@ def run_row(suction, lateral, summary, folder, out):
 def main(argv=None):
     args = parse_args(argv)
     out = os.path.abspath(args.out)       # workers elsewhere see the same paths
-    os.makedirs(os.path.join(out, "samples"), exist_ok=True)
     common = _common(args)
+    triaxial = _triaxial()
+    for suction in args.suctions:       # refuse bad input here, not in a worker
+        for lateral in args.confining:
+            argv_run = common + ["--confining", repr(lateral)]
+            if suction > 0:
+                argv_run += ["--suction", repr(suction)]
+            try:
+                triaxial.configs(triaxial.parse_args(argv_run))
+            except ValueError as error:
+                sys.exit(f"chapter5.py: error: {error}")
+    os.makedirs(os.path.join(out, "samples"), exist_ok=True)
     preparations = [(common + ["--confining", repr(c)], sample_path(out, c))
                     for c in args.confining
                     if not made_with(sample_path(out, c), common + ["--confining", repr(c)])]
