@@ -91,6 +91,9 @@ def parse_args(argv=None):
     parser.add_argument("--void-ratio", default=None,
                         help="void ratio(s) of the core, comma separated (default: Kim's 0.72, "
                              "0.58)")
+    parser.add_argument("--roughness", type=float, default=0.0,
+                        help="meniscus separation of touching grains H/R (Kim's sand: "
+                             f"{KIM_SEPARATION}, as in the packing_state prediction; 0: smooth)")
     parser.add_argument("--water-content", default=None,
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
@@ -171,6 +174,7 @@ def check_settings(args):
     check_range("--surface-tension", args.surface_tension, 0.0, 1.0, low_inclusive=False,
                 unit="N/m")
     check_range("--specific-gravity", args.specific_gravity, 1.0, 10.0)
+    check_range("--roughness", args.roughness, 0.0, 0.5)
     check_range("--confining", args.confining, 1.0, 1e5, unit="Pa")
     check_range("--friction", args.friction, 0.0, 90.0, high_inclusive=False, unit="deg")
     check_range("--young", args.young, 0.0, 1e12, low_inclusive=False, unit="Pa")
@@ -275,10 +279,11 @@ def wet(dry, args, water_content, progress):
     aimed = target
     attempts = []
     for _ in range(WETTINGS):
-        suction = formation_suction(table, radius_i, radius_j, aimed, args.surface_tension)
+        suction = formation_suction(table, radius_i, radius_j, aimed, args.surface_tension,
+                                    args.roughness)
         sim = copy.deepcopy(dry)
         bridges = CapillaryBridges(suction, args.surface_tension, args.contact_angle,
-                                   control="volume").insert(sim)
+                                   control="volume", roughness=args.roughness).insert(sim)
         steps = sim.run(WET_STEPS, until=equilibrated(config), check_every=CHECK_EVERY,
                         progress="wet" if progress else None)
         held = bridges.water_volume(sim.contacts)
@@ -485,7 +490,8 @@ def _percent(value):
 def write_report(summaries, args, path):
     """report.md: one table row per case."""
     lines = [f"# Direct tension, {args.particles} spheres, R = {args.radius * 1e3:g} mm, "
-             f"theta = {args.contact_angle:g} deg, gamma = {args.surface_tension:g} N/m",
+             f"theta = {args.contact_angle:g} deg, gamma = {args.surface_tension:g} N/m, "
+             f"bridge roughness H/R = {args.roughness:g}",
              "",
              "Tensile strength [Pa] positive in tension. e: core void ratio (box less one "
              "diameter along each wall); packing_state: psi_xx of the comparison packing at the "

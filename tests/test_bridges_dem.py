@@ -325,3 +325,35 @@ def test_wet_scenario_refuses_bad_input(arguments, message):
     result = subprocess.run(command, capture_output=True, text=True)
     assert result.returncode != 0
     assert message in result.stderr
+
+
+def test_rough_contact_bridge_is_the_exact_bridge_at_the_roughness_separation():
+    """Volume control with roughness h: the bridge of two touching spheres is the Young–Laplace
+    bridge whose surfaces are h R apart: solved independently from its filling angle and
+    suction, it has the DEM bridge's separation, volume and force."""
+    radius, roughness, surface_tension = 1e-4, 0.09, 0.073
+    sim = two_body_scene([[0.0, 0.0, 0.0], [2 * radius * (1 - 1e-6), 0.0, 0.0]],
+                         [[0.0] * 3] * 2, radius=radius)
+    bridges = CapillaryBridges(5000.0, surface_tension, control="volume",
+                               roughness=roughness).insert(sim)
+    sim.run(1)
+    extra = sim.contacts.extra
+    assert bridges.count(sim) == 1
+    suction_star = extra["bridge_suction"][0] * radius / surface_tension
+    exact = capillary.solve_bridge(1.0, 0.0, suction_star, extra["filling_angle_i"][0])
+    assert exact.distance == pytest.approx(roughness, abs=2e-3)
+    assert extra["bridge_volume"][0] / radius**3 == pytest.approx(exact.volume, rel=2e-3)
+    force_star = extra["bridge_force"][0] / (2 * math.pi * surface_tension * radius)
+    assert force_star == pytest.approx(exact.force, rel=2e-3)
+    smooth = two_body_scene([[0.0, 0.0, 0.0], [2 * radius * (1 - 1e-6), 0.0, 0.0]],
+                            [[0.0] * 3] * 2, radius=radius)
+    CapillaryBridges(5000.0, surface_tension, control="volume").insert(smooth)
+    smooth.run(1)
+    assert extra["bridge_force"][0] < 0.95 * smooth.contacts.extra["bridge_force"][0]
+
+
+def test_roughness_needs_volume_control():
+    with pytest.raises(ValueError, match="roughness"):
+        CapillaryBridges(5000.0, roughness=0.05)
+    with pytest.raises(ValueError, match="roughness"):
+        CapillaryBridges(5000.0, control="volume", roughness=-0.1)

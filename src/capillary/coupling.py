@@ -231,11 +231,15 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
 @numba.njit(cache=True, parallel=True)
 def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
                    filling_i, filling_j, bridge_suction, pair_force, formation_suction,
-                   surface_tension, suction_table, volume_table):
+                   surface_tension, roughness, suction_table, volume_table):
     """Volume-controlled bridges: formed at contact with the volume of the suction-controlled
     bridge at ``formation_suction`` [Pa], then of constant volume; force and suction from
     (V*, d*) (capillary.lookup_volume), rupture where no bridge of that volume exists.
 
+    roughness: the meniscus separation of touching spheres / R2 (asperities hold the wetted
+    surfaces H = roughness R2 apart, thesis Ch. 4's H): d* = roughness at contact and
+    gap / R2 + roughness across a gap; 0 for smooth spheres. A pair whose bridge at formation
+    would not span H gets none.
     suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable.
     """
     for k in numba.prange(len(pair_i)):
@@ -251,15 +255,20 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
         ratio = larger / min(radius[i], radius[j])
         cube = larger * larger * larger
         if state[k] == NO_BRIDGE:
-            _, _, volume_star, _, _ = lookup_suction(
+            forms, _, volume_star, _, _ = lookup_suction(
                 suction_table[0], suction_table[1], suction_table[2], suction_table[3],
-                suction_table[4], ratio, formation_suction * larger / surface_tension, 0.0)
+                suction_table[4], ratio, formation_suction * larger / surface_tension, roughness)
+            if not forms:
+                pair_force[k, 0] = 0.0
+                pair_force[k, 1] = 0.0
+                pair_force[k, 2] = 0.0
+                continue
             volume[k] = volume_star * cube
             state[k] = ACROSS_GAP   # not yet evaluated at contact
         if touching and state[k] == AT_CONTACT:
             _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
             continue
-        gap_star = 0.0 if touching else -overlap[k] / larger
+        gap_star = roughness if touching else roughness - overlap[k] / larger
         exists, force_star, suction_star, delta1, delta2 = lookup_volume(
             volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
             ratio, volume[k] / cube, gap_star)
@@ -342,6 +351,8 @@ class CapillaryBridges:
     control: "suction" (default, thesis Ch. 5) or "volume" (each bridge keeps its volume);
     persist: suction control only: bridges live up to the rupture distance instead of breaking
         when contact is lost (volume-controlled bridges always persist up to rupture);
+    roughness: volume control only: meniscus separation of touching spheres H / R2 in [0, 0.5]
+        (rough grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
     table_options: keyword arguments of BridgeTable.cached (model 'exact') or
         capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
 
@@ -350,7 +361,7 @@ class CapillaryBridges:
     """
 
     def __init__(self, suction, surface_tension=0.073, contact_angle=0.0, model="exact",
-                 control="suction", persist=False, table_options=None):
+                 control="suction", persist=False, table_options=None, roughness=0.0):
         self.suction = check_range("suction", suction, 0.0, unit="Pa")
         self.surface_tension = check_positive("surface_tension", surface_tension, "N/m")
         self.contact_angle = check_contact_angle(contact_angle)
@@ -363,6 +374,10 @@ class CapillaryBridges:
         self.model = model
         self.control = control
         self.persist = bool(persist) or control == "volume"
+        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
+        if self.roughness > 0.0 and control != "volume":
+            raise ValueError(f"roughness = {self.roughness:g} needs control='volume' (suction-"
+                             "controlled bridges are between smooth spheres: roughness 0)")
         self.table_options = dict(table_options or {})
         self.suction_table = None
         self.volume_table = None
@@ -511,7 +526,7 @@ class CapillaryBridges:
                            extra["bridge"], extra["bridge_volume"], extra["bridge_force"],
                            extra["filling_angle_i"], extra["filling_angle_j"],
                            extra["bridge_suction"], self.pair_force, self.suction,
-                           self.surface_tension, self._table_arrays,
+                           self.surface_tension, self.roughness, self._table_arrays,
                            self.volume_table.arrays())
         gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
         if self.persist:

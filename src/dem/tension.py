@@ -117,10 +117,11 @@ def core_void_ratio(particles, walls, margin, spacing):
 
 
 def formation_suction(table, radius_i, radius_j, water_volume, surface_tension,
-                      tolerance=1e-6):
+                      roughness=0.0, tolerance=1e-6):
     """Suction [Pa] at which suction-controlled bridges at contact between the pairs of radii
     (radius_i, radius_j) [m] hold ``water_volume`` [m^3] in total (volume-controlled wetting at
     a fixed water content). Bisection on ln u*: V(u*) at contact falls monotonically with u*.
+    roughness: the menisci's separation at contact / R2 (CapillaryBridges ``roughness``).
 
     table: a capillary.BridgeTable (``lookup(r, u*, d*)`` -> (exists, F*, V*, delta1, delta2),
     u* = s R2 / gamma, V = V* R2^3, R2 the larger radius of the pair).
@@ -134,7 +135,8 @@ def formation_suction(table, radius_i, radius_j, water_volume, surface_tension,
     groups, multiplicity = np.unique(pairs, axis=0, return_counts=True)
 
     def held(suction):
-        return sum(count * table.lookup(ratio, suction * big / surface_tension, 0.0)[2] * big ** 3
+        return sum(count * table.lookup(ratio, suction * big / surface_tension, roughness)[2]
+                   * big ** 3
                    for (big, ratio), count in zip(groups, multiplicity))
 
     smallest_star = 1e-6
