@@ -2,6 +2,7 @@
 
     python scenarios/direct_tension.py [--void-ratio E[,E...]] [--water-content W[,W...]]
         [--particles N] [--radius M] [--contact-angle DEG] [--surface-tension N/M]
+        [--roughness H_OVER_R]
         [--confining PA] [--friction DEG] [--inertial-number I] [--max-strain X]
         [--grip-depth D] [--vtk-frames F] [--seed S] [--out DIR] [--quiet]
 
@@ -18,8 +19,10 @@ Gs = 2.65). Each case:
    within --void-ratio-tolerance.
 2. Wetting at constant water content: volume-controlled bridges (CapillaryBridges,
    control="volume") form at every contact with the volume of the suction-controlled bridge at
-   their formation suction, found so that the bridges hold V_w = w Gs V_s
-   (dem.tension.formation_suction); contacts made while the sample settles under the bridges
+   their formation suction, found so that the bridges hold V_w = w Gs V_s. The grains are rough:
+   the menisci of touching grains are --roughness R apart (default Kim's H/R = 0.09, the
+   separation of thesis Ch. 4's prediction; 0 for smooth spheres). The suction is found by
+   dem.tension.formation_suction; contacts made while the sample settles under the bridges
    get bridges too, so the suction is corrected until w is within 1 %. Walls servoed at
    --confining until static.
 3. Pull: the particles within --grip-depth diameters of each z wall (surface to wall) move
@@ -91,9 +94,9 @@ def parse_args(argv=None):
     parser.add_argument("--void-ratio", default=None,
                         help="void ratio(s) of the core, comma separated (default: Kim's 0.72, "
                              "0.58)")
-    parser.add_argument("--roughness", type=float, default=0.0,
-                        help="meniscus separation of touching grains H/R (Kim's sand: "
-                             f"{KIM_SEPARATION}, as in the packing_state prediction; 0: smooth)")
+    parser.add_argument("--roughness", type=float, default=KIM_SEPARATION,
+                        help="meniscus separation of touching grains H/R (default Kim's sand, "
+                             "as in the packing_state prediction; 0: smooth spheres)")
     parser.add_argument("--water-content", default=None,
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")

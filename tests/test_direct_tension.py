@@ -104,7 +104,8 @@ def test_grip_pull_equals_the_force_across_a_plane(wetted, args, tmp_path):
 def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wetted, args,
                                                                         table, tmp_path):
     """Rumpf (1962): sigma_t = (1 - n) k F / (pi d^2), k bridges per particle, F the force of
-    a bridge at contact (computed here from the table, not by the scenario)."""
+    a bridge at contact, its menisci args.roughness R apart (computed here from the table, not
+    by the scenario)."""
     _, dry_history = direct_tension.Pull(copy.deepcopy(dry), None, args,
                                          str(tmp_path / "dry")).run(None)
     sim = copy.deepcopy(wetted[0])
@@ -113,7 +114,7 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     particles = sim.particles
     radius = float(particles.radius[0])
     porosity = 1.0 - particles.solid_volume() / sim.walls.volume()
-    force = (table.lookup(1.0, bridges.suction * radius / GAMMA, 0.0)[1]
+    force = (table.lookup(1.0, bridges.suction * radius / GAMMA, args.roughness)[1]
              * 2.0 * math.pi * GAMMA * radius)
     rumpf = (1.0 - porosity) * (2.0 * count / len(particles)) * force / (math.pi * 4 * radius ** 2)
     _, history = direct_tension.Pull(sim, bridges, args, str(tmp_path / "wet")).run(None)
