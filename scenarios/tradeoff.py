@@ -64,6 +64,8 @@ QUICK_KNOBS = {"timestep_safety": [0.5, 0.7, 0.9], "inertial_number": [3e-4, 1e-
                "table_resolution": ["50,20", "100,40", "350,80"]}
 #: Error bounds of the recommendations.
 PAPER_ERROR, QUICK_ERROR = 0.02, 0.10
+#: CPU times within this factor of each other count as equal in the recommendations.
+TIME_TIE = 1.05
 #: The uses recommended for, and their error bounds.
 USES = {"paper figure": PAPER_ERROR, "quick look": QUICK_ERROR}
 
@@ -111,7 +113,9 @@ def run(args, name, settings, particles):
     timing_path = os.path.join(folder, "timing.json")
     if os.path.exists(timing_path):
         with open(timing_path) as handle:
-            return json.load(handle)
+            done = json.load(handle)
+        if done["settings"] == settings and done["particles"] == particles:
+            return done
     sample = sample_file(args.out, particles, args.seed)
     if not os.path.exists(sample):
         triaxial.prepare_and_save(base_argv(args, particles), sample)
@@ -192,21 +196,23 @@ def measure(args):
 
 
 def recommendation(rows, bound):
-    """Per knob (the combined rows aside), the cheapest setting (CPU time) whose error is within
-    ``bound``."""
+    """Per knob (the combined rows aside), the cheapest setting whose error is within ``bound``;
+    settings within TIME_TIE of the cheapest CPU time count as equally cheap, and the one with
+    the smallest error among them is taken."""
     chosen = {}
-    for row in rows:
-        if row["error"] <= bound and row["knob"] != "combined":
-            best = chosen.get(row["knob"])
-            if best is None or row["cpu_time_s"] < best["cpu_time_s"]:
-                chosen[row["knob"]] = row
+    for knob in dict.fromkeys(r["knob"] for r in rows if r["knob"] != "combined"):
+        within = [r for r in rows if r["knob"] == knob and r["error"] <= bound]
+        if within:
+            cheapest = min(r["cpu_time_s"] for r in within)
+            chosen[knob] = min((r for r in within if r["cpu_time_s"] <= TIME_TIE * cheapest),
+                               key=lambda r: r["error"])
     return chosen
 
 
 def fastest_within(rows, bound, default_time):
     """The row with the largest speed-up over the default run whose peak-q error is within
     ``bound``, and that speed-up."""
-    within = [r for r in rows if r["peak_q_error"] <= bound]
+    within = [r for r in rows if r["peak_q_error"] <= bound and r["knob"] != "combined"]
     best = min(within, key=lambda r: r["cpu_time_s"])
     return best, default_time / best["cpu_time_s"]
 
