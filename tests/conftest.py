@@ -1,5 +1,9 @@
 """Shared fixtures: small scenes built with the public API."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -30,6 +34,19 @@ def two_body_scene(positions, velocities, radius=RADIUS, young=YOUNG, friction_d
                   ContactForces(young, 0.3, friction_deg), WallForces(young), *extra,
                   Integrator(damping)]
     return Simulation(particles, walls, dt, operations)
+
+
+@pytest.fixture(scope="session")
+def wet_triaxial_run(tmp_path_factory):
+    """Output folder of scenarios/triaxial.py: 200 spheres at 30 kPa to 1 % strain, run once
+    for every test that reads it."""
+    out = tmp_path_factory.mktemp("wet_triaxial") / "wet"
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    subprocess.run([sys.executable, os.path.join(root, "scenarios", "triaxial.py"),
+                    "--particles", "200", "--max-strain", "0.01", "--inertial-number", "2e-3",
+                    "--suction", "30000", "--quiet", "--out", str(out)],
+                   check=True, capture_output=True, text=True)
+    return out
 
 
 @pytest.fixture(scope="session")

@@ -131,7 +131,7 @@ def test_touching_pair_at_rest_has_the_capillary_equilibrium_overlap():
 def test_toroidal_bridges_use_appendix_a_and_need_equal_spheres():
     radius = 1e-3
     sim = two_body_scene([[0, 0, 0], [2 * radius - 1e-7, 0, 0]], np.zeros((2, 3)))
-    bridges = CapillaryBridges(1000.0, GAMMA, contact_angle=20.0, model="toroidal").insert(sim)
+    CapillaryBridges(1000.0, GAMMA, contact_angle=20.0, model="toroidal").insert(sim)
     sim.advance()
     extra = sim.contacts.extra
     alpha = extra["filling_angle_i"][0]
@@ -290,12 +290,8 @@ def test_dry_scenario_never_imports_capillary(tmp_path):
         "capillary at module level (homogenize/__init__.py loads every submodule)")
 
 
-def test_wet_triaxial_scenario_writes_the_capillary_history(tmp_path):
-    out = tmp_path / "wet"
-    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), "--particles",
-               "200", "--max-strain", "0.01", "--inertial-number", "2e-3", "--suction", "30000",
-               "--quiet", "--out", str(out)]
-    subprocess.run(command, check=True, capture_output=True, text=True)
+def test_wet_triaxial_scenario_writes_the_capillary_history(wet_triaxial_run):
+    out = wet_triaxial_run
     summary = json.loads((out / "summary.json").read_text())
     assert 0.0 < summary["saturation_at_peak"] < 0.1
     assert summary["initial_bridges"] > 0

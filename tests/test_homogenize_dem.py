@@ -223,13 +223,9 @@ def test_dry_history_has_no_capillary_columns(tmp_path):
     assert "peak_q_effective" not in summary and "saturation_at_peak" not in summary
 
 
-def test_wet_triaxial_history_has_the_homogenised_capillary_state(tmp_path):
+def test_wet_triaxial_history_has_the_homogenised_capillary_state(wet_triaxial_run):
     """200 spheres at 30 kPa, 1 % strain: the columns and their bookkeeping at every record."""
-    out = tmp_path / "wet"
-    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), "--particles",
-               "200", "--max-strain", "0.01", "--inertial-number", "2e-3", "--suction", "30000",
-               "--quiet", "--out", str(out)]
-    subprocess.run(command, check=True, capture_output=True, text=True)
+    out = wet_triaxial_run
     summary = json.loads((out / "summary.json").read_text())
     with h5py.File(out / "history.h5") as handle:
         history = {name: data[:] for name, data in handle["history"].items()}

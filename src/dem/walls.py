@@ -62,6 +62,7 @@ class StressServo:
                  scale_max_velocity=False, stiffness_every=1):
         self.axes = _axes(axes)
         self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
+        self._wall_index = np.array(self.walls)
         self.target = check_range("target stress", target, 0.0, unit="Pa")
         self.max_velocity = check_positive("max_velocity", max_velocity, "m/s")
         self.gain = check_range("servo gain", gain, 0.0, 1.0, low_inclusive=False)
@@ -74,18 +75,18 @@ class StressServo:
 
     def _step_caps(self, walls, dt):
         """Largest wall shift of this step per servoed wall [m]."""
+        cap = self.max_velocity * dt
         if not self.scale_max_velocity:
-            return np.full(len(self.walls), self.max_velocity * dt)
+            return np.full(len(self.walls), cap)
         lengths = walls.lengths()
-        scale = 3.0 * lengths / lengths.sum()
-        return np.array([self.max_velocity * dt * scale[w // 2] for w in self.walls])
+        return cap * (3.0 * lengths / lengths.sum())[self._wall_index // 2]
 
     def apply(self, sim):
         walls = sim.walls
         areas = walls.areas()
         step_caps = self._step_caps(walls, sim.dt)
         if self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0:
-            self.stiffness[:] = walls.stiffness[list(self.walls)]
+            self.stiffness[:] = walls.stiffness[self._wall_index]
         self.calls += 1
         for slot, w in enumerate(self.walls):
             stiffness = self.stiffness[slot]
