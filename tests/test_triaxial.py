@@ -1,4 +1,4 @@
-"""Servo, Love–Weber bookkeeping, determinism and the triaxial scenario on small samples."""
+"""Servo, Love–Weber bookkeeping, determinism, the triaxial test procedure and its command."""
 
 import copy
 import json
@@ -12,8 +12,9 @@ import numpy as np
 import pytest
 
 from dem.preparation import PrepareConfig, prepare_sample
-from dem.triaxial import ShearConfig, start_shear, summarize
 from homogenize import contact_stress
+from pendular.config import ShearConfig
+from pendular.triaxial import TriaxialShear, summarize
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -58,11 +59,10 @@ def _unbalanced(sim):
 def test_servo_holds_lateral_stress_within_one_percent_in_shear(small_sample):
     config, sim, _ = small_sample
     sim = copy.deepcopy(sim)
-    shear = ShearConfig(confining=config.confining, max_strain=0.05, inertial_number=1e-3,
-                        records=50)
-    recorder, steps, _ = start_shear(sim, shear, config.radius, config.density)
-    sim.run(steps)
-    history = recorder.arrays()
+    shear = ShearConfig(max_strain=0.05, inertial_number=1e-3, records=50)
+    run = TriaxialShear(sim, shear, config.confining, config.radius, config.density)
+    sim.run(run.steps)
+    history = run.recorder.arrays()
     lateral = history["sigma_wall"][5:, :2]    # past the first 0.5 % of strain
     assert np.abs(lateral / config.confining - 1).mean() < 0.01
     assert np.abs(lateral / config.confining - 1).max() < 0.03

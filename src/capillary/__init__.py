@@ -9,8 +9,13 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 - BridgeTable + lookup_suction, VolumeBridgeTable + lookup_volume: tables for Numba kernels.
 - write_yade / read_yade: YADE capillary files M(r=...) (capillary.yade_files).
 - toroidal_bridge: thesis Appendix A (capillary.toroidal).
+- CapillaryBridges: the bridge operation of wet DEM scenes (capillary.bridges), its per-pair
+  BridgeState (capillary.bridge_state) and kernels (capillary.bridge_kernels).
+- formation_suction, gravimetric_water_content: wetting at a water content (capillary.wetting).
 """
 
+from capillary.bridge_state import BridgeState
+from capillary.bridges import BRIDGE_MODELS, SURFACE_TENSION, CapillaryBridges, table_radius_ratios
 from capillary.meniscus import Bridge, solve_bridge
 from capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
 from capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
@@ -23,10 +28,18 @@ from capillary.volume_control import (
     volume_contour,
 )
 from capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
+from capillary.wetting import formation_suction, gravimetric_water_content
 from capillary.yade_files import YadeCapillaryFile, read_yade, write_yade
 
 __all__ = [
+    "BRIDGE_MODELS",
     "Bridge",
+    "BridgeState",
+    "CapillaryBridges",
+    "SURFACE_TENSION",
+    "formation_suction",
+    "gravimetric_water_content",
+    "table_radius_ratios",
     "BridgeTable",
     "CONTACT_SUCTION_MAX",
     "FIELDS",

@@ -2,8 +2,9 @@
 
 A checkpoint is one HDF5 file:
 
-    attrs        format, version, step, time [s], dt [s], operations and writers (their types,
-                 JSON), skipped (per operation, the attributes not saved, JSON)
+    attrs        format, version, step, time [s], dt [s], pipeline (the types of the neighbour
+                 list, forces, controls, integrator and writers, JSON), skipped (per operation,
+                 the attributes not saved, JSON)
     particles/   every array attribute of ``sim.particles`` (position, radius, velocity, ...);
                  scalar attributes (density) as attributes of the group
     walls/       likewise for ``sim.walls``
@@ -21,8 +22,10 @@ References to the simulation's own objects (the simulation, particles, walls, co
 arrays, ``contacts.extra``, other operations) are saved as references and point, after loading,
 to the loaded simulation's objects, so an operation that caches ``sim.contacts`` stays in sync.
 
-``load_checkpoint`` restores into a simulation built the same way (same operation and writer
-types, in the same order; the scene's closures are not saved) and raises ValueError otherwise.
+``load_checkpoint`` restores into a simulation built the same way (same operation types in
+the same places, in the same order; the scene's closures are not saved) and raises ValueError
+otherwise; a checkpoint of another format version (1: before the declared pipeline) is
+refused with its version.
 The file is written under a temporary name, flushed to disk (fsync) and renamed over the
 previous checkpoint, so a run killed at any moment (kill -9 included) leaves the previous
 checkpoint intact. Checkpoints hold pickles: load only files you trust.
@@ -41,7 +44,7 @@ from .neighbors import Contacts
 from .validate import check_int, reading
 
 FORMAT = "pendular-checkpoint"
-VERSION = 1
+VERSION = 2
 _SCALARS = (bool, int, float, str, np.generic)
 
 
@@ -64,13 +67,19 @@ def _owned_arrays(obj, owner):
     return arrays, scalars
 
 
+def _pipeline(sim):
+    """Kind -> list of the simulation's operations of that kind, in step order."""
+    return {"neighbors": [sim.neighbors], "forces": sim.forces, "controls": sim.controls,
+            "integrator": [sim.integrator], "writers": sim.writers}
+
+
 def _references(sim, particle_arrays, wall_arrays, contacts):
     """Path -> object of the simulation's own objects, saved by reference in the state pickle."""
     references = {("sim",): sim, ("particles",): sim.particles, ("walls",): sim.walls,
-                  ("operations",): sim.operations, ("writers",): sim.writers,
                   ("contacts",): contacts}
-    for kind in ("operations", "writers"):
-        for index, op in enumerate(getattr(sim, kind)):
+    for kind, ops in _pipeline(sim).items():
+        references[(kind,)] = ops
+        for index, op in enumerate(ops):
             references[(kind, index)] = op
     for owner, arrays in (("particles", particle_arrays), ("walls", wall_arrays)):
         for name, value in arrays.items():
@@ -142,7 +151,7 @@ def save_checkpoint(path, sim, extra_state=None):
 
     ``extra_state``: any picklable value (e.g. the scenario's phase), returned by
     ``load_checkpoint``. Returns the names of the operation attributes not saved
-    ({"operations[i] Type": [names]}).
+    ({"forces[i] Type": [names]}).
     """
     path = os.fspath(path)
     contacts = sim.contacts
@@ -151,9 +160,10 @@ def save_checkpoint(path, sim, extra_state=None):
     references = _references(sim, particle_arrays, wall_arrays, contacts)
     skipped = {}
     tree = {"extra_state": extra_state}
-    for kind in ("operations", "writers"):
+    pipeline = _pipeline(sim)
+    for kind, ops in pipeline.items():
         tree[kind] = []
-        for index, op in enumerate(getattr(sim, kind)):
+        for index, op in enumerate(ops):
             state, names = _operation_state(op, references)
             tree[kind].append(state)
             if names:
@@ -166,8 +176,8 @@ def save_checkpoint(path, sim, extra_state=None):
         handle.attrs.update({
             "format": FORMAT, "version": VERSION, "step": int(sim.step),
             "time": float(sim.time), "dt": float(sim.dt),
-            "operations": json.dumps([_type_name(op) for op in sim.operations]),
-            "writers": json.dumps([_type_name(op) for op in sim.writers]),
+            "pipeline": json.dumps({kind: [_type_name(op) for op in ops]
+                                    for kind, ops in pipeline.items()}),
             "skipped": json.dumps(skipped), "has_contacts": contacts is not None})
         _write_group(handle, "particles", particle_arrays, particle_scalars)
         _write_group(handle, "walls", wall_arrays, wall_scalars)
@@ -192,9 +202,10 @@ def _read_group(group):
 
 
 def _check_types(handle, sim):
-    for kind in ("operations", "writers"):
-        saved = json.loads(handle.attrs[kind])
-        current = [_type_name(op) for op in getattr(sim, kind)]
+    saved_pipeline = json.loads(handle.attrs["pipeline"])
+    for kind, ops in _pipeline(sim).items():
+        saved = saved_pipeline.get(kind)
+        current = [_type_name(op) for op in ops]
         if saved != current:
             raise ValueError(
                 f"checkpoint {handle.filename!r} does not match this simulation's {kind}: "
@@ -205,7 +216,8 @@ def _check_types(handle, sim):
 def load_checkpoint(path, sim):
     """Restore the state saved by ``save_checkpoint`` into ``sim``; return its ``extra_state``.
 
-    ``sim`` must have operations and writers of the same types in the same order (ValueError
+    ``sim`` must have neighbour list, forces, controls, integrator and writers of the same
+    types in the same order (ValueError
     otherwise, before anything is changed). Particles, walls, contacts, step, time, dt and the
     saved attributes of every operation and writer are replaced; attributes skipped at saving
     keep the values of ``sim``'s own operations.
@@ -248,8 +260,8 @@ def load_checkpoint(path, sim):
     sim.step = step
     sim.time = time
     sim.dt = dt
-    for kind in ("operations", "writers"):
-        for op, state in zip(getattr(sim, kind), tree[kind]):
+    for kind, ops in _pipeline(sim).items():
+        for op, state in zip(ops, tree[kind]):
             for name, value in state.items():
                 setattr(op, name, value)
     return tree["extra_state"]

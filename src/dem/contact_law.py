@@ -11,6 +11,20 @@ import numpy as np
 from .validate import check_positive, check_range
 
 
+@numba.njit(cache=True, inline="always")
+def normal_stiffness(young, radius_i, radius_j):
+    """Normal stiffness of a sphere pair kn = 2 E R1 R2 / (R1 + R2) [N/m] (YADE FrictMat,
+    SPEC §2; E R for equal spheres); scalars or arrays."""
+    return 2.0 * young * radius_i * radius_j / (radius_i + radius_j)
+
+
+@numba.njit(cache=True, inline="always")
+def wall_contact_stiffness(young, radius):
+    """Normal stiffness of a sphere–wall contact kn = E R [N/m] (the wall as a virtual sphere
+    of the same radius, YADE's Ig2_Box_Sphere_ScGeom); scalars or arrays."""
+    return young * radius
+
+
 @numba.njit(cache=True, parallel=True)
 def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j,
                 shear_force, normal, overlap, normal_force, force, torque_i, torque_j,
@@ -48,7 +62,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j,
         n0 = d0 / distance
         n1 = d1 / distance
         n2 = d2 / distance
-        kn = 2.0 * young * ri * rj / (ri + rj)
+        kn = normal_stiffness(young, ri, rj)
         ks = shear_ratio * kn
         fs0 = shear_force[k, 0]
         fs1 = shear_force[k, 1]
@@ -159,7 +173,7 @@ def wall_forces(position, radius, wall_position, young, force, wall_force, wall_
     wall_moment[:] = 0.0
     for p in range(position.shape[0]):
         r = radius[p]
-        kn = young * r
+        kn = wall_contact_stiffness(young, r)
         for axis in range(3):
             low_overlap = r - (position[p, axis] - wall_position[2 * axis])
             if low_overlap > 0.0:

@@ -3,6 +3,8 @@
 import numba
 import numpy as np
 
+from .contact_law import normal_stiffness, wall_contact_stiffness
+
 
 def porosity(particles, walls):
     """1 - (solid volume / volume inside the walls). Spheres are assumed inside the box."""
@@ -55,7 +57,7 @@ def elastic_energy(particles, contacts, walls, young, shear_ratio):
     touching = contacts.overlap > 0.0
     ri = particles.radius[contacts.pair_i[touching]]
     rj = particles.radius[contacts.pair_j[touching]]
-    kn = 2.0 * young * ri * rj / (ri + rj)
+    kn = normal_stiffness(young, ri, rj)
     energy = 0.5 * np.sum(kn * contacts.overlap[touching] ** 2)
     if shear_ratio > 0.0:
         energy += 0.5 * np.sum(np.sum(contacts.shear_force[touching] ** 2, axis=1)
@@ -64,5 +66,5 @@ def elastic_energy(particles, contacts, walls, young, shear_ratio):
     wall_overlap = np.concatenate([radius - (particles.position - walls.lo),
                                    radius - (walls.hi - particles.position)], axis=1)
     wall_overlap = np.maximum(wall_overlap, 0.0)
-    energy += 0.5 * np.sum(young * radius * wall_overlap ** 2)
+    energy += 0.5 * np.sum(wall_contact_stiffness(young, radius) * wall_overlap ** 2)
     return float(energy)

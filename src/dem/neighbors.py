@@ -7,8 +7,8 @@ can be gathered per particle without atomics (deterministic for any thread count
 
 Operations may keep their own per-pair state in ``Contacts.extra`` (name -> array with one row
 per pair, any dtype and trailing shape); ``build_contacts`` carries every such array to the same
-(i, j) pair across rebuilds, as it does for the shear history. ``NeighborList`` can reach beyond
-touching by an ``interaction_range`` (for interactions acting across a gap, e.g. liquid bridges).
+(i, j) pair across rebuilds, as it does for the shear history. ``NeighborList`` reaches beyond
+touching as far as the scene's forces declare (``reach(sim)``, e.g. liquid bridges across gaps).
 """
 
 from dataclasses import dataclass, field
@@ -289,26 +289,28 @@ class NeighborList:
     """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2.
 
     skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
-    interaction_range [m]: largest gap across which some operation still needs a pair (0 for
-    contacts only). The list holds pairs with gap < interaction_range + skin, so every pair
-    with gap < interaction_range is in it until the next rebuild. Changing it forces a rebuild.
+    The reach beyond touching is the largest ``reach(sim)`` [m] of the simulation's forces
+    (a force acting across gaps, e.g. a liquid bridge up to its rupture distance, declares it;
+    forces without ``reach`` need touching pairs only), asked every step: the list holds pairs
+    with gap < reach + skin, so every pair with gap < reach is in it until the next rebuild,
+    and a change of reach forces a rebuild. ``interaction_range`` [m]: the reach in use.
     """
 
-    def __init__(self, skin, interaction_range=0.0):
+    def __init__(self, skin):
         self.skin = check_positive("skin", skin, "m")
         self.rebuilds = 0
+        self.interaction_range = 0.0
         self._reference_position = None
         self._reference_radius = None
-        self.interaction_range = interaction_range
 
-    @property
-    def interaction_range(self):
-        return self._interaction_range
-
-    @interaction_range.setter
-    def interaction_range(self, value):
-        self._interaction_range = check_range("interaction_range", value, 0.0, unit="m")
-        self._reference_position = None     # rebuild with the new reach at the next step
+    def required_reach(self, sim):
+        """Largest reach [m] the simulation's forces declare (0: contacts only)."""
+        reach = 0.0
+        for op in sim.forces:
+            if hasattr(op, "reach"):
+                reach = max(reach, check_range(f"{type(op).__name__}.reach", op.reach(sim),
+                                               0.0, unit="m"))
+        return reach
 
     def rebuild(self, sim):
         p = sim.particles
@@ -320,8 +322,11 @@ class NeighborList:
 
     def apply(self, sim):
         p = sim.particles
-        if (sim.contacts is None or self._reference_position is None
+        reach = self.required_reach(sim)
+        if (reach != self.interaction_range or sim.contacts is None
+                or self._reference_position is None
                 or len(self._reference_radius) != len(p.radius)
                 or moved_beyond(p.position, self._reference_position, p.radius,
                                 self._reference_radius, 0.5 * self.skin)):
+            self.interaction_range = reach
             self.rebuild(sim)

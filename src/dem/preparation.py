@@ -18,7 +18,7 @@ from .contact_law import ContactForces
 from .integrate import Integrator, pwave_timestep
 from .measure import coordination, porosity, unbalanced_force
 from .neighbors import NeighborList
-from .simulation import ForceReset, Simulation
+from .simulation import Simulation
 from .state import Particles, Walls
 from .validate import check_int, check_positive, check_range
 from .walls import StressServo, WallForces
@@ -217,30 +217,33 @@ def equilibrated(config):
     def done(sim):
         if unbalanced_force(sim.particles, sim.contacts) > config.equilibrium_unbalanced:
             return False
-        try:
-            servo = sim.operation(StressServo)
-        except KeyError:
-            return True
-        error = np.abs(sim.walls.stress() - servo.target)
-        return bool(np.all(error <= config.stress_tolerance * max(servo.target, 1e-12)))
+        for servo in (op for op in sim.controls if isinstance(op, StressServo)):
+            error = np.abs(sim.walls.stress()[list(servo.axes)] - servo.target)
+            if np.any(error > config.stress_tolerance * max(servo.target, 1e-12)):
+                return False
+        return True
 
     return done
 
 
-def dry_operations(config, skin, friction_deg):
-    """The force pipeline of a dry scene: reset, neighbour list, contact law, wall springs."""
-    return [ForceReset(), NeighborList(skin),
-            ContactForces(config.young, config.shear_ratio, friction_deg), WallForces(config.young)]
+def dry_simulation(particles, walls, config, skin, friction_deg, controls, threads=None):
+    """The scene of a dry sample: neighbour list of ``skin`` [m], linear contacts at
+    ``friction_deg`` [deg], wall springs, the given wall ``controls``, leapfrog."""
+    return Simulation(particles, walls, timestep(particles, config),
+                      neighbors=NeighborList(skin),
+                      forces=[ContactForces(config.young, config.shear_ratio, friction_deg),
+                              WallForces(config.young)],
+                      controls=controls,
+                      integrator=Integrator(config.damping),
+                      threads=threads)
 
 
 def servoed_simulation(particles, walls, config, target, threads=None):
-    """A static sample's simulation: dry pipeline at the test friction, six walls servoed at
-    ``target`` [Pa], integrator. Used to continue from a saved sample."""
-    sim = Simulation(particles, walls, timestep(particles, config),
-                     dry_operations(config, config.skin_factor * float(np.mean(particles.radius)),
-                                    config.friction_deg), threads=threads)
-    sim.operations += [StressServo("xyz", target, max_velocity=_servo_speed(sim, config)),
-                       Integrator(config.damping)]
+    """A static sample's simulation: dry scene at the test friction, six walls servoed at
+    ``target`` [Pa]. Used to continue from a saved sample."""
+    skin = config.skin_factor * float(np.mean(particles.radius))
+    sim = dry_simulation(particles, walls, config, skin, config.friction_deg, [], threads)
+    sim.controls = [StressServo("xyz", target, max_velocity=_servo_speed(sim, config))]
     return sim
 
 
@@ -260,8 +263,9 @@ def rescale(sim, factor):
 def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
 
-    The returned simulation's operations are the dry pipeline, the six-wall servo at the
-    confining stress and the integrator; ``report`` gives porosity, coordination and steps.
+    The returned simulation is the dry scene with the six walls servoed at the confining
+    stress (``sim.controls``); ``report`` gives porosity, coordination and steps. ValueError
+    naming the phase when one ends at ``max_steps`` without reaching its target.
     """
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -276,11 +280,9 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     position = random_cloud(config.particles, cloud_radius, lo, hi, config.seed)
     particles = Particles(position, np.full(config.particles, cloud_radius), config.density)
     walls = Walls.box(lo, hi)
-    skin = config.skin_factor * config.radius
     growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
-    sim = Simulation(particles, walls, timestep(particles, config),
-                     dry_operations(config, skin, config.prep_friction_deg)
-                     + [growth, Integrator(config.damping)], threads=threads)
+    sim = dry_simulation(particles, walls, config, config.skin_factor * config.radius,
+                         config.prep_friction_deg, [growth], threads)
     done = equilibrated(config)
 
     def grown(s):
@@ -288,20 +290,22 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
         return (abs(stress - config.prep_stress) <= 0.02 * config.prep_stress and done(s))
 
     def status(s):
-        return {"sigma": f"{np.mean(s.walls.stress()):.0f}Pa",
+        return {"sigma": f"{np.mean(s.walls.stress()):.0f}/{config.prep_stress:g}Pa",
                 "n": f"{porosity(s.particles, s.walls):.3f}",
-                "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"}
+                "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"
+                         f"/{config.equilibrium_unbalanced:g}"}
 
     steps = {"growth": sim.run(max_steps, until=grown, check_every=200, progress=label and
                                "grow radii", status=status)}
+    _require(grown(sim), "radius growth", steps["growth"], status(sim))
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
-    growth_index = sim.operations.index(growth)
     servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim, config))
-    sim.operations[growth_index] = servo
+    sim.controls = [servo]
     sim.dt = timestep(sim.particles, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=label and "set friction", status=status)
+    _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim))
     start = servo.target
     stages = 20
     for stage in range(1, stages + 1):
@@ -310,6 +314,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     steps["unload"] = config.unload_steps // stages * stages
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
                                    progress=label and "equilibrate", status=status)
+    _require(done(sim), f"equilibrium at confining = {config.confining:g} Pa",
+             steps["equilibrate"], status(sim))
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),
@@ -320,6 +326,16 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
         "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
     }
     return sim, report
+
+
+def _require(reached, phase, steps, status):
+    """ValueError naming the preparation ``phase`` and what it reached when it ended at its
+    step limit without reaching its target."""
+    if not reached:
+        raise ValueError(f"preparation: {phase} not reached in {steps} steps (the step limit): "
+                         + ", ".join(f"{k} {v}" for k, v in status.items())
+                         + "; check the sample settings (e.g. a confining stress too low for "
+                           "the servo to settle, or too stiff springs)")
 
 
 def _servo_speed(sim, config):

@@ -1,11 +1,20 @@
-"""The Simulation: state plus an ordered list of operations run once per step.
+"""The Simulation: state plus the step pipeline, declared in one place.
 
-A dry triaxial step reads, as in YADE's engine list::
+A scene names what it needs, in the order a step runs it (YADE's engine list, HOOMD-blue's
+shape)::
 
-    ForceReset(), NeighborList(skin), ContactForces(E, 0.3, 18), WallForces(E),
-    StressServo("xy", 750, ...), ConstantStrainRate("z", rate, L0), Integrator(0.2), recorder
+    Simulation(particles, walls, dt,
+               neighbors=NeighborList(skin),
+               forces=[ContactForces(E, 0.3, 18), WallForces(E)],      # + CapillaryBridges
+               controls=[StressServo("xy", 750, v), ConstantStrainRate("z", rate, L0)],
+               integrator=Integrator(0.2),
+               writers=[recorder])
 
-Each operation has ``apply(sim)``; a scene runs only the operations it lists.
+One step (``advance``): zero forces and torques, the neighbour list, every force, every
+control, the integrator; then step and time advance and the writers see the new state.
+``forces``, ``controls`` and ``writers`` are plain lists: a phase change replaces
+``sim.controls``, wetting appends a force. An operation has ``apply(sim)``; a force that
+needs pairs beyond contact says so with ``reach(sim)`` [m] (dem.neighbors.NeighborList asks).
 """
 
 import time
@@ -16,47 +25,49 @@ from tqdm import tqdm
 from .state import Particles, Walls
 from .validate import check_int, check_positive
 
-
-class ForceReset:
-    """Zero the particles' forces and torques (first operation of every step)."""
-
-    def apply(self, sim):
-        sim.particles.force[:] = 0.0
-        sim.particles.torque[:] = 0.0
-
-
 #: Below this many particles a step is too short to pay for waking a second thread.
 SERIAL_BELOW = 2000
 
 
-class Simulation:
-    """Holds particles, walls, contacts, time step and the operations that advance them.
+def _check_operation(op):
+    if not callable(getattr(op, "apply", None)):
+        raise TypeError(f"operation {op!r} has no apply(sim) method")
+    return op
 
-    dt [s]; ``step`` and ``time`` [s] count from the start; ``contacts`` is filled by
-    ``NeighborList``. ``writers`` (recorders) run after each step, seeing the advanced
-    state, step and time, as HOOMD's writers do. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
+
+class Simulation:
+    """Holds particles, walls, contacts, time step and the step pipeline.
+
+    dt [s]; ``step`` and ``time`` [s] count from the start; ``contacts`` is filled by the
+    neighbour list. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
     SERIAL_BELOW particles or more, else 1). Results do not depend on the thread count.
     """
 
-    def __init__(self, particles, walls, dt, operations=(), writers=(), threads=None):
+    def __init__(self, particles, walls, dt, *, neighbors, forces=(), controls=(),
+                 integrator, writers=(), threads=None):
         for name, value, kind in (("particles", particles, Particles), ("walls", walls, Walls)):
             if not isinstance(value, kind):
                 raise TypeError(f"{name} must be a dem.state.{kind.__name__}, got "
                                 f"{type(value).__name__}")
-        for op in (*operations, *writers):
-            if not callable(getattr(op, "apply", None)):
-                raise TypeError(f"operation {op!r} has no apply(sim) method")
         self.particles = particles
         self.walls = walls
         self.dt = check_positive("dt", dt, "s")
-        self.operations = list(operations)
-        self.writers = list(writers)
+        self.neighbors = _check_operation(neighbors)
+        self.forces = [_check_operation(op) for op in forces]
+        self.controls = [_check_operation(op) for op in controls]
+        self.integrator = _check_operation(integrator)
+        self.writers = [_check_operation(op) for op in writers]
         self.contacts = None
         self.step = 0
         self.time = 0.0
         if threads is None:
             threads = numba.get_num_threads() if len(particles) >= SERIAL_BELOW else 1
         self.threads = check_int("threads", threads, low=1, high=numba.config.NUMBA_NUM_THREADS)
+
+    @property
+    def operations(self):
+        """The step's operations in order: neighbour list, forces, controls, integrator."""
+        return [self.neighbors, *self.forces, *self.controls, self.integrator]
 
     def operation(self, kind):
         """The first operation or writer of class ``kind`` (KeyError if absent)."""
@@ -65,10 +76,21 @@ class Simulation:
                 return op
         raise KeyError(f"no {kind.__name__} operation in this simulation")
 
-    def advance(self):
-        """One step: every operation in order, then the writers (which see the new step)."""
-        for op in self.operations:
+    def evaluate_forces(self):
+        """Forces and torques of the current state (neighbour list and every force), without
+        moving anything: the first part of a step."""
+        self.particles.force[:] = 0.0
+        self.particles.torque[:] = 0.0
+        self.neighbors.apply(self)
+        for op in self.forces:
             op.apply(self)
+
+    def advance(self):
+        """One step: forces, controls, integrator, then the writers (which see the new step)."""
+        self.evaluate_forces()
+        for op in self.controls:
+            op.apply(self)
+        self.integrator.apply(self)
         self.step += 1
         self.time += self.dt
         for writer in self.writers:
@@ -77,10 +99,11 @@ class Simulation:
     def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
         """Advance ``steps`` steps, or fewer if ``until(sim)`` becomes true (checked every
         ``check_every`` steps). ``progress`` is a label for a progress bar; ``status(sim)``
-        returns a dict shown beside it. Returns the number of steps taken."""
+        returns a dict shown beside it (an open-ended run, with ``until``, shows the steps
+        taken and its status, not a fraction of the step limit). Returns the steps taken."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
-        bar = tqdm(total=steps, desc=progress, unit="step", mininterval=1.0, smoothing=0.05,
+        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step", mininterval=1.0, smoothing=0.05,
                    disable=progress is None)
         taken = 0
         started = time.perf_counter()

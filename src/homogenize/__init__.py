@@ -6,7 +6,8 @@
   and the discrete sums chi_ij, B_ij, psi_ij, sigma'_ij, a_psi (Eqs. 3.43-3.46, 4.5).
 - harmonic: the continuous forms (Eqs. 3.50, 3.55-3.57).
 - on_the_fly: the same discrete sums over the bridges of a live DEM state, for the recorders
-  (homogenize_bridges, CapillaryHomogenization; capillary_quantities for the triaxial history).
+  (homogenize_bridges, capillary_force_stress, CapillaryHomogenization).
+- invariants: q and p of axisymmetric tests.
 - regular_packing, packing_state: SCP, BCC, FCP and their pendular states (Tables 4.1-4.4).
 """
 
@@ -33,7 +34,7 @@ from .on_the_fly import (
     BridgeStress,
     CapillaryHomogenization,
     bridges_in_region,
-    capillary_quantities,
+    capillary_force_stress,
     homogenize_bridges,
 )
 from .packing_state import PackingState, packing_state
@@ -45,7 +46,7 @@ __all__ = [
     "PackingState",
     "RegularPacking",
     "bridges_in_region",
-    "capillary_quantities",
+    "capillary_force_stress",
     "capillary_stress",
     "capillary_stress_anisotropy",
     "contact_line_integral",

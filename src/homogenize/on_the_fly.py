@@ -1,9 +1,9 @@
 """Effective stress of the live DEM state (thesis Eqs. 3.43-3.46, 3.51-3.54, 4.5), when a recorder asks.
 
-The discrete sums of homogenize.bridge_tensors taken over the liquid bridges of a simulation:
-the per-pair arrays that capillary.coupling.CapillaryBridges keeps in ``sim.contacts.extra``
-(``bridge`` != 0 marks a bridge; ``bridge_volume`` [m^3]; ``filling_angle_i`` and
-``filling_angle_j`` [deg], the caps on particles pair_i and pair_j, each with its own radius).
+The discrete sums of homogenize.bridge_tensors taken over the liquid bridges of a simulation,
+read through capillary.BridgeState (``state`` != NO_BRIDGE marks a bridge; ``volume`` [m^3];
+``filling_i`` and ``filling_j`` [deg], the caps on particles pair_i and pair_j, each with its
+own radius).
 Each bridge's normal is its current branch vector x_j - x_i, unit (valid for bridges at contact
 and across a gap alike; ``contacts.normal`` is the contact law's and lags for gap pairs).
 
@@ -41,15 +41,15 @@ Volume-controlled bridges carry their own suction (``bridge_suction``): psi is t
 each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
 bridge has the suction s; chi is Eq. 3.44 either way.
 
-A dry scene never needs this module's capillary half: ``capillary_quantities`` looks for a
-bridge operation among the operations without importing the capillary package.
+A wet scene's recorder builds ``CapillaryHomogenization(bridges)`` from its bridge operation;
+a dry scene never does.
 """
 
 from dataclasses import dataclass
-import sys
 
 import numpy as np
 
+from capillary.bridge_state import BridgeState
 from dem.validate import check_positive
 from homogenize.bridge_tensors import (
     _rotated_sum,
@@ -59,10 +59,8 @@ from homogenize.bridge_tensors import (
     surface_tension_stress,
     wetted_cap_integral,
 )
+from homogenize.contact_stress import pair_stress_sum
 from homogenize.fabric import fabric_tensor, principal_anisotropy
-
-NO_BRIDGE = 0
-"""Value of ``contacts.extra["bridge"]`` for a pair without a bridge (capillary.coupling)."""
 
 
 @dataclass(frozen=True)
@@ -88,10 +86,9 @@ class BridgeStress:
 
 def bridge_mask(contacts):
     """(K,) bool: the pairs holding a liquid bridge (none if no bridge operation ran)."""
-    state = contacts.extra.get("bridge")
-    if state is None:
+    if not BridgeState.present(contacts):
         return np.zeros(len(contacts), dtype=bool)
-    return state != NO_BRIDGE
+    return BridgeState.of(contacts).mask()
 
 
 def _branch(particles, contacts, index):
@@ -144,13 +141,15 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
             raise ValueError(f"mask selects {int(np.count_nonzero(mask & ~bridges))} pair(s) "
                              "without a bridge; valid: a subset of the bridges")
     index = np.flatnonzero(mask)
-    extra = contacts.extra
     _, normal = _branch(particles, contacts, index)
     radius_i = particles.radius[contacts.pair_i[index]]
     radius_j = particles.radius[contacts.pair_j[index]]
-    filling_i = extra["filling_angle_i"][index] if len(index) else np.zeros(0)
-    filling_j = extra["filling_angle_j"][index] if len(index) else np.zeros(0)
-    bridge_volume = extra["bridge_volume"][index] if len(index) else np.zeros(0)
+    if len(index):
+        state = BridgeState.of(contacts)
+        filling_i, filling_j = state.filling_i[index], state.filling_j[index]
+        bridge_volume = state.volume[index]
+    else:
+        filling_i = filling_j = bridge_volume = np.zeros(0)
     water_volume = float(np.sum(bridge_volume))
     caps = (normal, radius_i, radius_j, filling_i, filling_j)
     chi = effective_stress_parameter(*caps, water_volume, volume)
@@ -181,14 +180,25 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
     )
 
 
-class CapillaryHomogenization:
-    """The homogenised capillary state of a wet scene, evaluated when a recorder asks.
+def capillary_force_stress(sim, bridges):
+    """Love–Weber stress of the capillary forces (1/V) sum l_i f^cap_j [Pa] (3x3) of the bridge
+    operation ``bridges`` (capillary.CapillaryBridges), V the box inside the walls, with the
+    sign convention of homogenize.contact_stress (l = x_j - x_i, f on j from i, compression
+    positive): attractive bridges give a negative (tensile) stress, and in static equilibrium
+    sigma_wall = sigma_contact + sigma_capillary."""
+    c = sim.contacts
+    total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, bridges.pair_forces(sim),
+                            bridges.state(sim).mask())
+    return total / sim.walls.volume()
 
-    bridges: the scene's capillary.coupling.CapillaryBridges operation (its suction, contact
-    angle and surface tension, and the per-pair arrays it keeps in ``sim.contacts.extra``).
-    The volume is the box inside the walls; the total stress of Eq. 3.43 is the wall stress
-    diag(sigma_x, sigma_y, sigma_z), u_a = 0. One evaluation serves every column of a record
-    (cached for the state's step and contact list).
+
+class CapillaryHomogenization:
+    """The capillary state of a wet scene, evaluated when a recorder asks.
+
+    bridges: the scene's capillary.CapillaryBridges operation (its suction, contact angle and
+    surface tension, and its per-pair BridgeState). The volume is the box inside the walls; the
+    total stress of Eq. 3.43 is the wall stress diag(sigma_x, sigma_y, sigma_z), u_a = 0. One
+    evaluation serves every column of a record (cached for the state's step and contact list).
     """
 
     def __init__(self, bridges):
@@ -201,9 +211,7 @@ class CapillaryHomogenization:
         """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state."""
         if (sim.step, sim.time) != self._step or sim.contacts is not self._contacts:
             op = self.bridges
-            suction = (sim.contacts.extra["bridge_suction"]
-                       if op.control == "volume" and "bridge_suction" in sim.contacts.extra
-                       else op.suction)
+            suction = (op.state(sim).suction if op.control == "volume" else op.suction)
             state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
                                        suction=suction, contact_angle=op.contact_angle,
                                        surface_tension=op.surface_tension)
@@ -211,6 +219,9 @@ class CapillaryHomogenization:
             self._step, self._contacts = (sim.step, sim.time), sim.contacts
             self._state = (state, effective)
         return self._state
+
+    def sigma_capillary(self, sim):
+        return capillary_force_stress(sim, self.bridges)
 
     def chi(self, sim):
         return self.evaluate(sim)[0].chi
@@ -234,8 +245,17 @@ class CapillaryHomogenization:
         return self.evaluate(sim)[0].a_psi
 
     def quantities(self):
-        """Recorded columns (bound methods, so that a deep-copied recorder follows its copy)."""
+        """Recorded columns of a wet scene, name -> function of sim (bound methods, so that a
+        deep-copied recorder follows its copy): the bridges' saturation, suction [Pa],
+        sigma_capillary [Pa], bridges, pendular_overlaps, then chi, B, psi, sigma_effective,
+        fabric_bridges, anisotropy_bridges, a_psi (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+        op = self.bridges
         return {
+            "saturation": op.saturation,
+            "suction": op.mean_suction,
+            "sigma_capillary": self.sigma_capillary,
+            "bridges": op.count,
+            "pendular_overlaps": op.pendular_overlaps,
             "chi": self.chi,
             "B": self.B,
             "psi": self.psi,
@@ -244,22 +264,3 @@ class CapillaryHomogenization:
             "anisotropy_bridges": self.anisotropy_bridges,
             "a_psi": self.a_psi,
         }
-
-
-def capillary_quantities(operations):
-    """History columns of the homogenised capillary state (CapillaryHomogenization) for the
-    bridge operation among ``operations``; {} for a dry scene.
-
-    A scene with bridges has imported capillary.coupling to build them, so a dry scene is
-    recognised without importing the capillary package (SPEC: a dry test never touches it).
-    """
-    coupling = sys.modules.get("capillary.coupling")
-    if coupling is None:
-        return {}
-    found = [op for op in operations if isinstance(op, coupling.CapillaryBridges)]
-    if not found:
-        return {}
-    if len(found) > 1:
-        raise ValueError(f"{len(found)} CapillaryBridges operations in the simulation; the "
-                         "homogenisation expects one")
-    return CapillaryHomogenization(found[0]).quantities()

@@ -2,7 +2,7 @@
 
 ``VtkWriter(folder, period)`` is a writer: on its first call and then every ``period`` steps it
 writes, each file under a temporary name then renamed (a killed run never leaves a truncated
-file), three series indexed by ParaView collection files whose ``timestep`` is the simulation
+file), four series indexed by ParaView collection files whose ``timestep`` is the simulation
 time [s]:
 
 ``particles.pvd`` / ``particles_NNNNNN.vtu`` (NNNNNN: the step), one VTK vertex per sphere,
@@ -15,8 +15,7 @@ point data (SI units):
                        the mechanical contact force (normal + shear, ``contacts.force``); wall
                        contacts and capillary forces are not included
     coordination       number of touching sphere–sphere pairs (overlap > 0)
-    bridges            number of liquid bridges (pairs with ``contacts.extra["bridge"]`` set;
-                       0 in a dry scene)
+    bridges            number of liquid bridges (capillary.BridgeState; 0 in a dry scene)
 
 ``walls.pvd`` / ``walls_NNNNNN.vtu``: the six walls as quads spanning the box, cell data
     wall               index 0..5 (x-, x+, y-, y+, z-, z+; ``dem.state.WALL_NAMES``)
@@ -25,13 +24,17 @@ point data (SI units):
     velocity           [m/s] outward wall speed of the last step
 
 ``bridges.pvd`` / ``bridges_NNNNNN.vtu``: one line per liquid bridge between the two centres,
-cell data from the per-pair arrays of ``sim.contacts.extra`` that are present:
-    force              [N] from "bridge_force" (magnitude, attractive)
-    volume             [m^3] from "bridge_volume"
-    delta1, delta2     [deg] filling angles on the smaller / larger sphere, from "delta1" and
-                       "delta2", or else from the capillary operation's "filling_angle_i" /
-                       "filling_angle_j" (sorted by radius)
-A scene without bridges gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
+cell data from capillary.BridgeState:
+    force              [N] magnitude of the attractive capillary force
+    volume             [m^3]
+    delta1, delta2     [deg] filling angles on the smaller / larger sphere
+
+``contacts.pvd`` / ``contacts_NNNNNN.vtu``: the contact network, one line per touching sphere
+pair between the two centres (YADE's interaction network), cell data
+    normal_force       [N] spring normal force (compressive, >= 0)
+    shear_force        [N] magnitude of the elastic shear force
+    bridge             1 when the pair also holds a liquid bridge
+A scene without bridges (or contacts) gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
 file without cells back; ParaView and VTK can.
 """
 
@@ -41,11 +44,12 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from .atomic import replacing
-from .validate import check_int
+from capillary.bridge_state import BridgeState
+from dem.atomic import replacing
+from dem.validate import check_int
 
 #: The series written, each a .pvd collection of .vtu files.
-SERIES = ("particles", "walls", "bridges")
+SERIES = ("particles", "walls", "bridges", "contacts")
 
 
 def write_vtu(path, mesh, compression="zlib"):
@@ -82,8 +86,8 @@ def _contacts_per_particle(contacts, count):
     contact_force = (np.bincount(first, weights=magnitude, minlength=count)
                      + np.bincount(second, weights=magnitude, minlength=count))
     bridges = np.zeros(count, np.int64)
-    if "bridge" in contacts.extra:
-        mask = contacts.extra["bridge"] != 0
+    if BridgeState.present(contacts):
+        mask = BridgeState.of(contacts).mask()
         bridges = (np.bincount(contacts.pair_i[mask], minlength=count)
                    + np.bincount(contacts.pair_j[mask], minlength=count))
     return coordination, contact_force, bridges
@@ -124,46 +128,54 @@ def wall_mesh(walls):
         "velocity": [np.array(walls.velocity)]})
 
 
-def _filling_angles(sim, mask):
-    """(delta1, delta2) [deg] of the bridges of ``mask`` (smaller / larger sphere), or None."""
-    extra = sim.contacts.extra
-    if "delta1" in extra and "delta2" in extra:
-        return extra["delta1"][mask], extra["delta2"][mask]
-    if "filling_angle_i" in extra and "filling_angle_j" in extra:
-        radius = sim.particles.radius
-        on_i = extra["filling_angle_i"][mask]
-        on_j = extra["filling_angle_j"][mask]
-        i_smaller = radius[sim.contacts.pair_i[mask]] <= radius[sim.contacts.pair_j[mask]]
-        return np.where(i_smaller, on_i, on_j), np.where(i_smaller, on_j, on_i)
-    return None
+def _lines(position, first, second):
+    """(points, line cells) of segments between the centres ``first`` -> ``second``."""
+    count = len(first)
+    points = (np.concatenate([position[first], position[second]]) if count
+              else np.zeros((0, 3)))
+    lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
+    return points, lines
 
 
 def bridge_mesh(sim):
     """One line per liquid bridge (centre to centre) with the cell data of the module
     docstring; no points and no cells when there is no bridge."""
     contacts = sim.contacts
-    if contacts is None or "bridge" not in contacts.extra:
-        mask = np.zeros(0 if contacts is None else len(contacts), bool)
-    else:
-        mask = contacts.extra["bridge"] != 0
-    count = int(np.count_nonzero(mask))
-    if count:
-        position = sim.particles.position
-        points = np.concatenate([position[contacts.pair_i[mask]],
-                                 position[contacts.pair_j[mask]]])
-    else:
-        points = np.zeros((0, 3))
-    lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
-    data = {}
-    extra = contacts.extra if contacts is not None else {}
-    for name, key in (("force", "bridge_force"), ("volume", "bridge_volume")):
-        if key in extra:
-            data[name] = [np.asarray(extra[key][mask], np.float64)]
-    angles = _filling_angles(sim, mask) if contacts is not None else None
-    if angles is not None:
-        data["delta1"] = [np.asarray(angles[0], np.float64)]
-        data["delta2"] = [np.asarray(angles[1], np.float64)]
+    if contacts is None or not BridgeState.present(contacts):
+        points, lines = _lines(sim.particles.position, np.zeros(0, np.int64),
+                               np.zeros(0, np.int64))
+        return meshio.Mesh(points, [("line", lines)])
+    state = BridgeState.of(contacts)
+    mask = state.mask()
+    first, second = contacts.pair_i[mask], contacts.pair_j[mask]
+    points, lines = _lines(sim.particles.position, first, second)
+    radius = sim.particles.radius
+    i_smaller = radius[first] <= radius[second]
+    on_i, on_j = state.filling_i[mask], state.filling_j[mask]
+    data = {"force": [np.array(state.force[mask])], "volume": [np.array(state.volume[mask])],
+            "delta1": [np.where(i_smaller, on_i, on_j)],
+            "delta2": [np.where(i_smaller, on_j, on_i)]}
     return meshio.Mesh(points, [("line", lines)], cell_data=data)
+
+
+def contact_mesh(sim):
+    """The contact network: one line per touching sphere pair (centre to centre) with cell data
+    normal_force [N] (spring, compressive), shear_force [N] (magnitude of the elastic shear
+    force) and bridge (1 when the pair holds a liquid bridge)."""
+    contacts = sim.contacts
+    if contacts is None:
+        points, lines = _lines(sim.particles.position, np.zeros(0, np.int64),
+                               np.zeros(0, np.int64))
+        return meshio.Mesh(points, [("line", lines)])
+    touching = contacts.overlap > 0.0
+    points, lines = _lines(sim.particles.position, contacts.pair_i[touching],
+                           contacts.pair_j[touching])
+    bridge = (BridgeState.of(contacts).mask()[touching] if BridgeState.present(contacts)
+              else np.zeros(int(np.count_nonzero(touching)), bool))
+    return meshio.Mesh(points, [("line", lines)], cell_data={
+        "normal_force": [np.array(contacts.normal_force[touching])],
+        "shear_force": [np.linalg.norm(contacts.shear_force[touching], axis=1)],
+        "bridge": [bridge.astype(np.int64)]})
 
 
 class VtkWriter:
@@ -172,11 +184,14 @@ class VtkWriter:
     Writes on its first call and then whenever ``sim.step % period == 0``; the .pvd index files
     are rewritten with every frame (so that a killed run leaves a usable series) and by
     ``close()``. ``frames`` lists (step, time [s]) of the frames written. ``compression``:
-    "zlib" (default) or None (larger files, about 10x faster to write).
+    "zlib" (default) or None (larger files, about 10x faster to write). Every file's field data
+    holds ``step``, ``time`` [s] and what ``field_data(sim)`` returns (name -> number, e.g. the
+    axial strain of a triaxial test).
     """
 
-    def __init__(self, folder, period, compression="zlib"):
+    def __init__(self, folder, period, compression="zlib", field_data=None):
         self.folder = os.fspath(folder)
+        self.field_data = field_data
         self.period = check_int("vtk period", period, low=1)
         if compression not in ("zlib", "lzma", None):
             raise ValueError(f"compression = {compression!r} is not one of 'zlib', 'lzma', None")
@@ -193,8 +208,13 @@ class VtkWriter:
         if self.frames and self.frames[-1][0] == sim.step:
             return
         meshes = {"particles": particle_mesh(sim), "walls": wall_mesh(sim.walls),
-                  "bridges": bridge_mesh(sim)}
+                  "bridges": bridge_mesh(sim), "contacts": contact_mesh(sim)}
+        fields = {"step": np.array([sim.step], np.int64), "time": np.array([sim.time])}
+        if self.field_data is not None:
+            fields.update({k: np.atleast_1d(np.asarray(v, np.float64))
+                           for k, v in self.field_data(sim).items()})
         for series, mesh in meshes.items():
+            mesh.field_data.update(fields)
             write_vtu(os.path.join(self.folder, self.file_name(series, sim.step)), mesh,
                       self.compression)
         self.frames.append((int(sim.step), float(sim.time)))

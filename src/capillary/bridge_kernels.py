@@ -1,0 +1,274 @@
+"""Numba kernels of the liquid bridges in the DEM (thesis Ch. 5, SPEC section 4).
+
+Per pair (parallel over pairs) a bridge forms when the spheres touch (overlap > 0, from the
+contact law of the same step) and breaks when contact is lost or, across gaps, where no bridge
+exists at that gap; its force F [N] acts along the branch vector, attractive (force on j from
+i: -F n, n unit i -> j). Gathers add the forces per particle, each particle summing its own
+pairs in a fixed order (deterministic for any thread count, no atomics).
+
+Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
+d* = max(gap, 0) / R2, F = F* 2 pi gamma R2, V = V* R2^3, filling angles delta1 on the smaller
+sphere and delta2 on the larger one. Arguments named state, volume, force, filling_i,
+filling_j, bridge_suction are the arrays of capillary.bridge_state.BridgeState.
+"""
+
+import math
+
+import numba
+import numpy as np
+
+from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
+from capillary.table import lookup_suction
+from capillary.volume_table import lookup_volume
+
+
+@numba.njit(cache=True, inline="always")
+def _clear(k, state, volume, force, filling_i, filling_j, pair_force):
+    state[k] = NO_BRIDGE
+    volume[k] = 0.0
+    force[k] = 0.0
+    filling_i[k] = 0.0
+    filling_j[k] = 0.0
+    pair_force[k, 0] = 0.0
+    pair_force[k, 1] = 0.0
+    pair_force[k, 2] = 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _store(k, radius_i, radius_j, force_star, delta1, delta2, surface_tension, force,
+           filling_i, filling_j):
+    """Write the force [N] and filling angles of pair k; delta1 belongs to the smaller sphere."""
+    force[k] = force_star * 2.0 * math.pi * surface_tension * max(radius_i, radius_j)
+    if radius_i <= radius_j:
+        filling_i[k] = delta1
+        filling_j[k] = delta2
+    else:
+        filling_i[k] = delta2
+        filling_j[k] = delta1
+
+
+@numba.njit(cache=True, inline="always")
+def _apply_along(k, magnitude, n0, n1, n2, pair_force):
+    """Attractive force on j from i: -F n (n unit i -> j)."""
+    pair_force[k, 0] = -magnitude * n0
+    pair_force[k, 1] = -magnitude * n1
+    pair_force[k, 2] = -magnitude * n2
+
+
+@numba.njit(cache=True, inline="always")
+def _apply_across_gap(k, position, i, j, magnitude, pair_force):
+    d0 = position[j, 0] - position[i, 0]
+    d1 = position[j, 1] - position[i, 1]
+    d2 = position[j, 2] - position[i, 2]
+    inverse = 1.0 / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    _apply_along(k, magnitude, d0 * inverse, d1 * inverse, d2 * inverse, pair_force)
+
+
+@numba.njit(cache=True, inline="always")
+def _form_at_contact(k, radius_i, radius_j, state, volume, force, filling_i, filling_j, suction,
+                     surface_tension, radius_ratios, suction_axis, distance_low,
+                     log_distance_rupture, log_values):
+    """Give pair k the suction-controlled bridge of touching spheres (table at d* = 0)."""
+    larger = max(radius_i, radius_j)
+    _, force_star, volume_star, delta1, delta2 = lookup_suction(
+        radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+        larger / min(radius_i, radius_j), suction * larger / surface_tension, 0.0)
+    _store(k, radius_i, radius_j, force_star, delta1, delta2, surface_tension, force, filling_i,
+           filling_j)
+    volume[k] = volume_star * larger * larger * larger
+    state[k] = AT_CONTACT
+
+
+@numba.njit(cache=True, parallel=True)
+def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filling_i, filling_j,
+                    suction, surface_tension, radius_ratios, suction_axis, distance_low,
+                    log_distance_rupture, log_values):
+    """Suction-controlled bridges that exist exactly while the spheres touch (thesis Ch. 5.2.2).
+
+    A pair that starts touching gets its bridge from the table at d* = 0 (force, volume and
+    filling angles depend only on the radii then); a pair that stops touching loses it. In
+    steady state this pass only reads overlap and state. overlap: the contact law's, this step.
+    """
+    for k in numba.prange(len(pair_i)):
+        touching = overlap[k] > 0.0
+        if touching == (state[k] == AT_CONTACT):   # no change: the (predictable) common case
+            continue
+        if touching:
+            _form_at_contact(k, radius[pair_i[k]], radius[pair_j[k]], state, volume, force,
+                             filling_i, filling_j, suction, surface_tension, radius_ratios,
+                             suction_axis, distance_low, log_distance_rupture, log_values)
+        else:
+            state[k] = NO_BRIDGE
+            volume[k] = 0.0
+            force[k] = 0.0
+            filling_i[k] = 0.0
+            filling_j[k] = 0.0
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_contact_bridges(force, normal, row_start, second_start, second_pair, out):
+    """Add bridge forces of magnitude ``force`` (0 where no bridge) along the contact normals
+    (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction).
+
+    Branch-free (a pair without bridge adds 0 x its normal); each particle sums its own pairs
+    in a fixed order, as dem.neighbors.gather_pair_vectors: deterministic without atomics.
+    """
+    for p in numba.prange(len(row_start) - 1):
+        f0 = f1 = f2 = 0.0
+        for k in range(row_start[p], row_start[p + 1]):
+            f = force[k]
+            f0 += f * normal[k, 0]
+            f1 += f * normal[k, 1]
+            f2 += f * normal[k, 2]
+        for slot in range(second_start[p], second_start[p + 1]):
+            k = second_pair[slot]
+            f = force[k]
+            f0 -= f * normal[k, 0]
+            f1 -= f * normal[k, 1]
+            f2 -= f * normal[k, 2]
+        out[p, 0] += f0
+        out[p, 1] += f1
+        out[p, 2] += f2
+
+
+@numba.njit(cache=True, parallel=True)
+def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
+                    filling_i, filling_j, pair_force, suction, surface_tension, radius_ratios,
+                    suction_axis, distance_low, log_distance_rupture, log_values):
+    """Suction-controlled bridges that persist across gaps (thesis Table 5.1, ``persist``).
+
+    A bridge forms when the spheres touch and lives while the table has a bridge at the gap
+    (d* = gap / R2 up to the rupture distance at u* = s R2 / gamma). At contact its values are
+    cached (looked up once per contact); across a gap it is looked up each step and pulls along
+    the current branch vector. overlap and normal: the contact law's values of this step.
+    suction [Pa], surface_tension [N/m]; the last five arguments are a BridgeTable's arrays().
+    Fills the per-pair state and pair_force (force on j from i) [N].
+    """
+    for k in numba.prange(len(pair_i)):
+        i = pair_i[k]
+        j = pair_j[k]
+        if overlap[k] > 0.0:
+            if state[k] != AT_CONTACT:
+                _form_at_contact(k, radius[i], radius[j], state, volume, force, filling_i,
+                                 filling_j, suction, surface_tension, radius_ratios,
+                                 suction_axis, distance_low, log_distance_rupture, log_values)
+            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+        elif state[k] != NO_BRIDGE:
+            larger = max(radius[i], radius[j])
+            exists, force_star, volume_star, delta1, delta2 = lookup_suction(
+                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                larger / min(radius[i], radius[j]), suction * larger / surface_tension,
+                -overlap[k] / larger)
+            if exists:
+                _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
+                       force, filling_i, filling_j)
+                volume[k] = volume_star * larger * larger * larger
+                state[k] = ACROSS_GAP
+                _apply_across_gap(k, position, i, j, force[k], pair_force)
+            else:
+                _clear(k, state, volume, force, filling_i, filling_j, pair_force)
+        else:
+            pair_force[k, 0] = 0.0
+            pair_force[k, 1] = 0.0
+            pair_force[k, 2] = 0.0
+
+
+@numba.njit(cache=True, parallel=True)
+def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
+                   filling_i, filling_j, bridge_suction, pair_force, formation_suction,
+                   surface_tension, roughness, suction_table, volume_table):
+    """Volume-controlled bridges: formed at contact with the volume of the suction-controlled
+    bridge at ``formation_suction`` [Pa], then of constant volume; force and suction from
+    (V*, d*) (capillary.lookup_volume), rupture where no bridge of that volume exists.
+
+    roughness: the meniscus separation of touching spheres / R2 (asperities hold the wetted
+    surfaces H = roughness R2 apart, thesis Ch. 4's H): d* = roughness at contact and
+    gap / R2 + roughness across a gap; 0 for smooth spheres. A pair whose bridge at formation
+    would not span H gets none.
+    suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable.
+    """
+    for k in numba.prange(len(pair_i)):
+        i = pair_i[k]
+        j = pair_j[k]
+        touching = overlap[k] > 0.0
+        if state[k] == NO_BRIDGE and not touching:
+            pair_force[k, 0] = 0.0
+            pair_force[k, 1] = 0.0
+            pair_force[k, 2] = 0.0
+            continue
+        larger = max(radius[i], radius[j])
+        ratio = larger / min(radius[i], radius[j])
+        cube = larger * larger * larger
+        if state[k] == NO_BRIDGE:
+            forms, _, volume_star, _, _ = lookup_suction(
+                suction_table[0], suction_table[1], suction_table[2], suction_table[3],
+                suction_table[4], ratio, formation_suction * larger / surface_tension, roughness)
+            if not forms:
+                pair_force[k, 0] = 0.0
+                pair_force[k, 1] = 0.0
+                pair_force[k, 2] = 0.0
+                continue
+            volume[k] = volume_star * cube
+            state[k] = ACROSS_GAP   # not yet evaluated at contact
+        if touching and state[k] == AT_CONTACT:
+            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+            continue
+        gap_star = roughness if touching else roughness - overlap[k] / larger
+        exists, force_star, suction_star, delta1, delta2 = lookup_volume(
+            volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
+            ratio, volume[k] / cube, gap_star)
+        if not exists:
+            _clear(k, state, volume, force, filling_i, filling_j, pair_force)
+            bridge_suction[k] = 0.0
+            continue
+        _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension, force,
+               filling_i, filling_j)
+        bridge_suction[k] = suction_star * surface_tension / larger
+        if touching:
+            state[k] = AT_CONTACT
+            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+        else:
+            state[k] = ACROSS_GAP
+            _apply_across_gap(k, position, i, j, force[k], pair_force)
+
+
+@numba.njit(cache=True, parallel=True)
+def pendular_overlap_counts(position, row_start, second_start, second_pair, pair_i, pair_j,
+                            state, filling_i, filling_j):
+    """Per particle, the number of pairs of its menisci that overlap (SPEC section 4 pendular
+    limit): two wetted caps whose normals are separated by less than the sum of their filling
+    angles (YADE's Law2_ScGeom_CapillaryPhys_Capillarity fusion test)."""
+    count = len(row_start) - 1
+    overlaps = np.zeros(count, np.int64)
+    for p in numba.prange(count):
+        size = row_start[p + 1] - row_start[p] + second_start[p + 1] - second_start[p]
+        direction = np.empty((size, 3))
+        angle = np.empty(size)
+        found = 0
+        for slot in range(size):
+            if slot < row_start[p + 1] - row_start[p]:
+                k = row_start[p] + slot
+                other = pair_j[k]
+                cap = filling_i[k]
+            else:
+                k = second_pair[second_start[p] + slot - (row_start[p + 1] - row_start[p])]
+                other = pair_i[k]
+                cap = filling_j[k]
+            if state[k] == NO_BRIDGE:
+                continue
+            length = 0.0
+            for c in range(3):
+                direction[found, c] = position[other, c] - position[p, c]
+                length += direction[found, c] ** 2
+            length = math.sqrt(length)
+            for c in range(3):
+                direction[found, c] /= length
+            angle[found] = math.radians(cap)
+            found += 1
+        for a in range(found):
+            for b in range(a + 1, found):
+                cosine = (direction[a, 0] * direction[b, 0] + direction[a, 1] * direction[b, 1]
+                          + direction[a, 2] * direction[b, 2])
+                if math.acos(min(max(cosine, -1.0), 1.0)) < angle[a] + angle[b]:
+                    overlaps[p] += 1
+    return overlaps

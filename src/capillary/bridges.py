@@ -1,0 +1,307 @@
+"""Liquid bridges in the DEM: the capillary operation of wet scenes (thesis Ch. 5, SPEC section 4).
+
+A wet scene lists ``CapillaryBridges`` among its forces after the contact law and the wall
+springs (``sim.forces.append(bridges)``; YADE's order: InteractionLoop,
+Law2_ScGeom_CapillaryPhys_Capillarity, TriaxialStressController, NewtonIntegrator); a dry scene
+never builds it. Bridges that persist across gaps declare how far the neighbour list must reach
+(``reach(sim)``, their largest rupture distance). Each step:
+
+1. per pair (parallel over pairs): a bridge forms when the spheres touch (overlap > 0, from
+   the contact law of the same step) and breaks when contact is lost (the thesis's choice) or,
+   with ``persist``, where no bridge exists at that gap: the table says no solution (suction
+   control), or the volume-controlled rupture distance is passed (volume control). Its force
+   F [N] acts along the branch vector, attractive: the force on j from i is -F n (n unit i -> j);
+2. the forces are gathered per particle, -f to i and +f to j, each particle summing its own
+   pairs in a fixed order (deterministic for any thread count, no atomics).
+
+The kernels are capillary.bridge_kernels. Default (suction control, bridges only at contact):
+``contact_bridges`` only reads overlap and
+the bridge state and looks a bridge up when it forms, and ``gather_contact_bridges`` applies the
+cached magnitudes along the contact law's normals without building per-pair vectors (about
+0.15-0.2 of a dry step's cost for 10,000 spheres). Bridges across gaps (``persist``, volume
+control): ``suction_bridges`` / ``volume_bridges`` write per-pair force vectors ``pair_force``,
+gathered by ``dem.neighbors.gather_pair_vectors``.
+
+The capillary force is added on top of the mechanical contact force and does not enter the
+Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack caps the shear
+force with ``phys->normalForce`` (the spring's force only), and
+Law2_ScGeom_CapillaryPhys_Capillarity adds fCap separately through ``scene->forces.addForce``
+(YADE 2023 sources, pkg/dem/ElasticContactLaw.cpp and
+pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bridges (YADE's
+capillary law skips pairs of different shapes), and ``contacts.force`` stays the mechanical
+force, so that homogenize.contact_stress is Eq. 3.41's contact stress.
+
+Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
+d* = max(gap, 0) / R2 (overlaps read the table's contact values, as YADE does), F = F* 2 pi gamma
+R2, V = V* R2^3, filling angles delta1 on the smaller sphere and delta2 on the larger one. At
+d* = 0 a bridge's force, volume and filling angles depend only on the radii (suction control)
+or on the radii and its volume (volume control): they are looked up once when the bridge forms
+(or comes back into contact) and cached in its per-pair arrays, so a bridge at contact costs
+no lookup per step; only bridges across a gap (``persist``, volume control) are looked up
+each step.
+
+Per-pair state: capillary.bridge_state.BridgeState (state, volume, force, filling_i,
+filling_j, suction), kept in ``sim.contacts.extra`` and carried across neighbour-list rebuilds.
+
+Volume control: a bridge forms at contact with the volume of the suction-controlled bridge at
+contact at ``suction`` (the formation suction, the same for bridges that form later), then keeps
+that volume; its force and suction follow from (V*, d*) and it ruptures at the
+volume-controlled rupture distance (capillary.VolumeBridgeTable). Bridges persist across gaps.
+"""
+
+
+import math
+
+import numpy as np
+
+from capillary.bridge_kernels import (contact_bridges, gather_contact_bridges,
+                                      pendular_overlap_counts, suction_bridges, volume_bridges)
+from capillary.bridge_state import BridgeState
+from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
+from capillary.validation import (check_bridge_stiffness, check_contact_angle,
+                                  check_pendular_suction)
+from capillary.volume_table import VolumeBridgeTable
+from dem.contact_law import ContactForces
+from dem.neighbors import gather_pair_vectors
+from dem.validate import check_positive, check_range
+
+#: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
+SURFACE_TENSION = 0.073
+#: Bridge models: exact Young–Laplace tables, or the toroidal approximation (Appendix A).
+BRIDGE_MODELS = ("exact", "toroidal")
+#: How bridges are controlled: imposed suction, or constant volume.
+CONTROLS = ("suction", "volume")
+
+
+def table_radius_ratios(largest_ratio):
+    """YADE's radius ratios 1 ... 10 up to the first one covering ``largest_ratio``."""
+    if largest_ratio > YADE_RADIUS_RATIOS[-1] * (1.0 + 1e-12):
+        raise ValueError(f"radius ratio R2/R1 = {largest_ratio:g} of the sample is outside the "
+                         f"valid range [1, {YADE_RADIUS_RATIOS[-1]:g}] of the bridge tables")
+    for index, ratio in enumerate(YADE_RADIUS_RATIOS):
+        if ratio >= largest_ratio * (1.0 - 1e-12):
+            return YADE_RADIUS_RATIOS[:index + 1]
+    return YADE_RADIUS_RATIOS
+
+
+class CapillaryBridges:
+    """Capillary bridges between touching spheres (SPEC section 4); an operation ``apply(sim)``.
+
+    suction [Pa] >= 0: imposed matric suction (suction control), or the suction at which bridges
+        form (volume control);
+    surface_tension [N/m] > 0 (thesis Ch. 5: 0.073); contact_angle [deg] in [0, 90);
+    model: "exact" (Young–Laplace tables, capillary.BridgeTable) or "toroidal" (thesis
+        Appendix A, equal spheres only);
+    control: "suction" (default, thesis Ch. 5) or "volume" (each bridge keeps its volume);
+    persist: suction control only: bridges live up to the rupture distance instead of breaking
+        when contact is lost (volume-controlled bridges always persist up to rupture);
+    roughness: volume control only: meniscus separation of touching spheres H / R2 in [0, 0.5]
+        (rough grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
+    table_options: keyword arguments of BridgeTable.cached (model 'exact') or
+        capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
+
+    Add it to a scene's forces after the contact and wall forces; ``reach(sim)`` tells the
+    neighbour list how far bridges across gaps reach. Radii must not change while bridges
+    exist.
+    """
+
+    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
+                 control="suction", persist=False, table_options=None, roughness=0.0):
+        self.suction = check_range("suction", suction, 0.0, unit="Pa")
+        self.surface_tension = check_positive("surface_tension", surface_tension, "N/m")
+        self.contact_angle = check_contact_angle(contact_angle)
+        if model not in BRIDGE_MODELS:
+            raise ValueError(f"model = {model!r} is not one of {BRIDGE_MODELS}")
+        if control not in CONTROLS:
+            raise ValueError(f"control = {control!r} is not one of {CONTROLS}")
+        if control == "volume" and model != "exact":
+            raise ValueError("volume-controlled bridges need model='exact'")
+        self.model = model
+        self.control = control
+        self.persist = bool(persist) or control == "volume"
+        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
+        if self.roughness > 0.0 and control != "volume":
+            raise ValueError(f"roughness = {self.roughness:g} needs control='volume' (suction-"
+                             "controlled bridges are between smooth spheres: roughness 0)")
+        self.table_options = dict(table_options or {})
+        self.suction_table = None
+        self.volume_table = None
+        self.required_range = 0.0
+        self.pair_force = np.zeros((0, 3))
+        self._table_arrays = None
+        self._contacts = None
+        self._bridges = 0
+        self._radius_bounds = None
+        self._checked_stiffness = False
+        self._state = None
+
+    # ---------------------------------------------------------------- set-up, once per sample
+    def reach(self, sim):
+        """Largest gap [m] at which a bridge of this operation may exist (0 unless bridges
+        persist): the neighbour list holds every pair closer than that."""
+        if sim.contacts is not None and sim.contacts is self._contacts:
+            return self.required_range        # radii change only with a rebuild
+        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
+        return self.required_range
+
+    def load_tables(self, low, high):
+        """Check the input against spheres of radii in [low, high] [m] and load (or build and
+        cache) the tables; ValueError naming the parameter when out of range."""
+        low = check_positive("smallest radius", low, "m")
+        high = check_range("largest radius", high, low, unit="m")
+        if self._radius_bounds == (low, high):
+            return
+        ratio = high / low
+        suction_star_high = self.suction * high / self.surface_tension
+        options = dict(self.table_options)
+        if self.model == "toroidal":
+            if ratio > 1.0:
+                raise ValueError(f"model='toroidal' needs equal spheres; the radii range from "
+                                 f"{low:g} to {high:g} m (use model='exact')")
+            from capillary.toroidal_table import toroidal_table
+
+            options.setdefault("suction_max", max(suction_star_high * 1.001, 1e-3))
+            self.suction_table = toroidal_table(self.contact_angle, **options)
+        else:
+            options.setdefault("radius_ratios", table_radius_ratios(ratio))
+            self.suction_table = BridgeTable.cached(self.contact_angle, **options)
+        if suction_star_high > self.suction_table.suction_max:
+            raise ValueError(
+                f"suction = {self.suction:g} Pa is outside the valid range [0, "
+                f"{self.suction_table.suction_max * self.surface_tension / high:g}] Pa for these "
+                f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
+                f"{self.surface_tension:g} N/m) exceeds the table's "
+                f"{self.suction_table.suction_max:g}")
+        check_pendular_suction(self.suction_table, self.suction, low, self.surface_tension)
+        if self.control == "volume":
+            self.volume_table = VolumeBridgeTable.cached(
+                self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
+        self._table_arrays = self.suction_table.arrays()
+        self.required_range = self._rupture_range(low, high)
+        self._radius_bounds = (low, high)
+
+    def _rupture_range(self, low, high):
+        """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).
+
+        The rupture distance d*_rupture(u*) decreases with u*, and u* = s R2/gamma >= s Rmin/gamma,
+        so Rmax * max_r d*_rupture(r, s Rmin/gamma) bounds D (5 % margin). Volume control: the
+        largest volume forms at the smallest suction; d*_rupture grows with the volume.
+        """
+        if not self.persist:
+            return 0.0
+        table = self.suction_table
+        xi = math.log1p(self.suction * low / self.surface_tension / table.suction_scale)
+        nodes = np.log1p(table.suction / table.suction_scale)
+        ruptures = [np.interp(xi, nodes, row) for row in table.distance_rupture]
+        if self.control == "suction":
+            return 1.05 * high * max(ruptures)
+        volumes = [table.lookup(r, self.suction * low / self.surface_tension, 0.0)[2]
+                   for r in table.radius_ratios]
+        largest = []
+        vtable = self.volume_table
+        for index, axis in enumerate(vtable.volume_axes):
+            volume_nodes = np.linspace(axis[0], axis[1], vtable.n_volume)
+            largest.append(np.interp(math.log(max(volumes)), volume_nodes,
+                                     vtable.distance_rupture[index]))
+        return 1.05 * high * max(largest)
+
+    # ---------------------------------------------------------------- every step
+    def _attach(self, sim):
+        """Per-pair arrays for a new neighbour list (after a rebuild): create or pick them up."""
+        contacts = sim.contacts
+        state = BridgeState.of(contacts)
+        carried = state.count()
+        if carried < self._bridges:
+            raise RuntimeError(
+                f"{self._bridges - carried} liquid bridge(s) left the neighbour list at a "
+                f"rebuild: its reach ({sim.neighbors.interaction_range:g} m plus skin) is "
+                f"shorter than the rupture distance ({self.required_range:g} m)")
+        self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
+        self._contacts = contacts
+        self._state = state
+
+    def _sync(self, sim):
+        """Tables, stiffness check and per-pair arrays for the current radii and neighbour
+        list."""
+        if sim.contacts is self._contacts:
+            return
+        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
+        if not self._checked_stiffness:
+            for contact_law in (op for op in sim.forces if isinstance(op, ContactForces)):
+                check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
+                                       self.surface_tension)
+            self._checked_stiffness = True
+        self._attach(sim)
+
+    def apply(self, sim):
+        self._sync(sim)
+        p = sim.particles
+        c = sim.contacts
+        b = self._state
+        if self.control == "suction" and not self.persist:
+            contact_bridges(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
+                            b.filling_i, b.filling_j, self.suction, self.surface_tension,
+                            *self._table_arrays)
+            gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
+                                   c.second_pair, p.force)
+            return
+        if self.control == "suction":
+            suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
+                            b.state, b.volume, b.force, b.filling_i, b.filling_j,
+                            self.pair_force, self.suction, self.surface_tension,
+                            *self._table_arrays)
+        else:
+            volume_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
+                           b.state, b.volume, b.force, b.filling_i, b.filling_j, b.suction,
+                           self.pair_force, self.suction, self.surface_tension, self.roughness,
+                           self._table_arrays, self.volume_table.arrays())
+        gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
+        if self.persist:
+            self._bridges = b.count()
+
+    # ---------------------------------------------------------------- measures (record time)
+    def state(self, sim):
+        """The BridgeState of the current neighbour list."""
+        self._sync(sim)
+        return self._state
+
+    def count(self, sim):
+        """Number of bridges."""
+        return self.state(sim).count()
+
+    def water_volume(self, contacts):
+        """Total liquid volume of the bridges of ``contacts`` [m^3]."""
+        return float(np.sum(BridgeState.of(contacts).volume))
+
+    def saturation(self, sim):
+        """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume minus the
+        solid volume."""
+        self._sync(sim)
+        voids = sim.walls.volume() - sim.particles.solid_volume()
+        return self.water_volume(sim.contacts) / voids
+
+    def mean_suction(self, sim):
+        """The imposed suction [Pa] (suction control) or the bridges' mean suction (volume
+        control; NaN without bridges)."""
+        state = self.state(sim)
+        if self.control == "suction":
+            return self.suction
+        mask = state.mask()
+        if not mask.any():
+            return math.nan
+        return float(np.mean(state.suction[mask]))
+
+    def pair_forces(self, sim):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
+        state = self.state(sim)
+        if self.persist:
+            return self.pair_force
+        return -state.force[:, None] * sim.contacts.normal
+
+    def pendular_overlaps(self, sim):
+        """Number of pairs of overlapping menisci on a same particle, summed over particles."""
+        b = self.state(sim)
+        c = sim.contacts
+        return int(np.sum(pendular_overlap_counts(
+            sim.particles.position, c.row_start, c.second_start, c.second_pair, c.pair_i,
+            c.pair_j, b.state, b.filling_i, b.filling_j)))

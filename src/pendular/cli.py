@@ -1,0 +1,131 @@
+"""The ``pendular`` command: ``pendular <command> [options]`` (``pendular --help`` lists them).
+
+Each command lives in ``pendular.commands.<name>`` with ``add_arguments(parser)`` and
+``run(args)``; scenarios/*.py call ``main`` with their command's name. A failure a user can
+cause (bad option, bad or missing file, unusable output folder) ends in one line
+``<prog>: error: <what is wrong>`` and exit status 2, never a traceback; an interrupted run exits
+with 130.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import math
+import sys
+
+import numba
+
+from . import __version__
+
+#: Command name -> (module under pendular.commands, one-line description).
+COMMANDS = {
+    "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
+    "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
+    "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
+    "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
+    "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
+    "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),
+    "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),
+}
+
+#: Exit status of a run stopped by Ctrl-C or --stop-after.
+INTERRUPTED = 130
+
+
+class Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Help that shows every option's default after its text (units are in the text)."""
+
+
+class UsageError(Exception):
+    """A user's mistake found after parsing (printed as one ``error:`` line)."""
+
+
+def positive_int(name, low=0):
+    """argparse type: an integer >= ``low`` (the error names the option)."""
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: an integer expected") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{name} {value} is outside the valid range "
+                                             f"[{low}, inf)")
+        return value
+    return parse
+
+
+def finite_float(name):
+    """argparse type: a finite number (the error names the option)."""
+    def parse(text):
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: a number expected") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{name} {value} is not finite")
+        return value
+    return parse
+
+
+def add_run_options(parser, threads_default=None):
+    """Options every command shares: --threads, --quiet."""
+    parser.add_argument("--threads", type=positive_int("--threads", 1), default=threads_default,
+                        help="Numba threads (default: all for large samples)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def set_threads(threads):
+    """Apply --threads (error naming it outside [1, NUMBA_NUM_THREADS])."""
+    if threads is None:
+        return
+    if not 1 <= threads <= numba.config.NUMBA_NUM_THREADS:
+        raise UsageError(f"--threads {threads} is outside the valid range "
+                         f"[1, {numba.config.NUMBA_NUM_THREADS}]")
+    numba.set_num_threads(threads)
+
+
+def command_parser(name, prog=None):
+    """(argparse parser of command ``name``, its module)."""
+    module = importlib.import_module(f"pendular.commands.{COMMANDS[name][0]}")
+    parser = argparse.ArgumentParser(prog=prog or f"pendular {name}",
+                                     description=module.__doc__, formatter_class=Formatter)
+    module.add_arguments(parser)
+    return parser, module
+
+
+def run_command(name, argv, prog=None):
+    """Parse ``argv`` for command ``name`` and run it; returns the exit status."""
+    parser, module = command_parser(name, prog)
+    args = parser.parse_args(argv)
+    try:
+        return module.run(args) or 0
+    except (UsageError, ValueError, FileNotFoundError, IsADirectoryError,
+            NotADirectoryError, PermissionError) as error:
+        parser.exit(2, f"{parser.prog}: error: {error}\n")
+    except KeyboardInterrupt:
+        parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
+
+
+def main(argv=None, prog=None):
+    """``pendular <command> ...``; with ``prog`` (a scenario's file name) and argv starting
+    with the command, that command alone."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if prog is not None:
+        return run_command(argv[0], argv[1:], prog)
+    parser = argparse.ArgumentParser(
+        prog="pendular", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="DEM of wet granular media in the pendular regime (Khosravani 2014).",
+        epilog="commands:\n" + "\n".join(f"  {name:<11} {text}"
+                                         for name, (_, text) in COMMANDS.items())
+        + "\n\n'pendular <command> --help' shows a command's options with their defaults.")
+    parser.add_argument("--version", action="version", version=f"pendular {__version__}")
+    parser.add_argument("command", choices=list(COMMANDS), metavar="command",
+                        help="one of: " + ", ".join(COMMANDS))
+    parser.add_argument("options", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    return run_command(args.command, args.options)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,181 @@
+"""Drained triaxial test of thesis Chapter 5 (Table 5.2 defaults): prepare, wet, shear, write.
+
+Writes into --out: history.h5 (one row per record), summary.json, triaxial.png, plots/,
+vtk/*.pvd (ParaView), sample.h5 (the sample the shear starts from) and, with
+--checkpoint-every N, checkpoint.h5; --resume DIR continues an interrupted run. Stresses
+compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at the confining
+stress, re-equilibrated, then sheared (pendular.triaxial).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from dem.preparation import PrepareConfig
+
+from ..cli import INTERRUPTED, UsageError, add_run_options, finite_float, positive_int, set_threads
+from ..config import BridgeConfig, ShearConfig, TriaxialConfig
+from ..triaxial import Interrupted, TriaxialTest
+
+#: Options a resumed run takes from its own command line, not from the stored run.
+RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after", "force")
+#: Summary keys printed at the end.
+SHOWN = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak", "peak_q_effective",
+         "p_effective_at_peak", "initial_porosity", "saturation_at_peak", "wall_time_s",
+         "particle_steps_per_s")
+
+
+def add_arguments(parser):
+    number = finite_float
+    parser.add_argument("--particles", type=int, default=10000, help="number of spheres")
+    parser.add_argument("--confining", type=number("--confining"), default=750.0,
+                        help="lateral stress [Pa]")
+    parser.add_argument("--suction", type=number("--suction"), default=0.0,
+                        help="matric suction [Pa] (0: dry)")
+    parser.add_argument("--contact-angle", type=number("--contact-angle"), default=None,
+                        help="wetting angle [deg] (wet test; default 0)")
+    parser.add_argument("--bridges", choices=("exact", "toroidal"), default=None,
+                        help="bridge model of the wet test: exact Young-Laplace tables "
+                             "(default) or the toroidal approximation (equal spheres)")
+    parser.add_argument("--surface-tension", type=number("--surface-tension"), default=None,
+                        help="liquid surface tension [N/m] (wet test; default 0.073)")
+    parser.add_argument("--persist-bridges", action="store_true",
+                        help="bridges live up to their rupture distance instead of breaking "
+                             "when contact is lost")
+    parser.add_argument("--wet-steps", type=int, default=200000,
+                        help="most steps to equilibrate the wetted (or loaded) sample [-]")
+    parser.add_argument("--max-strain", type=number("--max-strain"), default=0.25,
+                        help="final axial strain [-]")
+    parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
+    parser.add_argument("--out", default="runs/triaxial", help="output folder")
+    parser.add_argument("--radius", type=number("--radius"), default=0.024e-3,
+                        help="sphere radius [m]")
+    parser.add_argument("--porosity", type=number("--porosity"), default=0.40,
+                        help="porosity of the initial cloud box [-] (0.30-0.60)")
+    parser.add_argument("--friction", type=number("--friction"), default=18.0,
+                        help="contact friction [deg]")
+    parser.add_argument("--prep-friction", type=number("--prep-friction"), default=0.5,
+                        help="contact friction during the radius growth [deg] (thesis 0.5; "
+                             "higher gives a looser sample)")
+    parser.add_argument("--young", type=number("--young"), default=1e6,
+                        help="YADE young E [Pa], kn = E R")
+    parser.add_argument("--damping", type=number("--damping"), default=0.2,
+                        help="Cundall local damping [-]")
+    parser.add_argument("--inertial-number", type=number("--inertial-number"), default=3e-4,
+                        help="target inertial number setting the strain rate [-]")
+    parser.add_argument("--strain-rate", type=number("--strain-rate"), default=None,
+                        help="axial strain rate [1/s] (overrides --inertial-number)")
+    parser.add_argument("--timestep-safety", type=number("--timestep-safety"), default=0.7,
+                        help="time step as a fraction of the P-wave estimate [-]")
+    parser.add_argument("--skin-factor", type=number("--skin-factor"), default=0.3,
+                        help="Verlet skin of the neighbour list / radius (0, 2]")
+    parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
+                        help="bridge table nodes in suction and in distance (exact default "
+                             "350,80; toroidal 64,80)")
+    parser.add_argument("--records", type=int, default=500, help="history rows over the test")
+    parser.add_argument("--force", action="store_true",
+                        help="run settings refused as not quasi-static or too long (experts)")
+    add_run_options(parser)
+    frames = parser.add_mutually_exclusive_group()
+    frames.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
+                        help="steps between ParaView frames of the shear (default: about "
+                             f"{TriaxialConfig.vtk_frames} frames; 0: no ParaView output)")
+    frames.add_argument("--vtk-frames", type=positive_int("--vtk-frames"), default=None,
+                        help="ParaView frames over the shear (0: none; default "
+                             f"{TriaxialConfig.vtk_frames}); instead of --vtk-every")
+    parser.add_argument("--checkpoint-every", type=positive_int("--checkpoint-every"),
+                        default=0, help="steps between checkpoints DIR/checkpoint.h5 (0: none)")
+    parser.add_argument("--sample", metavar="PATH", default=None,
+                        help="start from this prepared sample (sample.h5) instead of "
+                             "preparing one")
+    parser.add_argument("--resume", metavar="DIR", default=None,
+                        help="continue the interrupted run of DIR from its checkpoint, with the "
+                             "configuration stored there (only --quiet and --threads may be "
+                             "added)")
+    # tests: stop the shear after this many steps as an interruption would (exit status 130)
+    parser.add_argument("--stop-after", type=positive_int("--stop-after"), default=None,
+                        help=argparse.SUPPRESS)
+
+
+def table_resolution(text):
+    """(NS, ND) of --table-resolution, or None."""
+    if text is None:
+        return None
+    try:
+        nodes = tuple(int(v) for v in text.split(","))
+    except ValueError:
+        nodes = ()
+    if len(nodes) != 2 or min(nodes) < 4:
+        raise UsageError(f"--table-resolution {text!r}: two integers NS,ND, each in [4, inf), "
+                         "expected")
+    return nodes
+
+
+def config_from(args):
+    """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
+    if args.suction < 0.0:
+        raise UsageError(f"--suction {args.suction} Pa is outside the valid range [0, inf) "
+                         "(0: dry)")
+    wet_only = {"--contact-angle": args.contact_angle is not None,
+                "--table-resolution": args.table_resolution is not None,
+                "--bridges": args.bridges is not None,
+                "--surface-tension": args.surface_tension is not None,
+                "--persist-bridges": args.persist_bridges}
+    if args.suction == 0.0 and any(wet_only.values()):
+        raise UsageError(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet "
+                         "test: give --suction > 0")
+    sample = PrepareConfig(particles=args.particles, radius=args.radius, porosity=args.porosity,
+                           young=args.young, friction_deg=args.friction, damping=args.damping,
+                           prep_friction_deg=args.prep_friction,
+                           timestep_safety=args.timestep_safety, confining=args.confining,
+                           seed=args.seed, skin_factor=args.skin_factor)
+    shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
+                        strain_rate=args.strain_rate, records=args.records)
+    bridges = None
+    if args.suction > 0.0:
+        options = {"surface_tension": args.surface_tension,
+                   "contact_angle": args.contact_angle, "model": args.bridges}
+        bridges = BridgeConfig(args.suction, persist=args.persist_bridges,
+                               table_resolution=table_resolution(args.table_resolution),
+                               **{k: v for k, v in options.items() if v is not None})
+    frames = {} if args.vtk_frames is None else {"vtk_frames": args.vtk_frames}
+    return TriaxialConfig(sample=sample, shear=shear, bridges=bridges, sample_path=args.sample,
+                          wet_steps=args.wet_steps, vtk_every=args.vtk_every,
+                          checkpoint_every=args.checkpoint_every, **frames)
+
+
+def run(args):
+    set_threads(args.threads)
+    progress = not args.quiet
+    try:
+        if args.resume is not None:
+            defaults = vars(_defaults())
+            given = [name for name, value in vars(args).items()
+                     if name not in RESUME_OPTIONS and value != defaults.get(name)]
+            if given:
+                raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
+                                 f"{', '.join('--' + n.replace('_', '-') for n in given)} "
+                                 "cannot be changed (only --quiet and --threads may be added)")
+            summary = TriaxialTest.resume(args.resume, progress=progress, threads=args.threads,
+                                          stop_after=args.stop_after)
+            out = args.resume
+        else:
+            config = config_from(args)
+            summary = TriaxialTest(config, force=args.force).run(args.out, progress=progress, threads=args.threads,
+                                               stop_after=args.stop_after)
+            out = args.out
+    except Interrupted as stop:
+        print(f"{stop}", file=sys.stderr)
+        return INTERRUPTED
+    print(json.dumps({k: summary[k] for k in SHOWN if k in summary}, indent=2))
+    print(f"outputs in {out}")
+    return 0
+
+
+def _defaults():
+    """The options' default values (those of an empty command line)."""
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return parser.parse_args([])

@@ -1,0 +1,234 @@
+"""Run configurations: typed dataclasses, validated once, saved into every output as JSON.
+
+A configuration says everything that changes a result; how a run is watched (output folder,
+progress bars, threads) is not part of it, so two runs with equal configurations give the same
+results. ``config_to_dict`` / ``config_from_dict`` write and read the nested dataclasses as
+plain JSON with ``CONFIG_SCHEMA_VERSION``; a file of another version is refused by name.
+A campaign builds variants with ``dataclasses.replace``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from capillary import BRIDGE_MODELS, SURFACE_TENSION
+from dem.preparation import PrepareConfig
+from dem.validate import check_int, check_positive, check_range
+
+#: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
+CONFIG_SCHEMA_VERSION = 2
+
+
+@dataclass
+class ShearConfig:
+    """Shear phase of a triaxial test. ``strain_rate`` [1/s] defaults to the one giving
+    ``inertial_number`` I = rate * 2R * sqrt(rho / confining) (GDR MiDi 2004).
+
+    Wall-control options, pendular's choice by default; ``YADE_CHOICES`` holds YADE's
+    (TriaxialStressController, docs/yade_crosscheck.md):
+    rate_on_current_length: the axial rate acts on the current height (true strain rate)
+        instead of the initial one (engineering strain rate);
+    servo_max_velocity: speed cap of the lateral walls [m/s] (None: the preparation servo's);
+    servo_scale_max_velocity: scale the cap per axis by 3 L_a / (L_x + L_y + L_z);
+    servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
+        the first 100) instead of every step.
+    """
+
+    max_strain: float = 0.25
+    inertial_number: float = 3e-4
+    strain_rate: float | None = None
+    records: int = 500
+    rate_on_current_length: bool = False
+    servo_max_velocity: float | None = None
+    servo_scale_max_velocity: bool = False
+    servo_stiffness_every: int = 1
+
+    def __post_init__(self):
+        self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.9,
+                                      low_inclusive=False)
+        self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
+                                           low_inclusive=False)
+        if self.strain_rate is not None:
+            self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
+        self.records = check_int("records", self.records, low=2, high=10_000_000)
+        if self.servo_max_velocity is not None:
+            self.servo_max_velocity = check_positive("servo_max_velocity",
+                                                     self.servo_max_velocity, "m/s")
+        self.servo_stiffness_every = check_int("servo_stiffness_every",
+                                               self.servo_stiffness_every, low=1)
+
+    def rate(self, radius, density, confining):
+        """Axial strain rate [1/s]: the given one, or the one of the target inertial number at
+        the confining stress [Pa] for spheres of ``radius`` [m] and ``density`` [kg/m^3]."""
+        if self.strain_rate is not None:
+            return self.strain_rate
+        return self.inertial_number / inertial_number(1.0, radius, density, confining)
+
+
+#: ShearConfig options that reproduce YADE's TriaxialStressController (stiffnessUpdateInterval 10).
+YADE_CHOICES = {"rate_on_current_length": True, "servo_scale_max_velocity": True,
+                "servo_stiffness_every": 10}
+
+
+def inertial_number(strain_rate, radius, density, pressure):
+    """I = strain_rate * d * sqrt(rho / p), d = 2R (GDR MiDi 2004); SI units."""
+    return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
+
+
+@dataclass
+class BridgeConfig:
+    """Capillary bridges of a wet test (SPEC §4; capillary.CapillaryBridges).
+
+    suction [Pa] > 0 (suction control: imposed; volume control: at formation);
+    surface_tension [N/m]; contact_angle [deg] in [0, 90); model: 'exact' (Young–Laplace
+    tables) or 'toroidal' (thesis Appendix A, equal spheres); control: 'suction' or 'volume';
+    persist: suction-controlled bridges live to their rupture distance instead of breaking when
+    contact is lost; roughness: meniscus separation at contact H/R2 (volume control);
+    table_resolution: (nodes in suction, nodes in distance) of the tables, None for the model's
+    default.
+    """
+
+    suction: float
+    surface_tension: float = SURFACE_TENSION
+    contact_angle: float = 0.0
+    model: str = "exact"
+    control: str = "suction"
+    persist: bool = False
+    roughness: float = 0.0
+    table_resolution: tuple[int, int] | None = None
+
+    def __post_init__(self):
+        self.suction = check_positive("suction", self.suction, "Pa")
+        self.surface_tension = check_positive("surface_tension", self.surface_tension, "N/m")
+        self.contact_angle = check_range("contact_angle", self.contact_angle, 0.0, 90.0,
+                                         high_inclusive=False, unit="deg")
+        if self.model not in BRIDGE_MODELS:
+            raise ValueError(f"bridges = {self.model!r} is not one of {BRIDGE_MODELS}")
+        if self.table_resolution is not None:
+            if len(self.table_resolution) != 2:
+                raise ValueError(f"table_resolution = {self.table_resolution!r}: two integers "
+                                 "(nodes in suction, nodes in distance) expected")
+            self.table_resolution = tuple(check_int(name, value, low=4) for name, value in
+                                          zip(("table_resolution[0]", "table_resolution[1]"),
+                                              self.table_resolution))
+
+    def build(self):
+        """The capillary operation (capillary.CapillaryBridges) of this configuration."""
+        from capillary import CapillaryBridges   # a dry run never builds one
+
+        table_options = (None if self.table_resolution is None else
+                         dict(zip(("n_suction", "n_distance"), self.table_resolution)))
+        return CapillaryBridges(self.suction, surface_tension=self.surface_tension,
+                                contact_angle=self.contact_angle, model=self.model,
+                                control=self.control, persist=self.persist,
+                                roughness=self.roughness, table_options=table_options)
+
+
+@dataclass
+class TriaxialConfig:
+    """A drained triaxial test (thesis Ch. 5.2.3): sample, optional bridges, shear, outputs.
+
+    sample: preparation and material (dem.preparation.PrepareConfig; its ``confining`` [Pa] is
+    the lateral stress of the shear); bridges: None for a dry test; shear: ShearConfig;
+    sample_path: start from this saved sample (dem.sample) instead of preparing one;
+    wet_steps: most steps to equilibrate after wetting (or after loading a sample);
+    vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
+    instead (None: from vtk_frames);
+    checkpoint_every: steps between checkpoints of the shear (0: none).
+    """
+
+    sample: PrepareConfig = field(default_factory=PrepareConfig)
+    shear: ShearConfig = field(default_factory=ShearConfig)
+    bridges: BridgeConfig | None = None
+    sample_path: str | None = None
+    wet_steps: int = 200000
+    vtk_frames: int = 50
+    vtk_every: int | None = None
+    checkpoint_every: int = 0
+
+    def __post_init__(self):
+        for name, kind in (("sample", PrepareConfig), ("shear", ShearConfig)):
+            if not isinstance(getattr(self, name), kind):
+                raise TypeError(f"{name} must be a {kind.__name__}, got "
+                                f"{type(getattr(self, name)).__name__}")
+        if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
+            raise TypeError(f"bridges must be a BridgeConfig or None, got "
+                            f"{type(self.bridges).__name__}")
+        self.wet_steps = check_int("wet_steps", self.wet_steps, low=1, high=100_000_000)
+        self.vtk_frames = check_int("vtk_frames", self.vtk_frames)
+        if self.vtk_every is not None:
+            self.vtk_every = check_int("vtk_every", self.vtk_every)
+        self.checkpoint_every = check_int("checkpoint_every", self.checkpoint_every)
+
+    @property
+    def confining(self):
+        """Lateral stress of the shear [Pa] (the sample's confining stress)."""
+        return self.sample.confining
+
+    @property
+    def suction(self):
+        """Matric suction [Pa]; 0 for a dry test."""
+        return 0.0 if self.bridges is None else self.bridges.suction
+
+
+# ---------------------------------------------------------------- JSON form
+
+#: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
+CONFIG_TYPES = {kind.__name__: kind for kind in
+                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig)}
+
+
+def config_to_dict(config):
+    """Plain-JSON form of a (nested) configuration dataclass, with its type and the schema
+    version: {"type": ..., "schema_version": ..., "fields": {...}}."""
+    def plain(value):
+        if dataclasses.is_dataclass(value):
+            return {"type": type(value).__name__,
+                    "fields": {f.name: plain(getattr(value, f.name))
+                               for f in dataclasses.fields(value)}}
+        if isinstance(value, tuple):
+            return list(value)
+        if isinstance(value, np.generic):
+            return value.item()
+        return value
+
+    data = plain(config)
+    data["schema_version"] = CONFIG_SCHEMA_VERSION
+    return data
+
+
+def config_from_dict(data, source="configuration"):
+    """The configuration dataclass of ``config_to_dict``'s output, validated; ValueError naming
+    ``source`` (e.g. a file path) for another schema version or a malformed layout."""
+    if not isinstance(data, dict) or "schema_version" not in data:
+        raise ValueError(f"{source}: no pendular configuration (schema_version missing); it was "
+                         "written by pendular before 0.2 — prepare the sample again")
+    if data["schema_version"] != CONFIG_SCHEMA_VERSION:
+        raise ValueError(f"{source}: configuration schema_version {data['schema_version']!r} "
+                         f"is not this pendular's {CONFIG_SCHEMA_VERSION}")
+
+    def build(value):
+        if isinstance(value, dict) and "type" in value and "fields" in value:
+            kind = CONFIG_TYPES.get(value["type"])
+            if kind is None:
+                raise ValueError(f"{source}: unknown configuration type {value['type']!r}")
+            names = {f.name for f in dataclasses.fields(kind)}
+            unknown = set(value["fields"]) - names
+            if unknown:
+                raise ValueError(f"{source}: {value['type']} has no field(s) {sorted(unknown)}")
+            fields = {k: build(v) for k, v in value["fields"].items()}
+            if "table_resolution" in fields and fields["table_resolution"] is not None:
+                fields["table_resolution"] = tuple(fields["table_resolution"])
+            return kind(**fields)
+        return value
+
+    return build({k: v for k, v in data.items() if k != "schema_version"})
+
+
+def config_json(config):
+    """The configuration as a JSON string (sorted keys: equal configurations, equal text)."""
+    return json.dumps(config_to_dict(config), sort_keys=True)

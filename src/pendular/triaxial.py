@@ -1,0 +1,492 @@
+"""Drained triaxial test (thesis Ch. 5.2.3): prepare, wet, shear, record, resume.
+
+Building blocks, usable alone for a custom loading path (README "Using it"):
+
+- ``equilibrate(sim, ...)``: run until static (unbalanced force and servoed stresses within
+  tolerance);
+- ``wet(sim, bridges, ...)``: add capillary bridges to a static sample and re-equilibrate;
+- ``TriaxialShear(sim, shear, ...)``: lateral walls servoed, axial walls at a constant strain
+  rate, a history recorder; ``run()`` shears to the final strain;
+- ``summarize(history)``: peak values.
+
+``TriaxialTest(config).run(out)`` chains them as the thesis does and writes the outputs
+(history.h5, summary.json, triaxial.png, plots/, vtk/, sample.h5, checkpoint.h5);
+``TriaxialTest.resume(out)`` continues an interrupted run from its checkpoint bit-identically.
+
+Stresses compression positive [Pa], q and p as homogenize.invariants; strains compression
+positive, volumetric strain positive in contraction (SPEC §1).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+
+import numba
+import numpy as np
+
+from dem.atomic import write_json
+from dem.checkpoint import CheckpointWriter, load_checkpoint
+from dem.integrate import pwave_timestep
+from dem.measure import coordination, porosity, unbalanced_force
+from dem.preparation import prepare_sample, servoed_simulation
+from dem.record import HistoryRecorder
+from dem.sample import load_sample, save_sample
+from dem.walls import ConstantStrainRate, StressServo
+from homogenize import contact_stress, fabric_tensor, principal_anisotropy
+from homogenize.invariants import deviator_stress, lateral_stress, mean_stress
+
+from .config import TriaxialConfig, config_from_dict, config_to_dict, inertial_number
+from .io import write_history
+from .schema import SUMMARY_UNITS, peak_reached
+from .plots import plot_history, run_label, write_plots
+from .vtk import VtkWriter
+
+#: Largest inertial number of a quasi-static shear (GDR MiDi 2004: I < 1e-3 quasi-static,
+#: dense flow beyond; at 1e-2 the wall and Love–Weber stresses already differ by a few %).
+MAX_INERTIAL_NUMBER = 1e-2
+#: Most shear steps a run may ask for without --force (about 1 h at 1,000 spheres here).
+MAX_SHEAR_STEPS = 20_000_000
+#: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
+ESTIMATE_RATE = 4e6
+
+
+class NotStatic(ValueError):
+    """An equilibrium phase ended at its step limit without reaching equilibrium."""
+
+
+class Interrupted(Exception):
+    """A run stopped before its end (Ctrl-C, or ``stop_after``); the checkpoint, if any, is
+    where ``TriaxialTest.resume`` starts."""
+
+
+# ---------------------------------------------------------------- building blocks
+
+def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check_every=200,
+                progress=None, phase="equilibrium"):
+    """Run ``sim`` until static: unbalanced force below ``unbalanced`` and, if a StressServo
+    controls walls, their stresses within ``tolerance`` (relative) of its target; at most
+    ``max_steps`` steps. Returns the steps taken; NotStatic (naming ``phase`` and what it
+    reached) when the limit is hit first."""
+    done = static(unbalanced, tolerance)
+    steps = sim.run(max_steps, until=done, check_every=check_every, progress=progress,
+                    status=equilibrium_status(unbalanced))
+    if not done(sim):
+        reached = equilibrium_status(unbalanced)(sim)
+        raise NotStatic(f"{phase} not reached in {steps} steps (the step limit): "
+                        + ", ".join(f"{k} {v}" for k, v in reached.items())
+                        + f"; raise the step limit (e.g. --wet-steps) or check the settings")
+    return steps
+
+
+def equilibrium_status(unbalanced):
+    """Progress fields of an equilibrium phase: the unbalanced force against its target and
+    each servo's stress against its target."""
+
+    def status(sim):
+        fields = {"unbalanced": f"{unbalanced_force(sim.particles, sim.contacts):.3g}"
+                                f"/{unbalanced:g}"}
+        for servo in (op for op in sim.controls if isinstance(op, StressServo)):
+            stress = sim.walls.stress()[list(servo.axes)]
+            fields["stress"] = (f"{np.max(np.abs(stress - servo.target)):.3g}Pa off "
+                                f"{servo.target:g}Pa")
+        return fields
+
+    return status
+
+
+def static(unbalanced=0.01, tolerance=0.01):
+    """Predicate of ``equilibrate`` (a function of sim)."""
+
+    def done(sim):
+        if unbalanced_force(sim.particles, sim.contacts) > unbalanced:
+            return False
+        servos = [op for op in sim.controls if isinstance(op, StressServo)]
+        for servo in servos:
+            axes = list(servo.axes)
+            error = np.abs(sim.walls.stress()[axes] - servo.target)
+            if np.any(error > tolerance * max(servo.target, 1e-12)):
+                return False
+        return True
+
+    return done
+
+
+def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None):
+    """Add the capillary operation ``bridges`` to the forces of a static sample and run until
+    static again; returns the wetting report (steps, time, Sr, bridges, porosity)."""
+    sim.forces.append(bridges)
+    started = time.perf_counter()
+    steps = equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
+                        progress=progress, phase="equilibrium after wetting")
+    return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
+            "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
+            "wet_porosity": porosity(sim.particles, sim.walls)}
+
+
+def capillary_operation(sim):
+    """The scene's capillary bridge operation, or None for a dry scene."""
+    found = [op for op in sim.forces if hasattr(op, "water_volume")]
+    return found[0] if found else None
+
+
+def history_columns(sim, axial, reference_volume, bridges=None):
+    """Recorded columns of a triaxial history (name -> function of sim); pendular.schema
+    declares their units. A wet scene adds the capillary and homogenised columns of
+    homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+
+    def contact_fabric(s):
+        return fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0)   # Eq. 4.1
+
+    columns = {
+        "step": lambda s: s.step,
+        "time": lambda s: s.time,
+        "axial_strain": lambda s: axial.strain(s.walls),
+        "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
+        "sigma_wall": lambda s: s.walls.stress(),
+        "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
+        "porosity": lambda s: porosity(s.particles, s.walls),
+        "coordination": lambda s: coordination(s.contacts, len(s.particles)),
+        "fabric": contact_fabric,
+        "anisotropy": lambda s: principal_anisotropy(contact_fabric(s)),      # Eq. 3.51
+        "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
+    }
+    if bridges is not None:
+        from homogenize.on_the_fly import CapillaryHomogenization
+
+        columns.update(CapillaryHomogenization(bridges).quantities())
+    return columns
+
+
+class TriaxialShear:
+    """The shear phase of a static sample: its wall control becomes the lateral walls servoed
+    at ``confining`` [Pa] and the axial (z) walls at the strain rate of ``shear``
+    (pendular.config.ShearConfig), and a HistoryRecorder of ``history_columns`` records about
+    ``shear.records`` rows (the first now, the last at the final strain).
+
+    radius [m], density [kg/m^3]: set the strain rate from the inertial number. ``steps``: steps
+    to the final strain; ``rate`` [1/s]; ``recorder``.
+    """
+
+    def __init__(self, sim, shear, confining, radius, density):
+        self.sim = sim
+        servo = next(op for op in sim.controls if isinstance(op, StressServo))
+        self.rate = shear.rate(radius, density, confining)
+        self.axial = ConstantStrainRate("z", self.rate, sim.walls.lengths()[2],
+                                        on_current_length=shear.rate_on_current_length)
+        max_velocity = (servo.max_velocity if shear.servo_max_velocity is None
+                        else shear.servo_max_velocity)
+        lateral = StressServo("xy", confining, max_velocity,
+                              scale_max_velocity=shear.servo_scale_max_velocity,
+                              stiffness_every=shear.servo_stiffness_every)
+        if sim.contacts is None:
+            sim.evaluate_forces()     # a sample just loaded: the first record sees its contacts
+        sim.controls = [lateral, self.axial]
+        steps = self.axial.steps_to(shear.max_strain, sim.dt)
+        period = max(1, steps // shear.records)
+        self.steps = -(-steps // period) * period     # whole periods: the last step is recorded
+        self.recorder = HistoryRecorder(period, history_columns(
+            sim, self.axial, sim.walls.volume(), capillary_operation(sim)))
+        self.recorder.record(sim)
+        sim.writers.append(self.recorder)
+
+    def status(self, sim):
+        """Progress-bar fields: strain, axial and lateral stress, q/p."""
+        sigma = sim.walls.stress()
+        return {"strain": f"{self.recorder.last('axial_strain'):.3f}",
+                "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral_stress(sigma):.0f}Pa",
+                "q/p": f"{deviator_stress(sigma) / mean_stress(sigma):.2f}"}
+
+
+def summarize(history):
+    """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at the
+    peak of q (and Sr there when recorded). A wet history adds ``peak_q_effective`` and
+    ``p_effective_at_peak``: q' and p' of the effective stress (Eq. 3.43) at the peak of q."""
+    sigma = history["sigma_wall"]
+    q = deviator_stress(sigma)
+    peak = int(np.argmax(q))
+    summary = {
+        "peak_axial_stress": float(sigma[:, 2].max()),
+        "peak_q": float(q[peak]),
+        "p_at_peak": float(mean_stress(sigma)[peak]),
+        "axial_strain_at_peak": float(history["axial_strain"][peak]),
+        "lateral_stress": float(np.mean(lateral_stress(sigma))),
+        "peak_index": peak,
+    }
+    if "saturation" in history:
+        summary["saturation_at_peak"] = float(history["saturation"][peak])
+    if "sigma_effective" in history:
+        effective = np.diagonal(history["sigma_effective"][peak])
+        summary["peak_q_effective"] = float(deviator_stress(effective))
+        summary["p_effective_at_peak"] = float(effective.mean())
+    return summary
+
+
+# ---------------------------------------------------------------- the whole test
+
+def check_feasible(config, force=False):
+    """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
+    MAX_INERTIAL_NUMBER) or would not finish in reasonable time (more than MAX_SHEAR_STEPS shear
+    steps), with the estimate; ``force`` lets an expert run it anyway. Output periods must fit
+    the shear. ValueError naming the setting."""
+    sample, shear = config.sample, config.shear
+    rate = shear.rate(sample.radius, sample.density, sample.confining)
+    number = inertial_number(rate, sample.radius, sample.density, sample.confining)
+    dt = sample.timestep_safety * pwave_timestep(sample.radius, sample.young, sample.density)
+    steps = shear.max_strain / (rate * dt)
+    if not force and number > MAX_INERTIAL_NUMBER:
+        raise ValueError(
+            f"strain rate {rate:.3g} 1/s gives the inertial number I = {number:.3g}, outside "
+            f"the quasi-static range (0, {MAX_INERTIAL_NUMBER:g}] at confining = "
+            f"{sample.confining:g} Pa: lower --strain-rate / --inertial-number (or --force)")
+    if not force and steps > MAX_SHEAR_STEPS:
+        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
+        raise ValueError(
+            f"the shear would take {steps:.3g} steps (dt = {dt:.3g} s, strain rate {rate:.3g} "
+            f"1/s; about {hours:.3g} h here), outside the valid range [1, {MAX_SHEAR_STEPS:g}]:"
+            " raise the strain rate or lower young / the time step's cost (or --force)")
+    for name in ("vtk_every", "checkpoint_every"):
+        value = getattr(config, name)
+        if value is not None and value > max(steps, 1.0) + 1:
+            raise ValueError(f"{name} = {value} is outside the valid range [0, {int(steps) + 1}]"
+                             f": the shear has about {int(steps)} steps")
+
+
+def parameters(config):
+    """Flat name -> value of a configuration, named as the command's options (history file
+    attributes, campaign tables)."""
+    sample, shear, bridges = config.sample, config.shear, config.bridges
+    flat = {"particles": sample.particles, "radius": sample.radius, "porosity": sample.porosity,
+            "young": sample.young, "shear_ratio": sample.shear_ratio,
+            "friction": sample.friction_deg, "prep_friction": sample.prep_friction_deg,
+            "density": sample.density, "damping": sample.damping,
+            "timestep_safety": sample.timestep_safety, "prep_stress": sample.prep_stress,
+            "confining": sample.confining, "seed": sample.seed, "skin_factor": sample.skin_factor,
+            "max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
+            "strain_rate": shear.strain_rate, "records": shear.records,
+            "suction": config.suction, "wet_steps": config.wet_steps,
+            "vtk_every": config.vtk_every, "checkpoint_every": config.checkpoint_every,
+            "sample": config.sample_path}
+    if bridges is not None:
+        flat.update({"contact_angle": bridges.contact_angle, "bridges": bridges.model,
+                     "surface_tension": bridges.surface_tension,
+                     "persist_bridges": bridges.persist, "control": bridges.control,
+                     "table_resolution": (None if bridges.table_resolution is None else
+                                          ",".join(map(str, bridges.table_resolution)))})
+    return flat
+
+
+class TriaxialTest:
+    """A drained triaxial test of ``config`` (pendular.config.TriaxialConfig).
+
+    ``run(out)`` prepares the sample (or loads ``config.sample_path``), wets it at the confining
+    stress (bridges at every contact, six walls servoed until static), shears it and writes
+    into ``out``: history.h5, summary.json, triaxial.png, plots/, vtk/ (ParaView), sample.h5
+    (the sample the shear starts from, with the configuration) and, with checkpoint_every,
+    checkpoint.h5. Returns the summary (dict).
+    """
+
+    def __init__(self, config: TriaxialConfig, *, force=False):
+        if not isinstance(config, TriaxialConfig):
+            raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
+        self.config = config
+        check_feasible(config, force=force)
+        if config.bridges is not None:
+            # check the bridges against the sample's radius before any preparation
+            config.bridges.build().load_tables(config.sample.radius, config.sample.radius)
+
+    # ------------------------------------------------------------ phases
+    def start(self, progress=True, threads=None):
+        """(static sample at the confining stress, preparation report)."""
+        config = self.config
+        if config.sample_path is None:
+            return prepare_sample(config.sample, progress=progress, threads=threads)
+        return self.load_sample(config.sample_path, progress, threads)
+
+    def load_sample(self, path, progress=True, threads=None):
+        """(sample saved at ``path`` servoed at the confining stress and run until static,
+        its report)."""
+        sample = self.config.sample
+        particles, walls, report, _ = load_sample(path)
+        if len(particles) != sample.particles:
+            raise ValueError(f"sample = {path!r} has {len(particles)} particles; the "
+                             f"configuration says particles = {sample.particles}")
+        sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
+        started = time.perf_counter()
+        steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
+                            tolerance=sample.stress_tolerance, max_steps=self.config.wet_steps,
+                            progress="equilibrate sample" if progress else None,
+                            phase=f"equilibrium of sample {path!r} at the confining stress")
+        report = dict(report)
+        report.update({"sample": os.path.abspath(path), "sample_equilibration_steps": steps,
+                       "sample_equilibration_time_s": time.perf_counter() - started,
+                       "porosity": porosity(sim.particles, sim.walls),
+                       "coordination": coordination(sim.contacts, len(sim.particles)),
+                       "sigma_wall": sim.walls.stress().tolist()})
+        report.setdefault("steps", steps)
+        report.setdefault("timestep", f"{sample.timestep_safety} x P-wave time step "
+                                      "min R / sqrt(E / rho)")
+        return sim, report
+
+    def run(self, out, *, progress=True, threads=None, stop_after=None):
+        """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
+        shear after this many steps as an interruption would (raises Interrupted)."""
+        config = self.config
+        os.makedirs(out, exist_ok=True)
+        started = time.perf_counter()
+        sim, preparation = self.start(progress, threads)
+        prepared = time.perf_counter()
+        wetting = {}
+        if config.bridges is not None:
+            wetting = wet(sim, config.bridges.build(),
+                          unbalanced=config.sample.equilibrium_unbalanced,
+                          tolerance=config.sample.stress_tolerance, max_steps=config.wet_steps,
+                          progress="wet" if progress else None)
+        before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
+                               "wetting": wetting, "preparation_time_s": prepared - started,
+                               "pre_shear_time_s": time.perf_counter() - started})
+        save_sample(os.path.join(out, "sample.h5"), sim, preparation, before_shear)
+        run = _ShearRun(sim, config, out, before_shear)
+        if run.checkpoint is not None:
+            run.checkpoint.write(sim)
+        return run.finish(progress, stop_after)
+
+    @classmethod
+    def resume(cls, out, *, progress=True, threads=None, stop_after=None):
+        """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
+        configuration stored in its sample.h5; returns the summary."""
+        sample_file = os.path.join(out, "sample.h5")
+        checkpoint = os.path.join(out, "checkpoint.h5")
+        for path in (sample_file, checkpoint):
+            if not os.path.exists(path):
+                raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
+                                 "with checkpoint_every > 0?)")
+        particles, walls, _, before_shear = load_sample(sample_file)
+        config = config_from_dict(before_shear.get("config"), sample_file)
+        sim = servoed_simulation(particles, walls, config.sample, config.confining,
+                                 threads=threads)
+        if config.bridges is not None:
+            sim.forces.append(config.bridges.build())
+        run = _ShearRun(sim, config, out, before_shear)
+        state = load_checkpoint(checkpoint, sim)
+        if state.get("phase") != "shear" or state["steps"] != run.steps:
+            raise ValueError(f"{checkpoint} does not belong to this run's shear")
+        run.resumed(state)
+        return run.finish(progress, stop_after)
+
+
+class _ShearRun:
+    """The shear of a TriaxialTest with its writers in a fixed order (recorder, ParaView,
+    checkpoint), so that a resumed run builds the same simulation; ``finish`` runs the
+    remaining steps and writes the outputs."""
+
+    def __init__(self, sim, config, out, before_shear):
+        self.sim, self.config, self.out, self.before_shear = sim, config, out, before_shear
+        sample = config.sample
+        self.shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius,
+                                   sample.density)
+        self.steps = self.shear.steps
+        self.start_step = sim.step
+        self.shear_time = 0.0        # seconds spent shearing by earlier (interrupted) runs
+        self.vtk_period = config.vtk_every
+        if self.vtk_period is None:
+            self.vtk_period = max(1, self.steps // config.vtk_frames) if config.vtk_frames else 0
+        self.vtk = None
+        if self.vtk_period > 0:
+            axial = self.shear.axial
+            self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
+                                 field_data=lambda s: {"axial_strain": axial.strain(s.walls)})
+            sim.writers.append(self.vtk)
+        self.checkpoint = None
+        if config.checkpoint_every > 0:
+            self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),
+                                               config.checkpoint_every, self.extra_state)
+            sim.writers.append(self.checkpoint)
+        self._clock = time.perf_counter()
+
+    def extra_state(self, sim):
+        """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
+        return {"phase": "shear", "steps": self.steps, "start_step": self.start_step,
+                "shear_time_s": self.shear_time + time.perf_counter() - self._clock,
+                "config": self.before_shear["config"]}
+
+    def resumed(self, state):
+        """Take the progress of the checkpoint loaded into the simulation."""
+        self.start_step = state["start_step"]
+        self.shear_time = state["shear_time_s"]
+        self._clock = time.perf_counter()
+
+    def finish(self, progress, stop_after):
+        """Run the rest of the shear (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
+        and write the outputs; returns the summary."""
+        sim = self.sim
+        remaining = self.steps - (sim.step - self.start_step)
+        stop = stop_after is not None and stop_after < remaining
+        self._clock = time.perf_counter()
+        try:
+            sim.run(stop_after if stop else remaining,
+                    progress="shear" if progress else None, status=self.shear.status)
+        except KeyboardInterrupt:
+            stop = True
+        self.shear_time += time.perf_counter() - self._clock
+        if stop:        # keep what was sheared: the history so far, its summary not completed
+            self.write_outputs(completed=False)
+            raise Interrupted(f"interrupted at step {sim.step}; history so far in {self.out}"
+                              + (f"; continue with --resume {self.out}"
+                                 if self.checkpoint is not None else ""))
+        if self.vtk is not None:
+            self.vtk.close(sim)
+        return self.write_outputs()
+
+    def write_outputs(self, completed=True):
+        """history.h5, summary.json (``completed``: whether the shear reached its final strain)
+        and, for a completed run, the plots."""
+        sim, config, out = self.sim, self.config, self.out
+        sample = config.sample
+        preparation = self.before_shear["preparation"]
+        history = self.shear.recorder.arrays()
+        summary = summarize(history)
+        rate = self.shear.rate
+        sheared = sim.step - self.start_step
+        summary.update({
+            "completed": completed,
+            "peak_reached": peak_reached(history["axial_strain"], summary["peak_index"]),
+            "initial_porosity": preparation["porosity"],
+            "initial_coordination": preparation["coordination"],
+            "wall_time_s": self.before_shear["pre_shear_time_s"] + self.shear_time,
+            "preparation_time_s": self.before_shear["preparation_time_s"],
+            "shear_time_s": self.shear_time,
+            "steps": self.steps,
+            "preparation_steps": preparation["steps"],
+            "particle_steps_per_s": (len(sim.particles) * sheared / self.shear_time
+                                     if self.shear_time > 0.0 else None),
+            "dt": sim.dt,
+            "strain_rate": rate,
+            "inertial_number": inertial_number(rate, sample.radius, sample.density,
+                                               sample.confining),
+            "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
+            "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
+            "threads": numba.get_num_threads(),
+            **self.before_shear["wetting"],
+        })
+        summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
+        attributes = {k: v for k, v in parameters(config).items() if v is not None}
+        attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
+                           "strain_rate": rate, "vtk_every": self.vtk_period})
+        write_history(os.path.join(out, "history.h5"), history, self.before_shear["config"],
+                      attributes=attributes)
+        write_json(os.path.join(out, "summary.json"), summary)
+        if not completed:
+            return summary
+        title = run_label(parameters(config), preparation["porosity"])
+        plot_history(history, os.path.join(out, "triaxial.png"), title)
+        write_plots(history, os.path.join(out, "plots"), title)
+        return summary
+
+
+def _plain(data):
+    """``data`` with NumPy scalars and arrays as JSON values."""
+    return json.loads(json.dumps(data, default=lambda v: v.tolist() if hasattr(v, "tolist")
+                                 else str(v)))
+
