@@ -11,7 +11,7 @@ from dem.contact_law import ContactForces
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig, prepare_sample
-from dem.simulation import ForceReset, Simulation
+from dem.simulation import Simulation
 from dem.state import Particles, Walls
 from dem.walls import WallForces
 
@@ -23,17 +23,17 @@ YOUNG = 1e6
 def two_body_scene(positions, velocities, radius=RADIUS, young=YOUNG, friction_deg=0.0,
                    damping=0.0, dt=None, extra=(), box=1.0):
     """Spheres of ``radius`` (scalar or one per sphere) in a box [-box, box]^3 (walls out of
-    reach unless placed near them) with the standard dry pipeline."""
+    reach unless placed near them) with the standard dry pipeline; ``extra``: further forces
+    (after the contact and wall forces)."""
     radii = np.broadcast_to(np.asarray(radius, float), (len(positions),))
     particles = Particles(np.array(positions, float), radii, DENSITY,
                           velocity=np.array(velocities, float))
     walls = Walls.box([-box] * 3, [box] * 3)
     if dt is None:
         dt = 0.01 * np.sqrt(particles.mass.min() / (young * radii.min()))
-    operations = [ForceReset(), NeighborList(0.2 * radii.min()),
-                  ContactForces(young, 0.3, friction_deg), WallForces(young), *extra,
-                  Integrator(damping)]
-    return Simulation(particles, walls, dt, operations)
+    return Simulation(particles, walls, dt, neighbors=NeighborList(0.2 * radii.min()),
+                      forces=[ContactForces(young, 0.3, friction_deg), WallForces(young), *extra],
+                      integrator=Integrator(damping))
 
 
 @pytest.fixture(scope="session")

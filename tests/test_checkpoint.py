@@ -15,10 +15,12 @@ from conftest import two_body_scene
 from dem.checkpoint import CheckpointWriter, load_checkpoint, save_checkpoint
 from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig, prepare_sample
-from dem.simulation import ForceReset, Simulation
+from dem.integrate import Integrator
+from dem.simulation import Simulation
 from dem.state import Particles, Walls
-from dem.triaxial import ShearConfig, start_shear
 from dem.walls import StressServo
+from pendular.config import ShearConfig
+from pendular.triaxial import TriaxialShear
 
 TESTS = os.path.dirname(os.path.abspath(__file__))
 
@@ -34,10 +36,10 @@ def sheared(prepared, checkpoint_path):
     """The prepared sample in triaxial shear, built the same way every time."""
     config, sample = prepared
     sim = copy.deepcopy(sample)
-    shear = ShearConfig(confining=750.0, max_strain=0.05, inertial_number=2e-3, records=100)
-    recorder, _, _ = start_shear(sim, shear, config.radius, config.density)
+    shear = ShearConfig(max_strain=0.05, inertial_number=2e-3, records=100)
+    run = TriaxialShear(sim, shear, 750.0, config.radius, config.density)
     sim.writers.append(CheckpointWriter(checkpoint_path, period=10 ** 9))
-    return sim, recorder
+    return sim, run.recorder
 
 
 def test_resumed_shear_is_bit_identical_to_an_uninterrupted_one(prepared, tmp_path):
@@ -109,10 +111,10 @@ def scene_with_bridges(operation):
 
 def test_references_extra_arrays_and_unpicklable_attributes(tmp_path):
     saved = scene_with_bridges(CachingOperation())
-    saved.operations[4].scratch = "saved"
+    saved.forces[2].scratch = "saved"
     path = tmp_path / "c.h5"
     skipped = save_checkpoint(path, saved)
-    assert skipped == {"operations[4] CachingOperation": ["callback", "scratch"]}
+    assert skipped == {"forces[2] CachingOperation": ["callback", "scratch"]}
 
     fresh_operation = CachingOperation()
     fresh_callback = fresh_operation.callback
@@ -124,14 +126,14 @@ def test_references_extra_arrays_and_unpicklable_attributes(tmp_path):
         assert np.array_equal(loaded.contacts.extra[name], values)
     for name in ("pair_i", "pair_j", "row_start", "second_start", "second_pair", "overlap"):
         assert np.array_equal(getattr(loaded.contacts, name), getattr(saved.contacts, name))
-    op = loaded.operations[4]
+    op = loaded.forces[2]
     assert op.contacts is loaded.contacts                       # references follow the load
     assert op.position is loaded.particles.position
     assert op.callback is fresh_callback and op.scratch == "fresh"
-    assert op.kicks == saved.operations[4].kicks
+    assert op.kicks == saved.forces[2].kicks
     saved.run(5)
     loaded.run(5)
-    assert op.kicks == saved.operations[4].kicks                # generator state carried on
+    assert op.kicks == saved.forces[2].kicks                # generator state carried on
     assert np.array_equal(loaded.particles.position, saved.particles.position)
     assert np.array_equal(loaded.contacts.extra["state"], saved.contacts.extra["state"])
 
@@ -145,7 +147,7 @@ def test_loading_into_a_differently_built_simulation_raises_and_changes_nothing(
     _, sample = prepared
     other = copy.deepcopy(sample)          # six-wall servo, no strain control, no writers
     before = other.particles.position.copy()
-    with pytest.raises(ValueError, match="operations.*ConstantStrainRate"):
+    with pytest.raises(ValueError, match="controls.*ConstantStrainRate"):
         load_checkpoint(path, other)
     assert other.step == sample.step and np.array_equal(other.particles.position, before)
     missing_writer, _ = sheared(prepared, path)
@@ -154,7 +156,7 @@ def test_loading_into_a_differently_built_simulation_raises_and_changes_nothing(
         load_checkpoint(path, missing_writer)
     with h5py.File(tmp_path / "other.h5", "w") as handle:
         handle.attrs["format"] = "something else"
-    with pytest.raises(ValueError, match="not a pendular checkpoint"):
+    with pytest.raises(ValueError, match="not a checksummed pendular checkpoint"):
         load_checkpoint(tmp_path / "other.h5", sim)
 
 
@@ -179,7 +181,8 @@ def bulky_scene():
     count = 50_000
     particles = Particles(np.zeros((count, 3)), np.ones(count), 1000.0)
     return Simulation(particles, Walls.box([0, 0, 0], [1, 1, 1]), 1.0,
-                      [ForceReset(), StressServo("xyz", 1.0, 1.0)])
+                      neighbors=NeighborList(1.0), controls=[StressServo("xyz", 1.0, 1.0)],
+                      integrator=Integrator(0.0))
 
 
 def checkpoint_forever(path):
@@ -189,7 +192,7 @@ def checkpoint_forever(path):
         sim.step += 1
         sim.time = 0.5 * sim.step
         for array in (sim.particles.position, sim.particles.velocity, sim.walls.position,
-                      sim.operations[1].previous):
+                      sim.controls[0].previous):
             array[:] = sim.step
         save_checkpoint(path, sim, extra_state=sim.step)
 
@@ -217,5 +220,5 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     step = load_checkpoint(path, sim)
     assert step == sim.step > 1 and sim.time == 0.5 * step
     for array in (sim.particles.position, sim.particles.velocity, sim.walls.position,
-                  sim.operations[1].previous):
+                  sim.controls[0].previous):
         assert np.all(array == step)

@@ -24,7 +24,7 @@ def test_head_on_collision_duration_and_restitution():
     kn = YOUNG * RADIUS  # 2 E R R / (2 R)
     expected = np.pi * np.sqrt(0.5 * mass / kn)
     counter = CountContactSteps()
-    sim.operations.append(counter)
+    sim.writers.append(counter)
     sim.run(int(3 * expected / sim.dt) + int(0.01 * RADIUS / (speed * sim.dt)))
     duration = counter.steps * sim.dt
     assert duration == pytest.approx(expected, rel=0.01)

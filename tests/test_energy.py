@@ -9,7 +9,6 @@ from dem.state import Particles, Walls
 from dem.contact_law import ContactForces
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
-from dem.simulation import ForceReset
 from dem.walls import WallForces
 
 
@@ -36,9 +35,9 @@ def energy_error(timestep_factor, steps=10000):
     walls = Walls.box(np.zeros(3), np.full(3, edge))
     dt = timestep_factor * np.sqrt(particles.mass[0] / (young * radius))
     probe = SpringEnergyProbe(young)
-    sim = Simulation(particles, walls, dt, [ForceReset(), NeighborList(0.3 * radius),
-                                            ContactForces(young, 0.3, 0.0), WallForces(young),
-                                            probe, Integrator(damping=0.0)])
+    sim = Simulation(particles, walls, dt, neighbors=NeighborList(0.3 * radius),
+                     forces=[ContactForces(young, 0.3, 0.0), WallForces(young)],
+                     controls=[probe], integrator=Integrator(damping=0.0))
 
     def total():
         # leapfrog: springs at x(t), velocities at t -/+ dt/2; v(t) is their mean
@@ -73,8 +72,9 @@ def test_damping_dissipates_energy():
                           velocity=rng.normal(scale=0.05, size=(200, 3)))
     walls = Walls.box(np.zeros(3), np.full(3, 0.02))
     sim = Simulation(particles, walls, 0.05 * np.sqrt(particles.mass[0] / (young * radius)),
-                     [ForceReset(), NeighborList(0.3 * radius), ContactForces(young, 0.3, 20.0),
-                      WallForces(young), Integrator(damping=0.2)])
+                     neighbors=NeighborList(0.3 * radius),
+                     forces=[ContactForces(young, 0.3, 20.0), WallForces(young)],
+                     integrator=Integrator(damping=0.2))
     start = kinetic_energy(sim.particles)
     sim.run(5000)
     assert kinetic_energy(sim.particles) < 0.8 * start

@@ -9,12 +9,12 @@ import numba
 import numpy as np
 import pytest
 
-from capillary.coupling import CapillaryBridges
+from capillary import CapillaryBridges
 from dem.contact_law import ContactForces
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
 from dem.preparation import random_cloud
-from dem.simulation import ForceReset, Simulation
+from dem.simulation import Simulation
 from dem.state import Particles, Walls
 from dem.walls import WallForces
 from test_energy import SpringEnergyProbe
@@ -37,12 +37,12 @@ def dense_packing(threads, friction_deg=0.0, damping=0.0, suction=None, count=20
     particles = Particles(position, np.full(count, INFLATION * RADIUS), DENSITY, velocity=velocity)
     dt = 0.05 * np.sqrt(particles.mass[0] / (YOUNG * RADIUS))
     probe = SpringEnergyProbe(YOUNG)
-    sim = Simulation(particles, Walls.box(np.zeros(3), np.full(3, EDGE)), dt,
-                     [ForceReset(), NeighborList(0.3 * RADIUS),
-                      ContactForces(YOUNG, 0.3, friction_deg), WallForces(YOUNG), probe,
-                      Integrator(damping)], threads=threads)
+    forces = [ContactForces(YOUNG, 0.3, friction_deg), WallForces(YOUNG)]
     if suction is not None:
-        CapillaryBridges(suction, 0.073).insert(sim)
+        forces.append(CapillaryBridges(suction, 0.073))
+    sim = Simulation(particles, Walls.box(np.zeros(3), np.full(3, EDGE)), dt,
+                     neighbors=NeighborList(0.3 * RADIUS), forces=forces, controls=[probe],
+                     integrator=Integrator(damping), threads=threads)
     return sim, probe
 
 

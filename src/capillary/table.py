@@ -18,6 +18,7 @@ import hashlib
 import json
 import math
 import os
+import sys
 from pathlib import Path
 
 import h5py
@@ -28,6 +29,7 @@ from capillary.meniscus import bridge_kernel
 from capillary.suction_control import rupture_point, stable_filling_angle
 from capillary.validation import check_contact_angle, check_positive, check_radius_ratio
 from dem.atomic import replacing
+from dem.integrity import stamp, verify
 from dem.validate import reading
 
 YADE_RADIUS_RATIOS = (1.0, 1.1, 1.25, 1.5, 1.75, 2.0, 3.0, 4.0, 5.0, 10.0)
@@ -45,18 +47,75 @@ def cache_directory():
     return Path(os.environ.get("PENDULAR_CACHE", Path.home() / ".cache" / "pendular"))
 
 
-def save_atomically(table, path):
+def save_atomically(table, path, identity=None):
     """table.save to path (atomic: concurrent runs never read a partial table), creating its
-    folder."""
+    folder; stamped (dem.integrity: checksum and ``identity``) before it appears when
+    ``identity`` is given."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    table.save(path)
+    if identity is None:
+        table.save(path)
+        return
+    with replacing(path) as temporary:
+        table.save(temporary)
+        stamp(temporary, identity)
 
 
 def cache_key(kind, parameters):
     """Short hash of a table's kind and build parameters."""
     text = json.dumps({"kind": kind, "format": TABLE_FORMAT, **parameters}, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def cache_identity(kind, parameters):
+    """Identity stamped on a cached table: its kind, layout version, key and build parameters."""
+    return {"kind": "table cache", "table": kind, "table_format": TABLE_FORMAT,
+            "key": cache_key(kind, parameters), "parameters": parameters}
+
+
+def cached_table(path, identity, load, check, build):
+    """The table cached at ``path`` if it passes every check, else ``build()`` saved there.
+
+    Checks: checksum and ``identity`` (dem.integrity.verify), ``load(path)``, then
+    ``check(table)`` (ValueError when its nodes do not match the key or are not finite). A
+    file that fails is rebuilt, never used, with a one-line warning on stderr saying why."""
+    path = Path(path)
+    if path.exists():
+        try:
+            verify(path, identity, kind="table cache")
+            with np.errstate(invalid="ignore", divide="ignore"):    # found by check below
+                table = load(path)
+            check(table)
+            return table
+        except (ValueError, OSError) as error:
+            named = f"path = {str(path)!r}"
+            reason = str(error).replace(f"{named}: ", "").replace(f"{named} ", "the file ")
+            reason = " ".join(reason.split())
+            print(f"warning: cached bridge table {path} not used, rebuilding it: {reason}",
+                  file=sys.stderr)
+    table = build()
+    save_atomically(table, path, identity)
+    return table
+
+
+def check_table_nodes(table, shapes, settings):
+    """ValueError unless the table's arrays have the ``shapes`` (name -> tuple) and settings
+    (name -> value) its cache key promises, and every lookup array (table.arrays()) is finite
+    (no NaN, no logarithm of a non-positive node)."""
+    for name, shape in shapes.items():
+        found = tuple(getattr(table, name).shape)
+        if found != tuple(shape):
+            raise ValueError(f"{name} has shape {found}; the cache key says {tuple(shape)}")
+    for name, value in settings.items():
+        found = getattr(table, name)
+        if not np.array_equal(np.asarray(found, dtype=np.float64), np.asarray(value, dtype=np.float64)):
+            raise ValueError(f"{name} = {np.asarray(found).tolist()}; the cache key says "
+                             f"{np.asarray(value).tolist()}")
+    with np.errstate(invalid="ignore"):
+        for index, array in enumerate(table.arrays()):
+            if not np.isfinite(array).all():
+                raise ValueError(f"lookup array {index} holds {int(np.sum(~np.isfinite(array)))} "
+                                 "NaN or infinite nodes")
 
 
 @numba.njit(cache=True)
@@ -312,17 +371,26 @@ class BridgeTable:
     @classmethod
     def cached(cls, contact_angle=0.0, radius_ratios=YADE_RADIUS_RATIOS, n_suction=350, n_distance=80,
                suction_max=15000.0, suction_scale=0.1, directory=None):
-        """Load the table with these parameters from the cache directory, building and saving it if absent."""
+        """Load the table with these parameters from the cache directory, building and saving it if
+        absent; a cached file failing its checksum, identity or node checks is rebuilt (cached_table)."""
         parameters = cls._parameters(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
         path = Path(directory or cache_directory()) / f"bridge_table_{cache_key('suction', parameters)}.h5"
-        if path.exists():
-            try:
-                return cls.load(path)
-            except ValueError:      # a corrupt or foreign file in the cache: build it again
-                pass
-        table = cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
-        save_atomically(table, path)
-        return table
+        n_r = len(parameters["radius_ratios"])
+
+        def check(table):
+            check_table_nodes(
+                table,
+                {"values": (n_r, parameters["n_suction"], parameters["n_distance"], len(FIELDS)),
+                 "distance_low": (n_r, parameters["n_suction"]),
+                 "distance_rupture": (n_r, parameters["n_suction"])},
+                {name: parameters[name] for name in ("contact_angle", "radius_ratios", "suction_scale",
+                                                     "suction_max")},
+            )
+
+        return cached_table(
+            path, cache_identity("suction", parameters), cls.load, check,
+            lambda: cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale),
+        )
 
     def arrays(self):
         """(radius_ratios, suction_axis = [suction_scale, xi step, suction_max], distance_low,

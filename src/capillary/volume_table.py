@@ -25,12 +25,14 @@ from capillary.table import (
     along_axis,
     bilinear,
     cache_directory,
+    cache_identity,
     cache_key,
+    cached_table,
+    check_table_nodes,
     distance_cell,
     distance_fraction,
     grid_position,
     radius_ratio_bracket,
-    save_atomically,
 )
 from capillary.validation import check_contact_angle, check_radius_ratio
 from dem.atomic import replacing
@@ -214,17 +216,26 @@ class VolumeBridgeTable:
 
     @classmethod
     def cached(cls, contact_angle=0.0, radius_ratios=YADE_RADIUS_RATIOS, n_volume=80, n_distance=80, directory=None):
-        """Load the table with these parameters from the cache directory, building and saving it if absent."""
-        key = cache_key("volume", cls._parameters(contact_angle, radius_ratios, n_volume, n_distance))
-        path = Path(directory or cache_directory()) / f"volume_bridge_table_{key}.h5"
-        if path.exists():
-            try:
-                return cls.load(path)
-            except ValueError:      # a corrupt or foreign file in the cache: build it again
-                pass
-        table = cls.build(contact_angle, radius_ratios, n_volume, n_distance)
-        save_atomically(table, path)
-        return table
+        """Load the table with these parameters from the cache directory, building and saving it if
+        absent; a cached file failing its checksum, identity or node checks is rebuilt (cached_table)."""
+        parameters = cls._parameters(contact_angle, radius_ratios, n_volume, n_distance)
+        path = Path(directory or cache_directory()) / f"volume_bridge_table_{cache_key('volume', parameters)}.h5"
+        n_r = len(parameters["radius_ratios"])
+
+        def check(table):
+            check_table_nodes(
+                table,
+                {"values": (n_r, parameters["n_volume"], parameters["n_distance"], len(VOLUME_FIELDS)),
+                 "volume_axes": (n_r, 2),
+                 "distance_low": (n_r, parameters["n_volume"]),
+                 "distance_rupture": (n_r, parameters["n_volume"])},
+                {name: parameters[name] for name in ("contact_angle", "radius_ratios")},
+            )
+
+        return cached_table(
+            path, cache_identity("volume", parameters), cls.load, check,
+            lambda: cls.build(contact_angle, radius_ratios, n_volume, n_distance),
+        )
 
     def arrays(self):
         """(radius_ratios, volume_axes = [[ln V*_min, ln V*_max]] per radius ratio, distance_low,

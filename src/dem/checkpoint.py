@@ -40,6 +40,7 @@ import h5py
 import numpy as np
 
 from .atomic import replacing
+from .integrity import stamp, verify
 from .neighbors import Contacts
 from .validate import check_int, reading
 
@@ -146,11 +147,12 @@ def _write_group(handle, name, arrays, scalars=None):
     return group
 
 
-def save_checkpoint(path, sim, extra_state=None):
+def save_checkpoint(path, sim, extra_state=None, identity=None):
     """Write the complete state of ``sim`` to ``path`` atomically (module docstring).
 
     ``extra_state``: any picklable value (e.g. the scenario's phase), returned by
-    ``load_checkpoint``. Returns the names of the operation attributes not saved
+    ``load_checkpoint``; ``identity``: what made the run (dict, e.g. its configuration hash and
+    seed), stamped with a content checksum (dem.integrity) and checked by ``load_checkpoint``. Returns the names of the operation attributes not saved
     ({"forces[i] Type": [names]}).
     """
     path = os.fspath(path)
@@ -194,6 +196,8 @@ def save_checkpoint(path, sim, extra_state=None):
                                     f"{type(value).__name__}: only arrays are supported")
             _write_group(group, "extra", contacts.extra)
         handle.create_dataset("state", data=blob)
+        stamp(handle, {"kind": "checkpoint", "format": FORMAT, "version": VERSION,
+                       **(identity or {})})
     return skipped
 
 
@@ -213,9 +217,11 @@ def _check_types(handle, sim):
                 "the checkpointed one was built")
 
 
-def load_checkpoint(path, sim):
+def load_checkpoint(path, sim, expected_identity=None):
     """Restore the state saved by ``save_checkpoint`` into ``sim``; return its ``extra_state``.
 
+    The file's checksum is verified first, and its identity against ``expected_identity``
+    (ValueError naming the path: edited or damaged, another run's, or older than checksums).
     ``sim`` must have neighbour list, forces, controls, integrator and writers of the same
     types in the same order (ValueError
     otherwise, before anything is changed). Particles, walls, contacts, step, time, dt and the
@@ -223,6 +229,7 @@ def load_checkpoint(path, sim):
     keep the values of ``sim``'s own operations.
     """
     path = os.fspath(path)
+    verify(path, expected_identity, kind="checkpoint")
     with reading(path, "pendular checkpoint"), h5py.File(path, "r") as handle:
         if handle.attrs.get("format") != FORMAT:
             raise ValueError(f"{path!r} is not a pendular checkpoint")
@@ -271,13 +278,15 @@ class CheckpointWriter:
     """Writer saving a checkpoint to ``path`` every ``period`` steps (``sim.step % period == 0``).
 
     Append it after the other writers, so that the checkpoint holds the record of its own step.
-    ``extra_state``: None, a picklable value, or a function of sim returning one.
+    ``extra_state``: None, a picklable value, or a function of sim returning one; ``identity``:
+    see ``save_checkpoint``.
     """
 
-    def __init__(self, path, period, extra_state=None):
+    def __init__(self, path, period, extra_state=None, identity=None):
         self.path = os.fspath(path)
         self.period = check_int("checkpoint period", period, low=1)
         self.extra_state = extra_state
+        self.identity = identity
         self.written = 0
 
     def apply(self, sim):
@@ -288,4 +297,4 @@ class CheckpointWriter:
         """Save a checkpoint of the current state now."""
         extra = self.extra_state(sim) if callable(self.extra_state) else self.extra_state
         self.written += 1
-        save_checkpoint(self.path, sim, extra)
+        save_checkpoint(self.path, sim, extra, self.identity)

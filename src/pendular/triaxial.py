@@ -29,6 +29,7 @@ import numpy as np
 from dem.atomic import write_json
 from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.integrate import pwave_timestep
+from dem.integrity import checksum, config_hash
 from dem.measure import coordination, porosity, unbalanced_force
 from dem.preparation import prepare_sample, servoed_simulation
 from dem.record import HistoryRecorder
@@ -39,6 +40,7 @@ from homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 
 from .config import TriaxialConfig, config_from_dict, config_to_dict, inertial_number
 from .io import write_history
+from .outputs import OutputFolder
 from .schema import SUMMARY_UNITS, peak_reached
 from .plots import plot_history, run_label, write_plots
 from .vtk import VtkWriter
@@ -50,6 +52,11 @@ MAX_INERTIAL_NUMBER = 1e-2
 MAX_SHEAR_STEPS = 20_000_000
 #: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
 ESTIMATE_RATE = 4e6
+
+
+#: Files and folders a triaxial run owns in its output folder (pendular.outputs).
+OUTPUTS = ("history.h5", "summary.json", "triaxial.png", "plots", "vtk", "sample.h5",
+           "checkpoint.h5")
 
 
 class NotStatic(ValueError):
@@ -308,10 +315,7 @@ class TriaxialTest:
         """(sample saved at ``path`` servoed at the confining stress and run until static,
         its report)."""
         sample = self.config.sample
-        particles, walls, report, _ = load_sample(path)
-        if len(particles) != sample.particles:
-            raise ValueError(f"sample = {path!r} has {len(particles)} particles; the "
-                             f"configuration says particles = {sample.particles}")
+        particles, walls, report, _ = load_sample(path, expected=sample)
         sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
         started = time.perf_counter()
         steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
@@ -332,8 +336,13 @@ class TriaxialTest:
     def run(self, out, *, progress=True, threads=None, stop_after=None):
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
         shear after this many steps as an interruption would (raises Interrupted)."""
+        with OutputFolder(out, "triaxial") as folder:
+            for name in OUTPUTS:
+                folder.claim(name)
+            return self._run(out, progress, threads, stop_after)
+
+    def _run(self, out, progress, threads, stop_after):
         config = self.config
-        os.makedirs(out, exist_ok=True)
         started = time.perf_counter()
         sim, preparation = self.start(progress, threads)
         prepared = time.perf_counter()
@@ -346,8 +355,10 @@ class TriaxialTest:
         before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
                                "wetting": wetting, "preparation_time_s": prepared - started,
                                "pre_shear_time_s": time.perf_counter() - started})
-        save_sample(os.path.join(out, "sample.h5"), sim, preparation, before_shear)
-        run = _ShearRun(sim, config, out, before_shear)
+        sample_file = os.path.join(out, "sample.h5")
+        save_sample(sample_file, sim, preparation, before_shear,
+                    identity={"seed": config.sample.seed})
+        run = _ShearRun(sim, config, out, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
         return run.finish(progress, stop_after)
@@ -362,18 +373,27 @@ class TriaxialTest:
             if not os.path.exists(path):
                 raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
                                  "with checkpoint_every > 0?)")
-        particles, walls, _, before_shear = load_sample(sample_file)
-        config = config_from_dict(before_shear.get("config"), sample_file)
-        sim = servoed_simulation(particles, walls, config.sample, config.confining,
-                                 threads=threads)
-        if config.bridges is not None:
-            sim.forces.append(config.bridges.build())
-        run = _ShearRun(sim, config, out, before_shear)
-        state = load_checkpoint(checkpoint, sim)
-        if state.get("phase") != "shear" or state["steps"] != run.steps:
-            raise ValueError(f"{checkpoint} does not belong to this run's shear")
-        run.resumed(state)
-        return run.finish(progress, stop_after)
+        with OutputFolder(out, "triaxial --resume", keep=True):
+            particles, walls, _, before_shear = load_sample(sample_file)
+            config = config_from_dict(before_shear.get("config"), sample_file)
+            sim = servoed_simulation(particles, walls, config.sample, config.confining,
+                                     threads=threads)
+            if config.bridges is not None:
+                sim.forces.append(config.bridges.build())
+            identity = run_identity(config, sample_file)
+            run = _ShearRun(sim, config, out, before_shear, identity)
+            state = load_checkpoint(checkpoint, sim, expected_identity=identity)
+            if state.get("phase") != "shear" or state["steps"] != run.steps:
+                raise ValueError(f"{checkpoint} does not belong to this run's shear")
+            run.resumed(state)
+            return run.finish(progress, stop_after)
+
+
+def run_identity(config, sample_file):
+    """What a checkpoint of this run must carry (dem.integrity): the configuration's hash, the
+    seed and the checksum of the sample the shear started from."""
+    return {"config_hash": config_hash(config_to_dict(config)), "seed": config.sample.seed,
+            "sample_checksum": checksum(sample_file)}
 
 
 class _ShearRun:
@@ -381,7 +401,7 @@ class _ShearRun:
     checkpoint), so that a resumed run builds the same simulation; ``finish`` runs the
     remaining steps and writes the outputs."""
 
-    def __init__(self, sim, config, out, before_shear):
+    def __init__(self, sim, config, out, before_shear, identity):
         self.sim, self.config, self.out, self.before_shear = sim, config, out, before_shear
         sample = config.sample
         self.shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius,
@@ -401,7 +421,8 @@ class _ShearRun:
         self.checkpoint = None
         if config.checkpoint_every > 0:
             self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),
-                                               config.checkpoint_every, self.extra_state)
+                                               config.checkpoint_every, self.extra_state,
+                                               identity)
             sim.writers.append(self.checkpoint)
         self._clock = time.perf_counter()
 

@@ -14,8 +14,9 @@ import json
 import sys
 
 from dem.preparation import PrepareConfig
+from dem.validate import check_range
 
-from ..cli import INTERRUPTED, UsageError, add_run_options, finite_float, positive_int, set_threads
+from ..cli import INTERRUPTED, UsageError, add_run_options, positive_int, set_threads
 from ..config import BridgeConfig, ShearConfig, TriaxialConfig
 from ..triaxial import Interrupted, TriaxialTest
 
@@ -28,48 +29,47 @@ SHOWN = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak", "pe
 
 
 def add_arguments(parser):
-    number = finite_float
     parser.add_argument("--particles", type=int, default=10000, help="number of spheres")
-    parser.add_argument("--confining", type=number("--confining"), default=750.0,
+    parser.add_argument("--confining", type=float, default=750.0,
                         help="lateral stress [Pa]")
-    parser.add_argument("--suction", type=number("--suction"), default=0.0,
+    parser.add_argument("--suction", type=float, default=0.0,
                         help="matric suction [Pa] (0: dry)")
-    parser.add_argument("--contact-angle", type=number("--contact-angle"), default=None,
+    parser.add_argument("--contact-angle", type=float, default=None,
                         help="wetting angle [deg] (wet test; default 0)")
     parser.add_argument("--bridges", choices=("exact", "toroidal"), default=None,
                         help="bridge model of the wet test: exact Young-Laplace tables "
                              "(default) or the toroidal approximation (equal spheres)")
-    parser.add_argument("--surface-tension", type=number("--surface-tension"), default=None,
+    parser.add_argument("--surface-tension", type=float, default=None,
                         help="liquid surface tension [N/m] (wet test; default 0.073)")
     parser.add_argument("--persist-bridges", action="store_true",
                         help="bridges live up to their rupture distance instead of breaking "
                              "when contact is lost")
     parser.add_argument("--wet-steps", type=int, default=200000,
                         help="most steps to equilibrate the wetted (or loaded) sample [-]")
-    parser.add_argument("--max-strain", type=number("--max-strain"), default=0.25,
+    parser.add_argument("--max-strain", type=float, default=0.25,
                         help="final axial strain [-]")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
-    parser.add_argument("--radius", type=number("--radius"), default=0.024e-3,
+    parser.add_argument("--radius", type=float, default=0.024e-3,
                         help="sphere radius [m]")
-    parser.add_argument("--porosity", type=number("--porosity"), default=0.40,
+    parser.add_argument("--porosity", type=float, default=0.40,
                         help="porosity of the initial cloud box [-] (0.30-0.60)")
-    parser.add_argument("--friction", type=number("--friction"), default=18.0,
+    parser.add_argument("--friction", type=float, default=18.0,
                         help="contact friction [deg]")
-    parser.add_argument("--prep-friction", type=number("--prep-friction"), default=0.5,
+    parser.add_argument("--prep-friction", type=float, default=0.5,
                         help="contact friction during the radius growth [deg] (thesis 0.5; "
                              "higher gives a looser sample)")
-    parser.add_argument("--young", type=number("--young"), default=1e6,
+    parser.add_argument("--young", type=float, default=1e6,
                         help="YADE young E [Pa], kn = E R")
-    parser.add_argument("--damping", type=number("--damping"), default=0.2,
+    parser.add_argument("--damping", type=float, default=0.2,
                         help="Cundall local damping [-]")
-    parser.add_argument("--inertial-number", type=number("--inertial-number"), default=3e-4,
+    parser.add_argument("--inertial-number", type=float, default=3e-4,
                         help="target inertial number setting the strain rate [-]")
-    parser.add_argument("--strain-rate", type=number("--strain-rate"), default=None,
+    parser.add_argument("--strain-rate", type=float, default=None,
                         help="axial strain rate [1/s] (overrides --inertial-number)")
-    parser.add_argument("--timestep-safety", type=number("--timestep-safety"), default=0.7,
+    parser.add_argument("--timestep-safety", type=float, default=0.7,
                         help="time step as a fraction of the P-wave estimate [-]")
-    parser.add_argument("--skin-factor", type=number("--skin-factor"), default=0.3,
+    parser.add_argument("--skin-factor", type=float, default=0.3,
                         help="Verlet skin of the neighbour list / radius (0, 2]")
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
                         help="bridge table nodes in suction and in distance (exact default "
@@ -115,9 +115,7 @@ def table_resolution(text):
 
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
-    if args.suction < 0.0:
-        raise UsageError(f"--suction {args.suction} Pa is outside the valid range [0, inf) "
-                         "(0: dry)")
+    check_range("suction", args.suction, 0.0, unit="Pa")
     wet_only = {"--contact-angle": args.contact_angle is not None,
                 "--table-resolution": args.table_resolution is not None,
                 "--bridges": args.bridges is not None,
