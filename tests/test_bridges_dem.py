@@ -1,4 +1,4 @@
-"""Capillary bridges in the DEM (capillary.coupling): pair laws against the exact solver and
+"""Capillary bridges in the DEM (capillary.bridges): pair laws against the exact solver and
 the tables, force bookkeeping, saturation, neighbour-list reach, the wet triaxial scenario."""
 
 import copy
@@ -14,14 +14,21 @@ import numpy as np
 import pytest
 
 import capillary
-from capillary.coupling import CapillaryBridges, pendular_overlap_counts
+from capillary import BridgeState, CapillaryBridges
+from capillary.bridge_kernels import pendular_overlap_counts
 from conftest import two_body_scene
 from dem.neighbors import NeighborList, build_contacts
-from homogenize import contact_stress
+from homogenize import capillary_force_stress, contact_stress
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAMMA = 0.073
 YOUNG = 1e6
+
+
+def add(sim, bridges):
+    """Add the bridge operation to the scene's forces; return it."""
+    sim.forces.append(bridges)
+    return bridges
 
 
 class PrescribedGap:
@@ -42,15 +49,15 @@ def pull_apart(bridges, radii, rate, max_steps=20000):
     sphere 1 along x, bridge state, volume) after each step, until the bridge breaks."""
     sim = two_body_scene([[0, 0, 0], [sum(radii) - 2 * rate, 0, 0]], np.zeros((2, 3)),
                          radius=radii)
-    sim.operations[-1] = PrescribedGap(-2 * rate, rate)
-    bridges.insert(sim)
+    sim.integrator = PrescribedGap(-2 * rate, rate)
+    sim.forces.append(bridges)
     rows = []
     for _ in range(max_steps):
         sim.advance()
-        extra = sim.contacts.extra
-        rows.append((-sim.contacts.overlap[0], sim.particles.force[1, 0], extra["bridge"][0],
-                     extra["bridge_volume"][0]))
-        if rows[-1][0] > 0 and extra["bridge"][0] == 0:
+        extra = BridgeState.of(sim.contacts)
+        rows.append((-sim.contacts.overlap[0], sim.particles.force[1, 0], extra.state[0],
+                     extra.volume[0]))
+        if rows[-1][0] > 0 and extra.state[0] == 0:
             break
     return sim, np.array(rows)
 
@@ -108,18 +115,15 @@ def test_volume_controlled_pair_keeps_its_volume_and_ruptures_near_lian():
     exact = capillary.rupture_distance_for_volume(1.0, 0.0, volume / radius ** 3) * radius
     assert rupture_gap == pytest.approx(exact, abs=2e-7, rel=5e-3)
     assert rupture_gap == pytest.approx(volume ** (1 / 3), rel=0.03)     # Lian, theta = 0
-    # the suction of the bridge falls as it stretches (volume control)
-    extra = sim.contacts.extra
-    assert "bridge_suction" in extra
 
 
 def test_touching_pair_at_rest_has_the_capillary_equilibrium_overlap():
     """The capillary force acts on top of the contact spring: overlap = F_cap / kn."""
     radius = 1e-3
     sim = two_body_scene([[0, 0, 0], [2 * radius - 1e-7, 0, 0]], np.zeros((2, 3)), damping=0.5)
-    bridges = CapillaryBridges(1000.0, GAMMA).insert(sim)
+    bridges = add(sim, CapillaryBridges(1000.0, GAMMA))
     sim.run(15000)
-    force = sim.contacts.extra["bridge_force"][0]
+    force = BridgeState.of(sim.contacts).force[0]
     table = bridges.suction_table.lookup(1.0, 1000.0 * radius / GAMMA, 0.0)
     assert force == pytest.approx(table[1] * 2 * math.pi * GAMMA * radius, rel=1e-12)
     assert sim.contacts.overlap[0] == pytest.approx(force / (YOUNG * radius), rel=1e-4)
@@ -131,18 +135,18 @@ def test_touching_pair_at_rest_has_the_capillary_equilibrium_overlap():
 def test_toroidal_bridges_use_appendix_a_and_need_equal_spheres():
     radius = 1e-3
     sim = two_body_scene([[0, 0, 0], [2 * radius - 1e-7, 0, 0]], np.zeros((2, 3)))
-    CapillaryBridges(1000.0, GAMMA, contact_angle=20.0, model="toroidal").insert(sim)
+    add(sim, CapillaryBridges(1000.0, GAMMA, contact_angle=20.0, model="toroidal"))
     sim.advance()
-    extra = sim.contacts.extra
-    alpha = extra["filling_angle_i"][0]
+    extra = BridgeState.of(sim.contacts)
+    alpha = extra.filling_i[0]
     exact = capillary.toroidal_bridge(alpha, 20.0, 0.0)
     assert exact.suction_star == pytest.approx(1000.0 * radius / GAMMA, rel=1e-3)
-    assert extra["bridge_force"][0] == pytest.approx(exact.force * 2 * math.pi * GAMMA * radius,
-                                                     rel=1e-3)
-    assert extra["bridge_volume"][0] == pytest.approx(exact.volume * radius ** 3, rel=1e-3)
-    unequal = two_body_scene([[0, 0, 0], [2.1e-3, 0, 0]], np.zeros((2, 3)), radius=[1e-3, 1.1e-3])
+    assert extra.force[0] == pytest.approx(exact.force * 2 * math.pi * GAMMA * radius, rel=1e-3)
+    assert extra.volume[0] == pytest.approx(exact.volume * radius ** 3, rel=1e-3)
+    unequal = two_body_scene([[0, 0, 0], [2.1e-3, 0, 0]], np.zeros((2, 3)),
+                             radius=[1e-3, 1.1e-3], extra=[CapillaryBridges(1000.0, model="toroidal")])
     with pytest.raises(ValueError, match="equal spheres"):
-        CapillaryBridges(1000.0, model="toroidal").insert(unequal)
+        unequal.advance()
 
 
 @pytest.fixture(scope="module")
@@ -150,7 +154,7 @@ def wet_sample(small_sample):
     """The 300-sphere sample wetted at 30 kPa and run 300 steps (bridges formed, rebuilds)."""
     _, sim, _ = small_sample
     sim = copy.deepcopy(sim)
-    bridges = CapillaryBridges(30000.0, GAMMA).insert(sim)
+    bridges = add(sim, CapillaryBridges(30000.0, GAMMA))
     sim.run(300)
     return sim, bridges
 
@@ -175,8 +179,8 @@ def test_saturation_bridges_and_pendular_overlaps_against_hand_sums(wet_sample):
         i, j = c.pair_i[k], c.pair_j[k]
         branch = p.position[j] - p.position[i]
         branch /= np.linalg.norm(branch)
-        caps[i].append((branch, c.extra["filling_angle_i"][k]))
-        caps[j].append((-branch, c.extra["filling_angle_j"][k]))
+        caps[i].append((branch, BridgeState.of(c).filling_i[k]))
+        caps[j].append((-branch, BridgeState.of(c).filling_j[k]))
     expected = 0
     for items in caps.values():
         for a in range(len(items)):
@@ -202,7 +206,7 @@ def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_samp
     from dem.measure import unbalanced_force
     sim.run(30000, until=lambda s: unbalanced_force(s.particles, s.contacts) < 2e-4,
             check_every=500)
-    capillary_stress = bridges.capillary_stress(sim)
+    capillary_stress = capillary_force_stress(sim, bridges)
     total = contact_stress(sim.particles, sim.contacts, sim.walls) + capillary_stress
     walls = sim.walls.stress()
     assert np.all(np.diag(capillary_stress) < -2 * walls.mean())   # tensile, large at 30 kPa
@@ -222,8 +226,8 @@ def test_bridges_survive_rebuilds_and_thread_count_does_not_change_results(wet_s
         copied.run(200)
         runs.append(copied)
     assert np.array_equal(runs[0].particles.position, runs[1].particles.position)
-    assert np.array_equal(runs[0].contacts.extra["bridge_force"],
-                          runs[1].contacts.extra["bridge_force"])
+    assert np.array_equal(BridgeState.of(runs[0].contacts).force,
+                          BridgeState.of(runs[1].contacts).force)
 
 
 def test_extra_pair_arrays_are_carried_to_the_same_pair():
@@ -245,14 +249,33 @@ def test_extra_pair_arrays_are_carried_to_the_same_pair():
             assert new.extra["flag"][k] == 0 and not new.extra["vector"][k].any()
 
 
-def test_a_neighbour_list_too_short_for_persisting_bridges_is_refused():
+def test_the_neighbour_list_reaches_as_far_as_persisting_bridges_declare():
     radii = (1e-3, 1e-3)
     sim = two_body_scene([[0, 0, 0], [2e-3 - 1e-7, 0, 0]], np.zeros((2, 3)), radius=radii)
-    bridges = CapillaryBridges(2000.0, GAMMA, persist=True).insert(sim)
-    reach = sim.operation(NeighborList).interaction_range
-    assert reach == bridges.required_range > 0
-    sim.operation(NeighborList).interaction_range = 0.0
-    with pytest.raises(ValueError, match="interaction_range"):
+    sim.advance()
+    assert sim.neighbors.interaction_range == 0.0
+    rebuilds = sim.neighbors.rebuilds
+    bridges = add(sim, CapillaryBridges(2000.0, GAMMA, persist=True))
+    sim.advance()
+    assert sim.neighbors.interaction_range == bridges.required_range > 0
+    assert sim.neighbors.rebuilds == rebuilds + 1           # a new reach rebuilds the list
+    sim.forces.remove(bridges)
+    sim.advance()
+    assert sim.neighbors.interaction_range == 0.0
+
+
+class NegativeReach:
+    def reach(self, sim):
+        return -1.0
+
+    def apply(self, sim):
+        pass
+
+
+def test_a_force_declaring_a_negative_reach_is_refused():
+    sim = two_body_scene([[0, 0, 0], [2e-3 - 1e-7, 0, 0]], np.zeros((2, 3)),
+                         extra=[NegativeReach()])
+    with pytest.raises(ValueError, match="NegativeReach.reach"):
         sim.advance()
 
 
@@ -275,19 +298,17 @@ def test_suction_beyond_the_table_is_refused():
         bridges.load_tables(2.4e-5, 2.4e-5)
 
 
-def test_dry_scenario_never_imports_capillary(tmp_path):
-    code = ("import runpy, sys; sys.argv = ['triaxial.py', '--particles', '60', '--max-strain', "
-            f"'0.002', '--inertial-number', '2e-3', '--quiet', '--out', {str(tmp_path)!r}]; "
-            f"runpy.run_path({os.path.join(ROOT, 'scenarios', 'triaxial.py')!r}, "
-            "run_name='__main__'); "
-            "loaded = sorted(m for m in sys.modules if m.split('.')[0] == 'capillary'); "
-            "print('CAPILLARY', loaded)")
+def test_dry_triaxial_runs_no_capillary_physics(tmp_path):
+    """A dry scene pays only for what it uses: no bridge operation, no bridge kernel run."""
+    code = ("import sys; from pendular.cli import main; "
+            "main(['triaxial', '--particles', '60', '--max-strain', '0.002', "
+            f"'--inertial-number', '2e-3', '--quiet', '--out', {str(tmp_path)!r}], 'x'); "
+            "import capillary.bridge_kernels as k; "
+            "ran = [n for n in ('contact_bridges', 'suction_bridges', 'volume_bridges', "
+            "'gather_contact_bridges') if getattr(k, n).signatures]; "
+            "print('RAN', ran)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    loaded = done.stdout[done.stdout.index("CAPILLARY"):].strip()
-    assert loaded == "CAPILLARY []", (
-        f"a dry triaxial run loaded the capillary package ({loaded}); the dry path imports "
-        "dem.*, homogenize.contact_stress and homogenize.fabric, none of which may import "
-        "capillary at module level (homogenize/__init__.py loads every submodule)")
+    assert "RAN []" in done.stdout, done.stdout
 
 
 def test_wet_triaxial_scenario_writes_the_capillary_history(wet_triaxial_run):
@@ -330,22 +351,22 @@ def test_rough_contact_bridge_is_the_exact_bridge_at_the_roughness_separation():
     radius, roughness, surface_tension = 1e-4, 0.09, 0.073
     sim = two_body_scene([[0.0, 0.0, 0.0], [2 * radius * (1 - 1e-6), 0.0, 0.0]],
                          [[0.0] * 3] * 2, radius=radius)
-    bridges = CapillaryBridges(5000.0, surface_tension, control="volume",
-                               roughness=roughness).insert(sim)
+    bridges = add(sim, CapillaryBridges(5000.0, surface_tension, control="volume",
+                               roughness=roughness))
     sim.run(1)
-    extra = sim.contacts.extra
+    extra = BridgeState.of(sim.contacts)
     assert bridges.count(sim) == 1
-    suction_star = extra["bridge_suction"][0] * radius / surface_tension
-    exact = capillary.solve_bridge(1.0, 0.0, suction_star, extra["filling_angle_i"][0])
+    suction_star = extra.suction[0] * radius / surface_tension
+    exact = capillary.solve_bridge(1.0, 0.0, suction_star, extra.filling_i[0])
     assert exact.distance == pytest.approx(roughness, abs=2e-3)
-    assert extra["bridge_volume"][0] / radius**3 == pytest.approx(exact.volume, rel=2e-3)
-    force_star = extra["bridge_force"][0] / (2 * math.pi * surface_tension * radius)
+    assert extra.volume[0] / radius**3 == pytest.approx(exact.volume, rel=2e-3)
+    force_star = extra.force[0] / (2 * math.pi * surface_tension * radius)
     assert force_star == pytest.approx(exact.force, rel=2e-3)
     smooth = two_body_scene([[0.0, 0.0, 0.0], [2 * radius * (1 - 1e-6), 0.0, 0.0]],
                             [[0.0] * 3] * 2, radius=radius)
-    CapillaryBridges(5000.0, surface_tension, control="volume").insert(smooth)
+    add(smooth, CapillaryBridges(5000.0, surface_tension, control="volume"))
     smooth.run(1)
-    assert extra["bridge_force"][0] < 0.95 * smooth.contacts.extra["bridge_force"][0]
+    assert extra.force[0] < 0.95 * BridgeState.of(smooth.contacts).force[0]
 
 
 def test_roughness_needs_volume_control():

@@ -13,7 +13,9 @@ import pytest
 
 from dem.contact_law import ContactForces
 from dem.neighbors import NeighborList
-from dem.simulation import ForceReset, Simulation
+from capillary import BridgeState, CapillaryBridges
+from dem.integrate import Integrator
+from dem.simulation import Simulation
 from dem.state import Particles, Walls
 from homogenize import (
     bridges_in_region,
@@ -39,23 +41,22 @@ def lattice(packing, radius=RADIUS, cells=BLOCK):
     position = np.concatenate([(corners + site) * packing.cell_size * radius for site in basis])
     particles = Particles(position, np.full(len(position), radius * (1.0 + 1e-12)), 2650.0)
     walls = Walls.box(position.min(axis=0) - 2 * radius, position.max(axis=0) + 2 * radius)
-    sim = Simulation(particles, walls, 1e-9, [ForceReset(), NeighborList(0.1 * radius),
-                                              ContactForces(1e6, 0.3, 18.0)])
-    for op in sim.operations:
-        op.apply(sim)
+    sim = Simulation(particles, walls, 1e-9, neighbors=NeighborList(0.1 * radius),
+                     forces=[ContactForces(1e6, 0.3, 18.0)], integrator=Integrator(0.0))
+    sim.evaluate_forces()
     return sim
 
 
 def wet_with(sim, state):
     """One bridge per contact with the unit cell's bridge (filling angle, volume, force), in the
-    per-pair arrays that capillary.coupling.CapillaryBridges keeps."""
+    per-pair BridgeState that capillary.CapillaryBridges keeps."""
     touching = sim.contacts.overlap > 0.0
-    extra = sim.contacts.extra
-    extra["bridge"] = touching.astype(np.int8)
-    extra["bridge_volume"] = np.where(touching, state.bridge_volume, 0.0)
-    extra["bridge_force"] = np.where(touching, state.bridge_force, 0.0)
-    extra["filling_angle_i"] = np.where(touching, state.filling_angle, 0.0)
-    extra["filling_angle_j"] = np.where(touching, state.filling_angle, 0.0)
+    bridges = BridgeState.of(sim.contacts)
+    bridges.state[:] = touching
+    bridges.volume[:] = np.where(touching, state.bridge_volume, 0.0)
+    bridges.force[:] = np.where(touching, state.bridge_force, 0.0)
+    bridges.filling_i[:] = np.where(touching, state.filling_angle, 0.0)
+    bridges.filling_j[:] = np.where(touching, state.filling_angle, 0.0)
     return touching
 
 
@@ -114,14 +115,12 @@ def test_lattice_homogenised_on_the_fly_equals_the_unit_cell(kind, l_prime, cont
 def test_lattice_wetted_by_the_capillary_operation_matches_the_unit_cell():
     """The same FCP lattice wetted by CapillaryBridges itself (table lookup at contact, filling
     angles stored per particle): the unit cell's chi, B, psi to the table's accuracy."""
-    from capillary.coupling import CapillaryBridges
-
     packing = regular_packing("fcp")
     state = packing_state(packing, radius=RADIUS, contact_angle=0.0, surface_tension=GAMMA,
                           suction=SUCTION)
     sim = lattice(packing)
     bridges = CapillaryBridges(SUCTION, GAMMA)
-    bridges.insert(sim)
+    sim.forces.append(bridges)
     bridges.apply(sim)
     assert bridges.count(sim) == np.count_nonzero(sim.contacts.overlap > 0.0)
     mask, volume = representative_volume(sim, packing)
@@ -149,7 +148,7 @@ def test_per_bridge_suctions_reduce_to_chi_s_plus_b_and_input_is_checked():
     # bridges of half the suction: the suction terms halve, B stays
     half = homogenize_bridges(*args, suction=np.full(len(touching), 0.5 * SUCTION), **common)
     assert half.psi == pytest.approx(0.5 * SUCTION * uniform.chi + uniform.B, rel=1e-13)
-    sim.contacts.extra["bridge"][0] = 0
+    BridgeState.of(sim.contacts).state[0] = 0
     with pytest.raises(ValueError, match="1 pair.* without a bridge"):
         homogenize_bridges(*args, suction=SUCTION, mask=touching, **common)
     with pytest.raises(ValueError, match="mask has shape"):
@@ -172,18 +171,17 @@ def test_recorder_columns_follow_the_bridge_operation_volume_control_included():
     control), caches one evaluation per record and survives a deep copy of the simulation."""
     import copy
 
-    from capillary.coupling import CapillaryBridges
-    from homogenize import CapillaryHomogenization, capillary_quantities
+    from homogenize import CapillaryHomogenization
 
     packing = regular_packing("bcc")
     for control in ("suction", "volume"):
         sim = lattice(packing, cells=3)
-        bridges = CapillaryBridges(SUCTION, GAMMA, contact_angle=0.0, control=control).insert(sim)
+        bridges = CapillaryBridges(SUCTION, GAMMA, contact_angle=0.0, control=control)
+        sim.forces.append(bridges)
         bridges.apply(sim)
-        columns = capillary_quantities(sim.operations)
-        assert set(columns) == {"chi", "B", "psi", "sigma_effective", "fabric_bridges",
-                                "anisotropy_bridges", "a_psi"}
-        own = sim.contacts.extra["bridge_suction"] if control == "volume" else SUCTION
+        columns = CapillaryHomogenization(bridges).quantities()
+        assert set(columns) == set(CAPILLARY_COLUMNS)
+        own = BridgeState.of(sim.contacts).suction if control == "volume" else SUCTION
         expected = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(), suction=own,
                                       contact_angle=0.0, surface_tension=GAMMA)
         assert np.array_equal(columns["psi"](sim), expected.psi)
@@ -197,7 +195,6 @@ def test_recorder_columns_follow_the_bridge_operation_volume_control_included():
         assert homogenization.evaluate(sim) is homogenization.evaluate(sim)      # cached
         copied = copy.deepcopy({"sim": sim, "columns": columns})
         assert copied["columns"]["chi"].__self__.bridges is copied["sim"].operation(CapillaryBridges)
-    assert capillary_quantities(sim.operations[:-1]) == {}     # without the bridge operation
 
 
 CAPILLARY_COLUMNS = ("chi", "B", "psi", "sigma_effective", "fabric_bridges", "anisotropy_bridges",
@@ -206,13 +203,9 @@ CAPILLARY_COLUMNS = ("chi", "B", "psi", "sigma_effective", "fabric_bridges", "an
 
 
 def test_dry_history_has_no_capillary_columns(tmp_path):
-    code = ("import runpy, sys; sys.argv = ['triaxial.py', '--particles', '60', '--max-strain', "
-            f"'0.002', '--inertial-number', '2e-3', '--quiet', '--out', {str(tmp_path)!r}]; "
-            f"runpy.run_path({os.path.join(ROOT, 'scenarios', 'triaxial.py')!r}, "
-            "run_name='__main__'); "
-            "print('CAPILLARY', sorted(m for m in sys.modules if m.split('.')[0] == 'capillary'))")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert done.stdout[done.stdout.index("CAPILLARY"):].strip() == "CAPILLARY []"
+    subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"),
+                    "--particles", "60", "--max-strain", "0.002", "--inertial-number", "2e-3",
+                    "--quiet", "--out", str(tmp_path)], capture_output=True, text=True, check=True)
     with h5py.File(tmp_path / "history.h5") as handle:
         history = handle["history"]
         assert not set(CAPILLARY_COLUMNS) & set(history)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import capillary
-from capillary.coupling import CapillaryBridges
+from capillary import CapillaryBridges
 from capillary.table import BridgeTable
 from capillary.toroidal_table import toroidal_table
 from capillary.validation import check_filling_angle, check_radius_ratio, check_suction
@@ -21,7 +21,7 @@ from dem.record import HistoryRecorder
 from dem.sample import load_sample
 from dem.simulation import Simulation
 from dem.state import Particles, Walls
-from dem.vtk import VtkWriter
+from pendular.vtk import VtkWriter
 from dem.walls import StressServo
 from dem.yade_io import read_plot_data, read_spheres, write_spheres
 from homogenize import (capillary_stress, contact_line_integral, fabric_tensor,
@@ -29,6 +29,8 @@ from homogenize import (capillary_stress, contact_line_integral, fabric_tensor,
 
 NAN = float("nan")
 ONE = np.zeros((1, 3))
+#: The neighbour list and integrator every Simulation needs (not under test here).
+PIPELINE = {"neighbors": NeighborList(1e-4), "integrator": Integrator(0.0)}
 
 
 def scene():
@@ -77,8 +79,6 @@ CASES = {
     "cloud count": (lambda: random_cloud(1000, 0.1, [0, 0, 0], [1, 1, 1], 0), "particles"),
     # operations and the simulation
     "skin": (lambda: NeighborList(0.0), "skin"),
-    "interaction_range": (lambda: NeighborList(1e-4, interaction_range=-1.0),
-                          "interaction_range"),
     "contact young": (lambda: ContactForces(-1.0), "young"),
     "shear_ratio": (lambda: ContactForces(1e6, shear_ratio=11.0), "shear_ratio"),
     "contact friction": (lambda: ContactForces(1e6, friction_deg=95.0), "friction"),
@@ -87,14 +87,14 @@ CASES = {
     "pwave radius": (lambda: pwave_timestep([-1e-3], 1e6, 2650.0), "radius"),
     "servo target": (lambda: StressServo("xyz", -1.0, 1.0), "target stress"),
     "servo axes": (lambda: StressServo("xw", 1.0, 1.0), "axes"),
-    "dt": (lambda: Simulation(Particles(ONE, [1e-3], 1.0), Walls.box([-1] * 3, [1] * 3), 0.0),
-           "dt"),
+    "dt": (lambda: Simulation(Particles(ONE, [1e-3], 1.0), Walls.box([-1] * 3, [1] * 3), 0.0,
+                              **PIPELINE), "dt"),
     "threads": (lambda: Simulation(Particles(ONE, [1e-3], 1.0), Walls.box([-1] * 3, [1] * 3),
-                                   1.0, threads=0), "threads"),
+                                   1.0, threads=0, **PIPELINE), "threads"),
     "simulation particles": (lambda: Simulation(np.zeros((1, 3)), Walls.box([-1] * 3, [1] * 3),
-                                                1.0), "particles"),
+                                                1.0, **PIPELINE), "particles"),
     "operation": (lambda: Simulation(Particles(ONE, [1e-3], 1.0), Walls.box([-1] * 3, [1] * 3),
-                                     1.0, operations=[object()]), "operation"),
+                                     1.0, forces=[object()], **PIPELINE), "operation"),
     "run steps": (lambda: scene().run(-1), "steps"),
     "record period": (lambda: HistoryRecorder(0, {}), "record period"),
     "record quantity": (lambda: HistoryRecorder(1, {"x": 3.0}), "quantities['x']"),
@@ -117,8 +117,8 @@ CASES = {
         lambda: CapillaryBridges(10.0).load_tables(2.4e-5, 2.4e-5), "suction"),
     "bridge radii": (lambda: CapillaryBridges(1e4).load_tables(-1.0, 1.0), "smallest radius"),
     "bridges on soft spheres": (
-        lambda: CapillaryBridges(1e4).insert(two_body_scene([[0, 0, 0], [2e-6, 0, 0]],
-                                                            np.zeros((2, 3)), radius=1e-6)),
+        lambda: two_body_scene([[0, 0, 0], [2e-6, 0, 0]], np.zeros((2, 3)), radius=1e-6,
+                               extra=[CapillaryBridges(1e4)]).advance(),
         "young"),
     "table contact_angle": (lambda: BridgeTable.build(95.0, radius_ratios=(1.0,), n_suction=3,
                                                       n_distance=3), "contact_angle"),

@@ -1,4 +1,4 @@
-"""ParaView series written by dem.vtk.VtkWriter, read back with meshio (and as XML)."""
+"""ParaView series written by pendular.vtk.VtkWriter, read back with meshio (and as XML)."""
 
 import copy
 import os
@@ -10,7 +10,8 @@ import pytest
 
 from conftest import two_body_scene
 from dem.preparation import PrepareConfig, prepare_sample
-from dem.vtk import VtkWriter
+from capillary import BridgeState
+from pendular.vtk import VtkWriter
 
 
 @pytest.fixture(scope="module")
@@ -111,17 +112,18 @@ def test_dry_scene_writes_an_empty_valid_bridge_file(prepared, tmp_path):
     assert read_pvd(tmp_path / "bridges.pvd") == [(sim.time, path.name)]
 
 
-def test_bridges_from_contacts_extra_are_lines_with_their_data(prepared, tmp_path):
+def test_bridges_are_lines_with_their_data(prepared, tmp_path):
     sim = copy.deepcopy(prepared)
     sim.run(1)
     c = sim.contacts
     touching = np.flatnonzero(c.overlap > 0)
     chosen = touching[[0, len(touching) // 2]]
-    bridge = np.zeros(len(c), bool)
-    bridge[chosen] = True
-    c.extra.update({"bridge": bridge, "bridge_force": np.arange(len(c), dtype=float) * 1e-6,
-                    "bridge_volume": np.arange(len(c), dtype=float) * 1e-15,
-                    "delta1": np.full(len(c), 20.0), "delta2": np.full(len(c), 15.0)})
+    bridges = BridgeState.of(c)
+    bridges.state[chosen] = 1
+    bridges.force[:] = np.arange(len(c), dtype=float) * 1e-6
+    bridges.volume[:] = np.arange(len(c), dtype=float) * 1e-15
+    bridges.filling_i[:] = 20.0            # equal spheres: delta1 on pair_i
+    bridges.filling_j[:] = 15.0
     writer = VtkWriter(tmp_path, period=1)
     writer.apply(sim)
     mesh = meshio.read(tmp_path / f"bridges_{sim.step:06d}.vtu")
@@ -148,10 +150,12 @@ def test_filling_angles_of_the_capillary_operation_are_sorted_by_radius(tmp_path
     sim.run(1)
     c = sim.contacts
     assert list(zip(c.pair_i, c.pair_j)) == [(0, 1), (1, 2)] and np.all(c.overlap > 0)
-    c.extra.update({"bridge": np.array([1, 1], np.int8), "bridge_force": np.array([1e-5, 2e-5]),
-                    "bridge_volume": np.array([1e-12, 2e-12]),
-                    "filling_angle_i": np.array([10.0, 30.0]),
-                    "filling_angle_j": np.array([25.0, 12.0])})
+    bridges = BridgeState.of(c)
+    bridges.state[:] = 1
+    bridges.force[:] = [1e-5, 2e-5]
+    bridges.volume[:] = [1e-12, 2e-12]
+    bridges.filling_i[:] = [10.0, 30.0]
+    bridges.filling_j[:] = [25.0, 12.0]
     VtkWriter(tmp_path, period=1).apply(sim)
     mesh = meshio.read(tmp_path / f"bridges_{sim.step:06d}.vtu")
     # pair (0, 1): sphere 1 is the smaller; pair (1, 2): sphere 1 again
@@ -159,9 +163,27 @@ def test_filling_angles_of_the_capillary_operation_are_sorted_by_radius(tmp_path
     assert np.array_equal(mesh.cell_data["delta2"][0], [10.0, 12.0])
     counts = meshio.read(tmp_path / f"particles_{sim.step:06d}.vtu").point_data["bridges"]
     assert np.array_equal(counts, [1, 2, 1])
-    from capillary.coupling import PAIR_ARRAYS      # the names read here are the operation's
-    assert {"bridge", "bridge_force", "bridge_volume", "filling_angle_i",
-            "filling_angle_j"} <= set(PAIR_ARRAYS)
+
+
+def test_contact_network_series_and_strain_field_data(prepared, tmp_path):
+    """contacts.pvd: one line per touching pair with its normal and shear force; every frame
+    carries its step, time and the writer's field data (e.g. the axial strain)."""
+    sim = copy.deepcopy(prepared)
+    sim.run(1)
+    VtkWriter(tmp_path, period=1, field_data=lambda s: {"axial_strain": 0.0125}).apply(sim)
+    mesh = meshio.read(tmp_path / f"contacts_{sim.step:06d}.vtu")
+    c = sim.contacts
+    touching = np.flatnonzero(c.overlap > 0)
+    assert mesh.cells[0].type == "line" and len(mesh.cells[0].data) == len(touching)
+    assert np.array_equal(mesh.cell_data["normal_force"][0], c.normal_force[touching])
+    assert np.allclose(mesh.cell_data["shear_force"][0],
+                       np.linalg.norm(c.shear_force[touching], axis=1))
+    assert not mesh.cell_data["bridge"][0].any()
+    root = ElementTree.parse(tmp_path / f"contacts_{sim.step:06d}.vtu").getroot()
+    fields = {array.get("Name"): float(array.text)
+              for array in root.find("UnstructuredGrid/FieldData")}
+    assert fields == {"step": sim.step, "time": sim.time, "axial_strain": 0.0125}
+    assert read_pvd(tmp_path / "contacts.pvd") == [(sim.time, f"contacts_{sim.step:06d}.vtu")]
 
 
 def test_writer_input_is_checked(tmp_path):

@@ -139,10 +139,19 @@ class CapillaryBridges:
     def reach(self, sim):
         """Largest gap [m] at which a bridge of this operation may exist (0 unless bridges
         persist): the neighbour list holds every pair closer than that."""
-        if sim.contacts is not None and sim.contacts is self._contacts:
-            return self.required_range        # radii change only with a rebuild
-        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
+        if sim.contacts is None or sim.contacts is not self._contacts:
+            self._prepare(sim)                # radii change only with a rebuild
         return self.required_range
+
+    def _prepare(self, sim):
+        """Check the contact stiffness against the bridges (once) and load the tables for the
+        scene's radii."""
+        if not self._checked_stiffness:
+            for contact_law in (op for op in sim.forces if isinstance(op, ContactForces)):
+                check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
+                                       self.surface_tension)
+            self._checked_stiffness = True
+        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
 
     def load_tables(self, low, high):
         """Check the input against spheres of radii in [low, high] [m] and load (or build and
@@ -225,12 +234,7 @@ class CapillaryBridges:
         list."""
         if sim.contacts is self._contacts:
             return
-        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
-        if not self._checked_stiffness:
-            for contact_law in (op for op in sim.forces if isinstance(op, ContactForces)):
-                check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
-                                       self.surface_tension)
-            self._checked_stiffness = True
+        self._prepare(sim)
         self._attach(sim)
 
     def apply(self, sim):

@@ -416,7 +416,8 @@ class _ShearRun:
         if self.vtk_period > 0:
             axial = self.shear.axial
             self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
-                                 field_data=lambda s: {"axial_strain": axial.strain(s.walls)})
+                                 field_data=lambda s: {"axial_strain": axial.strain(s.walls)},
+                                 time_axis=lambda s: 100.0 * axial.strain(s.walls))
             sim.writers.append(self.vtk)
         self.checkpoint = None
         if config.checkpoint_every > 0:

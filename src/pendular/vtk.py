@@ -3,7 +3,7 @@
 ``VtkWriter(folder, period)`` is a writer: on its first call and then every ``period`` steps it
 writes, each file under a temporary name then renamed (a killed run never leaves a truncated
 file), four series indexed by ParaView collection files whose ``timestep`` is the simulation
-time [s]:
+time [s] or the writer's ``time_axis`` (the triaxial test: axial strain in %):
 
 ``particles.pvd`` / ``particles_NNNNNN.vtu`` (NNNNNN: the step), one VTK vertex per sphere,
 point data (SI units):
@@ -52,13 +52,30 @@ from dem.validate import check_int
 SERIES = ("particles", "walls", "bridges", "contacts")
 
 
-def write_vtu(path, mesh, compression="zlib"):
-    """Write a meshio mesh as VTK XML unstructured grid, atomically. Meshes without cells are
-    written uncompressed (VTK's empty compressed arrays are not read back by every reader)."""
+def write_vtu(path, mesh, compression="zlib", field_data=None):
+    """Write a meshio mesh as VTK XML unstructured grid, atomically, with ``field_data`` (name ->
+    number, VTK FieldData: meshio's writer drops field data). Meshes without cells are written
+    uncompressed (VTK's empty compressed arrays are not read back by every reader)."""
     if not any(len(block.data) for block in mesh.cells):
         compression = None
     with replacing(path) as temporary:
         meshio.write(temporary, mesh, file_format="vtu", compression=compression)
+        if field_data:
+            _insert_field_data(temporary, field_data)
+
+
+def _insert_field_data(path, field_data):
+    """Add a <FieldData> block of float64 scalars to the VTU file ``path``."""
+    arrays = "".join(f'<DataArray type="Float64" Name={quoteattr(name)} NumberOfTuples="1" '
+                     f'format="ascii">{float(value)!r}</DataArray>\n'
+                     for name, value in field_data.items())
+    with open(path, "rb") as handle:
+        text = handle.read()
+    marker = b"<UnstructuredGrid>"
+    text = text.replace(marker, marker + b"\n<FieldData>\n" + arrays.encode() + b"</FieldData>",
+                        1)
+    with open(path, "wb") as handle:
+        handle.write(text)
 
 
 def write_pvd(path, frames):
@@ -183,15 +200,17 @@ class VtkWriter:
 
     Writes on its first call and then whenever ``sim.step % period == 0``; the .pvd index files
     are rewritten with every frame (so that a killed run leaves a usable series) and by
-    ``close()``. ``frames`` lists (step, time [s]) of the frames written. ``compression``:
+    ``close()``. ``frames`` lists (step, time axis value) of the frames written. ``compression``:
     "zlib" (default) or None (larger files, about 10x faster to write). Every file's field data
     holds ``step``, ``time`` [s] and what ``field_data(sim)`` returns (name -> number, e.g. the
-    axial strain of a triaxial test).
+    axial strain of a triaxial test); ``time_axis(sim)``, if given, is the .pvd ``timestep``
+    instead of the time (e.g. the axial strain in %, ParaView's time slider then in strain).
     """
 
-    def __init__(self, folder, period, compression="zlib", field_data=None):
+    def __init__(self, folder, period, compression="zlib", field_data=None, time_axis=None):
         self.folder = os.fspath(folder)
         self.field_data = field_data
+        self.time_axis = time_axis
         self.period = check_int("vtk period", period, low=1)
         if compression not in ("zlib", "lzma", None):
             raise ValueError(f"compression = {compression!r} is not one of 'zlib', 'lzma', None")
@@ -209,15 +228,14 @@ class VtkWriter:
             return
         meshes = {"particles": particle_mesh(sim), "walls": wall_mesh(sim.walls),
                   "bridges": bridge_mesh(sim), "contacts": contact_mesh(sim)}
-        fields = {"step": np.array([sim.step], np.int64), "time": np.array([sim.time])}
+        fields = {"step": sim.step, "time": sim.time}
         if self.field_data is not None:
-            fields.update({k: np.atleast_1d(np.asarray(v, np.float64))
-                           for k, v in self.field_data(sim).items()})
+            fields.update(self.field_data(sim))
         for series, mesh in meshes.items():
-            mesh.field_data.update(fields)
             write_vtu(os.path.join(self.folder, self.file_name(series, sim.step)), mesh,
-                      self.compression)
-        self.frames.append((int(sim.step), float(sim.time)))
+                      self.compression, fields)
+        self.frames.append((int(sim.step),
+                            float(sim.time if self.time_axis is None else self.time_axis(sim))))
         self.close()
 
     def file_name(self, series, step):

@@ -115,7 +115,7 @@ def table_resolution(text):
 
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
-    check_range("suction", args.suction, 0.0, unit="Pa")
+    check_range("--suction", args.suction, 0.0, unit="Pa")
     wet_only = {"--contact-angle": args.contact_angle is not None,
                 "--table-resolution": args.table_resolution is not None,
                 "--bridges": args.bridges is not None,
