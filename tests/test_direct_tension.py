@@ -1,22 +1,25 @@
-"""scenarios/direct_tension.py and dem.tension: wetting to a water content, grips, strength."""
+"""The direct-tension test (pendular.tension, dem.tension, capillary.wetting): wetting to a
+water content, grips, strength, and its command line."""
 
 import copy
+import dataclasses
+import json
 import math
 import os
+import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from capillary.table import BridgeTable
+from capillary import BridgeTable, formation_suction
+from dem.measure import unbalanced_force
 from dem.preparation import prepare_sample
 from dem.state import Particles, Walls
-from dem.tension import Grip, formation_suction, grip_members
+from dem.tension import Grip, grip_members
+from pendular import tension as direct_tension
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "scenarios"))
-import direct_tension  # noqa: E402
-
 GAMMA = 0.074
 WATER = 0.0104       # Kim's middle water content (fraction)
 TINY = ["--particles", "200", "--max-strain", "0.03", "--vtk-frames", "0", "--quiet"]
@@ -29,7 +32,7 @@ def table():
 
 @pytest.fixture(scope="module")
 def args():
-    return direct_tension.parse_args(TINY)
+    return direct_tension.TensionConfig(particles=200, max_strain=0.03, vtk_frames=0)
 
 
 @pytest.fixture(scope="module")
@@ -89,10 +92,10 @@ def test_grip_pull_equals_the_force_across_a_plane(wetted, args, tmp_path):
     carried across the mid-height plane by contact and capillary forces."""
     sim = copy.deepcopy(wetted[0])
     bridges = sim.operation(type(wetted[1]))
-    pull = direct_tension.Pull(sim, bridges, args, str(tmp_path))
+    pull = direct_tension.Pull(sim, bridges, args, str(tmp_path), progress=False)
     sim.run(int(0.01 / (pull.rate * sim.dt)))
     pull.extension.rate = 0.0
-    sim.run(20000, until=lambda s: direct_tension.unbalanced_force(s.particles, s.contacts)
+    sim.run(20000, until=lambda s: unbalanced_force(s.particles, s.contacts)
             < 1e-3, check_every=200)
     walls = sim.walls
     tension = -_force_on_upper_part(sim, bridges, 0.5 * (walls.lo[2] + walls.hi[2]))
@@ -106,8 +109,8 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     """Rumpf (1962): sigma_t = (1 - n) k F / (pi d^2), k bridges per particle, F the force of
     a bridge at contact, its menisci args.roughness R apart (computed here from the table, not
     by the scenario)."""
-    _, dry_history = direct_tension.Pull(copy.deepcopy(dry), None, args,
-                                         str(tmp_path / "dry")).run(None)
+    _, dry_history = direct_tension.Pull(copy.deepcopy(dry), None, args, str(tmp_path / "dry"),
+                                  progress=False).run(None)
     sim = copy.deepcopy(wetted[0])
     bridges = sim.operation(type(wetted[1]))
     count = bridges.count(sim)
@@ -117,7 +120,8 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     force = (table.lookup(1.0, bridges.suction * radius / GAMMA, args.roughness)[1]
              * 2.0 * math.pi * GAMMA * radius)
     rumpf = (1.0 - porosity) * (2.0 * count / len(particles)) * force / (math.pi * 4 * radius ** 2)
-    _, history = direct_tension.Pull(sim, bridges, args, str(tmp_path / "wet")).run(None)
+    _, history = direct_tension.Pull(sim, bridges, args, str(tmp_path / "wet"),
+                              progress=False).run(None)
     wet_strength = float(np.max(history["tensile_stress"]))
     dry_strength = float(np.max(dry_history["tensile_stress"]))
     assert dry_strength < 0.01 * rumpf
@@ -136,17 +140,32 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     (["--residual", "1.5"], "--residual = 1.5 is outside"),
     (["--void-ratio", "0.7,x"], "--void-ratio = '0.7,x' is not a comma-separated list"),
 ])
-def test_bad_inputs_are_refused_by_name(arguments, message, capsys):
-    with pytest.raises(SystemExit):
-        direct_tension.parse_args(TINY + arguments)
-    assert message in capsys.readouterr().err
+def test_bad_inputs_are_refused_by_name(arguments, message):
+    result = subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
+                             *TINY, *arguments, "--out", os.devnull], capture_output=True,
+                            text=True)
+    assert result.returncode == 2
+    assert message in result.stderr and "Traceback" not in result.stderr
+    assert result.stderr.count("error:") == 1
 
 
 def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
-    dense = copy.copy(args)
-    dense.particles = 100
+    dense = dataclasses.replace(args, particles=100)
     with pytest.raises(ValueError, match=r"--void-ratio = 0.52 is outside the valid range"):
         direct_tension.prepare_void_ratio(dense, 0.52, progress=False)
+
+
+def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
+    out = tmp_path / "tension"
+    subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
+                    "--particles", "200", "--void-ratio", "0.65", "--water-content", "1",
+                    "--max-strain", "0.01", "--vtk-frames", "0", "--quiet", "--out", str(out)],
+                   check=True, capture_output=True, text=True)
+    result = json.loads((out / "tension.json").read_text())
+    (case,) = result["cases"]
+    assert case["tensile_strength_pa"] > 0.0 and case["water_content"] == pytest.approx(
+        0.01, rel=direct_tension.WATER_TOLERANCE)
+    assert (out / "report.md").exists() and (out / "cases" / case["case"] / "history.h5").exists()
 
 
 def test_grips_take_every_particle_touching_their_wall():
