@@ -1,4 +1,5 @@
-"""scenarios/chapter5.py: a small campaign (2 suctions x 2 confining stresses, 2 processes)."""
+"""The Chapter 5 campaign (pendular.chapter5, pendular.campaign) through its command line:
+2 suctions x 2 confining stresses, 2 processes; reuse; a Dask cluster."""
 
 import json
 import math
@@ -83,8 +84,7 @@ def test_campaign_figures(campaign):
 
 
 def test_directional_value_of_a_tensor_is_its_quadratic_form():
-    sys.path.insert(0, os.path.dirname(SCENARIO))
-    from chapter5_figures import directional
+    from pendular.chapter5_figures import directional
 
     tensor = np.array([[2.0, 0.0, 0.5], [0.0, 7.0, 0.0], [0.5, 0.0, 3.0]])
     angles = np.linspace(0.0, 2 * np.pi, 13)

@@ -1,6 +1,6 @@
 """Figures of a Chapter 5 campaign (thesis Figs. 5.3–5.8) from its runs' histories.
 
-Every function takes the campaign's ``runs`` rows (scenarios/chapter5.py) or the histories
+Every function takes the campaign's ``runs`` rows (pendular.chapter5) or the histories
 read by ``load_histories`` and writes one PNG. Stresses in the histories are compression
 positive [Pa]; the figures show kPa where the thesis does.
 """
@@ -11,8 +11,9 @@ import os
 import h5py
 import numpy as np
 
-from dem.figures import pyplot, save_figure
 from homogenize.fabric import principal_anisotropy
+
+from .plots import pyplot, save_figure
 
 #: History columns the figures use (the rest of a history is not read).
 COLUMNS = ("axial_strain", "volumetric_strain", "sigma_wall", "sigma_effective", "psi",
