@@ -1,4 +1,5 @@
-"""scenarios/tradeoff.py: the quick grid runs and its table is consistent with its runs."""
+"""The trade-off study (pendular.tradeoff) through scenarios/tradeoff.py: the quick grid runs and
+its table is consistent with its runs."""
 
 import json
 import math
@@ -24,8 +25,7 @@ def tradeoff(tmp_path_factory):
 
 def test_rows_cover_the_quick_knobs(tradeoff):
     _, data = tradeoff
-    sys.path.insert(0, os.path.dirname(SCENARIO))
-    from tradeoff import QUICK_KNOBS, USES
+    from pendular.tradeoff import QUICK_KNOBS, USES
 
     assert [(r["knob"], r["value"]) for r in data["rows"]] == [
         (knob, value) for knob, values in QUICK_KNOBS.items() for value in values] + [
@@ -61,7 +61,7 @@ def test_combined_rows_take_each_knobs_cheapest_setting_within_the_bound(tradeof
     """Each knob's setting in a combined row is within the bound, and no setting within it is
     both cheaper (beyond the tie factor) or as cheap and more accurate."""
     _, data = tradeoff
-    from tradeoff import TIME_TIE, USES
+    from pendular.tradeoff import TIME_TIE, USES
 
     knobs = [r for r in data["rows"] if r["knob"] != "combined"]
     for use, bound in USES.items():
@@ -82,3 +82,14 @@ def test_report_and_plot(tradeoff):
     text = (out / "tradeoff.md").read_text()
     assert "Paper figure" in text and "Quick look" in text
     assert (out / "tradeoff.png").stat().st_size > 0
+
+
+def test_runs_are_configured_with_dataclasses_not_option_strings(tmp_path):
+    from pendular.tradeoff import DEFAULTS, REFERENCE, Study, configure
+
+    study = Study(out=str(tmp_path), particles=300)
+    reference = configure(study, REFERENCE, 300)
+    assert reference.sample.timestep_safety == 0.35 and reference.shear.inertial_number == 1e-4
+    assert reference.bridges.table_resolution == (700, 160) and reference.bridges.suction == 3e4
+    default = configure(study, DEFAULTS, 300)
+    assert default.sample.particles == 300 and default.shear.max_strain == 0.15
