@@ -1,31 +1,25 @@
-"""The --quick extremes grid (scenarios/extremes.py): no case fails, refusals name the
-parameter, the JSON report is complete."""
+"""The --quick extremes grid (pendular.extremes): no case fails, refusals name the parameter,
+the JSON report is complete; and the command line."""
 
-import importlib.util
 import json
 import math
 import os
+import subprocess
+import sys
+
+from pendular import extremes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def load_extremes():
-    spec = importlib.util.spec_from_file_location(
-        "extremes", os.path.join(ROOT, "scenarios", "extremes.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_quick_grid_has_no_failed_case_and_writes_the_report(tmp_path, capsys):
-    extremes = load_extremes()
-    status = extremes.main(["--out", str(tmp_path), "--quick"])
+    counts = extremes.run_grid(str(tmp_path), quick=True)
     report = json.loads((tmp_path / "extremes.json").read_text())
     cases = report["cases"]
     failed = [(c["parameter_varied"], c["value"], c["message"]) for c in cases
               if c["status"] == "failed"]
-    assert not failed and status == 0
-    assert report["counts"]["failed"] == 0
+    assert not failed and counts["failed"] == 0
+    assert report["counts"] == counts
     assert sum(report["counts"].values()) == len(cases) == len(extremes.cases(quick=True))
     assert report["counts"]["ok"] > 0 and report["counts"]["refused"] > 0
     for case in cases:
@@ -46,3 +40,9 @@ def test_quick_grid_has_no_failed_case_and_writes_the_report(tmp_path, capsys):
     assert 0.0 < base["state"]["saturation"] < 0.1
     assert math.isfinite(base["checks"]["max_speed_over_wave_speed"])
     assert "ok:" in capsys.readouterr().out
+
+
+def test_command_line_requires_an_output_folder():
+    result = subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "extremes.py")],
+                            capture_output=True, text=True)
+    assert result.returncode == 2 and "--out" in result.stderr

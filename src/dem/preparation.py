@@ -297,7 +297,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
 
     steps = {"growth": sim.run(max_steps, until=grown, check_every=200, progress=label and
                                "grow radii", status=status)}
-    _require(grown(sim), "radius growth", steps["growth"], status(sim))
+    _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
     servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim, config))
     sim.controls = [servo]
@@ -305,7 +305,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     sim.operation(ContactForces).friction_deg = config.friction_deg
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=label and "set friction", status=status)
-    _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim))
+    _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim),
+             config)
     start = servo.target
     stages = 20
     for stage in range(1, stages + 1):
@@ -314,8 +315,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     steps["unload"] = config.unload_steps // stages * stages
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
                                    progress=label and "equilibrate", status=status)
-    _require(done(sim), f"equilibrium at confining = {config.confining:g} Pa",
-             steps["equilibrate"], status(sim))
+    _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
+             status(sim), config)
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),
@@ -328,14 +329,17 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     return sim, report
 
 
-def _require(reached, phase, steps, status):
-    """ValueError naming the preparation ``phase`` and what it reached when it ended at its
-    step limit without reaching its target."""
+def _require(reached, phase, steps, status, config):
+    """ValueError naming the step limit, what the preparation ``phase`` reached and the
+    settings that set its length, when it ended at its step limit without reaching its
+    target (a run never continues from a sample that is not in equilibrium)."""
     if not reached:
-        raise ValueError(f"preparation: {phase} not reached in {steps} steps (the step limit): "
-                         + ", ".join(f"{k} {v}" for k, v in status.items())
-                         + "; check the sample settings (e.g. a confining stress too low for "
-                           "the servo to settle, or too stiff springs)")
+        raise ValueError(
+            f"max_steps = {steps} is outside the valid range for this sample: preparation "
+            f"{phase} not reached ({', '.join(f'{k} {v}' for k, v in status.items())}); the "
+            f"time step falls as 1/sqrt(young) (young = {config.young:g} Pa, timestep_safety = "
+            f"{config.timestep_safety:g}) and the servo settles slowly at low stress "
+            f"(confining = {config.confining:g} Pa)")
 
 
 def _servo_speed(sim, config):

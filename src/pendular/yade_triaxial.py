@@ -1,11 +1,12 @@
-# YADE driver: dry drained triaxial shear of a sphere packing, timed (a YADE script, not pendular).
+# YADE driver: drained triaxial shear of a sphere packing, timed (a YADE script, not pendular).
 #
-#   yade -n -x -j THREADS benchmarks/yade_triaxial.py CONFIG.json
+#   yade -n -x -j THREADS yade_triaxial.py CONFIG.json
 #
 # (YADE 2023.02a, Debian package ``yade``: -n no GUI, -x exit when the script ends, -j OpenMP
 # threads; arguments after the script land in sys.argv[1:]). Exit status 1 on any error.
-# ``benchmarks/yade_runner.py`` calls this from Python. YADE is only a cross-check: pendular never
-# imports it.
+# Shipped with pendular as a file, run by YADE's own Python, never imported:
+# ``pendular.yade.run_yade_triaxial`` finds it beside itself (pendular.yade.DRIVER) and runs it.
+# YADE is only a cross-check: pendular never imports it.
 #
 # CONFIG.json (SI units, stresses compression positive, angles in degrees):
 #   spheres       sphere file, yade.export.textExt 'x_y_z_r' layout (dem.yade_io.write_spheres)
