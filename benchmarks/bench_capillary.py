@@ -6,8 +6,8 @@ and against YADE's capillary triaxial (Law2_ScGeom_CapillaryPhys_Capillarity) in
 
 For each size the prepared dry sample of benchmarks/bench_triaxial.py (thesis Ch. 5.2.2, 750 Pa,
 cached under .cache/) is sheared twice by pendular: dry, and wet with suction-controlled
-bridges at every contact (capillary.coupling.CapillaryBridges, added to the dry sample at the
-start of the shear, as YADE's law is here). Both runs first take ``warmup`` steps (the wetted
+bridges at every contact (capillary.CapillaryBridges, appended to the forces of the dry sample
+at the start of the shear, as YADE's law is here). Both runs first take ``warmup`` steps (the wetted
 sample compacts under the capillary forces), then are timed in alternating chunks so that a
 change of machine load hits both alike. YADE 2023 runs the same sample, time step and strain
 rate with and without its capillary law, reading capillary files M(r=1) ... M(r=10) written
@@ -19,43 +19,33 @@ import argparse
 import copy
 import json
 import os
-import sys
 import tempfile
 import time
 
 import numpy as np
 
-import capillary
-from capillary.coupling import CapillaryBridges
+from bench_triaxial import write_results  # benchmarks/ (the script's folder)
+from capillary import SURFACE_TENSION, CapillaryBridges
 from dem.neighbors import NeighborList
 from dem.preparation import servoed_simulation
-from dem.triaxial import ShearConfig, start_shear
 from dem.yade_io import write_spheres
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from bench_triaxial import CACHE, sample, write_results  # noqa: E402
-from yade_runner import find_yade, run_yade_triaxial  # noqa: E402
-
-SURFACE_TENSION = 0.073
-
-
-def yade_capillary_files(contact_angle=0.0):
-    """Folder with YADE's ten capillary files for this contact angle (written once, cached)."""
-    folder = os.path.join(CACHE, f"yade_capillary_theta{contact_angle:g}")
-    if not os.path.exists(os.path.join(folder, "M(r=10)")):
-        partial = folder + f".partial{os.getpid()}"
-        capillary.BridgeTable.cached(contact_angle).write_yade(partial)
-        os.replace(partial, folder)
-    return folder
+from homogenize.on_the_fly import capillary_force_stress
+from pendular.config import ShearConfig
+from pendular.triaxial import TriaxialShear
+from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)
+from pendular.yade import find_yade, run_yade_triaxial, yade_capillary_files
 
 
 def shear_simulation(config, particles, walls, threads, suction):
     """The prepared sample under triaxial shear (no recorder), with bridges if ``suction``."""
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
                              config.confining, threads=threads)
-    bridges = CapillaryBridges(suction, SURFACE_TENSION).insert(sim) if suction else None
-    _, _, rate = start_shear(sim, ShearConfig(confining=config.confining, max_strain=0.25),
-                             config.radius, config.density)
+    bridges = None
+    if suction:
+        bridges = CapillaryBridges(suction, SURFACE_TENSION)
+        sim.forces.append(bridges)
+    rate = TriaxialShear(sim, ShearConfig(max_strain=0.25), config.confining, config.radius,
+                         config.density).rate
     sim.writers.clear()     # time the physics, as the YADE runs (which record nothing)
     return sim, bridges, rate
 
@@ -86,7 +76,7 @@ def time_pendular(config, particles, walls, threads, steps, warmup, suction, chu
             "pairs": len(c),
         }
         if bridges is not None:
-            capillary_stress = np.diag(bridges.capillary_stress(sim))
+            capillary_stress = np.diag(capillary_force_stress(sim, bridges))
             results[name].update({"bridges": bridges.count(sim),
                                   "saturation": bridges.saturation(sim),
                                   "sigma_capillary": capillary_stress.tolist()})

@@ -6,7 +6,7 @@
 For each size, a sample is prepared with pendular (thesis Ch. 5.2.2, 750 Pa; cached under
 .cache/), sheared with x, y servoed and z strained, and timed in particle-steps per second after
 a warm-up. The same packing is exported as a YADE sphere file and sheared by YADE 2023
-(benchmarks/yade_triaxial.py) with the equivalent engine list, time step and strain rate.
+(pendular.yade_triaxial) with the equivalent engine list, time step and strain rate.
 Prints a table of particle-steps/s and the ratio pendular / YADE for each thread count.
 """
 
@@ -14,35 +14,17 @@ import argparse
 import copy
 import json
 import os
-import sys
 import tempfile
 import time
 
 import numba
 
-from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
-from dem.sample import load_sample, save_sample
-from dem.triaxial import ShearConfig, start_shear
+from dem.preparation import servoed_simulation
 from dem.yade_io import write_spheres
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from yade_runner import find_yade, run_yade_triaxial  # noqa: E402
-
-CACHE = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".cache")
-
-
-def sample(count, confining):
-    """Prepared sample of ``count`` spheres at ``confining`` Pa (prepared once, then cached)."""
-    config = PrepareConfig(particles=count, confining=confining)
-    path = os.path.join(CACHE, f"sample_{count}_{confining:g}.h5")
-    if not os.path.exists(path):
-        os.makedirs(CACHE, exist_ok=True)
-        started = time.perf_counter()
-        sim, report = prepare_sample(config, progress=True)
-        report["preparation_wall_time_s"] = time.perf_counter() - started
-        save_sample(path, sim, report)
-    particles, walls, report, _ = load_sample(path)
-    return config, particles, walls, report
+from pendular.config import ShearConfig
+from pendular.triaxial import TriaxialShear
+from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)
+from pendular.yade import find_yade, run_yade_triaxial
 
 
 def time_pendular(config, particles, walls, threads, steps, warmup):
@@ -52,8 +34,8 @@ def time_pendular(config, particles, walls, threads, steps, warmup):
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
                              config.confining)
     sim.run(warmup)         # settle the loaded packing (saved without its shear history)
-    shear = ShearConfig(confining=config.confining, max_strain=0.25)
-    _, _, rate = start_shear(sim, shear, config.radius, config.density)
+    rate = TriaxialShear(sim, ShearConfig(max_strain=0.25), config.confining, config.radius,
+                         config.density).rate
     sim.writers.clear()     # time the physics, as the YADE run (which records nothing)
     sim.run(warmup)
     started = time.perf_counter()

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from dem.contact_law import ContactForces
+from dem.contact_law import ContactForces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig, prepare_sample
@@ -30,7 +30,8 @@ def two_body_scene(positions, velocities, radius=RADIUS, young=YOUNG, friction_d
                           velocity=np.array(velocities, float))
     walls = Walls.box([-box] * 3, [box] * 3)
     if dt is None:
-        dt = 0.01 * np.sqrt(particles.mass.min() / (young * radii.min()))
+        smallest = radii.min()
+        dt = 0.01 * np.sqrt(particles.mass.min() / normal_stiffness(young, smallest, smallest))
     return Simulation(particles, walls, dt, neighbors=NeighborList(0.2 * radii.min()),
                       forces=[ContactForces(young, 0.3, friction_deg), WallForces(young), *extra],
                       integrator=Integrator(damping))

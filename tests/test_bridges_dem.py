@@ -21,7 +21,7 @@ from dem.neighbors import NeighborList, build_contacts
 from homogenize import capillary_force_stress, contact_stress
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-GAMMA = 0.073
+GAMMA = capillary.SURFACE_TENSION
 YOUNG = 1e6
 
 

@@ -1,6 +1,9 @@
-"""The Chapter 5 campaign (pendular.chapter5, pendular.campaign) through its command line:
-2 suctions x 2 confining stresses, 2 processes; reuse; a Dask cluster."""
+"""The Chapter 5 campaign (pendular.chapter5): its grid, envelopes and report as library code;
+scenarios/chapter5.py on 2 suctions x 2 confining stresses in 2 processes, reused when started
+again; the library on a Dask cluster."""
 
+import csv
+import dataclasses
 import json
 import math
 import os
@@ -10,18 +13,112 @@ import sys
 import numpy as np
 import pytest
 
+from pendular.chapter5 import Chapter5Grid, chapter5_campaign, envelopes, write_report
+from pendular.config import ShearConfig
+from pendular.reference import FIG_5_5, TABLE_5_3
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
 KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
         "saturation_at_peak", "peak_q_effective", "p_effective_at_peak")
+#: campaign.json's "arguments" as scenarios/chapter5.py wrote them before the library.
+ARGUMENTS = ["particles", "suctions", "confining", "jobs", "out", "seed", "max_strain",
+             "inertial_number", "prep_friction", "scheduler"]
+SMALL = ["--particles", "120", "--suctions", "0,30000", "--confining", "500,1000",
+         "--max-strain", "0.01", "--inertial-number", "3e-3", "--jobs", "2"]
+
+
+# ---------------------------------------------------------------- library, no runs
+
+def test_grid_from_the_shipped_table_with_overrides():
+    grid = Chapter5Grid.from_table(particles=300, suctions=[0, 30000.0], seed=None)
+    assert grid.particles == 300 and grid.seed == 0 and grid.suctions == [0.0, 30000.0]
+    assert grid.confining == [250.0, 500.0, 750.0, 1000.0] and grid.max_strain == 0.25
+    wet = grid.run(30000.0, 500.0, "/x")
+    assert wet.bridges.suction == 30000.0 and wet.sample.confining == 500.0
+    assert wet.sample_path == "/x/samples/c500.h5" and wet.sample == grid.sample(500.0)
+    assert grid.run(0.0, 250.0, "/x").bridges is None
+    assert dataclasses.replace(grid.run(0.0, 750.0, "/x"), sample_path=None).shear == \
+        ShearConfig(max_strain=0.25, inertial_number=3e-4)
+
+
+@pytest.mark.parametrize("values, message", [
+    ({"suctions": [-1.0]}, "--suctions [-1.0]: every value must be in [0, inf)"),
+    ({"confining": [0.0]}, "--confining [0.0]: every value must be in (0, inf)"),
+    ({"confining": [500, 500]}, "must not repeat a value"),
+    ({"suctions": []}, "--suctions: at least one value expected"),
+])
+def test_grid_refuses_bad_values(values, message):
+    with pytest.raises(ValueError) as error:
+        Chapter5Grid(**{"suctions": [0.0], "confining": [500.0], **values})
+    assert message in str(error.value)
+
+
+def test_grid_tables_name_what_a_chapter5_grid_cannot_hold(tmp_path):
+    table = tmp_path / "grid.toml"
+    table.write_text("[fixed]\nparticles = 200\nfriction = 30\n[sweep]\nsuction = [0]\n"
+                     "confining = [250]\n")
+    with pytest.raises(ValueError, match="a Chapter 5 grid has no fixed.friction"):
+        Chapter5Grid.from_table(table)
+    table.write_text("[fixed]\nparticles = 200\n")
+    with pytest.raises(ValueError, match="no suctions"):
+        Chapter5Grid.from_table(table)
+    assert Chapter5Grid.from_table(table, suctions=[0], confining=[250]).particles == 200
+
+
+def _row(suction, confining, q, p, q_eff=None, p_eff=None):
+    return {"suction": suction, "confining": confining, "peak_axial_stress": confining + q,
+            "peak_q": q, "p_at_peak": p, "saturation_at_peak": 0.01 if suction else 0.0,
+            "peak_q_effective": q if q_eff is None else q_eff,
+            "p_effective_at_peak": p if p_eff is None else p_eff,
+            "axial_strain_at_peak": 0.05, "saturation_at_20_percent": None,
+            "folder": f"runs/s{suction:g}_c{confining:g}"}
+
+
+def test_envelopes_recover_the_mohr_coulomb_line_of_their_peaks():
+    phi, cohesion = 25.0, 300.0
+    sin_phi = math.sin(math.radians(phi))
+    slope = 6 * sin_phi / (3 - sin_phi)
+    q0 = cohesion * 6 * math.cos(math.radians(phi)) / (3 - sin_phi)
+    rows = [_row(0.0, c, slope * p, p) for c, p in ((250.0, 400.0), (750.0, 1200.0))]
+    rows += [_row(30000.0, c, slope * p + q0, p, slope * (p + 900.0), p + 900.0)
+             for c, p in ((250.0, 2000.0), (750.0, 2900.0))]
+    rows.append(_row(15000.0, 250.0, 5000.0, 2000.0))         # one stress only: no fit
+    fits = envelopes(rows)
+    assert sorted(fits) == ["0", "30000"]
+    assert fits["0"]["phi_deg"] == pytest.approx(phi) and abs(fits["0"]["cohesion"]) < 1e-6
+    assert fits["30000"]["phi_deg"] == pytest.approx(phi)
+    assert fits["30000"]["cohesion"] == pytest.approx(cohesion)
+    assert fits["30000"]["phi_eff_deg"] == pytest.approx(phi)             # Eq. 3.43: on the
+    assert abs(fits["30000"]["cohesion_eff"]) < 1e-6                      # dry line
+    falling = [_row(0.0, 250.0, 900.0, 500.0), _row(0.0, 750.0, 100.0, 900.0)]
+    fit = envelopes(falling)["0"]
+    assert fit["phi_deg"] is None and "outside the Mohr–Coulomb range" in fit["errors"][0]
+
+
+def test_report_sets_every_cell_beside_the_thesis(tmp_path):
+    rows = [_row(0.0, 250.0, 350.0, 370.0), _row(30000.0, 250.0, 5400.0, 2050.0)]
+    figure = tmp_path / "plots" / "envelopes.png"
+    grid = Chapter5Grid(suctions=[0.0, 30000.0], confining=[250.0], particles=120)
+    write_report(tmp_path / "report.md", rows, envelopes(rows), grid,
+                 {"envelopes": str(figure)}, str(tmp_path))
+    report = (tmp_path / "report.md").read_text()
+    assert "# Chapter 5 campaign: 120 spheres, seed 0" in report
+    assert "| 0 | 250 | 600 | 591 | +1.5 % |" in report            # ours beside Table 5.3
+    assert "| 15000 | 1000 |  | 8018 |  |" in report                # a thesis cell not run
+    assert "| 30000 | 250 | 1.000 |  | 2.20 |" in report             # Sr beside Fig. 5.5
+    assert "(no suction has two confining stresses)" in report
+    assert "![envelopes](plots/envelopes.png)" in report
+    assert TABLE_5_3[(300000, 750)] == 8289 and FIG_5_5[30000] == 0.022
+
+
+# ---------------------------------------------------------------- the scenario, 2 x 2 runs
 
 
 @pytest.fixture(scope="module")
 def campaign(tmp_path_factory):
     out = tmp_path_factory.mktemp("chapter5") / "campaign"
-    subprocess.run([sys.executable, SCENARIO, "--particles", "120", "--suctions", "0,30000",
-                    "--confining", "500,1000", "--max-strain", "0.01",
-                    "--inertial-number", "3e-3", "--jobs", "2", "--out", str(out)],
+    subprocess.run([sys.executable, SCENARIO, *SMALL, "--out", str(out)],
                    check=True, capture_output=True, text=True, timeout=300)
     with open(out / "campaign.json") as handle:
         return out, json.load(handle)
@@ -97,30 +194,41 @@ def test_directional_value_of_a_tensor_is_its_quadratic_form():
 def test_rerun_reuses_finished_runs(campaign):
     out, data = campaign
     stamps = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/history.h5")}
-    result = subprocess.run([sys.executable, SCENARIO, "--particles", "120", "--suctions",
-                             "0,30000", "--confining", "500,1000", "--max-strain", "0.01",
-                             "--inertial-number", "3e-3", "--jobs", "2", "--out", str(out)],
+    samples = {p: p.stat().st_mtime_ns for p in (out / "samples").glob("*.h5")}
+    result = subprocess.run([sys.executable, SCENARIO, *SMALL, "--suction", "0,30000",
+                             "--out", str(out)],
                             check=True, capture_output=True, text=True, timeout=120)
-    assert "4 finished runs" in result.stdout
+    assert "4 finished runs" in result.stdout and "0 run" in result.stdout
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps        # nothing re-run
+    assert {p: p.stat().st_mtime_ns for p in samples} == samples      # nor prepared
     with open(out / "campaign.json") as handle:
         assert json.load(handle)["runs"] == data["runs"]
+    with open(out / "campaign.csv") as handle:
+        assert [r["status"] for r in csv.DictReader(handle)] == ["reused"] * 4
+
+
+def test_campaign_json_keeps_its_keys(campaign):
+    out, data = campaign
+    assert list(data) == ["arguments", "runs", "envelopes", "thesis"]
+    assert list(data["arguments"]) == ARGUMENTS
+    assert data["arguments"]["out"] == str(out) and data["arguments"]["jobs"] == 2
+    assert data["arguments"]["suctions"] == [0.0, 30000.0]
+    assert list(data["thesis"]) == ["table_5_3", "fig_5_5_saturation", "dry_friction_deg"]
 
 
 def test_campaign_on_a_dask_cluster(tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     out = tmp_path / "dask"
+    grid = Chapter5Grid(suctions=[30000.0], confining=[500.0, 1000.0], particles=120,
+                        max_strain=0.01, inertial_number=3e-3)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
-        subprocess.run([sys.executable, SCENARIO, "--particles", "120", "--suctions", "30000",
-                        "--confining", "500,1000", "--max-strain", "0.01",
-                        "--inertial-number", "3e-3", "--scheduler", cluster.scheduler_address,
-                        "--out", str(out)], check=True, capture_output=True, text=True,
-                       timeout=300)
-    with open(out / "campaign.json") as handle:
-        runs = json.load(handle)["runs"]
-    assert sorted(r["confining"] for r in runs) == [500, 1000]
+        campaign, reused = chapter5_campaign(grid, out, scheduler=cluster.scheduler_address,
+                                             quiet=True)
+    runs = campaign["runs"]
+    assert reused == 0 and sorted(r["confining"] for r in runs) == [500, 1000]
     for run in runs:
         assert run["peak_axial_stress"] > run["confining"]
         assert 0.0 < run["saturation_at_peak"] < 1.0
         assert (out / run["folder"] / "history.h5").exists()
+    assert campaign["arguments"]["scheduler"] == cluster.scheduler_address

@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 
 from conftest import two_body_scene
-from dem.checkpoint import CheckpointWriter, load_checkpoint, save_checkpoint
+from dem.checkpoint import FORMAT, CheckpointWriter, load_checkpoint, save_checkpoint
+from dem.integrity import stamp
 from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig, prepare_sample
 from dem.integrate import Integrator
@@ -158,6 +159,22 @@ def test_loading_into_a_differently_built_simulation_raises_and_changes_nothing(
         handle.attrs["format"] = "something else"
     with pytest.raises(ValueError, match="not a checksummed pendular checkpoint"):
         load_checkpoint(tmp_path / "other.h5", sim)
+
+
+def test_a_checkpoint_of_version_1_is_refused_naming_its_version(tmp_path):
+    """Version 1 (an operations list, before the declared pipeline) cannot be resumed."""
+    path = tmp_path / "c.h5"
+    scene = [[0, 0, 0], [1.9e-3, 0, 0]], np.zeros((2, 3))
+    sim = two_body_scene(*scene)
+    sim.run(2)
+    save_checkpoint(path, sim)
+    with h5py.File(path, "r+") as handle:
+        handle.attrs["version"] = 1
+        stamp(handle, {"kind": "checkpoint", "format": FORMAT, "version": 1})
+    fresh = two_body_scene(*scene)
+    with pytest.raises(ValueError, match="checkpoint version 1; this code reads version 2"):
+        load_checkpoint(path, fresh)
+    assert fresh.step == 0 and fresh.contacts is None
 
 
 def test_checkpoint_writer_saves_every_period(tmp_path):

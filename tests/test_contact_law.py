@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
+from dem.contact_law import normal_stiffness
 
 
 class CountContactSteps:
@@ -21,7 +22,7 @@ def test_head_on_collision_duration_and_restitution():
     sim = two_body_scene([[-1.001 * RADIUS, 0, 0], [1.001 * RADIUS, 0, 0]],
                          [[speed, 0, 0], [-speed, 0, 0]])
     mass = sim.particles.mass[0]
-    kn = YOUNG * RADIUS  # 2 E R R / (2 R)
+    kn = normal_stiffness(YOUNG, RADIUS, RADIUS)     # E R
     expected = np.pi * np.sqrt(0.5 * mass / kn)
     counter = CountContactSteps()
     sim.writers.append(counter)
@@ -97,3 +98,16 @@ def test_wall_contact_stiffness_is_young_times_radius():
     assert sim.walls.force[4] == pytest.approx(expected, rel=1e-9)
     assert sim.walls.stiffness[4] == pytest.approx(YOUNG * RADIUS)
     assert np.count_nonzero(sim.walls.force) == 1
+
+
+def test_normal_stiffness_of_unequal_spheres():
+    """Spheres of radii R and 2 R overlapping by d push each other apart with
+    kn d = 2 E R1 R2 / (R1 + R2) d = 4/3 E R d."""
+    overlap = 1e-6
+    sim = two_body_scene([[0, 0, 0], [3 * RADIUS - overlap, 0, 0]], np.zeros((2, 3)),
+                         radius=[RADIUS, 2 * RADIUS])
+    sim.advance()
+    expected = 4.0 / 3.0 * YOUNG * RADIUS * overlap
+    assert normal_stiffness(YOUNG, RADIUS, 2 * RADIUS) == pytest.approx(4.0 / 3.0 * YOUNG * RADIUS)
+    assert sim.contacts.normal_force[0] == pytest.approx(expected, rel=1e-6)
+    assert sim.particles.force[1, 0] == pytest.approx(expected, rel=1e-6)

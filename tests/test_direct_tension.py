@@ -18,6 +18,8 @@ from dem.preparation import prepare_sample
 from dem.state import Particles, Walls
 from dem.tension import Grip, grip_members
 from pendular import tension as direct_tension
+from pendular.cli import command_parser
+from pendular.config import CONFIG_TYPES, TensionConfig, config_from_dict, config_to_dict
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAMMA = 0.074
@@ -32,7 +34,7 @@ def table():
 
 @pytest.fixture(scope="module")
 def args():
-    return direct_tension.TensionConfig(particles=200, max_strain=0.03, vtk_frames=0)
+    return TensionConfig(particles=200, max_strain=0.03, vtk_frames=0)
 
 
 @pytest.fixture(scope="module")
@@ -149,6 +151,30 @@ def test_bad_inputs_are_refused_by_name(arguments, message):
     assert result.stderr.count("error:") == 1
 
 
+def test_config_is_validated_and_saved_as_json(args):
+    """Variants by dataclasses.replace are validated again; the JSON form reads back equal."""
+    assert CONFIG_TYPES["TensionConfig"] is TensionConfig
+    variant = dataclasses.replace(args, cases=[(0.65, 0.01), (0.65, 0.02)], vtk_every=50)
+    assert config_from_dict(json.loads(json.dumps(config_to_dict(variant)))) == variant
+    assert TensionConfig().cases == [(e, w) for e, w, _ in direct_tension.KIM_2001]
+    with pytest.raises(ValueError, match="--friction = 95.0 deg is outside"):
+        dataclasses.replace(args, friction=95.0)
+    with pytest.raises(ValueError, match="--void-ratio = 1.5 is outside"):
+        dataclasses.replace(args, cases=[(1.5, 0.01)])
+    with pytest.raises(ValueError, match="empty"):
+        dataclasses.replace(args, cases=[])
+
+
+def test_command_options_build_the_config():
+    parser, module = command_parser("tension")
+    config = module.config_from(parser.parse_args(
+        ["--void-ratio", "0.65,0.6", "--water-content", "1", "--vtk-every", "100"]))
+    assert config.cases == [(0.65, 0.01), (0.6, 0.01)] and config.vtk_every == 100
+    assert module.config_from(parser.parse_args([])) == TensionConfig()
+    with pytest.raises(SystemExit):           # one of --vtk-every, --vtk-frames
+        parser.parse_args(["--vtk-every", "100", "--vtk-frames", "5"])
+
+
 def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
     dense = dataclasses.replace(args, particles=100)
     with pytest.raises(ValueError, match=r"--void-ratio = 0.52 is outside the valid range"):
@@ -159,13 +185,31 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     out = tmp_path / "tension"
     subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
                     "--particles", "200", "--void-ratio", "0.65", "--water-content", "1",
-                    "--max-strain", "0.01", "--vtk-frames", "0", "--quiet", "--out", str(out)],
+                    "--max-strain", "0.01", "--vtk-every", "2000", "--quiet", "--out", str(out)],
                    check=True, capture_output=True, text=True)
     result = json.loads((out / "tension.json").read_text())
     (case,) = result["cases"]
     assert case["tensile_strength_pa"] > 0.0 and case["water_content"] == pytest.approx(
         0.01, rel=direct_tension.WATER_TOLERANCE)
-    assert (out / "report.md").exists() and (out / "cases" / case["case"] / "history.h5").exists()
+    folder = out / "cases" / case["case"]
+    assert (out / "report.md").exists() and (folder / "history.h5").exists()
+    assert list((folder / "vtk").glob("*.pvd"))
+    # the command line as given, and the configuration it built
+    assert result["arguments"]["void_ratio"] == "0.65" and result["arguments"]["quiet"] is True
+    assert config_from_dict(result["config"]).vtk_every == 2000
+
+
+def test_prediction_is_chapter4s_kim_comparison(args):
+    """pendular.tension's prediction of Kim's cases is Table 4.5's exact, theta = 0 column of
+    pendular.chapter4 (same reference data, same packing choice)."""
+    from homogenize import regular_packing
+    from pendular import chapter4
+    from pendular.reference import KIM_2001, KIM_RADIUS, KIM_SEPARATION, comparison_packing
+
+    for e, w, _ in KIM_2001:
+        packing = regular_packing(comparison_packing(e)[0], separation=KIM_SEPARATION)
+        expected = chapter4.state(packing, KIM_RADIUS, 0.0, "exact", water_content=w).psi[0, 0]
+        assert direct_tension.prediction(args, e, w)[0] == pytest.approx(expected, rel=1e-12)
 
 
 def test_grips_take_every_particle_touching_their_wall():

@@ -6,7 +6,7 @@ from dem.measure import elastic_energy, kinetic_energy
 from dem.preparation import random_cloud
 from dem.simulation import Simulation
 from dem.state import Particles, Walls
-from dem.contact_law import ContactForces
+from dem.contact_law import ContactForces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
 from dem.walls import WallForces
@@ -33,7 +33,7 @@ def energy_error(timestep_factor, steps=10000):
     particles = Particles(position, np.full(500, 1.1 * radius), density,
                           velocity=rng.normal(scale=0.05, size=(500, 3)))
     walls = Walls.box(np.zeros(3), np.full(3, edge))
-    dt = timestep_factor * np.sqrt(particles.mass[0] / (young * radius))
+    dt = timestep_factor * np.sqrt(particles.mass[0] / normal_stiffness(young, radius, radius))
     probe = SpringEnergyProbe(young)
     sim = Simulation(particles, walls, dt, neighbors=NeighborList(0.3 * radius),
                      forces=[ContactForces(young, 0.3, 0.0), WallForces(young)],
@@ -71,7 +71,8 @@ def test_damping_dissipates_energy():
     particles = Particles(position, np.full(200, radius), 2650.0,
                           velocity=rng.normal(scale=0.05, size=(200, 3)))
     walls = Walls.box(np.zeros(3), np.full(3, 0.02))
-    sim = Simulation(particles, walls, 0.05 * np.sqrt(particles.mass[0] / (young * radius)),
+    dt = 0.05 * np.sqrt(particles.mass[0] / normal_stiffness(young, radius, radius))
+    sim = Simulation(particles, walls, dt,
                      neighbors=NeighborList(0.3 * radius),
                      forces=[ContactForces(young, 0.3, 20.0), WallForces(young)],
                      integrator=Integrator(damping=0.2))

@@ -13,7 +13,7 @@ import pytest
 
 from dem.contact_law import ContactForces
 from dem.neighbors import NeighborList
-from capillary import BridgeState, CapillaryBridges
+from capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
 from dem.integrate import Integrator
 from dem.simulation import Simulation
 from dem.state import Particles, Walls
@@ -27,7 +27,7 @@ from homogenize import (
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RADIUS = 2.4e-5
-GAMMA = 0.073
+GAMMA = SURFACE_TENSION
 SUCTION = 30000.0
 BLOCK = 5          # lattice cells per axis
 REGION = (1.125, 3.125)   # representative volume, in cells: 2 x 2 x 2 cells, off every bridge centre

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from homogenize import packing_state, regular_packing
+from pendular.reference import CHAPTER4_SURFACE_TENSION as GAMMA
 
-GAMMA = 0.074
 RADIUS = 1e-4
 TABLE_4_1_PRINTED = {  # l': (n, Fx, Fz, a) as printed in the thesis
     2.1: (0.312, 0.362, 0.276, -0.22), 2.2: (0.318, 0.335, 0.330, -0.012), 2.3094: (0.320, 0.333, 0.333, 0.0),

@@ -1,7 +1,10 @@
-"""Verlet list against brute force; contact history survives rebuilds."""
+"""Verlet list against brute force; contact history survives rebuilds; the list reaches as
+far as the forces ask (``reach(sim)``)."""
 
 import numpy as np
+import pytest
 
+from conftest import RADIUS, two_body_scene
 from dem.neighbors import build_contacts
 
 
@@ -50,3 +53,51 @@ def test_history_is_carried_to_the_same_pair_after_a_rebuild():
         else:
             assert not new.shear_force[k].any()
     assert kept > 0.5 * len(new)
+
+
+class Reaching:
+    """Test force: no force, needs pairs up to ``gap`` [m] apart (the reach interface)."""
+
+    def __init__(self, gap):
+        self.gap = gap
+
+    def reach(self, sim):
+        return self.gap
+
+    def apply(self, sim):
+        pass
+
+
+def pairs(sim):
+    return set(zip(sim.contacts.pair_i.tolist(), sim.contacts.pair_j.tolist()))
+
+
+def test_the_list_reaches_as_far_as_the_forces_ask():
+    """Two spheres at a gap of 0.5 R, skin 0.2 R: paired only while a force reaches that far;
+    a change of the largest reach rebuilds the list, an unchanged one does not."""
+    gap = 0.5 * RADIUS
+    sim = two_body_scene([[0, 0, 0], [2 * RADIUS + gap, 0, 0]], np.zeros((2, 3)))
+    sim.advance()
+    neighbors = sim.neighbors
+    assert pairs(sim) == set() and neighbors.interaction_range == 0.0
+    rebuilds = neighbors.rebuilds
+    reaching = Reaching(0.6 * RADIUS)
+    sim.forces += [reaching, Reaching(0.1 * RADIUS)]
+    sim.advance()
+    assert pairs(sim) == {(0, 1)}
+    assert neighbors.interaction_range == 0.6 * RADIUS
+    assert neighbors.rebuilds == rebuilds + 1
+    sim.advance()
+    assert neighbors.rebuilds == rebuilds + 1
+    reaching.gap = 0.0
+    sim.advance()
+    assert pairs(sim) == set() and neighbors.interaction_range == 0.1 * RADIUS
+    sim.forces[2:] = []
+    sim.advance()
+    assert neighbors.interaction_range == 0.0 and neighbors.rebuilds == rebuilds + 3
+
+
+def test_a_negative_reach_is_refused_naming_the_force():
+    sim = two_body_scene([[0, 0, 0]], np.zeros((1, 3)), extra=[Reaching(-1e-6)])
+    with pytest.raises(ValueError, match="Reaching.reach"):
+        sim.advance()

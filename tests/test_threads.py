@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from capillary import CapillaryBridges
-from dem.contact_law import ContactForces
+from dem.contact_law import ContactForces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
 from dem.preparation import random_cloud
@@ -35,7 +35,7 @@ def dense_packing(threads, friction_deg=0.0, damping=0.0, suction=None, count=20
     position = random_cloud(count, RADIUS, np.zeros(3), np.full(3, EDGE), seed=4)
     velocity = np.random.default_rng(9).normal(scale=0.05, size=(count, 3))
     particles = Particles(position, np.full(count, INFLATION * RADIUS), DENSITY, velocity=velocity)
-    dt = 0.05 * np.sqrt(particles.mass[0] / (YOUNG * RADIUS))
+    dt = 0.05 * np.sqrt(particles.mass[0] / normal_stiffness(YOUNG, RADIUS, RADIUS))
     probe = SpringEnergyProbe(YOUNG)
     forces = [ContactForces(YOUNG, 0.3, friction_deg), WallForces(YOUNG)]
     if suction is not None:

@@ -1,6 +1,8 @@
-"""The trade-off study (pendular.tradeoff) through scenarios/tradeoff.py: the quick grid runs and
-its table is consistent with its runs."""
+"""The trade-off study (pendular.tradeoff): its runs are configurations built with
+dataclasses.replace, reused only when their stored configuration is equal; and the quick grid
+through scenarios/tradeoff.py, whose table is consistent with its runs."""
 
+import dataclasses
 import json
 import math
 import os
@@ -9,27 +11,102 @@ import sys
 
 import pytest
 
+from pendular import tradeoff
+from pendular.config import config_to_dict
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "tradeoff.py")
 
 
+def _plain(value):
+    """``value`` as it reads back from JSON (tuples as lists)."""
+    return json.loads(json.dumps(value))
+
+
+# ---------------------------------------------------------------- configurations (no run)
+
+def test_knobs_set_their_field_of_the_default_configuration(tmp_path):
+    study = tradeoff.Study(out=str(tmp_path), particles=300, max_strain=0.02, seed=4)
+    default = study.default()
+    assert default.sample.particles == 300 and default.sample.seed == 4
+    assert default.shear.max_strain == 0.02 and default.bridges.suction == tradeoff.SUCTION
+    assert default.bridges.table_resolution == tradeoff.DEFAULT_TABLE
+    assert default.sample_path == tradeoff.sample_file(tmp_path, 300, 4)
+    reference = study.reference()
+    assert reference.sample.timestep_safety == 0.35 and reference.shear.inertial_number == 1e-4
+    assert reference.bridges.table_resolution == (700, 160)
+    for knob, values in tradeoff.KNOBS.items():
+        for value in values:
+            config, shown = study.variant(knob, value)
+            assert tradeoff.setting(config, knob) == shown
+            # nothing else changed: setting the knob back gives the default
+            assert tradeoff.with_setting(config, knob, tradeoff.setting(default, knob)) == \
+                dataclasses.replace(default, sample_path=config.sample_path)
+    assert study.variant("particles", 0.5)[0].sample_path == tradeoff.sample_file(tmp_path, 150, 4)
+    assert study.variant("bridges", "toroidal")[0].bridges.model == "toroidal"
+
+
+def test_bad_study_settings_are_refused_naming_them(tmp_path):
+    with pytest.raises(ValueError, match="particles = 10 is outside the valid range"):
+        tradeoff.Study(out=str(tmp_path), particles=10)
+    with pytest.raises(ValueError, match="max_strain = 0.6 is outside the valid range"):
+        tradeoff.Study(out=str(tmp_path), max_strain=0.6)
+    with pytest.raises(ValueError, match="table_resolution"):
+        tradeoff.with_setting(tradeoff.Study(out=str(tmp_path)).default(), "table_resolution",
+                              (2, 80))
+
+
+def test_a_finished_run_is_reused_only_with_an_equal_configuration(tmp_path, monkeypatch):
+    study = tradeoff.Study(out=str(tmp_path), particles=300)
+    config = study.default()
+    folder = tmp_path / "runs" / "default"
+    folder.mkdir(parents=True)
+    stored = {"settings": tradeoff.settings(config), "particles": 300, "peak_q": 123.0}
+    (folder / "timing.json").write_text(json.dumps({**stored, "config": config_to_dict(config)}))
+    assert tradeoff.run_variant(config, str(folder), study.sample(300)) == stored
+
+    ran = []
+
+    class FakeTest:
+        def __init__(self, config):
+            self.config = config
+
+        def run(self, out, progress, threads):
+            ran.append((self.config, threads))
+            return {"steps": 10, "particle_steps_per_s": 1.0, "peak_q": 99.0,
+                    "saturation_at_peak": 0.01, "peak_q_effective": 2.0,
+                    "p_effective_at_peak": 4.0, "axial_strain_at_peak": 0.01}
+
+    monkeypatch.setattr(tradeoff, "TriaxialTest", FakeTest)
+    monkeypatch.setattr(tradeoff, "sample_made_with", lambda path, sample: True)
+    other = dataclasses.replace(config, shear=dataclasses.replace(config.shear, max_strain=0.1))
+    result = tradeoff.run_variant(other, str(folder), study.sample(300))
+    assert ran == [(other, 1)] and result["peak_q"] == 99.0
+    assert result["stress_ratio_at_peak"] == 0.5
+    saved = json.loads((folder / "timing.json").read_text())
+    assert saved["config"] == _plain(config_to_dict(other))
+    assert tradeoff.run_variant(other, str(folder), study.sample(300)) == _plain(result)
+    assert len(ran) == 1
+
+
+# ---------------------------------------------------------------- the quick grid
+
 @pytest.fixture(scope="module")
-def tradeoff(tmp_path_factory):
+def quick_grid(tmp_path_factory):
     out = tmp_path_factory.mktemp("tradeoff")
     subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--quick", "--particles", "200",
                     "--max-strain", "0.01"], check=True, capture_output=True, text=True,
-                   timeout=600)
+                   timeout=900)
     with open(out / "tradeoff.json") as handle:
         return out, json.load(handle)
 
 
-def test_rows_cover_the_quick_knobs(tradeoff):
-    _, data = tradeoff
-    from pendular.tradeoff import QUICK_KNOBS, USES
-
-    assert [(r["knob"], r["value"]) for r in data["rows"]] == [
-        (knob, value) for knob, values in QUICK_KNOBS.items() for value in values] + [
-        ("combined", use) for use in USES]
+def test_rows_cover_the_quick_knobs(quick_grid):
+    _, data = quick_grid
+    assert [[r["knob"], r["value"]] for r in data["rows"]] == _plain([
+        (knob, value) for knob, values in tradeoff.QUICK_KNOBS.items() for value in values] + [
+        ("combined", use) for use in tradeoff.USES])
+    assert set(data["arguments"]) == {"out", "particles", "max_strain", "seed", "quick", "docs"}
     for row in data["rows"]:
         assert row["wall_time_s"] > 0 and row["cpu_time_s"] > 0
         for key in ("peak_q_error", "saturation_error", "stress_ratio_error"):
@@ -38,8 +115,8 @@ def test_rows_cover_the_quick_knobs(tradeoff):
                                    row["stress_ratio_error"])
 
 
-def test_errors_are_measured_against_the_reference(tradeoff):
-    _, data = tradeoff
+def test_errors_are_measured_against_the_reference(quick_grid):
+    _, data = quick_grid
     reference = data["reference"]
     assert reference["settings"]["timestep_safety"] == 0.35
     for row in data["rows"]:
@@ -48,23 +125,21 @@ def test_errors_are_measured_against_the_reference(tradeoff):
         assert 0.0 < row["saturation_at_peak"] < 1.0
 
 
-def test_default_run_is_shared_between_knobs(tradeoff):
-    _, data = tradeoff
+def test_default_run_is_shared_between_knobs(quick_grid):
+    _, data = quick_grid
     defaults = [r for r in data["rows"] if (r["knob"], r["value"]) in
                 (("timestep_safety", 0.7), ("inertial_number", 3e-4),
-                 ("table_resolution", "350,80"))]
+                 ("table_resolution", [350, 80]))]
     assert len(defaults) == 3
     assert len({(r["peak_q"], r["cpu_time_s"]) for r in defaults}) == 1   # one run, reused
 
 
-def test_combined_rows_take_each_knobs_cheapest_setting_within_the_bound(tradeoff):
+def test_combined_rows_take_each_knobs_cheapest_setting_within_the_bound(quick_grid):
     """Each knob's setting in a combined row is within the bound, and no setting within it is
     both cheaper (beyond the tie factor) or as cheap and more accurate."""
-    _, data = tradeoff
-    from pendular.tradeoff import TIME_TIE, USES
-
+    _, data = quick_grid
     knobs = [r for r in data["rows"] if r["knob"] != "combined"]
-    for use, bound in USES.items():
+    for use, bound in tradeoff.USES.items():
         combined = next(r for r in data["rows"] if r["knob"] == "combined" and r["value"] == use)
         for knob, setting in combined["settings"].items():
             rows = [r for r in knobs if r["knob"] == knob and r["error"] <= bound]
@@ -72,24 +147,17 @@ def test_combined_rows_take_each_knobs_cheapest_setting_within_the_bound(tradeof
                 continue
             chosen = next(r for r in rows if r["value"] == setting)
             cheapest = min(r["cpu_time_s"] for r in rows)
-            assert chosen["cpu_time_s"] <= TIME_TIE * cheapest, knob
+            assert chosen["cpu_time_s"] <= tradeoff.TIME_TIE * cheapest, knob
             assert all(r["error"] >= chosen["error"] for r in rows
-                       if r["cpu_time_s"] <= TIME_TIE * cheapest), knob
+                       if r["cpu_time_s"] <= tradeoff.TIME_TIE * cheapest), knob
 
 
-def test_report_and_plot(tradeoff):
-    out, data = tradeoff
+def test_report_and_plot(quick_grid):
+    out, data = quick_grid
     text = (out / "tradeoff.md").read_text()
     assert "Paper figure" in text and "Quick look" in text
+    assert "| table_resolution | 350,80 |" in text
     assert (out / "tradeoff.png").stat().st_size > 0
-
-
-def test_runs_are_configured_with_dataclasses_not_option_strings(tmp_path):
-    from pendular.tradeoff import DEFAULTS, REFERENCE, Study, configure
-
-    study = Study(out=str(tmp_path), particles=300)
-    reference = configure(study, REFERENCE, 300)
-    assert reference.sample.timestep_safety == 0.35 and reference.shear.inertial_number == 1e-4
-    assert reference.bridges.table_resolution == (700, 160) and reference.bridges.suction == 3e4
-    default = configure(study, DEFAULTS, 300)
-    assert default.sample.particles == 300 and default.shear.max_strain == 0.15
+    # each run keeps its configuration beside its timing
+    timing = json.loads((out / "runs" / "reference" / "timing.json").read_text())
+    assert timing["config"]["fields"]["shear"]["fields"]["inertial_number"] == 1e-4

@@ -2,6 +2,7 @@
 
 import math
 
+from dem.contact_law import normal_stiffness
 from dem.validate import check_positive, finite_number  # noqa: F401  (shared checks)
 
 MAX_RADIUS_RATIO = 20.0
@@ -90,8 +91,9 @@ def check_pendular_suction(table, suction, radius, surface_tension):
 def check_bridge_stiffness(young, radius, surface_tension):
     """ValueError naming ``young`` [Pa] and ``radius`` [m] when the force of a bridge at contact
     (at most 2 pi gamma R, surface_tension gamma [N/m]) would press spheres of normal stiffness
-    kn = E R together by more than MAX_BRIDGE_OVERLAP of their radius."""
-    overlap = 2.0 * math.pi * surface_tension / (young * radius)
+    kn = E R (dem.contact_law.normal_stiffness) together by more than MAX_BRIDGE_OVERLAP of
+    their radius: overlap / R = 2 pi gamma R / (kn R)."""
+    overlap = 2.0 * math.pi * surface_tension / normal_stiffness(young, radius, radius)
     if overlap > MAX_BRIDGE_OVERLAP:
         bound = 2.0 * math.pi * surface_tension / MAX_BRIDGE_OVERLAP
         raise ValueError(

@@ -79,9 +79,10 @@ def _references(sim, particle_arrays, wall_arrays, contacts):
     references = {("sim",): sim, ("particles",): sim.particles, ("walls",): sim.walls,
                   ("contacts",): contacts}
     for kind, ops in _pipeline(sim).items():
-        references[(kind,)] = ops
         for index, op in enumerate(ops):
             references[(kind, index)] = op
+    for kind in ("forces", "controls", "writers"):
+        references[(kind,)] = getattr(sim, kind)
     for owner, arrays in (("particles", particle_arrays), ("walls", wall_arrays)):
         for name, value in arrays.items():
             references[(owner, name)] = value
@@ -152,8 +153,8 @@ def save_checkpoint(path, sim, extra_state=None, identity=None):
 
     ``extra_state``: any picklable value (e.g. the scenario's phase), returned by
     ``load_checkpoint``; ``identity``: what made the run (dict, e.g. its configuration hash and
-    seed), stamped with a content checksum (dem.integrity) and checked by ``load_checkpoint``. Returns the names of the operation attributes not saved
-    ({"forces[i] Type": [names]}).
+    seed), stamped with a content checksum (dem.integrity) and checked by ``load_checkpoint``.
+    Returns the names of the operation attributes not saved ({"forces[i] Type": [names]}).
     """
     path = os.fspath(path)
     contacts = sim.contacts
@@ -223,10 +224,9 @@ def load_checkpoint(path, sim, expected_identity=None):
     The file's checksum is verified first, and its identity against ``expected_identity``
     (ValueError naming the path: edited or damaged, another run's, or older than checksums).
     ``sim`` must have neighbour list, forces, controls, integrator and writers of the same
-    types in the same order (ValueError
-    otherwise, before anything is changed). Particles, walls, contacts, step, time, dt and the
-    saved attributes of every operation and writer are replaced; attributes skipped at saving
-    keep the values of ``sim``'s own operations.
+    types in the same order (ValueError otherwise, before anything is changed). Particles,
+    walls, contacts, step, time, dt and the saved attributes of every operation and writer are
+    replaced; attributes skipped at saving keep the values of ``sim``'s own operations.
     """
     path = os.fspath(path)
     verify(path, expected_identity, kind="checkpoint")
@@ -235,7 +235,8 @@ def load_checkpoint(path, sim, expected_identity=None):
             raise ValueError(f"{path!r} is not a pendular checkpoint")
         if int(handle.attrs["version"]) != VERSION:
             raise ValueError(f"{path!r} has checkpoint version {handle.attrs['version']}; "
-                             f"this code reads version {VERSION}")
+                             f"this code reads version {VERSION} only (version 1 was written "
+                             "before the declared pipeline): restart the run from its sample")
         _check_types(handle, sim)
         particle_arrays = _read_group(handle["particles"])
         particle_scalars = dict(handle["particles"].attrs)

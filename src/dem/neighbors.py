@@ -313,6 +313,8 @@ class NeighborList:
         return reach
 
     def rebuild(self, sim):
+        """Rebuild the list now (``apply`` does when needed; dem.preparation.rescale after
+        scaling every length)."""
         p = sim.particles
         sim.contacts = build_contacts(p.position, p.radius, self.skin + self.interaction_range,
                                       previous=sim.contacts)

@@ -126,7 +126,8 @@ def random_cloud(count, radius, lo, hi, seed):
 class RadiusGrowth:
     """Grow all radii by (1 + g) per step, g = max_rate * clip(1 - sigma_mean / target, -1, 1).
 
-    Runs after WallForces; masses follow the radii (constant density).
+    A control (it reads the wall stress of this step's forces); masses follow the radii
+    (constant density). target_stress [Pa].
     """
 
     def __init__(self, target_stress, max_rate):
@@ -226,10 +227,10 @@ def equilibrated(config):
     return done
 
 
-def dry_simulation(particles, walls, config, skin, friction_deg, controls, threads=None):
-    """The scene of a dry sample: neighbour list of ``skin`` [m], linear contacts at
-    ``friction_deg`` [deg], wall springs, the given wall ``controls``, leapfrog."""
-    return Simulation(particles, walls, timestep(particles, config),
+def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None):
+    """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m], linear
+    contacts at ``friction_deg`` [deg], wall springs, the given wall ``controls``, leapfrog."""
+    return Simulation(particles, walls, dt,
                       neighbors=NeighborList(skin),
                       forces=[ContactForces(config.young, config.shear_ratio, friction_deg),
                               WallForces(config.young)],
@@ -241,10 +242,11 @@ def dry_simulation(particles, walls, config, skin, friction_deg, controls, threa
 def servoed_simulation(particles, walls, config, target, threads=None):
     """A static sample's simulation: dry scene at the test friction, six walls servoed at
     ``target`` [Pa]. Used to continue from a saved sample."""
-    skin = config.skin_factor * float(np.mean(particles.radius))
-    sim = dry_simulation(particles, walls, config, skin, config.friction_deg, [], threads)
-    sim.controls = [StressServo("xyz", target, max_velocity=_servo_speed(sim, config))]
-    return sim
+    dt = timestep(particles, config)
+    servo = StressServo("xyz", target, max_velocity=_servo_speed(walls, dt))
+    return dry_simulation(particles, walls, config, dt,
+                          config.skin_factor * float(np.mean(particles.radius)),
+                          config.friction_deg, [servo], threads)
 
 
 def rescale(sim, factor):
@@ -281,8 +283,9 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     particles = Particles(position, np.full(config.particles, cloud_radius), config.density)
     walls = Walls.box(lo, hi)
     growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
-    sim = dry_simulation(particles, walls, config, config.skin_factor * config.radius,
-                         config.prep_friction_deg, [growth], threads)
+    sim = dry_simulation(particles, walls, config, timestep(particles, config),
+                         config.skin_factor * config.radius, config.prep_friction_deg, [growth],
+                         threads)
     done = equilibrated(config)
 
     def grown(s):
@@ -299,7 +302,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
                                "grow radii", status=status)}
     _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
-    servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim, config))
+    servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim.walls, sim.dt))
     sim.controls = [servo]
     sim.dt = timestep(sim.particles, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
@@ -342,6 +345,6 @@ def _require(reached, phase, steps, status, config):
             f"(confining = {config.confining:g} Pa)")
 
 
-def _servo_speed(sim, config):
-    """Servo speed cap [m/s]: a wall may travel 1e-4 of the box per time step."""
-    return 1e-4 * float(np.mean(sim.walls.lengths())) / sim.dt
+def _servo_speed(walls, dt):
+    """Servo speed cap [m/s]: a wall may travel 1e-4 of the box per time step ``dt`` [s]."""
+    return 1e-4 * float(np.mean(walls.lengths())) / dt

@@ -66,12 +66,13 @@ class Simulation:
 
     @property
     def operations(self):
-        """The step's operations in order: neighbour list, forces, controls, integrator."""
-        return [self.neighbors, *self.forces, *self.controls, self.integrator]
+        """The step's operations in order (read-only tuple): neighbour list, forces, controls,
+        integrator. Change the scene through ``forces``, ``controls`` and ``writers``."""
+        return (self.neighbors, *self.forces, *self.controls, self.integrator)
 
     def operation(self, kind):
         """The first operation or writer of class ``kind`` (KeyError if absent)."""
-        for op in self.operations + self.writers:
+        for op in (*self.operations, *self.writers):
             if isinstance(op, kind):
                 return op
         raise KeyError(f"no {kind.__name__} operation in this simulation")
@@ -103,8 +104,8 @@ class Simulation:
         taken and its status, not a fraction of the step limit). Returns the steps taken."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
-        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step", mininterval=1.0, smoothing=0.05,
-                   disable=progress is None)
+        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
+                   mininterval=1.0, smoothing=0.05, disable=progress is None)
         taken = 0
         started = time.perf_counter()
         caller_threads = numba.get_num_threads()

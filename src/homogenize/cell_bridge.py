@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-
-METHODS = ("exact", "toroidal")
+import capillary
+from capillary import BRIDGE_MODELS
 
 _EXACT_SUCTION_GRID = np.concatenate([[0.0], np.geomspace(1e-4, 1e10, 141)])
 """u* scanned from the top for the largest-suction bridge with a given filling angle (10 per decade)."""
@@ -50,15 +50,14 @@ class CellBridge:
 
 
 def check_contact_angle(contact_angle):
-    """The contact angle [deg], checked by the capillary package (loaded on first use)."""
-    import capillary  # lazy: dry scenes never load the capillary package
+    """The contact angle [deg], checked by the capillary package."""
     return capillary.validation.check_contact_angle(contact_angle)
 
 
 def check_method(method):
-    """method in METHODS."""
-    if method not in METHODS:
-        raise ValueError(f"method = {method!r} is not a bridge method; valid methods {METHODS}")
+    """method in BRIDGE_MODELS."""
+    if method not in BRIDGE_MODELS:
+        raise ValueError(f"method = {method!r} is not a bridge method; valid methods {BRIDGE_MODELS}")
     return method
 
 
@@ -81,14 +80,12 @@ def _from_exact(bridge):
 
 
 def _toroidal(filling_angle, contact_angle, separation):
-    import capillary  # lazy: dry scenes never load the capillary package
     bridge = capillary.toroidal_bridge(filling_angle, contact_angle, separation)
     return CellBridge(bridge.suction_star, bridge.volume, bridge.force, float(filling_angle))
 
 
 def _toroidal_lowest_angle(contact_angle, separation):
     """Smallest alpha [deg] with a positive toroidal neck radius (Eq. A.2) at this gap."""
-    import capillary  # lazy: dry scenes never load the capillary package
     def neck_ok(alpha):
         try:
             capillary.toroidal_bridge(alpha, contact_angle, separation)
@@ -107,7 +104,6 @@ def _toroidal_lowest_angle(contact_angle, separation):
 
 def bridge_from_filling_angle(method, filling_angle, contact_angle, separation):
     """CellBridge with filling angle alpha [deg] spanning the gap H/R = separation."""
-    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "toroidal":
         return _positive(_toroidal(filling_angle, contact_angle, separation), method, contact_angle, separation)
@@ -134,7 +130,6 @@ def bridge_from_filling_angle(method, filling_angle, contact_angle, separation):
 
 def bridge_from_suction(method, suction_star, contact_angle, separation):
     """CellBridge at suction u* = s R/gamma > 0 spanning the gap: the larger bridge."""
-    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "exact":
         return _from_exact(capillary.bridge_at_distance(1.0, contact_angle, suction_star, separation))
@@ -158,7 +153,6 @@ def bridge_from_suction(method, suction_star, contact_angle, separation):
 
 def bridge_from_volume(method, volume_star, contact_angle, separation):
     """CellBridge holding V* = V/R^3 > 0 at the gap (exact: volume-controlled; toroidal: root in alpha)."""
-    import capillary  # lazy: dry scenes never load the capillary package
     check_method(method)
     if method == "exact":
         bridge = _from_exact(capillary.bridge_with_volume(1.0, contact_angle, volume_star, separation))

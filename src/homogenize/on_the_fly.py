@@ -37,7 +37,7 @@ meniscus ring, e_x = -cos(alpha + theta) at azimuth 0). Hence, at theta = 0 and 
 diagonal of psi is positive for the near-isotropic bridge fabrics of packings and triaxial
 samples, and the capillary terms add to the net stress: sigma' = sigma_net + psi.
 
-Volume-controlled bridges carry their own suction (``bridge_suction``): psi is then the sum of
+Volume-controlled bridges carry their own suction (``BridgeState.suction``): psi is the sum of
 each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
 bridge has the suction s; chi is Eq. 3.44 either way.
 
@@ -186,9 +186,10 @@ def capillary_force_stress(sim, bridges):
     sign convention of homogenize.contact_stress (l = x_j - x_i, f on j from i, compression
     positive): attractive bridges give a negative (tensile) stress, and in static equilibrium
     sigma_wall = sigma_contact + sigma_capillary."""
+    pair_force = bridges.pair_forces(sim)
     c = sim.contacts
-    total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, bridges.pair_forces(sim),
-                            bridges.state(sim).mask())
+    total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, pair_force,
+                            BridgeState.of(c).mask())
     return total / sim.walls.volume()
 
 
@@ -211,7 +212,8 @@ class CapillaryHomogenization:
         """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state."""
         if (sim.step, sim.time) != self._step or sim.contacts is not self._contacts:
             op = self.bridges
-            suction = (op.state(sim).suction if op.control == "volume" else op.suction)
+            suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
+                       else op.suction)
             state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
                                        suction=suction, contact_angle=op.contact_angle,
                                        surface_tension=op.surface_tension)

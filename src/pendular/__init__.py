@@ -9,6 +9,7 @@ dem <- capillary <- homogenize <- pendular <- scenarios):
 - preparation: ``PrepareConfig``, ``prepare_sample``;
 - test procedures: ``TriaxialConfig``, ``ShearConfig``, ``BridgeConfig``, ``TriaxialTest``,
   with the building blocks ``equilibrate``, ``wet``, ``TriaxialShear``, ``summarize``;
+  ``TensionConfig``, ``TensionTest``; campaigns of runs: ``Campaign``, ``Run``;
 - results: ``read_history``, ``read_summary``.
 
 Units are SI, stresses compression positive.
@@ -31,14 +32,16 @@ from dem.simulation import Simulation
 from dem.state import Particles, Walls
 from dem.walls import ConstantStrainRate, StressServo, WallForces
 
-from .config import BridgeConfig, ShearConfig, TriaxialConfig
+from .campaign import Campaign, Run
+from .config import BridgeConfig, ShearConfig, TensionConfig, TriaxialConfig
 from .io import read_history, read_summary
+from .tension import TensionTest
 from .triaxial import TriaxialShear, TriaxialTest, equilibrate, summarize, wet
 
 __all__ = [
-    "BridgeConfig", "CapillaryBridges", "ConstantStrainRate", "ContactForces",
-    "HistoryRecorder", "Integrator", "NeighborList", "Particles", "PrepareConfig",
-    "ShearConfig", "Simulation", "StressServo", "TriaxialConfig", "TriaxialShear",
-    "TriaxialTest", "WallForces", "Walls", "__version__", "equilibrate", "prepare_sample",
-    "read_history", "read_summary", "summarize", "wet",
+    "BridgeConfig", "Campaign", "CapillaryBridges", "ConstantStrainRate", "ContactForces",
+    "HistoryRecorder", "Integrator", "NeighborList", "Particles", "PrepareConfig", "Run",
+    "ShearConfig", "Simulation", "StressServo", "TensionConfig", "TensionTest",
+    "TriaxialConfig", "TriaxialShear", "TriaxialTest", "WallForces", "Walls", "__version__",
+    "equilibrate", "prepare_sample", "read_history", "read_summary", "summarize", "wet",
 ]

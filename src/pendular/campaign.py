@@ -1,13 +1,24 @@
 """Campaigns: many runs of configurations, in parallel processes or on a Dask cluster.
 
-A campaign is a list of ``Run`` (a name and a TriaxialConfig or TensionConfig built with
-``dataclasses.replace``). ``run_campaign(runs, out, ...)`` runs each into ``out/runs/<name>/``
-(its outputs, and log.txt with its progress bar), one Numba thread per run, and reuses a run
-whose folder holds a finished result of an equal configuration (``pendular.config.config_json``
-of the configuration stored with it), so an interrupted campaign goes on where it stopped. The
-campaign's progress bar shows each running run's own progress.
+A campaign is a list of runs, each a folder name and a TriaxialConfig or TensionConfig (built
+with ``dataclasses.replace``)::
 
-``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``):
+    base = TriaxialConfig(sample=PrepareConfig(particles=300), shear=ShearConfig(0.02))
+    runs = [Run(f"s{s:g}", dataclasses.replace(base, bridges=BridgeConfig(s))) for s in (1e4, 3e4)]
+    result = Campaign(runs).run("runs/mine", jobs=2)      # result.summaries["s10000"] ...
+
+``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
+progress bars), with ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned
+processes or on the Dask cluster of ``scheduler``. A run whose folder holds a finished result
+of an equal configuration (``pendular.config.config_json`` of the configuration stored with it:
+sample.h5 of a triaxial, tension.json of a tension test) is reused, so an interrupted campaign
+goes on where it stopped; so is a shared sample (``samples``) saved with an equal
+PrepareConfig. The campaign's progress bar shows each running run's own progress. A run that
+fails does not stop the others: ``CampaignResult.failed`` names it with its error. A run's
+summary is its summary.json (triaxial) or the scalars of its first case (tension: give each
+run one void ratio and one water content).
+
+``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 
     command = "triaxial"            # or "tension"
     [fixed]                         # options of the command, underscores for dashes
@@ -16,10 +27,15 @@ campaign's progress bar shows each running run's own progress.
     [sweep]                         # lists: every combination (cartesian product)
     suction = [0, 30000]
     confining = [250, 750]
-    # or explicit rows:  [[runs]]  suction = 0  confining = 250
+    # or explicit rows instead of [sweep] (a row's values override [fixed]):
+    # [[runs]]
+    # name = "loose"                # optional folder name
+    # prep_friction = 3
 
 Any option of the command can be fixed or swept; each run's configuration is built by the
-command's own option parser, so it is validated as on the command line.
+command's own option parser and ``config_from``, so it is validated as on the command line.
+Flags take true/false, list values are joined with commas (``table_resolution = [350, 80]``),
+a relative ``sample`` path is relative to the table's folder.
 """
 
 from __future__ import annotations
@@ -27,78 +43,116 @@ from __future__ import annotations
 import concurrent.futures
 import contextlib
 import csv
+import dataclasses
 import itertools
 import json
 import multiprocessing
 import os
 import re
-from dataclasses import dataclass
+import threading
+import traceback
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Callable, Union
 
 from tqdm import tqdm
 
 from dem.atomic import replacing
-from dem.preparation import prepare_sample
+from dem.preparation import PrepareConfig, prepare_sample
 from dem.sample import save_sample
+from dem.validate import check_int
 
-from .config import TriaxialConfig, config_json, config_to_dict
+from .config import TensionConfig, TriaxialConfig, config_json, config_to_dict
+from .tension import TensionTest
+from .triaxial import Interrupted, TriaxialTest, parameters
 
 #: Seconds between updates of the campaign's progress bar.
 PROGRESS_PERIOD = 5.0
+#: What a campaign runs.
+RunConfig = Union[TriaxialConfig, TensionConfig]
+#: Options a parameter table cannot set: the campaign decides them.
+CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after")
 
 
 @dataclass
 class Run:
-    """One run of a campaign: its folder name under ``out/runs`` and its configuration."""
+    """One run of a campaign: its folder name under ``out/runs`` and its configuration;
+    ``force``: run a triaxial refused as not quasi-static or too long (TriaxialTest)."""
 
     name: str
-    config: object
+    config: RunConfig
+    force: bool = False
+
+    def __post_init__(self):
+        if (not isinstance(self.name, str) or self.name in ("", ".", "..")
+                or os.sep in self.name or (os.altsep and os.altsep in self.name)):
+            raise ValueError(f"run name {self.name!r} is not a folder name (valid: a non-empty "
+                             "name without path separators)")
+        if not isinstance(self.config, (TriaxialConfig, TensionConfig)):
+            raise TypeError(f"run {self.name}: config must be a TriaxialConfig or TensionConfig,"
+                            f" got {type(self.config).__name__}")
 
 
-def _tension():
-    from . import tension          # the tension test, imported where a campaign needs it
-    return tension
+@dataclass
+class CampaignResult:
+    """What ``Campaign.run`` did: ``summaries`` {name: summary dict} of the finished runs (run
+    now or reused), ``reused`` the names of the reused ones, ``failed`` {name: error text} (the
+    traceback is in the run's log.txt)."""
+
+    runs: list[Run]
+    summaries: dict[str, dict] = field(default_factory=dict)
+    reused: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+
+    def check(self) -> None:
+        """ValueError naming every failed run and its error (nothing when none failed)."""
+        if self.failed:
+            raise ValueError(f"{len(self.failed)} of {len(self.runs)} runs failed: " + "; ".join(
+                f"{name}: {error}" for name, error in self.failed.items()))
 
 
 # ---------------------------------------------------------------- workers (top level: picklable)
 
-def run_one(config, folder):
-    """Worker: the test of ``config`` into ``folder`` with one Numba thread, its output and
-    progress bar in ``folder``/log.txt; returns its summary (dict)."""
+def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False) -> dict:
+    """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads, its output
+    and progress bars in ``folder``/log.txt (with the traceback if it fails); its summary."""
     import numba
 
-    from .triaxial import TriaxialTest
-
-    numba.set_num_threads(1)
+    numba.set_num_threads(threads)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
-        if isinstance(config, TriaxialConfig):
-            return TriaxialTest(config).run(folder, threads=1)
-        return tension_summary(_tension().TensionTest(config).run(folder))
+        try:
+            if isinstance(config, TriaxialConfig):
+                return TriaxialTest(config, force=force).run(folder, threads=threads)
+            return tension_summary(TensionTest(config).run(folder))
+        except BaseException:
+            traceback.print_exc()
+            raise
 
 
-def prepare_one(sample, path):
+def prepare_one(sample: PrepareConfig, path: str, threads: int = 1) -> str:
     """Worker: prepare the sample of ``sample`` (a PrepareConfig) and save it at ``path`` with
     its configuration (``{"sample": config_to_dict(sample)}``)."""
     import numba
 
-    numba.set_num_threads(1)
-    sim, report = prepare_sample(sample, progress=False, threads=1)
+    numba.set_num_threads(threads)
+    sim, report = prepare_sample(sample, progress=False, threads=threads)
     save_sample(path, sim, report, {"sample": config_to_dict(sample)},
                 identity={"seed": sample.seed})
     return path
 
 
-def tension_summary(result):
-    """One summary row of a tension run: its first case's scalars (a campaign run holds one
-    void ratio and one water content)."""
+def tension_summary(result: dict) -> dict:
+    """One summary row of a tension run: its first case's scalars (a campaign run of the
+    tension command holds one void ratio and one water content)."""
     case = result["cases"][0]
     return {k: v for k, v in case.items() if isinstance(v, (int, float, str, bool))}
 
 
 # ---------------------------------------------------------------- reuse
 
-def stored_config(path, key):
+def stored_config(path: str, key: str) -> dict | None:
     """The configuration dict stored under ``key`` in the config attribute of a pendular HDF5
     file (sample.h5), or None when absent or unreadable."""
     import h5py
@@ -108,17 +162,21 @@ def stored_config(path, key):
     try:
         with h5py.File(path, "r") as handle:
             return json.loads(handle.attrs["config"]).get(key)
-    except (OSError, KeyError, ValueError):
+    except (OSError, KeyError, ValueError, AttributeError):
         return None
 
 
-def sample_made_with(path, sample):
+def same_config(stored: dict | None, config: Any) -> bool:
+    """Whether a stored configuration dict equals ``config`` (``config_json``)."""
+    return stored is not None and json.dumps(stored, sort_keys=True) == config_json(config)
+
+
+def sample_made_with(path: str, sample: PrepareConfig) -> bool:
     """Whether the saved sample ``path`` was prepared with the PrepareConfig ``sample``."""
-    stored = stored_config(path, "sample")
-    return stored is not None and json.dumps(stored, sort_keys=True) == config_json(sample)
+    return same_config(stored_config(path, "sample"), sample)
 
 
-def finished_summary(config, folder):
+def finished_summary(config: RunConfig, folder: str) -> dict | None:
     """The summary of a run of ``folder`` that finished with an equal configuration, or None."""
     if isinstance(config, TriaxialConfig):
         summary_path = os.path.join(folder, "summary.json")
@@ -126,15 +184,17 @@ def finished_summary(config, folder):
     else:
         summary_path = os.path.join(folder, "tension.json")
         stored = None
-        if os.path.isfile(summary_path):
-            with open(summary_path) as handle:
-                stored = json.load(handle).get("config")
-    if stored is None or not os.path.isfile(summary_path):
+    if not os.path.isfile(summary_path):
         return None
-    if json.dumps(stored, sort_keys=True) != config_json(config):
+    try:
+        with open(summary_path) as handle:
+            summary = json.load(handle)
+    except (OSError, ValueError):
         return None
-    with open(summary_path) as handle:
-        summary = json.load(handle)
+    if isinstance(config, TensionConfig):
+        stored = summary.get("config")
+    if not same_config(stored, config):
+        return None
     if isinstance(config, TriaxialConfig):
         return summary if summary.get("completed", True) else None
     return tension_summary(summary)
@@ -143,16 +203,21 @@ def finished_summary(config, folder):
 # ---------------------------------------------------------------- execution
 
 @contextlib.contextmanager
-def executor(jobs, scheduler=None):
+def executor(jobs: int, scheduler: str | None = None):
     """Where the runs go: None (here, one after the other), a spawn process pool of ``jobs``
-    workers, or the concurrent.futures executor of the Dask cluster at ``scheduler``."""
+    workers, or the concurrent.futures executor of the Dask cluster at ``scheduler``. On an
+    exception (Ctrl-C) the runs not started are cancelled."""
     if scheduler is not None:
         try:
             from dask.distributed import Client
         except ImportError:
             raise ValueError("--scheduler needs dask.distributed: pip install "
                              "'pendular[dask]'") from None
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler)
+        except (OSError, ValueError) as error:
+            raise ValueError(f"--scheduler {scheduler!r}: cannot connect ({error})") from None
+        with client:
             pool = client.get_executor(pure=False)
             try:
                 yield pool
@@ -162,13 +227,19 @@ def executor(jobs, scheduler=None):
         yield None
     else:
         # fresh interpreters (no fork of a running Numba threading layer)
-        with concurrent.futures.ProcessPoolExecutor(
-                jobs, mp_context=multiprocessing.get_context("spawn")) as pool:
+        pool = concurrent.futures.ProcessPoolExecutor(
+            jobs, mp_context=multiprocessing.get_context("spawn"))
+        try:
             yield pool
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
 
 
-def run_progress(folder):
-    """The last progress a run's log.txt shows ('shear 42%', 'wet 1234step'), or ''."""
+def run_progress(folder: str) -> str:
+    """The last progress a run's log.txt shows: 'shear 42%', or for an open-ended phase its
+    steps and what it waits for ('wet 1200step unbalanced=0.02/0.01'); '' if none."""
     try:
         with open(os.path.join(folder, "log.txt"), "rb") as handle:
             handle.seek(0, os.SEEK_END)
@@ -177,61 +248,173 @@ def run_progress(folder):
     except OSError:
         return ""
     for line in reversed(re.split(r"[\r\n]+", tail)):
-        match = re.match(r"\s*(\w[\w ]*?):\s*(\d+%|\d+step)", line)
+        match = re.match(r"\s*(\w[\w ]*?):\s*(\d+%|\d+step)(.*)", line)
         if match:
-            return f"{match.group(1)} {match.group(2)}"
+            text = f"{match.group(1)} {match.group(2)}"
+            if match.group(2).endswith("step"):
+                waits = re.findall(r"(\w+=[^,\]\s]+)", match.group(3))
+                text += "".join(" " + item for item in waits[:2])
+            return text
     return ""
 
 
-def map_tasks(pool, function, tasks, description, quiet=False):
+def map_tasks(pool, function: Callable, tasks: Sequence[tuple], *, description: str,
+              folders: Sequence[str] | None = None, quiet: bool = False):
     """``function(*task)`` for every task (in ``pool`` or here) with a progress bar whose status
-    shows each running run's own progress (tasks whose last item is a folder); the results in
-    the order of ``tasks``."""
-    results = [None] * len(tasks)
+    shows each running task's own progress (the log.txt of its folder in ``folders``).
+    Returns (results in the order of ``tasks``, {index: error text} of the tasks that failed)."""
+    results: list = [None] * len(tasks)
+    errors: dict[int, str] = {}
     if not tasks:
-        return results
+        return results, errors
+    names = [os.path.basename(str(f)) for f in folders] if folders else [""] * len(tasks)
+
+    def status(indices):
+        if not folders:
+            return ""
+        return ", ".join(f"{names[i]} {p}".strip() for i in indices
+                         for p in [run_progress(folders[i])])
+
     with tqdm(total=len(tasks), desc=description, unit="run", disable=quiet) as bar:
         if pool is None:
             for index, task in enumerate(tasks):
-                bar.set_postfix_str(os.path.basename(str(task[-1])))
-                results[index] = function(*task)
+                bar.set_postfix_str(names[index])
+                with _watching(bar, lambda i=index: status([i]), quiet):
+                    try:
+                        results[index] = function(*task)
+                    except Interrupted:          # Ctrl-C in a run here stops the campaign
+                        raise KeyboardInterrupt from None
+                    except Exception as error:   # noqa: BLE001 - reported per run
+                        errors[index] = _error_text(error)
                 bar.update()
-            return results
+            return results, errors
         pending = {pool.submit(function, *task): i for i, task in enumerate(tasks)}
-        while pending:
-            done, _ = concurrent.futures.wait(pending, timeout=PROGRESS_PERIOD,
-                                              return_when=concurrent.futures.FIRST_COMPLETED)
-            for future in done:
-                results[pending.pop(future)] = future.result()
-                bar.update()
-            running = (tasks[i][-1] for i in sorted(pending.values()))
-            bar.set_postfix_str(", ".join(f"{os.path.basename(str(f))} {p}" for f in running
-                                          for p in [run_progress(f)] if p))
-    return results
+        try:
+            while pending:
+                done, _ = concurrent.futures.wait(pending, timeout=PROGRESS_PERIOD,
+                                                  return_when=concurrent.futures.FIRST_COMPLETED)
+                for future in done:
+                    index = pending.pop(future)
+                    try:
+                        results[index] = future.result()
+                    except Exception as error:   # noqa: BLE001 - reported per run
+                        errors[index] = _error_text(error)
+                    bar.update()
+                bar.set_postfix_str(status(sorted(pending.values())))
+        except BaseException:
+            for future in pending:
+                future.cancel()
+            raise
+    return results, errors
 
 
-def run_campaign(runs, out, *, jobs=1, scheduler=None, quiet=False, samples=()):
-    """Run every ``Run`` into ``out``/runs/<name> (reusing finished ones); ``samples``: (sample
-    PrepareConfig, path) pairs to prepare first unless already there. Returns ({name:
-    summary}, number of runs reused)."""
-    folders = {run.name: os.path.join(out, "runs", run.name) for run in runs}
-    summaries = {run.name: finished_summary(run.config, folders[run.name]) for run in runs}
-    todo = [run for run in runs if summaries[run.name] is None]
-    preparations = [(sample, path) for sample, path in samples
-                    if not sample_made_with(path, sample)]
-    for _, path in preparations:
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-    with executor(jobs, scheduler) as pool:
-        map_tasks(pool, prepare_one, preparations, "prepare", quiet)
-        results = map_tasks(pool, run_one, [(run.config, folders[run.name]) for run in todo],
-                            "runs", quiet)
-    summaries.update({run.name: result for run, result in zip(todo, results)})
-    return summaries, len(runs) - len(todo)
+def _error_text(error: BaseException) -> str:
+    text = str(error).strip().splitlines()
+    return f"{type(error).__name__}: {text[-1] if text else ''}".rstrip(": ")
+
+
+@contextlib.contextmanager
+def _watching(bar, status: Callable[[], str], quiet: bool):
+    """While a task runs here, refresh ``bar``'s status from ``status()`` every
+    PROGRESS_PERIOD seconds (a reader thread; the run keeps the main thread and Ctrl-C)."""
+    if quiet:
+        yield
+        return
+    stop = threading.Event()
+
+    def watch():
+        while not stop.wait(PROGRESS_PERIOD):
+            bar.set_postfix_str(status())
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        watcher.join()
+
+
+class Campaign:
+    """Runs (``Run`` or (name, config) pairs, names unique) and the shared samples they start
+    from (``samples``: (PrepareConfig, path) pairs, prepared first unless saved with an equal
+    configuration); ``run(out)`` (module docstring)."""
+
+    def __init__(self, runs: Iterable[Run | tuple[str, RunConfig]],
+                 samples: Iterable[tuple[PrepareConfig, str]] = ()):
+        self.runs = [run if isinstance(run, Run) else Run(*run) for run in runs]
+        names = [run.name for run in self.runs]
+        repeated = sorted({name for name in names if names.count(name) > 1})
+        if repeated:
+            raise ValueError(f"run names must be unique: {', '.join(repeated)} repeated")
+        self.samples = [(sample, os.fspath(path)) for sample, path in samples]
+        for sample, _ in self.samples:
+            if not isinstance(sample, PrepareConfig):
+                raise TypeError(f"samples: a PrepareConfig expected, got "
+                                f"{type(sample).__name__}")
+
+    def folder(self, out: str, name: str) -> str:
+        """The folder of run ``name``."""
+        return os.path.join(out, "runs", name)
+
+    def run(self, out: str, *, jobs: int = 1, scheduler: str | None = None, threads: int = 1,
+            quiet: bool = False) -> CampaignResult:
+        """Run every run into ``out``/runs/<name> (reusing finished ones) with ``threads``
+        Numba threads each, in ``jobs`` local processes or on the Dask cluster at
+        ``scheduler`` (its workers must see ``out`` at the same path). Every configuration
+        still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
+        tables), so a bad one is refused before anything runs."""
+        jobs = check_int("jobs", jobs, low=1)
+        threads = check_int("threads", threads, low=1)
+        out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
+        result = CampaignResult(self.runs)
+        todo = []
+        for run in self.runs:
+            summary = finished_summary(run.config, self.folder(out, run.name))
+            if summary is None:
+                todo.append(run)
+            else:
+                result.summaries[run.name] = summary
+                result.reused.append(run.name)
+        for run in todo:
+            if isinstance(run.config, TriaxialConfig):
+                try:
+                    TriaxialTest(run.config, force=run.force)
+                except ValueError as error:
+                    raise ValueError(f"run {run.name}: {error}") from None
+        preparations = [(sample, path) for sample, path in self.samples
+                        if not sample_made_with(path, sample)]
+        for _, path in preparations:
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+        with executor(jobs, scheduler) as pool:
+            _, errors = map_tasks(pool, prepare_one,
+                                  [(sample, path, threads) for sample, path in preparations],
+                                  description="prepare", quiet=quiet)
+            unprepared = {os.path.abspath(preparations[i][1]): text
+                          for i, text in errors.items()}
+            for run in list(todo):
+                path = getattr(run.config, "sample_path", None)
+                if path is not None and os.path.abspath(path) in unprepared:
+                    todo.remove(run)
+                    result.failed[run.name] = (f"its sample {path} could not be prepared: "
+                                               f"{unprepared[os.path.abspath(path)]}")
+            folders = [self.folder(out, run.name) for run in todo]
+            results, errors = map_tasks(
+                pool, run_one, [(run.config, folder, threads, run.force)
+                                for run, folder in zip(todo, folders)],
+                description="runs", folders=folders, quiet=quiet)
+        for index, (run, summary) in enumerate(zip(todo, results)):
+            if index in errors:
+                result.failed[run.name] = (f"{errors[index]} (log: "
+                                           f"{os.path.join(folders[index], 'log.txt')})")
+            else:
+                result.summaries[run.name] = summary
+        return result
 
 
 # ---------------------------------------------------------------- parameter tables
 
-def read_table(path):
+def read_table(path: str | os.PathLike) -> dict:
     """The TOML table at ``path`` as a dict (ValueError naming the path when unreadable)."""
     try:
         import tomllib
@@ -245,24 +428,33 @@ def read_table(path):
                          f"{error}") from None
 
 
-def table_rows(table, source):
-    """(command, [options dict per run]) of a parameter table (module docstring)."""
+def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str]]]:
+    """(command, [options dict per run], [the keys each run varies]) of a parameter table
+    (module docstring); ValueError starting with ``source``."""
     unknown = set(table) - {"command", "fixed", "sweep", "runs"}
     if unknown:
-        raise ValueError(f"{source}: unknown table key(s) {sorted(unknown)}; valid: command, "
-                         "fixed, sweep, runs")
+        raise ValueError(f"{source}: unknown table key(s) {', '.join(sorted(unknown))}; valid: "
+                         "command, fixed, sweep, runs")
     command = table.get("command", "triaxial")
     if command not in ("triaxial", "tension"):
         raise ValueError(f"{source}: command = {command!r} is not one of 'triaxial', "
                          "'tension'")
+    for key in ("fixed", "sweep"):
+        if not isinstance(table.get(key, {}), dict):
+            raise ValueError(f"{source}: {key} must be a table ([{key}])")
     fixed = dict(table.get("fixed", {}))
     sweep = table.get("sweep", {})
     explicit = table.get("runs", [])
+    if not isinstance(explicit, list) or not all(isinstance(r, dict) for r in explicit):
+        raise ValueError(f"{source}: runs must be an array of tables ([[runs]])")
     if sweep and explicit:
         raise ValueError(f"{source}: give [sweep] or [[runs]], not both")
     for name, values in sweep.items():
         if not isinstance(values, list) or not values:
             raise ValueError(f"{source}: sweep.{name} = {values!r} is not a non-empty list")
+    both = sorted(set(fixed) & set(sweep))
+    if both:
+        raise ValueError(f"{source}: {', '.join(both)} both in [fixed] and in [sweep]")
     if sweep:
         names = list(sweep)
         rows = [dict(zip(names, combination))
@@ -272,21 +464,28 @@ def table_rows(table, source):
     return command, [{**fixed, **row} for row in rows], [list(row) for row in rows]
 
 
-def run_name(row, varied):
-    """Folder name of a run: its varied options, e.g. 'suction30000_confining250'."""
-    if not varied:
+def run_name(row: dict, varied: Sequence[str]) -> str:
+    """Folder name of a run: its ``name`` key, else its varied options, e.g.
+    'suction30000_confining250' ('run' when nothing varies)."""
+    if "name" in row:
+        return str(row["name"])
+    keys = [key for key in varied if key != "name"]
+    if not keys:
         return "run"
-    return "_".join(f"{key}{_text(row[key])}" for key in varied)
+    return "_".join(f"{key}{_text(row[key])}" for key in keys)
 
 
-def _text(value):
+def _text(value: Any) -> str:
+    if isinstance(value, list):
+        return "-".join(_text(v) for v in value)
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return re.sub(r"[^\w.+-]", "-", str(value))
 
 
-def options_argv(options):
-    """Command-line options of a table row (underscores -> dashes; true flags; lists joined)."""
+def options_argv(options: dict) -> list[str]:
+    """Command-line options of a table row (underscores -> dashes; true flags; lists joined
+    with commas)."""
     argv = []
     for key, value in options.items():
         flag = "--" + key.replace("_", "-")
@@ -299,46 +498,78 @@ def options_argv(options):
     return argv
 
 
-def sweep_from_table(path):
+class _Refused(Exception):
+    """argparse's error, raised instead of printed (parser.error replaced)."""
+
+
+def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
     """(command, [Run]) of the TOML table at ``path``; each run's configuration is parsed and
-    validated by the command's own options (ValueError naming the run and the option)."""
-    from .cli import command_parser
+    validated by the command's own options (ValueError naming the table, the run and the
+    option)."""
+    from .cli import UsageError, command_parser
 
     source = f"table = {os.fspath(path)!r}"
     command, rows, varied = table_rows(read_table(path), source)
     parser, module = command_parser(command)
-    known = set(vars(parser.parse_args([])))
+
+    def refuse(message):
+        raise _Refused(message)
+
+    parser.error = refuse
+    known = set(vars(parser.parse_args([]))) - set(CAMPAIGN_OPTIONS)
+    keys = {key for row in rows for key in row} - {"name"}
+    unknown = sorted(keys - known)
+    if unknown:
+        reserved = [k for k in unknown if k in CAMPAIGN_OPTIONS]
+        raise ValueError(f"{source}: {command} has no option(s) "
+                         f"{', '.join('--' + k.replace('_', '-') for k in unknown)} in a table"
+                         + (f" ({', '.join(reserved)}: set by the campaign)" if reserved else "")
+                         + f"; see 'pendular {command} --help'")
+    folder = os.path.dirname(os.path.abspath(os.fspath(path)))
     runs = []
     for row, keys in zip(rows, varied):
-        unknown = sorted(set(row) - known)
-        if unknown:
-            raise ValueError(f"{source}: {command} has no option(s) "
-                             f"{', '.join('--' + k.replace('_', '-') for k in unknown)}")
         name = run_name(row, keys)
+        options = {k: v for k, v in row.items() if k != "name"}
         try:
-            args = parser.parse_args(options_argv(row))
-        except SystemExit:
-            raise ValueError(f"{source}: run {name}: options {row} are not valid for "
-                             f"{command} (see 'pendular {command} --help')") from None
-        try:
+            args = parser.parse_args(options_argv(options))
             config = module.config_from(args)
-        except ValueError as error:
+        except _Refused as error:
             raise ValueError(f"{source}: run {name}: {error}") from None
-        runs.append(Run(name, config))
+        except (ValueError, UsageError) as error:      # the command's own checks
+            raise ValueError(f"{source}: run {name}: {error}") from None
+        sample = getattr(config, "sample_path", None)
+        if sample is not None and not os.path.isabs(sample):
+            config = dataclasses.replace(config, sample_path=os.path.join(folder, sample))
+        runs.append(Run(name, config, force=bool(getattr(args, "force", False))))
+    names = [run.name for run in runs]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise ValueError(f"{source}: runs {', '.join(repeated)} repeat a folder name: give "
+                         "each [[runs]] row a distinct name or distinct values")
     return command, runs
 
 
-def write_campaign_csv(path, runs, summaries):
-    """``path``: one row per run with its options (flat) and its summary's scalars."""
-    from .triaxial import parameters
+def run_options(config: RunConfig) -> dict:
+    """A run's options, flat and named as the command's (campaign.csv columns; a tension run's
+    void ratio and water content are its summary's ``*_target`` columns)."""
+    if isinstance(config, TriaxialConfig):
+        return parameters(config)
+    return {k: v for k, v in config_to_dict(config)["fields"].items() if k != "cases"}
 
+
+def write_campaign_csv(path: str, result: CampaignResult) -> None:
+    """``path``: one row per run of ``result``: its name, status (run, reused, failed), its
+    options (flat) and its summary's scalars (the error of a failed run)."""
     rows = []
-    for run in runs:
-        options = (parameters(run.config) if isinstance(run.config, TriaxialConfig) else
-                   {k: v for k, v in vars(run.config).items() if k != "cases"})
-        summary = {k: v for k, v in (summaries.get(run.name) or {}).items()
+    for run in result.runs:
+        summary = {k: v for k, v in (result.summaries.get(run.name) or {}).items()
                    if isinstance(v, (int, float, str, bool)) or v is None}
-        rows.append({"run": run.name, **options, **summary})
+        status = ("failed" if run.name in result.failed else
+                  "reused" if run.name in result.reused else "run")
+        row = {"run": run.name, "status": status, **run_options(run.config), **summary}
+        if run.name in result.failed:
+            row["error"] = result.failed[run.name]
+        rows.append(row)
     columns = list(dict.fromkeys(key for row in rows for key in row))
     with replacing(path) as temporary, open(temporary, "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=columns)

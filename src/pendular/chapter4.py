@@ -17,6 +17,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from dem.atomic import write_text
+from dem.validate import check_int
 from homogenize import packing_state, regular_packing
 from homogenize.cell_bridge import largest_filling_angle
 
@@ -365,9 +366,10 @@ def save(fig, out, name):
     print(f"  wrote {name}", flush=True)
 
 
-def write_chapter4(out, points=40):
+def write_chapter4(out: str, points: int = 40) -> None:
     """Tables (printed and DIR/chapter4_tables.txt) and figures of thesis Chapter 4 into
-    ``out``; ``points`` states per curve."""
+    ``out``; ``points`` states per curve (10-400)."""
+    check_int("points", points, low=10, high=400)
     os.makedirs(out, exist_ok=True)
     start = time.time()
     sections = [table_4_1(), pendular_limits(), high_suction_limits(), crossovers(), anisotropy_at_limits(),

@@ -10,9 +10,10 @@ starts from its sample (TriaxialConfig.sample_path) in DIR/runs/s{suction}_c{con
 the outputs of pendular.triaxial (history.h5, summary.json, plots, vtk, sample.h5, log.txt with
 the run's progress bar). Preparations and tests run through pendular.campaign: --jobs parallel
 processes, or the Dask cluster of --scheduler (its workers must see the same file system and
-should run one thread each: ``dask worker ADDRESS --nthreads 1``), one Numba thread per run.
-Run again with the same DIR, a campaign reuses its samples and the runs that finished with an
-equal configuration (an interrupted campaign goes on where it stopped).
+should run one thread each: ``dask worker ADDRESS --nthreads 1``), one Numba thread per run
+(--threads). Run again with the same DIR, a campaign reuses its samples and the runs that
+finished with an equal configuration (an interrupted campaign goes on where it stopped); a run
+that fails does not stop the others, and the campaign then ends naming it.
 
 DIR/campaign.json: ``runs`` (suction, confining, peak_axial_stress, peak_q, p_at_peak,
 saturation_at_peak, peak_q_effective, p_effective_at_peak; a dry run's effective values are its
@@ -21,9 +22,11 @@ peak and {phi_eff_deg, cohesion_eff} to (p', q') at peak (Eq. 3.43; dem.envelope
 suction has at least two confining stresses. DIR/report.md compares with thesis Table 5.3 and
 Fig. 5.5. DIR/plots/ (chapter5_figures): envelopes.png (Figs. 5.4, 5.6), q_ev.png (5.3),
 q_p_effective.png (5.7), polar_psi.png (5.5), polar_fabric.png, anisotropy.png (5.8).
+DIR/campaign.csv: one row per run, its options and its whole summary (pendular.campaign).
 """
 
-import dataclasses
+from __future__ import annotations
+
 import math
 import os
 from dataclasses import dataclass
@@ -34,12 +37,11 @@ import numpy as np
 from dem.atomic import write_json, write_text
 from dem.preparation import PrepareConfig
 
-from .campaign import Run, read_table, run_campaign
+from .campaign import Campaign, Run, read_table, write_campaign_csv
 from .chapter5_figures import campaign_figures
 from .config import BridgeConfig, ShearConfig, TriaxialConfig
 from .envelope import mohr_coulomb_fit
 from .reference import DRY_FRICTION_DEG, FIG_5_5, TABLE_5_3
-from .triaxial import TriaxialTest
 
 #: Strain at which Sr is also reported (Fig. 5.5's horizontal axis ends there).
 LATE_STRAIN = 0.20
@@ -52,8 +54,8 @@ class Chapter5Grid:
     """The campaign's grid: suctions and confining stresses [Pa] (every combination) and the
     settings shared by every run (thesis Table 5.2 otherwise)."""
 
-    suctions: list
-    confining: list
+    suctions: list[float]
+    confining: list[float]
     particles: int = 10000
     seed: int = 0
     max_strain: float = 0.25
@@ -75,23 +77,38 @@ class Chapter5Grid:
             setattr(self, name, values)
 
     @classmethod
-    def from_table(cls, path=TABLE, **overrides):
-        """The grid of a campaign table ([sweep] suction and confining lists, [fixed] settings),
-        with ``overrides`` (None values ignored)."""
+    def from_table(cls, path: str = TABLE, **overrides) -> Chapter5Grid:
+        """The grid of a campaign table (``command = "triaxial"``, [sweep] suction and
+        confining lists, [fixed] particles, seed, max_strain, inertial_number, prep_friction),
+        with ``overrides`` (keyword arguments of Chapter5Grid; None values ignored). ValueError
+        naming the table and any other key."""
         table = read_table(path)
         fixed, sweep = table.get("fixed", {}), table.get("sweep", {})
+        settings = ("particles", "seed", "max_strain", "inertial_number", "prep_friction")
+        unknown = ([f"command = {table['command']!r}"] if table.get("command", "triaxial")
+                   != "triaxial" else [])
+        unknown += [k for k in table if k not in ("command", "fixed", "sweep")]
+        unknown += [f"fixed.{k}" for k in fixed if k not in settings]
+        unknown += [f"sweep.{k}" for k in sweep if k not in ("suction", "confining")]
+        if unknown:
+            raise ValueError(f"table = {os.fspath(path)!r}: a Chapter 5 grid has no "
+                             f"{', '.join(unknown)} (valid: [sweep] suction, confining; [fixed] "
+                             f"{', '.join(settings)})")
         values = {"suctions": sweep.get("suction"), "confining": sweep.get("confining"),
-                  **{k: fixed[k] for k in ("particles", "seed", "max_strain", "inertial_number",
-                                           "prep_friction") if k in fixed}}
+                  **{k: fixed[k] for k in settings if k in fixed}}
         values.update({k: v for k, v in overrides.items() if v is not None})
+        for name in ("suctions", "confining"):
+            if values[name] is None:
+                raise ValueError(f"table = {os.fspath(path)!r}: no {name} (give [sweep] "
+                                 f"{name.rstrip('s')} = [...] or --{name})")
         return cls(**values)
 
-    def sample(self, confining):
+    def sample(self, confining: float) -> PrepareConfig:
         """The PrepareConfig of the sample at ``confining`` [Pa]."""
         return PrepareConfig(particles=self.particles, confining=confining, seed=self.seed,
                              prep_friction_deg=self.prep_friction)
 
-    def run(self, suction, confining, out):
+    def run(self, suction: float, confining: float, out: str) -> TriaxialConfig:
         """The TriaxialConfig of one cell, starting from its sample."""
         return TriaxialConfig(
             sample=self.sample(confining),
@@ -228,21 +245,32 @@ def run_row(suction, lateral, summary, folder, out):
             "folder": os.path.relpath(folder, out)}
 
 
-def chapter5_campaign(grid, out, *, jobs=1, scheduler=None, quiet=False):
-    """Run the campaign of ``grid`` (Chapter5Grid) into ``out``; writes campaign.json,
-    report.md and plots/ (module docstring); returns (campaign dict, runs reused)."""
+def chapter5_campaign(grid: Chapter5Grid, out: str, *, jobs: int = 1,
+                      scheduler: str | None = None, threads: int = 1,
+                      quiet: bool = False) -> tuple[dict, int]:
+    """Run the campaign of ``grid`` (Chapter5Grid) into ``out`` (``jobs`` local processes or
+    the Dask cluster at ``scheduler``, ``threads`` Numba threads per run); writes
+    campaign.json, campaign.csv, report.md and plots/ (module docstring); returns (campaign
+    dict, runs reused). ValueError naming the runs that failed (the others are kept and
+    reused when started again)."""
+    given_out = out
     out = os.path.abspath(out)          # workers elsewhere see the same paths
     tests = [(s, c) for s in grid.suctions for c in grid.confining]
     runs = [Run(os.path.basename(run_folder(out, s, c)), grid.run(s, c, out)) for s, c in tests]
-    for run in runs:                    # refuse bad input here, not in a worker
-        TriaxialTest(run.config)
     samples = [(grid.sample(c), sample_path(out, c)) for c in grid.confining]
-    summaries, reused = run_campaign(runs, out, jobs=jobs, scheduler=scheduler, quiet=quiet,
-                                     samples=samples)
-    rows = [run_row(s, c, summaries[run.name], run_folder(out, s, c), out)
+    result = Campaign(runs, samples).run(out, jobs=jobs, scheduler=scheduler, threads=threads,
+                                         quiet=quiet)
+    write_campaign_csv(os.path.join(out, "campaign.csv"), result)
+    result.check()
+    rows = [run_row(s, c, result.summaries[run.name], run_folder(out, s, c), out)
             for (s, c), run in zip(tests, runs)]
     fits = envelopes(rows)
-    campaign = {"arguments": dataclasses.asdict(grid), "runs": rows, "envelopes": fits,
+    arguments = {"particles": grid.particles, "suctions": grid.suctions,
+                 "confining": grid.confining, "jobs": jobs, "out": os.fspath(given_out),
+                 "seed": grid.seed, "max_strain": grid.max_strain,
+                 "inertial_number": grid.inertial_number, "prep_friction": grid.prep_friction,
+                 "scheduler": scheduler}
+    campaign = {"arguments": arguments, "runs": rows, "envelopes": fits,
                 "thesis": {"table_5_3": [{"suction": s, "confining": c, "peak_axial_stress": v}
                                          for (s, c), v in TABLE_5_3.items()],
                            "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
@@ -250,4 +278,4 @@ def chapter5_campaign(grid, out, *, jobs=1, scheduler=None, quiet=False):
     write_json(os.path.join(out, "campaign.json"), campaign)
     figures = campaign_figures(out, rows, fits, label, LATE_STRAIN)
     write_report(os.path.join(out, "report.md"), rows, fits, grid, figures, out)
-    return campaign, reused
+    return campaign, len(result.reused)

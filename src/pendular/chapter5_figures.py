@@ -2,7 +2,7 @@
 
 Every function takes the campaign's ``runs`` rows (pendular.chapter5) or the histories
 read by ``load_histories`` and writes one PNG. Stresses in the histories are compression
-positive [Pa]; the figures show kPa where the thesis does.
+positive [Pa]; the figures show stresses in kPa and strains in %.
 """
 
 import math
@@ -12,6 +12,7 @@ import h5py
 import numpy as np
 
 from homogenize.fabric import principal_anisotropy
+from homogenize.invariants import deviator_stress, mean_stress
 
 from .plots import pyplot, save_figure
 
@@ -32,12 +33,12 @@ def load_histories(out, runs):
 
 
 def invariants(sigma):
-    """(p, q) [Pa] of (rows, 3) principal stresses or (rows, 3, 3) tensors, z axial:
-    p = tr / 3, q = s_z - (s_x + s_y) / 2."""
+    """(p, q) [Pa] of (rows, 3) principal stresses or (rows, 3, 3) tensors (their diagonals),
+    z axial (homogenize.invariants)."""
     sigma = np.asarray(sigma)
     if sigma.ndim == 3:
         sigma = np.diagonal(sigma, axis1=1, axis2=2)
-    return sigma.sum(axis=1) / 3.0, sigma[:, 2] - 0.5 * (sigma[:, 0] + sigma[:, 1])
+    return mean_stress(sigma), deviator_stress(sigma)
 
 
 def effective_invariants(history):
@@ -66,13 +67,13 @@ def plot_curves(path, histories, confining):
         if lateral != confining:
             continue
         _, q = invariants(history["sigma_wall"])
-        top.plot(history["axial_strain"], q / 1000, label=_suction_label(suction))
-        bottom.plot(history["axial_strain"], history["volumetric_strain"])
+        top.plot(100 * history["axial_strain"], q / 1000, label=_suction_label(suction))
+        bottom.plot(100 * history["axial_strain"], 100 * history["volumetric_strain"])
     top.set_ylabel("q [kPa]")
-    top.set_title(f"lateral stress {confining:g} Pa (thesis Fig. 5.3)")
+    top.set_title(f"lateral stress {confining / 1000:g} kPa (thesis Fig. 5.3)")
     top.legend(fontsize=8)
-    bottom.set_ylabel("volumetric strain (contraction +)")
-    bottom.set_xlabel("axial strain")
+    bottom.set_ylabel("volumetric strain [%] (contraction +)")
+    bottom.set_xlabel("axial strain [%]")
     return save_figure(figure, path)
 
 
@@ -85,7 +86,7 @@ def plot_effective_curves(path, histories, confining):
     for index, ((suction, lateral), history) in enumerate(sorted(histories.items())):
         if lateral != confining:
             continue
-        strain = history["axial_strain"]
+        strain = 100 * history["axial_strain"]
         p, q = invariants(history["sigma_wall"])
         if suction == 0:
             axes.plot(strain, q / p, "k-", lw=2, label="dry")
@@ -94,9 +95,9 @@ def plot_effective_curves(path, histories, confining):
         axes.plot(strain, q / p, ":", color=f"C{index}", label=f"net, {_suction_label(suction)}")
         axes.plot(strain, q_eff / p_eff, "-", color=f"C{index}",
                   label=f"effective, {_suction_label(suction)}")
-    axes.set_xlabel("axial strain")
+    axes.set_xlabel("axial strain [%]")
     axes.set_ylabel("q/p, q'/p'")
-    axes.set_title(f"lateral stress {confining:g} Pa (thesis Fig. 5.7)")
+    axes.set_title(f"lateral stress {confining / 1000:g} kPa (thesis Fig. 5.7)")
     axes.legend(fontsize=7)
     return save_figure(figure, path)
 
@@ -135,20 +136,20 @@ def polar_figures(folder, histories, confining, strain):
     chosen = [(suction, history) for (suction, lateral), history in sorted(histories.items())
               if lateral == confining]
     paths = []
+    at = f"at axial strain {100 * strain:g} %, lateral stress {confining / 1000:g} kPa"
     wet = [(s, h) for s, h in chosen if "psi" in h]
     if wet:
         series = [(f"{_suction_label(s)}, Sr = {100 * h['saturation'][record_at(h, strain)]:.2f} %",
                    h["psi"][record_at(h, strain)] / 1000) for s, h in wet]
         paths.append(plot_polar(os.path.join(folder, "polar_psi.png"), series,
-                                f"capillary stress psi (Eq. 3.46) at axial strain {strain:g}, "
-                                f"{confining:g} Pa (thesis Fig. 5.5)", "kPa"))
+                                f"capillary stress psi (Eq. 3.46) {at} (thesis Fig. 5.5)",
+                                "kPa"))
     series = [(f"contacts, {_suction_label(s)}", h["fabric"][record_at(h, strain)])
               for s, h in chosen]
     series += [(f"bridges, {_suction_label(s)}", h["fabric_bridges"][record_at(h, strain)])
                for s, h in wet]
     paths.append(plot_polar(os.path.join(folder, "polar_fabric.png"), series,
-                            f"fabric tensors (Eqs. 3.50, 3.53) at axial strain {strain:g}, "
-                            f"{confining:g} Pa", "-"))
+                            f"fabric tensors (Eqs. 3.50, 3.53) {at}", "-"))
     return paths
 
 
@@ -157,12 +158,12 @@ def plot_anisotropy(path, history, suction, confining):
     and of the capillary stress psi (Eq. 4.5) against axial strain."""
     plt = pyplot()
     figure, axes = plt.subplots(figsize=(6.5, 4.5))
-    strain = history["axial_strain"]
+    strain = 100 * history["axial_strain"]
     for key, name in (("sigma_effective", "effective stress"), ("psi", "capillary stress")):
         axes.plot(strain, [principal_anisotropy(t) for t in history[key]], label=name)
-    axes.set_xlabel("axial strain")
+    axes.set_xlabel("axial strain [%]")
     axes.set_ylabel("anisotropy factor")
-    axes.set_title(f"{_suction_label(suction)}, lateral stress {confining:g} Pa "
+    axes.set_title(f"{_suction_label(suction)}, lateral stress {confining / 1000:g} kPa "
                    "(thesis Fig. 5.8)")
     axes.legend()
     return save_figure(figure, path)
@@ -175,6 +176,11 @@ def _line(phi_deg, cohesion, p_max):
     q0 = cohesion * 6 * math.cos(math.radians(phi_deg)) / (3 - sin_phi)
     p = np.array([0.0, p_max])
     return p, slope * p + q0
+
+
+def _kpa(points):
+    """(p, q) [Pa] as kPa."""
+    return tuple(np.asarray(values) / 1000 for values in points)
 
 
 def plot_envelopes(path, runs, fits, label):
@@ -191,18 +197,19 @@ def plot_envelopes(path, runs, fits, label):
         for index, suction in enumerate(sorted({r["suction"] for r in runs})):
             rows = [r for r in runs if r["suction"] == suction]
             color = f"C{index}"
-            axes.plot([r[pk] for r in rows], [r[qk] for r in rows], "o", color=color,
+            axes.plot([r[pk] / 1000 for r in rows], [r[qk] / 1000 for r in rows], "o",
+                      color=color,
                       label=_suction_label(suction))
             fit = fits.get(label(suction))
             if fit and fit[phik] is not None and suction != 0:
-                axes.plot(*_line(fit[phik], fit[ck], p_max), "--", color=color, lw=1)
+                axes.plot(*_kpa(_line(fit[phik], fit[ck], p_max)), "--", color=color, lw=1)
         if dry and dry["phi_deg"] is not None:
-            axes.plot(*_line(dry["phi_deg"], dry["cohesion"], p_max), "k-", lw=1.5,
+            axes.plot(*_kpa(_line(dry["phi_deg"], dry["cohesion"], p_max)), "k-", lw=1.5,
                       label=f"dry line, phi = {dry['phi_deg']:.1f} deg")
-        axes.set_xlim(0, p_max)
+        axes.set_xlim(0, p_max / 1000)
         axes.set_ylim(bottom=0)
-        axes.set_xlabel("p' [Pa]" if "effective" in pk else "p [Pa]")
-        axes.set_ylabel("q' [Pa]" if "effective" in pk else "q [Pa]")
+        axes.set_xlabel("p' [kPa]" if "effective" in pk else "p [kPa]")
+        axes.set_ylabel("q' [kPa]" if "effective" in pk else "q [kPa]")
         axes.set_title(title)
         axes.legend(fontsize=8)
     return save_figure(figure, path)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import math
 import sys
 
 import numba
@@ -56,23 +55,13 @@ def positive_int(name, low=0):
     return parse
 
 
-def finite_float(name):
-    """argparse type: a finite number (the error names the option)."""
-    def parse(text):
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} {text!r}: a number expected") from None
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"{name} {value} is not finite")
-        return value
-    return parse
-
-
 def add_run_options(parser, threads_default=None):
-    """Options every command shares: --threads, --quiet."""
+    """Options every command shares: --threads (``threads_default``: None lets a run choose:
+    all of Numba's threads from 2,000 spheres on, else 1), --quiet."""
     parser.add_argument("--threads", type=positive_int("--threads", 1), default=threads_default,
-                        help="Numba threads (default: all for large samples)")
+                        help="Numba threads of a run" + (
+                            " (None: all from 2,000 spheres on, else 1)"
+                            if threads_default is None else ""))
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 

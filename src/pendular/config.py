@@ -18,6 +18,10 @@ import numpy as np
 from capillary import BRIDGE_MODELS, SURFACE_TENSION
 from dem.preparation import PrepareConfig
 from dem.validate import check_int, check_positive, check_range
+from homogenize import packing_state, regular_packing
+
+from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS, KIM_SEPARATION,
+                        SPECIFIC_GRAVITY, comparison_packing)
 
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
@@ -175,11 +179,95 @@ class TriaxialConfig:
         return 0.0 if self.bridges is None else self.bridges.suction
 
 
+@dataclass
+class TensionConfig:
+    """Direct tension of wet sand at fixed water content (pendular.tension; Kim 2001, thesis
+    §4.4.1.2 and Table 4.5). Validated on creation (ValueError naming the command's option).
+
+    cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
+    void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
+    particles, radius [m], contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
+    confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
+    wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
+    max_strain: largest axial extension [-]; residual: fraction of the peak below which the
+    pull has ruptured [-]; grip_depth: grip thickness [diameters]; void_ratio_tolerance [-];
+    vtk_frames: ParaView frames per pull (0: none); vtk_every: steps between frames instead
+    (None: from vtk_frames; 0: none); seed: random seed of the samples.
+    """
+
+    cases: list[tuple[float, float]] = field(
+        default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
+    roughness: float = KIM_SEPARATION
+    particles: int = 2000
+    radius: float = KIM_RADIUS
+    contact_angle: float = 0.0
+    surface_tension: float = CHAPTER4_SURFACE_TENSION
+    specific_gravity: float = SPECIFIC_GRAVITY
+    confining: float = 100.0
+    friction: float = 18.0
+    young: float = 1e6
+    inertial_number: float = 1e-3
+    max_strain: float = 0.1
+    residual: float = 0.2
+    grip_depth: float = 1.0
+    void_ratio_tolerance: float = 0.01
+    vtk_frames: int = 20
+    vtk_every: int | None = None
+    seed: int = 0
+
+    def __post_init__(self):
+        self.cases = [(float(e), float(w)) for e, w in self.cases]
+        if not self.cases:
+            raise ValueError("cases = [] is empty: give at least one (void ratio, water "
+                             "content)")
+        for e, _ in self.cases:
+            # denser than random close packing or looser than the loosest growth: unreachable
+            check_range("--void-ratio", e, 0.5, 1.2)
+        check_range("--particles", self.particles, 100, 1e6)
+        check_range("--radius", self.radius, 1e-6, 1e-2, unit="m")
+        check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
+                    unit="deg")
+        check_range("--surface-tension", self.surface_tension, 0.0, 1.0, low_inclusive=False,
+                    unit="N/m")
+        check_range("--specific-gravity", self.specific_gravity, 1.0, 10.0)
+        check_range("--roughness", self.roughness, 0.0, 0.5)
+        check_range("--confining", self.confining, 1.0, 1e5, unit="Pa")
+        check_range("--friction", self.friction, 0.0, 90.0, high_inclusive=False, unit="deg")
+        check_range("--young", self.young, 0.0, 1e12, low_inclusive=False, unit="Pa")
+        check_range("--inertial-number", self.inertial_number, 0.0, 0.01, low_inclusive=False)
+        check_range("--max-strain", self.max_strain, 0.0, 0.5, low_inclusive=False)
+        check_range("--residual", self.residual, 0.0, 1.0, low_inclusive=False,
+                    high_inclusive=False)
+        check_range("--grip-depth", self.grip_depth, 0.0, 3.0)
+        check_range("--void-ratio-tolerance", self.void_ratio_tolerance, 0.001, 0.1)
+        check_range("--vtk-frames", self.vtk_frames, 0, 1000)
+        if self.vtk_every is not None:
+            self.vtk_every = check_int("--vtk-every", self.vtk_every)
+        check_range("--seed", self.seed, 0)
+        for e, w in self.cases:
+            limit = self.pendular_limit(e)
+            if not 0.0 < w <= limit:
+                raise ValueError(f"--water-content = {100.0 * w:g} % is outside the valid "
+                                 f"range (0, {100.0 * limit:.3g}] %: the pendular regime ends "
+                                 "at the pendular limit of the "
+                                 f"{comparison_packing(e)[1]} packing")
+
+    def pendular_limit(self, void_ratio):
+        """Gravimetric water content [-] at the pendular limit of the regular packing compared
+        with a sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION)."""
+        kind, _ = comparison_packing(void_ratio)
+        return packing_state(regular_packing(kind, separation=KIM_SEPARATION),
+                             radius=self.radius, contact_angle=self.contact_angle,
+                             surface_tension=self.surface_tension,
+                             filling_angle=regular_packing(kind).max_filling_angle,
+                             specific_gravity=self.specific_gravity).water_content
+
+
 # ---------------------------------------------------------------- JSON form
 
 #: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
 CONFIG_TYPES = {kind.__name__: kind for kind in
-                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig)}
+                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, TensionConfig)}
 
 
 def config_to_dict(config):

@@ -1,7 +1,10 @@
-"""Reference numbers the scenarios compare with, in one place (SI units, thesis tables).
+"""Reference numbers the tests and studies compare with, in one place (SI units).
 
-Sources: Khosravani (2014), thesis Tables 4.1, 4.5, 5.3 and Fig. 5.5; Kim (2001) through the
-thesis's Table 4.5; SPEC §7 for the Chapter 4 surface tension.
+Sources: Khosravani (2014), thesis Tables 4.1, 4.5, 5.3 and Fig. 5.5; Kim, T.-H. (2001),
+Moisture-induced tensile strength and cohesion of sand, PhD thesis, University of Colorado at
+Boulder, through the thesis's Table 4.5 (direct tension of F-75 sand); SPEC §7 for the Chapter 4
+surface tension. ``comparison_packing`` names the regular packing of thesis Ch. 4 a sample of a
+given void ratio is compared with (pendular.tension, pendular.chapter4).
 """
 
 #: Surface tension of Chapter 4 [N/m] (the printed "74 µN/m" is 0.074 N/m, SPEC §7); Chapter 5
@@ -31,6 +34,14 @@ KIM_RADIUS = 0.11e-3
 KIM_SEPARATION = 0.09
 #: Regular packing compared with each of Kim's void ratios: (kind, label).
 KIM_PACKINGS = {0.72: ("bcc", "isotropic BCC"), 0.58: ("fcp", "FCP")}
+#: Void ratio from which a sample is compared with Kim's loose packing (docs/chapter4.md).
+KIM_LOOSE_FROM = 0.65
+
+
+def comparison_packing(void_ratio: float) -> tuple[str, str]:
+    """(kind, label) of the regular packing a sample of this void ratio is compared with:
+    isotropic BCC for e >= KIM_LOOSE_FROM, FCP below (docs/chapter4.md)."""
+    return KIM_PACKINGS[0.72] if void_ratio >= KIM_LOOSE_FROM else KIM_PACKINGS[0.58]
 
 #: Thesis Table 5.3: axial stress at peak [Pa], keyed (suction [Pa], lateral stress [Pa]).
 TABLE_5_3 = {

@@ -1,9 +1,10 @@
 """Direct tension of wet sand at fixed water content (Kim 2001; thesis §4.4.1.2, Table 4.5).
 
-``TensionTest(TensionConfig(...)).run(out)``; command ``pendular tension`` (options in
-pendular.commands.tension, named as the fields below with dashes). By default Kim's six cases: F-75 sand, R = 0.11 mm,
-e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
-Gs = 2.65). Each case:
+``TensionTest(TensionConfig(...)).run(out)`` returns the content of tension.json; command
+``pendular tension`` (pendular.commands.tension; options named as the TensionConfig fields,
+dashes for underscores). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``. By
+default Kim's six cases: F-75 sand, R = 0.11 mm, e = 0.72 at w = 0.47, 1.04, 2.11 % and
+e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric, Gs = 2.65). Each case:
 
 1. Sample (one per void ratio, shared by its water contents): equal spheres prepared as thesis
    Ch. 5.2.2 (dem.preparation, radius growth to 5 kPa, friction set, walls servoed at
@@ -17,7 +18,7 @@ Gs = 2.65). Each case:
    their formation suction, found so that the bridges hold V_w = w Gs V_s. The grains are rough:
    the menisci of touching grains are --roughness R apart (default Kim's H/R = 0.09, the
    separation of thesis Ch. 4's prediction; 0 for smooth spheres). The suction is found by
-   dem.tension.formation_suction; contacts made while the sample settles under the bridges
+   capillary.formation_suction; contacts made while the sample settles under the bridges
    get bridges too, so the suction is corrected until w is within 1 %. Walls servoed at
    --confining until static.
 3. Pull: the particles within --grip-depth diameters of each z wall (surface to wall) move
@@ -37,14 +38,16 @@ strength against w beside Kim and the prediction), and per case cases/<case>/his
 (group ``history``: step, time, axial_strain (compression positive, so negative here),
 tensile_stress [Pa], grip_pull (2) [N] (z-, z+ grips), sigma_wall (3) [Pa], coordination,
 bridges, water_content, saturation, unbalanced_force) and the ParaView series
-cases/<case>/vtk/*.pvd.
+cases/<case>/vtk/*.pvd (every --vtk-every steps, or --vtk-frames frames per pull).
 """
+
+from __future__ import annotations
 
 import copy
 import math
 import os
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 
 import numpy as np
 
@@ -54,17 +57,17 @@ from dem.atomic import write_json, write_text
 from dem.measure import coordination, unbalanced_force
 from dem.preparation import PrepareConfig, equilibrated, prepare_sample
 from dem.record import HistoryRecorder
+from dem.simulation import Simulation
 from dem.tension import Grip, core_void_ratio, grip_members, tensile_stress
-from dem.validate import check_range
 from dem.walls import ConstantStrainRate
 from homogenize import packing_state, regular_packing
 
-from .config import config_to_dict, inertial_number
+from .config import TensionConfig, config_to_dict, inertial_number
 from .io import write_history
 from .outputs import OutputFolder
 from .plots import pyplot, save_figure
-from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_PACKINGS, KIM_RADIUS,
-                        KIM_SEPARATION, SPECIFIC_GRAVITY)
+from .reference import CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION, comparison_packing
+from .schema import TENSION_SUMMARY_UNITS
 from .vtk import VtkWriter
 
 #: Surface tension [N/m] of the Chapter 4 comparison (SPEC section 7).
@@ -85,46 +88,16 @@ POST_PEAK_STRAIN = 0.01
 RECORDS = 400
 
 
-@dataclass
-class TensionConfig:
-    """A direct-tension campaign: the (void ratio, water content as a fraction) ``cases`` and
-    the sample, bridge and pull settings (SI units, angles in degrees; module docstring).
-    Validated on creation (ValueError naming the option)."""
-
-    cases: list = field(default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
-    roughness: float = KIM_SEPARATION
-    particles: int = 2000
-    radius: float = KIM_RADIUS
-    contact_angle: float = 0.0
-    surface_tension: float = SURFACE_TENSION
-    specific_gravity: float = SPECIFIC_GRAVITY
-    confining: float = 100.0
-    friction: float = 18.0
-    young: float = 1e6
-    inertial_number: float = 1e-3
-    max_strain: float = 0.1
-    residual: float = 0.2
-    grip_depth: float = 1.0
-    void_ratio_tolerance: float = 0.01
-    vtk_frames: int = 20
-    seed: int = 0
-
-    def __post_init__(self):
-        self.cases = [(float(e), float(w)) for e, w in self.cases]
-        check_settings(self)
-
-
-def cases_of(void_ratios=None, water_contents=None):
+def cases_of(void_ratios: list[float] | None = None,
+             water_contents: list[float] | None = None) -> list[tuple[float, float]]:
     """[(void ratio, water content as a fraction)]: Kim's six cases by default; ``void_ratios``
     and ``water_contents`` [%] (lists) otherwise, every water content at every void ratio
-    (Kim's water contents at his void ratios when none are given, else 0.5, 1, 2 %)."""
+    (Kim's water contents at his void ratios when none are given, else 0.5, 1, 2 %).
+    TensionConfig checks them."""
     if void_ratios is None and water_contents is None:
         return [(e, w) for e, w, _ in KIM_2001]
     if void_ratios is None:
         void_ratios = sorted({e for e, _, _ in KIM_2001}, reverse=True)
-    for e in void_ratios:
-        # denser than random close packing or looser than the loosest growth: never reachable
-        check_range("--void-ratio", e, 0.5, 1.2)
     result = []
     for e in void_ratios:
         if water_contents is not None:
@@ -136,58 +109,20 @@ def cases_of(void_ratios=None, water_contents=None):
     return result
 
 
-def check_settings(config):
-    """Every input against its valid range (ValueError naming it); water contents against the
-    pendular limit of the comparison packing."""
-    check_range("--particles", config.particles, 100, 1e6)
-    check_range("--radius", config.radius, 1e-6, 1e-2, unit="m")
-    check_range("--contact-angle", config.contact_angle, 0.0, 90.0, high_inclusive=False,
-                unit="deg")
-    check_range("--surface-tension", config.surface_tension, 0.0, 1.0, low_inclusive=False,
-                unit="N/m")
-    check_range("--specific-gravity", config.specific_gravity, 1.0, 10.0)
-    check_range("--roughness", config.roughness, 0.0, 0.5)
-    check_range("--confining", config.confining, 1.0, 1e5, unit="Pa")
-    check_range("--friction", config.friction, 0.0, 90.0, high_inclusive=False, unit="deg")
-    check_range("--young", config.young, 0.0, 1e12, low_inclusive=False, unit="Pa")
-    check_range("--inertial-number", config.inertial_number, 0.0, 0.01, low_inclusive=False)
-    check_range("--max-strain", config.max_strain, 0.0, 0.5, low_inclusive=False)
-    check_range("--residual", config.residual, 0.0, 1.0, low_inclusive=False,
-                high_inclusive=False)
-    check_range("--grip-depth", config.grip_depth, 0.0, 3.0)
-    check_range("--void-ratio-tolerance", config.void_ratio_tolerance, 0.001, 0.1)
-    check_range("--vtk-frames", config.vtk_frames, 0, 1000)
-    check_range("--seed", config.seed, 0)
-    for e, w in config.cases:
-        kind, label = comparison_packing(e)
-        limit = packing_state(regular_packing(kind, separation=KIM_SEPARATION),
-                              radius=config.radius, contact_angle=config.contact_angle,
-                              surface_tension=config.surface_tension,
-                              filling_angle=regular_packing(kind).max_filling_angle,
-                              specific_gravity=config.specific_gravity).water_content
-        if not 0.0 < w <= limit:
-            raise ValueError(f"--water-content = {100.0 * w:g} % is outside the valid range "
-                             f"(0, {100.0 * limit:.3g}] %: the pendular regime ends at the "
-                             f"pendular limit of the {label} packing")
-
-
-def comparison_packing(void_ratio):
-    """(kind, label) of the regular packing a sample is compared with (docs/chapter4.md)."""
-    return KIM_PACKINGS[0.72] if void_ratio >= 0.65 else KIM_PACKINGS[0.58]
-
-
-def prepare_config(config, prep_friction):
+def prepare_config(config: TensionConfig, prep_friction: float) -> PrepareConfig:
+    """The sample's preparation (thesis Ch. 5.2.2) with growth friction ``prep_friction`` [deg]."""
     return PrepareConfig(particles=config.particles, radius=config.radius, young=config.young,
                          friction_deg=config.friction, prep_friction_deg=prep_friction,
                          confining=config.confining, seed=config.seed)
 
 
-def sample_void_ratio(sim, radius):
+def sample_void_ratio(sim: Simulation, radius: float) -> float:
     """Void ratio of the core: the box less one diameter along each wall."""
     return core_void_ratio(sim.particles, sim.walls, 2.0 * radius, radius / 8.0)
 
 
-def prepare_void_ratio(config, target, progress):
+def prepare_void_ratio(config: TensionConfig, target: float,
+                       progress: bool) -> tuple[Simulation, dict]:
     """(sim, preparation report) of the sample whose core void ratio is within tolerance of
     ``target``: regula falsi on the growth friction over PREP_FRICTION_RANGE; the closest
     preparation if none is within tolerance after PREPARATIONS tries. ValueError when the
@@ -236,10 +171,12 @@ def prepare_void_ratio(config, target, progress):
     return sim, report
 
 
-def wet(dry, config, water_content, progress):
+def wet(dry: Simulation, config: TensionConfig, water_content: float,
+        progress: bool) -> tuple[Simulation, CapillaryBridges, dict]:
     """(wetted sim, bridges, wetting report): volume-controlled bridges at every contact of a
     copy of ``dry`` holding water content ``water_content`` (fraction) once static, the
-    formation suction corrected for the contacts the bridges add."""
+    formation suction corrected for the contacts the bridges add (the wetting law itself,
+    formation suction at a water volume, is capillary.formation_suction)."""
     particles = dry.particles
     target = water_content * config.specific_gravity * particles.solid_volume()
     touching = dry.contacts.overlap > 0.0
@@ -278,9 +215,11 @@ def wet(dry, config, water_content, progress):
 class Pull:
     """The pull of a sample held by its six walls' servo: z walls apart at constant strain
     rate, grips, recorder (with the bridges' columns when ``bridges`` is given) and ParaView
-    writer; ``run()`` pulls to rupture and returns (steps, history)."""
+    writer (a frame every ``config.vtk_every`` steps, or ``config.vtk_frames`` frames over
+    --max-strain); ``run()`` pulls to rupture and returns (steps, history)."""
 
-    def __init__(self, sim, bridges, config, folder, progress):
+    def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
+                 config: TensionConfig, folder: str, progress: bool):
         self.sim, self.bridges, self.config, self.progress = sim, bridges, config, progress
         self.rate = config.inertial_number / inertial_number(1.0, config.radius,
                                                            sim.particles.density, config.confining)
@@ -313,12 +252,16 @@ class Pull:
         self.recorder = HistoryRecorder(period, columns)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
+        self.vtk_period = config.vtk_every
+        if self.vtk_period is None:
+            self.vtk_period = (max(1, self.steps // config.vtk_frames) if config.vtk_frames > 0
+                               else 0)
         self.vtk = None
-        if config.vtk_frames > 0:
-            self.vtk = VtkWriter(os.path.join(folder, "vtk"), max(1, self.steps // config.vtk_frames))
+        if self.vtk_period > 0:
+            self.vtk = VtkWriter(os.path.join(folder, "vtk"), self.vtk_period)
             sim.writers.append(self.vtk)
 
-    def ruptured(self, sim):
+    def ruptured(self, sim: Simulation) -> bool:
         """The stress has stayed below the residual fraction of its positive peak for
         POST_PEAK_STRAIN of extension."""
         stress = self.recorder.rows["tensile_stress"]
@@ -327,7 +270,7 @@ class Pull:
         return (stress[peak] > 0.0 and stress[-1] < self.config.residual * stress[peak]
                 and strain[peak] - strain[-1] >= POST_PEAK_STRAIN)
 
-    def run(self, label):
+    def run(self, label: str | None) -> tuple[int, dict]:
         def status(s):
             return {"ext": f"{-self.extension.strain(s.walls):.4f}",
                     "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
@@ -339,7 +282,8 @@ class Pull:
         return steps, self.recorder.arrays()
 
 
-def prediction(config, void_ratio, water_content):
+def prediction(config: TensionConfig, void_ratio: float,
+               water_content: float) -> tuple[float, str, float]:
     """(psi_xx [Pa], label, void ratio of the packing) of homogenize.packing_state for the
     comparison packing at this water content (exact bridges, H/R = 0.09)."""
     kind, label = comparison_packing(void_ratio)
@@ -350,7 +294,7 @@ def prediction(config, void_ratio, water_content):
     return float(state.psi[0, 0]), label, packing.void_ratio
 
 
-def kim_measured(void_ratio, water_content):
+def kim_measured(void_ratio: float, water_content: float) -> float | None:
     """Kim's (2001) tensile strength [Pa] of this case, or None."""
     for e, w, strength in KIM_2001:
         if math.isclose(e, void_ratio) and math.isclose(w, water_content):
@@ -358,12 +302,17 @@ def kim_measured(void_ratio, water_content):
     return None
 
 
-def case_name(void_ratio, water_content):
+def case_name(void_ratio: float, water_content: float) -> str:
+    """Folder name of a case, e.g. 'e0.72_w1.04'."""
     return f"e{void_ratio:.2f}_w{100 * water_content:.2f}"
 
 
-def run_case(dry, preparation, config, void_ratio, water_content, out, progress):
-    """Wet, pull and summarise one case into ``out``/cases/<case>: history.h5 (and vtk/)."""
+def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_ratio: float,
+             water_content: float, out: str, progress: bool,
+             arguments: dict | None = None) -> tuple[dict, dict]:
+    """Wet, pull and summarise one case into ``out``/cases/<case>: history.h5 (and vtk/);
+    returns (summary, history). ``arguments``: history file attributes (default the
+    configuration's fields but cases)."""
     name = case_name(void_ratio, water_content)
     folder = os.path.join(out, "cases", name)
     os.makedirs(folder, exist_ok=True)
@@ -409,15 +358,22 @@ def run_case(dry, preparation, config, void_ratio, water_content, out, progress)
         "wetting_time_s": wetted - started,
         "pull_time_s": time.perf_counter() - wetted,
     }
-    attributes = {key: value for key, value in asdict(config).items() if key != "cases"}
+    attributes = dict(arguments if arguments is not None else _fields(config))
     attributes.update({key: value for key, value in summary.items()
                        if isinstance(value, (int, float, str))})
     write_history(os.path.join(folder, "history.h5"), history, config_to_dict(config),
                   attributes=attributes)
+    summary["units"] = {key: unit for key, unit in TENSION_SUMMARY_UNITS.items()
+                        if key in summary}
     return summary, history
 
 
-def plot_curves(histories, folder):
+def _fields(config):
+    """The configuration's fields but cases (tension.json 'arguments' of a library run)."""
+    return {key: value for key, value in asdict(config).items() if key != "cases"}
+
+
+def plot_curves(histories: dict, folder: str) -> None:
     """Tensile stress against axial extension, one figure per case and one with all."""
     plt = pyplot()
     every, all_axes = plt.subplots(figsize=(6, 4))
@@ -432,7 +388,7 @@ def plot_curves(histories, folder):
     save_figure(every, os.path.join(folder, "tension_all.png"))
 
 
-def plot_strength(summaries, config, path):
+def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> None:
     """Tensile strength against water content: DEM, Kim (2001) and packing_state's curve."""
     figure, axes = pyplot().subplots(figsize=(6, 4.5))
     void_ratios = sorted({s["void_ratio_target"] for s in summaries}, reverse=True)
@@ -458,8 +414,8 @@ def _percent(value):
     return "" if value is None else f"{100 * value:+.0f} %"
 
 
-def write_report(summaries, config, path):
-    """report.md: one table row per case."""
+def report_lines(summaries: list[dict], config: TensionConfig) -> list[str]:
+    """The lines of report.md: one table row per case."""
     lines = [f"# Direct tension, {config.particles} spheres, R = {config.radius * 1e3:g} mm, "
              f"theta = {config.contact_angle:g} deg, gamma = {config.surface_tension:g} N/m, "
              f"bridge roughness H/R = {config.roughness:g}",
@@ -480,6 +436,12 @@ def write_report(summaries, config, path):
             f"| {s['tensile_strength_pa']:.1f} | {kim} | {s['packing_state_pa']:.1f} "
             f"| {_percent(s['relative_difference_to_kim'])} "
             f"| {_percent(s['relative_difference_to_packing_state'])} |")
+    return lines
+
+
+def write_report(summaries: list[dict], config: TensionConfig, path: str) -> list[str]:
+    """report.md at ``path``; returns its lines."""
+    lines = report_lines(summaries, config)
     write_text(path, "\n".join(lines) + "\n")
     return lines
 
@@ -488,20 +450,23 @@ class TensionTest:
     """The direct-tension cases of ``config`` (TensionConfig): one sample per void ratio, each
     water content wetted and pulled from a copy of it (module docstring)."""
 
-    def __init__(self, config: TensionConfig):
+    def __init__(self, config: TensionConfig) -> None:
         if not isinstance(config, TensionConfig):
             raise TypeError(f"config must be a TensionConfig, got {type(config).__name__}")
         self.config = config
 
-    def run(self, out, *, progress=True):
+    def run(self, out: str, *, progress: bool = True, arguments: dict | None = None) -> dict:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
-        the tension.json content."""
+        the tension.json content. ``arguments``: what tension.json records under 'arguments'
+        and the histories as attributes (the command: its options; default: the
+        configuration's fields but cases); the configuration itself is under 'config'."""
         with OutputFolder(out, "tension") as folder:
             for name in ("tension.json", "report.md", "plots", "cases"):
                 folder.claim(name)
-            return self._run(out, progress)
+            return self._run(out, progress, _fields(self.config) if arguments is None
+                             else dict(arguments))
 
-    def _run(self, out, progress):
+    def _run(self, out, progress, arguments):
         config = self.config
         started = time.perf_counter()
         summaries, histories, samples = [], {}, {}
@@ -514,7 +479,7 @@ class TensionTest:
                 if e != void_ratio:
                     continue
                 summary, history = run_case(dry, preparation, config, e, water_content, out,
-                                            progress)
+                                            progress, arguments)
                 summaries.append(summary)
                 histories[summary["case"]] = history
                 if progress:
@@ -522,7 +487,7 @@ class TensionTest:
                           f"{summary['tensile_strength_pa']:.1f} Pa (Kim "
                           f"{summary['kim_measured_pa']}, packing_state "
                           f"{summary['packing_state_pa']:.1f})", flush=True)
-        output = {"arguments": {k: v for k, v in asdict(config).items() if k != "cases"},
+        output = {"arguments": arguments,
                   "cases_requested": [list(case) for case in config.cases],
                   "config": config_to_dict(config),
                   "samples": {str(e): {k: v for k, v in r.items() if k != "sigma_wall"}
@@ -531,7 +496,5 @@ class TensionTest:
         write_json(os.path.join(out, "tension.json"), output, default=float)
         plot_curves(histories, os.path.join(out, "plots"))
         plot_strength(summaries, config, os.path.join(out, "plots", "strength_vs_water.png"))
-        report = write_report(summaries, config, os.path.join(out, "report.md"))
-        if progress:
-            print("\n".join(report))
+        write_report(summaries, config, os.path.join(out, "report.md"))
         return output

@@ -1,81 +1,127 @@
 """Speed against accuracy: one knob at a time, measured against a slow, fine reference run.
 
-``measure(study)`` / command ``pendular tradeoff --out DIR [--particles N] [--max-strain X]
-[--quick] [--docs FOLDER]``.
+``write_study(Study(out, particles=..., max_strain=..., quick=...))``; command
+``pendular tradeoff --out DIR [--particles N] [--max-strain X] [--quick] [--docs FOLDER]``.
 
 The reference test is a wet drained triaxial (30 kPa suction, 750 Pa lateral stress, thesis
-Table 5.2 otherwise) of ``--particles`` spheres to ``--max-strain`` (the peak lies near 4 %).
-Every run starts from the same prepared sample (DIR/samples/, TriaxialConfig.sample_path; the
+Table 5.2 otherwise) of ``particles`` spheres to ``max_strain`` (the peak lies near 4 %). Every
+run is a pendular.triaxial.TriaxialTest of a configuration built from the default one
+(``Study.default``: the defaults of ``pendular triaxial``, exact bridge table 350 x 80)
+with ``dataclasses.replace``; it starts from the same prepared sample (DIR/samples/, the
 sample-size knob prepares one per size), runs on one Numba thread, and is compared with the
 reference: time-step safety 0.35, inertial number 1e-4, bridge table 700 x 160 nodes, the other
-knobs at their defaults. Each run's configuration is the default TriaxialConfig with the knobs'
-settings applied by ``dataclasses.replace``. Each knob is varied alone around the defaults:
+knobs at their defaults. Each knob (``KNOB_FIELDS``: the field of the configuration it sets) is
+varied alone around the defaults:
 
     timestep_safety, inertial_number, damping, particles, table_resolution (exact bridges),
     bridges (exact / toroidal), records (history rows), skin_factor (neighbour list)
 
-For each run: wall_time_s and cpu_time_s (wetting and shear, the sample's preparation
-excluded), its particle-steps per second, and the relative errors of peak q, of Sr at the
-peak of q and of q'/p' at the peak of q (Eq. 3.43) against the reference; ``error`` is the
-largest of the three. A knob that does not change the physics (records, skin) shows the
-run-to-run scatter of a chaotic many-body system, not an error of the knob.
+For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, the
+sample's preparation excluded), its particle-steps per second, and the relative errors of peak
+q, of Sr at the peak of q and of q'/p' at the peak of q (Eq. 3.43) against the reference;
+``error`` is the largest of the three. A knob that does not change the physics (records, skin)
+shows the run-to-run scatter of a chaotic many-body system, not an error of the knob.
 
-Writes DIR/tradeoff.json (``reference``, ``rows``: knob, value, wall_time_s, cpu_time_s,
-error, peak_q_error, saturation_error, stress_ratio_error, ...), DIR/tradeoff.md with a
-recommendation per use (quick look, paper figure) and DIR/tradeoff.png; --docs FOLDER copies
-the three there (docs/tradeoff.*). Finished runs in DIR/runs/ are reused when run again.
+Writes DIR/tradeoff.json (``arguments``, ``suction``, ``confining``, ``reference``, ``rows``:
+knob, value, settings, particles, wall_time_s, cpu_time_s, steps, wetting_steps,
+particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_strain_at_peak,
+peak_q_error, saturation_error, stress_ratio_error, error), DIR/tradeoff.md with a
+recommendation per use (quick look, paper figure) and DIR/tradeoff.png; ``docs`` copies the
+three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
+result and the run's configuration); run again, a study reuses a finished run only when its
+stored configuration equals the wanted one (pendular.config.config_json).
 """
 
-import contextlib
+from __future__ import annotations
+
 import dataclasses
-import io
 import json
 import os
 import shutil
-import sys
 import time
 from dataclasses import dataclass
 
+import numba
+
 from dem.atomic import write_json, write_text
 from dem.preparation import PrepareConfig
+from dem.validate import check_int, check_range
 
-from .campaign import prepare_one
-from .config import BridgeConfig, TriaxialConfig
+from .campaign import prepare_one, sample_made_with
+from .config import BridgeConfig, ShearConfig, TriaxialConfig, config_json, config_to_dict
+from .outputs import OutputFolder
 from .plots import pyplot, save_figure
 from .triaxial import TriaxialTest
 
 SUCTION = 30000.0
 CONFINING = 750.0
-#: Defaults of a triaxial run, as the knobs' values (their centre).
-DEFAULTS = {"timestep_safety": 0.7, "inertial_number": 3e-4, "damping": 0.2,
-            "table_resolution": "350,80", "bridges": "exact", "records": 500,
-            "skin_factor": 0.3}
-#: The slow, fine reference (particles: --particles).
-REFERENCE = dict(DEFAULTS, timestep_safety=0.35, inertial_number=1e-4,
-                 table_resolution="700,160")
-#: Settings of each knob (particles: multiples of --particles).
+#: Knob -> (part of the TriaxialConfig, field of that part) it sets.
+KNOB_FIELDS = {"timestep_safety": ("sample", "timestep_safety"),
+               "inertial_number": ("shear", "inertial_number"),
+               "damping": ("sample", "damping"),
+               "particles": ("sample", "particles"),
+               "table_resolution": ("bridges", "table_resolution"),
+               "bridges": ("bridges", "model"),
+               "records": ("shear", "records"),
+               "skin_factor": ("sample", "skin_factor")}
+#: The exact bridge table of the default run (nodes in suction, in distance).
+DEFAULT_TABLE = (350, 80)
+#: What the slow, fine reference changes in the default run.
+REFERENCE = {"timestep_safety": 0.35, "inertial_number": 1e-4, "table_resolution": (700, 160)}
+#: Settings of each knob (particles: multiples of the study's particles).
 KNOBS = {"timestep_safety": [0.3, 0.5, 0.7, 0.9],
          "inertial_number": [1e-4, 3e-4, 1e-3, 3e-3],
          "damping": [0.05, 0.1, 0.2, 0.4],
          "particles": [0.25, 0.5, 1.0, 2.0],
-         "table_resolution": ["50,20", "100,40", "350,80", "700,160"],
+         "table_resolution": [(50, 20), (100, 40), (350, 80), (700, 160)],
          "bridges": ["exact", "toroidal"],
          "records": [50, 500, 2000],
          "skin_factor": [0.1, 0.3, 0.6, 1.0]}
 QUICK_KNOBS = {"timestep_safety": [0.5, 0.7, 0.9], "inertial_number": [3e-4, 1e-3, 3e-3],
-               "table_resolution": ["50,20", "100,40", "350,80"]}
+               "table_resolution": [(50, 20), (100, 40), (350, 80)]}
 #: Error bounds of the recommendations.
 PAPER_ERROR, QUICK_ERROR = 0.02, 0.10
 #: CPU times within this factor of each other count as equal in the recommendations.
 TIME_TIE = 1.05
 #: The uses recommended for, and their error bounds.
 USES = {"paper figure": PAPER_ERROR, "quick look": QUICK_ERROR}
+#: Smallest sample of the study (the particles knob included).
+MIN_PARTICLES = 50
+
+
+# ---------------------------------------------------------------- knobs on configurations
+
+def setting(config, knob):
+    """The value of ``knob`` in the TriaxialConfig ``config``."""
+    part, name = KNOB_FIELDS[knob]
+    return getattr(getattr(config, part), name)
+
+
+def with_setting(config, knob, value):
+    """``config`` with ``knob`` set to ``value`` (dataclasses.replace; validated)."""
+    part, name = KNOB_FIELDS[knob]
+    return dataclasses.replace(
+        config, **{part: dataclasses.replace(getattr(config, part), **{name: value})})
+
+
+def settings(config):
+    """The knobs' values of ``config`` (the sample size aside), as JSON values."""
+    return json.loads(json.dumps({knob: setting(config, knob) for knob in KNOB_FIELDS
+                                  if knob != "particles"}))
+
+
+def text(value):
+    """A knob's value as shown: (350, 80) -> '350,80', 0.0001 -> '0.0001'."""
+    if isinstance(value, (tuple, list)):
+        return ",".join(str(v) for v in value)
+    return str(value)
 
 
 @dataclass
 class Study:
-    """The trade-off study's settings: output folder, reference sample size, final strain,
-    seed, --quick (three knobs, three settings each)."""
+    """The study's inputs: output folder ``out``, ``particles`` of the reference sample
+    (>= 50), ``max_strain`` in (0, 0.5], the samples' ``seed``; ``quick``: three knobs, three
+    settings each (QUICK_KNOBS, a smoke test)."""
 
     out: str
     particles: int = 2000
@@ -84,68 +130,90 @@ class Study:
     quick: bool = False
 
     def __post_init__(self):
-        if self.particles < 50:
-            raise ValueError(f"--particles {self.particles} is outside the valid range [50, inf)")
-        if not 0.0 < self.max_strain <= 0.5:
-            raise ValueError(f"--max-strain {self.max_strain} is outside the valid range "
-                             "(0, 0.5]")
+        self.particles = check_int("particles", self.particles, low=MIN_PARTICLES)
+        self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.5,
+                                      low_inclusive=False)
+        self.seed = check_int("seed", self.seed)
+        self.quick = bool(self.quick)
+        if not str(self.out).strip():
+            raise ValueError(f"out = {self.out!r} is empty: give a folder name")
+
+    def knobs(self):
+        return QUICK_KNOBS if self.quick else KNOBS
+
+    def sample(self, particles):
+        """The PrepareConfig of the prepared sample of ``particles`` spheres (every run of that
+        size starts from it)."""
+        return PrepareConfig(particles=particles, confining=CONFINING, seed=self.seed)
+
+    def default(self):
+        """The knobs' centre: ``pendular triaxial``'s defaults, wet at SUCTION, from the saved
+        sample of ``particles`` spheres in ``out``/samples, no ParaView output."""
+        return TriaxialConfig(sample=self.sample(self.particles),
+                              shear=ShearConfig(max_strain=self.max_strain),
+                              bridges=BridgeConfig(SUCTION, table_resolution=DEFAULT_TABLE),
+                              sample_path=sample_file(self.out, self.particles, self.seed),
+                              vtk_every=0)
+
+    def reference(self):
+        """The slow, fine reference (REFERENCE applied to the default)."""
+        config = self.default()
+        for knob, value in REFERENCE.items():
+            config = with_setting(config, knob, value)
+        return config
+
+    def variant(self, knob, value):
+        """(configuration, value shown) of ``knob`` at ``value`` around the default; the
+        particles knob takes a multiple of ``particles`` and its own sample."""
+        config = self.default()
+        if knob != "particles":
+            return with_setting(config, knob, value), value
+        count = max(MIN_PARTICLES, int(round(value * self.particles)))
+        config = with_setting(config, "particles", count)
+        return (dataclasses.replace(config, sample_path=sample_file(self.out, count, self.seed)),
+                count)
 
 
 def sample_file(out, particles, seed):
-    return os.path.join(out, "samples", f"n{particles}_seed{seed}.h5")
+    return os.path.join(os.path.abspath(out), "samples", f"n{particles}_seed{seed}.h5")
 
 
-def sample_config(study, particles):
-    """The PrepareConfig of the study's sample of ``particles`` spheres."""
-    return PrepareConfig(particles=particles, seed=study.seed, confining=CONFINING)
+# ---------------------------------------------------------------- runs
 
-
-def configure(study, settings, particles):
-    """The TriaxialConfig of one run: the defaults with the knobs' ``settings`` applied."""
-    sample = dataclasses.replace(sample_config(study, particles),
-                                 timestep_safety=settings["timestep_safety"],
-                                 damping=settings["damping"],
-                                 skin_factor=settings["skin_factor"])
-    config = TriaxialConfig(sample=sample, bridges=BridgeConfig(SUCTION),
-                            sample_path=sample_file(study.out, particles, study.seed),
-                            vtk_every=0)
-    return dataclasses.replace(
-        config,
-        shear=dataclasses.replace(config.shear, max_strain=study.max_strain,
-                                  inertial_number=settings["inertial_number"],
-                                  records=settings["records"]),
-        bridges=dataclasses.replace(config.bridges, model=settings["bridges"],
-                                    table_resolution=tuple(
-                                        int(n) for n in settings["table_resolution"].split(","))))
-
-
-def run(study, name, settings, particles):
-    """One wet triaxial of ``settings`` from the saved sample of ``particles`` spheres, in
-    DIR/runs/``name`` (reused when finished): its summary with the measured times."""
-    folder = os.path.join(study.out, "runs", name)
-    timing_path = os.path.join(folder, "timing.json")
-    if os.path.exists(timing_path):
-        with open(timing_path) as handle:
-            done = json.load(handle)
-        if done["settings"] == settings and done["particles"] == particles:
-            return done
-    config = configure(study, settings, particles)
-    if not os.path.exists(config.sample_path):
-        prepare_one(sample_config(study, particles), config.sample_path)
+def run_variant(config, folder, sample):
+    """One wet triaxial of ``config`` in ``folder`` (TriaxialTest on one thread), its sample
+    ``sample`` (PrepareConfig, saved at config.sample_path) prepared first when missing: its
+    summary values with the measured times. A finished run whose timing.json holds an equal
+    configuration is reused."""
+    timing = os.path.join(folder, "timing.json")
+    done = _read_json(timing)
+    if done is not None and json.dumps(done.get("config"), sort_keys=True) == config_json(config):
+        return {k: v for k, v in done.items() if k != "config"}
+    if not sample_made_with(config.sample_path, sample):
+        os.makedirs(os.path.dirname(config.sample_path), exist_ok=True)
+        prepare_one(sample, config.sample_path)
+    test = TriaxialTest(config)           # checks, and builds the bridge tables untimed
     wall, cpu = time.perf_counter(), time.process_time()
-    with contextlib.redirect_stdout(io.StringIO()):
-        summary = TriaxialTest(config).run(folder, progress=False, threads=1)
+    summary = test.run(folder, progress=False, threads=1)
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    result = {"settings": settings, "particles": particles, "wall_time_s": wall,
-              "cpu_time_s": cpu, "steps": summary["steps"],
+    result = {"settings": settings(config), "particles": config.sample.particles,
+              "wall_time_s": wall, "cpu_time_s": cpu, "steps": summary["steps"],
               "wetting_steps": summary.get("wetting_steps", 0),
               "particle_steps_per_s": summary["particle_steps_per_s"],
               "peak_q": summary["peak_q"], "saturation_at_peak": summary["saturation_at_peak"],
               "stress_ratio_at_peak": (summary["peak_q_effective"]
                                        / summary["p_effective_at_peak"]),
               "axial_strain_at_peak": summary["axial_strain_at_peak"]}
-    write_json(timing_path, result)
+    write_json(timing, {**result, "config": config_to_dict(config)})
     return result
+
+
+def _read_json(path):
+    try:
+        with open(path) as handle:
+            return json.load(handle)
+    except (OSError, ValueError):
+        return None
 
 
 def errors(result, reference):
@@ -157,46 +225,34 @@ def errors(result, reference):
     return values
 
 
-def label(name, value):
-    return f"{name}={value}"
+def measure(study, log=None):
+    """(reference result, rows) of the Study ``study``: every knob's runs and, per use, the
+    run combining each knob's recommended setting (module docstring). ``log(text)`` hears of
+    each run."""
+    log = log or (lambda message: None)
+    default = study.default()
 
+    def run(name, config):
+        return run_variant(config, os.path.join(study.out, "runs", name),
+                           study.sample(config.sample.particles))
 
-def build_tables(resolutions, radius):
-    """Build (or load from the cache) the exact bridge tables of ``resolutions`` ("NS,ND") for
-    spheres of ``radius`` [m], so that no run's time includes a table build."""
-    for resolution in resolutions:
-        BridgeConfig(SUCTION, table_resolution=tuple(int(n) for n in resolution.split(","))
-                     ).build().load_tables(radius, radius)
-
-
-def measure(args):
-    """The reference and every knob's rows of the Study ``args`` (module docstring)."""
-    knobs = QUICK_KNOBS if args.quick else KNOBS
-    radius = PrepareConfig().radius
-    build_tables({REFERENCE["table_resolution"], DEFAULTS["table_resolution"],
-                  *knobs.get("table_resolution", [])}, radius)
-    reference = run(args, "reference", REFERENCE, args.particles)
+    reference = run("reference", study.reference())
     rows = []
-    for knob, values in knobs.items():
+    for knob, values in study.knobs().items():
         for value in values:
-            settings, particles = dict(DEFAULTS), args.particles
-            if knob == "particles":
-                particles = max(50, int(round(value * args.particles)))
-                value = particles
-            else:
-                settings[knob] = value
-            name = "default" if settings == DEFAULTS and particles == args.particles else \
-                label(knob, value).replace(",", "x")
-            print(f"tradeoff: {knob} = {value}", file=sys.stderr, flush=True)
-            result = run(args, name, settings, particles)
+            config, value = study.variant(knob, value)
+            name = ("default" if config == default else
+                    f"{knob}={text(value)}".replace(",", "x"))
+            log(f"{knob} = {text(value)}")
+            result = run(name, config)
             rows.append({"knob": knob, "value": value, **result, **errors(result, reference)})
     for use, bound in USES.items():
-        settings = dict(DEFAULTS)
-        settings.update({knob: row["value"] for knob, row in recommendation(rows, bound).items()
-                         if knob in settings})
-        print(f"tradeoff: combined settings for a {use}: {settings}", file=sys.stderr,
-              flush=True)
-        result = run(args, f"combined_{use.replace(' ', '_')}", settings, args.particles)
+        config = default
+        for knob, row in recommendation(rows, bound).items():
+            if knob != "particles":
+                config = with_setting(config, knob, row["value"])
+        log(f"combined settings for a {use}: {settings(config)}")
+        result = run(f"combined_{use.replace(' ', '_')}", config)
         rows.append({"knob": "combined", "value": use, **result, **errors(result, reference)})
     return reference, rows
 
@@ -223,16 +279,19 @@ def fastest_within(rows, bound, default_time):
     return best, default_time / best["cpu_time_s"]
 
 
-def write_markdown(path, args, reference, rows):
-    default = next(r for r in rows if r["settings"] == DEFAULTS
-                   and r["particles"] == args.particles)
+# ---------------------------------------------------------------- report
+
+def write_markdown(path, study, reference, rows):
+    centre = settings(study.default())
+    default = next(r for r in rows if r["knob"] != "combined" and r["settings"] == centre
+                   and r["particles"] == study.particles)
     best, speedup = fastest_within(rows, PAPER_ERROR, default["cpu_time_s"])
     lines = [
         "# Speed against accuracy (pendular tradeoff)", "",
-        f"`python scenarios/tradeoff.py --out DIR --particles {args.particles} --max-strain "
-        f"{args.max_strain}`: a wet triaxial (suction {SUCTION:g} Pa, lateral {CONFINING:g} Pa) "
-        f"of {args.particles} spheres to {args.max_strain:g} axial strain, one knob varied at a "
-        "time around the defaults; one Numba thread per run. Errors are relative to the "
+        f"`pendular tradeoff --out DIR --particles {study.particles} --max-strain "
+        f"{study.max_strain}`: a wet triaxial (suction {SUCTION:g} Pa, lateral {CONFINING:g} Pa) "
+        f"of {study.particles} spheres to {study.max_strain:g} axial strain, one knob varied at "
+        "a time around the defaults; one Numba thread per run. Errors are relative to the "
         "reference run (time-step safety 0.35, inertial number 1e-4, table 700 x 160): "
         f"peak q = {reference['peak_q']:.1f} Pa, Sr at peak = "
         f"{100 * reference['saturation_at_peak']:.3f} %, q'/p' at peak = "
@@ -244,14 +303,15 @@ def write_markdown(path, args, reference, rows):
         "| knob | value | CPU [s] | wall [s] | M particle-steps/s | peak q error | "
         "Sr error | q'/p' error | error |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['knob']} | {r['value']} | {r['cpu_time_s']:.1f} | "
+        lines.append(f"| {r['knob']} | {text(r['value'])} | {r['cpu_time_s']:.1f} | "
                      f"{r['wall_time_s']:.1f} | {r['particle_steps_per_s'] / 1e6:.2f} | "
                      f"{100 * r['peak_q_error']:.2f} % | {100 * r['saturation_error']:.2f} % | "
                      f"{100 * r['stress_ratio_error']:.2f} % | {100 * r['error']:.2f} % |")
     lines += ["", "## Recommendations", "",
               f"Fastest single-knob run within {PAPER_ERROR:.0%} of the reference on peak q: "
-              f"{best['knob']} = {best['value']}, {speedup:.2f} x faster than the defaults "
-              f"({best['cpu_time_s']:.1f} s against {default['cpu_time_s']:.1f} s of CPU).", ""]
+              f"{best['knob']} = {text(best['value'])}, {speedup:.2f} x faster than the "
+              f"defaults ({best['cpu_time_s']:.1f} s against {default['cpu_time_s']:.1f} s of "
+              "CPU).", ""]
     for use, bound in USES.items():
         chosen = recommendation(rows, bound)
         together = next(r for r in rows if r["knob"] == "combined" and r["value"] == use)
@@ -264,7 +324,7 @@ def write_markdown(path, args, reference, rows):
         for knob in KNOBS:
             if knob in chosen:
                 row = chosen[knob]
-                lines.append(f"- {knob} = {row['value']} ({100 * row['error']:.1f} %, "
+                lines.append(f"- {knob} = {text(row['value'])} ({100 * row['error']:.1f} %, "
                              f"{row['cpu_time_s']:.1f} s)")
             elif any(r["knob"] == knob for r in rows):
                 lines.append(f"- {knob}: no setting within {bound:.0%} (keep the reference's)")
@@ -288,7 +348,7 @@ def plot(path, rows):
         axes.plot([r["cpu_time_s"] for r in chosen], [100 * max(r["error"], 1e-4) for r in chosen],
                   "o-", color=f"C{index}", label=knob)
         for r in chosen:
-            axes.annotate(str(r["value"]), (r["cpu_time_s"], 100 * max(r["error"], 1e-4)),
+            axes.annotate(text(r["value"]), (r["cpu_time_s"], 100 * max(r["error"], 1e-4)),
                           fontsize=6)
     axes.axhline(100 * PAPER_ERROR, color="k", ls=":", lw=1)
     axes.set_xscale("log")
@@ -299,19 +359,29 @@ def plot(path, rows):
     save_figure(figure, path)
 
 
-def write_study(study, docs=None):
-    """Measure the study and write DIR/tradeoff.json, .md and .png (copied into ``docs`` if
-    given); returns the tradeoff.json content."""
-    os.makedirs(os.path.join(study.out, "samples"), exist_ok=True)
-    reference, rows = measure(study)
-    data = {"arguments": {**dataclasses.asdict(study), "docs": docs}, "suction": SUCTION,
-            "confining": CONFINING, "reference": reference, "rows": rows}
-    paths = {name: os.path.join(study.out, f"tradeoff.{name}") for name in ("json", "md", "png")}
-    write_json(paths["json"], data)
-    write_markdown(paths["md"], study, reference, rows)
-    plot(paths["png"], rows)
+#: Files the study owns in its output folder (its runs and samples are reused, not owned).
+OUTPUTS = ("tradeoff.json", "tradeoff.md", "tradeoff.png")
+
+
+def write_study(study, *, docs=None, log=None):
+    """Run the Study ``study`` and write tradeoff.json/.md/.png into its folder (and copies
+    in ``docs`` if given); returns the tradeoff.json content. One Numba thread; ``log(text)``
+    hears of each run."""
+    if not isinstance(study, Study):
+        raise TypeError(f"study must be a pendular.tradeoff.Study, got {type(study).__name__}")
+    if docs is not None and not os.path.isdir(docs):
+        raise ValueError(f"docs = {docs!r} is not a folder")
+    numba.set_num_threads(1)
+    with OutputFolder(study.out, "tradeoff") as folder:
+        paths = {name.rsplit(".", 1)[1]: folder.claim(name) for name in OUTPUTS}
+        reference, rows = measure(study, log)
+        data = {"arguments": {**dataclasses.asdict(study), "docs": docs},
+                "suction": SUCTION, "confining": CONFINING, "reference": reference,
+                "rows": rows}
+        write_json(paths["json"], data)
+        write_markdown(paths["md"], study, reference, rows)
+        plot(paths["png"], rows)
     if docs is not None:
         for path in paths.values():
             shutil.copy(path, docs)
-    print(f"tradeoff: {len(rows)} rows; outputs in {study.out} ({paths['md']})")
     return data

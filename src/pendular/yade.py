@@ -125,9 +125,10 @@ def cache_folder():
     return str(capillary.cache_directory())
 
 
-def cached_sample(config, *, progress=True):
+def cached_sample(config, *, progress=True, threads=None):
     """(Particles, Walls, preparation report) of the sample of ``config`` (a PrepareConfig),
-    prepared once (thesis Ch. 5.2.2, at config.confining) and saved in the cache folder with its
+    prepared once (thesis Ch. 5.2.2, at config.confining; ``threads``: Numba threads of the
+    preparation, dem.simulation's policy by default) and saved in the cache folder with its
     configuration; a saved sample of another configuration is prepared again."""
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -136,7 +137,7 @@ def cached_sample(config, *, progress=True):
     if not sample_made_with(path, config):
         os.makedirs(os.path.dirname(path), exist_ok=True)
         started = time.perf_counter()
-        sim, report = prepare_sample(config, progress=progress)
+        sim, report = prepare_sample(config, progress=progress, threads=threads)
         report["preparation_wall_time_s"] = time.perf_counter() - started
         save_sample(path, sim, report, {"sample": config_to_dict(config)},
                     identity={"seed": config.seed})

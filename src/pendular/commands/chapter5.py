@@ -2,10 +2,11 @@
 stress, from one sample per confining stress; campaign.json, report.md (every Table 5.3 cell
 and Sr beside the thesis's, Mohr–Coulomb envelopes in net and effective stress) and plots/
 (Figs. 5.3-5.8). The default grid is the table pendular/campaigns/chapter5.toml; options
-override it. Finished runs with equal configurations are reused."""
+override it. Finished runs with equal configurations are reused. Each run has --threads Numba
+threads (one by default) and its own log.txt with its progress."""
 
 from ..chapter5 import Chapter5Grid, chapter5_campaign
-from ..cli import UsageError, add_run_options, positive_int
+from ..cli import UsageError, add_run_options, positive_int, set_threads
 
 
 def _values(name):
@@ -41,12 +42,13 @@ def add_arguments(parser):
     parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
                         help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
                              "instead of --jobs local processes")
-    add_run_options(parser)
+    add_run_options(parser, threads_default=1)
 
 
 def run(args):
     if args.out == "":
         raise UsageError("--out '': an output folder is required")
+    set_threads(args.threads)
     if args.particles is not None and args.particles < 2:
         raise UsageError(f"--particles {args.particles} is outside the valid range [2, inf)")
     grid = Chapter5Grid.from_table(
@@ -55,7 +57,8 @@ def run(args):
         particles=args.particles, seed=args.seed, max_strain=args.max_strain,
         inertial_number=args.inertial_number, prep_friction=args.prep_friction)
     campaign, reused = chapter5_campaign(grid, args.out, jobs=args.jobs,
-                                         scheduler=args.scheduler, quiet=args.quiet)
+                                         scheduler=args.scheduler, threads=args.threads,
+                                         quiet=args.quiet)
     runs = len(campaign["runs"])
     if reused:
         print(f"chapter5: {reused} finished runs in {args.out} reused, {runs - reused} run")

@@ -7,11 +7,15 @@ content, pulled apart by grips at its z walls. Writes tension.json, report.md, p
 cases/<case>/history.h5 and vtk/ (pendular.tension).
 """
 
-from ..cli import UsageError, add_run_options, set_threads
+from __future__ import annotations
+
+import argparse
+
+from ..cli import UsageError, add_run_options, positive_int, set_threads
+from ..config import TensionConfig
 from ..reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
 from ..reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
-from ..tension import TensionConfig, TensionTest, cases_of
-
+from ..tension import TensionTest, cases_of, report_lines
 
 
 def _numbers(name, text):
@@ -24,59 +28,64 @@ def _numbers(name, text):
         raise UsageError(f"{name} = {text!r} is not a comma-separated list of numbers") from None
 
 
-def add_arguments(parser):
+def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--void-ratio", default=None,
-                        help="void ratio(s) of the core, comma separated (default: Kim's 0.72, "
+                        help="void ratio(s) of the core [-], comma separated (default: Kim's 0.72, "
                              "0.58)")
     parser.add_argument("--roughness", type=float, default=KIM_SEPARATION,
-                        help="meniscus separation of touching grains H/R (default Kim's sand, "
+                        help="meniscus separation of touching grains H/R [-] (default Kim's sand, "
                              "as in the packing_state prediction; 0: smooth spheres)")
     parser.add_argument("--water-content", default=None,
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
-    parser.add_argument("--particles", type=int, default=2000, help="number of spheres")
+    parser.add_argument("--particles", type=int, default=2000, help="number of spheres [-]")
     parser.add_argument("--radius", type=float, default=KIM_RADIUS, help="sphere radius [m]")
     parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
     parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
                         help="surface tension [N/m]")
     parser.add_argument("--specific-gravity", type=float, default=SPECIFIC_GRAVITY,
-                        help="specific gravity Gs of the grains")
+                        help="specific gravity Gs of the grains [-]")
     parser.add_argument("--confining", type=float, default=100.0,
                         help="isotropic stress of preparation and wetting [Pa]")
     parser.add_argument("--friction", type=float, default=18.0,
                         help="contact friction during wetting and pull [deg]")
     parser.add_argument("--young", type=float, default=1e6, help="YADE young E [Pa], kn = E R")
     parser.add_argument("--inertial-number", type=float, default=1e-3,
-                        help="I = strain rate x d x sqrt(rho / confining) of the pull")
+                        help="I = strain rate x d x sqrt(rho / confining) of the pull [-]")
     parser.add_argument("--max-strain", type=float, default=0.1,
-                        help="largest axial extension of the pull")
+                        help="largest axial extension of the pull [-]")
     parser.add_argument("--residual", type=float, default=0.2,
-                        help="fraction of the peak below which the pull has ruptured")
+                        help="fraction of the peak below which the pull has ruptured [-]")
     parser.add_argument("--grip-depth", type=float, default=1.0,
                         help="grip thickness: particles whose surface is within this many "
-                             "diameters of a z wall")
+                             "diameters of a z wall [diameters]")
     parser.add_argument("--void-ratio-tolerance", type=float, default=0.01,
-                        help="largest |e - target| accepted from the preparation")
-    parser.add_argument("--vtk-frames", type=int, default=20,
+                        help="largest |e - target| accepted from the preparation [-]")
+    frames = parser.add_mutually_exclusive_group()
+    frames.add_argument("--vtk-frames", type=int, default=TensionConfig.vtk_frames,
                         help="ParaView frames per pull (0: none)")
+    frames.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
+                        help="steps between ParaView frames of the pull, instead of "
+                             "--vtk-frames (0: none)")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the samples")
     parser.add_argument("--out", default="runs/direct_tension", help="output folder")
     add_run_options(parser, threads_default=1)
 
 
-def config_from(args):
+def config_from(args: argparse.Namespace) -> TensionConfig:
     """The TensionConfig of parsed options (ValueError naming the option)."""
     cases = cases_of(_numbers("--void-ratio", args.void_ratio),
                      _numbers("--water-content", args.water_content))
     return TensionConfig(cases=cases, **{name: getattr(args, name) for name in (
         "roughness", "particles", "radius", "contact_angle", "surface_tension",
         "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
-        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "seed")})
+        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed")})
 
 
-def run(args):
+def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
     config = config_from(args)
-    output = TensionTest(config).run(args.out, progress=not args.quiet)
+    output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args))
+    print("\n".join(report_lines(output["cases"], config)))
     print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}")
     return 0

@@ -1,10 +1,12 @@
 """Speed against accuracy: a wet triaxial (30 kPa, 750 Pa) run with one knob changed at a time
 (time-step safety, inertial number, damping, sample size, table resolution, exact or toroidal
 bridges, records, neighbour-list skin), each compared with a slow, fine reference on peak q, Sr
-and q'/p' at the peak. Writes tradeoff.json, tradeoff.md (table and recommendations for a quick
-look and a paper figure) and tradeoff.png (pendular.tradeoff)."""
+and q'/p' at the peak. Every run uses one Numba thread. Writes tradeoff.json, tradeoff.md (table
+and recommendations for a quick look and a paper figure) and tradeoff.png (pendular.tradeoff);
+finished runs in DIR/runs/ with an equal configuration are reused."""
 
-from ..cli import add_run_options, set_threads
+import sys
+
 from ..tradeoff import Study, write_study
 
 
@@ -18,12 +20,16 @@ def add_arguments(parser):
                         help="three knobs, three settings each (a smoke test)")
     parser.add_argument("--docs", metavar="FOLDER", default=None,
                         help="also copy tradeoff.json/.md/.png into FOLDER")
-    add_run_options(parser, threads_default=1)
+
+
+def _log(message):
+    print(f"tradeoff: {message}", file=sys.stderr, flush=True)
 
 
 def run(args):
-    set_threads(args.threads)
     study = Study(out=args.out, particles=args.particles, max_strain=args.max_strain,
                   seed=args.seed, quick=args.quick)
-    write_study(study, docs=args.docs)
+    data = write_study(study, docs=args.docs, log=_log)
+    print(f"tradeoff: {len(data['rows'])} rows; outputs in {args.out} "
+          "(tradeoff.json, tradeoff.md, tradeoff.png)")
     return 0

@@ -1,0 +1,91 @@
+"""The step pipeline of dem.simulation.Simulation: order of a step, the read-only list of
+operations, lookup by type, and scene changes through the public lists."""
+
+import numpy as np
+import pytest
+
+from conftest import RADIUS, YOUNG, two_body_scene
+from dem.contact_law import ContactForces
+from dem.integrate import Integrator
+from dem.neighbors import NeighborList
+from dem.record import HistoryRecorder
+from dem.simulation import Simulation
+from dem.state import Particles, Walls
+from dem.walls import StressServo, WallForces
+
+
+class Logged:
+    """Test operation: note (name, step, time, whether any force is set) in ``journal``, then
+    run ``inner`` if given."""
+
+    def __init__(self, name, journal, inner=None):
+        self.name = name
+        self.journal = journal
+        self.inner = inner
+
+    def apply(self, sim):
+        self.journal.append((self.name, sim.step, sim.time, bool(sim.particles.force.any())))
+        if self.inner is not None:
+            self.inner.apply(sim)
+
+
+def logged_scene(journal):
+    """Two overlapping spheres (a contact force every step), every operation logged."""
+    particles = Particles(np.array([[0.0, 0, 0], [1.9 * RADIUS, 0, 0]]), np.full(2, RADIUS),
+                          2650.0)
+    return Simulation(particles, Walls.box([-1.0] * 3, [1.0] * 3), 1e-6,
+                      neighbors=Logged("neighbors", journal, NeighborList(0.2 * RADIUS)),
+                      forces=[Logged("contacts", journal, ContactForces(YOUNG)),
+                              Logged("walls", journal, WallForces(YOUNG))],
+                      controls=[Logged("servo", journal), Logged("growth", journal)],
+                      integrator=Logged("integrator", journal, Integrator(0.0)),
+                      writers=[Logged("writer", journal)])
+
+
+def test_a_step_runs_the_declared_pipeline_in_order():
+    """Forces zeroed, neighbour list, forces, controls, integrator; then step and time advance
+    and the writers see the new state."""
+    journal = []
+    sim = logged_scene(journal)
+    sim.run(2)
+    expected = []
+    for step in range(2):
+        time = step * sim.dt
+        expected += [("neighbors", step, time, False), ("contacts", step, time, False),
+                     ("walls", step, time, True), ("servo", step, time, True),
+                     ("growth", step, time, True), ("integrator", step, time, True),
+                     ("writer", step + 1, time + sim.dt, True)]
+    assert journal == expected
+
+
+def test_operations_are_read_only_and_follow_the_public_lists():
+    sim = two_body_scene([[0, 0, 0], [1.9 * RADIUS, 0, 0]], np.zeros((2, 3)))
+    assert sim.operations == (sim.neighbors, *sim.forces, sim.integrator)
+    with pytest.raises(AttributeError):
+        sim.operations = ()
+    with pytest.raises(TypeError):
+        sim.operations[0] = NeighborList(1.0)
+    servo = StressServo("xyz", 1.0, 1.0)
+    sim.controls = [servo]
+    assert sim.operations[-2] is servo
+    assert sim.operation(StressServo) is servo
+    assert sim.operation(WallForces) is sim.forces[1]
+    recorder = HistoryRecorder(1, {"step": lambda s: s.step})
+    sim.writers.append(recorder)
+    assert sim.operation(HistoryRecorder) is recorder
+    sim.controls = []
+    with pytest.raises(KeyError, match="StressServo"):
+        sim.operation(StressServo)
+
+
+def test_an_appended_force_acts_from_the_next_step():
+    class Push:
+        def apply(self, sim):
+            sim.particles.force[0, 0] += 1e-9
+
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    sim.advance()
+    assert not sim.particles.velocity.any()
+    sim.forces.append(Push())
+    sim.advance()
+    assert sim.particles.velocity[0, 0] > 0.0
