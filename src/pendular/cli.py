@@ -65,6 +65,17 @@ def add_run_options(parser, threads_default=None):
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
 
+def add_executor_options(parser):
+    """Options of commands that run many tests: --jobs, --scheduler, and --threads (per run,
+    default 1), --quiet."""
+    parser.add_argument("--jobs", type=positive_int("--jobs", 1), default=1,
+                        help="parallel processes")
+    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                        help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
+                             "instead of --jobs local processes")
+    add_run_options(parser, threads_default=1)
+
+
 def set_threads(threads):
     """Apply --threads (error naming it outside [1, NUMBA_NUM_THREADS])."""
     if threads is None:

@@ -23,18 +23,13 @@ then ends with an error naming it (its traceback is in its log.txt).
 import os
 
 from ..campaign import Campaign, sweep_from_table, write_campaign_csv
-from ..cli import UsageError, add_run_options, positive_int, set_threads
+from ..cli import UsageError, add_executor_options, set_threads
 
 
 def add_arguments(parser):
     parser.add_argument("table", help="TOML parameter table")
     parser.add_argument("--out", default="runs/campaign", help="output folder")
-    parser.add_argument("--jobs", type=positive_int("--jobs", 1), default=1,
-                        help="parallel processes")
-    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                        help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
-                             "instead of --jobs local processes")
-    add_run_options(parser, threads_default=1)
+    add_executor_options(parser)
 
 
 def run(args):

@@ -6,7 +6,7 @@ override it. Finished runs with equal configurations are reused. Each run has --
 threads (one by default) and its own log.txt with its progress."""
 
 from ..chapter5 import Chapter5Grid, chapter5_campaign
-from ..cli import UsageError, add_run_options, positive_int, set_threads
+from ..cli import UsageError, add_executor_options, set_threads
 
 
 def _values(name):
@@ -27,8 +27,6 @@ def add_arguments(parser):
                              "0,15000,30000,300000)")
     parser.add_argument("--confining", default=None,
                         help="lateral stresses [Pa], comma-separated (table: 250,500,750,1000)")
-    parser.add_argument("--jobs", type=positive_int("--jobs", 1), default=1,
-                        help="parallel processes")
     parser.add_argument("--out", default="runs/chapter5", help="output folder")
     parser.add_argument("--seed", type=int, default=None, help="random seed of every sample "
                                                                "(table: 0)")
@@ -39,10 +37,7 @@ def add_arguments(parser):
     parser.add_argument("--prep-friction", type=float, default=None,
                         help="contact friction during the radius growth [deg] (table: 0.5; "
                              "higher gives looser samples)")
-    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                        help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
-                             "instead of --jobs local processes")
-    add_run_options(parser, threads_default=1)
+    add_executor_options(parser)
 
 
 def run(args):
