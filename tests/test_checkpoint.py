@@ -239,3 +239,36 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     for array in (sim.particles.position, sim.particles.velocity, sim.walls.position,
                   sim.controls[0].previous):
         assert np.all(array == step)
+
+
+def test_samples_and_checkpoints_describe_their_datasets(prepared, tmp_path):
+    """Every dataset of a sample and of a checkpoint has units and a description (an array
+    dem.checkpoint does not declare: units "unknown"); both files carry pendular_version and
+    schema_version, written before the checksum, so that they still load."""
+    from dem.sample import DATASETS, load_sample, save_sample
+
+    _, sample = prepared
+    sim = copy.deepcopy(sample)
+    sim.run(1)
+    sim.contacts.extra["someone.thing"] = np.zeros(len(sim.contacts))
+    save_sample(tmp_path / "sample.h5", sim, {"porosity": 0.4})
+    save_checkpoint(tmp_path / "checkpoint.h5", sim)
+    for name in ("sample.h5", "checkpoint.h5"):
+        datasets = []
+        with h5py.File(tmp_path / name, "r") as handle:
+            assert handle.attrs["pendular_version"] and int(handle.attrs["schema_version"]) >= 2
+            handle.visititems(lambda path, item: datasets.append((path, dict(item.attrs)))
+                              if isinstance(item, h5py.Dataset) else None)
+        assert len(datasets) >= 5
+        for path, attrs in datasets:
+            assert attrs.get("units") and attrs.get("description"), (name, path)
+        units = dict((path, attrs["units"]) for path, attrs in datasets)
+        if name == "sample.h5":
+            assert set(units) == set(DATASETS)
+            assert units["velocity"] == "m/s" and units["angular_velocity"] == "rad/s"
+        else:
+            assert units["particles/position"] == "m" and units["contacts/overlap"] == "m"
+            assert units["contacts/extra/someone.thing"] == "unknown"
+    load_sample(tmp_path / "sample.h5")
+    del sim.contacts.extra["someone.thing"]
+    load_checkpoint(tmp_path / "checkpoint.h5", copy.deepcopy(sample))

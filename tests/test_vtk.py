@@ -191,3 +191,92 @@ def test_writer_input_is_checked(tmp_path):
         VtkWriter(tmp_path, period=0)
     with pytest.raises(ValueError, match="compression"):
         VtkWriter(tmp_path, period=1, compression="gzip")
+
+
+# ---------------------------------------------------------------- read back with VTK itself
+
+#: Point or cell arrays of each series (pendular.vtk docstring); bridges and contacts carry
+#: theirs only when they have cells.
+SERIES_ARRAYS = {
+    "particles": ("point", {"id", "radius", "velocity", "angular_velocity", "contact_force",
+                            "coordination", "bridges"}),
+    "walls": ("cell", {"wall", "normal_stress", "force", "velocity"}),
+    "bridges": ("cell", {"force", "volume", "delta1", "delta2"}),
+    "contacts": ("cell", {"normal_force", "shear_force", "bridge"}),
+}
+
+
+def vtk_frames(folder, series):
+    """[(pvd timestep, vtkUnstructuredGrid)] of every frame of ``folder``/``series``.pvd, read
+    with VTK's own XML reader."""
+    vtk = pytest.importorskip("vtk")
+    frames = []
+    for timestep, name in read_pvd(folder / f"{series}.pvd"):
+        reader = vtk.vtkXMLUnstructuredGridReader()
+        reader.SetFileName(str(folder / name))
+        reader.Update()
+        assert reader.GetErrorCode() == 0, name
+        frames.append((timestep, reader.GetOutput()))
+    return frames
+
+
+def vtk_arrays(data):
+    """name -> NumPy array of a vtkDataSetAttributes / vtkFieldData."""
+    from vtk.util.numpy_support import vtk_to_numpy
+    return {data.GetArrayName(i): vtk_to_numpy(data.GetArray(i))
+            for i in range(data.GetNumberOfArrays())}
+
+
+@pytest.mark.parametrize("folder", ["vtk", "vtk_prep"])
+def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder):
+    """Each series of the shear (vtk/) and of the preparation and wetting (vtk_prep/) opens
+    with the vtk package: 200 spheres, six wall quads, two points per bridge or contact line,
+    the declared arrays, and field data step, time and axial_strain (shear: the .pvd time axis
+    is the axial strain in %) or phase (preparation: every phase of a wet run, in order)."""
+    pytest.importorskip("vtk")
+    from pendular.triaxial import PREP_PHASES
+
+    path = wet_triaxial_run / folder
+    steps = None
+    for series, (where, names) in SERIES_ARRAYS.items():
+        frames = vtk_frames(path, series)
+        assert len(frames) >= 10
+        fields = [vtk_arrays(grid.GetFieldData()) for _, grid in frames]
+        if steps is None:
+            steps = [f["step"][0] for f in fields]
+            assert steps == sorted(set(steps))
+        assert [f["step"][0] for f in fields] == steps          # every series, same frames
+        for (timestep, grid), field in zip(frames, fields):
+            points, cells = grid.GetNumberOfPoints(), grid.GetNumberOfCells()
+            data = vtk_arrays(grid.GetPointData() if where == "point" else grid.GetCellData())
+            if series == "particles":
+                assert points == cells == 200
+                assert data["radius"].shape == (200,) and data["velocity"].shape == (200, 3)
+            elif series == "walls":
+                assert (points, cells) == (24, 6)
+                assert list(data["wall"]) == list(range(6))
+            else:
+                assert points == 2 * cells
+            if cells:
+                assert set(data) == names, (series, sorted(data))
+                assert all(len(values) == cells for values in data.values())
+            if folder == "vtk":
+                assert set(field) == {"step", "time", "axial_strain"}
+                assert timestep == pytest.approx(100.0 * field["axial_strain"][0], abs=1e-12)
+            else:
+                assert set(field) == {"step", "time", "phase", "mean_wall_stress"}
+                assert timestep == field["time"][0]
+    if folder == "vtk":
+        strain = [f["axial_strain"][0] for f in fields]
+        assert 0.0 < strain[0] < 1e-3                  # the first step of the shear
+        assert np.all(np.diff(strain) > 0.0)
+        assert strain[-1] == pytest.approx(0.01, rel=0.02)
+        bridges = vtk_arrays(vtk_frames(path, "contacts")[-1][1].GetCellData())["bridge"]
+        assert bridges.any()                       # a wet run: contacts holding bridges
+    else:
+        phases = [PREP_PHASES[int(f["phase"][0])] for f in fields]
+        assert list(dict.fromkeys(phases)) == ["growth", "friction", "unload", "equilibrate",
+                                               "wetting"]
+        last = vtk_frames(path, "bridges")[-1][1]
+        assert last.GetNumberOfCells() > 0            # the wetted sample holds bridges
+        assert fields[-1]["mean_wall_stress"][0] == pytest.approx(750.0, rel=0.02)

@@ -19,6 +19,7 @@ import json
 import math
 import os
 import sys
+import time
 from pathlib import Path
 
 import h5py
@@ -78,7 +79,8 @@ def cached_table(path, identity, load, check, build):
 
     Checks: checksum and ``identity`` (dem.integrity.verify), ``load(path)``, then
     ``check(table)`` (ValueError when its nodes do not match the key or are not finite). A
-    file that fails is rebuilt, never used, with a one-line warning on stderr saying why."""
+    file that fails is rebuilt, never used, with a one-line warning on stderr saying why; a
+    build says on stderr what it builds and how long it took (seconds to minutes)."""
     path = Path(path)
     if path.exists():
         try:
@@ -93,8 +95,12 @@ def cached_table(path, identity, load, check, build):
             reason = " ".join(reason.split())
             print(f"warning: cached bridge table {path} not used, rebuilding it: {reason}",
                   file=sys.stderr)
+    print(f"building bridge table {path.name} (cached for later runs) ...", file=sys.stderr,
+          flush=True)
+    started = time.perf_counter()
     table = build()
     save_atomically(table, path, identity)
+    print(f"built {path.name} in {time.perf_counter() - started:.1f} s", file=sys.stderr)
     return table
 
 

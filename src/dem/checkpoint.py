@@ -12,6 +12,10 @@ A checkpoint is one HDF5 file:
                  contacts/extra/ the arrays of ``Contacts.extra`` (absent if no contacts yet)
     state        pickled state of every operation and writer, and the caller's ``extra_state``
 
+Every dataset has ``units`` and ``description`` attributes (DATASETS; an array this module does
+not know, e.g. another operation's ``Contacts.extra`` entry, gets units "unknown" and a
+description naming it), and the file ``pendular_version`` and ``schema_version`` (VERSION).
+
 The state of an operation is its ``vars(op)``: arrays, scalars and any picklable value
 (``StressServo.previous``, the NeighborList's reference positions and rebuild count,
 ``HistoryRecorder.rows``, a writer's list of frames ...). Values that cannot be pickled
@@ -40,13 +44,56 @@ import h5py
 import numpy as np
 
 from .atomic import replacing
-from .integrity import stamp, verify
+from .integrity import software_version, stamp, verify
 from .neighbors import Contacts
 from .validate import check_int, reading
 
 FORMAT = "pendular-checkpoint"
 VERSION = 2
 _SCALARS = (bool, int, float, str, np.generic)
+
+#: Units and description of the datasets of a checkpoint, by group (dataset attributes).
+DATASETS = {
+    "particles": {
+        "position": ("m", "sphere centres (N, 3)"), "radius": ("m", "sphere radii"),
+        "velocity": ("m/s", "translational velocities (N, 3)"),
+        "angular_velocity": ("rad/s", "angular velocities (N, 3)"),
+        "force": ("N", "resultant force on each sphere (N, 3)"),
+        "torque": ("N m", "resultant torque on each sphere (N, 3)"),
+        "mass": ("kg", "sphere masses"), "inertia": ("kg m^2", "sphere moments of inertia")},
+    "walls": {
+        "position": ("m", "wall plane coordinates (6,), x-, x+, y-, y+, z-, z+"),
+        "velocity": ("m/s", "outward wall speeds of the last step (6,)"),
+        "force": ("N", "normal force of the particles on each wall, compression positive"),
+        "stiffness": ("N/m", "sum of the normal stiffnesses of each wall's contacts"),
+        "moment": ("N m", "sum over each wall's contacts of distance * force")},
+    "contacts": {
+        "pair_i": ("1", "first particle of each candidate pair (K,), i < j"),
+        "pair_j": ("1", "second particle of each candidate pair (K,)"),
+        "row_start": ("1", "CSR row starts of the pairs by first particle"),
+        "second_start": ("1", "CSR row starts of the pairs by second particle"),
+        "second_pair": ("1", "pair indices ordered by second particle"),
+        "shear_force": ("N", "elastic tangential force on j from i (K, 3), spring history"),
+        "normal": ("1", "unit normal i -> j at the last force evaluation (K, 3)"),
+        "overlap": ("m", "r_i + r_j - |x_j - x_i| (negative: gap)"),
+        "normal_force": ("N", "magnitude of the spring normal force (0 when apart)"),
+        "force": ("N", "total contact force on j from i (K, 3)"),
+        "torque_i": ("N m", "contact torque on i (K, 3)"),
+        "torque_j": ("N m", "contact torque on j (K, 3)")},
+    "": {"state": ("1", "pickled state of every operation and writer and the caller's "
+                        "extra_state (bytes; see dem.checkpoint)")},
+}
+
+
+def _describe(dataset, group, name):
+    """Set the ``units`` and ``description`` attributes of a dataset (DATASETS), "unknown"
+    units for a name not declared there."""
+    units, description = DATASETS.get(group, {}).get(
+        name, ("unknown", f"{group}/{name}: an array of the simulation's state not declared "
+                          "in dem.checkpoint.DATASETS (e.g. another operation's per-pair "
+                          "Contacts.extra entry); see dem.checkpoint"))
+    dataset.attrs["units"] = units
+    dataset.attrs["description"] = description
 
 
 def _type_name(obj):
@@ -139,10 +186,12 @@ def _operation_state(op, references):
     return state, skipped
 
 
-def _write_group(handle, name, arrays, scalars=None):
+def _write_group(handle, name, arrays, scalars=None, kind=None):
+    """Group ``name`` with a described dataset per array (``kind``: its DATASETS key, default
+    ``name``) and the ``scalars`` as group attributes."""
     group = handle.create_group(name)
     for key, value in arrays.items():
-        group.create_dataset(key, data=value)
+        _describe(group.create_dataset(key, data=value), name if kind is None else kind, key)
     for key, value in (scalars or {}).items():
         group.attrs[key] = value
     return group
@@ -195,8 +244,10 @@ def save_checkpoint(path, sim, extra_state=None, identity=None):
                 if not isinstance(value, np.ndarray):
                     raise TypeError(f"cannot checkpoint contacts.extra[{key!r}] of type "
                                     f"{type(value).__name__}: only arrays are supported")
-            _write_group(group, "extra", contacts.extra)
-        handle.create_dataset("state", data=blob)
+            _write_group(group, "extra", contacts.extra, kind="contacts/extra")
+        _describe(handle.create_dataset("state", data=blob), "", "state")
+        handle.attrs["pendular_version"] = software_version()
+        handle.attrs["schema_version"] = VERSION
         stamp(handle, {"kind": "checkpoint", "format": FORMAT, "version": VERSION,
                        **(identity or {})})
     return skipped

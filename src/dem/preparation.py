@@ -7,6 +7,10 @@
    kn = E R, forces scale as R^2 and stresses are unchanged.
 4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
    target lowered slowly to the confining stress, and equilibrium again.
+
+The phases, by name (PREPARATION_PHASES): "growth" (2), "friction" (equilibrium at the test
+friction, 4), "unload" (4), "equilibrate" (at the confining stress, 4). Writers passed to
+``prepare_sample`` watch all of them (e.g. ParaView frames, pendular.vtk.VtkWriter).
 """
 
 from dataclasses import dataclass
@@ -93,6 +97,9 @@ def _random_cloud_pairwise(count, radius, lo, hi, seed, max_attempts):
     return position[:placed]
 
 
+#: Names of the phases of ``prepare_sample``, in order (module docstring).
+PREPARATION_PHASES = ("growth", "friction", "unload", "equilibrate")
+
 #: Largest count for which random_cloud falls back to pairwise insertion.
 PAIRWISE_CLOUD_MAX = 2000
 
@@ -111,7 +118,7 @@ def random_cloud(count, radius, lo, hi, seed):
         raise ValueError(f"radius = {radius:g} m is outside the valid range (0, "
                          f"{0.5 * float(np.min(hi - lo)):g}] m for a box of edges "
                          f"{(hi - lo).tolist()} m")
-    seed = check_int("seed", seed)
+    seed = check_int("seed", seed, high=MAX_SEED)
     position = _random_cloud(count, radius, lo, hi, seed, 200 * count + 10000)
     if len(position) < count and count <= PAIRWISE_CLOUD_MAX:
         position = _random_cloud_pairwise(count, radius, lo, hi, seed, 200 * count + 10000)
@@ -145,6 +152,15 @@ class RadiusGrowth:
 #: overlaps of about 8 sigma / E times the radius at the most loaded contact (measured on
 #: prepared samples), so 0.02 keeps every overlap below about 16 % of the radius.
 MAX_STRESS_OVER_YOUNG = 0.02
+
+#: Largest sample: about 1 kB of state per sphere and hours per 1e-3 of strain at 1e6 spheres
+#: on a few cores; beyond, memory and run time are out of reach (issue 12).
+MAX_PARTICLES = 10_000_000
+#: Sphere radii a run accepts [m]: grains of a micron to a metre. Outside, the strain rate of
+#: an inertial number, the box and the masses leave the floating-point range a run needs.
+RADIUS_RANGE = (1e-6, 1.0)
+#: Largest random seed (NumPy's legacy generator, used by the Numba kernels: 32 bits).
+MAX_SEED = 2 ** 32 - 1
 
 
 def check_soft_contacts(name, stress, young):
@@ -181,8 +197,8 @@ class PrepareConfig:
     unload_steps: int = 10000
 
     def __post_init__(self):
-        self.particles = check_int("particles", self.particles, low=2)
-        self.radius = check_positive("radius", self.radius, "m")
+        self.particles = check_int("particles", self.particles, low=2, high=MAX_PARTICLES)
+        self.radius = check_range("radius", self.radius, *RADIUS_RANGE, unit="m")
         self.porosity = check_range("porosity", self.porosity, 0.30, 0.60)
         self.young = check_positive("young", self.young, "Pa")
         self.shear_ratio = check_range("shear_ratio", self.shear_ratio, 0.0, 10.0)
@@ -196,7 +212,7 @@ class PrepareConfig:
                                            low_inclusive=False)
         self.prep_stress = check_positive("prep_stress", self.prep_stress, "Pa")
         self.confining = check_range("confining", self.confining, 0.0, 1e7, unit="Pa")
-        self.seed = check_int("seed", self.seed)
+        self.seed = check_int("seed", self.seed, high=MAX_SEED)
         self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
         self.skin_factor = check_range("skin_factor", self.skin_factor, 0.0, 2.0,
                                        low_inclusive=False)
@@ -212,19 +228,26 @@ def timestep(particles, config):
     return config.timestep_safety * pwave_timestep(particles.radius, config.young, config.density)
 
 
-def equilibrated(config):
-    """Predicate: unbalanced force below threshold (and wall stresses within tolerance if servoed)."""
+def static(unbalanced=0.01, tolerance=0.01):
+    """Predicate (a function of sim): the unbalanced force is at most ``unbalanced`` and every
+    StressServo's walls hold their target within ``tolerance`` (relative)."""
 
     def done(sim):
-        if unbalanced_force(sim.particles, sim.contacts) > config.equilibrium_unbalanced:
+        if unbalanced_force(sim.particles, sim.contacts) > unbalanced:
             return False
         for servo in (op for op in sim.controls if isinstance(op, StressServo)):
             error = np.abs(sim.walls.stress()[list(servo.axes)] - servo.target)
-            if np.any(error > config.stress_tolerance * max(servo.target, 1e-12)):
+            if np.any(error > tolerance * max(servo.target, 1e-12)):
                 return False
         return True
 
     return done
+
+
+def equilibrated(config):
+    """``static`` with the thresholds of a PrepareConfig (equilibrium_unbalanced,
+    stress_tolerance)."""
+    return static(config.equilibrium_unbalanced, config.stress_tolerance)
 
 
 def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None):
@@ -262,12 +285,16 @@ def rescale(sim, factor):
     sim.operation(NeighborList).rebuild(sim)
 
 
-def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
+def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, writers=()):
     """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
 
     The returned simulation is the dry scene with the six walls servoed at the confining
     stress (``sim.controls``); ``report`` gives porosity, coordination and steps. ValueError
     naming the phase when one ends at ``max_steps`` without reaching its target.
+    ``writers``: operations that only read the state (e.g. pendular.vtk.VtkWriter), appended
+    to the simulation's writers for the whole preparation and removed before it returns; a
+    writer with an attribute ``phase`` has it set to the running phase's name
+    (PREPARATION_PHASES) when the phase starts. They change no result.
     """
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -286,6 +313,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     sim = dry_simulation(particles, walls, config, timestep(particles, config),
                          config.skin_factor * config.radius, config.prep_friction_deg, [growth],
                          threads)
+    writers = list(writers)
+    sim.writers.extend(writers)
     done = equilibrated(config)
 
     def grown(s):
@@ -298,6 +327,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
                 "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"
                          f"/{config.equilibrium_unbalanced:g}"}
 
+    _enter(writers, "growth")
     steps = {"growth": sim.run(max_steps, until=grown, check_every=200, progress=label and
                                "grow radii", status=status)}
     _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
@@ -306,20 +336,24 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
     sim.controls = [servo]
     sim.dt = timestep(sim.particles, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
+    _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=label and "set friction", status=status)
     _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim),
              config)
     start = servo.target
     stages = 20
+    _enter(writers, "unload")
     for stage in range(1, stages + 1):
         servo.target = start + (config.confining - start) * stage / stages
         sim.run(config.unload_steps // stages)
     steps["unload"] = config.unload_steps // stages * stages
+    _enter(writers, "equilibrate")
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
                                    progress=label and "equilibrate", status=status)
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)
+    sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),
@@ -330,6 +364,13 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None):
         "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
     }
     return sim, report
+
+
+def _enter(writers, phase):
+    """Tell the ``writers`` that have a ``phase`` attribute that ``phase`` starts."""
+    for writer in writers:
+        if hasattr(writer, "phase"):
+            writer.phase = phase
 
 
 def _require(reached, phase, steps, status, config):

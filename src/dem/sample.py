@@ -4,6 +4,10 @@ A sample file is stamped (dem.integrity: checksum and identity) and every sample
 is checked before use (``check_packing``): finite values, every sphere inside the box, overlaps
 within what the linear contact law holds, not collapsed to one point; ``check_consistent``
 refuses a sample made with another radius, particle count or density than the run asks for.
+
+A sample describes itself: every dataset has ``units`` and ``description`` attributes
+(DATASETS), the file the attributes ``pendular_version``, ``schema_version`` (the layout
+version, VERSION), ``format``, ``density`` [kg/m^3], ``report`` and ``config`` (JSON).
 """
 
 import json
@@ -14,7 +18,7 @@ import numba
 import numpy as np
 
 from .atomic import replacing
-from .integrity import config_hash, stamp, verify
+from .integrity import config_hash, software_version, stamp, verify
 from .state import WALL_NAMES, Particles, Walls
 from .validate import reading
 
@@ -29,6 +33,16 @@ are a small-overlap law; the stress / young limit of dem.preparation (0.02) keep
 samples below about 0.16 R at the most loaded contact, so 0.2 R bounds every valid sample and
 refuses overlapped, edited or misplaced spheres."""
 
+#: Units and description of each dataset of a sample file (its attributes).
+DATASETS = {
+    "position": ("m", "sphere centres (N, 3): x, y, z"),
+    "radius": ("m", "sphere radii (N,)"),
+    "velocity": ("m/s", "sphere translational velocities (N, 3)"),
+    "angular_velocity": ("rad/s", "sphere angular velocities (N, 3)"),
+    "walls": ("m", "wall plane coordinates along their axis (6,), ordered x-, x+, y-, y+, z-, "
+                   "z+ (dem.state.WALL_NAMES)"),
+}
+
 RADIUS_TOLERANCE = 1e-9
 """Relative difference allowed between a sample's mean radius (or density) and the run's."""
 
@@ -37,13 +51,20 @@ _MAX_CELLS_PER_AXIS = 2 ** 20     # cell keys (cx * ny + cy) * nz + cz fit in in
 
 def save_sample(path, sim, report=None, config=None, identity=None):
     """Write the particles and walls of ``sim`` (and the preparation report/config) atomically,
-    stamped with a checksum and an identity: kind, format version, software version, hash of
-    ``config``, and the entries of ``identity`` (e.g. the seed)."""
+    each dataset with its ``units`` and ``description`` (DATASETS), the file with
+    ``pendular_version`` and ``schema_version``, stamped last with a checksum and an identity:
+    kind, format version, software version, hash of ``config``, and the entries of
+    ``identity`` (e.g. the seed)."""
     with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
         p = sim.particles
         for name in ("position", "radius", "velocity", "angular_velocity"):
             handle.create_dataset(name, data=getattr(p, name))
         handle.create_dataset("walls", data=sim.walls.position)
+        for name, (units, description) in DATASETS.items():
+            handle[name].attrs["units"] = units
+            handle[name].attrs["description"] = description
+        handle.attrs["pendular_version"] = software_version()
+        handle.attrs["schema_version"] = VERSION
         handle.attrs["format"] = FORMAT
         handle.attrs["version"] = VERSION
         handle.attrs["density"] = p.density

@@ -71,7 +71,7 @@ PROGRESS_PERIOD = 5.0
 #: What a campaign runs.
 RunConfig = Union[TriaxialConfig, TensionConfig]
 #: Options a parameter table cannot set: the campaign decides them.
-CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after")
+CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep")
 
 
 @dataclass

@@ -104,6 +104,13 @@ def run_command(name, argv, prog=None):
     except (UsageError, ValueError, FileNotFoundError, IsADirectoryError,
             NotADirectoryError, PermissionError) as error:
         parser.exit(2, f"{parser.prog}: error: {error}\n")
+    except (ArithmeticError, MemoryError, numba.core.errors.NumbaError) as error:
+        # a value the configurations' ranges let through but this run cannot hold (the ranges
+        # refuse such values where they enter; this is the last line of defence)
+        first = str(error).strip().splitlines()[0] if str(error).strip() else ""
+        parser.exit(2, f"{parser.prog}: error: a setting is out of this run's reach "
+                       f"({type(error).__name__}{': ' + first if first else ''}): check the "
+                       "options' magnitudes (particles, radius, young, rates, resolutions)\n")
     except KeyboardInterrupt:
         parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
 

@@ -16,12 +16,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from capillary import BRIDGE_MODELS, SURFACE_TENSION
-from dem.preparation import PrepareConfig
+from dem.preparation import MAX_SEED, PrepareConfig
 from dem.validate import check_int, check_positive, check_range
 from homogenize import packing_state, regular_packing
 
 from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS, KIM_SEPARATION,
                         SPECIFIC_GRAVITY, comparison_packing)
+
+#: Most nodes (suction x distance) of a bridge table: about 1 kB of memory per node over the
+#: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
+MAX_TABLE_NODES = 200_000
 
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
@@ -116,9 +120,15 @@ class BridgeConfig:
             if len(self.table_resolution) != 2:
                 raise ValueError(f"table_resolution = {self.table_resolution!r}: two integers "
                                  "(nodes in suction, nodes in distance) expected")
-            self.table_resolution = tuple(check_int(name, value, low=4) for name, value in
+            self.table_resolution = tuple(check_int(name, value, low=4, high=MAX_TABLE_NODES // 4)
+                                          for name, value in
                                           zip(("table_resolution[0]", "table_resolution[1]"),
                                               self.table_resolution))
+            nodes = self.table_resolution[0] * self.table_resolution[1]
+            if nodes > MAX_TABLE_NODES:
+                raise ValueError(f"table_resolution = {self.table_resolution!r} has {nodes} nodes, "
+                                 f"outside the valid range [16, {MAX_TABLE_NODES}] (suction "
+                                 "nodes x distance nodes)")
 
     def build(self):
         """The capillary operation (capillary.CapillaryBridges) of this configuration."""
@@ -162,6 +172,10 @@ class TriaxialConfig:
         if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
             raise TypeError(f"bridges must be a BridgeConfig or None, got "
                             f"{type(self.bridges).__name__}")
+        if self.sample.confining <= 0.0:
+            # the shear's lateral stress: the inertial number and the servo need it > 0
+            raise ValueError(f"confining = {self.sample.confining:g} Pa is outside the valid "
+                             f"range (0, 1e+07] Pa for a triaxial test")
         self.wet_steps = check_int("wet_steps", self.wet_steps, low=1, high=100_000_000)
         self.vtk_frames = check_int("vtk_frames", self.vtk_frames)
         if self.vtk_every is not None:
@@ -243,7 +257,7 @@ class TensionConfig:
         check_range("--vtk-frames", self.vtk_frames, 0, 1000)
         if self.vtk_every is not None:
             self.vtk_every = check_int("--vtk-every", self.vtk_every)
-        check_range("--seed", self.seed, 0)
+        check_int("--seed", self.seed, high=MAX_SEED)
         for e, w in self.cases:
             limit = self.pendular_limit(e)
             if not 0.0 < w <= limit:

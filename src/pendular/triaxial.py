@@ -6,11 +6,12 @@ Building blocks, usable alone for a custom loading path (README "Using it"):
   tolerance);
 - ``wet(sim, bridges, ...)``: add capillary bridges to a static sample and re-equilibrate;
 - ``TriaxialShear(sim, shear, ...)``: lateral walls servoed, axial walls at a constant strain
-  rate, a history recorder; ``run()`` shears to the final strain;
+  rate, a history recorder; ``sim.run(shear.steps)`` shears to the final strain;
 - ``summarize(history)``: peak values.
 
 ``TriaxialTest(config).run(out)`` chains them as the thesis does and writes the outputs
-(history.h5, summary.json, triaxial.png, plots/, vtk/, sample.h5, checkpoint.h5);
+(history.h5, summary.json, triaxial.png, plots/, vtk/, sample.h5, checkpoint.h5; with
+``vtk_prep``, vtk_prep/: ParaView frames of the preparation and wetting);
 ``TriaxialTest.resume(out)`` continues an interrupted run from its checkpoint bit-identically.
 
 Stresses compression positive [Pa], q and p as homogenize.invariants; strains compression
@@ -19,6 +20,7 @@ positive, volumetric strain positive in contraction (SPEC §1).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import time
@@ -31,9 +33,10 @@ from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.integrate import pwave_timestep
 from dem.integrity import checksum, config_hash
 from dem.measure import coordination, porosity, unbalanced_force
-from dem.preparation import prepare_sample, servoed_simulation
+from dem.preparation import PREPARATION_PHASES, prepare_sample, servoed_simulation, static
 from dem.record import HistoryRecorder
 from dem.sample import load_sample, save_sample
+from dem.validate import check_int
 from dem.walls import ConstantStrainRate, StressServo
 from homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from homogenize.invariants import deviator_stress, lateral_stress, mean_stress
@@ -50,13 +53,26 @@ from .vtk import VtkWriter
 MAX_INERTIAL_NUMBER = 1e-2
 #: Most shear steps a run may ask for without --force (about 1 h at 1,000 spheres here).
 MAX_SHEAR_STEPS = 20_000_000
+#: Smallest prep_stress / young of a preparation: the radius growth (1e-4 R per step) settles
+#: only when the overlaps at the target stress (about 8 prep_stress / young R) are well above
+#: its step (60 spheres: 1.7e-4 settles in 7,400 steps, 5e-5 not in 2,000,000).
+MIN_PREP_STRESS_OVER_YOUNG = 1e-4
+#: Smallest confining / young: below, the six servoed walls do not hold the confining stress
+#: within the 1 % tolerance (60 spheres, young 1e6 Pa: 5 Pa is static after 8,600 steps,
+#: 3 Pa not after 250,000; the walls hover at 10-30 Pa).
+MIN_CONFINING_OVER_YOUNG = 5e-6
 #: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
 ESTIMATE_RATE = 4e6
 
 
 #: Files and folders a triaxial run owns in its output folder (pendular.outputs).
 OUTPUTS = ("history.h5", "summary.json", "triaxial.png", "plots", "vtk", "sample.h5",
-           "checkpoint.h5")
+           "checkpoint.h5", "vtk_prep")
+
+#: Phases of the vtk_prep/ series, by the code in each frame's field data ``phase``: those of
+#: dem.preparation.prepare_sample, then "sample" (a loaded sample equilibrated at the confining
+#: stress) and "wetting" (bridges added, equilibrated again).
+PREP_PHASES = (*PREPARATION_PHASES, "sample", "wetting")
 
 
 class NotStatic(ValueError):
@@ -103,23 +119,6 @@ def equilibrium_status(unbalanced):
     return status
 
 
-def static(unbalanced=0.01, tolerance=0.01):
-    """Predicate of ``equilibrate`` (a function of sim)."""
-
-    def done(sim):
-        if unbalanced_force(sim.particles, sim.contacts) > unbalanced:
-            return False
-        servos = [op for op in sim.controls if isinstance(op, StressServo)]
-        for servo in servos:
-            axes = list(servo.axes)
-            error = np.abs(sim.walls.stress()[axes] - servo.target)
-            if np.any(error > tolerance * max(servo.target, 1e-12)):
-                return False
-        return True
-
-    return done
-
-
 def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None):
     """Add the capillary operation ``bridges`` to the forces of a static sample and run until
     static again; returns the wetting report (steps, time, Sr, bridges, porosity)."""
@@ -130,6 +129,29 @@ def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, prog
     return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
             "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
             "wet_porosity": porosity(sim.particles, sim.walls)}
+
+
+@contextlib.contextmanager
+def watched(sim, writers, phase):
+    """Within the block, ``writers`` (read-only operations, e.g. the vtk_prep VtkWriter) are
+    appended to ``sim.writers`` and those with a ``phase`` attribute have it set to ``phase``;
+    they are removed at its end."""
+    writers = list(writers)
+    for writer in writers:
+        if hasattr(writer, "phase"):
+            writer.phase = phase
+    sim.writers.extend(writers)
+    try:
+        yield
+    finally:
+        sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
+
+
+def prep_vtk_period(sample):
+    """Default steps between the frames of vtk_prep/: one per unload stage of the preparation
+    (``unload_steps`` / 20, 500 steps by default), so that a preparation (a radius growth of at
+    least 5,000 steps, the unload, the equilibria) gives a few tens of frames."""
+    return max(1, sample.unload_steps // 20)
 
 
 def capillary_operation(sim):
@@ -235,8 +257,10 @@ def summarize(history):
 def check_feasible(config, force=False):
     """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
     MAX_INERTIAL_NUMBER) or would not finish in reasonable time (more than MAX_SHEAR_STEPS shear
-    steps), with the estimate; ``force`` lets an expert run it anyway. Output periods must fit
-    the shear. ValueError naming the setting."""
+    steps), with the estimate, or whose equilibrium phases cannot settle (confining below
+    MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
+    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. Output periods
+    must fit the shear. ValueError naming the setting."""
     sample, shear = config.sample, config.shear
     rate = shear.rate(sample.radius, sample.density, sample.confining)
     number = inertial_number(rate, sample.radius, sample.density, sample.confining)
@@ -253,6 +277,21 @@ def check_feasible(config, force=False):
             f"the shear would take {steps:.3g} steps (dt = {dt:.3g} s, strain rate {rate:.3g} "
             f"1/s; about {hours:.3g} h here), outside the valid range [1, {MAX_SHEAR_STEPS:g}]:"
             " raise the strain rate or lower young / the time step's cost (or --force)")
+    if (not force and config.sample_path is None
+            and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
+        raise ValueError(
+            f"young = {sample.young:g} Pa is outside the valid range (0, "
+            f"{sample.prep_stress / MIN_PREP_STRESS_OVER_YOUNG:g}] Pa for the preparation at "
+            f"prep_stress = {sample.prep_stress:g} Pa: the radius growth cannot settle at "
+            f"overlaps below {MIN_PREP_STRESS_OVER_YOUNG:g} of the radius (it would run "
+            "2,000,000 steps and stop); lower young (or --force)")
+    if not force and sample.confining < MIN_CONFINING_OVER_YOUNG * sample.young:
+        raise ValueError(
+            f"confining = {sample.confining:g} Pa is outside the valid range "
+            f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, 1e+07] Pa for young = "
+            f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
+            "never hold the confining stress (the equilibrium would run to its step limit); "
+            "raise confining or lower young (or --force)")
     for name in ("vtk_every", "checkpoint_every"):
         value = getattr(config, name)
         if value is not None and value > max(steps, 1.0) + 1:
@@ -290,8 +329,9 @@ class TriaxialTest:
     ``run(out)`` prepares the sample (or loads ``config.sample_path``), wets it at the confining
     stress (bridges at every contact, six walls servoed until static), shears it and writes
     into ``out``: history.h5, summary.json, triaxial.png, plots/, vtk/ (ParaView), sample.h5
-    (the sample the shear starts from, with the configuration) and, with checkpoint_every,
-    checkpoint.h5. Returns the summary (dict).
+    (the sample the shear starts from, with the configuration), with checkpoint_every
+    checkpoint.h5 and, with ``vtk_prep``, vtk_prep/ (ParaView frames of the preparation and
+    wetting). Returns the summary (dict).
     """
 
     def __init__(self, config: TriaxialConfig, *, force=False):
@@ -304,24 +344,28 @@ class TriaxialTest:
             config.bridges.build().load_tables(config.sample.radius, config.sample.radius)
 
     # ------------------------------------------------------------ phases
-    def start(self, progress=True, threads=None):
-        """(static sample at the confining stress, preparation report)."""
+    def start(self, progress=True, threads=None, writers=()):
+        """(static sample at the confining stress, preparation report); ``writers`` watch the
+        preparation or the equilibrium of a loaded sample (e.g. the vtk_prep VtkWriter)."""
         config = self.config
         if config.sample_path is None:
-            return prepare_sample(config.sample, progress=progress, threads=threads)
-        return self.load_sample(config.sample_path, progress, threads)
+            return prepare_sample(config.sample, progress=progress, threads=threads,
+                                  writers=writers)
+        return self.load_sample(config.sample_path, progress, threads, writers)
 
-    def load_sample(self, path, progress=True, threads=None):
+    def load_sample(self, path, progress=True, threads=None, writers=()):
         """(sample saved at ``path`` servoed at the confining stress and run until static,
-        its report)."""
+        its report); ``writers`` watch the equilibrium (phase "sample")."""
         sample = self.config.sample
         particles, walls, report, _ = load_sample(path, expected=sample)
         sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
         started = time.perf_counter()
-        steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
-                            tolerance=sample.stress_tolerance, max_steps=self.config.wet_steps,
-                            progress="equilibrate sample" if progress else None,
-                            phase=f"equilibrium of sample {path!r} at the confining stress")
+        with watched(sim, writers, "sample"):
+            steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
+                                tolerance=sample.stress_tolerance,
+                                max_steps=self.config.wet_steps,
+                                progress="equilibrate sample" if progress else None,
+                                phase=f"equilibrium of sample {path!r} at the confining stress")
         report = dict(report)
         report.update({"sample": os.path.abspath(path), "sample_equilibration_steps": steps,
                        "sample_equilibration_time_s": time.perf_counter() - started,
@@ -333,25 +377,48 @@ class TriaxialTest:
                                       "min R / sqrt(E / rho)")
         return sim, report
 
-    def run(self, out, *, progress=True, threads=None, stop_after=None):
+    def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False):
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
-        shear after this many steps as an interruption would (raises Interrupted)."""
+        shear after this many steps as an interruption would (raises Interrupted).
+        ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
+        (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
+        many steps, False (default) or 0 none. Output only: the results are the same."""
+        if vtk_prep is not True and vtk_prep is not False:
+            vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         with OutputFolder(out, "triaxial") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, stop_after)
+            return self._run(out, progress, threads, stop_after, vtk_prep)
 
-    def _run(self, out, progress, threads, stop_after):
+    def prep_writer(self, out, vtk_prep):
+        """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
+        series of pendular.vtk, ParaView's time axis the simulated time [s], field data
+        ``phase`` (index in PREP_PHASES: 0 growth, 1 friction, 2 unload, 3 equilibrate, 4
+        sample, 5 wetting) and ``mean_wall_stress`` [Pa]; a frame every period steps and at
+        the first step of each phase."""
+        if vtk_prep is False or vtk_prep == 0:
+            return None
+        period = prep_vtk_period(self.config.sample) if vtk_prep is True else vtk_prep
+        return VtkWriter(os.path.join(out, "vtk_prep"), period, phases=PREP_PHASES,
+                         field_data=lambda s: {"mean_wall_stress":
+                                               float(np.mean(s.walls.stress()))})
+
+    def _run(self, out, progress, threads, stop_after, vtk_prep=False):
         config = self.config
         started = time.perf_counter()
-        sim, preparation = self.start(progress, threads)
+        frames = self.prep_writer(out, vtk_prep)
+        writers = () if frames is None else (frames,)
+        sim, preparation = self.start(progress, threads, writers)
         prepared = time.perf_counter()
         wetting = {}
         if config.bridges is not None:
-            wetting = wet(sim, config.bridges.build(),
-                          unbalanced=config.sample.equilibrium_unbalanced,
-                          tolerance=config.sample.stress_tolerance, max_steps=config.wet_steps,
-                          progress="wet" if progress else None)
+            with watched(sim, writers, "wetting"):
+                wetting = wet(sim, config.bridges.build(),
+                              unbalanced=config.sample.equilibrium_unbalanced,
+                              tolerance=config.sample.stress_tolerance,
+                              max_steps=config.wet_steps, progress="wet" if progress else None)
+        if frames is not None:
+            frames.close(sim)           # the state the shear starts from
         before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
                                "wetting": wetting, "preparation_time_s": prepared - started,
                                "pre_shear_time_s": time.perf_counter() - started})
@@ -385,6 +452,11 @@ class TriaxialTest:
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
             if state.get("phase") != "shear" or state["steps"] != run.steps:
                 raise ValueError(f"{checkpoint} does not belong to this run's shear")
+            start, end = state["start_step"], state["start_step"] + run.steps
+            if not start <= sim.step <= end:
+                # a checksum can be forged: the step must lie in this shear
+                raise ValueError(f"{checkpoint}: step = {sim.step} is outside the valid range "
+                                 f"[{start}, {end}] of this run's shear (an edited checkpoint)")
             run.resumed(state)
             return run.finish(progress, stop_after)
 

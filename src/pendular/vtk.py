@@ -36,6 +36,11 @@ pair between the two centres (YADE's interaction network), cell data
     bridge             1 when the pair also holds a liquid bridge
 A scene without bridges (or contacts) gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
 file without cells back; ParaView and VTK can.
+
+A writer given ``phases`` (names) also writes a frame whenever its ``phase`` attribute changes
+(set by whoever drives the simulation, e.g. dem.preparation.prepare_sample), and every frame's
+field data holds ``phase``: the index of the current phase in ``phases`` (the triaxial test's
+``vtk_prep/`` series: pendular.triaxial.PREP_PHASES).
 """
 
 import os
@@ -205,12 +210,19 @@ class VtkWriter:
     holds ``step``, ``time`` [s] and what ``field_data(sim)`` returns (name -> number, e.g. the
     axial strain of a triaxial test); ``time_axis(sim)``, if given, is the .pvd ``timestep``
     instead of the time (e.g. the axial strain in %, ParaView's time slider then in strain).
+    ``phases``: names of the phases of a multi-phase run; the writer then has an attribute
+    ``phase`` (one of them, set by the driver of the run), writes a frame at the first step of
+    each new phase and stores the phase's index as field data ``phase``.
     """
 
-    def __init__(self, folder, period, compression="zlib", field_data=None, time_axis=None):
+    def __init__(self, folder, period, compression="zlib", field_data=None, time_axis=None,
+                 phases=None):
         self.folder = os.fspath(folder)
         self.field_data = field_data
         self.time_axis = time_axis
+        self.phases = None if phases is None else tuple(phases)
+        self.phase = None
+        self._frame_phase = None
         self.period = check_int("vtk period", period, low=1)
         if compression not in ("zlib", "lzma", None):
             raise ValueError(f"compression = {compression!r} is not one of 'zlib', 'lzma', None")
@@ -219,7 +231,8 @@ class VtkWriter:
         os.makedirs(self.folder, exist_ok=True)
 
     def apply(self, sim):
-        if not self.frames or sim.step % self.period == 0:
+        if (not self.frames or sim.step % self.period == 0
+                or (self.phases is not None and self.phase != self._frame_phase)):
             self.write(sim)
 
     def write(self, sim):
@@ -229,6 +242,11 @@ class VtkWriter:
         meshes = {"particles": particle_mesh(sim), "walls": wall_mesh(sim.walls),
                   "bridges": bridge_mesh(sim), "contacts": contact_mesh(sim)}
         fields = {"step": sim.step, "time": sim.time}
+        if self.phases is not None:
+            if self.phase not in self.phases:
+                raise ValueError(f"vtk phase = {self.phase!r} is not one of {self.phases}")
+            fields["phase"] = self.phases.index(self.phase)
+            self._frame_phase = self.phase
         if self.field_data is not None:
             fields.update(self.field_data(sim))
         for series, mesh in meshes.items():

@@ -84,4 +84,5 @@ def run(args):
                             packing=args.packing, concurrent=args.concurrent,
                             threads=args.threads, progress=not args.quiet)
     print(json.dumps({k: result[k] for k in SHOWN}, indent=2))
+    print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)")
     return 0

@@ -1,8 +1,9 @@
 """Drained triaxial test of thesis Chapter 5 (Table 5.2 defaults): prepare, wet, shear, write.
 
 Writes into --out: history.h5 (one row per record), summary.json, triaxial.png, plots/,
-vtk/*.pvd (ParaView), sample.h5 (the sample the shear starts from) and, with
---checkpoint-every N, checkpoint.h5; --resume DIR continues an interrupted run. Stresses
+vtk/*.pvd (ParaView), sample.h5 (the sample the shear starts from), with
+--checkpoint-every N checkpoint.h5 and, with --vtk-prep, vtk_prep/*.pvd (ParaView frames of the
+preparation and wetting); --resume DIR continues an interrupted run. Stresses
 compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at the confining
 stress, re-equilibrated, then sheared (pendular.triaxial).
 """
@@ -85,6 +86,12 @@ def add_arguments(parser):
     frames.add_argument("--vtk-frames", type=positive_int("--vtk-frames"), default=None,
                         help="ParaView frames over the shear (0: none; default "
                              f"{TriaxialConfig.vtk_frames}); instead of --vtk-every")
+    parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
+                        type=positive_int("--vtk-prep", low=1),
+                        help="also write ParaView frames of the preparation and wetting into "
+                             "DIR/vtk_prep/ (field data 'phase': 0 growth, 1 friction, 2 "
+                             "unload, 3 equilibrate, 4 sample, 5 wetting), every N steps "
+                             "(default: unload_steps / 20 = 500, a few tens of frames)")
     parser.add_argument("--checkpoint-every", type=positive_int("--checkpoint-every"),
                         default=0, help="steps between checkpoints DIR/checkpoint.h5 (0: none)")
     parser.add_argument("--sample", metavar="PATH", default=None,
@@ -161,8 +168,9 @@ def run(args):
             out = args.resume
         else:
             config = config_from(args)
-            summary = TriaxialTest(config, force=args.force).run(args.out, progress=progress, threads=args.threads,
-                                               stop_after=args.stop_after)
+            summary = TriaxialTest(config, force=args.force).run(
+                args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
+                vtk_prep=args.vtk_prep)
             out = args.out
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
