@@ -89,3 +89,23 @@ def test_an_appended_force_acts_from_the_next_step():
     sim.forces.append(Push())
     sim.advance()
     assert sim.particles.velocity[0, 0] > 0.0
+
+
+def test_a_recorder_counts_its_periods_from_its_origin():
+    """A shear that starts at step 7 with period 3 records at 7, 10, 13: its last record falls
+    on its last step whatever step the preparation ended at."""
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    sim.run(7)
+    recorder = HistoryRecorder(3, {"step": lambda s: s.step}, origin=sim.step)
+    recorder.record(sim)
+    sim.writers.append(recorder)
+    sim.run(6)
+    assert recorder.arrays()["step"].tolist() == [7, 10, 13]
+
+
+def test_a_recorder_records_the_end_of_a_phase_between_periods():
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    recorder = HistoryRecorder(4, {"step": lambda s: s.step}, end=10)
+    sim.writers.append(recorder)
+    sim.run(12)
+    assert recorder.arrays()["step"].tolist() == [4, 8, 10, 12]

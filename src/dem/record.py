@@ -8,14 +8,18 @@ from .validate import check_int
 
 
 class HistoryRecorder:
-    """Every ``period`` steps, evaluate each ``quantities[name](sim)`` and append it as a row.
+    """Every ``period`` steps counted from step ``origin`` (and at step ``end`` when given, so a
+    phase of any length records its final state), evaluate each ``quantities[name](sim)`` and
+    append it as a row.
 
     Quantities are only computed on recording steps, so costly measures (homogenisation) do not
     run every step. ``rows`` maps name -> list of values; ``arrays()`` stacks them.
     """
 
-    def __init__(self, period, quantities):
+    def __init__(self, period, quantities, origin=0, end=None):
         self.period = check_int("record period", period, low=1)
+        self.origin = check_int("record origin", origin)
+        self.end = None if end is None else check_int("record end", end, low=self.origin)
         self.quantities = dict(quantities)
         for name, quantity in self.quantities.items():
             if not callable(quantity):
@@ -23,7 +27,7 @@ class HistoryRecorder:
         self.rows = {name: [] for name in self.quantities}
 
     def apply(self, sim):
-        if sim.step % self.period == 0:
+        if (sim.step - self.origin) % self.period == 0 or sim.step == self.end:
             self.record(sim)
 
     def record(self, sim):

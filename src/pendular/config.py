@@ -27,6 +27,9 @@ from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS, KIM_SEPA
 #: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
 MAX_TABLE_NODES = 200_000
 
+#: Largest surface tension of a wetting liquid [N/m] (water 0.0728, mercury 0.485).
+MAX_SURFACE_TENSION = 1.0
+
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
 
@@ -111,7 +114,8 @@ class BridgeConfig:
 
     def __post_init__(self):
         self.suction = check_positive("suction", self.suction, "Pa")
-        self.surface_tension = check_positive("surface_tension", self.surface_tension, "N/m")
+        self.surface_tension = check_range("surface_tension", self.surface_tension, 0.0,
+                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
         self.contact_angle = check_range("contact_angle", self.contact_angle, 0.0, 90.0,
                                          high_inclusive=False, unit="deg")
         if self.model not in BRIDGE_MODELS:
@@ -241,8 +245,8 @@ class TensionConfig:
         check_range("--radius", self.radius, 1e-6, 1e-2, unit="m")
         check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
                     unit="deg")
-        check_range("--surface-tension", self.surface_tension, 0.0, 1.0, low_inclusive=False,
-                    unit="N/m")
+        check_range("--surface-tension", self.surface_tension, 0.0, MAX_SURFACE_TENSION,
+                    low_inclusive=False, unit="N/m")
         check_range("--specific-gravity", self.specific_gravity, 1.0, 10.0)
         check_range("--roughness", self.roughness, 0.0, 0.5)
         check_range("--confining", self.confining, 1.0, 1e5, unit="Pa")

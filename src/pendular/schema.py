@@ -116,7 +116,8 @@ TRIAXIAL_SUMMARY_UNITS = {
     "particle_steps_per_s": "1/s", "dt": "s", "strain_rate": "1/s", "inertial_number": "1",
     "max_unbalanced_force": "1", "mean_unbalanced_force": "1", "threads": "1",
     "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
-    "wetting_steps": "1", "stress_balance_error": "1",
+    "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
+    "stress_balance_flagged": "record",
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.tension).

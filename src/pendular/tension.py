@@ -249,7 +249,7 @@ class Pull:
                 "water_content": lambda s: gravimetric_water_content(
                     bridges.water_volume(s.contacts), solid, config.specific_gravity),
                 "saturation": bridges.saturation})
-        self.recorder = HistoryRecorder(period, columns)
+        self.recorder = HistoryRecorder(period, columns, origin=sim.step)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         self.vtk_period = config.vtk_every

@@ -1,0 +1,313 @@
+"""Fault injection against the triaxial command (issue 12): what a hostile user can give it ends
+in one ``<prog>: error: ...`` line naming the parameter or the path (exit 2), or in a correct
+result; never a traceback, never exit 0 with garbage.
+
+Classes: extreme settings (huge, tiny, NaN, beyond 2**63; quasi-static guards), output paths,
+corrupt / truncated / edited / forged / foreign checkpoints, corrupt and mismatched samples,
+concurrent runs on one folder, a run into a used folder, SIGINT during a shear. Checksums,
+identities and the physical checks of samples at the library level, and tampered table caches,
+are in tests/test_integrity.py (not repeated here).
+
+Option cases run in-process through pendular.cli.run_command (they are refused before anything
+runs); runs and signals are subprocesses of 60 spheres.
+"""
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+import pytest
+
+from dem.integrity import stamp, verify
+from pendular.cli import run_command
+from pendular.outputs import OutputFolder
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scenarios", "triaxial.py")
+TINY = ["--particles", "60", "--max-strain", "0.005", "--inertial-number", "2e-3",
+        "--vtk-frames", "0", "--quiet"]
+BIG = "18446744073709551617"      # 2**64 + 1
+
+
+def command(argv, capsys):
+    """(exit status, stderr) of ``triaxial.py ARGV`` run in-process."""
+    try:
+        status = run_command("triaxial", list(argv), prog="triaxial.py")
+    except SystemExit as stop:
+        status = stop.code
+    return status, capsys.readouterr().err
+
+
+def script(argv, cwd, timeout=120, **options):
+    return subprocess.run([sys.executable, SCRIPT, *argv], cwd=cwd, capture_output=True,
+                          text=True, timeout=timeout, **options)
+
+
+def refused(status, err, *words):
+    """One ``error:`` line (argparse may add its usage line first) naming ``words``."""
+    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("usage:")
+             and not line.startswith("  ")]
+    assert status == 2, err
+    assert "Traceback" not in err
+    assert len(lines) == 1 and ": error: " in lines[0], err
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+
+
+# ---------------------------------------------------------------- extreme settings
+EXTREMES = {
+    "radius huge": (["--radius", "1e300"], ["radius", "[1e-06, 1] m"]),
+    "radius tiny": (["--radius", "1e-300"], ["radius"]),
+    "young huge": (["--young", "1e300"], ["steps"]),
+    "young 1e12": (["--young", "1e12"], ["young"]),
+    "young 1e8 (growth cannot settle)": (["--young", "1e8"], ["young", "prep_stress"]),
+    "strain rate huge": (["--strain-rate", "1e300"], ["inertial number"]),
+    "strain rate 1e6": (["--strain-rate", "1e6"], ["inertial number", "--force"]),
+    "strain rate 1e-12": (["--strain-rate", "1e-12"], ["steps", "h here"]),
+    "inertial number 1": (["--inertial-number", "1"], ["inertial number"]),
+    "confining 1": (["--confining", "1"], ["confining"]),
+    "confining 0": (["--confining", "0"], ["confining"]),
+    "confining nan": (["--confining", "nan"], ["confining", "not finite"]),
+    "young inf": (["--young", "inf"], ["young", "not finite"]),
+    "radius negative": (["--radius", "-1"], ["radius"]),
+    "particles 2**64": (["--particles", BIG], ["particles", "10000000"]),
+    "particles 1e9": (["--particles", "1000000000"], ["particles"]),
+    "seed 2**64": (["--seed", BIG], ["seed", "4294967295"]),
+    "records 2**64": (["--records", BIG], ["records"]),
+    "wet steps 2**64": (["--wet-steps", BIG], ["wet_steps"]),
+    "checkpoint every 2**64": (["--checkpoint-every", BIG], ["checkpoint_every"]),
+    "threads 2**64": (["--threads", BIG], ["--threads"]),
+    "table resolution 1e9": (["--suction", "1000", "--table-resolution", "1000000000,80"],
+                             ["table_resolution"]),
+    "table resolution 2**64": (["--suction", "1000", "--table-resolution", f"{BIG},80"],
+                               ["table_resolution"]),
+    "table nodes beyond the limit": (["--suction", "1000", "--table-resolution", "5000,80"],
+                                     ["table_resolution", "nodes"]),
+    "table resolution negative": (["--suction", "1000", "--table-resolution=-1,80"],
+                                  ["--table-resolution"]),
+    "surface tension 1e300": (["--suction", "1000", "--surface-tension", "1e300"],
+                              ["surface_tension", "(0, 1] N/m"]),
+    "suction negative": (["--suction", "-5"], ["--suction"]),
+    "out empty": (["--out", ""], ["out", "empty"]),
+    "out /dev/null": (["--out", "/dev/null"], ["/dev/null"]),
+    "out under /proc": (["--out", "/proc/pendular-no-such"], ["/proc/pendular-no-such"]),
+    "sample missing": (["--sample", "/nonexistent/sample.h5"], ["/nonexistent/sample.h5"]),
+    "sample a folder": (["--sample", "/"], ["'/'"]),
+    "resume missing": (["--resume", "/nonexistent"], ["/nonexistent"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(EXTREMES))
+def test_extreme_settings_are_refused_naming_the_parameter(name, tmp_path, capsys,
+                                                          monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    options, words = EXTREMES[name]
+    argv = ([] if "--resume" in options else TINY) + options
+    if "--out" not in options and "--resume" not in options:
+        argv += ["--out", str(tmp_path / "out")]
+    refused(*command(argv, capsys), *words)
+
+
+def test_an_out_that_is_a_file_is_refused(tmp_path, capsys):
+    path = tmp_path / "afile"
+    path.write_text("mine")
+    refused(*command(TINY + ["--out", str(path)], capsys), str(path), "a file")
+    assert path.read_text() == "mine"
+
+
+# ---------------------------------------------------------------- a run to damage
+@pytest.fixture(scope="module")
+def interrupted(tmp_path_factory):
+    """An interrupted run of 60 spheres with a checkpoint (folder), as --stop-after leaves it."""
+    out = tmp_path_factory.mktemp("faults") / "run"
+    done = script(TINY + ["--checkpoint-every", "50", "--stop-after", "120", "--out", str(out)],
+                  cwd=out.parent)
+    assert done.returncode == 130, done.stderr
+    assert json.loads((out / "summary.json").read_text())["completed"] is False
+    return out
+
+
+def copy_run(interrupted, tmp_path):
+    target = tmp_path / "run"
+    shutil.copytree(interrupted, target)
+    return target
+
+
+def zero_bytes(path, dataset, count=32):
+    with h5py.File(path, "r") as handle:
+        offset = handle[dataset].id.get_offset()
+    with open(path, "r+b") as raw:
+        raw.seek(offset)
+        raw.write(bytes(count))
+
+
+def forge(path, change, **identity):
+    """Edit the HDF5 file and stamp it again (a valid checksum over a wrong content)."""
+    stored = verify(path, kind="file")
+    stored.update(identity)
+    with h5py.File(path, "r+") as handle:
+        change(handle)
+    stamp(path, stored)
+
+
+def set_step(handle):
+    handle.attrs["step"] = -5
+
+
+CHECKPOINT_FAULTS = {
+    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position"), ["checksum mismatch"]),
+    "truncated": (lambda p: os.truncate(p, os.path.getsize(p) // 2), ["not a readable"]),
+    "not HDF5": (lambda p: open(p, "w").write("not a checkpoint"), ["not a readable"]),
+    "step edited to -5": (lambda p: _edit_step(p), ["checksum mismatch"]),
+    "step -5, checksum forged": (lambda p: forge(p, set_step), ["step = -5", "outside"]),
+    "another run's (seed 1)": (lambda p: forge(p, lambda h: None, seed=1), ["identity mismatch",
+                                                                            "seed"]),
+    "missing": (os.remove, ["checkpoint.h5 is missing"]),
+}
+
+
+def _edit_step(path):
+    with h5py.File(path, "r+") as handle:
+        handle.attrs["step"] = -5
+
+
+@pytest.mark.parametrize("name", sorted(CHECKPOINT_FAULTS))
+def test_a_damaged_checkpoint_is_refused_naming_it(name, interrupted, tmp_path, capsys):
+    run = copy_run(interrupted, tmp_path)
+    damage, words = CHECKPOINT_FAULTS[name]
+    damage(str(run / "checkpoint.h5"))
+    before = (run / "history.h5").read_bytes()
+    refused(*command(["--resume", str(run), "--quiet"], capsys), "checkpoint.h5", *words)
+    assert (run / "history.h5").read_bytes() == before      # nothing written over
+
+
+SAMPLE_FAULTS = {
+    "zeroed bytes": (lambda p: zero_bytes(p, "position"), ["checksum mismatch"]),
+    "truncated": (lambda p: os.truncate(p, os.path.getsize(p) // 2), ["not a readable"]),
+    "sphere moved outside, checksum forged": (
+        lambda p: forge(p, lambda h: h["position"].__setitem__(0, [1.0, 1.0, 1.0])),
+        ["particle 0", "wall"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(SAMPLE_FAULTS))
+def test_a_damaged_sample_is_refused_naming_it(name, interrupted, tmp_path, capsys):
+    path = tmp_path / "sample.h5"
+    shutil.copy(interrupted / "sample.h5", path)
+    damage, words = SAMPLE_FAULTS[name]
+    damage(str(path))
+    argv = TINY + ["--sample", str(path), "--out", str(tmp_path / "out")]
+    refused(*command(argv, capsys), str(path), *words)
+
+
+def test_a_sample_of_another_radius_is_refused(interrupted, tmp_path, capsys):
+    argv = TINY + ["--sample", str(interrupted / "sample.h5"), "--radius", "3e-5",
+                   "--out", str(tmp_path / "out")]
+    refused(*command(argv, capsys), "radius", "3e-05")
+
+
+# ---------------------------------------------------------------- output folders
+def test_a_second_run_on_a_folder_in_use_is_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    with OutputFolder(str(out), "triaxial (another run)"):
+        refused(*command(TINY + ["--out", str(out)], capsys), str(out), "in use")
+
+
+def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp_path):
+    """A dry run into an old wet run's folder: its ParaView frames and wet-only plots go, the
+    user's own files stay."""
+    out = copy_run(interrupted, tmp_path)
+    (out / "vtk").mkdir()
+    (out / "vtk" / "shear.pvd").write_text("old")
+    (out / "plots").mkdir(exist_ok=True)
+    (out / "plots" / "saturation.png").write_text("old")
+    (out / "notes.txt").write_text("mine")
+    manifest = json.loads((out / ".pendular-outputs.json").read_text())
+    manifest["files"] = sorted(set(manifest["files"]) | {"vtk", "plots"})
+    (out / ".pendular-outputs.json").write_text(json.dumps(manifest))
+    done = script(TINY + ["--sample", str(interrupted / "sample.h5"), "--out", str(out)],
+                  cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert not (out / "vtk").exists() and not (out / "checkpoint.h5").exists()
+    assert not (out / "plots" / "saturation.png").exists()
+    assert (out / "notes.txt").read_text() == "mine"
+    assert json.loads((out / "summary.json").read_text())["completed"] is True
+
+
+# ---------------------------------------------------------------- signals
+def test_sigint_during_the_shear_keeps_the_history_so_far(tmp_path):
+    out = tmp_path / "out"
+    argv = ["--particles", "60", "--max-strain", "0.1", "--inertial-number", "2e-4",
+            "--vtk-frames", "0", "--quiet", "--out", str(out)]
+    # a child of a shell started with & ignores SIGINT: give it the default disposition
+    process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=tmp_path, text=True,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    started = time.monotonic()
+    while not (out / "sample.h5").exists() and time.monotonic() - started < 60:
+        time.sleep(0.05)          # sample.h5 is written just before the shear starts
+    time.sleep(0.5)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "Traceback" not in err and "interrupted at step" in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is False
+    with h5py.File(out / "history.h5", "r") as handle:
+        assert len(handle["history/step"]) >= 2
+
+
+def test_sigint_during_the_preparation_ends_in_one_line(tmp_path):
+    out, log = tmp_path / "out", tmp_path / "stderr.txt"
+    argv = ["--particles", "5000", "--max-strain", "0.01", "--vtk-frames", "0", "--out", str(out)]
+    with open(log, "w") as stderr:
+        process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=tmp_path, text=True,
+                                   stdout=subprocess.DEVNULL, stderr=stderr,
+                                   preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        started = time.monotonic()
+        while "grow radii" not in log.read_text() and time.monotonic() - started < 120:
+            time.sleep(0.05)          # the progress line of the radius growth (about 10 s)
+        time.sleep(0.5)
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=60)
+    err = log.read_text()
+    assert process.returncode == 130, err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == "triaxial.py: interrupted", err
+    assert not (out / "sample.h5").exists()
+
+
+# ---------------------------------------------------------------- stress bookkeeping
+def test_records_whose_wall_and_love_weber_stresses_drift_apart_are_flagged():
+    from pendular.triaxial import STRESS_BALANCE_BOUND, stress_balance_error, summarize
+
+    records = 5
+    wall = np.tile([1000.0, 1000.0, 3000.0], (records, 1))        # p = 5/3 kPa
+    contact = np.array([np.diag(row) for row in wall])
+    capillary = np.zeros_like(contact)
+    capillary[3] = np.diag([0.0, 0.0, -0.1 * 5000.0 / 3.0])       # 10 % of p missing on z
+    history = {"sigma_wall": wall, "sigma_contact": contact - capillary,
+               "sigma_capillary": capillary, "axial_strain": np.linspace(0.0, 0.01, records)}
+    history["sigma_contact"][3] = contact[3]                       # the bridges' pull unbalanced
+    assert stress_balance_error(history) == pytest.approx([0, 0, 0, 0.1, 0], abs=1e-12)
+    summary = summarize(history)
+    assert summary["stress_balance_flagged"] == [3]
+    assert summary["stress_balance_bound"] == STRESS_BALANCE_BOUND < 0.1
+
+
+def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
+    out = tmp_path / "out"
+    argv = ["--particles", "60", "--max-strain", "0.01", "--inertial-number", "0.05", "--force",
+            "--vtk-frames", "0", "--quiet", "--out", str(out)]
+    result = script(argv, tmp_path)
+    assert result.returncode == 0, result.stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["stress_balance_error"] > summary["stress_balance_bound"]
+    assert summary["stress_balance_flagged"]
+    assert "not quasi-static" in result.stderr and "Traceback" not in result.stderr
