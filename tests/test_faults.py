@@ -72,6 +72,7 @@ EXTREMES = {
     "strain rate 1e-12": (["--strain-rate", "1e-12"], ["steps", "h here"]),
     "inertial number 1": (["--inertial-number", "1"], ["inertial number"]),
     "confining 1": (["--confining", "1"], ["confining"]),
+    "max strain 1e-300": (["--max-strain", "1e-300"], ["max_strain", "[1e-06, 0.9]"]),
     "confining 0": (["--confining", "0"], ["confining"]),
     "confining nan": (["--confining", "nan"], ["confining", "not finite"]),
     "young inf": (["--young", "inf"], ["young", "not finite"]),
