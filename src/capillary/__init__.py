@@ -15,7 +15,8 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 """
 
 from capillary.bridge_state import BridgeState
-from capillary.bridges import BRIDGE_MODELS, SURFACE_TENSION, CapillaryBridges, table_radius_ratios
+from capillary.bridges import (BRIDGE_MODELS, SURFACE_TENSION, CapillaryBridges,
+                               sample_radius_ratios, table_radius_ratios)
 from capillary.meniscus import Bridge, solve_bridge
 from capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
 from capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
@@ -39,6 +40,7 @@ __all__ = [
     "SURFACE_TENSION",
     "formation_suction",
     "gravimetric_water_content",
+    "sample_radius_ratios",
     "table_radius_ratios",
     "BridgeTable",
     "CONTACT_SUCTION_MAX",

@@ -84,6 +84,48 @@ def table_radius_ratios(largest_ratio):
     return YADE_RADIUS_RATIOS
 
 
+#: Largest number of distinct pair radius ratios that get a table node each (exact lookups).
+EXACT_RATIO_NODES = 24
+#: Spacing factor of the geometric radius-ratio nodes of a sample with more distinct ratios.
+RATIO_NODE_FACTOR = 1.1
+
+
+def sample_radius_ratios(radii):
+    """Radius-ratio nodes of the bridge tables of a sample with these sphere radii [m].
+
+    Equal spheres only: (1.0,), the first of YADE's nodes (as ``table_radius_ratios(1)``).
+    Otherwise the tables are exact for every pair of the sample, not interpolated between
+    YADE's ratios 1, 1.1, 1.25, ..., 5, 10 (linear interpolation in r between those costs about
+    1 % in force between 2 and 3 and 5 % between 5 and 10 mid-range, 5 % and 14 % near
+    rupture, up to 3 % in rupture distance; docs/capillary.md): a node at each distinct ratio
+    R2/R1 of two radii of the sample (and 1 if two spheres have the same radius), computed as
+    the bridge kernels compute a pair's ratio (max / min of the two radii), so every pair
+    reads its own node exactly, up to
+    EXACT_RATIO_NODES nodes; beyond that (a continuous size distribution) geometric nodes
+    1 = r_0 < ... < r_n = the sample's largest ratio, r_(k+1) / r_k <= RATIO_NODE_FACTOR,
+    interpolated within 0.15 % in force, 0.4 % in volume and 0.06 % in rupture distance up to
+    0.9 of the rupture distance (0.4 % and 0.7 % at 0.99 of it). Building a node takes about
+    0.5 s (suction table) and 4 s (volume table, one core), once: tables are cached by their
+    nodes. ValueError beyond YADE's largest ratio 10.
+    """
+    sizes, counts = np.unique(np.asarray(radii, dtype=np.float64), return_counts=True)
+    if sizes.size == 0 or not sizes[0] > 0.0:
+        raise ValueError(f"radii = {sizes.tolist()[:3]}... must be positive (at least one sphere)")
+    if sizes.size == 1:
+        return table_radius_ratios(1.0)
+    largest = float(sizes[-1] / sizes[0])
+    table_radius_ratios(largest)                  # range check
+    if sizes.size - 1 <= EXACT_RATIO_NODES:      # else more distinct ratios than that anyway
+        ratios = {float(sizes[b] / sizes[a]) for a in range(sizes.size)
+                  for b in range(a + 1, sizes.size)}
+        if np.any(counts > 1):
+            ratios.add(1.0)
+        if len(ratios) <= EXACT_RATIO_NODES:
+            return tuple(sorted(ratios))
+    n = math.ceil(math.log(largest) / math.log(RATIO_NODE_FACTOR) - 1e-9)
+    return (1.0, *(largest ** (k / n) for k in range(1, n)), largest)
+
+
 class CapillaryBridges:
     """Capillary bridges between touching spheres (SPEC section 4); an operation ``apply(sim)``.
 
@@ -151,14 +193,23 @@ class CapillaryBridges:
                 check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
                                        self.surface_tension)
             self._checked_stiffness = True
-        self.load_tables(float(sim.particles.radius.min()), float(sim.particles.radius.max()))
+        radius = sim.particles.radius
+        nodes = sample_radius_ratios(radius) if self.model == "exact" else None
+        self.load_tables(float(radius.min()), float(radius.max()), radius_ratios=nodes)
 
-    def load_tables(self, low, high):
+    def load_tables(self, low, high, radius_ratios=None):
         """Check the input against spheres of radii in [low, high] [m] and load (or build and
-        cache) the tables; ValueError naming the parameter when out of range."""
+        cache) the tables; ValueError naming the parameter when out of range.
+
+        radius_ratios: the exact tables' ratio nodes (``sample_radius_ratios`` of the scene's
+        radii, which ``reach``/``apply`` pass); default YADE's ratios up to high / low
+        (``table_radius_ratios``). table_options' radius_ratios, if given, win.
+        """
         low = check_positive("smallest radius", low, "m")
         high = check_range("largest radius", high, low, unit="m")
-        if self._radius_bounds == (low, high):
+        if radius_ratios is None and self.model == "exact":
+            radius_ratios = table_radius_ratios(high / low)
+        if self._radius_bounds == (low, high, radius_ratios):
             return
         ratio = high / low
         suction_star_high = self.suction * high / self.surface_tension
@@ -172,7 +223,7 @@ class CapillaryBridges:
             options.setdefault("suction_max", max(suction_star_high * 1.001, 1e-3))
             self.suction_table = toroidal_table(self.contact_angle, **options)
         else:
-            options.setdefault("radius_ratios", table_radius_ratios(ratio))
+            options.setdefault("radius_ratios", radius_ratios)
             self.suction_table = BridgeTable.cached(self.contact_angle, **options)
         if suction_star_high > self.suction_table.suction_max:
             raise ValueError(
@@ -187,7 +238,7 @@ class CapillaryBridges:
                 self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
         self._table_arrays = self.suction_table.arrays()
         self.required_range = self._rupture_range(low, high)
-        self._radius_bounds = (low, high)
+        self._radius_bounds = (low, high, radius_ratios)
 
     def _rupture_range(self, low, high):
         """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).

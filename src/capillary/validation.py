@@ -63,8 +63,11 @@ MAX_BRIDGE_OVERLAP = 0.05
 
 
 def _widest_filling_angle(table, suction_star):
-    """Largest filling angle [deg] of the table's bridges at contact at u* (every radius ratio)."""
-    return max(max(table.lookup(ratio, suction_star, 0.0)[3:]) for ratio in table.radius_ratios)
+    """Largest filling angle [deg] of the table's bridges at contact, u* = s R/gamma with R the
+    smallest radius: a pair of ratio r has R2 >= r R, so its u* = s R2/gamma >= r u* (every
+    radius ratio of the table, each at its smallest u*; the filling angles fall as u* grows)."""
+    return max(max(table.lookup(ratio, min(ratio * suction_star, table.suction_max), 0.0)[3:])
+               for ratio in table.radius_ratios)
 
 
 def check_pendular_suction(table, suction, radius, surface_tension):

@@ -3,7 +3,9 @@
 The discrete sums of homogenize.bridge_tensors taken over the liquid bridges of a simulation,
 read through capillary.BridgeState (``state`` != NO_BRIDGE marks a bridge; ``volume`` [m^3];
 ``filling_i`` and ``filling_j`` [deg], the caps on particles pair_i and pair_j, each with its
-own radius).
+own radius: delta1 sits on the smaller sphere, delta2 on the larger, and A, B' of each cap use
+that sphere's radius; checked for two sizes against a hand computation of Eqs. 3.44-3.49 and
+3.53 in tests/test_unequal_bridges.py).
 Each bridge's normal is its current branch vector x_j - x_i, unit (valid for bridges at contact
 and across a gap alike; ``contacts.normal`` is the contact law's and lags for gap pairs).
 
