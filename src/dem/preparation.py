@@ -19,6 +19,7 @@ import numba
 import numpy as np
 
 from .contact_law import ContactForces
+from .grading import check_grading_curve, check_spread, grading, sample_radii
 from .integrate import Integrator, pwave_timestep
 from .measure import coordination, porosity, unbalanced_force
 from .neighbors import NeighborList
@@ -97,6 +98,61 @@ def _random_cloud_pairwise(count, radius, lo, hi, seed, max_attempts):
     return position[:placed]
 
 
+@numba.njit(cache=True)
+def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
+    """Random sequential insertion of spheres of unequal ``radius`` in [lo, hi] without
+    overlap, largest first (positions returned in the order of ``radius``; fewer rows if
+    ``max_attempts`` ran out). Cells of edge 2 max(radius) hold any number of centres (linked
+    lists), so a sphere is checked against the 27 cells around its own."""
+    np.random.seed(seed)
+    count = radius.size
+    cell = 2.0 * radius.max()
+    dims = np.empty(3, np.int64)
+    for a in range(3):
+        dims[a] = max(1, int((hi[a] - lo[a]) / cell))
+    head = -np.ones(dims[0] * dims[1] * dims[2], np.int64)
+    following = -np.ones(count, np.int64)
+    position = np.empty((count, 3))
+    order = np.argsort(-radius, kind="mergesort")
+    placed = 0
+    attempts = 0
+    while placed < count:
+        attempts += 1
+        if attempts > max_attempts:
+            return position[order[:placed]], order[:placed]
+        i = order[placed]
+        r = radius[i]
+        x = np.empty(3)
+        c = np.empty(3, np.int64)
+        for a in range(3):
+            x[a] = lo[a] + r + np.random.random() * (hi[a] - lo[a] - 2.0 * r)
+            c[a] = min(int((x[a] - lo[a]) / ((hi[a] - lo[a]) / dims[a])), dims[a] - 1)
+        free = True
+        for dx in range(-1, 2):
+            for dy in range(-1, 2):
+                for dz in range(-1, 2):
+                    nx = c[0] + dx
+                    ny = c[1] + dy
+                    nz = c[2] + dz
+                    if not free or nx < 0 or ny < 0 or nz < 0 or nx >= dims[0] \
+                            or ny >= dims[1] or nz >= dims[2]:
+                        continue
+                    q = head[(nx * dims[1] + ny) * dims[2] + nz]
+                    while q >= 0 and free:
+                        d = x - position[q]
+                        reach = r + radius[q]
+                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach:
+                            free = False
+                        q = following[q]
+        if free:
+            position[i] = x
+            key = (c[0] * dims[1] + c[1]) * dims[2] + c[2]
+            following[i] = head[key]
+            head[key] = i
+            placed += 1
+    return position, order
+
+
 #: Names of the phases of ``prepare_sample``, in order (module docstring).
 PREPARATION_PHASES = ("growth", "friction", "unload", "equilibrate")
 
@@ -105,26 +161,36 @@ PAIRWISE_CLOUD_MAX = 2000
 
 
 def random_cloud(count, radius, lo, hi, seed):
-    """``count`` non-overlapping spheres of ``radius`` [m] uniformly placed in the box [lo, hi].
+    """``count`` non-overlapping spheres of ``radius`` [m] (one value, or one per sphere)
+    uniformly placed in the box [lo, hi].
 
-    Cell-list insertion admits one centre per cell, which in a box only a few diameters wide
-    leaves room for fewer spheres than fit; small counts that it cannot place are placed by
-    pairwise insertion instead (the cell-list result is kept whenever it succeeds)."""
+    Equal spheres: cell-list insertion admits one centre per cell, which in a box only a few
+    diameters wide leaves room for fewer spheres than fit; small counts that it cannot place
+    are placed by pairwise insertion instead (the cell-list result is kept whenever it
+    succeeds). Unequal spheres: insertion largest first with any number of centres per cell."""
     count = check_int("particles", count, low=1)
-    radius = check_positive("radius", radius, "m")
+    radii = np.ascontiguousarray(np.broadcast_to(np.asarray(radius, dtype=np.float64),
+                                                 (count,)))
+    for value in (radii.min(), radii.max()):
+        check_positive("radius", value, "m")
     box = Walls.box(lo, hi)
     lo, hi = np.ascontiguousarray(box.lo), np.ascontiguousarray(box.hi)
-    if np.any(hi - lo <= 2.0 * radius):
-        raise ValueError(f"radius = {radius:g} m is outside the valid range (0, "
+    largest = float(radii.max())
+    if np.any(hi - lo <= 2.0 * largest):
+        raise ValueError(f"radius = {largest:g} m is outside the valid range (0, "
                          f"{0.5 * float(np.min(hi - lo)):g}] m for a box of edges "
                          f"{(hi - lo).tolist()} m")
     seed = check_int("seed", seed, high=MAX_SEED)
-    position = _random_cloud(count, radius, lo, hi, seed, 200 * count + 10000)
-    if len(position) < count and count <= PAIRWISE_CLOUD_MAX:
-        position = _random_cloud_pairwise(count, radius, lo, hi, seed, 200 * count + 10000)
+    if radii.min() < largest:
+        position, _ = _random_cloud_graded(radii, lo, hi, seed, 200 * count + 10000)
+    else:
+        position = _random_cloud(count, largest, lo, hi, seed, 200 * count + 10000)
+        if len(position) < count and count <= PAIRWISE_CLOUD_MAX:
+            position = _random_cloud_pairwise(count, largest, lo, hi, seed,
+                                              200 * count + 10000)
     if len(position) < count:
         raise ValueError(f"particles = {count} is outside the valid range [1, {len(position)}] "
-                         f"for spheres of radius {radius:g} m in this box: only "
+                         f"for spheres of radius up to {largest:g} m in this box: only "
                          f"{len(position)} could be placed without overlap; use a larger box "
                          "or a smaller radius")
     return position
@@ -176,10 +242,18 @@ def check_soft_contacts(name, stress, young):
 
 @dataclass
 class PrepareConfig:
-    """Sample and preparation parameters (SI, angles in degrees); defaults are thesis Table 5.2."""
+    """Sample and preparation parameters (SI, angles in degrees); defaults are thesis Table 5.2.
+
+    Sizes (dem.grading): equal spheres of ``radius`` [m]; with ``radius_spread`` S > 0 radii
+    uniform in radius (1 ± S), ``radius`` their mean; with ``psd``, a grading curve
+    ((diameter [m], percent passing by mass), ...), the curve's own sizes, ``radius`` set on
+    creation to their mean. Largest / smallest radius at most dem.grading.MAX_RADIUS_RATIO.
+    """
 
     particles: int = 10000
     radius: float = 0.024e-3
+    radius_spread: float = 0.0
+    psd: tuple | None = None
     porosity: float = 0.40
     young: float = 1e6
     shear_ratio: float = 0.3
@@ -198,6 +272,13 @@ class PrepareConfig:
 
     def __post_init__(self):
         self.particles = check_int("particles", self.particles, low=2, high=MAX_PARTICLES)
+        self.radius_spread = check_spread(self.radius_spread)
+        if self.psd is not None:
+            if self.radius_spread > 0.0:
+                raise ValueError(f"radius_spread = {self.radius_spread:g} and a psd given: "
+                                 "valid is one of them (the grading curve sets the sizes)")
+            self.psd = check_grading_curve(self.psd)
+            self.radius = float(np.mean(self.radii()))
         self.radius = check_range("radius", self.radius, *RADIUS_RANGE, unit="m")
         self.porosity = check_range("porosity", self.porosity, 0.30, 0.60)
         self.young = check_positive("young", self.young, "Pa")
@@ -221,6 +302,17 @@ class PrepareConfig:
         self.equilibrium_unbalanced = check_positive("equilibrium_unbalanced",
                                                      self.equilibrium_unbalanced)
         self.stress_tolerance = check_positive("stress_tolerance", self.stress_tolerance)
+
+    @property
+    def graded(self):
+        """Whether the spheres have unequal radii (a spread or a grading curve)."""
+        return self.radius_spread > 0.0 or self.psd is not None
+
+    def radii(self):
+        """The sample's radii [m] after preparation (its mean is ``radius``), in particle order
+        (dem.grading.sample_radii from ``seed``)."""
+        return sample_radii(self.particles, self.radius, self.radius_spread, self.psd,
+                            self.seed)
 
 
 def timestep(particles, config):
@@ -300,14 +392,18 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
     max_steps = check_int("max_steps", max_steps, low=1)
     label = "prepare" if progress else None
-    solid = config.particles * 4.0 / 3.0 * np.pi * config.radius ** 3
+    radii = config.radii()
+    if config.graded:
+        solid = 4.0 / 3.0 * np.pi * float(np.sum(radii ** 3))
+    else:
+        solid = config.particles * 4.0 / 3.0 * np.pi * config.radius ** 3
     edge = (solid / (1.0 - config.porosity)) ** (1.0 / 3.0)
-    # cloud at 60 % of the nominal radius (solid fraction ~0.13): sequential insertion is easy
-    cloud_radius = 0.6 * config.radius
+    # cloud at 60 % of the final radii (solid fraction ~0.13): sequential insertion is easy
+    cloud_radius = 0.6 * radii
     lo = np.zeros(3)
     hi = np.full(3, edge)
     position = random_cloud(config.particles, cloud_radius, lo, hi, config.seed)
-    particles = Particles(position, np.full(config.particles, cloud_radius), config.density)
+    particles = Particles(position, cloud_radius, config.density)
     walls = Walls.box(lo, hi)
     growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
     sim = dry_simulation(particles, walls, config, timestep(particles, config),
@@ -362,6 +458,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         "steps": steps,
         "dt": sim.dt,
         "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
+        "grading": grading(sim.particles.radius),
     }
     return sim, report
 

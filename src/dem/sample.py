@@ -18,6 +18,7 @@ import numba
 import numpy as np
 
 from .atomic import replacing
+from .grading import GRADING_UNITS, grading
 from .integrity import config_hash, software_version, stamp, verify
 from .state import WALL_NAMES, Particles, Walls
 from .validate import reading
@@ -69,6 +70,7 @@ def save_sample(path, sim, report=None, config=None, identity=None):
         handle.attrs["version"] = VERSION
         handle.attrs["density"] = p.density
         handle.attrs["report"] = json.dumps(report or {})
+        handle.attrs["grading"] = json.dumps({**grading(p.radius), "units": GRADING_UNITS})
         handle.attrs["config"] = json.dumps(config or {})
         stamp(handle, {"kind": "sample", "format": FORMAT, "version": VERSION,
                        "config_hash": config_hash(config or {}), **(identity or {})})

@@ -44,7 +44,12 @@ def _diagonals(values):
 
 def run_label(parameters, initial_porosity=None):
     """One line of a run's parameters for figure titles: N, sigma_3, s, theta, porosity."""
-    parts = [f"N = {parameters['particles']}",
+    parts = [f"N = {parameters['particles']}"]
+    if parameters.get("psd") is not None:
+        parts[0] += " (graded)"
+    elif parameters.get("radius_spread"):
+        parts[0] += f", R(1 ± {parameters['radius_spread']:g})"
+    parts += [
              f"σ3 = {parameters['confining'] / 1e3:g} kPa",
              f"s = {parameters.get('suction', 0.0) / 1e3:g} kPa"]
     if parameters.get("suction", 0.0) > 0.0:

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from dem.grading import GRADING_UNITS
+
 #: Version of the history/summary layout (attributes, dimension names).
 SCHEMA_VERSION = 1
 
@@ -117,7 +119,7 @@ TRIAXIAL_SUMMARY_UNITS = {
     "max_unbalanced_force": "1", "mean_unbalanced_force": "1", "threads": "1",
     "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
     "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
-    "stress_balance_flagged": "record",
+    "stress_balance_flagged": "record", "grading": GRADING_UNITS,
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.tension).

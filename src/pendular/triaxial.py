@@ -31,6 +31,7 @@ import numpy as np
 
 from dem.atomic import write_json
 from dem.checkpoint import CheckpointWriter, load_checkpoint
+from dem.grading import grading
 from dem.integrate import pwave_timestep
 from dem.integrity import checksum, config_hash
 from dem.measure import coordination, porosity, unbalanced_force
@@ -328,7 +329,8 @@ def parameters(config):
     """Flat name -> value of a configuration, named as the command's options (history file
     attributes, campaign tables)."""
     sample, shear, bridges = config.sample, config.shear, config.bridges
-    flat = {"particles": sample.particles, "radius": sample.radius, "porosity": sample.porosity,
+    flat = {"particles": sample.particles, "radius": sample.radius,
+            "radius_spread": sample.radius_spread, "psd": sample.psd, "porosity": sample.porosity,
             "young": sample.young, "shear_ratio": sample.shear_ratio,
             "friction": sample.friction_deg, "prep_friction": sample.prep_friction_deg,
             "density": sample.density, "damping": sample.damping,
@@ -365,8 +367,12 @@ class TriaxialTest:
         self.config = config
         check_feasible(config, force=force)
         if config.bridges is not None:
-            # check the bridges against the sample's radius before any preparation
-            config.bridges.build().load_tables(config.sample.radius, config.sample.radius)
+            # check the bridges against the sample's radii before any preparation
+            from capillary import sample_radius_ratios
+
+            radii = config.sample.radii()
+            config.bridges.build().load_tables(float(radii.min()), float(radii.max()),
+                                               radius_ratios=sample_radius_ratios(radii))
 
     # ------------------------------------------------------------ phases
     def start(self, progress=True, threads=None, writers=()):
@@ -587,6 +593,7 @@ class _ShearRun:
             "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
             "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
             "threads": numba.get_num_threads(),
+            "grading": grading(sim.particles.radius),
             **self.before_shear["wetting"],
         })
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}

@@ -19,6 +19,7 @@ Shared by the cross-check (pendular.crosscheck) and the benchmarks (benchmarks/b
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
@@ -34,7 +35,7 @@ from dem.sample import load_sample, save_sample
 from dem.yade_io import read_plot_data
 
 from .campaign import sample_made_with
-from .config import config_to_dict
+from .config import config_json, config_to_dict
 
 #: The YADE script run by ``run_yade_triaxial`` (package data beside this module).
 DRIVER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "yade_triaxial.py")
@@ -128,12 +129,13 @@ def cache_folder():
 def cached_sample(config, *, progress=True, threads=None):
     """(Particles, Walls, preparation report) of the sample of ``config`` (a PrepareConfig),
     prepared once (thesis Ch. 5.2.2, at config.confining; ``threads``: Numba threads of the
-    preparation, dem.simulation's policy by default) and saved in the cache folder with its
-    configuration; a saved sample of another configuration is prepared again."""
+    preparation, dem.simulation's policy by default) and saved in the cache folder under a name
+    keyed by its configuration, which the saved sample holds and is checked against."""
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
+    key = hashlib.sha256(config_json(config).encode()).hexdigest()[:12]
     path = os.path.join(cache_folder(), "samples", f"sample_{config.particles}_"
-                        f"{config.confining:g}_seed{config.seed}.h5")
+                        f"{config.confining:g}_seed{config.seed}_{key}.h5")
     if not sample_made_with(path, config):
         os.makedirs(os.path.dirname(path), exist_ok=True)
         started = time.perf_counter()

@@ -14,6 +14,7 @@ import argparse
 import json
 import sys
 
+from dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
 from dem.preparation import PrepareConfig
 from dem.validate import check_range
 
@@ -51,8 +52,17 @@ def add_arguments(parser):
                         help="final axial strain [-]")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
-    parser.add_argument("--radius", type=float, default=0.024e-3,
-                        help="sphere radius [m]")
+    parser.add_argument("--radius", type=float, default=None,
+                        help="sphere radius [m], the mean radius of a graded sample (default "
+                             "2.4e-05)")
+    parser.add_argument("--radius-spread", type=float, default=0.0,
+                        help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
+                             f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
+                             f"{MAX_RADIUS_RATIO:g})")
+    parser.add_argument("--psd", metavar="FILE", default=None,
+                        help="grading curve, CSV rows 'diameter [m], percent passing by mass' "
+                             "from 0 to 100 %% (a sieve analysis); sets the sizes instead of "
+                             "--radius")
     parser.add_argument("--porosity", type=float, default=0.40,
                         help="porosity of the initial cloud box [-] (0.30-0.60)")
     parser.add_argument("--friction", type=float, default=18.0,
@@ -120,6 +130,18 @@ def table_resolution(text):
     return nodes
 
 
+def sizes_from(args):
+    """PrepareConfig's size options of parsed --radius, --radius-spread and --psd."""
+    if args.psd is not None and args.radius is not None:
+        raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
+    sizes = {"radius_spread": args.radius_spread}
+    if args.radius is not None:
+        sizes["radius"] = args.radius
+    if args.psd is not None:
+        sizes["psd"] = read_grading_curve(args.psd)
+    return sizes
+
+
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
     check_range("--suction", args.suction, 0.0, unit="Pa")
@@ -131,7 +153,8 @@ def config_from(args):
     if args.suction == 0.0 and any(wet_only.values()):
         raise UsageError(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet "
                          "test: give --suction > 0")
-    sample = PrepareConfig(particles=args.particles, radius=args.radius, porosity=args.porosity,
+    sample = PrepareConfig(particles=args.particles, porosity=args.porosity,
+                           **sizes_from(args),
                            young=args.young, friction_deg=args.friction, damping=args.damping,
                            prep_friction_deg=args.prep_friction,
                            timestep_safety=args.timestep_safety, confining=args.confining,
