@@ -162,6 +162,20 @@ def test_configuration_and_refusals():
         crosscheck.check_mirrored(toroidal)
 
 
+def test_the_crosscheck_takes_the_grading_options_of_the_triaxial_command(tmp_path):
+    from pendular.cli import command_parser
+    from pendular.commands.crosscheck import config_from
+
+    curve = tmp_path / "psd.csv"
+    curve.write_text("3e-5,0\n5e-5,50\n8e-5,100\n")
+    parser, _ = command_parser("crosscheck")
+    spread = config_from(parser.parse_args(["--radius", "2.31e-5", "--radius-spread", "0.3",
+                                            "--seed", "2"])).sample
+    assert (spread.radius, spread.radius_spread, spread.seed) == (2.31e-5, 0.3, 2)
+    graded = config_from(parser.parse_args(["--psd", str(curve)])).sample
+    assert graded.psd == ((3e-5, 0.0), (5e-5, 50.0), (8e-5, 100.0))
+
+
 def test_command_line_says_when_yade_is_missing():
     environment = dict(os.environ, PATH="")
     result = subprocess.run([sys.executable, SCENARIO, "--particles", "100", "--quiet"],

@@ -72,15 +72,16 @@ SETUP = ("pendular prepares and settles the sample at the confining stress (wett
 
 
 def crosscheck_config(particles=1000, suction=0.0, confining=750.0, max_strain=0.25,
-                      records=200, mimic_yade=False, settle_steps=200000):
+                      records=200, mimic_yade=False, settle_steps=200000, seed=0, **sizes):
     """The TriaxialConfig of a cross-check: the thesis-default sample (Table 5.2) of
-    ``particles`` spheres at ``confining`` [Pa]; suction-controlled exact bridges at
+    ``particles`` spheres at ``confining`` [Pa] from ``seed``, of the ``sizes`` given
+    (PrepareConfig's radius, radius_spread, psd); suction-controlled exact bridges at
     ``suction`` [Pa] (0: dry; surface tension capillary.SURFACE_TENSION, contact angle 0);
     the shear to ``max_strain`` with ``records`` rows, with YADE's wall-control choices if
     ``mimic_yade``; at most ``settle_steps`` steps (wet_steps) to bring the (wetted) sample to
     rest before the export."""
     return TriaxialConfig(
-        sample=PrepareConfig(particles=particles, confining=confining),
+        sample=PrepareConfig(particles=particles, confining=confining, seed=seed, **sizes),
         shear=ShearConfig(max_strain=max_strain, records=records,
                           **(YADE_CHOICES if mimic_yade else {})),
         bridges=BridgeConfig(suction) if suction else None,
