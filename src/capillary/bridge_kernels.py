@@ -232,6 +232,30 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
             _apply_across_gap(k, position, i, j, force[k], pair_force)
 
 
+@numba.njit(cache=True)
+def bridges_across_gaps(radius, pair_i, pair_j, overlap, state, volume, formation_suction,
+                        surface_tension, roughness, max_gap, suction_table):
+    """Wetting across gaps: every pair without a bridge whose spheres are apart by a gap in
+    (0, max_gap] [m] gets, marked ACROSS_GAP, the volume [m^3] of the suction-controlled bridge
+    at ``formation_suction`` [Pa] at its gap (d* = roughness + gap / R2), if one exists there;
+    volume_bridges then carries it. Returns the number of bridges formed."""
+    formed = 0
+    for k in range(len(pair_i)):
+        gap = -overlap[k]
+        if state[k] != NO_BRIDGE or gap <= 0.0 or gap > max_gap:
+            continue
+        larger = max(radius[pair_i[k]], radius[pair_j[k]])
+        exists, _, volume_star, _, _ = lookup_suction(
+            suction_table[0], suction_table[1], suction_table[2], suction_table[3],
+            suction_table[4], larger / min(radius[pair_i[k]], radius[pair_j[k]]),
+            formation_suction * larger / surface_tension, roughness + gap / larger)
+        if exists:
+            volume[k] = volume_star * larger * larger * larger
+            state[k] = ACROSS_GAP
+            formed += 1
+    return formed
+
+
 @numba.njit(cache=True, parallel=True)
 def pendular_overlap_counts(position, row_start, second_start, second_pair, pair_i, pair_j,
                             state, filling_i, filling_j):

@@ -54,8 +54,9 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (contact_bridges, gather_contact_bridges,
-                                      pendular_overlap_counts, suction_bridges, volume_bridges)
+from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges,
+                                      gather_contact_bridges, pendular_overlap_counts,
+                                      suction_bridges, volume_bridges)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
@@ -316,6 +317,22 @@ class CapillaryBridges:
         gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
         if self.persist:
             self._bridges = b.count()
+
+    def form_across_gaps(self, sim, max_gap):
+        """Wetting where the liquid would be (volume control): besides the bridges that form
+        at contact, give every pair of the neighbour list apart by a gap in (0, ``max_gap``]
+        [m] the bridge of the formation suction at its own gap (bridge_kernels.
+        bridges_across_gaps); returns how many formed. Pairs beyond the rupture distance of
+        that suction get none, so the neighbour list (``reach``) holds every pair that can."""
+        if self.control != "volume":
+            raise ValueError(f"control = {self.control!r}: bridges across gaps form at wetting "
+                             "with control = 'volume' only")
+        max_gap = check_positive("max_gap", max_gap, "m")
+        self._sync(sim)
+        b, c = self._state, sim.contacts
+        return int(bridges_across_gaps(sim.particles.radius, c.pair_i, c.pair_j, c.overlap,
+                                       b.state, b.volume, self.suction, self.surface_tension,
+                                       self.roughness, max_gap, self._table_arrays))
 
     # ---------------------------------------------------------------- measures (record time)
     def state(self, sim):

@@ -15,6 +15,8 @@ import sys
 
 import numba
 
+from dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
+
 from . import __version__
 
 #: Command name -> (module under pendular.commands, one-line description).
@@ -74,6 +76,35 @@ def add_executor_options(parser):
                         help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
                              "instead of --jobs local processes")
     add_run_options(parser, threads_default=1)
+
+
+def add_size_options(parser, default_radius):
+    """Sphere-size options of commands that prepare a sample: --radius (the mean radius,
+    ``default_radius`` [m] when not given), --radius-spread, --psd (dem.grading)."""
+    parser.add_argument("--radius", type=float, default=None,
+                        help=f"sphere radius [m], the mean radius of a graded sample (default "
+                             f"{default_radius:g})")
+    parser.add_argument("--radius-spread", type=float, default=0.0,
+                        help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
+                             f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
+                             f"{MAX_RADIUS_RATIO:g})")
+    parser.add_argument("--psd", metavar="FILE", default=None,
+                        help="grading curve, CSV rows 'diameter [m], percent passing by mass' "
+                             "from 0 to 100 %% (a sieve analysis); sets the sizes instead of "
+                             "--radius")
+
+
+def sizes_from(args):
+    """The size settings (radius, radius_spread, psd) of parsed add_size_options options; a
+    radius not given is left to the configuration's default."""
+    if args.psd is not None and args.radius is not None:
+        raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
+    sizes = {"radius_spread": args.radius_spread}
+    if args.radius is not None:
+        sizes["radius"] = args.radius
+    if args.psd is not None:
+        sizes["psd"] = read_grading_curve(args.psd)
+    return sizes
 
 
 def set_threads(threads):

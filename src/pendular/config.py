@@ -204,7 +204,10 @@ class TensionConfig:
 
     cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
     void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
-    particles, radius [m], contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
+    form_gap: at wetting, bridges also form across gaps up to form_gap x radius [-] (0: at
+    contacts only; capillary.wetting); particles, radius [m] (the mean radius),
+    radius_spread [-] and psd (grading curve) as in dem.preparation.PrepareConfig,
+    contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
     confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
     wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
     max_strain: largest axial extension [-]; residual: fraction of the peak below which the
@@ -216,8 +219,11 @@ class TensionConfig:
     cases: list[tuple[float, float]] = field(
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
     roughness: float = KIM_SEPARATION
+    form_gap: float = 0.0
     particles: int = 2000
     radius: float = KIM_RADIUS
+    radius_spread: float = 0.0
+    psd: tuple | None = None
     contact_angle: float = 0.0
     surface_tension: float = CHAPTER4_SURFACE_TENSION
     specific_gravity: float = SPECIFIC_GRAVITY
@@ -242,6 +248,12 @@ class TensionConfig:
             # denser than random close packing or looser than the loosest growth: unreachable
             check_range("--void-ratio", e, 0.5, 1.2)
         check_range("--particles", self.particles, 100, 1e6)
+        check_range("--form-gap", self.form_gap, 0.0, 1.0)
+        if self.psd is not None or self.radius_spread:
+            sizes = PrepareConfig(particles=int(self.particles), radius=self.radius,
+                                  radius_spread=self.radius_spread, psd=self.psd,
+                                  seed=self.seed)
+            self.radius, self.psd = sizes.radius, sizes.psd
         check_range("--radius", self.radius, 1e-6, 1e-2, unit="m")
         check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
                     unit="deg")

@@ -134,6 +134,7 @@ TENSION_SUMMARY_UNITS = {
     "strain_rate": "1/s", "inertial_number": "1", "mean_unbalanced_force_to_peak": "1",
     "unbalanced_force_at_peak": "1", "pull_steps": "1", "dt": "s", "wetting_time_s": "s",
     "pull_time_s": "s",
+    "grading": GRADING_UNITS,
 }
 
 #: Units of the run options in campaign rows (pendular.triaxial.parameters, TensionConfig) and

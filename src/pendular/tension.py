@@ -50,10 +50,12 @@ import time
 from dataclasses import asdict
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from capillary import (BridgeTable, CapillaryBridges, formation_suction,
-                       gravimetric_water_content, table_radius_ratios)
+                       gravimetric_water_content, sample_radius_ratios)
 from dem.atomic import write_json, write_text
+from dem.grading import grading
 from dem.measure import coordination, unbalanced_force
 from dem.preparation import PrepareConfig, equilibrated, prepare_sample
 from dem.record import HistoryRecorder
@@ -111,9 +113,11 @@ def cases_of(void_ratios: list[float] | None = None,
 
 def prepare_config(config: TensionConfig, prep_friction: float) -> PrepareConfig:
     """The sample's preparation (thesis Ch. 5.2.2) with growth friction ``prep_friction`` [deg]."""
-    return PrepareConfig(particles=config.particles, radius=config.radius, young=config.young,
-                         friction_deg=config.friction, prep_friction_deg=prep_friction,
-                         confining=config.confining, seed=config.seed)
+    return PrepareConfig(particles=config.particles, radius=config.radius,
+                         radius_spread=config.radius_spread, psd=config.psd,
+                         young=config.young, friction_deg=config.friction,
+                         prep_friction_deg=prep_friction, confining=config.confining,
+                         seed=config.seed)
 
 
 def sample_void_ratio(sim: Simulation, radius: float) -> float:
@@ -171,29 +175,52 @@ def prepare_void_ratio(config: TensionConfig, target: float,
     return sim, report
 
 
+def wetted_pairs(sim: Simulation, max_gap: float) -> tuple[np.ndarray, np.ndarray,
+                                                             np.ndarray | None]:
+    """(pair_i, pair_j, gap [m] or None) of the pairs that take liquid at wetting: the
+    touching pairs of ``sim``'s contacts, and with ``max_gap`` [m] > 0 every pair whose gap is
+    at most max_gap (found afresh over all spheres, gap 0 for touching ones)."""
+    particles = sim.particles
+    if max_gap <= 0.0:
+        touching = sim.contacts.overlap > 0.0
+        return sim.contacts.pair_i[touching], sim.contacts.pair_j[touching], None
+    radius = particles.radius
+    pairs = cKDTree(particles.position).query_pairs(2.0 * radius.max() + max_gap,
+                                                    output_type="ndarray")
+    i, j = pairs[:, 0], pairs[:, 1]
+    gap = (np.linalg.norm(particles.position[j] - particles.position[i], axis=1)
+           - radius[i] - radius[j])
+    near = gap <= max_gap
+    return i[near], j[near], np.maximum(gap[near], 0.0)
+
+
 def wet(dry: Simulation, config: TensionConfig, water_content: float,
         progress: bool) -> tuple[Simulation, CapillaryBridges, dict]:
     """(wetted sim, bridges, wetting report): volume-controlled bridges at every contact of a
-    copy of ``dry`` holding water content ``water_content`` (fraction) once static, the
-    formation suction corrected for the contacts the bridges add (the wetting law itself,
-    formation suction at a water volume, is capillary.formation_suction)."""
+    copy of ``dry`` (and across every gap up to config.form_gap radii) holding water content
+    ``water_content`` (fraction) once static, the formation suction corrected for the contacts
+    the bridges add (the wetting law itself, formation suction at a water volume, is
+    capillary.formation_suction)."""
     particles = dry.particles
     target = water_content * config.specific_gravity * particles.solid_volume()
-    touching = dry.contacts.overlap > 0.0
-    radius_i = particles.radius[dry.contacts.pair_i[touching]]
-    radius_j = particles.radius[dry.contacts.pair_j[touching]]
-    table = BridgeTable.cached(config.contact_angle, radius_ratios=table_radius_ratios(
-        float(particles.radius.max() / particles.radius.min())))
+    max_gap = config.form_gap * config.radius
+    pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
+    radius_i, radius_j = particles.radius[pair_i], particles.radius[pair_j]
+    table = BridgeTable.cached(config.contact_angle,
+                               radius_ratios=sample_radius_ratios(particles.radius))
     thresholds = prepare_config(config, 0.0)      # for the equilibrium thresholds only
     aimed = target
     attempts = []
     for _ in range(WETTINGS):
         suction = formation_suction(table, radius_i, radius_j, aimed, config.surface_tension,
-                                    config.roughness)
+                                    config.roughness, gap=gap)
         sim = copy.deepcopy(dry)
         bridges = CapillaryBridges(suction, config.surface_tension, config.contact_angle,
                                    control="volume", roughness=config.roughness)
         sim.forces.append(bridges)
+        if max_gap > 0.0:
+            sim.evaluate_forces()          # the neighbour list at the bridges' reach
+            bridges.form_across_gaps(sim, max_gap)
         steps = sim.run(WET_STEPS, until=equilibrated(thresholds), check_every=CHECK_EVERY,
                         progress="wet" if progress else None)
         held = bridges.water_volume(sim.contacts)
@@ -336,6 +363,7 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
         "prep_friction_deg": preparation["prep_friction_deg"],
         "water_content_target": water_content,
         **wetting,
+        "grading": grading(sim.particles.radius),
         "grip_particles": [len(grip.members) for grip in pull.grips],
         "tensile_strength_pa": strength,
         "axial_extension_at_peak": float(-history["axial_strain"][peak]),

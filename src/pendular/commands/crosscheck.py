@@ -16,10 +16,11 @@ import math
 
 import numba
 
-from ..cli import UsageError, positive_int, set_threads
+from dem.preparation import PrepareConfig
+
+from ..cli import UsageError, add_size_options, positive_int, set_threads, sizes_from
 from ..crosscheck import SHOWN, crosscheck_config, run_crosscheck
 from ..yade import find_yade
-from .triaxial import sizes_from
 
 
 def add_arguments(parser):
@@ -27,12 +28,7 @@ def add_arguments(parser):
     parser.add_argument("--suction", type=float, default=0.0, help="matric suction [Pa] (0: dry)")
     parser.add_argument("--confining", type=float, default=750.0, help="lateral stress [Pa]")
     parser.add_argument("--max-strain", type=float, default=0.25, help="final axial strain")
-    parser.add_argument("--radius", type=float, default=None,
-                        help="sphere radius [m], the mean of a graded sample (default 2.4e-05)")
-    parser.add_argument("--radius-spread", type=float, default=0.0,
-                        help="radii uniform in R(1 ± S) [-] (0: equal spheres)")
-    parser.add_argument("--psd", metavar="FILE", default=None,
-                        help="grading curve, CSV rows 'diameter [m], percent passing by mass'")
+    add_size_options(parser, PrepareConfig.radius)
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/crosscheck", help="output folder")
     parser.add_argument("--mimic-yade", action="store_true",

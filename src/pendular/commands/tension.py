@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..cli import UsageError, add_run_options, positive_int, set_threads
+from ..cli import (UsageError, add_run_options, add_size_options, positive_int, set_threads,
+                   sizes_from)
 from ..config import TensionConfig
 from ..reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
 from ..reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
@@ -39,7 +40,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
     parser.add_argument("--particles", type=int, default=2000, help="number of spheres [-]")
-    parser.add_argument("--radius", type=float, default=KIM_RADIUS, help="sphere radius [m]")
+    parser.add_argument("--form-gap", type=float, default=0.0,
+                        help="at wetting, bridges also form across gaps up to this many "
+                             "radii [-] (0: at contacts only)")
+    add_size_options(parser, KIM_RADIUS)
     parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
     parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
                         help="surface tension [N/m]")
@@ -76,10 +80,11 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
     """The TensionConfig of parsed options (ValueError naming the option)."""
     cases = cases_of(_numbers("--void-ratio", args.void_ratio),
                      _numbers("--water-content", args.water_content))
-    return TensionConfig(cases=cases, **{name: getattr(args, name) for name in (
-        "roughness", "particles", "radius", "contact_angle", "surface_tension",
+    options = {name: getattr(args, name) for name in (
+        "roughness", "form_gap", "particles", "contact_angle", "surface_tension",
         "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
-        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed")})
+        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed")}
+    return TensionConfig(cases=cases, **sizes_from(args), **options)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -14,11 +14,11 @@ import argparse
 import json
 import sys
 
-from dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
 from dem.preparation import PrepareConfig
 from dem.validate import check_range
 
-from ..cli import INTERRUPTED, UsageError, add_run_options, positive_int, set_threads
+from ..cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
+                   set_threads, sizes_from)
 from ..config import BridgeConfig, ShearConfig, TriaxialConfig
 from ..triaxial import Interrupted, TriaxialTest
 
@@ -52,17 +52,7 @@ def add_arguments(parser):
                         help="final axial strain [-]")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
-    parser.add_argument("--radius", type=float, default=None,
-                        help="sphere radius [m], the mean radius of a graded sample (default "
-                             "2.4e-05)")
-    parser.add_argument("--radius-spread", type=float, default=0.0,
-                        help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
-                             f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
-                             f"{MAX_RADIUS_RATIO:g})")
-    parser.add_argument("--psd", metavar="FILE", default=None,
-                        help="grading curve, CSV rows 'diameter [m], percent passing by mass' "
-                             "from 0 to 100 %% (a sieve analysis); sets the sizes instead of "
-                             "--radius")
+    add_size_options(parser, PrepareConfig.radius)
     parser.add_argument("--porosity", type=float, default=0.40,
                         help="porosity of the initial cloud box [-] (0.30-0.60)")
     parser.add_argument("--friction", type=float, default=18.0,
@@ -128,18 +118,6 @@ def table_resolution(text):
         raise UsageError(f"--table-resolution {text!r}: two integers NS,ND, each in [4, inf), "
                          "expected")
     return nodes
-
-
-def sizes_from(args):
-    """PrepareConfig's size options of parsed --radius, --radius-spread and --psd."""
-    if args.psd is not None and args.radius is not None:
-        raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
-    sizes = {"radius_spread": args.radius_spread}
-    if args.radius is not None:
-        sizes["radius"] = args.radius
-    if args.psd is not None:
-        sizes["psd"] = read_grading_curve(args.psd)
-    return sizes
 
 
 def config_from(args):
