@@ -205,7 +205,8 @@ class TensionConfig:
     cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
     void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
     form_gap: at wetting, bridges also form across gaps up to form_gap x radius [-] (0: at
-    contacts only; capillary.wetting); particles, radius [m] (the mean radius),
+    contacts only; the default 1 reaches past the rupture distance of Kim's bridges, so they
+    form wherever they can; capillary.wetting); particles, radius [m] (the mean radius),
     radius_spread [-] and psd (grading curve) as in dem.preparation.PrepareConfig,
     contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
     confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
@@ -219,7 +220,7 @@ class TensionConfig:
     cases: list[tuple[float, float]] = field(
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
     roughness: float = KIM_SEPARATION
-    form_gap: float = 0.0
+    form_gap: float = 1.0
     particles: int = 2000
     radius: float = KIM_RADIUS
     radius_spread: float = 0.0

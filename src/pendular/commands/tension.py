@@ -40,9 +40,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
     parser.add_argument("--particles", type=int, default=2000, help="number of spheres [-]")
-    parser.add_argument("--form-gap", type=float, default=0.0,
+    parser.add_argument("--form-gap", type=float, default=TensionConfig.form_gap,
                         help="at wetting, bridges also form across gaps up to this many "
-                             "radii [-] (0: at contacts only)")
+                             "radii [-] (0: at contacts only; 1: wherever a bridge of the "
+                             "formation suction can exist, docs/direct_tension.md)")
     add_size_options(parser, KIM_RADIUS)
     parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
     parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
