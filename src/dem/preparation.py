@@ -3,7 +3,7 @@
 1. A random non-overlapping cloud in a fixed frictionless box, friction ``prep_friction`` (0.5°).
 2. Radii grown homogeneously until the mean wall stress reaches ``prep_stress`` (5 kPa) and the
    packing is in quasi-static equilibrium.
-3. The whole sample rescaled so that the radius is the nominal one. With linear springs
+3. The whole sample rescaled so that the mean radius is the nominal one. With linear springs
    kn = E R, forces scale as R^2 and stresses are unchanged.
 4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
    target lowered slowly to the confining stress, and equilibrium again.
@@ -101,8 +101,8 @@ def _random_cloud_pairwise(count, radius, lo, hi, seed, max_attempts):
 @numba.njit(cache=True)
 def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
     """Random sequential insertion of spheres of unequal ``radius`` in [lo, hi] without
-    overlap, largest first (positions returned in the order of ``radius``; fewer rows if
-    ``max_attempts`` ran out). Cells of edge 2 max(radius) hold any number of centres (linked
+    overlap, largest first (positions in the order of ``radius``; only those placed, in
+    insertion order, if ``max_attempts`` ran out). Cells of edge 2 max(radius) hold any number of centres (linked
     lists), so a sphere is checked against the 27 cells around its own."""
     np.random.seed(seed)
     count = radius.size
@@ -119,7 +119,7 @@ def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
     while placed < count:
         attempts += 1
         if attempts > max_attempts:
-            return position[order[:placed]], order[:placed]
+            return position[order[:placed]]
         i = order[placed]
         r = radius[i]
         x = np.empty(3)
@@ -150,7 +150,7 @@ def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
             following[i] = head[key]
             head[key] = i
             placed += 1
-    return position, order
+    return position
 
 
 #: Names of the phases of ``prepare_sample``, in order (module docstring).
@@ -182,7 +182,7 @@ def random_cloud(count, radius, lo, hi, seed):
                          f"{(hi - lo).tolist()} m")
     seed = check_int("seed", seed, high=MAX_SEED)
     if radii.min() < largest:
-        position, _ = _random_cloud_graded(radii, lo, hi, seed, 200 * count + 10000)
+        position = _random_cloud_graded(radii, lo, hi, seed, 200 * count + 10000)
     else:
         position = _random_cloud(count, largest, lo, hi, seed, 200 * count + 10000)
         if len(position) < count and count <= PAIRWISE_CLOUD_MAX:
@@ -272,6 +272,7 @@ class PrepareConfig:
 
     def __post_init__(self):
         self.particles = check_int("particles", self.particles, low=2, high=MAX_PARTICLES)
+        self.seed = check_int("seed", self.seed, high=MAX_SEED)
         self.radius_spread = check_spread(self.radius_spread)
         if self.psd is not None:
             if self.radius_spread > 0.0:
@@ -293,7 +294,6 @@ class PrepareConfig:
                                            low_inclusive=False)
         self.prep_stress = check_positive("prep_stress", self.prep_stress, "Pa")
         self.confining = check_range("confining", self.confining, 0.0, 1e7, unit="Pa")
-        self.seed = check_int("seed", self.seed, high=MAX_SEED)
         self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
         self.skin_factor = check_range("skin_factor", self.skin_factor, 0.0, 2.0,
                                        low_inclusive=False)
