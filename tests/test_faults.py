@@ -312,3 +312,21 @@ def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
     assert summary["stress_balance_error"] > summary["stress_balance_bound"]
     assert summary["stress_balance_flagged"]
     assert "not quasi-static" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_an_interrupt_wrapped_by_numba_is_an_interrupt(capsys, monkeypatch):
+    """Ctrl-C while Numba unpickles a cached kernel surfaces as a SystemError whose cause is
+    the KeyboardInterrupt: it ends like any interrupt (exit 130, one line)."""
+    from pendular.commands import triaxial as command
+
+    def interrupted_while_loading(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as stop:
+            raise SystemError("CPUDispatcher returned a result with an exception set") from stop
+
+    monkeypatch.setattr(command, "run", interrupted_while_loading)
+    with pytest.raises(SystemExit) as stop:
+        run_command("triaxial", ["--particles", "60"], prog="triaxial.py")
+    assert stop.value.code == 130
+    assert capsys.readouterr().err.strip() == "triaxial.py: interrupted"
