@@ -150,3 +150,18 @@ def test_a_graded_wet_triaxial_reports_its_grading(tmp_path):
     assert summary["grading"]["Cu"] > 1.2 and summary["units"]["grading"]["D50"] == "m"
     assert summary["stress_balance_flagged"] == []
     assert summary["saturation_at_peak"] > 0.0
+
+
+def test_a_sample_of_another_spread_is_refused_naming_the_sizes(tmp_path, capsys):
+    out = tmp_path / "graded"
+    assert run_command("triaxial", ["--particles", "120", "--radius-spread", "0.3",
+                                    "--max-strain", "0.002", "--inertial-number", "2e-3",
+                                    "--vtk-frames", "0", "--quiet", "--out", str(out)]) == 0
+    sample = str(out / "sample.h5")
+    again = ["--particles", "120", "--max-strain", "0.002", "--inertial-number", "2e-3",
+             "--vtk-frames", "0", "--quiet", "--sample", sample]
+    assert run_command("triaxial", again + ["--radius-spread", "0.3",
+                                            "--out", str(tmp_path / "same")]) == 0
+    capsys.readouterr()
+    refused(capsys, again + ["--radius-spread", "0.2", "--out", str(tmp_path / "other")],
+            "radius_spread = 0.2", sample.rsplit("/", 1)[0])

@@ -120,9 +120,11 @@ def load_sample(path, expected=None, expected_identity=None):
 # ---------------------------------------------------------------- physical checks
 def sample_parameters(particles):
     """What a sample was made with, read from its spheres: {"radius": mean radius [m],
-    "particles": count, "density": [kg/m^3]} (preparation rescales the spheres to the
-    configured mean radius)."""
-    return {"radius": float(np.mean(particles.radius)), "particles": len(particles),
+    "radius_min", "radius_max" [m], "particles": count, "density": [kg/m^3]} (preparation
+    rescales the spheres to the configured mean radius)."""
+    return {"radius": float(np.mean(particles.radius)),
+            "radius_min": float(np.min(particles.radius)),
+            "radius_max": float(np.max(particles.radius)), "particles": len(particles),
             "density": float(particles.density)}
 
 
@@ -156,6 +158,18 @@ def check_consistent(sample_config, requested, source="sample"):
                 f"{asked!r} {unit} (relative difference {difference:.3g}, allowed "
                 f"{RADIUS_TOLERANCE:g}): use {name} = {made!r} or prepare a sample with "
                 f"{name} = {asked!r}")
+    sizes = getattr(requested, "radii", None)          # a PrepareConfig's size distribution
+    low, high = _get(sample_config, "radius_min"), _get(sample_config, "radius_max")
+    if callable(sizes) and low is not None and high is not None:
+        radii = sizes()
+        for made, asked in ((low, radii.min()), (high, radii.max())):
+            if not abs(made - asked) <= RADIUS_TOLERANCE * max(abs(made), abs(asked)):
+                raise ValueError(
+                    f"{source} has radii from {low:.6g} to {high:.6g} m; the run's sizes "
+                    f"(radius_spread = {getattr(requested, 'radius_spread', 0.0):g}, psd = "
+                    f"{'given' if getattr(requested, 'psd', None) else 'none'}) give "
+                    f"{radii.min():.6g} to {radii.max():.6g} m: use the radius_spread or psd "
+                    "the sample was made with, or prepare a new sample")
 
 
 def _wall_overlaps(position, radius, walls):
