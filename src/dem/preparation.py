@@ -102,8 +102,9 @@ def _random_cloud_pairwise(count, radius, lo, hi, seed, max_attempts):
 def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
     """Random sequential insertion of spheres of unequal ``radius`` in [lo, hi] without
     overlap, largest first (positions in the order of ``radius``; only those placed, in
-    insertion order, if ``max_attempts`` ran out). Cells of edge 2 max(radius) hold any number of centres (linked
-    lists), so a sphere is checked against the 27 cells around its own."""
+    insertion order, if ``max_attempts`` ran out). Cells of edge 2 max(radius) hold any
+    number of centres (linked lists), so a sphere is checked against the 27 cells around its
+    own."""
     np.random.seed(seed)
     count = radius.size
     cell = 2.0 * radius.max()

@@ -255,12 +255,13 @@ def summarize(history):
         effective = np.diagonal(history["sigma_effective"][peak])
         summary["peak_q_effective"] = float(deviator_stress(effective))
         summary["p_effective_at_peak"] = float(effective.mean())
-    error = stress_balance_error(history)
-    summary.update({
-        "stress_balance_error": float(np.max(error)),
-        "stress_balance_bound": STRESS_BALANCE_BOUND,
-        "stress_balance_flagged": np.flatnonzero(error > STRESS_BALANCE_BOUND).tolist(),
-    })
+    if "sigma_contact" in history:                # not in a YADE history
+        error = stress_balance_error(history)
+        summary.update({
+            "stress_balance_error": float(np.max(error)),
+            "stress_balance_bound": STRESS_BALANCE_BOUND,
+            "stress_balance_flagged": np.flatnonzero(error > STRESS_BALANCE_BOUND).tolist(),
+        })
     return summary
 
 
@@ -268,8 +269,6 @@ def stress_balance_error(history):
     """Per record, max over the axes of |sigma_wall - diag(sigma_contact + sigma_capillary)| / p
     (p the mean wall stress): how far the wall stress and the Love–Weber stress (Eq. 3.41) of
     the contacts and bridges inside are from the balance that holds in equilibrium."""
-    if "sigma_contact" not in history:            # a YADE history: no Love–Weber stress
-        return np.zeros(len(history["sigma_wall"]))
     inside = history["sigma_contact"]
     if "sigma_capillary" in history:
         inside = inside + history["sigma_capillary"]
@@ -330,7 +329,8 @@ def parameters(config):
     attributes, campaign tables)."""
     sample, shear, bridges = config.sample, config.shear, config.bridges
     flat = {"particles": sample.particles, "radius": sample.radius,
-            "radius_spread": sample.radius_spread, "psd": sample.psd, "porosity": sample.porosity,
+            "radius_spread": sample.radius_spread, "psd": sample.psd,
+            "porosity": sample.porosity,
             "young": sample.young, "shear_ratio": sample.shear_ratio,
             "friction": sample.friction_deg, "prep_friction": sample.prep_friction_deg,
             "density": sample.density, "damping": sample.damping,
