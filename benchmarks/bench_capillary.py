@@ -50,27 +50,37 @@ def shear_simulation(config, particles, walls, threads, suction):
     return sim, bridges, rate
 
 
-def time_pendular(config, particles, walls, threads, steps, warmup, suction, chunks=6):
-    """Dry and wet shear of the same sample, timed in alternating chunks after ``warmup``."""
-    runs = {"dry": shear_simulation(config, particles, walls, threads, 0.0),
-            "wet": shear_simulation(config, particles, walls, threads, suction)}
-    for sim, _, _ in runs.values():
+def time_alternately(simulations, steps, warmup, chunks=6):
+    """({name: seconds}, {name: neighbour-list rebuilds}) of ``steps`` steps of each of the
+    named ``simulations`` after ``warmup`` steps, run in alternating chunks so that a change
+    of machine load hits them alike."""
+    for sim in simulations.values():
         sim.run(warmup)
-    elapsed = {name: 0.0 for name in runs}
-    rebuilds = {name: sim.operation(NeighborList).rebuilds for name, (sim, _, _) in runs.items()}
+    elapsed = {name: 0.0 for name in simulations}
+    rebuilds = {name: sim.operation(NeighborList).rebuilds for name, sim in simulations.items()}
     for chunk in range(chunks):
         count = steps // chunks + (1 if chunk < steps % chunks else 0)
-        for name, (sim, _, _) in runs.items():
+        for name, sim in simulations.items():
             started = time.perf_counter()
             sim.run(count)
             elapsed[name] += time.perf_counter() - started
+    return elapsed, {name: sim.operation(NeighborList).rebuilds - rebuilds[name]
+                     for name, sim in simulations.items()}
+
+
+def time_pendular(config, particles, walls, threads, steps, warmup, suction):
+    """Dry and wet shear of the same sample, timed in alternating chunks after ``warmup``."""
+    runs = {"dry": shear_simulation(config, particles, walls, threads, 0.0),
+            "wet": shear_simulation(config, particles, walls, threads, suction)}
+    elapsed, rebuilds = time_alternately({name: run[0] for name, run in runs.items()}, steps,
+                                         warmup)
     results = {}
     for name, (sim, bridges, rate) in runs.items():
         c = sim.contacts
         results[name] = {
             "particle_steps_per_s": len(particles) * steps / elapsed[name],
             "wall_time_s": elapsed[name],
-            "rebuilds": sim.operation(NeighborList).rebuilds - rebuilds[name],
+            "rebuilds": rebuilds[name],
             "sigma_wall": sim.walls.stress().tolist(),
             "contacts": int(np.count_nonzero(c.overlap > 0.0)),
             "pairs": len(c),

@@ -14,35 +14,24 @@ more steps per unit strain, which the table reports separately (dt ratio).
 
 import argparse
 import json
-import time
 
 import numba
 
-from bench_capillary import shear_simulation  # benchmarks/ (the script's folder)
+from bench_capillary import shear_simulation, time_alternately  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig
 from pendular.yade import cached_sample
 
 
-def time_wet_shears(samples, threads, steps, warmup, suction, chunks=6):
+def time_wet_shears(samples, threads, steps, warmup, suction):
     """Particle-steps/s of the wet shear of each (config, particles, walls) in ``samples``."""
     numba.set_num_threads(threads)
     runs = {name: shear_simulation(config, particles, walls, threads, suction)
             for name, (config, particles, walls) in samples.items()}
-    for sim, _, _ in runs.values():
-        sim.run(warmup)
-    elapsed = {name: 0.0 for name in runs}
-    rebuilds = {name: sim.operation(NeighborList).rebuilds for name, (sim, _, _) in runs.items()}
-    for chunk in range(chunks):
-        count = steps // chunks + (1 if chunk < steps % chunks else 0)
-        for name, (sim, _, _) in runs.items():
-            started = time.perf_counter()
-            sim.run(count)
-            elapsed[name] += time.perf_counter() - started
+    elapsed, rebuilds = time_alternately({name: run[0] for name, run in runs.items()}, steps,
+                                         warmup)
     return {name: {"particle_steps_per_s": len(sim.particles) * steps / elapsed[name],
-                   "wall_time_s": elapsed[name], "dt": sim.dt,
-                   "rebuilds": sim.operation(NeighborList).rebuilds - rebuilds[name],
+                   "wall_time_s": elapsed[name], "dt": sim.dt, "rebuilds": rebuilds[name],
                    "bridges": bridges.count(sim), "pairs": len(sim.contacts),
                    "radius_ratio": float(sim.particles.radius.max() / sim.particles.radius.min())}
             for name, (sim, bridges, _) in runs.items()}

@@ -4,6 +4,7 @@ import os
 import subprocess
 import sys
 
+import h5py
 import numpy as np
 import pytest
 
@@ -18,6 +19,36 @@ from dem.walls import WallForces
 RADIUS = 1e-3
 DENSITY = 2650.0
 YOUNG = 1e6
+
+
+class PrescribedGap:
+    """Replaces the integrator: sphere 1 on the x axis at a surface gap ``start + rate (step + 1)``
+    [m] from sphere 0."""
+
+    def __init__(self, start, rate):
+        self.start = start
+        self.rate = rate
+
+    def apply(self, sim):
+        p = sim.particles
+        p.position[1] = [p.radius[0] + p.radius[1] + self.start + self.rate * (sim.step + 1), 0, 0]
+        p.velocity[:] = 0.0
+
+
+class Still:
+    """Replaces the integrator: nothing moves."""
+
+    def apply(self, sim):
+        sim.particles.velocity[:] = 0.0
+
+
+def zero_bytes(path, dataset, count=16):
+    """Overwrite the first ``count`` bytes of a (contiguous) HDF5 dataset's data with zeros."""
+    with h5py.File(path, "r") as handle:
+        offset = handle[dataset].id.get_offset()
+    with open(path, "r+b") as raw:
+        raw.seek(offset)
+        raw.write(bytes(count))
 
 
 def two_body_scene(positions, velocities, radius=RADIUS, young=YOUNG, friction_deg=0.0,

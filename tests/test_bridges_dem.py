@@ -16,7 +16,7 @@ import pytest
 import capillary
 from capillary import BridgeState, CapillaryBridges
 from capillary.bridge_kernels import pendular_overlap_counts
-from conftest import two_body_scene
+from conftest import PrescribedGap, two_body_scene
 from dem.neighbors import NeighborList, build_contacts
 from homogenize import capillary_force_stress, contact_stress
 
@@ -29,19 +29,6 @@ def add(sim, bridges):
     """Add the bridge operation to the scene's forces; return it."""
     sim.forces.append(bridges)
     return bridges
-
-
-class PrescribedGap:
-    """Replaces the integrator: sphere 1 on the x axis at a gap growing by ``rate`` per step."""
-
-    def __init__(self, start, rate):
-        self.start = start
-        self.rate = rate
-
-    def apply(self, sim):
-        p = sim.particles
-        p.position[1] = [p.radius[0] + p.radius[1] + self.start + self.rate * (sim.step + 1), 0, 0]
-        p.velocity[:] = 0.0
 
 
 def pull_apart(bridges, radii, rate, max_steps=20000):

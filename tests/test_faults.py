@@ -24,6 +24,7 @@ import h5py
 import numpy as np
 import pytest
 
+from conftest import zero_bytes
 from dem.integrity import stamp, verify
 from pendular.cli import run_command
 from pendular.outputs import OutputFolder
@@ -140,14 +141,6 @@ def copy_run(interrupted, tmp_path):
     return target
 
 
-def zero_bytes(path, dataset, count=32):
-    with h5py.File(path, "r") as handle:
-        offset = handle[dataset].id.get_offset()
-    with open(path, "r+b") as raw:
-        raw.seek(offset)
-        raw.write(bytes(count))
-
-
 def forge(path, change, **identity):
     """Edit the HDF5 file and stamp it again (a valid checksum over a wrong content)."""
     stored = verify(path, kind="file")
@@ -162,7 +155,7 @@ def set_step(handle):
 
 
 CHECKPOINT_FAULTS = {
-    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position"), ["checksum mismatch"]),
+    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position", 32), ["checksum mismatch"]),
     "truncated": (lambda p: os.truncate(p, os.path.getsize(p) // 2), ["not a readable"]),
     "not HDF5": (lambda p: open(p, "w").write("not a checkpoint"), ["not a readable"]),
     "step edited to -5": (lambda p: _edit_step(p), ["checksum mismatch"]),
@@ -189,7 +182,7 @@ def test_a_damaged_checkpoint_is_refused_naming_it(name, interrupted, tmp_path, 
 
 
 SAMPLE_FAULTS = {
-    "zeroed bytes": (lambda p: zero_bytes(p, "position"), ["checksum mismatch"]),
+    "zeroed bytes": (lambda p: zero_bytes(p, "position", 32), ["checksum mismatch"]),
     "truncated": (lambda p: os.truncate(p, os.path.getsize(p) // 2), ["not a readable"]),
     "sphere moved outside, checksum forged": (
         lambda p: forge(p, lambda h: h["position"].__setitem__(0, [1.0, 1.0, 1.0])),

@@ -12,6 +12,7 @@ import pytest
 
 from capillary.table import BridgeTable
 from capillary.volume_table import VolumeBridgeTable
+from conftest import zero_bytes
 from dem.integrity import checksum, config_hash, stamp, verify
 from dem.sample import MAX_OVERLAP, check_consistent, load_sample, save_sample
 from dem.state import Particles, Walls
@@ -38,15 +39,6 @@ def write_sample(path, particles=None, walls=None, config=None):
     save_sample(path, types.SimpleNamespace(particles=particles, walls=walls), {"steps": 1},
                 config if config is not None else {"radius": RADIUS, "seed": 3})
     return str(path)
-
-
-def zero_bytes(path, dataset, count=16):
-    """Overwrite the first ``count`` bytes of a (contiguous) dataset's data with zeros."""
-    with h5py.File(path, "r") as handle:
-        offset = handle[dataset].id.get_offset()
-    with open(path, "r+b") as raw:
-        raw.seek(offset)
-        raw.write(bytes(count))
 
 
 def edit(path, change):

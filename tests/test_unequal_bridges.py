@@ -10,7 +10,7 @@ import pytest
 
 import capillary
 from capillary import BridgeState, CapillaryBridges, sample_radius_ratios
-from conftest import two_body_scene
+from conftest import PrescribedGap, Still, two_body_scene
 from dem.contact_law import ContactForces
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList
@@ -28,26 +28,6 @@ WET = {1.5: 3.0, 3.0: 12.0, 8.0: 40.0}
 #: Table force and volume against the exact solver at the pair's own ratio node (measured:
 #: < 0.03 % up to 0.99 of the rupture distance, rupture distance within 0.01 %).
 FORCE_TOLERANCE = 2e-3
-
-
-class PrescribedGap:
-    """Replaces the integrator: sphere 1 on the x axis at a surface gap ``start + rate (step + 1)``."""
-
-    def __init__(self, start, rate):
-        self.start = start
-        self.rate = rate
-
-    def apply(self, sim):
-        p = sim.particles
-        p.position[1] = [p.radius[0] + p.radius[1] + self.start + self.rate * (sim.step + 1), 0, 0]
-        p.velocity[:] = 0.0
-
-
-class Still:
-    """Replaces the integrator: nothing moves."""
-
-    def apply(self, sim):
-        sim.particles.velocity[:] = 0.0
 
 
 def pull(bridges, radii, rate, max_steps=5000):

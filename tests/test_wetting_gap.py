@@ -7,19 +7,12 @@ import pytest
 
 import capillary
 from capillary import BridgeState, BridgeTable, CapillaryBridges, formation_suction
-from conftest import two_body_scene
+from conftest import Still, two_body_scene
 from dem.simulation import Simulation
 
 GAMMA = capillary.SURFACE_TENSION
 RADIUS = 1e-3                     # the larger sphere R2 [m]
 SUCTION_STAR = 5.0                # u* = s R2 / gamma at formation
-
-
-class Still:
-    """Replaces the integrator: nothing moves."""
-
-    def apply(self, sim):
-        sim.particles.velocity[:] = 0.0
 
 
 def wetted_pair(ratio, gap_star, max_gap_star, roughness=0.0):

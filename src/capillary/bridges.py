@@ -198,8 +198,11 @@ class CapillaryBridges:
                                        self.surface_tension)
             self._checked_stiffness = True
         radius = sim.particles.radius
+        low, high = float(radius.min()), float(radius.max())
+        if self._radius_bounds is not None and self._radius_bounds[:2] == (low, high):
+            return                            # same spheres: the tables of the last rebuild
         nodes = sample_radius_ratios(radius) if self.model == "exact" else None
-        self.load_tables(float(radius.min()), float(radius.max()), radius_ratios=nodes)
+        self.load_tables(low, high, radius_ratios=nodes)
 
     def load_tables(self, low, high, radius_ratios=None):
         """Check the input against spheres of radii in [low, high] [m] and load (or build and

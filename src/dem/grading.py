@@ -80,10 +80,7 @@ def read_grading_curve(path):
                 continue                     # a header
             raise ValueError(f"psd file {path!r}: row {number + 1} {row!r} is not "
                              "'diameter [m], percent passing'") from None
-    try:
-        return check_grading_curve(points, name=f"psd file {path!r}")
-    except ValueError as error:
-        raise ValueError(str(error)) from None
+    return check_grading_curve(points, name=f"psd file {path!r}")
 
 
 def _number_quantiles(curve, quantiles):

@@ -396,7 +396,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     radii = config.radii()
     if config.graded:
         solid = 4.0 / 3.0 * np.pi * float(np.sum(radii ** 3))
-    else:
+    else:       # the product, not the sum: equal-sphere samples stay bit-identical
         solid = config.particles * 4.0 / 3.0 * np.pi * config.radius ** 3
     edge = (solid / (1.0 - config.porosity)) ** (1.0 / 3.0)
     # cloud at 60 % of the final radii (solid fraction ~0.13): sequential insertion is easy
