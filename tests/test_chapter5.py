@@ -20,7 +20,8 @@ from pendular.reference import FIG_5_5, TABLE_5_3
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
 KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
-        "saturation_at_peak", "peak_q_effective", "p_effective_at_peak")
+        "saturation_at_peak", "peak_q_effective", "p_effective_at_peak",
+        "peak_q_effective_complete", "p_effective_complete_at_peak")
 #: campaign.json's "arguments" as scenarios/chapter5.py wrote them before the library.
 ARGUMENTS = ["particles", "suctions", "confining", "jobs", "out", "seed", "max_strain",
              "inertial_number", "prep_friction", "scheduler"]
@@ -66,11 +67,13 @@ def test_grid_tables_name_what_a_chapter5_grid_cannot_hold(tmp_path):
     assert Chapter5Grid.from_table(table, suctions=[0], confining=[250]).particles == 200
 
 
-def _row(suction, confining, q, p, q_eff=None, p_eff=None):
+def _row(suction, confining, q, p, q_eff=None, p_eff=None, q_complete=None, p_complete=None):
     return {"suction": suction, "confining": confining, "peak_axial_stress": confining + q,
             "peak_q": q, "p_at_peak": p, "saturation_at_peak": 0.01 if suction else 0.0,
             "peak_q_effective": q if q_eff is None else q_eff,
             "p_effective_at_peak": p if p_eff is None else p_eff,
+            "peak_q_effective_complete": q if q_complete is None else q_complete,
+            "p_effective_complete_at_peak": p if p_complete is None else p_complete,
             "axial_strain_at_peak": 0.05, "saturation_at_20_percent": None,
             "folder": f"runs/s{suction:g}_c{confining:g}"}
 
@@ -81,7 +84,8 @@ def test_envelopes_recover_the_mohr_coulomb_line_of_their_peaks():
     slope = 6 * sin_phi / (3 - sin_phi)
     q0 = cohesion * 6 * math.cos(math.radians(phi)) / (3 - sin_phi)
     rows = [_row(0.0, c, slope * p, p) for c, p in ((250.0, 400.0), (750.0, 1200.0))]
-    rows += [_row(30000.0, c, slope * p + q0, p, slope * (p + 900.0), p + 900.0)
+    rows += [_row(30000.0, c, slope * p + q0, p, slope * (p + 900.0), p + 900.0,
+                  1.1 * slope * (p + 950.0), p + 950.0)
              for c, p in ((250.0, 2000.0), (750.0, 2900.0))]
     rows.append(_row(15000.0, 250.0, 5000.0, 2000.0))         # one stress only: no fit
     fits = envelopes(rows)
@@ -91,6 +95,9 @@ def test_envelopes_recover_the_mohr_coulomb_line_of_their_peaks():
     assert fits["30000"]["cohesion"] == pytest.approx(cohesion)
     assert fits["30000"]["phi_eff_deg"] == pytest.approx(phi)             # Eq. 3.43: on the
     assert abs(fits["30000"]["cohesion_eff"]) < 1e-6                      # dry line
+    steeper = math.degrees(math.asin(3 * 1.1 * slope / (6 + 1.1 * slope)))
+    assert fits["30000"]["phi_eff_complete_deg"] == pytest.approx(steeper)  # its own fit
+    assert abs(fits["30000"]["cohesion_eff_complete"]) < 1e-6
     falling = [_row(0.0, 250.0, 900.0, 500.0), _row(0.0, 750.0, 100.0, 900.0)]
     fit = envelopes(falling)["0"]
     assert fit["phi_deg"] is None and "outside the Mohr–Coulomb range" in fit["errors"][0]
@@ -143,6 +150,8 @@ def test_runs_cover_every_cell_with_finite_peaks(campaign):
         else:
             assert 0.0 < run["saturation_at_peak"] < 1.0
             assert run["p_effective_at_peak"] > run["p_at_peak"]   # psi adds compression
+            # the interface term adds more
+            assert run["p_effective_complete_at_peak"] > run["p_effective_at_peak"]
     for lateral in (500, 1000):
         assert (out / "samples" / f"c{lateral}.h5").exists()
 
@@ -152,11 +161,13 @@ def test_envelopes_for_both_suctions(campaign):
     envelopes = data["envelopes"]
     assert sorted(envelopes) == ["0", "30000"]
     for fit in envelopes.values():
-        for key in ("phi_deg", "cohesion", "phi_eff_deg", "cohesion_eff"):
+        for key in ("phi_deg", "cohesion", "phi_eff_deg", "cohesion_eff",
+                    "phi_eff_complete_deg", "cohesion_eff_complete"):
             assert math.isfinite(fit[key]), key
         assert 0.0 <= fit["phi_deg"] < 90.0
     dry = envelopes["0"]
     assert dry["phi_eff_deg"] == dry["phi_deg"] and dry["cohesion_eff"] == dry["cohesion"]
+    assert dry["phi_eff_complete_deg"] == dry["phi_deg"]
 
 
 def test_report_and_plot(campaign):

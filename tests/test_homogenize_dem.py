@@ -199,7 +199,7 @@ def test_recorder_columns_follow_the_bridge_operation_volume_control_included():
 
 CAPILLARY_COLUMNS = ("chi", "B", "psi", "sigma_effective", "fabric_bridges", "anisotropy_bridges",
                      "a_psi", "saturation", "suction", "sigma_capillary", "bridges",
-                     "pendular_overlaps")
+                     "pendular_overlaps", "psi_interface", "sigma_effective_complete")
 
 
 def test_dry_history_has_no_capillary_columns(tmp_path):
@@ -249,3 +249,15 @@ def test_wet_triaxial_history_has_the_homogenised_capillary_state(wet_triaxial_r
     assert summary["p_effective_at_peak"] == pytest.approx(effective.mean())
     assert summary["p_effective_at_peak"] > summary["p_at_peak"]
     assert 0.0 < summary["saturation_at_peak"] < 0.1
+    # the complete capillary stress: psi + interface term = -sigma_capillary up to the overlaps
+    # of touching spheres (about 1 % of their centre distance at 30 kPa)
+    complete = psi + history["psi_interface"]
+    scale = np.abs(history["sigma_capillary"]).max()
+    assert np.allclose(complete, -history["sigma_capillary"], rtol=0, atol=0.02 * scale)
+    assert np.all(np.diagonal(history["psi_interface"], axis1=1, axis2=2) > 0.02 * diagonal)
+    assert np.allclose(history["sigma_effective_complete"], expected + history["psi_interface"],
+                       rtol=1e-13, atol=0)
+    complete_peak = np.diag(history["sigma_effective_complete"][peak])
+    assert summary["peak_q_effective_complete"] == pytest.approx(
+        complete_peak[2] - 0.5 * (complete_peak[0] + complete_peak[1]))
+    assert summary["p_effective_complete_at_peak"] == pytest.approx(complete_peak.mean())

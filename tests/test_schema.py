@@ -16,7 +16,8 @@ from pendular.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHE
 DRY = ["step", "time", "axial_strain", "volumetric_strain", "sigma_wall", "sigma_contact",
        "porosity", "coordination", "fabric", "anisotropy", "unbalanced_force"]
 WET = DRY + ["saturation", "suction", "sigma_capillary", "bridges", "pendular_overlaps", "chi",
-             "B", "psi", "sigma_effective", "fabric_bridges", "anisotropy_bridges", "a_psi"]
+             "B", "psi", "sigma_effective", "fabric_bridges", "anisotropy_bridges", "a_psi",
+             "psi_interface", "sigma_effective_complete"]
 TENSION = ["step", "time", "axial_strain", "tensile_stress", "grip_pull", "sigma_wall",
            "coordination", "unbalanced_force", "bridges", "water_content", "saturation"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}
@@ -85,7 +86,7 @@ def test_the_columns_the_triaxial_records_are_all_declared():
     from pendular.triaxial import history_columns
 
     bridges = SimpleNamespace(saturation=None, mean_suction=None, count=None,
-                              pendular_overlaps=None)
+                              pendular_overlaps=None, model="exact")
     assert list(history_columns(None, None, 1.0)) == DRY
     assert set(CapillaryHomogenization(bridges).quantities()) == set(WET) - set(DRY)
 

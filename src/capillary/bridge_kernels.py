@@ -18,8 +18,8 @@ import numba
 import numpy as np
 
 from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
-from capillary.table import lookup_suction
-from capillary.volume_table import lookup_volume
+from capillary.table import lookup_interface, lookup_suction
+from capillary.volume_table import lookup_volume, lookup_volume_interface
 
 
 @numba.njit(cache=True, inline="always")
@@ -254,6 +254,60 @@ def bridges_across_gaps(radius, pair_i, pair_j, overlap, state, volume, formatio
             state[k] = ACROSS_GAP
             formed += 1
     return formed
+
+
+@numba.njit(cache=True, inline="always")
+def _bridge_gap_star(position, radius, i, j, at_contact, roughness):
+    """(R2, r, d*) of the bridge between i and j as the bridge kernels read it: d* = roughness
+    at contact, roughness + gap / R2 across a gap."""
+    larger = max(radius[i], radius[j])
+    gap = 0.0
+    if not at_contact:
+        distance = math.sqrt((position[j, 0] - position[i, 0]) ** 2
+                             + (position[j, 1] - position[i, 1]) ** 2
+                             + (position[j, 2] - position[i, 2]) ** 2)
+        gap = max(distance - radius[i] - radius[j], 0.0)
+    return larger, larger / min(radius[i], radius[j]), roughness + gap / larger
+
+
+@numba.njit(cache=True, parallel=True)
+def suction_interfaces(position, radius, pair_i, pair_j, state, index, suction, surface_tension,
+                       suction_table):
+    """Liquid-gas interfaces of the suction-controlled bridges ``index`` (pair numbers) at the
+    suction [Pa]: (B, 2) [m^2], per bridge nn11 = ∫ n_x n_x dS and nn33 = ∫ n_z n_z dS over
+    its interface in the bridge frame (z along the branch vector; the area is 2 nn11 + nn33),
+    from the suction table at its gap."""
+    out = np.empty((len(index), 2))
+    for b in numba.prange(len(index)):
+        k = index[b]
+        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i[k], pair_j[k],
+                                                        state[k] == AT_CONTACT, 0.0)
+        _, nn11, nn33 = lookup_interface(
+            suction_table[0], suction_table[1], suction_table[2], suction_table[3],
+            suction_table[4], ratio, suction * larger / surface_tension, distance_star)
+        out[b, 0] = nn11 * larger * larger
+        out[b, 1] = nn33 * larger * larger
+    return out
+
+
+@numba.njit(cache=True, parallel=True)
+def volume_interfaces(position, radius, pair_i, pair_j, state, index, volume, roughness,
+                      volume_table):
+    """As suction_interfaces for volume-controlled bridges, from the volume table at each
+    bridge's volume [m^3] and gap (d* with the roughness): a bridge near its volume-controlled
+    rupture is off the stable branch of the suction-controlled family, so its suction alone does
+    not name it."""
+    out = np.empty((len(index), 2))
+    for b in numba.prange(len(index)):
+        k = index[b]
+        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i[k], pair_j[k],
+                                                        state[k] == AT_CONTACT, roughness)
+        _, nn11, nn33 = lookup_volume_interface(
+            volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
+            ratio, volume[k] / (larger * larger * larger), distance_star)
+        out[b, 0] = nn11 * larger * larger
+        out[b, 1] = nn33 * larger * larger
+    return out
 
 
 @numba.njit(cache=True, parallel=True)

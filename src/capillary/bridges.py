@@ -56,7 +56,8 @@ import numpy as np
 
 from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges,
                                       gather_contact_bridges, pendular_overlap_counts,
-                                      suction_bridges, volume_bridges)
+                                      suction_bridges, suction_interfaces, volume_bridges,
+                                      volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
@@ -375,6 +376,31 @@ class CapillaryBridges:
         if self.persist:
             return self.pair_force
         return -state.force[:, None] * sim.contacts.normal
+
+    def bridge_suctions(self, sim):
+        """Suction [Pa] of every pair (K,): the imposed one (suction control; also where no
+        bridge is) or each bridge's own (volume control)."""
+        state = self.state(sim)
+        if self.control == "volume":
+            return state.suction
+        return np.full(len(state.state), self.suction)
+
+    def interfaces(self, sim, index):
+        """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each
+        bridge of the pairs ``index``, in its bridge frame (bridge_kernels.suction_interfaces,
+        volume_interfaces). ValueError for the toroidal model, whose table holds no interface."""
+        if self.model != "exact":
+            raise ValueError(f"model = {self.model!r}: the liquid-gas interface is tabulated for "
+                             "model = 'exact' only")
+        state = self.state(sim)
+        index = np.ascontiguousarray(index, dtype=np.int64)
+        p, c = sim.particles, sim.contacts
+        if self.control == "volume":
+            return volume_interfaces(p.position, p.radius, c.pair_i, c.pair_j, state.state,
+                                     index, state.volume, self.roughness,
+                                     self.volume_table.arrays())
+        return suction_interfaces(p.position, p.radius, c.pair_i, c.pair_j, state.state, index,
+                                  self.suction, self.surface_tension, self._table_arrays)
 
     def pendular_overlaps(self, sim):
         """Number of pairs of overlapping menisci on a same particle, summed over particles."""

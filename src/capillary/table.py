@@ -238,6 +238,30 @@ def _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, field):
 
 
 @numba.njit(cache=True)
+def _suction_cell(radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                  radius_ratio, suction_star, distance_star):
+    """Checked table cell of (r, u*, d*): (exists, i_r, i_next, t_r, i_u, t_u, j, t_z); exists
+    is False beyond the rupture distance, and the cell is then the rupture node (z = 0)."""
+    if not (math.isfinite(suction_star) and math.isfinite(distance_star) and math.isfinite(radius_ratio)):
+        raise ValueError("lookup_suction: non-finite radius_ratio, suction_star or distance_star")
+    suction_scale, suction_step, suction_max = suction_axis[0], suction_axis[1], suction_axis[2]
+    if not 0.0 <= suction_star <= suction_max:
+        raise ValueError("lookup_suction: suction_star is outside the table range [0, suction_max]")
+    i_r, t_r = radius_ratio_bracket(radius_ratios, radius_ratio)
+    i_next = i_r + 1 if t_r > 0.0 else i_r
+    i_u, t_u = grid_position(math.log1p(suction_star / suction_scale), suction_step, log_values.shape[1])
+    d_rupture = math.exp(
+        (1.0 - t_r) * along_axis(log_distance_rupture, i_r, i_u, t_u)
+        + t_r * along_axis(log_distance_rupture, i_next, i_u, t_u)
+    )
+    if distance_star > d_rupture:
+        return False, i_r, i_next, t_r, i_u, t_u, 0, 0.0
+    d_low = (1.0 - t_r) * along_axis(distance_low, i_r, i_u, t_u) + t_r * along_axis(distance_low, i_next, i_u, t_u)
+    j, t_z = distance_cell(distance_star, d_low, d_rupture, log_values.shape[2])
+    return True, i_r, i_next, t_r, i_u, t_u, j, t_z
+
+
+@numba.njit(cache=True)
 def lookup_suction(
     radius_ratios,
     suction_axis,
@@ -259,27 +283,31 @@ def lookup_suction(
     the distance coordinate z is taken relative to the interpolated rupture distance, so every
     radius ratio is read at the same stage of its family.
     """
-    if not (math.isfinite(suction_star) and math.isfinite(distance_star) and math.isfinite(radius_ratio)):
-        raise ValueError("lookup_suction: non-finite radius_ratio, suction_star or distance_star")
-    suction_scale, suction_step, suction_max = suction_axis[0], suction_axis[1], suction_axis[2]
-    if not 0.0 <= suction_star <= suction_max:
-        raise ValueError("lookup_suction: suction_star is outside the table range [0, suction_max]")
-    i_r, t_r = radius_ratio_bracket(radius_ratios, radius_ratio)
-    i_next = i_r + 1 if t_r > 0.0 else i_r
-    i_u, t_u = grid_position(math.log1p(suction_star / suction_scale), suction_step, log_values.shape[1])
-    d_rupture = math.exp(
-        (1.0 - t_r) * along_axis(log_distance_rupture, i_r, i_u, t_u)
-        + t_r * along_axis(log_distance_rupture, i_next, i_u, t_u)
-    )
-    if distance_star > d_rupture:
+    exists, i_r, i_next, t_r, i_u, t_u, j, t_z = _suction_cell(
+        radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values, radius_ratio,
+        suction_star, distance_star)
+    if not exists:
         return False, 0.0, 0.0, 0.0, 0.0
-    d_low = (1.0 - t_r) * along_axis(distance_low, i_r, i_u, t_u) + t_r * along_axis(distance_low, i_next, i_u, t_u)
-    j, t_z = distance_cell(distance_star, d_low, d_rupture, log_values.shape[2])
     force = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 0)
     volume = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 1)
     delta1 = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 2)
     delta2 = _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 3)
     return True, force, volume, delta1, delta2
+
+
+@numba.njit(cache=True)
+def lookup_interface(radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                     radius_ratio, suction_star, distance_star):
+    """The liquid-gas interface of a suction-controlled bridge (same arguments and cell as
+    lookup_suction): (exists, nn11*, nn33*), nn_ii* = (1/R2^2) ∫_interface n_i n_i dS with axis
+    3 along the bridge (capillary.meniscus.Bridge); beyond the rupture distance exists is False
+    and the values are those at rupture (a volume-controlled bridge read at its own suction may
+    sit a round-off beyond). Exact tables only (the toroidal table holds no interface: NaN)."""
+    exists, i_r, i_next, t_r, i_u, t_u, j, t_z = _suction_cell(
+        radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values, radius_ratio,
+        suction_star, distance_star)
+    return (exists, _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 4),
+            _interpolate_log(log_values, i_r, i_next, t_r, i_u, t_u, j, t_z, 5))
 
 
 def suction_nodes(suction_scale, suction_max, n_suction):
@@ -408,6 +436,11 @@ class BridgeTable:
     def lookup(self, radius_ratio, suction_star, distance_star):
         """Python-side lookup_suction: (exists, F*, V*, delta1, delta2)."""
         return lookup_suction(*self.arrays(), float(radius_ratio), float(suction_star), float(distance_star))
+
+    def lookup_interface(self, radius_ratio, suction_star, distance_star):
+        """Python-side lookup_interface: (exists, nn11*, nn33*)."""
+        return lookup_interface(*self.arrays(), float(radius_ratio), float(suction_star),
+                                float(distance_star))
 
     def save(self, path):
         """Write the table to an HDF5 file, atomically (dem.atomic.replacing)."""

@@ -117,6 +117,22 @@ def lookup_volume(
     range of either bracketing radius ratio, or non-finite input. The grid holds u* and the
     logarithms of the other (positive) quantities; interpolation as in lookup_suction.
     """
+    exists, cells = _volume_cell(radius_ratios, volume_axes, distance_low, log_distance_rupture,
+                                 grid, radius_ratio, volume_star, distance_star)
+    if not exists:
+        return False, 0.0, 0.0, 0.0, 0.0
+    force = math.exp(_interpolate(*cells, 0))
+    suction = _interpolate(*cells, 1)
+    delta1 = math.exp(_interpolate(*cells, 2))
+    delta2 = math.exp(_interpolate(*cells, 3))
+    return True, force, suction, delta1, delta2
+
+
+@numba.njit(cache=True)
+def _volume_cell(radius_ratios, volume_axes, distance_low, log_distance_rupture, grid,
+                 radius_ratio, volume_star, distance_star):
+    """Checked table cell of (r, V*, d*) for _interpolate: (exists, cell); exists is False
+    beyond the volume-controlled rupture distance, and the cell is then the rupture node."""
     if not (math.isfinite(volume_star) and math.isfinite(distance_star) and math.isfinite(radius_ratio)):
         raise ValueError("lookup_volume: non-finite radius_ratio, volume_star or distance_star")
     if not volume_star > 0.0:
@@ -131,16 +147,20 @@ def lookup_volume(
         (1.0 - t_r) * along_axis(log_distance_rupture, i_r, i_v, t_v)
         + t_r * along_axis(log_distance_rupture, i_next, i_w, t_w)
     )
-    if distance_star > d_rupture:
-        return False, 0.0, 0.0, 0.0, 0.0
     d_low = (1.0 - t_r) * along_axis(distance_low, i_r, i_v, t_v) + t_r * along_axis(distance_low, i_next, i_w, t_w)
-    j, t_z = distance_cell(distance_star, d_low, d_rupture, grid.shape[2])
-    cells = (grid, i_r, i_v, t_v, i_next, i_w, t_w, t_r, j, t_z)
-    force = math.exp(_interpolate(*cells, 0))
-    suction = _interpolate(*cells, 1)
-    delta1 = math.exp(_interpolate(*cells, 2))
-    delta2 = math.exp(_interpolate(*cells, 3))
-    return True, force, suction, delta1, delta2
+    j, t_z = distance_cell(min(distance_star, d_rupture), d_low, d_rupture, grid.shape[2])
+    return distance_star <= d_rupture, (grid, i_r, i_v, t_v, i_next, i_w, t_w, t_r, j, t_z)
+
+
+@numba.njit(cache=True)
+def lookup_volume_interface(radius_ratios, volume_axes, distance_low, log_distance_rupture, grid,
+                            radius_ratio, volume_star, distance_star):
+    """The liquid-gas interface of a volume-controlled bridge (arguments as lookup_volume):
+    (exists, nn11*, nn33*), nn_ii* = (1/R2^2) ∫_interface n_i n_i dS, axis 3 along the bridge;
+    beyond the rupture distance exists is False and the values are those at rupture."""
+    exists, cells = _volume_cell(radius_ratios, volume_axes, distance_low, log_distance_rupture,
+                                 grid, radius_ratio, volume_star, distance_star)
+    return exists, math.exp(_interpolate(*cells, 4)), math.exp(_interpolate(*cells, 5))
 
 
 def _build_one_radius_ratio(job):

@@ -188,6 +188,23 @@ def surface_tension_stress(normal, radius_1, radius_2, filling_angle_1, filling_
     return _rotated_sum(lines, normal) / volume
 
 
+def interface_stress(normal, nn11, nn33, surface_tension, volume):
+    """(gamma / V) sum_bridges ∫_interface (delta_ij - n_i n_j) dS (3, 3) [Pa]: the liquid-gas
+    interface term that Eq. 3.46's psi omits (Duriez, Wan, Pouragha & Darve 2018; YADE's
+    MeasureCapStress): in the bridge frame the integral is diag(nn11 + nn33, same, 2 nn11),
+    since the area is 2 nn11 + nn33.
+
+    normal: (K, 3) unit bridge normals; nn11, nn33 (K,) [m^2]: ∫ n_x n_x dS and ∫ n_z n_z dS
+    over each interface in its bridge frame (capillary.CapillaryBridges.interfaces);
+    surface_tension [N/m]; volume V [m^3]. psi + this term is the Love–Weber stress of the
+    capillary forces, sign reversed (tests/test_complete_capillary_stress.py)."""
+    normal = np.asarray(normal, dtype=float).reshape(-1, 3)
+    nn11 = np.broadcast_to(np.asarray(nn11, dtype=float), (len(normal),))
+    nn33 = np.broadcast_to(np.asarray(nn33, dtype=float), (len(normal),))
+    local = _axisymmetric(nn11 + nn33, 2.0 * nn11)
+    return surface_tension * _rotated_sum(local, normal) / volume
+
+
 def capillary_stress(chi, tension_stress, suction):
     """psi_ij = chi_ij s + B_ij [Pa] (Eq. 3.46); tension_stress = B_ij [Pa], suction s = u_a - u_w [Pa]."""
     return np.asarray(chi) * check_values("suction", suction, unit="Pa") + np.asarray(tension_stress)

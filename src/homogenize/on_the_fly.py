@@ -15,6 +15,8 @@ and across a gap alike; ``contacts.normal`` is the contact law's and lags for ga
     sigma'_ij = (sigma_ij - u_a delta_ij) + psi_ij                                                  (Eq. 3.43)
     F^LB_ij   = (1/N_LB) sum_bridges n_i n_j, a_LB = 5/2 (F_z - F_x) / tr F                        (Eqs. 3.53-3.54)
     a_psi     = 5/2 (psi_z - psi_x) / tr psi                                                        (Eq. 4.5)
+    I_ij      = (gamma/V) sum_bridges ∫_interface (delta_ij - n_i n_j) dS      (liquid-gas interface)
+    sigma'^c  = (sigma_ij - u_a delta_ij) + psi_ij + I_ij                     (complete effective stress)
 
 with V_w the water volume (sum of the bridge volumes, V_w / V = n Sr) and V the volume
 homogenised over (the box inside the walls for a recorder). In the triaxial the total stress
@@ -43,6 +45,17 @@ Volume-controlled bridges carry their own suction (``BridgeState.suction``): psi
 each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
 bridge has the suction s; chi is Eq. 3.44 either way.
 
+The complete capillary stress (docs/capillary.md "The complete capillary stress"). Eq. 3.46
+sums the water pressure on the wetted caps and the surface tension along the contact lines,
+but not the tension carried by the liquid-gas interface itself. Averaging the stress of every
+phase (solids, water, air and the interface as a membrane of tension gamma) over V adds
+-(gamma/V) ∫ (delta - n n) dS to the total stress, so that psi + I is exactly, bridge by bridge,
+the Love–Weber stress of the capillary forces with its sign reversed, (1/V) d F n n (d the
+centre distance, F the attraction; Duriez et al. 2018, YADE's MeasureCapStress; checked against
+the exact solver and in a static packing in tests/test_complete_capillary_stress.py). Then
+sigma'^c = sigma_net + psi + I is the stress the contacts carry. I is taken from the exact
+tables (nn11, nn33 at each bridge's suction and gap); the toroidal model has none.
+
 A wet scene's recorder builds ``CapillaryHomogenization(bridges)`` from its bridge operation;
 a dry scene never does.
 """
@@ -58,6 +71,7 @@ from homogenize.bridge_tensors import (
     capillary_stress,
     capillary_stress_anisotropy,
     effective_stress_parameter,
+    interface_stress,
     surface_tension_stress,
     wetted_cap_integral,
 )
@@ -72,7 +86,8 @@ class BridgeStress:
     bridges: number of bridges counted (N_LB); water_volume: V_w [m^3]; volume: V [m^3];
     chi: chi_ij (3, 3), dimensionless (Eq. 3.44); B: B_ij (3, 3) [Pa] (Eq. 3.45);
     psi: psi_ij (3, 3) [Pa] (Eq. 3.46); fabric: bridge fabric F^LB_ij (3, 3) (Eq. 3.53, zeros
-    without bridges); anisotropy: a_LB (Eq. 3.54); a_psi (Eq. 4.5) (both NaN without bridges).
+    without bridges); anisotropy: a_LB (Eq. 3.54); a_psi (Eq. 4.5) (both NaN without bridges);
+    interface: the liquid-gas interface term I_ij (3, 3) [Pa] (None when not asked for).
     """
 
     bridges: int
@@ -84,6 +99,7 @@ class BridgeStress:
     fabric: np.ndarray
     anisotropy: float
     a_psi: float
+    interface: np.ndarray | None = None
 
 
 def bridge_mask(contacts):
@@ -123,13 +139,15 @@ def bridges_in_region(particles, contacts, lo, hi):
 
 
 def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, surface_tension,
-                       mask=None):
+                       mask=None, interfaces=None):
     """chi, B, psi, bridge fabric and anisotropies of the bridges of a DEM state (Eqs. 3.44-3.46,
     3.53-3.54, 4.5) over the volume V [m^3]; a BridgeStress.
 
     suction: s = u_a - u_w [Pa], a scalar (suction control) or one value per pair (K,)
     (volume control: each bridge's own suction); contact_angle [deg]; surface_tension [N/m];
-    mask: (K,) bool, the pairs counted (default: every bridge); it must select bridges only.
+    mask: (K,) bool, the pairs counted (default: every bridge); it must select bridges only;
+    interfaces: (B, 2) [m^2], nn11 and nn33 of each counted bridge in pair order
+    (capillary.CapillaryBridges.interfaces): adds the interface term (``interface``).
     """
     volume = check_positive("volume", volume, "m^3")
     bridges = bridge_mask(contacts)
@@ -168,6 +186,14 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
                                          + wetted_cap_integral(radius_j, filling_j))
         psi = (float(np.sum(own * bridge_volume)) * np.eye(3)
                + _rotated_sum(weighted, normal)) / volume + tension
+    interface = None
+    if interfaces is not None:
+        interfaces = np.asarray(interfaces, dtype=float)
+        if interfaces.shape != (len(index), 2):
+            raise ValueError(f"interfaces has shape {interfaces.shape}; expected "
+                             f"({len(index)}, 2), nn11 and nn33 of each counted bridge")
+        interface = interface_stress(normal, interfaces[:, 0], interfaces[:, 1],
+                                     surface_tension, volume)
     fabric = fabric_tensor(normal, np.ones(len(index), dtype=bool))
     return BridgeStress(
         bridges=len(index),
@@ -179,6 +205,7 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
         fabric=fabric,
         anisotropy=principal_anisotropy(fabric),
         a_psi=capillary_stress_anisotropy(psi),
+        interface=interface,
     )
 
 
@@ -202,6 +229,7 @@ class CapillaryHomogenization:
     surface tension, and its per-pair BridgeState). The volume is the box inside the walls; the
     total stress of Eq. 3.43 is the wall stress diag(sigma_x, sigma_y, sigma_z), u_a = 0. One
     evaluation serves every column of a record (cached for the state's step and contact list).
+    The exact model adds the interface term and the complete effective stress.
     """
 
     def __init__(self, bridges):
@@ -216,9 +244,13 @@ class CapillaryHomogenization:
             op = self.bridges
             suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
                        else op.suction)
+            interfaces = None
+            if op.model == "exact":
+                interfaces = op.interfaces(sim, np.flatnonzero(bridge_mask(sim.contacts)))
             state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
                                        suction=suction, contact_angle=op.contact_angle,
-                                       surface_tension=op.surface_tension)
+                                       surface_tension=op.surface_tension,
+                                       interfaces=interfaces)
             effective = np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
             self._step, self._contacts = (sim.step, sim.time), sim.contacts
             self._state = (state, effective)
@@ -239,6 +271,12 @@ class CapillaryHomogenization:
     def sigma_effective(self, sim):
         return self.evaluate(sim)[1]
 
+    def psi_interface(self, sim):
+        return self.evaluate(sim)[0].interface
+
+    def sigma_effective_complete(self, sim):
+        return self.evaluate(sim)[1] + self.evaluate(sim)[0].interface
+
     def fabric_bridges(self, sim):
         return self.evaluate(sim)[0].fabric
 
@@ -252,9 +290,10 @@ class CapillaryHomogenization:
         """Recorded columns of a wet scene, name -> function of sim (bound methods, so that a
         deep-copied recorder follows its copy): the bridges' saturation, suction [Pa],
         sigma_capillary [Pa], bridges, pendular_overlaps, then chi, B, psi, sigma_effective,
-        fabric_bridges, anisotropy_bridges, a_psi (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+        fabric_bridges, anisotropy_bridges, a_psi (Eqs. 3.43-3.46, 3.53-3.54, 4.5), and with
+        the exact model psi_interface and sigma_effective_complete."""
         op = self.bridges
-        return {
+        columns = {
             "saturation": op.saturation,
             "suction": op.mean_suction,
             "sigma_capillary": self.sigma_capillary,
@@ -268,3 +307,7 @@ class CapillaryHomogenization:
             "anisotropy_bridges": self.anisotropy_bridges,
             "a_psi": self.a_psi,
         }
+        if op.model == "exact":
+            columns.update({"psi_interface": self.psi_interface,
+                            "sigma_effective_complete": self.sigma_effective_complete})
+        return columns

@@ -16,10 +16,12 @@ finished with an equal configuration (an interrupted campaign goes on where it s
 that fails does not stop the others, and the campaign then ends naming it.
 
 DIR/campaign.json: ``runs`` (suction, confining, peak_axial_stress, peak_q, p_at_peak,
-saturation_at_peak, peak_q_effective, p_effective_at_peak; a dry run's effective values are its
-net ones) and ``envelopes`` keyed by suction (str), each {phi_deg, cohesion} fitted to (p, q) at
-peak and {phi_eff_deg, cohesion_eff} to (p', q') at peak (Eq. 3.43; dem.envelope), where a
-suction has at least two confining stresses. DIR/report.md compares with thesis Table 5.3 and
+saturation_at_peak, peak_q_effective, p_effective_at_peak, peak_q_effective_complete,
+p_effective_complete_at_peak; a dry run's effective values are its net ones) and ``envelopes``
+keyed by suction (str), each {phi_deg, cohesion} fitted to (p, q) at peak, {phi_eff_deg,
+cohesion_eff} to (p', q') at peak (Eq. 3.43) and {phi_eff_complete_deg, cohesion_eff_complete}
+to those of the complete effective stress (psi plus the liquid-gas interface term,
+homogenize.on_the_fly) (dem.envelope), where a suction has at least two confining stresses. DIR/report.md compares with thesis Table 5.3 and
 Fig. 5.5. DIR/plots/ (chapter5_figures): envelopes.png (Figs. 5.4, 5.6), q_ev.png (5.3),
 q_p_effective.png (5.7), polar_psi.png (5.5), polar_fabric.png, anisotropy.png (5.8).
 DIR/campaign.csv: one row per run, its options and its whole summary (pendular.campaign).
@@ -153,7 +155,9 @@ def envelopes(runs):
         fit = {}
         for names, keys in ((("phi_deg", "cohesion"), ("p_at_peak", "peak_q")),
                             (("phi_eff_deg", "cohesion_eff"),
-                             ("p_effective_at_peak", "peak_q_effective"))):
+                             ("p_effective_at_peak", "peak_q_effective")),
+                            (("phi_eff_complete_deg", "cohesion_eff_complete"),
+                             ("p_effective_complete_at_peak", "peak_q_effective_complete"))):
             try:
                 values = mohr_coulomb_fit([r[keys[0]] for r in rows], [r[keys[1]] for r in rows])
             except ValueError as error:
@@ -203,27 +207,36 @@ def write_report(path, runs, fits, args, figures, out):
                      f"{_fmt(thesis, '.2f', 100)} |")
     lines += ["", "## Failure envelopes (Mohr–Coulomb in p–q)", "",
               f"Thesis: dry friction angle {DRY_FRICTION_DEG:.0f} deg; with the effective stress "
-              "of Eq. 3.43 every suction should fall on the dry line (Fig. 5.6b).", "",
+              "of Eq. 3.43 every suction should fall on the dry line (Fig. 5.6b). phi'c: the "
+              "complete effective stress (psi plus the liquid-gas interface term).", "",
               "| suction [Pa] | phi net [deg] | c net [Pa] | phi' [deg] | c' [Pa] | "
-              "phi' - phi dry [deg] |", "|---:|---:|---:|---:|---:|---:|"]
+              "phi' - phi dry [deg] | phi'c [deg] | c'c [Pa] | phi'c - phi dry [deg] |",
+              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     dry_phi = fits.get(label(0.0), {}).get("phi_deg")
+
+    def offset(phi):
+        return None if dry_phi is None or phi is None else phi - dry_phi
+
     for key, fit in fits.items():
-        offset = (None if dry_phi is None or fit["phi_eff_deg"] is None
-                  else fit["phi_eff_deg"] - dry_phi)
         lines.append(f"| {key} | {_fmt(fit['phi_deg'], '.2f')} | {_fmt(fit['cohesion'], '.1f')} "
                      f"| {_fmt(fit['phi_eff_deg'], '.2f')} | {_fmt(fit['cohesion_eff'], '.1f')} "
-                     f"| {_fmt(offset, '+.2f')} |")
+                     f"| {_fmt(offset(fit['phi_eff_deg']), '+.2f')} "
+                     f"| {_fmt(fit['phi_eff_complete_deg'], '.2f')} "
+                     f"| {_fmt(fit['cohesion_eff_complete'], '.1f')} "
+                     f"| {_fmt(offset(fit['phi_eff_complete_deg']), '+.2f')} |")
         for error in fit.get("errors", []):
             lines.append(f"| {key} | fit failed: {error} | | | |")
     if not fits:
         lines.append("(no suction has two confining stresses)")
     lines += ["", "## Runs", "",
               "| suction [Pa] | confining [Pa] | q peak [Pa] | p at peak [Pa] | q' peak [Pa] | "
-              "p' at peak [Pa] | folder |", "|---:|---:|---:|---:|---:|---:|---|"]
+              "p' at peak [Pa] | q'c peak [Pa] | p'c at peak [Pa] | folder |",
+              "|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in runs:
         lines.append(f"| {label(r['suction'])} | {label(r['confining'])} | {r['peak_q']:.0f} | "
                      f"{r['p_at_peak']:.0f} | {r['peak_q_effective']:.0f} | "
-                     f"{r['p_effective_at_peak']:.0f} | {r['folder']} |")
+                     f"{r['p_effective_at_peak']:.0f} | {r['peak_q_effective_complete']:.0f} | "
+                     f"{r['p_effective_complete_at_peak']:.0f} | {r['folder']} |")
     lines += ["", "## Figures", ""]
     lines += [f"![{name}]({os.path.relpath(figure, out)})" for name, figure in figures.items()]
     lines += ["", "Each run's own plots: " + ", ".join(f"{r['folder']}/plots" for r in runs)]
@@ -240,6 +253,10 @@ def run_row(suction, lateral, summary, folder, out):
             "peak_q_effective": summary["peak_q_effective"] if wet else summary["peak_q"],
             "p_effective_at_peak": (summary["p_effective_at_peak"] if wet
                                     else summary["p_at_peak"]),
+            "peak_q_effective_complete": (summary["peak_q_effective_complete"] if wet
+                                          else summary["peak_q"]),
+            "p_effective_complete_at_peak": (summary["p_effective_complete_at_peak"] if wet
+                                             else summary["p_at_peak"]),
             "axial_strain_at_peak": summary["axial_strain_at_peak"],
             "saturation_at_20_percent": saturation_at(folder, LATE_STRAIN) if wet else None,
             "folder": os.path.relpath(folder, out)}

@@ -184,16 +184,21 @@ def _kpa(points):
 
 
 def plot_envelopes(path, runs, fits, label):
-    """Figs. 5.4 and 5.6: failure points (p, q) and (p', q') with each suction's fit and the
+    """Figs. 5.4 and 5.6: failure points (p, q), (p', q') of Eq. 3.43 and those of the
+    complete effective stress (psi plus the interface term), with each suction's fit and the
     dry line; ``label(suction)`` is the key of ``fits``."""
     plt = pyplot()
-    figure, panels = plt.subplots(1, 2, figsize=(11, 4.5))
-    p_max = max(max(r["p_at_peak"], r["p_effective_at_peak"]) for r in runs) * 1.1
+    figure, panels = plt.subplots(1, 3, figsize=(16, 4.5))
+    p_max = max(max(r["p_at_peak"], r["p_effective_at_peak"],
+                    r["p_effective_complete_at_peak"]) for r in runs) * 1.1
     dry = fits.get(label(0.0))
     for axes, (pk, qk, phik, ck, title) in zip(panels, (
             ("p_at_peak", "peak_q", "phi_deg", "cohesion", "net stress (Figs. 5.4, 5.6a)"),
             ("p_effective_at_peak", "peak_q_effective", "phi_eff_deg", "cohesion_eff",
-             "effective stress, Eq. 3.43 (Fig. 5.6b)"))):
+             "effective stress, Eq. 3.43 (Fig. 5.6b)"),
+            ("p_effective_complete_at_peak", "peak_q_effective_complete",
+             "phi_eff_complete_deg", "cohesion_eff_complete",
+             "complete effective stress (psi + interface)"))):
         for index, suction in enumerate(sorted({r["suction"] for r in runs})):
             rows = [r for r in runs if r["suction"] == suction]
             color = f"C{index}"

@@ -114,6 +114,9 @@ def write_plots(history, folder, title=""):
     if "sigma_effective" in history:
         ratios.append(("q'/p', effective stress (Eq. 3.43)",
                        stress_ratio(_diagonals(history["sigma_effective"]))))
+    if "sigma_effective_complete" in history:
+        ratios.append(("q'/p', complete effective stress (ψ + interface)",
+                       stress_ratio(_diagonals(history["sigma_effective_complete"]))))
     single("q_p.png", "stress ratio [-]", ratios)
     single("volumetric_strain.png", "volumetric strain εv [%] (contraction +)",
            [("εv", 100.0 * history["volumetric_strain"])])
@@ -122,6 +125,7 @@ def write_plots(history, folder, title=""):
                [("Sr", 100.0 * history["saturation"])])
     capillary = [(key, title_) for key, title_ in
                  (("psi", "capillary stress ψ = χ s + B [kPa] (Eq. 3.46)"),
+                  ("psi_interface", "liquid–gas interface stress [kPa]"),
                   ("sigma_capillary", "Love–Weber stress of the capillary forces [kPa] "
                                       "(tension negative)"))
                  if key in history]

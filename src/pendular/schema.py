@@ -12,6 +12,7 @@ Columns by test (pendular.triaxial.history_columns, pendular.tension):
   porosity, coordination, fabric, anisotropy, unbalanced_force;
 - triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
   pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
+  and, with exact bridges, psi_interface and sigma_effective_complete
   (homogenize.on_the_fly.CapillaryHomogenization);
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
@@ -95,6 +96,12 @@ HISTORY_COLUMNS = {
                   equation="Eq. 3.46"),
     "sigma_effective": Column("Pa", "effective stress sigma'_ij = diag(sigma_wall) + psi_ij "
                                     "(u_a = 0)", _TENSOR, equation="Eq. 3.43"),
+    "psi_interface": Column("Pa", "liquid-gas interface stress (gamma/V) sum ∫ (delta_ij - "
+                                  "n_i n_j) dS, which psi omits", _TENSOR,
+                            equation="Duriez et al. 2018"),
+    "sigma_effective_complete": Column("Pa", "complete effective stress diag(sigma_wall) + "
+                                             "psi_ij + psi_interface_ij (u_a = 0)", _TENSOR,
+                                       equation="Eq. 3.43 + interface term"),
     "fabric_bridges": Column("1", "liquid-bridge fabric tensor (1/N_LB) sum n n", _TENSOR,
                              equation="Eq. 3.53"),
     "anisotropy_bridges": Column("1", "liquid-bridge fabric anisotropy 5/2 (F_z - F_x) / tr F "
@@ -111,7 +118,8 @@ HISTORY_COLUMNS = {
 #: Units of a triaxial summary.json (pendular.triaxial.summarize and TriaxialTest).
 TRIAXIAL_SUMMARY_UNITS = {
     "peak_axial_stress": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "lateral_stress": "Pa",
-    "peak_q_effective": "Pa", "p_effective_at_peak": "Pa", "axial_strain_at_peak": "1",
+    "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
+    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa", "axial_strain_at_peak": "1",
     "peak_index": "1", "saturation_at_peak": "1", "initial_porosity": "1",
     "initial_coordination": "1", "wall_time_s": "s", "preparation_time_s": "s",
     "shear_time_s": "s", "wetting_time_s": "s", "steps": "1", "preparation_steps": "1",

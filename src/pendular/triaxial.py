@@ -237,7 +237,10 @@ class TriaxialShear:
 def summarize(history):
     """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at the
     peak of q (and Sr there when recorded). A wet history adds ``peak_q_effective`` and
-    ``p_effective_at_peak``: q' and p' of the effective stress (Eq. 3.43) at the peak of q."""
+    ``p_effective_at_peak``: q' and p' of the effective stress (Eq. 3.43) at the peak of q,
+    and with the exact bridge model ``peak_q_effective_complete`` and
+    ``p_effective_complete_at_peak``: those of the complete effective stress (psi plus the
+    liquid-gas interface term, homogenize.on_the_fly)."""
     sigma = history["sigma_wall"]
     q = deviator_stress(sigma)
     peak = int(np.argmax(q))
@@ -255,6 +258,10 @@ def summarize(history):
         effective = np.diagonal(history["sigma_effective"][peak])
         summary["peak_q_effective"] = float(deviator_stress(effective))
         summary["p_effective_at_peak"] = float(effective.mean())
+    if "sigma_effective_complete" in history:
+        complete = np.diagonal(history["sigma_effective_complete"][peak])
+        summary["peak_q_effective_complete"] = float(deviator_stress(complete))
+        summary["p_effective_complete_at_peak"] = float(complete.mean())
     if "sigma_contact" in history:                # not in a YADE history
         error = stress_balance_error(history)
         summary.update({
