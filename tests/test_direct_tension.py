@@ -18,6 +18,7 @@ from dem.preparation import prepare_sample
 from dem.state import Particles, Walls
 from dem.tension import Grip, grip_members
 from pendular import tension as direct_tension
+from pendular.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
 from pendular.config import CONFIG_TYPES, TensionConfig, config_from_dict, config_to_dict
 
@@ -71,7 +72,7 @@ def test_wetting_reaches_the_water_content(wetted, dry, args):
     sim, bridges, report = wetted
     water = bridges.water_volume(sim.contacts) / (args.specific_gravity
                                                   * sim.particles.solid_volume())
-    assert water == pytest.approx(WATER, rel=direct_tension.WATER_TOLERANCE)
+    assert water == pytest.approx(WATER, rel=WATER_TOLERANCE)
     assert report["water_content"] == pytest.approx(water)
     # the bridges outnumber the dry contacts: the settling under the bridges made new ones
     assert bridges.count(sim) >= np.count_nonzero(dry.contacts.overlap > 0.0)
@@ -190,7 +191,7 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     result = json.loads((out / "tension.json").read_text())
     (case,) = result["cases"]
     assert case["tensile_strength_pa"] > 0.0 and case["water_content"] == pytest.approx(
-        0.01, rel=direct_tension.WATER_TOLERANCE)
+        0.01, rel=WATER_TOLERANCE)
     folder = out / "cases" / case["case"]
     assert (out / "report.md").exists() and (folder / "history.h5").exists()
     assert list((folder / "vtk").glob("*.pvd"))

@@ -49,11 +49,11 @@ def test_no_bridge_forms_beyond_the_rupture_distance_or_the_formation_gap():
     assert wetted_pair(1.0, 0.95 * rupture, 2.0)[2] == 1
 
 
-def test_gap_bridges_need_volume_control():
+def test_gap_bridges_need_volume_control_or_persisting_bridges():
     bridges = CapillaryBridges(1000.0, GAMMA)
     sim = two_body_scene([[0, 0, 0], [2.1 * RADIUS, 0, 0]], np.zeros((2, 3)), radius=RADIUS,
                          extra=[bridges])
-    with pytest.raises(ValueError, match="control = 'volume'"):
+    with pytest.raises(ValueError, match="persist = False"):
         bridges.form_across_gaps(sim, 0.1 * RADIUS)
 
 

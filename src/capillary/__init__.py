@@ -15,7 +15,7 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 """
 
 from capillary.bridge_state import BridgeState
-from capillary.bridges import (BRIDGE_MODELS, SURFACE_TENSION, CapillaryBridges,
+from capillary.bridges import (BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION, CapillaryBridges,
                                sample_radius_ratios, table_radius_ratios)
 from capillary.meniscus import Bridge, solve_bridge
 from capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
@@ -37,6 +37,7 @@ __all__ = [
     "Bridge",
     "BridgeState",
     "CapillaryBridges",
+    "LIQUID_MODELS",
     "SURFACE_TENSION",
     "formation_suction",
     "gravimetric_water_content",

@@ -106,6 +106,19 @@ def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filli
 
 
 @numba.njit(cache=True, parallel=True)
+def refresh_contact_bridges(radius, pair_i, pair_j, state, volume, force, filling_i, filling_j,
+                            suction, surface_tension, radius_ratios, suction_axis, distance_low,
+                            log_distance_rupture, log_values):
+    """Look every bridge at contact (AT_CONTACT, values cached) up again at a new ``suction``
+    [Pa] (a suction path); bridges across gaps are looked up each step anyway."""
+    for k in numba.prange(len(pair_i)):
+        if state[k] == AT_CONTACT:
+            _form_at_contact(k, radius[pair_i[k]], radius[pair_j[k]], state, volume, force,
+                             filling_i, filling_j, suction, surface_tension, radius_ratios,
+                             suction_axis, distance_low, log_distance_rupture, log_values)
+
+
+@numba.njit(cache=True, parallel=True)
 def gather_contact_bridges(force, normal, row_start, second_start, second_pair, out):
     """Add bridge forces of magnitude ``force`` (0 where no bridge) along the contact normals
     (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction).
@@ -173,13 +186,26 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
             pair_force[k, 2] = 0.0
 
 
+#: Values of the per-pair ``events`` of volume_bridges (what exchange_liquid handles).
+NO_EVENT = 0
+RUPTURED = 1
+FORMS_FROM_FILMS = 2
+
+
 @numba.njit(cache=True, parallel=True)
 def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
                    filling_i, filling_j, bridge_suction, pair_force, formation_suction,
-                   surface_tension, roughness, suction_table, volume_table):
-    """Volume-controlled bridges: formed at contact with the volume of the suction-controlled
-    bridge at ``formation_suction`` [Pa], then of constant volume; force and suction from
-    (V*, d*) (capillary.lookup_volume), rupture where no bridge of that volume exists.
+                   surface_tension, roughness, suction_table, volume_table, closed, film,
+                   released, events):
+    """Volume-controlled bridges: formed at contact, then of constant volume; force and suction
+    from (V*, d*) (capillary.lookup_volume), rupture where no bridge of that volume exists.
+
+    Formation: open liquid (``closed`` False, a reservoir), with the volume of the
+    suction-controlled bridge at ``formation_suction`` [Pa]; closed liquid (a fixed water
+    content), only where the two grains hold liquid as film (``film`` (N,) [m^3], read here):
+    the pair is marked FORMS_FROM_FILMS in ``events`` for exchange_liquid. A bridge that
+    ruptures is marked RUPTURED with its volume [m^3] in ``released`` (closed liquid).
+    Returns the number of events marked.
 
     roughness: the meniscus separation of touching spheres / R2 (asperities hold the wetted
     surfaces H = roughness R2 apart, thesis Ch. 4's H): d* = roughness at contact and
@@ -187,6 +213,7 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
     would not span H gets none.
     suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable.
     """
+    marked = 0
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
         j = pair_j[k]
@@ -200,13 +227,18 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
         ratio = larger / min(radius[i], radius[j])
         cube = larger * larger * larger
         if state[k] == NO_BRIDGE:
+            pair_force[k, 0] = 0.0
+            pair_force[k, 1] = 0.0
+            pair_force[k, 2] = 0.0
+            if closed:
+                if film[i] + film[j] > 0.0:
+                    events[k] = FORMS_FROM_FILMS
+                    marked += 1
+                continue
             forms, _, volume_star, _, _ = lookup_suction(
                 suction_table[0], suction_table[1], suction_table[2], suction_table[3],
                 suction_table[4], ratio, formation_suction * larger / surface_tension, roughness)
             if not forms:
-                pair_force[k, 0] = 0.0
-                pair_force[k, 1] = 0.0
-                pair_force[k, 2] = 0.0
                 continue
             volume[k] = volume_star * cube
             state[k] = ACROSS_GAP   # not yet evaluated at contact
@@ -218,6 +250,10 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
             volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
             ratio, volume[k] / cube, gap_star)
         if not exists:
+            if closed:
+                released[k] = volume[k]
+                events[k] = RUPTURED
+                marked += 1
             _clear(k, state, volume, force, filling_i, filling_j, pair_force)
             bridge_suction[k] = 0.0
             continue
@@ -230,6 +266,83 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
         else:
             state[k] = ACROSS_GAP
             _apply_across_gap(k, position, i, j, force[k], pair_force)
+    return marked
+
+
+@numba.njit(cache=True)
+def _give_to_bridges(p, share, row_start, second_start, second_pair, radius, pair_i, pair_j,
+                     state, volume, film, largest_star):
+    """Share ``share`` [m^3] of grain p's liquid equally among its bridges (each capped at
+    ``largest_star`` R2^3, the volume table's range; the rest stays on the grain as film); a
+    grain without bridge keeps it all as film. Bridges that receive liquid are marked
+    ACROSS_GAP, so volume_bridges looks them up again."""
+    count = 0
+    for k in range(row_start[p], row_start[p + 1]):
+        count += state[k] != NO_BRIDGE
+    for slot in range(second_start[p], second_start[p + 1]):
+        count += state[second_pair[slot]] != NO_BRIDGE
+    if count == 0:
+        film[p] += share
+        return
+    each = share / count
+    kept = 0.0
+    for n in range(row_start[p + 1] - row_start[p] + second_start[p + 1] - second_start[p]):
+        if n < row_start[p + 1] - row_start[p]:
+            k = row_start[p] + n
+        else:
+            k = second_pair[second_start[p] + n - (row_start[p + 1] - row_start[p])]
+        if state[k] == NO_BRIDGE:
+            continue
+        larger = max(radius[pair_i[k]], radius[pair_j[k]])
+        room = largest_star * larger * larger * larger - volume[k]
+        given = min(each, max(room, 0.0))
+        volume[k] += given
+        kept += each - given
+        state[k] = ACROSS_GAP
+    film[p] += kept
+
+
+@numba.njit(cache=True)
+def exchange_liquid(events, released, row_start, second_start, second_pair, radius, pair_i,
+                    pair_j, state, volume, film, share, smallest_star, largest_star):
+    """The liquid exchanges of the events volume_bridges marked, in pair order (deterministic);
+    returns the liquid lost [m^3].
+
+    RUPTURED: with ``share`` (Mani, Kadau & Herrmann 2012's liquid of a ruptured bridge going
+    back to its grains), half of the released volume to each of the two grains, shared equally
+    among that grain's remaining bridges, or kept on the grain as film when it has none;
+    without ``share`` the volume is lost. FORMS_FROM_FILMS: a new contact takes the film of
+    both grains as its bridge (marked ACROSS_GAP, evaluated at the next step) when that volume
+    lies in the volume table's range [smallest_star, largest_star] R2^3; otherwise the films
+    stay. Events are cleared."""
+    lost = 0.0
+    for k in range(len(events)):
+        if events[k] != RUPTURED:
+            continue
+        if share:
+            for p in (pair_i[k], pair_j[k]):
+                _give_to_bridges(p, 0.5 * released[k], row_start, second_start, second_pair,
+                                 radius, pair_i, pair_j, state, volume, film, largest_star)
+        else:
+            lost += released[k]
+        released[k] = 0.0
+        events[k] = NO_EVENT
+    for k in range(len(events)):
+        if events[k] != FORMS_FROM_FILMS:
+            continue
+        events[k] = NO_EVENT
+        i = pair_i[k]
+        j = pair_j[k]
+        larger = max(radius[i], radius[j])
+        cube = larger * larger * larger
+        held = film[i] + film[j]
+        if state[k] != NO_BRIDGE or not smallest_star * cube <= held <= largest_star * cube:
+            continue
+        volume[k] = held
+        state[k] = ACROSS_GAP
+        film[i] = 0.0
+        film[j] = 0.0
+    return lost
 
 
 @numba.njit(cache=True)

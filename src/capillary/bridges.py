@@ -47,6 +47,17 @@ Volume control: a bridge forms at contact with the volume of the suction-control
 contact at ``suction`` (the formation suction, the same for bridges that form later), then keeps
 that volume; its force and suction follow from (V*, d*) and it ruptures at the
 volume-controlled rupture distance (capillary.VolumeBridgeTable). Bridges persist across gaps.
+
+The liquid of volume-controlled bridges (``liquid``; docs/capillary.md "Liquid accounting"):
+"reservoir" (default): new contacts take their bridge's liquid from outside, a ruptured
+bridge's goes back there (a sample in contact with a water supply, the wetting phase);
+"shared" and "lost": the amount is closed (a fixed water content). On rupture, "shared" gives
+half of the bridge's liquid to each of its two grains, split equally among that grain's
+remaining bridges, or held on the grain as a film when it has none (Mani, Kadau & Herrmann
+2012; MercuryDPM's liquid migration); "lost" removes it, counted in ``liquid_lost``. A new
+contact forms a bridge only from the films of its two grains. ``close_liquid`` switches a
+reservoir-wetted sample to a closed model; then bridges + films + lost = the liquid at closing
+(``liquid_balance``) to round-off.
 """
 
 
@@ -54,8 +65,9 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges,
+from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
                                       gather_contact_bridges, pendular_overlap_counts,
+                                      refresh_contact_bridges,
                                       suction_bridges, suction_interfaces, volume_bridges,
                                       volume_interfaces)
 from capillary.bridge_state import BridgeState
@@ -73,6 +85,9 @@ SURFACE_TENSION = 0.073
 BRIDGE_MODELS = ("exact", "toroidal")
 #: How bridges are controlled: imposed suction, or constant volume.
 CONTROLS = ("suction", "volume")
+#: Where the liquid of volume-controlled bridges comes from and goes (``liquid``): an outside
+#: reservoir, or a closed amount shared among the grains' bridges on rupture, or lost on rupture.
+LIQUID_MODELS = ("reservoir", "shared", "lost")
 
 
 def table_radius_ratios(largest_ratio):
@@ -144,6 +159,8 @@ class CapillaryBridges:
         when contact is lost (volume-controlled bridges always persist up to rupture);
     roughness: volume control only: meniscus separation of touching spheres H / R2 in [0, 0.5]
         (rough grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
+    liquid: volume control only: "reservoir", "shared" or "lost" (LIQUID_MODELS, module
+        docstring);
     table_options: keyword arguments of BridgeTable.cached (model 'exact') or
         capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
 
@@ -153,7 +170,8 @@ class CapillaryBridges:
     """
 
     def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
-                 control="suction", persist=False, table_options=None, roughness=0.0):
+                 control="suction", persist=False, table_options=None, roughness=0.0,
+                 liquid="reservoir"):
         self.suction = check_range("suction", suction, 0.0, unit="Pa")
         self.surface_tension = check_positive("surface_tension", surface_tension, "N/m")
         self.contact_angle = check_contact_angle(contact_angle)
@@ -170,6 +188,15 @@ class CapillaryBridges:
         if self.roughness > 0.0 and control != "volume":
             raise ValueError(f"roughness = {self.roughness:g} needs control='volume' (suction-"
                              "controlled bridges are between smooth spheres: roughness 0)")
+        if liquid not in LIQUID_MODELS:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
+        if liquid != "reservoir" and control != "volume":
+            raise ValueError(f"liquid = {liquid!r} needs control='volume' (suction-controlled "
+                             "bridges exchange liquid with a reservoir at the imposed suction)")
+        self.liquid = liquid
+        self.liquid_initial = None       # [m^3] at closing (None: open liquid)
+        self.liquid_lost = 0.0           # [m^3] since closing
+        self.film = None                 # (N,) [m^3] liquid held on each grain
         self.table_options = dict(table_options or {})
         self.suction_table = None
         self.volume_table = None
@@ -181,6 +208,7 @@ class CapillaryBridges:
         self._radius_bounds = None
         self._checked_stiffness = False
         self._state = None
+        self._applied_suction = None
 
     # ---------------------------------------------------------------- set-up, once per sample
     def reach(self, sim):
@@ -220,7 +248,6 @@ class CapillaryBridges:
         if self._radius_bounds == (low, high, radius_ratios):
             return
         ratio = high / low
-        suction_star_high = self.suction * high / self.surface_tension
         options = dict(self.table_options)
         if self.model == "toroidal":
             if ratio > 1.0:
@@ -228,25 +255,51 @@ class CapillaryBridges:
                                  f"{low:g} to {high:g} m (use model='exact')")
             from capillary.toroidal_table import toroidal_table
 
+            suction_star_high = self.suction * high / self.surface_tension
             options.setdefault("suction_max", max(suction_star_high * 1.001, 1e-3))
             self.suction_table = toroidal_table(self.contact_angle, **options)
         else:
             options.setdefault("radius_ratios", radius_ratios)
             self.suction_table = BridgeTable.cached(self.contact_angle, **options)
-        if suction_star_high > self.suction_table.suction_max:
-            raise ValueError(
-                f"suction = {self.suction:g} Pa is outside the valid range [0, "
-                f"{self.suction_table.suction_max * self.surface_tension / high:g}] Pa for these "
-                f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
-                f"{self.surface_tension:g} N/m) exceeds the table's "
-                f"{self.suction_table.suction_max:g}")
-        check_pendular_suction(self.suction_table, self.suction, low, self.surface_tension)
+        self._check_suction(self.suction, low, high)
         if self.control == "volume":
             self.volume_table = VolumeBridgeTable.cached(
                 self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
         self._table_arrays = self.suction_table.arrays()
-        self.required_range = self._rupture_range(low, high)
         self._radius_bounds = (low, high, radius_ratios)
+        self.required_range = self._rupture_range(low, high)
+
+    def _check_suction(self, suction, low, high):
+        """ValueError naming ``suction`` [Pa] unless the loaded table covers it for spheres of
+        radii [low, high] [m] and bridges at contact stay pendular."""
+        suction_star_high = suction * high / self.surface_tension
+        if suction_star_high > self.suction_table.suction_max:
+            raise ValueError(
+                f"suction = {suction:g} Pa is outside the valid range [0, "
+                f"{self.suction_table.suction_max * self.surface_tension / high:g}] Pa for these "
+                f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
+                f"{self.surface_tension:g} N/m) exceeds the table's "
+                f"{self.suction_table.suction_max:g}")
+        check_pendular_suction(self.suction_table, suction, low, self.surface_tension)
+
+    def set_suction(self, suction):
+        """Impose a new suction [Pa] from the next step on (suction control; a path of drying
+        and wetting): bridges at contact are looked up again at it, bridges across a gap
+        (``persist``) follow it and rupture where the new rupture distance is shorter than their
+        gap, new bridges form at contact only, so drying and wetting differ (hysteresis). The
+        neighbour list's reach follows the lowest suction imposed so far, so no persisting
+        bridge leaves it. ValueError naming ``suction`` outside the table or the pendular
+        regime."""
+        if self.control != "suction":
+            raise ValueError(f"control = {self.control!r}: set_suction needs control = "
+                             "'suction' (volume-controlled bridges have their own suctions)")
+        suction = check_range("suction", suction, 0.0, unit="Pa")
+        if self._radius_bounds is not None:
+            low, high = self._radius_bounds[:2]
+            self._check_suction(suction, low, high)
+        self.suction = suction
+        if self._radius_bounds is not None:
+            self.required_range = max(self.required_range, self._rupture_range(low, high))
 
     def _rupture_range(self, low, high):
         """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).
@@ -285,6 +338,11 @@ class CapillaryBridges:
                 f"rebuild: its reach ({sim.neighbors.interaction_range:g} m plus skin) is "
                 f"shorter than the rupture distance ({self.required_range:g} m)")
         self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
+        if self.control == "volume":
+            self._released = np.zeros(len(contacts))
+            self._events = np.zeros(len(contacts), np.int8)
+            if self.film is None or len(self.film) != len(sim.particles):
+                self.film = np.zeros(len(sim.particles))
         self._contacts = contacts
         self._state = state
 
@@ -301,6 +359,12 @@ class CapillaryBridges:
         p = sim.particles
         c = sim.contacts
         b = self._state
+        if self.control == "suction" and self._applied_suction != self.suction:
+            if self._applied_suction is not None:          # set_suction: bridges at contact
+                refresh_contact_bridges(p.radius, c.pair_i, c.pair_j, b.state, b.volume,
+                                        b.force, b.filling_i, b.filling_j, self.suction,
+                                        self.surface_tension, *self._table_arrays)
+            self._applied_suction = self.suction
         if self.control == "suction" and not self.persist:
             contact_bridges(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
                             b.filling_i, b.filling_j, self.suction, self.surface_tension,
@@ -314,29 +378,62 @@ class CapillaryBridges:
                             self.pair_force, self.suction, self.surface_tension,
                             *self._table_arrays)
         else:
-            volume_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
-                           b.state, b.volume, b.force, b.filling_i, b.filling_j, b.suction,
-                           self.pair_force, self.suction, self.surface_tension, self.roughness,
-                           self._table_arrays, self.volume_table.arrays())
+            closed = self.liquid != "reservoir"
+            events = volume_bridges(
+                p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal, b.state,
+                b.volume, b.force, b.filling_i, b.filling_j, b.suction, self.pair_force,
+                self.suction, self.surface_tension, self.roughness, self._table_arrays,
+                self.volume_table.arrays(), closed, self.film, self._released, self._events)
+            if events:
+                self.liquid_lost += exchange_liquid(
+                    self._events, self._released, c.row_start, c.second_start, c.second_pair,
+                    p.radius, c.pair_i, c.pair_j, b.state, b.volume, self.film,
+                    self.liquid == "shared", *self.volume_table.volume_star_bounds())
         gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
         if self.persist:
             self._bridges = b.count()
 
     def form_across_gaps(self, sim, max_gap):
-        """Wetting where the liquid would be (volume control): besides the bridges that form
-        at contact, give every pair of the neighbour list apart by a gap in (0, ``max_gap``]
-        [m] the bridge of the formation suction at its own gap (bridge_kernels.
-        bridges_across_gaps); returns how many formed. Pairs beyond the rupture distance of
-        that suction get none, so the neighbour list (``reach``) holds every pair that can."""
-        if self.control != "volume":
-            raise ValueError(f"control = {self.control!r}: bridges across gaps form at wetting "
-                             "with control = 'volume' only")
+        """Wetting where the liquid would be (volume control, or suction control with
+        ``persist``): besides the bridges that form at contact, give every pair of the
+        neighbour list apart by a gap in (0, ``max_gap``] [m] the bridge of the (formation)
+        suction at its own gap (bridge_kernels.bridges_across_gaps); returns how many formed.
+        Pairs beyond the rupture distance of that suction get none, so the neighbour list
+        (``reach``) holds every pair that can."""
+        if not self.persist:
+            raise ValueError(f"control = {self.control!r}, persist = False: bridges across gaps "
+                             "form at wetting with control = 'volume' or persist = True only")
         max_gap = check_positive("max_gap", max_gap, "m")
         self._sync(sim)
         b, c = self._state, sim.contacts
         return int(bridges_across_gaps(sim.particles.radius, c.pair_i, c.pair_j, c.overlap,
                                        b.state, b.volume, self.suction, self.surface_tension,
                                        self.roughness, max_gap, self._table_arrays))
+
+    def close_liquid(self, sim, liquid="shared"):
+        """From now on the liquid is a closed amount (volume control; ``liquid`` "shared" or
+        "lost", module docstring): the bridges' liquid now is ``liquid_initial`` [m^3], and
+        every later exchange is accounted for (``liquid_balance``)."""
+        if self.control != "volume":
+            raise ValueError(f"control = {self.control!r}: a closed amount of liquid needs "
+                             "control = 'volume'")
+        if liquid not in LIQUID_MODELS[1:]:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS[1:]}")
+        self._sync(sim)
+        self.liquid = liquid
+        self.liquid_lost = 0.0
+        self.liquid_initial = self.water_volume(sim.contacts) + float(np.sum(self.film))
+
+    def liquid_balance(self, sim):
+        """(liquid in bridges, on grains as film, lost) [m^3] and the relative error of
+        bridges + film + lost against ``liquid_initial`` (NaN while the liquid is open)."""
+        self._sync(sim)
+        bridges = self.water_volume(sim.contacts)
+        film = 0.0 if self.film is None else float(np.sum(self.film))
+        if self.liquid_initial is None:
+            return bridges, film, self.liquid_lost, math.nan
+        error = abs(bridges + film + self.liquid_lost - self.liquid_initial) / self.liquid_initial
+        return bridges, film, self.liquid_lost, error
 
     # ---------------------------------------------------------------- measures (record time)
     def state(self, sim):

@@ -263,6 +263,12 @@ class VolumeBridgeTable:
         arguments of lookup_volume."""
         return self.radius_ratios, self.volume_axes, self.distance_low, self._log_distance_rupture, self._grid
 
+    def volume_star_bounds(self):
+        """(smallest, largest) V* that every radius ratio of the table covers (a round-off
+        inside)."""
+        return (float(np.exp(np.max(self.volume_axes[:, 0]))) * (1.0 + 1e-9),
+                float(np.exp(np.min(self.volume_axes[:, 1]))) * (1.0 - 1e-9))
+
     def lookup(self, radius_ratio, volume_star, distance_star):
         """Python-side lookup_volume: (exists, F*, u*, delta1, delta2)."""
         return lookup_volume(*self.arrays(), float(radius_ratio), float(volume_star), float(distance_star))

@@ -9,7 +9,8 @@ dem <- capillary <- homogenize <- pendular <- scenarios):
 - preparation: ``PrepareConfig``, ``prepare_sample``;
 - test procedures: ``TriaxialConfig``, ``ShearConfig``, ``BridgeConfig``, ``TriaxialTest``,
   with the building blocks ``equilibrate``, ``wet``, ``TriaxialShear``, ``summarize``;
-  ``TensionConfig``, ``TensionTest``; campaigns of runs: ``Campaign``, ``Run``;
+  ``TensionConfig``, ``TensionTest``; ``SwccConfig``, ``SwccTest`` (drying and wetting
+  paths); campaigns of runs: ``Campaign``, ``Run``;
 - results: ``read_history``, ``read_summary``.
 
 Units are SI, stresses compression positive.
@@ -33,15 +34,17 @@ from dem.state import Particles, Walls
 from dem.walls import ConstantStrainRate, StressServo, WallForces
 
 from .campaign import Campaign, Run
-from .config import BridgeConfig, ShearConfig, TensionConfig, TriaxialConfig
+from .config import BridgeConfig, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig
 from .io import read_history, read_summary
+from .swcc import SwccTest
 from .tension import TensionTest
 from .triaxial import TriaxialShear, TriaxialTest, equilibrate, summarize, wet
 
 __all__ = [
     "BridgeConfig", "Campaign", "CapillaryBridges", "ConstantStrainRate", "ContactForces",
     "HistoryRecorder", "Integrator", "NeighborList", "Particles", "PrepareConfig", "Run",
-    "ShearConfig", "Simulation", "StressServo", "TensionConfig", "TensionTest",
+    "ShearConfig", "Simulation", "StressServo", "SwccConfig", "SwccTest", "TensionConfig",
+    "TensionTest",
     "TriaxialConfig", "TriaxialShear", "TriaxialTest", "WallForces", "Walls", "__version__",
     "equilibrate", "prepare_sample", "read_history", "read_summary", "summarize", "wet",
 ]

@@ -23,6 +23,7 @@ from . import __version__
 COMMANDS = {
     "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
     "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
+    "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
     "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
     "campaign": ("campaign", "sweep of any command's options from a TOML parameter table"),

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from capillary import BRIDGE_MODELS, SURFACE_TENSION
+from capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
 from dem.preparation import MAX_SEED, PrepareConfig
 from dem.validate import check_int, check_positive, check_range
 from homogenize import packing_state, regular_packing
@@ -29,6 +30,9 @@ MAX_TABLE_NODES = 200_000
 
 #: Largest surface tension of a wetting liquid [N/m] (water 0.0728, mercury 0.485).
 MAX_SURFACE_TENSION = 1.0
+
+#: How the bridges of a triaxial test appear (TriaxialConfig.wetting).
+WETTING_PROTOCOLS = ("isotropic", "at-shear", "constant-volume")
 
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
@@ -94,7 +98,10 @@ def inertial_number(strain_rate, radius, density, pressure):
 class BridgeConfig:
     """Capillary bridges of a wet test (SPEC §4; capillary.CapillaryBridges).
 
-    suction [Pa] > 0 (suction control: imposed; volume control: at formation);
+    suction [Pa] > 0 (suction control: imposed; volume control: at formation), or instead
+    water_content: gravimetric water content w (a fraction) that volume-controlled bridges
+    hold, their formation suction found at wetting (pendular.water_content) and the liquid
+    then a closed amount (``liquid``: 'shared' or 'lost', capillary.CapillaryBridges);
     surface_tension [N/m]; contact_angle [deg] in [0, 90); model: 'exact' (Young–Laplace
     tables) or 'toroidal' (thesis Appendix A, equal spheres); control: 'suction' or 'volume';
     persist: suction-controlled bridges live to their rupture distance instead of breaking when
@@ -103,7 +110,7 @@ class BridgeConfig:
     default.
     """
 
-    suction: float
+    suction: float | None = None
     surface_tension: float = SURFACE_TENSION
     contact_angle: float = 0.0
     model: str = "exact"
@@ -111,9 +118,22 @@ class BridgeConfig:
     persist: bool = False
     roughness: float = 0.0
     table_resolution: tuple[int, int] | None = None
+    water_content: float | None = None
+    liquid: str = "shared"
 
     def __post_init__(self):
-        self.suction = check_positive("suction", self.suction, "Pa")
+        if (self.suction is None) == (self.water_content is None):
+            raise ValueError("bridges: give one of suction (Pa) and water_content (a fraction)")
+        if self.suction is not None:
+            self.suction = check_positive("suction", self.suction, "Pa")
+        else:
+            self.water_content = check_range("--water-content", self.water_content, 0.0, 1.0,
+                                             low_inclusive=False)
+            if self.control != "volume" or self.model != "exact":
+                raise ValueError("--water-content needs volume-controlled exact bridges "
+                                 "(control='volume', model='exact')")
+        if self.liquid not in LIQUID_MODELS[1:]:
+            raise ValueError(f"--liquid = {self.liquid!r} is not one of {LIQUID_MODELS[1:]}")
         self.surface_tension = check_range("surface_tension", self.surface_tension, 0.0,
                                            MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
         self.contact_angle = check_range("contact_angle", self.contact_angle, 0.0, 90.0,
@@ -134,13 +154,19 @@ class BridgeConfig:
                                  f"outside the valid range [16, {MAX_TABLE_NODES}] (suction "
                                  "nodes x distance nodes)")
 
-    def build(self):
-        """The capillary operation (capillary.CapillaryBridges) of this configuration."""
+    def build(self, suction=None):
+        """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
+        water content, ``suction`` [Pa] is the formation suction found at wetting."""
         from capillary import CapillaryBridges   # a dry run never builds one
 
+        if suction is None:
+            if self.suction is None:
+                raise ValueError("bridges at a water content: build(suction) needs the "
+                                 "formation suction found at wetting")
+            suction = self.suction
         table_options = (None if self.table_resolution is None else
                          dict(zip(("n_suction", "n_distance"), self.table_resolution)))
-        return CapillaryBridges(self.suction, surface_tension=self.surface_tension,
+        return CapillaryBridges(suction, surface_tension=self.surface_tension,
                                 contact_angle=self.contact_angle, model=self.model,
                                 control=self.control, persist=self.persist,
                                 roughness=self.roughness, table_options=table_options)
@@ -156,7 +182,11 @@ class TriaxialConfig:
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
     vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
     instead (None: from vtk_frames);
-    checkpoint_every: steps between checkpoints of the shear (0: none).
+    checkpoint_every: steps between checkpoints of the shear (0: none);
+    wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.triaxial.wet_sample):
+    'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
+    (switched on at the first shear step), 'constant-volume' (added with the walls fixed,
+    equilibrated, then servoed to the confining stress).
     """
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
@@ -167,6 +197,7 @@ class TriaxialConfig:
     vtk_frames: int = 50
     vtk_every: int | None = None
     checkpoint_every: int = 0
+    wetting: str = "isotropic"
 
     def __post_init__(self):
         for name, kind in (("sample", PrepareConfig), ("shear", ShearConfig)):
@@ -185,6 +216,12 @@ class TriaxialConfig:
         if self.vtk_every is not None:
             self.vtk_every = check_int("vtk_every", self.vtk_every)
         self.checkpoint_every = check_int("checkpoint_every", self.checkpoint_every)
+        if self.wetting not in WETTING_PROTOCOLS:
+            raise ValueError(f"--wetting = {self.wetting!r} is not one of {WETTING_PROTOCOLS}")
+        if self.wetting != "isotropic" and (self.bridges is None
+                                            or self.bridges.water_content is not None):
+            raise ValueError(f"--wetting = {self.wetting!r} needs a wet test at a suction "
+                             "(--suction > 0)")
 
     @property
     def confining(self):
@@ -193,8 +230,11 @@ class TriaxialConfig:
 
     @property
     def suction(self):
-        """Matric suction [Pa]; 0 for a dry test."""
-        return 0.0 if self.bridges is None else self.bridges.suction
+        """Matric suction [Pa]; 0 for a dry test, NaN at a water content (the suction is an
+        output)."""
+        if self.bridges is None:
+            return 0.0
+        return math.nan if self.bridges.suction is None else self.bridges.suction
 
 
 @dataclass
@@ -294,11 +334,55 @@ class TensionConfig:
                              specific_gravity=self.specific_gravity).water_content
 
 
+@dataclass
+class SwccConfig:
+    """The soil-water characteristic curve of a sample (pendular.swcc): drying through
+    ``suctions`` then wetting back, at the sample's confining stress.
+
+    sample: preparation and material (dem.preparation.PrepareConfig; its ``confining`` [Pa]
+    holds during the path); suctions [Pa]: the path's stages, ascending and distinct, at least
+    two; surface_tension [N/m]; contact_angle [deg]; form_gap: at wetting, bridges also form
+    across gaps up to form_gap mean radii (0: at contacts only); stage_steps: most steps per
+    stage to reach equilibrium; record_every: steps between history records.
+    """
+
+    sample: PrepareConfig = field(default_factory=PrepareConfig)
+    suctions: list[float] = field(default_factory=lambda: [3000.0, 10000.0, 30000.0,
+                                                           100000.0, 300000.0])
+    surface_tension: float = SURFACE_TENSION
+    contact_angle: float = 0.0
+    form_gap: float = 1.0
+    stage_steps: int = 200000
+    record_every: int = 1000
+
+    def __post_init__(self):
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        self.suctions = [check_positive("--suctions", value, "Pa") for value in self.suctions]
+        if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
+                                                                   self.suctions[1:])):
+            raise ValueError(f"--suctions = {','.join(f'{s:g}' for s in self.suctions)}: at "
+                             "least two suctions [Pa], ascending and distinct, expected (the "
+                             "drying path; wetting goes back along it)")
+        if self.sample.confining <= 0.0:
+            raise ValueError(f"--confining = {self.sample.confining:g} Pa is outside the valid "
+                             "range (0, 1e+07] Pa for an SWCC at constant stress")
+        self.surface_tension = check_range("--surface-tension", self.surface_tension, 0.0,
+                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
+        self.contact_angle = check_range("--contact-angle", self.contact_angle, 0.0, 90.0,
+                                         high_inclusive=False, unit="deg")
+        self.form_gap = check_range("--form-gap", self.form_gap, 0.0, 1.0)
+        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
+                                     high=100_000_000)
+        self.record_every = check_int("--record-every", self.record_every, low=1)
+
+
 # ---------------------------------------------------------------- JSON form
 
 #: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
 CONFIG_TYPES = {kind.__name__: kind for kind in
-                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, TensionConfig)}
+                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, TensionConfig,
+                 SwccConfig)}
 
 
 def config_to_dict(config):

@@ -49,10 +49,13 @@ def run_label(parameters, initial_porosity=None):
         parts[0] += " (graded)"
     elif parameters.get("radius_spread"):
         parts[0] += f", R(1 ± {parameters['radius_spread']:g})"
-    parts += [
-             f"σ3 = {parameters['confining'] / 1e3:g} kPa",
-             f"s = {parameters.get('suction', 0.0) / 1e3:g} kPa"]
-    if parameters.get("suction", 0.0) > 0.0:
+    parts.append(f"σ3 = {parameters['confining'] / 1e3:g} kPa")
+    if parameters.get("water_content_percent") is not None:
+        parts.append(f"w = {parameters['water_content_percent']:g} %")
+    else:
+        parts.append(f"s = {parameters.get('suction', 0.0) / 1e3:g} kPa")
+    if (parameters.get("water_content_percent") is not None
+            or parameters.get("suction", 0.0) > 0.0):
         parts.append(f"θ = {parameters.get('contact_angle', 0.0):g}°")
     if initial_porosity is not None:
         parts.append(f"n0 = {initial_porosity:.3f}")

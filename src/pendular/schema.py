@@ -13,7 +13,8 @@ Columns by test (pendular.triaxial.history_columns, pendular.tension):
 - triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
   pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
   and, with exact bridges, psi_interface and sigma_effective_complete
-  (homogenize.on_the_fly.CapillaryHomogenization);
+  (homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
+  liquid_bridges, liquid_film, liquid_lost;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
 """
@@ -108,6 +109,13 @@ HISTORY_COLUMNS = {
                                       "(NaN without bridges)", equation="Eq. 3.54"),
     "a_psi": Column("1", "capillary stress anisotropy 5/2 (psi_z - psi_x) / tr psi (NaN "
                          "without bridges)", equation="Eq. 4.5"),
+    "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
+                                    "water content)"),
+    "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "
+                                 "(closed liquid)"),
+    "liquid_lost": Column("m^3", "liquid of ruptured bridges removed (closed liquid, model "
+                                 "'lost'); bridges + film + lost = the liquid at the start of "
+                                 "the shear"),
     "tensile_stress": Column("Pa", "mean pull of the grips over the cross-section, tension "
                                    "positive"),
     "grip_pull": Column("N", "force of the specimen on each grip, toward the specimen",
@@ -119,7 +127,10 @@ HISTORY_COLUMNS = {
 TRIAXIAL_SUMMARY_UNITS = {
     "peak_axial_stress": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "lateral_stress": "Pa",
     "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
-    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa", "axial_strain_at_peak": "1",
+    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa",
+    "suction_at_peak": "Pa", "liquid_balance_error": "1", "liquid_lost_fraction": "1",
+    "liquid_initial": "m^3", "water_content": "1", "formation_suction_pa": "Pa",
+    "axial_strain_at_peak": "1",
     "peak_index": "1", "saturation_at_peak": "1", "initial_porosity": "1",
     "initial_coordination": "1", "wall_time_s": "s", "preparation_time_s": "s",
     "shear_time_s": "s", "wetting_time_s": "s", "steps": "1", "preparation_steps": "1",
@@ -156,7 +167,7 @@ OPTION_UNITS = {
     "checkpoint_every": "1", "contact_angle": "deg", "surface_tension": "N/m",
     "roughness": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
-    "saturation_at_20_percent": "1",
+    "saturation_at_20_percent": "1", "water_content_percent": "%",
 }
 
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign

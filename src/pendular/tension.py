@@ -43,7 +43,6 @@ cases/<case>/vtk/*.pvd (every --vtk-every steps, or --vtk-frames frames per pull
 
 from __future__ import annotations
 
-import copy
 import math
 import os
 import time
@@ -52,8 +51,8 @@ from dataclasses import asdict
 import numpy as np
 from scipy.spatial import cKDTree
 
-from capillary import (BridgeTable, CapillaryBridges, formation_suction,
-                       gravimetric_water_content, sample_radius_ratios)
+from capillary import (BridgeTable, CapillaryBridges, gravimetric_water_content,
+                       sample_radius_ratios)
 from dem.atomic import write_json, write_text
 from dem.grading import grading
 from dem.measure import coordination, unbalanced_force
@@ -71,6 +70,7 @@ from .plots import pyplot, save_figure
 from .reference import CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION, comparison_packing
 from .schema import TENSION_SUMMARY_UNITS
 from .vtk import VtkWriter
+from .water_content import wet_to_water_volume
 
 #: Surface tension [N/m] of the Chapter 4 comparison (SPEC section 7).
 SURFACE_TENSION = CHAPTER4_SURFACE_TENSION
@@ -78,9 +78,6 @@ SURFACE_TENSION = CHAPTER4_SURFACE_TENSION
 PREP_FRICTION_RANGE = (0.0, 30.0)
 #: Largest number of preparations tried per void ratio.
 PREPARATIONS = 7
-#: Relative tolerance on the water content reached, and the most wetting attempts.
-WATER_TOLERANCE = 0.01
-WETTINGS = 4
 #: Steps allowed to reach equilibrium after wetting; steps between convergence checks.
 WET_STEPS = 200000
 CHECK_EVERY = 200
@@ -205,31 +202,27 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
     target = water_content * config.specific_gravity * particles.solid_volume()
     max_gap = config.form_gap * config.radius
     pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
-    radius_i, radius_j = particles.radius[pair_i], particles.radius[pair_j]
     table = BridgeTable.cached(config.contact_angle,
                                radius_ratios=sample_radius_ratios(particles.radius))
     thresholds = prepare_config(config, 0.0)      # for the equilibrium thresholds only
-    aimed = target
-    attempts = []
-    for _ in range(WETTINGS):
-        suction = formation_suction(table, radius_i, radius_j, aimed, config.surface_tension,
-                                    config.roughness, gap=gap)
-        sim = copy.deepcopy(dry)
-        bridges = CapillaryBridges(suction, config.surface_tension, config.contact_angle,
-                                   control="volume", roughness=config.roughness)
-        sim.forces.append(bridges)
-        if max_gap > 0.0:
-            sim.evaluate_forces()          # the neighbour list at the bridges' reach
-            bridges.form_across_gaps(sim, max_gap)
-        steps = sim.run(WET_STEPS, until=equilibrated(thresholds), check_every=CHECK_EVERY,
-                        progress="wet" if progress else None)
-        held = bridges.water_volume(sim.contacts)
-        attempts.append({"formation_suction_pa": suction, "steps": steps,
-                         "water_content": gravimetric_water_content(
-                             held, particles.solid_volume(), config.specific_gravity)})
-        if abs(held / target - 1.0) <= WATER_TOLERANCE:
-            break
-        aimed *= target / held
+
+    def build(suction):
+        return CapillaryBridges(suction, config.surface_tension, config.contact_angle,
+                                control="volume", roughness=config.roughness)
+
+    def settle(sim):
+        return sim.run(WET_STEPS, until=equilibrated(thresholds), check_every=CHECK_EVERY,
+                       progress="wet" if progress else None)
+
+    sim, bridges, tries = wet_to_water_volume(
+        dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,
+        settle, surface_tension=config.surface_tension, roughness=config.roughness,
+        max_gap=max_gap)
+    suction = tries[-1]["formation_suction_pa"]
+    attempts = [{"formation_suction_pa": t["formation_suction_pa"], "steps": t["steps"],
+                 "water_content": gravimetric_water_content(
+                     t["water_volume"], particles.solid_volume(), config.specific_gravity)}
+                for t in tries]
     report = {"formation_suction_pa": suction, "wetting_attempts": attempts,
               "water_content": attempts[-1]["water_content"],
               "saturation": bridges.saturation(sim), "bridges": bridges.count(sim),

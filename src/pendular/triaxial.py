@@ -49,6 +49,7 @@ from .outputs import OutputFolder
 from .schema import SUMMARY_UNITS, peak_reached
 from .plots import plot_history, run_label, write_plots
 from .vtk import VtkWriter
+from .water_content import wet_to_water_volume
 
 #: Largest inertial number of a quasi-static shear (GDR MiDi 2004: I < 1e-3 quasi-static,
 #: dense flow beyond; at 1e-2 the wall and Love–Weber stresses already differ by a few %).
@@ -69,6 +70,8 @@ MIN_CONFINING_OVER_YOUNG = 5e-6
 STRESS_BALANCE_BOUND = 0.05
 #: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
 ESTIMATE_RATE = 4e6
+#: Density of water [kg/m^3]: the specific gravity of the grains is their density over it.
+WATER_DENSITY = 1000.0
 
 
 #: Files and folders a triaxial run owns in its output folder (pendular.outputs).
@@ -105,7 +108,7 @@ def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check
         reached = equilibrium_status(unbalanced)(sim)
         raise NotStatic(f"{phase} not reached in {steps} steps (the step limit): "
                         + ", ".join(f"{k} {v}" for k, v in reached.items())
-                        + f"; raise the step limit (e.g. --wet-steps) or check the settings")
+                        + "; raise the step limit (e.g. --wet-steps) or check the settings")
     return steps
 
 
@@ -135,6 +138,91 @@ def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, prog
     return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
             "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
             "wet_porosity": porosity(sim.particles, sim.walls)}
+
+
+def wet_sample(sim, config, *, progress=None):
+    """Wet the static sample ``sim`` as ``config`` (TriaxialConfig) says; returns (the wet
+    simulation, its bridge operation, the wetting report). Protocols (config.wetting):
+
+    - 'isotropic': bridges added, the servo re-equilibrates the sample (``wet``);
+    - 'at-shear': bridges added, formed at the sample's contacts now and shearing starts at
+      once (the servo meets them during the shear);
+    - 'constant-volume': bridges added with the walls fixed, run until the unbalanced force is
+      below the threshold, then the servo brings the walls to the confining stress.
+
+    At a water content (config.bridges.water_content) the bridges are volume-controlled, their
+    formation suction found so that they hold w Gs V_s (Gs = density / 1000 kg/m^3;
+    pendular.water_content), the sample re-equilibrated; the liquid is then closed
+    (CapillaryBridges.close_liquid), so the shear conserves it."""
+    sample = config.sample
+    thresholds = {"unbalanced": sample.equilibrium_unbalanced,
+                  "tolerance": sample.stress_tolerance, "max_steps": config.wet_steps}
+    if config.bridges.water_content is not None:
+        return _wet_at_water_content(sim, config, thresholds, progress)
+    bridges = config.bridges.build()
+    if config.wetting == "isotropic":
+        return sim, bridges, wet(sim, bridges, progress=progress, **thresholds)
+    started = time.perf_counter()
+    sim.forces.append(bridges)
+    steps = 0
+    if config.wetting == "at-shear":
+        sim.evaluate_forces()               # the bridges form at the sample's contacts
+    else:
+        servo = sim.controls
+        sim.controls = []                   # walls fixed
+        steps = equilibrate(sim, phase="equilibrium of the wetted sample at constant volume",
+                            progress=progress, **thresholds)
+        fixed_stress = sim.walls.stress().tolist()
+        sim.controls = servo
+        steps += equilibrate(sim, phase="equilibrium after wetting at constant volume",
+                             progress=progress, **thresholds)
+    report = {"wetting": config.wetting, "wetting_steps": steps,
+              "wetting_time_s": time.perf_counter() - started,
+              "initial_saturation": bridges.saturation(sim),
+              "initial_bridges": bridges.count(sim),
+              "wet_porosity": porosity(sim.particles, sim.walls)}
+    if config.wetting == "constant-volume":
+        report["sigma_wall_at_constant_volume"] = fixed_stress
+    return sim, bridges, report
+
+
+def _wet_at_water_content(dry, config, thresholds, progress):
+    """wet_sample at config.bridges.water_content (volume-controlled bridges at contacts)."""
+    from capillary import BridgeTable, gravimetric_water_content, sample_radius_ratios
+
+    bridges_config = config.bridges
+    particles = dry.particles
+    specific_gravity = particles.density / WATER_DENSITY
+    target = bridges_config.water_content * specific_gravity * particles.solid_volume()
+    if dry.contacts is None:
+        dry.evaluate_forces()
+    touching = dry.contacts.overlap > 0.0
+    pairs = (particles.radius[dry.contacts.pair_i[touching]],
+             particles.radius[dry.contacts.pair_j[touching]], None)
+    table = BridgeTable.cached(bridges_config.contact_angle,
+                               radius_ratios=sample_radius_ratios(particles.radius))
+    started = time.perf_counter()
+    try:
+        sim, bridges, tries = wet_to_water_volume(
+            dry, target, table, pairs, bridges_config.build,
+            lambda s: equilibrate(s, progress=progress, phase="equilibrium after wetting",
+                                  **thresholds),
+            surface_tension=bridges_config.surface_tension,
+            roughness=bridges_config.roughness)
+    except ValueError as error:
+        raise ValueError(f"--water-content = {100 * bridges_config.water_content:g} %: {error}") \
+            from None
+    bridges.close_liquid(sim, bridges_config.liquid)
+    solid = particles.solid_volume()
+    return sim, bridges, {
+        "wetting": "water-content", "wetting_steps": sum(t["steps"] for t in tries),
+        "wetting_time_s": time.perf_counter() - started,
+        "formation_suction_pa": tries[-1]["formation_suction_pa"],
+        "water_content": gravimetric_water_content(bridges.liquid_initial, solid,
+                                                   specific_gravity),
+        "wetting_attempts": tries, "liquid_initial": bridges.liquid_initial,
+        "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
+        "wet_porosity": porosity(sim.particles, sim.walls)}
 
 
 @contextlib.contextmanager
@@ -191,6 +279,10 @@ def history_columns(sim, axial, reference_volume, bridges=None):
         from homogenize.on_the_fly import CapillaryHomogenization
 
         columns.update(CapillaryHomogenization(bridges).quantities())
+        if bridges.liquid != "reservoir":             # a closed amount of liquid
+            columns.update({"liquid_bridges": lambda s: bridges.liquid_balance(s)[0],
+                            "liquid_film": lambda s: bridges.liquid_balance(s)[1],
+                            "liquid_lost": lambda s: bridges.liquid_balance(s)[2]})
     return columns
 
 
@@ -254,6 +346,7 @@ def summarize(history):
     }
     if "saturation" in history:
         summary["saturation_at_peak"] = float(history["saturation"][peak])
+        summary["suction_at_peak"] = float(history["suction"][peak])
     if "sigma_effective" in history:
         effective = np.diagonal(history["sigma_effective"][peak])
         summary["peak_q_effective"] = float(deviator_stress(effective))
@@ -346,12 +439,16 @@ def parameters(config):
             "max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
             "strain_rate": shear.strain_rate, "records": shear.records,
             "suction": config.suction, "wet_steps": config.wet_steps,
+            "wetting": config.wetting,
             "vtk_every": config.vtk_every, "checkpoint_every": config.checkpoint_every,
             "sample": config.sample_path}
     if bridges is not None:
         flat.update({"contact_angle": bridges.contact_angle, "bridges": bridges.model,
                      "surface_tension": bridges.surface_tension,
                      "persist_bridges": bridges.persist, "control": bridges.control,
+                     "water_content_percent": (None if bridges.water_content is None
+                                               else 100.0 * bridges.water_content),
+                     "liquid": None if bridges.water_content is None else bridges.liquid,
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
     return flat
@@ -373,7 +470,7 @@ class TriaxialTest:
             raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
         self.config = config
         check_feasible(config, force=force)
-        if config.bridges is not None:
+        if config.bridges is not None and config.bridges.suction is not None:
             # check the bridges against the sample's radii before any preparation
             from capillary import sample_radius_ratios
 
@@ -450,11 +547,9 @@ class TriaxialTest:
         prepared = time.perf_counter()
         wetting = {}
         if config.bridges is not None:
-            with watched(sim, writers, "wetting"):
-                wetting = wet(sim, config.bridges.build(),
-                              unbalanced=config.sample.equilibrium_unbalanced,
-                              tolerance=config.sample.stress_tolerance,
-                              max_steps=config.wet_steps, progress="wet" if progress else None)
+            # the water-content wetting restarts from copies of the dry sample: no frames
+            with watched(sim, writers if config.bridges.suction is not None else (), "wetting"):
+                sim, _, wetting = wet_sample(sim, config, progress="wet" if progress else None)
         if frames is not None:
             frames.close(sim)           # the state the shear starts from
         before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
@@ -483,8 +578,9 @@ class TriaxialTest:
             config = config_from_dict(before_shear.get("config"), sample_file)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=threads)
-            if config.bridges is not None:
-                sim.forces.append(config.bridges.build())
+            if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
+                sim.forces.append(config.bridges.build(
+                    before_shear["wetting"].get("formation_suction_pa")))
             identity = run_identity(config, sample_file)
             run = _ShearRun(sim, config, out, before_shear, identity)
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
@@ -603,6 +699,12 @@ class _ShearRun:
             "grading": grading(sim.particles.radius),
             **self.before_shear["wetting"],
         })
+        if "liquid_bridges" in history:
+            initial = self.before_shear["wetting"]["liquid_initial"]
+            total = history["liquid_bridges"] + history["liquid_film"] + history["liquid_lost"]
+            summary.update({
+                "liquid_balance_error": float(np.max(np.abs(total - initial)) / initial),
+                "liquid_lost_fraction": float(history["liquid_lost"][-1] / initial)})
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,

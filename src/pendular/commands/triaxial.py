@@ -5,7 +5,10 @@ vtk/*.pvd (ParaView), sample.h5 (the sample the shear starts from), with
 --checkpoint-every N checkpoint.h5 and, with --vtk-prep, vtk_prep/*.pvd (ParaView frames of the
 preparation and wetting); --resume DIR continues an interrupted run. Stresses
 compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at the confining
-stress, re-equilibrated, then sheared (pendular.triaxial).
+stress, re-equilibrated, then sheared (pendular.triaxial); --wetting chooses when the bridges
+appear. Constant water content (--water-content W): volume-controlled bridges holding W % of
+the grains' mass, the liquid then conserved during the shear (--liquid) and the suction an
+output.
 """
 
 from __future__ import annotations
@@ -19,15 +22,16 @@ from dem.validate import check_range
 
 from ..cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
                    set_threads, sizes_from)
-from ..config import BridgeConfig, ShearConfig, TriaxialConfig
+from ..config import WETTING_PROTOCOLS, BridgeConfig, ShearConfig, TriaxialConfig
 from ..triaxial import Interrupted, TriaxialTest
 
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after", "force")
 #: Summary keys printed at the end.
 SHOWN = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak", "peak_q_effective",
-         "p_effective_at_peak", "initial_porosity", "saturation_at_peak", "wall_time_s",
-         "particle_steps_per_s")
+         "p_effective_at_peak", "peak_q_effective_complete", "p_effective_complete_at_peak",
+         "initial_porosity", "saturation_at_peak", "suction_at_peak", "liquid_balance_error",
+         "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
 
 
 def add_arguments(parser):
@@ -43,6 +47,17 @@ def add_arguments(parser):
                              "(default) or the toroidal approximation (equal spheres)")
     parser.add_argument("--surface-tension", type=float, default=None,
                         help="liquid surface tension [N/m] (wet test; default 0.073)")
+    parser.add_argument("--water-content", type=float, default=None,
+                        help="gravimetric water content [%%] held by volume-controlled bridges "
+                             "at constant liquid volume, instead of --suction")
+    parser.add_argument("--liquid", choices=("shared", "lost"), default=None,
+                        help="with --water-content: the liquid of a ruptured bridge goes to its "
+                             "grains' other bridges (shared, default) or is lost")
+    parser.add_argument("--wetting", choices=WETTING_PROTOCOLS, default="isotropic",
+                        help="when bridges appear (--suction): added to the static sample and "
+                             "re-equilibrated (isotropic), switched on at the first shear step "
+                             "(at-shear), or added with the walls fixed, then servoed "
+                             "(constant-volume)")
     parser.add_argument("--persist-bridges", action="store_true",
                         help="bridges live up to their rupture distance instead of breaking "
                              "when contact is lost")
@@ -123,12 +138,22 @@ def table_resolution(text):
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
     check_range("--suction", args.suction, 0.0, unit="Pa")
+    water = args.water_content
+    if water is not None and args.suction > 0.0:
+        raise UsageError("--suction and --water-content: give one (at a water content the "
+                         "suction is an output)")
+    if water is not None and (args.bridges == "toroidal" or args.persist_bridges):
+        raise UsageError("--water-content uses volume-controlled exact bridges: "
+                         "--bridges toroidal and --persist-bridges do not apply")
+    if args.liquid is not None and water is None:
+        raise UsageError("--liquid needs --water-content")
     wet_only = {"--contact-angle": args.contact_angle is not None,
                 "--table-resolution": args.table_resolution is not None,
                 "--bridges": args.bridges is not None,
                 "--surface-tension": args.surface_tension is not None,
-                "--persist-bridges": args.persist_bridges}
-    if args.suction == 0.0 and any(wet_only.values()):
+                "--persist-bridges": args.persist_bridges,
+                "--wetting": args.wetting != "isotropic"}
+    if args.suction == 0.0 and water is None and any(wet_only.values()):
         raise UsageError(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet "
                          "test: give --suction > 0")
     sample = PrepareConfig(particles=args.particles, porosity=args.porosity,
@@ -140,16 +165,22 @@ def config_from(args):
     shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
                         strain_rate=args.strain_rate, records=args.records)
     bridges = None
+    options = {"surface_tension": args.surface_tension, "contact_angle": args.contact_angle,
+               "model": args.bridges, "liquid": args.liquid}
+    options = {k: v for k, v in options.items() if v is not None}
     if args.suction > 0.0:
-        options = {"surface_tension": args.surface_tension,
-                   "contact_angle": args.contact_angle, "model": args.bridges}
         bridges = BridgeConfig(args.suction, persist=args.persist_bridges,
                                table_resolution=table_resolution(args.table_resolution),
-                               **{k: v for k, v in options.items() if v is not None})
+                               **options)
+    elif water is not None:
+        check_range("--water-content", water, 0.0, 100.0, low_inclusive=False, unit="%")
+        bridges = BridgeConfig(water_content=water / 100.0, control="volume",
+                               table_resolution=table_resolution(args.table_resolution),
+                               **options)
     frames = {} if args.vtk_frames is None else {"vtk_frames": args.vtk_frames}
     return TriaxialConfig(sample=sample, shear=shear, bridges=bridges, sample_path=args.sample,
                           wet_steps=args.wet_steps, vtk_every=args.vtk_every,
-                          checkpoint_every=args.checkpoint_every, **frames)
+                          checkpoint_every=args.checkpoint_every, wetting=args.wetting, **frames)
 
 
 def run(args):
