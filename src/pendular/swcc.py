@@ -22,7 +22,8 @@ the same suction (contact angle hysteresis and pore-scale ink-bottle effects are
 
 Outputs in ``out``: swcc.json (``drying`` and ``wetting`` lists of stage rows {suction [Pa],
 saturation, bridges, porosity, volumetric_strain (contraction positive, from the dry sample),
-chi (tr chi / 3, Eq. 3.44), ...}), swcc.png (Sr against log suction, both branches, with
+chi (tr chi / 3, Eq. 3.44), pendular_overlaps (pairs of menisci merging on a grain: beyond the
+pendular regime where many), ...}), swcc.png (Sr against log suction, both branches, with
 thesis Fig. 5.5's points and the regular packings' SWCCs of Chapter 4), history.h5 (the wet
 triaxial's columns, pendular.schema, recorded through the whole path) and sample.h5.
 """
@@ -59,7 +60,7 @@ OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
 STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1", "bridges_across_gaps": "1",
                "porosity": "1", "volumetric_strain": "1", "chi": "1", "chi_tensor": "1",
                "psi": "Pa", "psi_interface": "Pa", "sigma_wall": "Pa", "coordination": "1",
-               "steps": "1"}
+               "pendular_overlaps": "1", "steps": "1"}
 
 
 def path_bridges(config: SwccConfig, radii) -> CapillaryBridges:
@@ -163,6 +164,7 @@ class SwccTest:
                 "psi_interface": homogenization.psi_interface(sim).tolist(),
                 "sigma_wall": sim.walls.stress().tolist(),
                 "coordination": coordination(sim.contacts, len(sim.particles)),
+                "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
 
 

@@ -346,6 +346,7 @@ def summarize(history):
     }
     if "saturation" in history:
         summary["saturation_at_peak"] = float(history["saturation"][peak])
+    if "suction" in history:                      # not in a YADE history
         summary["suction_at_peak"] = float(history["suction"][peak])
     if "sigma_effective" in history:
         effective = np.diagonal(history["sigma_effective"][peak])
