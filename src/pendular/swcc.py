@@ -213,7 +213,7 @@ def plot_swcc(path, result):
             axes.plot(*zip(*points), ":", lw=1, label=f"{kind.upper()} packing (Ch. 4)")
     thesis = sorted((float(s), v) for s, v in result["thesis_fig_5_5"].items())
     axes.plot([s / 1e3 for s, _ in thesis], [100 * v for _, v in thesis], "k*", ms=10,
-              label="thesis Fig. 5.5 (DEM, at the peak)")
+              label="thesis Fig. 5.5 (its DEM samples)")
     axes.set_xscale("log")
     axes.set_yscale("log")
     axes.set_xlabel("suction [kPa]")

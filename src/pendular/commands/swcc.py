@@ -12,6 +12,8 @@ history.h5 and sample.h5.
 
 from __future__ import annotations
 
+import sys
+
 from dem.preparation import PrepareConfig
 
 from ..cli import UsageError, add_run_options, add_size_options, set_threads, sizes_from
@@ -77,5 +79,11 @@ def run(args):
             print(f"{branch:<8} {row['suction']:>12g} {100 * row['saturation']:>8.3f} "
                   f"{row['bridges']:>8d} {row['porosity']:>9.4f} "
                   f"{row['volumetric_strain']:>9.2e} {row['chi']:>8.4f}")
+    merged = sorted({row["suction"] for branch in ("drying", "wetting") for row in result[branch]
+                     if row["pendular_overlaps"] > 0})
+    if merged:
+        print(f"warning: at suction(s) {', '.join(f'{s:g}' for s in merged)} Pa menisci merge on "
+              "grains (pendular_overlaps > 0 in swcc.json): the sample is past the pendular "
+              "regime that the bridges model there", file=sys.stderr)
     print(f"done in {result['wall_time_s']:.0f} s; outputs in {args.out}")
     return 0
