@@ -91,7 +91,7 @@ def per_bridge(sim, bridges):
     index = np.flatnonzero(state.mask())
     interfaces = bridges.interfaces(sim, index)
     dipoles = own_dipoles(sim, bridges, index)
-    suction = bridges.bridge_suctions(sim)
+    suction = state.suction if bridges.control == "volume" else bridges.suction
     for row, k in enumerate(index[:40]):
         mask = np.zeros(len(sim.contacts), bool)
         mask[k] = True

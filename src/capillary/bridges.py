@@ -48,7 +48,7 @@ contact at ``suction`` (the formation suction, the same for bridges that form la
 that volume; its force and suction follow from (V*, d*) and it ruptures at the
 volume-controlled rupture distance (capillary.VolumeBridgeTable). Bridges persist across gaps.
 
-The liquid of volume-controlled bridges (``liquid``; docs/capillary.md "Liquid accounting"):
+The liquid of volume-controlled bridges (``liquid``; docs/hydro_mechanical.md):
 "reservoir" (default): new contacts take their bridge's liquid from outside, a ruptured
 bridge's goes back there (a sample in contact with a water supply, the wetting phase);
 "shared" and "lost": the amount is closed (a fixed water content). On rupture, "shared" gives
@@ -473,14 +473,6 @@ class CapillaryBridges:
         if self.persist:
             return self.pair_force
         return -state.force[:, None] * sim.contacts.normal
-
-    def bridge_suctions(self, sim):
-        """Suction [Pa] of every pair (K,): the imposed one (suction control; also where no
-        bridge is) or each bridge's own (volume control)."""
-        state = self.state(sim)
-        if self.control == "volume":
-            return state.suction
-        return np.full(len(state.state), self.suction)
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each
