@@ -98,6 +98,11 @@ def test_envelopes_recover_the_mohr_coulomb_line_of_their_peaks():
     steeper = math.degrees(math.asin(3 * 1.1 * slope / (6 + 1.1 * slope)))
     assert fits["30000"]["phi_eff_complete_deg"] == pytest.approx(steeper)  # its own fit
     assert abs(fits["30000"]["cohesion_eff_complete"]) < 1e-6
+    # fits through the origin: the same lines here, which pass through it
+    assert fits["30000"]["phi_eff_c0_deg"] == pytest.approx(phi)
+    assert fits["30000"]["phi_eff_complete_c0_deg"] == pytest.approx(steeper)
+    assert fits["0"]["phi_c0_deg"] == pytest.approx(phi)
+    assert fits["30000"]["phi_c0_deg"] > phi                           # net: cohesion shows
     falling = [_row(0.0, 250.0, 900.0, 500.0), _row(0.0, 750.0, 100.0, 900.0)]
     fit = envelopes(falling)["0"]
     assert fit["phi_deg"] is None and "outside the Mohr–Coulomb range" in fit["errors"][0]

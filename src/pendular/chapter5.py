@@ -21,7 +21,10 @@ p_effective_complete_at_peak; a dry run's effective values are its net ones) and
 keyed by suction (str), each {phi_deg, cohesion} fitted to (p, q) at peak, {phi_eff_deg,
 cohesion_eff} to (p', q') at peak (Eq. 3.43) and {phi_eff_complete_deg, cohesion_eff_complete}
 to those of the complete effective stress (psi plus the liquid-gas interface term,
-homogenize.on_the_fly) (dem.envelope), where a suction has at least two confining stresses. DIR/report.md compares with thesis Table 5.3 and
+homogenize.on_the_fly), each also fitted through the origin (cohesion 0: phi_c0_deg,
+phi_eff_c0_deg, phi_eff_complete_c0_deg; an effective stress that takes the capillary
+cohesion in leaves none) (pendular.envelope), where a suction has at least two confining
+stresses. DIR/report.md compares with thesis Table 5.3 and
 Fig. 5.5. DIR/plots/ (chapter5_figures): envelopes.png (Figs. 5.4, 5.6), q_ev.png (5.3),
 q_p_effective.png (5.7), polar_psi.png (5.5), polar_fabric.png, anisotropy.png (5.8).
 DIR/campaign.csv: one row per run, its options and its whole summary (pendular.campaign).
@@ -153,15 +156,18 @@ def envelopes(runs):
         if len({r["confining"] for r in rows}) < 2:
             continue
         fit = {}
-        for names, keys in ((("phi_deg", "cohesion"), ("p_at_peak", "peak_q")),
-                            (("phi_eff_deg", "cohesion_eff"),
+        for names, keys in ((("phi_deg", "cohesion", "phi_c0_deg"), ("p_at_peak", "peak_q")),
+                            (("phi_eff_deg", "cohesion_eff", "phi_eff_c0_deg"),
                              ("p_effective_at_peak", "peak_q_effective")),
-                            (("phi_eff_complete_deg", "cohesion_eff_complete"),
+                            (("phi_eff_complete_deg", "cohesion_eff_complete",
+                              "phi_eff_complete_c0_deg"),
                              ("p_effective_complete_at_peak", "peak_q_effective_complete"))):
+            p, q = [r[keys[0]] for r in rows], [r[keys[1]] for r in rows]
             try:
-                values = mohr_coulomb_fit([r[keys[0]] for r in rows], [r[keys[1]] for r in rows])
+                values = mohr_coulomb_fit(p, q)
+                values = (*values, mohr_coulomb_fit(p, q, through_origin=True)[0])
             except ValueError as error:
-                values = (None, None)
+                values = (None, None, None)
                 fit.setdefault("errors", []).append(f"{names[0]}: {error}")
             fit.update(zip(names, values))
         fits[label(suction)] = fit
@@ -208,14 +214,17 @@ def write_report(path, runs, fits, args, figures, out):
     lines += ["", "## Failure envelopes (Mohr–Coulomb in p–q)", "",
               f"Thesis: dry friction angle {DRY_FRICTION_DEG:.0f} deg; with the effective stress "
               "of Eq. 3.43 every suction should fall on the dry line (Fig. 5.6b). phi'c: the "
-              "complete effective stress (psi plus the liquid-gas interface term).", "",
+              "complete effective stress (psi plus the liquid-gas interface term). Offsets "
+              "from the dry line: the free fits against the dry free fit; c0, the fits "
+              "through the origin (cohesion 0) against the dry one.", "",
               "| suction [Pa] | phi net [deg] | c net [Pa] | phi' [deg] | c' [Pa] | "
-              "phi' - phi dry [deg] | phi'c [deg] | c'c [Pa] | phi'c - phi dry [deg] |",
-              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    dry_phi = fits.get(label(0.0), {}).get("phi_deg")
+              "phi' - phi dry [deg] | phi'c [deg] | c'c [Pa] | phi'c - phi dry [deg] | "
+              "c0: phi' - phi dry [deg] | c0: phi'c - phi dry [deg] |",
+              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    dry = fits.get(label(0.0), {})
 
-    def offset(phi):
-        return None if dry_phi is None or phi is None else phi - dry_phi
+    def offset(phi, key="phi_deg"):
+        return None if dry.get(key) is None or phi is None else phi - dry[key]
 
     for key, fit in fits.items():
         lines.append(f"| {key} | {_fmt(fit['phi_deg'], '.2f')} | {_fmt(fit['cohesion'], '.1f')} "
@@ -223,7 +232,9 @@ def write_report(path, runs, fits, args, figures, out):
                      f"| {_fmt(offset(fit['phi_eff_deg']), '+.2f')} "
                      f"| {_fmt(fit['phi_eff_complete_deg'], '.2f')} "
                      f"| {_fmt(fit['cohesion_eff_complete'], '.1f')} "
-                     f"| {_fmt(offset(fit['phi_eff_complete_deg']), '+.2f')} |")
+                     f"| {_fmt(offset(fit['phi_eff_complete_deg']), '+.2f')} "
+                     f"| {_fmt(offset(fit['phi_eff_c0_deg'], 'phi_c0_deg'), '+.2f')} "
+                     f"| {_fmt(offset(fit['phi_eff_complete_c0_deg'], 'phi_c0_deg'), '+.2f')} |")
         for error in fit.get("errors", []):
             lines.append(f"| {key} | fit failed: {error} | | | |")
     if not fits:
