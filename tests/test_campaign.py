@@ -197,3 +197,18 @@ def test_the_chapter5_grid_is_a_shipped_table():
     assert {r.config.sample.particles for r in runs} == {10000}
     grid = chapter5.Chapter5Grid.from_table()
     assert grid.suctions == [0, 15000, 30000, 300000] and grid.particles == 10000
+
+
+def test_a_run_stored_before_a_defaulted_field_existed_is_the_same_run():
+    """Reuse across versions: a configuration stored before ``wetting`` existed equals one with
+    its default (the former behaviour), not one with another value."""
+    from pendular.campaign import same_config
+    from pendular.config import BridgeConfig, TriaxialConfig, config_to_dict
+
+    config = TriaxialConfig(bridges=BridgeConfig(30000.0))
+    stored = config_to_dict(config)
+    del stored["fields"]["wetting"]
+    del stored["fields"]["bridges"]["fields"]["liquid"]
+    assert same_config(stored, config)
+    assert not same_config(stored, dataclasses.replace(config, wetting="at-shear"))
+    assert not same_config({"no": "config"}, config) and not same_config(None, config)

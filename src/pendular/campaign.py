@@ -62,7 +62,8 @@ from dem.preparation import PrepareConfig, prepare_sample
 from dem.sample import save_sample
 from dem.validate import check_int
 
-from .config import TensionConfig, TriaxialConfig, config_json, config_to_dict
+from .config import (TensionConfig, TriaxialConfig, config_from_dict, config_json,
+                     config_to_dict)
 from .tension import TensionTest
 from .triaxial import Interrupted, TriaxialTest, parameters
 
@@ -167,8 +168,16 @@ def stored_config(path: str, key: str) -> dict | None:
 
 
 def same_config(stored: dict | None, config: Any) -> bool:
-    """Whether a stored configuration dict equals ``config`` (``config_json``)."""
-    return stored is not None and json.dumps(stored, sort_keys=True) == config_json(config)
+    """Whether a stored configuration dict equals ``config`` (``config_json``). The stored one
+    is read back through ``config_from_dict`` first, so that a run stored before a field was
+    added (whose default keeps the former behaviour) equals a configuration with that default."""
+    if stored is None:
+        return False
+    try:
+        stored = config_to_dict(config_from_dict(stored))
+    except (ValueError, TypeError):
+        return False
+    return json.dumps(stored, sort_keys=True) == config_json(config)
 
 
 def sample_made_with(path: str, sample: PrepareConfig) -> bool:
