@@ -120,6 +120,8 @@ def test_report_sets_every_cell_beside_the_thesis(tmp_path):
     assert "| 15000 | 1000 |  | 8018 |  |" in report                # a thesis cell not run
     assert "| 30000 | 250 | 1.000 |  | 2.20 |" in report             # Sr beside Fig. 5.5
     assert "(no suction has two confining stresses)" in report
+    secant = math.degrees(math.asin(3 * (350 / 370) / (6 + 350 / 370)))   # one peak's own line
+    assert f"| 350 | 370 | {secant:.2f} | {secant:.2f} | runs/s0_c250 |" in report
     assert "![envelopes](plots/envelopes.png)" in report
     assert TABLE_5_3[(300000, 750)] == 8289 and FIG_5_5[30000] == 0.022
 

@@ -174,6 +174,14 @@ def envelopes(runs):
     return fits
 
 
+def secant_angle(p, q):
+    """Friction angle [deg] of one peak's line through the origin; None where undefined."""
+    try:
+        return mohr_coulomb_fit([p], [q], through_origin=True)[0]
+    except ValueError:
+        return None
+
+
 def _fmt(value, spec=".0f", scale=1.0):
     return "" if value is None else format(value * scale, spec)
 
@@ -240,14 +248,22 @@ def write_report(path, runs, fits, args, figures, out):
     if not fits:
         lines.append("(no suction has two confining stresses)")
     lines += ["", "## Runs", "",
+              "Secant angles: each peak's own line through the origin (one failure point "
+              "against the dry line).", "",
               "| suction [Pa] | confining [Pa] | q peak [Pa] | p at peak [Pa] | q' peak [Pa] | "
-              "p' at peak [Pa] | q'c peak [Pa] | p'c at peak [Pa] | folder |",
-              "|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+              "p' at peak [Pa] | q'c peak [Pa] | p'c at peak [Pa] | secant phi' [deg] | "
+              "secant phi'c [deg] | folder |",
+              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
     for r in runs:
+        secant = secant_angle(r["p_effective_at_peak"], r["peak_q_effective"])
+        secant_complete = secant_angle(r["p_effective_complete_at_peak"],
+                                       r["peak_q_effective_complete"])
         lines.append(f"| {label(r['suction'])} | {label(r['confining'])} | {r['peak_q']:.0f} | "
                      f"{r['p_at_peak']:.0f} | {r['peak_q_effective']:.0f} | "
                      f"{r['p_effective_at_peak']:.0f} | {r['peak_q_effective_complete']:.0f} | "
-                     f"{r['p_effective_complete_at_peak']:.0f} | {r['folder']} |")
+                     f"{r['p_effective_complete_at_peak']:.0f} | "
+                     f"{_fmt(secant, '.2f')} | {_fmt(secant_complete, '.2f')} | "
+                     f"{r['folder']} |")
     lines += ["", "## Figures", ""]
     lines += [f"![{name}]({os.path.relpath(figure, out)})" for name, figure in figures.items()]
     lines += ["", "Each run's own plots: " + ", ".join(f"{r['folder']}/plots" for r in runs)]
