@@ -109,3 +109,23 @@ def test_a_recorder_records_the_end_of_a_phase_between_periods():
     sim.writers.append(recorder)
     sim.run(12)
     assert recorder.arrays()["step"].tolist() == [4, 8, 10, 12]
+
+
+def test_an_interrupt_during_a_record_leaves_whole_rows_only():
+    """Ctrl-C while a record is computed (the CI failure: 'anisotropy' one record short of the
+    other columns) leaves no partial row; a row cut short while appending is not counted."""
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+
+    def interrupted(s):
+        if s.step == 2:
+            raise KeyboardInterrupt
+        return 2.0 * s.step
+
+    recorder = HistoryRecorder(1, {"step": lambda s: s.step, "twice": interrupted})
+    sim.writers.append(recorder)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(5)
+    columns = recorder.arrays()
+    assert columns["step"].tolist() == [1] and columns["twice"].tolist() == [2.0]
+    recorder.rows["step"].append(np.float64(3.0))        # an append cut short
+    assert len(recorder) == 1 and recorder.arrays()["step"].tolist() == [1]

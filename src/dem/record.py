@@ -31,16 +31,21 @@ class HistoryRecorder:
             self.record(sim)
 
     def record(self, sim):
-        """Sample every quantity now."""
-        for name, quantity in self.quantities.items():
-            self.rows[name].append(np.asarray(quantity(sim), dtype=np.float64))
+        """Sample every quantity now. The row is computed whole before any column grows, so an
+        interrupt (Ctrl-C) while the quantities are computed leaves no partial row."""
+        row = {name: np.asarray(quantity(sim), dtype=np.float64)
+               for name, quantity in self.quantities.items()}
+        for name, value in row.items():
+            self.rows[name].append(value)
 
     def __len__(self):
-        return len(next(iter(self.rows.values()), []))
+        """Complete records (a row cut short by an interrupt while appending is not one)."""
+        return min((len(values) for values in self.rows.values()), default=0)
 
     def arrays(self):
-        """Columns as stacked arrays (first axis: record)."""
-        return {name: np.array(values) for name, values in self.rows.items()}
+        """Columns of the complete records as stacked arrays (first axis: record)."""
+        complete = len(self)
+        return {name: np.array(values[:complete]) for name, values in self.rows.items()}
 
     def last(self, name):
         return self.rows[name][-1]
