@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, two_body_scene
-from dem.neighbors import build_contacts
+from dem.neighbors import build_contacts, spatial_order
+from dem.preparation import PrepareConfig, prepare_sample
 
 
 def brute_force_pairs(position, radius, skin):
@@ -101,3 +102,23 @@ def test_a_negative_reach_is_refused_naming_the_force():
     sim = two_body_scene([[0, 0, 0]], np.zeros((1, 3)), extra=[Reaching(-1e-6)])
     with pytest.raises(ValueError, match="Reaching.reach"):
         sim.advance()
+
+
+def test_spatial_order_walks_the_cells_along_the_z_curve():
+    """Eight points, one per cell of a 2 x 2 x 2 grid, listed in reverse: the order is the
+    Morton order (x the fastest bit), and points sharing a cell keep their index order."""
+    cells = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    position = (cells[::-1] + 0.5) * RADIUS
+    assert spatial_order(position, RADIUS).tolist() == [7, 6, 5, 4, 3, 2, 1, 0]
+    twice = np.concatenate([position, position])
+    assert spatial_order(twice, RADIUS).tolist()[:4] == [7, 15, 6, 14]
+
+
+def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory():
+    """The preparation numbers particles along the curve: the pairs' mean index distance is
+    under 40 % of the same packing's numbered at random (28 % measured at 1,000 spheres)."""
+    config = PrepareConfig(particles=1000, confining=750.0)
+    sim, _ = prepare_sample(config, progress=False)
+    i, j = sim.contacts.pair_i, sim.contacts.pair_j
+    shuffled = np.random.default_rng(0).permutation(len(sim.particles))
+    assert np.mean(np.abs(j - i)) < 0.4 * np.mean(np.abs(shuffled[j] - shuffled[i]))

@@ -242,6 +242,25 @@ def gather_pair_vectors(pair_vector, row_start, second_start, second_pair, out):
         out[p, 2] += v2
 
 
+def spatial_order(position, cell_size):
+    """Permutation [-] that lists particles cell by cell along a Z-order (Morton) curve through a
+    grid of cells of edge ``cell_size`` [m], in index order within a cell.
+
+    Particles listed in this order keep near neighbours near in memory, so the pair loops and
+    gathers read contiguous rows instead of jumping across the arrays (LAMMPS's atom_modify
+    sort, JAX-MD's cell ordering). 21 bits per axis: grids of up to 2^21 cells a side.
+    """
+    position = np.asarray(position, dtype=np.float64)
+    cell_size = check_positive("cell_size", cell_size, "m")
+    cells = np.floor((position - position.min(axis=0)) / cell_size).astype(np.int64)
+    cells = np.minimum(cells, 2 ** 21 - 1)
+    code = np.zeros(len(position), np.int64)
+    for bit in range(21):
+        for axis in range(3):
+            code |= ((cells[:, axis] >> bit) & 1) << (3 * bit + axis)
+    return np.argsort(code, kind="stable")
+
+
 def carry_pair_array(previous, values, row_start, pair_j):
     """``values`` (one row per pair of ``previous``) moved to the pairs of a new list
     (``row_start``, ``pair_j``); pairs absent before get zeros. Any dtype and trailing shape."""

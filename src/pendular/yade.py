@@ -30,7 +30,7 @@ import time
 import numpy as np
 
 import capillary
-from dem.preparation import PrepareConfig, prepare_sample
+from dem.preparation import PREPARATION_VERSION, PrepareConfig, prepare_sample
 from dem.sample import load_sample, save_sample
 from dem.yade_io import read_plot_data
 
@@ -133,7 +133,7 @@ def cached_sample(config, *, progress=True, threads=None):
     keyed by its configuration, which the saved sample holds and is checked against."""
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
-    key = hashlib.sha256(config_json(config).encode()).hexdigest()[:12]
+    key = hashlib.sha256(f"{PREPARATION_VERSION} {config_json(config)}".encode()).hexdigest()[:12]
     path = os.path.join(cache_folder(), "samples", f"sample_{config.particles}_"
                         f"{config.confining:g}_seed{config.seed}_{key}.h5")
     if not sample_made_with(path, config):
