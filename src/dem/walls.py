@@ -3,6 +3,7 @@
 A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, the high to +axis.
 """
 
+import numba
 import numpy as np
 
 from .contact_law import wall_forces
@@ -24,6 +25,38 @@ def move_walls(walls, wall_indices, outward, dt):
         sign = 1.0 if w % 2 else -1.0
         walls.position[w] += sign * shift
         walls.velocity[w] = shift / dt
+
+
+@numba.njit(cache=True)
+def servo_walls(wall_position, wall_velocity, wall_force, wall_stiffness, stiffness, previous,
+                walls, target, gain, memory, max_velocity, scale_max_velocity, refresh, dt):
+    """One step of StressServo's law (its docstring) for the walls ``walls``, in place: their
+    shifts from the current forces and face areas, then the moves. ``stiffness`` holds each
+    servoed wall's K_wall [N/m], refreshed from ``wall_stiffness`` when ``refresh``."""
+    lx = wall_position[1] - wall_position[0]
+    ly = wall_position[3] - wall_position[2]
+    lz = wall_position[5] - wall_position[4]
+    for slot in range(len(walls)):
+        w = walls[slot]
+        axis = w // 2
+        if refresh:
+            stiffness[slot] = wall_stiffness[w]
+        cap = max_velocity * dt
+        if scale_max_velocity:
+            length = lx if axis == 0 else (ly if axis == 1 else lz)
+            cap = cap * (3.0 * length / (lx + ly + lz))
+        if stiffness[slot] > 0.0:
+            area = ly * lz if axis == 0 else (lx * lz if axis == 1 else lx * ly)
+            shift = (wall_force[w] - target * area) / stiffness[slot]
+            shift = min(max(shift, -cap), cap)
+        else:
+            shift = -cap
+        previous[slot] = gain * shift + memory * previous[slot]
+    for slot in range(len(walls)):
+        w = walls[slot]
+        sign = 1.0 if w % 2 else -1.0
+        wall_position[w] += sign * previous[slot]
+        wall_velocity[w] = previous[slot] / dt
 
 
 class WallForces:
@@ -62,7 +95,7 @@ class StressServo:
                  scale_max_velocity=False, stiffness_every=1):
         self.axes = _axes(axes)
         self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
-        self._wall_index = np.array(self.walls)
+        self._wall_index = np.array(self.walls, dtype=np.int64)
         self.target = check_range("target stress", target, 0.0, unit="Pa")
         self.max_velocity = check_positive("max_velocity", max_velocity, "m/s")
         self.gain = check_range("servo gain", gain, 0.0, 1.0, low_inclusive=False)
@@ -73,31 +106,13 @@ class StressServo:
         self.stiffness = np.zeros(len(self.walls))
         self.calls = 0
 
-    def _step_caps(self, walls, dt):
-        """Largest wall shift of this step per servoed wall [m]."""
-        cap = self.max_velocity * dt
-        if not self.scale_max_velocity:
-            return np.full(len(self.walls), cap)
-        lengths = walls.lengths()
-        return cap * (3.0 * lengths / lengths.sum())[self._wall_index // 2]
-
     def apply(self, sim):
         walls = sim.walls
-        areas = walls.areas()
-        step_caps = self._step_caps(walls, sim.dt)
-        if self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0:
-            self.stiffness[:] = walls.stiffness[self._wall_index]
+        refresh = self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0
         self.calls += 1
-        for slot, w in enumerate(self.walls):
-            stiffness = self.stiffness[slot]
-            step_cap = step_caps[slot]
-            if stiffness > 0.0:
-                shift = (walls.force[w] - self.target * areas[w]) / stiffness
-                shift = min(max(shift, -step_cap), step_cap)
-            else:
-                shift = -step_cap
-            self.previous[slot] = self.gain * shift + self.memory * self.previous[slot]
-        move_walls(walls, self.walls, self.previous, sim.dt)
+        servo_walls(walls.position, walls.velocity, walls.force, walls.stiffness, self.stiffness,
+                    self.previous, self._wall_index, self.target, self.gain, self.memory,
+                    self.max_velocity, self.scale_max_velocity, refresh, sim.dt)
 
 
 class ConstantStrainRate:
