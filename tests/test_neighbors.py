@@ -122,3 +122,53 @@ def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory():
     i, j = sim.contacts.pair_i, sim.contacts.pair_j
     shuffled = np.random.default_rng(0).permutation(len(sim.particles))
     assert np.mean(np.abs(j - i)) < 0.4 * np.mean(np.abs(shuffled[j] - shuffled[i]))
+
+
+def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
+    """The first evaluation after a rebuild knows which pairs were touching: one found apart
+    there drops its shear force, as it would on any other step (it once kept it, and started
+    its next contact from a stale spring)."""
+    from dem.contact_law import pair_forces
+
+    radius = np.full(2, RADIUS)
+    touching = np.array([[0.0, 0, 0], [1.999 * RADIUS, 0, 0]])
+    contacts = build_contacts(touching, radius, 0.5 * RADIUS)
+    still = np.zeros((2, 3))
+
+    def evaluate(position, c):
+        pair_forces(position, still, still, radius, c.pair_i, c.pair_j, c.shear_force, c.normal,
+                    c.overlap, c.normal_force, c.force, c.torque_i, c.torque_j, 1e6, 0.3, 0.3,
+                    1e-7)
+
+    evaluate(touching, contacts)
+    contacts.shear_force[0] = [0.0, 1e-6, 0.0]           # a loaded spring
+    apart = touching.copy()
+    apart[1, 0] = 2.001 * RADIUS
+    rebuilt = build_contacts(apart, radius, 0.5 * RADIUS, previous=contacts)
+    assert rebuilt.overlap[0] > 0.0                      # carried: touching at the last step
+    evaluate(apart, rebuilt)
+    assert np.all(rebuilt.shear_force[0] == 0.0) and rebuilt.overlap[0] < 0.0
+
+
+def test_a_shear_does_not_depend_on_the_skin():
+    """The skin only decides when the list is rebuilt: contacts open and close on rebuild
+    steps as on any other, so a shear with a thin and a thick skin is the same to the bit."""
+    import copy
+    import dataclasses
+
+    from dem.preparation import servoed_simulation
+    from dem.walls import ConstantStrainRate, StressServo
+
+    config = PrepareConfig(particles=300, confining=750.0)
+    sample, _ = prepare_sample(config, progress=False)
+    runs = []
+    for skin_factor in (0.05, 0.6):
+        sim = servoed_simulation(copy.deepcopy(sample.particles), copy.deepcopy(sample.walls),
+                                 dataclasses.replace(config, skin_factor=skin_factor), 750.0)
+        sim.controls = [StressServo("xy", 750.0, sim.controls[0].max_velocity),
+                        ConstantStrainRate("z", 0.02 / (3000 * sim.dt), sim.walls.lengths()[2])]
+        sim.run(3000)                                    # to 2 % axial strain
+        runs.append((sim.particles.position.copy(), sim.neighbors.rebuilds))
+    (thin, thin_rebuilds), (thick, thick_rebuilds) = runs
+    assert thin_rebuilds > 3 * thick_rebuilds
+    assert np.array_equal(thin, thick)

@@ -273,8 +273,9 @@ def carry_pair_array(previous, values, row_start, pair_j):
 
 
 def build_contacts(position, radius, skin, previous=None):
-    """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals and
-    every ``extra`` per-pair array from ``previous`` if given. FloatingPointError if a position
+    """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals,
+    overlaps (new pairs: -inf, never touched) and every ``extra`` per-pair array from
+    ``previous`` if given. FloatingPointError if a position
     is not finite (a diverged simulation would otherwise get a meaningless list)."""
     if not np.isfinite(position).all():
         particle = int(np.argwhere(~np.isfinite(position))[0, 0])
@@ -286,9 +287,13 @@ def build_contacts(position, radius, skin, previous=None):
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
     second_start, second_pair = second_index(row_start, pair_j, count)
     size = len(pair_j)
-    history = np.zeros((size, 6))
+    # shear spring, normal and overlap of the last evaluation: a pair that was touching and
+    # is found apart at the first evaluation after the rebuild forgets its spring there
+    history = np.zeros((size, 7))
+    history[:, 6] = -np.inf
     if previous is not None and len(previous):
-        old = np.concatenate([previous.shear_force, previous.normal], axis=1)
+        old = np.concatenate([previous.shear_force, previous.normal, previous.overlap[:, None]],
+                             axis=1)
         carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j, history)
     extra = {}
     if previous is not None:
@@ -298,8 +303,8 @@ def build_contacts(position, radius, skin, previous=None):
         pair_i=pair_i, pair_j=pair_j, row_start=row_start,
         second_start=second_start, second_pair=second_pair,
         shear_force=np.ascontiguousarray(history[:, :3]),
-        normal=np.ascontiguousarray(history[:, 3:]),
-        overlap=np.full(size, -np.inf), normal_force=np.zeros(size),
+        normal=np.ascontiguousarray(history[:, 3:6]),
+        overlap=np.ascontiguousarray(history[:, 6]), normal_force=np.zeros(size),
         force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)),
         extra=extra)
 

@@ -158,8 +158,9 @@ def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
 PREPARATION_PHASES = ("growth", "friction", "unload", "equilibrate")
 
 #: Changes when the same PrepareConfig prepares a different sample (2: particles numbered
-#: along a space-filling curve); caches of prepared samples key on it.
-PREPARATION_VERSION = 2
+#: along a space-filling curve; 3: a contact lost on a neighbour-list rebuild step forgets
+#: its shear spring); caches of prepared samples key on it.
+PREPARATION_VERSION = 3
 
 #: Largest count for which random_cloud falls back to pairwise insertion.
 PAIRWISE_CLOUD_MAX = 2000
