@@ -7,7 +7,10 @@ For each size, a sample is prepared with pendular (thesis Ch. 5.2.2, 750 Pa; cac
 .cache/), sheared with x, y servoed and z strained, and timed in particle-steps per second after
 a warm-up. The same packing is exported as a YADE sphere file and sheared by YADE 2023
 (pendular.yade_triaxial) with the equivalent engine list, time step and strain rate.
-Prints a table of particle-steps/s and the ratio pendular / YADE for each thread count.
+Prints a table of particle-steps/s, the cost per particle-step and the ratio pendular / YADE
+for each thread count, and the fixed cost of a step: the step time of a FIXED_COST_SPHERES
+scene with the same operations, which is nearly all Python, Numba dispatch and kernel launches
+(its share of a step at each size is the overhead outside the compiled work).
 """
 
 import argparse
@@ -27,12 +30,13 @@ from pendular.yade import benchmark_sample as sample  # (config, particles, wall
 from pendular.yade import find_yade, run_yade_triaxial
 
 
-def time_pendular(config, particles, walls, threads, steps, warmup):
+def time_pendular(config, particles, walls, threads, steps, warmup, force_threads=False):
     """Shear-phase speed with ``threads`` Numba threads available; the Simulation's own policy
-    decides how many it uses (one below dem.simulation.SERIAL_BELOW particles)."""
+    decides how many it uses (one below dem.simulation.SERIAL_BELOW particles) unless
+    ``force_threads``."""
     numba.set_num_threads(threads)
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,
-                             config.confining)
+                             config.confining, threads=threads if force_threads else None)
     sim.run(warmup)         # settle the loaded packing (saved without its shear history)
     rate = TriaxialShear(sim, ShearConfig(max_strain=0.25), config.confining, config.radius,
                          config.density).rate
@@ -59,6 +63,10 @@ def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
     return result
 
 
+#: Spheres of the scene whose step time stands for the fixed cost of a step.
+FIXED_COST_SPHERES = 64
+
+
 def write_results(path, rows):
     """Benchmark rows and the machine's thread counts as JSON."""
     with open(path, "w") as handle:
@@ -81,16 +89,27 @@ def main(argv=None):
     use_yade = not args.no_yade
     if use_yade:
         find_yade()
+    fixed = {}
+    config, particles, walls, _ = sample(FIXED_COST_SPHERES, args.confining)
+    for thread_count in threads:
+        tiny, _, _ = time_pendular(config, particles, walls, thread_count, args.steps,
+                                   args.warmup, force_threads=True)
+        fixed[thread_count] = tiny["wall_time_s"] / args.steps
     rows = []
     for count in sizes:
         config, particles, walls, report = sample(count, args.confining)
         for thread_count in threads:
             ours, dt, rate = time_pendular(config, particles, walls, thread_count, args.steps,
                                            args.warmup)
+            step_time = ours["wall_time_s"] / args.steps
+            fixed_cost = fixed.get(ours["threads_used"], fixed[thread_count])
             row = {"particles": count, "threads": thread_count,
                    "threads_used": ours["threads_used"],
-                   "pendular": ours["particle_steps_per_s"], "dt": dt, "strain_rate": rate,
-                   "porosity": report["porosity"]}
+                   "pendular": ours["particle_steps_per_s"],
+                   "cost_per_particle_step_ns": 1e9 * step_time / count,
+                   "fixed_cost_per_step_us": 1e6 * fixed_cost,
+                   "fixed_cost_share": fixed_cost / step_time,
+                   "dt": dt, "strain_rate": rate, "porosity": report["porosity"]}
             if use_yade:
                 yade = time_yade(config, particles, walls, thread_count, args.steps,
                                  args.warmup, dt, rate)
@@ -99,12 +118,16 @@ def main(argv=None):
             rows.append(row)
             print(json.dumps(row), flush=True)
     print(f"\n{'particles':>9} {'threads':>7} {'used':>4} {'pendular [Mps/s]':>17} "
-          f"{'YADE [Mps/s]':>13} {'ratio':>6}")
+          f"{'[ns/particle-step]':>19} {'fixed cost share':>16} {'YADE [Mps/s]':>13} "
+          f"{'ratio':>6}")
     for row in rows:
         yade = f"{row['yade'] / 1e6:13.2f}" if "yade" in row else f"{'-':>13}"
         ratio = f"{row['ratio']:6.2f}" if "ratio" in row else f"{'-':>6}"
         print(f"{row['particles']:9d} {row['threads']:7d} {row['threads_used']:4d} "
-              f"{row['pendular'] / 1e6:17.2f} {yade} {ratio}")
+              f"{row['pendular'] / 1e6:17.2f} {row['cost_per_particle_step_ns']:19.0f} "
+              f"{row['fixed_cost_share']:16.1%} {yade} {ratio}")
+    print("fixed cost per step [us] (a " + str(FIXED_COST_SPHERES) + "-sphere scene): "
+          + ", ".join(f"{t} thread(s) {1e6 * v:.1f}" for t, v in fixed.items()))
     if args.out:
         write_results(args.out, rows)
 

@@ -161,3 +161,16 @@ def test_report_and_plot(quick_grid):
     # each run keeps its configuration beside its timing
     timing = json.loads((out / "runs" / "reference" / "timing.json").read_text())
     assert timing["config"]["fields"]["shear"]["fields"]["inertial_number"] == 1e-4
+
+
+def test_the_noise_floor_is_the_reference_on_other_samples(quick_grid):
+    """NOISE_SEEDS more samples at the reference settings; the floor is their largest error."""
+    _, data = quick_grid
+    noise, reference = data["noise"], data["reference"]
+    assert [r["seed"] for r in noise] == list(range(1, 1 + tradeoff.NOISE_SEEDS))
+    for row in noise:
+        assert row["settings"] == reference["settings"]
+        assert row["peak_q_error"] == pytest.approx(
+            abs(row["peak_q"] - reference["peak_q"]) / reference["peak_q"], rel=1e-12)
+        assert row["peak_q"] != reference["peak_q"]        # another sample, another peak
+    assert data["noise_floor"]["error"] == max(r["error"] for r in noise)

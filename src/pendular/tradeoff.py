@@ -19,13 +19,15 @@ varied alone around the defaults:
 For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, the
 sample's preparation excluded), its particle-steps per second, and the relative errors of peak
 q, of Sr at the peak of q and of q'/p' at the peak of q (Eq. 3.43) against the reference;
-``error`` is the largest of the three. A knob that does not change the physics (records, skin)
-shows the run-to-run scatter of a chaotic many-body system, not an error of the knob.
+``error`` is the largest of the three. The noise floor: the reference settings run on
+NOISE_SEEDS other samples (seeds seed + 1, ...), whose errors against the reference are the
+scatter between samples that a knob's error is read against.
 
 Writes DIR/tradeoff.json (``arguments``, ``suction``, ``confining``, ``reference``, ``rows``:
 knob, value, settings, particles, wall_time_s, cpu_time_s, steps, wetting_steps,
 particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_strain_at_peak,
-peak_q_error, saturation_error, stress_ratio_error, error), DIR/tradeoff.md with a
+peak_q_error, saturation_error, stress_ratio_error, error; ``noise``: the same for each other
+seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors), DIR/tradeoff.md with a
 recommendation per use (quick look, paper figure) and DIR/tradeoff.png; ``docs`` copies the
 three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
 result and the run's configuration); run again, a study reuses a finished run only when its
@@ -44,7 +46,7 @@ from dataclasses import dataclass
 import numba
 
 from dem.atomic import write_json, write_text
-from dem.preparation import PrepareConfig
+from dem.preparation import MAX_SEED, PrepareConfig
 from dem.validate import check_int, check_range
 
 from .campaign import prepare_one, sample_made_with
@@ -87,6 +89,9 @@ TIME_TIE = 1.05
 USES = {"paper figure": PAPER_ERROR, "quick look": QUICK_ERROR}
 #: Smallest sample of the study (the particles knob included).
 MIN_PARTICLES = 50
+#: Samples beside the reference's (seeds seed + 1 ...) run at the reference settings: their
+#: scatter is the noise floor a knob's error is read against.
+NOISE_SEEDS = 2
 
 
 # ---------------------------------------------------------------- knobs on configurations
@@ -133,7 +138,7 @@ class Study:
         self.particles = check_int("particles", self.particles, low=MIN_PARTICLES)
         self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.5,
                                       low_inclusive=False)
-        self.seed = check_int("seed", self.seed)
+        self.seed = check_int("seed", self.seed, high=MAX_SEED - NOISE_SEEDS)
         self.quick = bool(self.quick)
         if not str(self.out).strip():
             raise ValueError(f"out = {self.out!r} is empty: give a folder name")
@@ -141,10 +146,11 @@ class Study:
     def knobs(self):
         return QUICK_KNOBS if self.quick else KNOBS
 
-    def sample(self, particles):
+    def sample(self, particles, seed=None):
         """The PrepareConfig of the prepared sample of ``particles`` spheres (every run of that
-        size starts from it)."""
-        return PrepareConfig(particles=particles, confining=CONFINING, seed=self.seed)
+        size starts from it; ``seed``: another sample's, for the noise floor)."""
+        return PrepareConfig(particles=particles, confining=CONFINING,
+                             seed=self.seed if seed is None else seed)
 
     def default(self):
         """The knobs' centre: ``pendular triaxial``'s defaults, wet at SUCTION, from the saved
@@ -161,6 +167,13 @@ class Study:
         for knob, value in REFERENCE.items():
             config = with_setting(config, knob, value)
         return config
+
+    def reference_on(self, seed):
+        """The reference settings on the sample of another ``seed``."""
+        config = self.reference()
+        return dataclasses.replace(
+            config, sample=dataclasses.replace(config.sample, seed=seed),
+            sample_path=sample_file(self.out, self.particles, seed))
 
     def variant(self, knob, value):
         """(configuration, value shown) of ``knob`` at ``value`` around the default; the
@@ -226,17 +239,22 @@ def errors(result, reference):
 
 
 def measure(study, log=None):
-    """(reference result, rows) of the Study ``study``: every knob's runs and, per use, the
-    run combining each knob's recommended setting (module docstring). ``log(text)`` hears of
-    each run."""
+    """(reference result, rows, noise rows) of the Study ``study``: the reference on other
+    samples, every knob's runs and, per use, the run combining each knob's recommended setting
+    (module docstring). ``log(text)`` hears of each run."""
     log = log or (lambda message: None)
     default = study.default()
 
     def run(name, config):
         return run_variant(config, os.path.join(study.out, "runs", name),
-                           study.sample(config.sample.particles))
+                           study.sample(config.sample.particles, config.sample.seed))
 
     reference = run("reference", study.reference())
+    noise = []
+    for seed in range(study.seed + 1, study.seed + 1 + NOISE_SEEDS):
+        log(f"reference settings, seed {seed} (noise floor)")
+        result = run(f"reference_seed{seed}", study.reference_on(seed))
+        noise.append({"seed": seed, **result, **errors(result, reference)})
     rows = []
     for knob, values in study.knobs().items():
         for value in values:
@@ -254,7 +272,14 @@ def measure(study, log=None):
         log(f"combined settings for a {use}: {settings(config)}")
         result = run(f"combined_{use.replace(' ', '_')}", config)
         rows.append({"knob": "combined", "value": use, **result, **errors(result, reference)})
-    return reference, rows
+    return reference, rows, noise
+
+
+def noise_floor(noise):
+    """The largest of each relative error over the noise rows (other samples, reference
+    settings): the sample-to-sample scatter."""
+    return {key: max(r[key] for r in noise)
+            for key in ("peak_q_error", "saturation_error", "stress_ratio_error", "error")}
 
 
 def recommendation(rows, bound):
@@ -281,7 +306,7 @@ def fastest_within(rows, bound, default_time):
 
 # ---------------------------------------------------------------- report
 
-def write_markdown(path, study, reference, rows):
+def write_markdown(path, study, reference, rows, noise):
     centre = settings(study.default())
     default = next(r for r in rows if r["knob"] != "combined" and r["settings"] == centre
                    and r["particles"] == study.particles)
@@ -307,6 +332,20 @@ def write_markdown(path, study, reference, rows):
                      f"{r['wall_time_s']:.1f} | {r['particle_steps_per_s'] / 1e6:.2f} | "
                      f"{100 * r['peak_q_error']:.2f} % | {100 * r['saturation_error']:.2f} % | "
                      f"{100 * r['stress_ratio_error']:.2f} % | {100 * r['error']:.2f} % |")
+    floor = noise_floor(noise)
+    lines += ["", "## Noise floor", "",
+              f"The reference settings on {len(noise)} other samples (seeds "
+              f"{', '.join(str(r['seed']) for r in noise)}, prepared the same way) differ from "
+              f"the reference by up to {100 * floor['peak_q_error']:.2f} % in peak q, "
+              f"{100 * floor['saturation_error']:.2f} % in Sr and "
+              f"{100 * floor['stress_ratio_error']:.2f} % in q'/p' at the peak: a knob's error "
+              "below this is within the scatter between samples, and a setting cannot be told "
+              "from the reference by it.", "",
+              "| seed | peak q [Pa] | peak q error | Sr error | q'/p' error |",
+              "|---:|---:|---:|---:|---:|"]
+    lines += [f"| {r['seed']} | {r['peak_q']:.1f} | {100 * r['peak_q_error']:.2f} % | "
+              f"{100 * r['saturation_error']:.2f} % | {100 * r['stress_ratio_error']:.2f} % |"
+              for r in noise]
     lines += ["", "## Recommendations", "",
               f"Fastest single-knob run within {PAPER_ERROR:.0%} of the reference on peak q: "
               f"{best['knob']} = {text(best['value'])}, {speedup:.2f} x faster than the "
@@ -329,19 +368,17 @@ def write_markdown(path, study, reference, rows):
             elif any(r["knob"] == knob for r in rows):
                 lines.append(f"- {knob}: no setting within {bound:.0%} (keep the reference's)")
         lines.append("")
-    lines += ["Reading the table: the skin and the record interval leave the dynamics unchanged "
-              "(skins 0.3-1.0 give bit-identical runs; 0.1 rebuilds the neighbour list in "
-              "another order, so floating-point sums differ and the chaotic trajectories drift "
-              "apart after the peak). Their rows, and the default run itself (about 1-2 % from "
-              "the reference), show the run-to-run scatter: differences below it are noise, "
-              "not an error of the knob. The sample size changes the sample itself (smaller "
-              "samples prepared by the same procedure are looser, with proportionally more "
-              "wall layers), so its errors are a size effect, not a numerical one.", ""]
+    lines += ["Reading the table: the skin leaves the dynamics unchanged (every skin gives a "
+              "bit-identical run; only its speed differs) and the record interval changes only "
+              "which steps are sampled, so where the peak is read. The sample size changes the "
+              "sample itself (smaller samples prepared by the same procedure are looser, with "
+              "proportionally more wall layers), so its errors are a size effect, not a "
+              "numerical one.", ""]
     write_text(path, "\n".join(lines) + "\n")
 
 
-def plot(path, rows):
-    """CPU time against error, one series per knob."""
+def plot(path, rows, floor):
+    """CPU time against error, one series per knob; the noise floor ``floor`` shaded."""
     figure, axes = pyplot().subplots(figsize=(7, 5))
     for index, knob in enumerate(dict.fromkeys(r["knob"] for r in rows)):
         chosen = [r for r in rows if r["knob"] == knob]
@@ -351,6 +388,7 @@ def plot(path, rows):
             axes.annotate(text(r["value"]), (r["cpu_time_s"], 100 * max(r["error"], 1e-4)),
                           fontsize=6)
     axes.axhline(100 * PAPER_ERROR, color="k", ls=":", lw=1)
+    axes.axhspan(1e-2, 100 * floor, color="0.85", zorder=0, label="noise floor (other samples)")
     axes.set_xscale("log")
     axes.set_yscale("log")
     axes.set_xlabel("CPU time, wetting and shear [s]")
@@ -374,13 +412,13 @@ def write_study(study, *, docs=None, log=None):
     numba.set_num_threads(1)
     with OutputFolder(study.out, "tradeoff") as folder:
         paths = {name.rsplit(".", 1)[1]: folder.claim(name) for name in OUTPUTS}
-        reference, rows = measure(study, log)
+        reference, rows, noise = measure(study, log)
         data = {"arguments": {**dataclasses.asdict(study), "docs": docs},
                 "suction": SUCTION, "confining": CONFINING, "reference": reference,
-                "rows": rows}
+                "rows": rows, "noise": noise, "noise_floor": noise_floor(noise)}
         write_json(paths["json"], data)
-        write_markdown(paths["md"], study, reference, rows)
-        plot(paths["png"], rows)
+        write_markdown(paths["md"], study, reference, rows, noise)
+        plot(paths["png"], rows, data["noise_floor"]["error"])
     if docs is not None:
         for path in paths.values():
             shutil.copy(path, docs)
