@@ -150,14 +150,17 @@ def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
     assert np.all(rebuilt.shear_force[0] == 0.0) and rebuilt.overlap[0] < 0.0
 
 
-def test_a_shear_does_not_depend_on_the_skin():
-    """The skin only decides when the list is rebuilt: contacts open and close on rebuild
-    steps as on any other, so a shear with a thin and a thick skin is the same to the bit."""
+@pytest.mark.parametrize("suction", [0.0, 30000.0])
+def test_a_shear_does_not_depend_on_the_skin(suction):
+    """The skin only decides when the list is rebuilt: contacts open and close (and bridges
+    form and break) on rebuild steps as on any other, so a shear with a thin and a thick skin
+    is the same to the bit, dry or wet."""
     import copy
     import dataclasses
 
     from dem.preparation import servoed_simulation
     from dem.walls import ConstantStrainRate, StressServo
+    from pendular.config import BridgeConfig
 
     config = PrepareConfig(particles=300, confining=750.0)
     sample, _ = prepare_sample(config, progress=False)
@@ -165,6 +168,8 @@ def test_a_shear_does_not_depend_on_the_skin():
     for skin_factor in (0.05, 0.6):
         sim = servoed_simulation(copy.deepcopy(sample.particles), copy.deepcopy(sample.walls),
                                  dataclasses.replace(config, skin_factor=skin_factor), 750.0)
+        if suction:
+            sim.forces.append(BridgeConfig(suction).build())
         sim.controls = [StressServo("xy", 750.0, sim.controls[0].max_velocity),
                         ConstantStrainRate("z", 0.02 / (3000 * sim.dt), sim.walls.lengths()[2])]
         sim.run(3000)                                    # to 2 % axial strain

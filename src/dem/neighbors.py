@@ -275,8 +275,8 @@ def carry_pair_array(previous, values, row_start, pair_j):
 def build_contacts(position, radius, skin, previous=None):
     """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals,
     overlaps (new pairs: -inf, never touched) and every ``extra`` per-pair array from
-    ``previous`` if given. FloatingPointError if a position
-    is not finite (a diverged simulation would otherwise get a meaningless list)."""
+    ``previous`` if given. FloatingPointError if a position is not finite (a diverged
+    simulation would otherwise get a meaningless list)."""
     if not np.isfinite(position).all():
         particle = int(np.argwhere(~np.isfinite(position))[0, 0])
         raise FloatingPointError(
