@@ -19,12 +19,15 @@ def _axes(names):
         raise ValueError(f"axes must be letters among 'x', 'y', 'z', got {names!r}") from None
 
 
-def move_walls(walls, wall_indices, outward, dt):
-    """Shift the given walls outward by ``outward`` [m] each and record their velocity."""
-    for w, shift in zip(wall_indices, outward):
+@numba.njit(cache=True)
+def move_walls(wall_position, wall_velocity, wall_indices, outward, dt):
+    """Shift the walls ``wall_indices`` outward by ``outward`` [m] each and record their
+    velocity [m/s] over the step ``dt`` [s]."""
+    for slot in range(len(wall_indices)):
+        w = wall_indices[slot]
         sign = 1.0 if w % 2 else -1.0
-        walls.position[w] += sign * shift
-        walls.velocity[w] = shift / dt
+        wall_position[w] += sign * outward[slot]
+        wall_velocity[w] = outward[slot] / dt
 
 
 @numba.njit(cache=True)
@@ -52,11 +55,7 @@ def servo_walls(wall_position, wall_velocity, wall_force, wall_stiffness, stiffn
         else:
             shift = -cap
         previous[slot] = gain * shift + memory * previous[slot]
-    for slot in range(len(walls)):
-        w = walls[slot]
-        sign = 1.0 if w % 2 else -1.0
-        wall_position[w] += sign * previous[slot]
-        wall_velocity[w] = previous[slot] / dt
+    move_walls(wall_position, wall_velocity, walls, previous, dt)
 
 
 class WallForces:
@@ -129,6 +128,8 @@ class ConstantStrainRate:
         self.rate = check_range("strain_rate", rate, -1e6, 1e6, unit="1/s")
         self.reference_length = check_positive("reference_length", reference_length, "m")
         self.on_current_length = bool(on_current_length)
+        self._walls = np.array([2 * self.axis, 2 * self.axis + 1], dtype=np.int64)
+        self._shift = np.zeros(2)
 
     def strain(self, walls):
         """Engineering strain of the axis, compression positive."""
@@ -150,7 +151,8 @@ class ConstantStrainRate:
         return int(np.ceil(np.log1p(-strain) / np.log(factor)))
 
     def apply(self, sim):
-        length = (sim.walls.lengths()[self.axis] if self.on_current_length
-                  else self.reference_length)
-        shift = -0.5 * self.rate * length * sim.dt
-        move_walls(sim.walls, (2 * self.axis, 2 * self.axis + 1), (shift, shift), sim.dt)
+        walls = sim.walls
+        length = (walls.position[2 * self.axis + 1] - walls.position[2 * self.axis]
+                  if self.on_current_length else self.reference_length)
+        self._shift[:] = -0.5 * self.rate * length * sim.dt
+        move_walls(walls.position, walls.velocity, self._walls, self._shift, sim.dt)
