@@ -27,8 +27,8 @@ Writes DIR/tradeoff.json (``arguments``, ``suction``, ``confining``, ``reference
 knob, value, settings, particles, wall_time_s, cpu_time_s, steps, wetting_steps,
 particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_strain_at_peak,
 peak_q_error, saturation_error, stress_ratio_error, error; ``noise``: the same for each other
-seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors), DIR/tradeoff.md with a
-recommendation per use (quick look, paper figure) and DIR/tradeoff.png; ``docs`` copies the
+seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors),
+DIR/tradeoff.md with a recommendation per use (quick look, paper figure) and DIR/tradeoff.png; ``docs`` copies the
 three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
 result and the run's configuration); run again, a study reuses a finished run only when its
 stored configuration equals the wanted one (pendular.config.config_json).
