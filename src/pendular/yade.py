@@ -30,6 +30,7 @@ import time
 import numpy as np
 
 import capillary
+from dem import OPENMP_DEFAULTS
 from dem.preparation import PREPARATION_VERSION, PrepareConfig, prepare_sample
 from dem.sample import load_sample, save_sample
 from dem.yade_io import read_plot_data
@@ -57,9 +58,10 @@ def find_yade():
 def yade_environment(extra=None):
     """os.environ for a YADE subprocess: without VIRTUAL_ENV, PYTHONPATH and PYTHONHOME, which
     make YADE's system Python load a virtual environment's packages (numpy, matplotlib) built
-    for another interpreter; plus ``extra`` variables."""
+    for another interpreter, and without the OpenMP settings pendular made for itself
+    (dem.OPENMP_DEFAULTS: YADE runs as a user would run it); plus ``extra`` variables."""
     environment = {key: value for key, value in os.environ.items()
-                   if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME")}
+                   if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", *OPENMP_DEFAULTS)}
     environment.update(extra or {})
     return environment
 
