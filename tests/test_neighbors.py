@@ -1,12 +1,18 @@
 """Verlet list against brute force; contact history survives rebuilds; the list reaches as
 far as the forces ask (``reach(sim)``)."""
 
+import copy
+import dataclasses
+
 import numpy as np
 import pytest
 
 from conftest import RADIUS, two_body_scene
+from dem.contact_law import pair_forces
 from dem.neighbors import build_contacts, spatial_order
-from dem.preparation import PrepareConfig, prepare_sample
+from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
+from dem.walls import ConstantStrainRate, StressServo
+from pendular.config import BridgeConfig
 
 
 def brute_force_pairs(position, radius, skin):
@@ -116,7 +122,7 @@ def test_spatial_order_walks_the_cells_along_the_z_curve():
 
 def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory():
     """The preparation numbers particles along the curve: the pairs' mean index distance is
-    under 40 % of the same packing's numbered at random (28 % measured at 1,000 spheres)."""
+    under 40 % of the same packing's numbered at random (about 28 % at 1,000 spheres)."""
     config = PrepareConfig(particles=1000, confining=750.0)
     sim, _ = prepare_sample(config, progress=False)
     i, j = sim.contacts.pair_i, sim.contacts.pair_j
@@ -128,8 +134,6 @@ def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
     """The first evaluation after a rebuild knows which pairs were touching: one found apart
     there drops its shear force, as it would on any other step (it once kept it, and started
     its next contact from a stale spring)."""
-    from dem.contact_law import pair_forces
-
     radius = np.full(2, RADIUS)
     touching = np.array([[0.0, 0, 0], [1.999 * RADIUS, 0, 0]])
     contacts = build_contacts(touching, radius, 0.5 * RADIUS)
@@ -155,13 +159,6 @@ def test_a_shear_does_not_depend_on_the_skin(suction):
     """The skin only decides when the list is rebuilt: contacts open and close (and bridges
     form and break) on rebuild steps as on any other, so a shear with a thin and a thick skin
     is the same to the bit, dry or wet."""
-    import copy
-    import dataclasses
-
-    from dem.preparation import servoed_simulation
-    from dem.walls import ConstantStrainRate, StressServo
-    from pendular.config import BridgeConfig
-
     config = PrepareConfig(particles=300, confining=750.0)
     sample, _ = prepare_sample(config, progress=False)
     runs = []
