@@ -8,9 +8,10 @@ OpenMP threads wait for the next parallel region by spinning; libgomp's default 
 (GOMP_SPINCOUNT 300,000) made a 2-thread run on a machine with one busy core 6-10 times slower
 than on a quiet one (10,000 spheres, dry: 1.0-1.8 against 10.1 M particle-steps/s). Unless the
 environment says otherwise, pendular sets GOMP_SPINCOUNT to 5,000 before OpenMP starts: the
-same run then does 10.0 M quiet (10.3 M with libgomp's default) and 4.5 M with a busy core (one
-thread does 5.6 M there: with other jobs on the machine, one thread per run is still faster). OPENMP_DEFAULTS
-holds what was set, so that other programs started from here (YADE) run with their own.
+same run then does 10.0 M quiet (10.3 M with libgomp's default) and 4.5 M with a busy core
+(one thread does 5.6 M there: with other jobs on the machine, one thread per run is still
+faster). OPENMP_DEFAULTS holds what was set, so that other programs started from here (YADE)
+run with their own.
 """
 
 import os

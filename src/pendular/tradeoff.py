@@ -28,8 +28,8 @@ knob, value, settings, particles, wall_time_s, cpu_time_s, steps, wetting_steps,
 particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_strain_at_peak,
 peak_q_error, saturation_error, stress_ratio_error, error; ``noise``: the same for each other
 seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors),
-DIR/tradeoff.md with a recommendation per use (quick look, paper figure) and DIR/tradeoff.png; ``docs`` copies the
-three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
+DIR/tradeoff.md with a recommendation per use (quick look, paper figure) and DIR/tradeoff.png;
+``docs`` copies the three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
 result and the run's configuration); run again, a study reuses a finished run only when its
 stored configuration equals the wanted one (pendular.config.config_json).
 """
@@ -306,7 +306,7 @@ def fastest_within(rows, bound, default_time):
 
 # ---------------------------------------------------------------- report
 
-def write_markdown(path, study, reference, rows, noise):
+def write_markdown(path, study, reference, rows, noise, floor):
     centre = settings(study.default())
     default = next(r for r in rows if r["knob"] != "combined" and r["settings"] == centre
                    and r["particles"] == study.particles)
@@ -332,7 +332,6 @@ def write_markdown(path, study, reference, rows, noise):
                      f"{r['wall_time_s']:.1f} | {r['particle_steps_per_s'] / 1e6:.2f} | "
                      f"{100 * r['peak_q_error']:.2f} % | {100 * r['saturation_error']:.2f} % | "
                      f"{100 * r['stress_ratio_error']:.2f} % | {100 * r['error']:.2f} % |")
-    floor = noise_floor(noise)
     lines += ["", "## Noise floor", "",
               f"The reference settings on {len(noise)} other samples (seeds "
               f"{', '.join(str(r['seed']) for r in noise)}, prepared the same way) differ from "
@@ -413,12 +412,13 @@ def write_study(study, *, docs=None, log=None):
     with OutputFolder(study.out, "tradeoff") as folder:
         paths = {name.rsplit(".", 1)[1]: folder.claim(name) for name in OUTPUTS}
         reference, rows, noise = measure(study, log)
+        floor = noise_floor(noise)
         data = {"arguments": {**dataclasses.asdict(study), "docs": docs},
                 "suction": SUCTION, "confining": CONFINING, "reference": reference,
-                "rows": rows, "noise": noise, "noise_floor": noise_floor(noise)}
+                "rows": rows, "noise": noise, "noise_floor": floor}
         write_json(paths["json"], data)
-        write_markdown(paths["md"], study, reference, rows, noise)
-        plot(paths["png"], rows, data["noise_floor"]["error"])
+        write_markdown(paths["md"], study, reference, rows, noise, floor)
+        plot(paths["png"], rows, floor["error"])
     if docs is not None:
         for path in paths.values():
             shutil.copy(path, docs)
