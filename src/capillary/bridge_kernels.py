@@ -17,6 +17,8 @@ import math
 import numba
 import numpy as np
 
+from dem.neighbors import branch_vector
+
 from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
 from capillary.table import lookup_interface, lookup_suction
 from capillary.volume_table import lookup_volume, lookup_volume_interface
@@ -56,10 +58,8 @@ def _apply_along(k, magnitude, n0, n1, n2, pair_force):
 
 
 @numba.njit(cache=True, inline="always")
-def _apply_across_gap(k, position, i, j, magnitude, pair_force):
-    d0 = position[j, 0] - position[i, 0]
-    d1 = position[j, 1] - position[i, 1]
-    d2 = position[j, 2] - position[i, 2]
+def _apply_across_gap(k, position, i, j, image, period, magnitude, pair_force):
+    d0, d1, d2 = branch_vector(position, i, j, image, k, period)
     inverse = 1.0 / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     _apply_along(k, magnitude, d0 * inverse, d1 * inverse, d2 * inverse, pair_force)
 
@@ -145,15 +145,17 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 
 
 @numba.njit(cache=True, parallel=True)
-def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
-                    filling_i, filling_j, pair_force, suction, surface_tension, radius_ratios,
-                    suction_axis, distance_low, log_distance_rupture, log_values):
+def suction_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
+                    volume, force, filling_i, filling_j, pair_force, suction, surface_tension,
+                    radius_ratios, suction_axis, distance_low, log_distance_rupture,
+                    log_values):
     """Suction-controlled bridges that persist across gaps (thesis Table 5.1, ``persist``).
 
     A bridge forms when the spheres touch and lives while the table has a bridge at the gap
     (d* = gap / R2 up to the rupture distance at u* = s R2 / gamma). At contact its values are
     cached (looked up once per contact); across a gap it is looked up each step and pulls along
-    the current branch vector. overlap and normal: the contact law's values of this step.
+    the current branch vector. overlap and normal: the contact law's values of this step;
+    image, period: the pairs' periodic images and the box period (dem.neighbors.branch_vector).
     suction [Pa], surface_tension [N/m]; the last five arguments are a BridgeTable's arrays().
     Fills the per-pair state and pair_force (force on j from i) [N].
     """
@@ -177,7 +179,7 @@ def suction_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vo
                        force, filling_i, filling_j)
                 volume[k] = volume_star * larger * larger * larger
                 state[k] = ACROSS_GAP
-                _apply_across_gap(k, position, i, j, force[k], pair_force)
+                _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
             else:
                 _clear(k, state, volume, force, filling_i, filling_j, pair_force)
         else:
@@ -193,10 +195,10 @@ FORMS_FROM_FILMS = 2
 
 
 @numba.njit(cache=True, parallel=True)
-def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, volume, force,
-                   filling_i, filling_j, bridge_suction, pair_force, formation_suction,
-                   surface_tension, roughness, suction_table, volume_table, closed, film,
-                   released, events):
+def volume_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
+                   volume, force, filling_i, filling_j, bridge_suction, pair_force,
+                   formation_suction, surface_tension, roughness, suction_table, volume_table,
+                   closed, film, released, events):
     """Volume-controlled bridges: formed at contact, then of constant volume; force and suction
     from (V*, d*) (capillary.lookup_volume), rupture where no bridge of that volume exists.
 
@@ -211,7 +213,8 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
     surfaces H = roughness R2 apart, thesis Ch. 4's H): d* = roughness at contact and
     gap / R2 + roughness across a gap; 0 for smooth spheres. A pair whose bridge at formation
     would not span H gets none.
-    suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable.
+    suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable;
+    image, period as suction_bridges.
     """
     marked = 0
     for k in numba.prange(len(pair_i)):
@@ -265,7 +268,7 @@ def volume_bridges(position, radius, pair_i, pair_j, overlap, normal, state, vol
             _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
         else:
             state[k] = ACROSS_GAP
-            _apply_across_gap(k, position, i, j, force[k], pair_force)
+            _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
     return marked
 
 
@@ -370,22 +373,24 @@ def bridges_across_gaps(radius, pair_i, pair_j, overlap, state, volume, formatio
 
 
 @numba.njit(cache=True, inline="always")
-def _bridge_gap_star(position, radius, i, j, at_contact, roughness):
-    """(R2, r, d*) of the bridge between i and j as the bridge kernels read it: d* = roughness
+def _bridge_gap_star(position, radius, pair_i, pair_j, image, period, k, at_contact,
+                     roughness):
+    """(R2, r, d*) of the bridge of pair k as the bridge kernels read it: d* = roughness
     at contact, roughness + gap / R2 across a gap."""
+    i = pair_i[k]
+    j = pair_j[k]
     larger = max(radius[i], radius[j])
     gap = 0.0
     if not at_contact:
-        distance = math.sqrt((position[j, 0] - position[i, 0]) ** 2
-                             + (position[j, 1] - position[i, 1]) ** 2
-                             + (position[j, 2] - position[i, 2]) ** 2)
+        d0, d1, d2 = branch_vector(position, i, j, image, k, period)
+        distance = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         gap = max(distance - radius[i] - radius[j], 0.0)
     return larger, larger / min(radius[i], radius[j]), roughness + gap / larger
 
 
 @numba.njit(cache=True, parallel=True)
-def suction_interfaces(position, radius, pair_i, pair_j, state, index, suction, surface_tension,
-                       suction_table):
+def suction_interfaces(position, radius, pair_i, pair_j, image, period, state, index, suction,
+                       surface_tension, suction_table):
     """Liquid-gas interfaces of the suction-controlled bridges ``index`` (pair numbers) at the
     suction [Pa]: (B, 2) [m^2], per bridge nn11 = ∫ n_x n_x dS and nn33 = ∫ n_z n_z dS over
     its interface in the bridge frame (z along the branch vector; the area is 2 nn11 + nn33),
@@ -393,8 +398,8 @@ def suction_interfaces(position, radius, pair_i, pair_j, state, index, suction, 
     out = np.empty((len(index), 2))
     for b in numba.prange(len(index)):
         k = index[b]
-        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i[k], pair_j[k],
-                                                        state[k] == AT_CONTACT, 0.0)
+        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i, pair_j, image,
+                                                        period, k, state[k] == AT_CONTACT, 0.0)
         _, nn11, nn33 = lookup_interface(
             suction_table[0], suction_table[1], suction_table[2], suction_table[3],
             suction_table[4], ratio, suction * larger / surface_tension, distance_star)
@@ -404,8 +409,8 @@ def suction_interfaces(position, radius, pair_i, pair_j, state, index, suction, 
 
 
 @numba.njit(cache=True, parallel=True)
-def volume_interfaces(position, radius, pair_i, pair_j, state, index, volume, roughness,
-                      volume_table):
+def volume_interfaces(position, radius, pair_i, pair_j, image, period, state, index, volume,
+                      roughness, volume_table):
     """As suction_interfaces for volume-controlled bridges, from the volume table at each
     bridge's volume [m^3] and gap (d* with the roughness): a bridge near its volume-controlled
     rupture is off the stable branch of the suction-controlled family, so its suction alone does
@@ -413,8 +418,9 @@ def volume_interfaces(position, radius, pair_i, pair_j, state, index, volume, ro
     out = np.empty((len(index), 2))
     for b in numba.prange(len(index)):
         k = index[b]
-        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i[k], pair_j[k],
-                                                        state[k] == AT_CONTACT, roughness)
+        larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i, pair_j, image,
+                                                        period, k, state[k] == AT_CONTACT,
+                                                        roughness)
         _, nn11, nn33 = lookup_volume_interface(
             volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
             ratio, volume[k] / (larger * larger * larger), distance_star)
@@ -425,7 +431,7 @@ def volume_interfaces(position, radius, pair_i, pair_j, state, index, volume, ro
 
 @numba.njit(cache=True, parallel=True)
 def pendular_overlap_counts(position, row_start, second_start, second_pair, pair_i, pair_j,
-                            state, filling_i, filling_j):
+                            image, period, state, filling_i, filling_j):
     """Per particle, the number of pairs of its menisci that overlap (SPEC section 4 pendular
     limit): two wetted caps whose normals are separated by less than the sum of their filling
     angles (YADE's Law2_ScGeom_CapillaryPhys_Capillarity fusion test)."""
@@ -439,17 +445,20 @@ def pendular_overlap_counts(position, row_start, second_start, second_pair, pair
         for slot in range(size):
             if slot < row_start[p + 1] - row_start[p]:
                 k = row_start[p] + slot
-                other = pair_j[k]
+                sign = 1.0
                 cap = filling_i[k]
             else:
                 k = second_pair[second_start[p] + slot - (row_start[p + 1] - row_start[p])]
-                other = pair_i[k]
+                sign = -1.0
                 cap = filling_j[k]
             if state[k] == NO_BRIDGE:
                 continue
+            d0, d1, d2 = branch_vector(position, pair_i[k], pair_j[k], image, k, period)
+            direction[found, 0] = sign * d0
+            direction[found, 1] = sign * d1
+            direction[found, 2] = sign * d2
             length = 0.0
             for c in range(3):
-                direction[found, c] = position[other, c] - position[p, c]
                 length += direction[found, c] ** 2
             length = math.sqrt(length)
             for c in range(3):

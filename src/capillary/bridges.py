@@ -373,16 +373,16 @@ class CapillaryBridges:
                                    c.second_pair, p.force)
             return
         if self.control == "suction":
-            suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal,
-                            b.state, b.volume, b.force, b.filling_i, b.filling_j,
-                            self.pair_force, self.suction, self.surface_tension,
+            suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period,
+                            c.overlap, c.normal, b.state, b.volume, b.force, b.filling_i,
+                            b.filling_j, self.pair_force, self.suction, self.surface_tension,
                             *self._table_arrays)
         else:
             closed = self.liquid != "reservoir"
             events = volume_bridges(
-                p.position, p.radius, c.pair_i, c.pair_j, c.overlap, c.normal, b.state,
-                b.volume, b.force, b.filling_i, b.filling_j, b.suction, self.pair_force,
-                self.suction, self.surface_tension, self.roughness, self._table_arrays,
+                p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period, c.overlap,
+                c.normal, b.state, b.volume, b.force, b.filling_i, b.filling_j, b.suction,
+                self.pair_force, self.suction, self.surface_tension, self.roughness, self._table_arrays,
                 self.volume_table.arrays(), closed, self.film, self._released, self._events)
             if events:
                 self.liquid_lost += exchange_liquid(
@@ -485,11 +485,12 @@ class CapillaryBridges:
         index = np.ascontiguousarray(index, dtype=np.int64)
         p, c = sim.particles, sim.contacts
         if self.control == "volume":
-            return volume_interfaces(p.position, p.radius, c.pair_i, c.pair_j, state.state,
-                                     index, state.volume, self.roughness,
-                                     self.volume_table.arrays())
-        return suction_interfaces(p.position, p.radius, c.pair_i, c.pair_j, state.state, index,
-                                  self.suction, self.surface_tension, self._table_arrays)
+            return volume_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
+                                     sim.walls.period, state.state, index, state.volume,
+                                     self.roughness, self.volume_table.arrays())
+        return suction_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
+                                  sim.walls.period, state.state, index, self.suction,
+                                  self.surface_tension, self._table_arrays)
 
     def pendular_overlaps(self, sim):
         """Number of pairs of overlapping menisci on a same particle, summed over particles."""
@@ -497,4 +498,4 @@ class CapillaryBridges:
         c = sim.contacts
         return int(np.sum(pendular_overlap_counts(
             sim.particles.position, c.row_start, c.second_start, c.second_pair, c.pair_i,
-            c.pair_j, b.state, b.filling_i, b.filling_j)))
+            c.pair_j, c.image, sim.walls.period, b.state, b.filling_i, b.filling_j)))

@@ -66,7 +66,11 @@ DATASETS = {
         "velocity": ("m/s", "outward wall speeds of the last step (6,)"),
         "force": ("N", "normal force of the particles on each wall, compression positive"),
         "stiffness": ("N/m", "sum of the normal stiffnesses of each wall's contacts"),
-        "moment": ("N m", "sum over each wall's contacts of distance * force")},
+        "moment": ("N m", "sum over each wall's contacts of distance * force"),
+        "rate": ("1/s", "periodic cell: stretching rate L'/L of each axis, extension positive"),
+        "stress_tensor": ("Pa", "periodic cell: Love-Weber stress of the pair forces (3, 3), "
+                                "compression positive"),
+        "wraps": ("1", "periodic cell: periods crossed by each particle (N, 3)")},
     "contacts": {
         "pair_i": ("1", "first particle of each candidate pair (K,), i < j"),
         "pair_j": ("1", "second particle of each candidate pair (K,)"),
@@ -79,7 +83,8 @@ DATASETS = {
         "normal_force": ("N", "magnitude of the spring normal force (0 when apart)"),
         "force": ("N", "total contact force on j from i (K, 3)"),
         "torque_i": ("N m", "contact torque on i (K, 3)"),
-        "torque_j": ("N m", "contact torque on j (K, 3)")},
+        "torque_j": ("N m", "contact torque on j (K, 3)"),
+        "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L")},
     "": {"state": ("1", "pickled state of every operation and writer and the caller's "
                         "extra_state (bytes; see dem.checkpoint)")},
 }

@@ -20,15 +20,19 @@ def _damped(force, velocity, acceleration_dt, damping):
 
 
 @numba.njit(cache=True, parallel=True)
-def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping, dt):
-    """Advance velocities to t + dt/2 and positions to t + dt (spheres: no orientation needed)."""
+def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+             affine_rate, dt):
+    """Advance velocities to t + dt/2 and positions to t + dt (spheres: no orientation needed).
+
+    affine_rate (3,) [1/s]: a periodic cell's homogeneous stretching (dem.cell), the velocity
+    affine_rate * x carrying every particle on top of its own; zeros inside walls."""
     for p in numba.prange(position.shape[0]):
         inverse_mass = 1.0 / mass[p]
         inverse_inertia = 1.0 / inertia[p]
         for c in range(3):
             f = _damped(force[p, c], velocity[p, c], force[p, c] * inverse_mass * dt, damping)
             velocity[p, c] += f * inverse_mass * dt
-            position[p, c] += velocity[p, c] * dt
+            position[p, c] += (velocity[p, c] + affine_rate[c] * position[p, c]) * dt
             t = _damped(torque[p, c], angular_velocity[p, c], torque[p, c] * inverse_inertia * dt,
                         damping)
             angular_velocity[p, c] += t * inverse_inertia * dt
@@ -51,4 +55,4 @@ class Integrator:
     def apply(self, sim):
         p = sim.particles
         leapfrog(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass, p.inertia,
-                 self.damping, sim.dt)
+                 self.damping, sim.walls.affine_rate, sim.dt)

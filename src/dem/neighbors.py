@@ -31,6 +31,8 @@ class Contacts:
     force: (K, 3) total contact force on j from i [N]; torque_i, torque_j: (K, 3) [N m].
     extra: name -> (K, ...) per-pair state owned by other operations (e.g. capillary bridges),
     carried to the same pair by ``build_contacts``; absent pairs start at 0.
+    image: (K, 3) int8 periodic image of j seen from i: the branch vector is
+    x_j - x_i + image * period (``branch_vector``; zeros inside walls).
     """
 
     pair_i: np.ndarray
@@ -46,6 +48,11 @@ class Contacts:
     torque_i: np.ndarray
     torque_j: np.ndarray
     extra: dict = field(default_factory=dict)
+    image: np.ndarray = None
+
+    def __post_init__(self):
+        if self.image is None:
+            self.image = np.zeros((len(self.pair_j), 3), np.int8)
 
     def __len__(self):
         return len(self.pair_i)
@@ -53,6 +60,15 @@ class Contacts:
     def touching(self):
         """Boolean mask of pairs in mechanical contact (overlap > 0)."""
         return self.overlap > 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def branch_vector(position, i, j, image, k, period):
+    """Branch vector of pair k from i to j [m]: x_j - x_i + image_k * period (the periodic
+    image of j nearest to i; period zeros inside walls)."""
+    return (position[j, 0] - position[i, 0] + image[k, 0] * period[0],
+            position[j, 1] - position[i, 1] + image[k, 1] * period[1],
+            position[j, 2] - position[i, 2] + image[k, 2] * period[2])
 
 
 @numba.njit(cache=True)
@@ -166,6 +182,116 @@ def build_pairs(position, radius, skin):
 
 
 @numba.njit(cache=True)
+def _periodic_grid(position, cell_size, period):
+    """Sort particles (wrapped into [0, period)) into cells of edge at least ``cell_size``
+    tiling the periodic box, at least 3 a side (so the 27 cells around a cell are distinct)."""
+    count = position.shape[0]
+    dims = np.empty(3, np.int64)
+    for axis in range(3):
+        dims[axis] = max(3, int(period[axis] / cell_size))
+    cell_of = np.empty(count, np.int64)
+    for p in range(count):
+        index = 0
+        for axis in range(3):
+            c = int(position[p, axis] / period[axis] * dims[axis])
+            c = min(max(c, 0), dims[axis] - 1)
+            index = index * dims[axis] + c
+        cell_of[p] = index
+    cell_count = dims[0] * dims[1] * dims[2]
+    cell_start = np.zeros(cell_count + 1, np.int64)
+    for p in range(count):
+        cell_start[cell_of[p] + 1] += 1
+    for c in range(cell_count):
+        cell_start[c + 1] += cell_start[c]
+    fill = cell_start[:-1].copy()
+    cell_particles = np.empty(count, np.int64)
+    for p in range(count):
+        cell_particles[fill[cell_of[p]]] = p
+        fill[cell_of[p]] += 1
+    return dims, cell_of, cell_start, cell_particles
+
+
+@numba.njit(cache=True)
+def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
+                           cell_particles, out, out_image):
+    """As _neighbors_of in a periodic box: the sorted j > p within r_p + r_j + skin of p
+    through the nearest image, written with that image into ``out`` and ``out_image``."""
+    found = 0
+    cell = cell_of[p]
+    centre = (cell // (dims[1] * dims[2]), (cell // dims[2]) % dims[1], cell % dims[2])
+    shift = np.zeros(3, np.int64)
+    neighbour = np.zeros(3, np.int64)
+    for dx in range(-1, 2):
+        for dy in range(-1, 2):
+            for dz in range(-1, 2):
+                offset = (dx, dy, dz)
+                for axis in range(3):
+                    c = centre[axis] + offset[axis]
+                    shift[axis] = 0
+                    if c < 0:
+                        c += dims[axis]
+                        shift[axis] = -1
+                    elif c >= dims[axis]:
+                        c -= dims[axis]
+                        shift[axis] = 1
+                    neighbour[axis] = c
+                c = (neighbour[0] * dims[1] + neighbour[1]) * dims[2] + neighbour[2]
+                for slot in range(cell_start[c], cell_start[c + 1]):
+                    q = cell_particles[slot]
+                    if q <= p:
+                        continue
+                    reach = radius[p] + radius[q] + skin
+                    d0 = position[q, 0] + shift[0] * period[0] - position[p, 0]
+                    d1 = position[q, 1] + shift[1] * period[1] - position[p, 1]
+                    d2 = position[q, 2] + shift[2] * period[2] - position[p, 2]
+                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                        k = found
+                        while k > 0 and out[k - 1] > q:
+                            out[k] = out[k - 1]
+                            out_image[k] = out_image[k - 1]
+                            k -= 1
+                        out[k] = q
+                        for axis in range(3):
+                            out_image[k, axis] = shift[axis]
+                        found += 1
+    return found
+
+
+@numba.njit(cache=True, parallel=True)
+def build_periodic_pairs(position, radius, skin, period):
+    """Half Verlet list of a periodic box (positions wrapped into [0, period)): CSR arrays
+    (row_start, pair_j) and each pair's image (K, 3) int8 (branch_vector). The box must be at
+    least 3 cells of 2 max(radius) + skin a side, so that a pair has one image in reach."""
+    count = position.shape[0]
+    cell_size = 2.0 * radius.max() + skin
+    dims, cell_of, cell_start, cell_particles = _periodic_grid(position, cell_size, period)
+    max_row = 0
+    for c in range(len(cell_start) - 1):
+        max_row = max(max_row, cell_start[c + 1] - cell_start[c])
+    max_row *= 27
+    row_count = np.zeros(count, np.int64)
+    for p in numba.prange(count):
+        scratch = np.empty(max_row, np.int64)
+        scratch_image = np.empty((max_row, 3), np.int8)
+        row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
+                                              cell_start, cell_particles, scratch,
+                                              scratch_image)
+    row_start = np.zeros(count + 1, np.int64)
+    for p in range(count):
+        row_start[p + 1] = row_start[p] + row_count[p]
+    pair_j = np.empty(row_start[count], np.int64)
+    image = np.empty((row_start[count], 3), np.int8)
+    for p in numba.prange(count):
+        scratch = np.empty(max_row, np.int64)
+        scratch_image = np.empty((max_row, 3), np.int8)
+        found = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
+                                       cell_start, cell_particles, scratch, scratch_image)
+        pair_j[row_start[p]:row_start[p] + found] = scratch[:found]
+        image[row_start[p]:row_start[p] + found] = scratch_image[:found]
+    return row_start, pair_j, image
+
+
+@numba.njit(cache=True)
 def second_index(row_start, pair_j, count):
     """For each particle, the pair indices in which it is the second member (CSR)."""
     second_start = np.zeros(count + 1, np.int64)
@@ -242,6 +368,16 @@ def gather_pair_vectors(pair_vector, row_start, second_start, second_pair, out):
         out[p, 2] += v2
 
 
+def branch_vectors(position, contacts, period, index=None):
+    """Branch vectors i -> j [m] (B, 3) of the pairs ``index`` (all if None) of ``contacts``:
+    x_j - x_i + image * period (branch_vector; ``period`` (3,) [m], zeros inside walls)."""
+    index = np.arange(len(contacts)) if index is None else index
+    branch = position[contacts.pair_j[index]] - position[contacts.pair_i[index]]
+    if np.any(period):
+        branch += contacts.image[index] * np.asarray(period)
+    return branch
+
+
 def spatial_order(position, cell_size):
     """Permutation [-] that lists particles cell by cell along a Z-order (Morton) curve through a
     grid of cells of edge ``cell_size`` [m], in index order within a cell.
@@ -272,18 +408,31 @@ def carry_pair_array(previous, values, row_start, pair_j):
     return carried
 
 
-def build_contacts(position, radius, skin, previous=None):
+def build_contacts(position, radius, skin, previous=None, period=None):
     """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals,
     overlaps (new pairs: -inf, never touched) and every ``extra`` per-pair array from
-    ``previous`` if given. FloatingPointError if a position is not finite (a diverged
-    simulation would otherwise get a meaningless list)."""
+    ``previous`` if given. ``period`` (3,) [m]: a periodic box [0, period) holding the
+    positions, pairs through the nearest image (ValueError if the box is narrower than 3
+    times 2 max(radius) + skin on an axis). FloatingPointError if a position is not finite (a
+    diverged simulation would otherwise get a meaningless list)."""
     if not np.isfinite(position).all():
         particle = int(np.argwhere(~np.isfinite(position))[0, 0])
         raise FloatingPointError(
             f"position of particle {particle} = {position[particle].tolist()} is not finite: the "
             "simulation diverged (lower the time step, e.g. timestep_safety, or check the forces)")
     count = len(radius)
-    row_start, pair_j = build_pairs(position, radius, skin)
+    if period is None:
+        row_start, pair_j = build_pairs(position, radius, skin)
+        image = None
+    else:
+        narrowest = 3.0 * (2.0 * float(radius.max()) + skin)
+        if np.min(period) < narrowest:
+            raise ValueError(
+                f"periodic cell edges {np.asarray(period).tolist()} m: valid range at least "
+                f"{narrowest:g} m (3 times the largest diameter plus the neighbour reach "
+                f"{skin:g} m); use more particles")
+        row_start, pair_j, image = build_periodic_pairs(position, radius, skin,
+                                                        np.asarray(period, dtype=np.float64))
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
     second_start, second_pair = second_index(row_start, pair_j, count)
     size = len(pair_j)
@@ -306,7 +455,7 @@ def build_contacts(position, radius, skin, previous=None):
         normal=np.ascontiguousarray(history[:, 3:6]),
         overlap=np.ascontiguousarray(history[:, 6]), normal_force=np.zeros(size),
         force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)),
-        extra=extra)
+        extra=extra, image=image)
 
 
 class NeighborList:
@@ -326,6 +475,7 @@ class NeighborList:
         self.interaction_range = 0.0
         self._reference_position = None
         self._reference_radius = None
+        self._reference_lengths = None
 
     def required_reach(self, sim):
         """Largest reach [m] the simulation's forces declare (0: contacts only)."""
@@ -340,19 +490,27 @@ class NeighborList:
         """Rebuild the list now (``apply`` does when needed; dem.preparation.rescale after
         scaling every length)."""
         p = sim.particles
+        box = sim.walls
+        box.wrap(p)
         sim.contacts = build_contacts(p.position, p.radius, self.skin + self.interaction_range,
-                                      previous=sim.contacts)
+                                      previous=sim.contacts,
+                                      period=box.period if box.periodic else None)
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
+        self._reference_lengths = box.lengths()
         self.rebuilds += 1
 
     def apply(self, sim):
         p = sim.particles
         reach = self.required_reach(sim)
+        # a periodic box that changed size by dL moves pairs across its faces by up to dL
+        limit = 0.5 * self.skin
+        if sim.walls.periodic and self._reference_lengths is not None:
+            limit -= 0.5 * float(np.max(np.abs(sim.walls.lengths() - self._reference_lengths)))
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
-                or len(self._reference_radius) != len(p.radius)
+                or len(self._reference_radius) != len(p.radius) or limit <= 0.0
                 or moved_beyond(p.position, self._reference_position, p.radius,
-                                self._reference_radius, 0.5 * self.skin)):
+                                self._reference_radius, limit)):
             self.interaction_range = reach
             self.rebuild(sim)

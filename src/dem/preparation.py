@@ -8,6 +8,10 @@
 4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
    target lowered slowly to the confining stress, and equilibrium again.
 
+With ``periodic`` the box is a periodic cell (dem.cell) instead of six walls: the same
+procedure, the cell's stress (the Love–Weber stress of the contacts) servoed instead of the
+walls'; no wall layers.
+
 The phases, by name (PREPARATION_PHASES): "growth" (2), "friction" (equilibrium at the test
 friction, 4), "unload" (4), "equilibrate" (at the confining stress, 4). Writers passed to
 ``prepare_sample`` watch all of them (e.g. ParaView frames, pendular.vtk.VtkWriter).
@@ -18,6 +22,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from .cell import PeriodicCell
 from .contact_law import ContactForces
 from .grading import check_grading_curve, check_spread, grading, sample_radii
 from .integrate import Integrator, pwave_timestep
@@ -254,6 +259,7 @@ class PrepareConfig:
     uniform in radius (1 ± S), ``radius`` their mean; with ``psd``, a grading curve
     ((diameter [m], percent passing by mass), ...), the curve's own sizes, ``radius`` set on
     creation to their mean. Largest / smallest radius at most dem.grading.MAX_RADIUS_RATIO.
+    ``periodic``: the sample fills a periodic cell (dem.cell) instead of a box of six walls.
     """
 
     particles: int = 10000
@@ -275,6 +281,7 @@ class PrepareConfig:
     equilibrium_unbalanced: float = 0.01
     stress_tolerance: float = 0.01
     unload_steps: int = 10000
+    periodic: bool = False
 
     def __post_init__(self):
         self.particles = check_int("particles", self.particles, low=2, high=MAX_PARTICLES)
@@ -308,6 +315,9 @@ class PrepareConfig:
         self.equilibrium_unbalanced = check_positive("equilibrium_unbalanced",
                                                      self.equilibrium_unbalanced)
         self.stress_tolerance = check_positive("stress_tolerance", self.stress_tolerance)
+        if not isinstance(self.periodic, (bool, np.bool_)):
+            raise ValueError(f"periodic = {self.periodic!r}: valid values True or False")
+        self.periodic = bool(self.periodic)
 
     @property
     def graded(self):
@@ -351,11 +361,14 @@ def equilibrated(config):
 
 def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m], linear
-    contacts at ``friction_deg`` [deg], wall springs, the given wall ``controls``, leapfrog."""
+    contacts at ``friction_deg`` [deg], wall springs (none in a periodic cell), the given
+    wall ``controls``, leapfrog."""
+    forces = [ContactForces(config.young, config.shear_ratio, friction_deg)]
+    if not walls.periodic:
+        forces.append(WallForces(config.young))
     return Simulation(particles, walls, dt,
                       neighbors=NeighborList(skin),
-                      forces=[ContactForces(config.young, config.shear_ratio, friction_deg),
-                              WallForces(config.young)],
+                      forces=forces,
                       controls=controls,
                       integrator=Integrator(config.damping),
                       threads=threads)
@@ -413,7 +426,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     # numbered along a space-filling curve: neighbours near in memory for the whole test
     order = spatial_order(position, 2.0 * float(radii.max()))
     particles = Particles(position[order], cloud_radius[order], config.density)
-    walls = Walls.box(lo, hi)
+    walls = (PeriodicCell if config.periodic else Walls).box(lo, hi)
     growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
     sim = dry_simulation(particles, walls, config, timestep(particles, config),
                          config.skin_factor * config.radius, config.prep_friction_deg, [growth],
@@ -468,6 +481,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         "dt": sim.dt,
         "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
         "grading": grading(sim.particles.radius),
+        "periodic": sim.walls.periodic,
     }
     return sim, report
 

@@ -7,7 +7,9 @@ refuses a sample made with another radius, particle count or density than the ru
 
 A sample describes itself: every dataset has ``units`` and ``description`` attributes
 (DATASETS), the file the attributes ``pendular_version``, ``schema_version`` (the layout
-version, VERSION), ``format``, ``density`` [kg/m^3], ``report`` and ``config`` (JSON).
+version, VERSION), ``format``, ``density`` [kg/m^3], ``periodic`` (the box is a periodic
+cell, dem.cell, instead of walls; positions saved wrapped into it), ``report`` and ``config``
+(JSON).
 """
 
 import json
@@ -20,6 +22,7 @@ import numpy as np
 from .atomic import replacing
 from .grading import GRADING_UNITS, grading
 from .integrity import config_hash, software_version, stamp, verify
+from .cell import PeriodicCell
 from .state import WALL_NAMES, Particles, Walls
 from .validate import reading
 
@@ -40,8 +43,8 @@ DATASETS = {
     "radius": ("m", "sphere radii (N,)"),
     "velocity": ("m/s", "sphere translational velocities (N, 3)"),
     "angular_velocity": ("rad/s", "sphere angular velocities (N, 3)"),
-    "walls": ("m", "wall plane coordinates along their axis (6,), ordered x-, x+, y-, y+, z-, "
-                   "z+ (dem.state.WALL_NAMES)"),
+    "walls": ("m", "wall plane (or periodic cell face) coordinates along their axis (6,), "
+                   "ordered x-, x+, y-, y+, z-, z+ (dem.state.WALL_NAMES)"),
 }
 
 RADIUS_TOLERANCE = 1e-9
@@ -58,9 +61,14 @@ def save_sample(path, sim, report=None, config=None, identity=None):
     ``identity`` (e.g. the seed)."""
     with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
         p = sim.particles
-        for name in ("position", "radius", "velocity", "angular_velocity"):
+        position = p.position
+        if sim.walls.periodic:          # a copy: the live list still holds its images
+            position = np.mod(position, sim.walls.lengths())
+        handle.create_dataset("position", data=position)
+        for name in ("radius", "velocity", "angular_velocity"):
             handle.create_dataset(name, data=getattr(p, name))
         handle.create_dataset("walls", data=sim.walls.position)
+        handle.attrs["periodic"] = bool(sim.walls.periodic)
         for name, (units, description) in DATASETS.items():
             handle[name].attrs["units"] = units
             handle[name].attrs["description"] = description
@@ -84,7 +92,8 @@ def _finite(source, name, values):
 
 
 def load_sample(path, expected=None, expected_identity=None):
-    """Read a sample written by ``save_sample``: (Particles, Walls, report dict, config dict).
+    """Read a sample written by ``save_sample``: (Particles, Walls or PeriodicCell, report dict,
+    config dict).
 
     The file's checksum and identity are verified first (dem.integrity.verify with
     ``expected_identity``), then its state (``check_packing``) and, if ``expected`` is given (a
@@ -98,6 +107,7 @@ def load_sample(path, expected=None, expected_identity=None):
         arrays = {name: handle[name][()] for name in ("position", "radius", "velocity",
                                                        "angular_velocity", "walls")}
         density = handle.attrs["density"]
+        periodic = bool(handle.attrs.get("periodic", False))
         report = json.loads(handle.attrs["report"])
         config = json.loads(handle.attrs["config"])
     for name, values in arrays.items():
@@ -108,12 +118,19 @@ def load_sample(path, expected=None, expected_identity=None):
         particles = Particles(arrays["position"], arrays["radius"], float(density),
                               velocity=arrays["velocity"],
                               angular_velocity=arrays["angular_velocity"])
-        walls = Walls(position=np.asarray(arrays["walls"], dtype=np.float64))
+        box = PeriodicCell if periodic else Walls
+        walls = box(position=np.asarray(arrays["walls"], dtype=np.float64))
     except (ValueError, TypeError) as error:
         raise ValueError(f"{source}: {error}") from None
     check_packing(particles, walls, source)
     if expected is not None:
         check_consistent(sample_parameters(particles), expected, source)
+        asked = _get(expected, "periodic")
+        if asked is not None and bool(asked) != periodic:
+            kinds = {True: "a periodic cell", False: "six walls"}
+            raise ValueError(f"{source} is a sample in {kinds[periodic]}; the run asks for "
+                             f"{kinds[bool(asked)]} (periodic = {bool(asked)}): prepare a "
+                             f"sample with periodic = {bool(asked)}")
     return particles, walls, report, config
 
 
@@ -245,7 +262,9 @@ def check_packing(particles, walls, source="sample"):
     """ValueError naming ``source`` and the offending spheres unless the state can enter a
     simulation: finite values; every sphere inside the box, its overlap with each wall at most
     MAX_OVERLAP of its radius; every pair overlapping by at most MAX_OVERLAP of the smaller
-    radius (found with a cell list, O(N)); not all centres at one point."""
+    radius (found with a cell list, O(N), not through the faces of a periodic cell); not all
+    centres at one point. A periodic cell (``walls.periodic``) has no walls: every centre
+    must lie in it."""
     position, radius = particles.position, particles.radius
     for name, values in (("position", position), ("radius", radius),
                          ("velocity", particles.velocity),
@@ -257,7 +276,16 @@ def check_packing(particles, walls, source="sample"):
     if count > 1 and float(extent.max()) <= 1e-9 * float(radius.max()):
         raise ValueError(f"{source}: all {count} particles are at one point "
                          f"{position[0].tolist()} m: not a packing (a damaged or edited file)")
-    overlaps = _wall_overlaps(position, radius, walls)
+    if walls.periodic:
+        outside = np.flatnonzero(np.any((position < walls.lo) | (position > walls.hi), axis=1))
+        if len(outside):
+            raise ValueError(
+                f"{source}: particle {int(outside[0])} (centre {position[outside[0]].tolist()} "
+                f"m) lies outside the periodic cell lo = {walls.lo.tolist()} m, hi = "
+                f"{walls.hi.tolist()} m; valid: every centre inside the cell")
+        overlaps = np.zeros((6, count))
+    else:
+        overlaps = _wall_overlaps(position, radius, walls)
     wall, sphere = np.unravel_index(int(np.argmax(overlaps)), overlaps.shape)
     if overlaps[wall, sphere] > MAX_OVERLAP:
         place = ("its centre lies outside the box" if overlaps[wall, sphere] > 1.0

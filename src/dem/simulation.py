@@ -10,8 +10,10 @@ shape)::
                integrator=Integrator(0.2),
                writers=[recorder])
 
-One step (``advance``): zero forces and torques, the neighbour list, every force, every
-control, the integrator; then step and time advance and the writers see the new state.
+One step (``advance``): zero forces and torques, the neighbour list, every force, what the box
+measures of them (a periodic cell: its stress), every control, the integrator; then step and
+time advance and the writers see the new state. The box is ``Walls`` (with ``WallForces``
+among the forces) or a ``dem.cell.PeriodicCell``.
 ``forces``, ``controls`` and ``writers`` are plain lists: a phase change replaces
 ``sim.controls``, wetting appends a force. An operation has ``apply(sim)``; a force that
 needs pairs beyond contact says so with ``reach(sim)`` [m] (dem.neighbors.NeighborList asks).
@@ -22,7 +24,7 @@ import time
 import numba
 from tqdm import tqdm
 
-from .state import Particles, Walls
+from .state import Box, Particles
 from .validate import check_int, check_positive
 
 #: Below this many particles a step is too short to pay for waking a second thread.
@@ -36,7 +38,8 @@ def _check_operation(op):
 
 
 class Simulation:
-    """Holds particles, walls, contacts, time step and the step pipeline.
+    """Holds particles, the box (``walls``: Walls or a PeriodicCell), contacts, time step and
+    the step pipeline.
 
     dt [s]; ``step`` and ``time`` [s] count from the start; ``contacts`` is filled by the
     neighbour list. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
@@ -45,7 +48,7 @@ class Simulation:
 
     def __init__(self, particles, walls, dt, *, neighbors, forces=(), controls=(),
                  integrator, writers=(), threads=None):
-        for name, value, kind in (("particles", particles, Particles), ("walls", walls, Walls)):
+        for name, value, kind in (("particles", particles, Particles), ("walls", walls, Box)):
             if not isinstance(value, kind):
                 raise TypeError(f"{name} must be a dem.state.{kind.__name__}, got "
                                 f"{type(value).__name__}")
@@ -78,13 +81,14 @@ class Simulation:
         raise KeyError(f"no {kind.__name__} operation in this simulation")
 
     def evaluate_forces(self):
-        """Forces and torques of the current state (neighbour list and every force), without
-        moving anything: the first part of a step."""
+        """Forces and torques of the current state (neighbour list, every force, the box's
+        measure of them), without moving anything: the first part of a step."""
         self.particles.force[:] = 0.0
         self.particles.torque[:] = 0.0
         self.neighbors.apply(self)
         for op in self.forces:
             op.apply(self)
+        self.walls.after_forces(self)
 
     def advance(self):
         """One step: forces, controls, integrator, then the writers (which see the new step)."""

@@ -60,8 +60,64 @@ class Particles:
 WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
 
 
+class Box:
+    """The sample's box [lo, hi], shared by its two kinds (``Walls``, ``PeriodicCell``).
+
+    position: (6,) face coordinates along their axes [m], ordered as WALL_NAMES. A kind
+    also provides ``period`` (3,) [m]: what a pair's periodic image shifts its branch vector
+    by per image (Contacts.image; zeros for walls), ``affine_rate`` (3,) [1/s]: the
+    homogeneous stretching rate that carries the particles (zeros for walls),
+    ``wrap(particles)`` (positions brought back into the box at a neighbour-list rebuild) and
+    ``after_forces(sim)`` (what the box measures once the step's forces are known).
+    """
+
+    periodic = False
+
+    @property
+    def lo(self):
+        return self.position[0::2]
+
+    @property
+    def hi(self):
+        return self.position[1::2]
+
+    def lengths(self):
+        """Box edge lengths (3,) [m]."""
+        return self.position[1::2] - self.position[0::2]
+
+    def volume(self):
+        """Volume of the box [m^3]."""
+        return float(np.prod(self.lengths()))
+
+    def areas(self):
+        """Area of each face (6,) [m^2]: the product of the two other edge lengths."""
+        lengths = self.lengths()
+        face = np.array([lengths[1] * lengths[2], lengths[0] * lengths[2], lengths[0] * lengths[1]])
+        return np.repeat(face, 2)
+
+
+def _check_box(position):
+    position = check_array("box position", position, length=6)
+    lo, hi = position[0::2], position[1::2]
+    if (hi <= lo).any():
+        raise ValueError(f"box position = {position.tolist()} m: each high face must lie above "
+                         f"its low face (valid range hi > lo on every axis)")
+    return position
+
+
+def _box_position(lo, hi):
+    lo = check_array("box_lo", np.reshape(lo, (1, 3)), (3,))[0]
+    hi = check_array("box_hi", np.reshape(hi, (1, 3)), (3,))[0]
+    if (hi <= lo).any():
+        raise ValueError(f"box_hi {hi.tolist()} must exceed box_lo {lo.tolist()} on every axis")
+    return np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], dtype=np.float64)
+
+
+_NO_SHIFT = np.zeros(3)
+
+
 @dataclass
-class Walls:
+class Walls(Box):
     """Six frictionless axis-aligned planar walls bounding the box [lo, hi].
 
     position: (6,) wall plane coordinate along its axis [m], ordered as WALL_NAMES;
@@ -78,42 +134,29 @@ class Walls:
     moment: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
     def __post_init__(self):
-        for name in ("position", "velocity", "force", "stiffness", "moment"):
+        self.position = _check_box(self.position)
+        for name in ("velocity", "force", "stiffness", "moment"):
             setattr(self, name, check_array(f"walls {name}", getattr(self, name), length=6))
-        lo, hi = self.position[0::2], self.position[1::2]
-        if (hi <= lo).any():
-            raise ValueError(f"walls position = {self.position.tolist()} m: each high wall must "
-                             f"lie above its low wall (valid range hi > lo on every axis)")
 
     @classmethod
     def box(cls, lo, hi):
-        lo = check_array("box_lo", np.reshape(lo, (1, 3)), (3,))[0]
-        hi = check_array("box_hi", np.reshape(hi, (1, 3)), (3,))[0]
-        if (hi <= lo).any():
-            raise ValueError(f"box_hi {hi.tolist()} must exceed box_lo {lo.tolist()} on every axis")
-        return cls(position=np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], dtype=np.float64))
+        return cls(position=_box_position(lo, hi))
 
     @property
-    def lo(self):
-        return self.position[0::2]
+    def period(self):
+        """No periodic images: zeros (3,) [m]."""
+        return _NO_SHIFT
 
     @property
-    def hi(self):
-        return self.position[1::2]
+    def affine_rate(self):
+        """Walls carry no particle: zeros (3,) [1/s]."""
+        return _NO_SHIFT
 
-    def lengths(self):
-        """Box edge lengths (3,) [m]."""
-        return self.position[1::2] - self.position[0::2]
+    def wrap(self, particles):
+        """Nothing to wrap inside walls."""
 
-    def volume(self):
-        """Volume enclosed by the walls [m^3]."""
-        return float(np.prod(self.lengths()))
-
-    def areas(self):
-        """Area of each wall's face (6,) [m^2]: the product of the two other edge lengths."""
-        lengths = self.lengths()
-        face = np.array([lengths[1] * lengths[2], lengths[0] * lengths[2], lengths[0] * lengths[1]])
-        return np.repeat(face, 2)
+    def after_forces(self, sim):
+        """The wall forces come from dem.walls.WallForces among the scene's forces."""
 
     def stress(self):
         """Mean normal stress on each axis (3,) [Pa], compression positive: both walls' force / area."""

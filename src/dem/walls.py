@@ -6,6 +6,7 @@ A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, 
 import numba
 import numpy as np
 
+from .cell import servo_cell
 from .contact_law import wall_forces
 from .validate import check_int, check_positive, check_range
 
@@ -71,7 +72,9 @@ class WallForces:
 
 
 class StressServo:
-    """Hold the normal stress of the walls of ``axes`` at ``target`` [Pa, compression positive].
+    """Hold the normal stress of the walls of ``axes`` at ``target`` [Pa, compression positive]
+    (in a periodic cell: the cell's stress, its lengths moving by dem.cell.servo_cell, the
+    same law with the cell's stiffness).
 
     Each step every wall moves outward by
         shift_n = gain * clip((F_wall - target A) / K_wall, +-cap) + memory * shift_n-1,
@@ -95,6 +98,7 @@ class StressServo:
         self.axes = _axes(axes)
         self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
         self._wall_index = np.array(self.walls, dtype=np.int64)
+        self._axis_index = np.array(self.axes, dtype=np.int64)
         self.target = check_range("target stress", target, 0.0, unit="Pa")
         self.max_velocity = check_positive("max_velocity", max_velocity, "m/s")
         self.gain = check_range("servo gain", gain, 0.0, 1.0, low_inclusive=False)
@@ -109,13 +113,20 @@ class StressServo:
         walls = sim.walls
         refresh = self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0
         self.calls += 1
+        if walls.periodic:          # slots 0 .. len(axes) - 1 of stiffness and previous
+            servo_cell(walls.position, walls.rate, walls.stress_tensor,
+                       walls.stiffness, self.stiffness, self.previous, self._axis_index,
+                       self.target, self.gain, self.memory, self.max_velocity,
+                       self.scale_max_velocity, refresh, sim.dt)
+            return
         servo_walls(walls.position, walls.velocity, walls.force, walls.stiffness, self.stiffness,
                     self.previous, self._wall_index, self.target, self.gain, self.memory,
                     self.max_velocity, self.scale_max_velocity, refresh, sim.dt)
 
 
 class ConstantStrainRate:
-    """Drive the two walls of ``axis`` at a constant strain rate [1/s].
+    """Drive the two walls of ``axis`` at a constant strain rate [1/s] (in a periodic cell:
+    its length on ``axis``, the particles following affinely).
 
     rate > 0 compresses: each wall moves inward at rate * L0 / 2, L0 being the box length on
     that axis when the operation is attached (the reference of ``axial_strain``), so that the
@@ -154,5 +165,8 @@ class ConstantStrainRate:
         walls = sim.walls
         length = (walls.position[2 * self.axis + 1] - walls.position[2 * self.axis]
                   if self.on_current_length else self.reference_length)
+        if walls.periodic:
+            walls.stretch(self.axis, -self.rate * length * sim.dt, sim.dt)
+            return
         self._shift[:] = -0.5 * self.rate * length * sim.dt
         move_walls(walls.position, walls.velocity, self._walls, self._shift, sim.dt)

@@ -65,6 +65,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from capillary.bridge_state import BridgeState
+from dem.neighbors import branch_vectors
 from dem.validate import check_positive
 from homogenize.bridge_tensors import (
     _rotated_sum,
@@ -109,15 +110,18 @@ def bridge_mask(contacts):
     return BridgeState.of(contacts).mask()
 
 
-def _branch(particles, contacts, index):
-    """Centre distances (B,) and unit branch vectors i -> j (B, 3) of the pairs ``index``."""
-    branch = particles.position[contacts.pair_j[index]] - particles.position[contacts.pair_i[index]]
+def _branch(particles, contacts, index, period):
+    """Centre distances (B,) and unit branch vectors i -> j (B, 3) of the pairs ``index``
+    (``period``: the periodic cell's edges [m], or None inside walls)."""
+    branch = branch_vectors(particles.position, contacts,
+                            np.zeros(3) if period is None else period, index)
     distance = np.sqrt(np.einsum("ka,ka->k", branch, branch))
     return distance, branch / distance[:, None]
 
 
-def bridges_in_region(particles, contacts, lo, hi):
-    """(K,) bool: the bridges whose centre lies in the half-open box [lo, hi) [m].
+def bridges_in_region(particles, contacts, lo, hi, period=None):
+    """(K,) bool: the bridges whose centre lies in the half-open box [lo, hi) [m] (``period``
+    [m]: the edges of a periodic cell holding the particles, None inside walls).
 
     The bridge centre is the middle of the gap (or overlap) on the branch vector,
     x_i + (d + R_i - R_j)/2 n (the contact point at touching; the midpoint for equal spheres).
@@ -130,7 +134,7 @@ def bridges_in_region(particles, contacts, lo, hi):
                          "expected lo, hi of shape (3,) with hi > lo")
     mask = bridge_mask(contacts)
     index = np.flatnonzero(mask)
-    distance, normal = _branch(particles, contacts, index)
+    distance, normal = _branch(particles, contacts, index, period)
     radius = particles.radius
     reach = 0.5 * (distance + radius[contacts.pair_i[index]] - radius[contacts.pair_j[index]])
     centre = particles.position[contacts.pair_i[index]] + reach[:, None] * normal
@@ -139,7 +143,7 @@ def bridges_in_region(particles, contacts, lo, hi):
 
 
 def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, surface_tension,
-                       mask=None, interfaces=None):
+                       mask=None, interfaces=None, period=None):
     """chi, B, psi, bridge fabric and anisotropies of the bridges of a DEM state (Eqs. 3.44-3.46,
     3.53-3.54, 4.5) over the volume V [m^3]; a BridgeStress.
 
@@ -147,7 +151,8 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
     (volume control: each bridge's own suction); contact_angle [deg]; surface_tension [N/m];
     mask: (K,) bool, the pairs counted (default: every bridge); it must select bridges only;
     interfaces: (B, 2) [m^2], nn11 and nn33 of each counted bridge in pair order
-    (capillary.CapillaryBridges.interfaces): adds the interface term (``interface``).
+    (capillary.CapillaryBridges.interfaces): adds the interface term (``interface``);
+    period: (3,) [m] the edges of a periodic cell (bridges through its faces), None inside walls.
     """
     volume = check_positive("volume", volume, "m^3")
     bridges = bridge_mask(contacts)
@@ -161,7 +166,7 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
             raise ValueError(f"mask selects {int(np.count_nonzero(mask & ~bridges))} pair(s) "
                              "without a bridge; valid: a subset of the bridges")
     index = np.flatnonzero(mask)
-    _, normal = _branch(particles, contacts, index)
+    _, normal = _branch(particles, contacts, index, period)
     radius_i = particles.radius[contacts.pair_i[index]]
     radius_j = particles.radius[contacts.pair_j[index]]
     if len(index):
@@ -217,8 +222,8 @@ def capillary_force_stress(sim, bridges):
     sigma_wall = sigma_contact + sigma_capillary."""
     pair_force = bridges.pair_forces(sim)
     c = sim.contacts
-    total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, pair_force,
-                            BridgeState.of(c).mask())
+    total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, c.image,
+                            sim.walls.period, pair_force, BridgeState.of(c).mask())
     return total / sim.walls.volume()
 
 
@@ -250,7 +255,7 @@ class CapillaryHomogenization:
             state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
                                        suction=suction, contact_angle=op.contact_angle,
                                        surface_tension=op.surface_tension,
-                                       interfaces=interfaces)
+                                       interfaces=interfaces, period=sim.walls.period)
             effective = np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
             self._step, self._contacts = (sim.step, sim.time), sim.contacts
             self._state = (state, effective)

@@ -71,7 +71,8 @@ HISTORY_COLUMNS = {
     "volumetric_strain": Column("1", "volumetric strain 1 - V/V0 of the box inside the walls, "
                                      "contraction positive (V0 at the start of the shear)"),
     "sigma_wall": Column("Pa", "mean normal stress on the two walls of each axis (total "
-                               "stress), compression positive", _VECTOR),
+                               "stress; in a periodic cell the Love-Weber stress of contacts "
+                               "and bridges over the cell), compression positive", _VECTOR),
     "sigma_contact": Column("Pa", "Love-Weber stress of the mechanical contact forces (sphere "
                                   "and wall contacts), compression positive", _TENSOR,
                             equation="Eq. 3.41"),

@@ -34,6 +34,10 @@ pair between the two centres (YADE's interaction network), cell data
     normal_force       [N] spring normal force (compressive, >= 0)
     shear_force        [N] magnitude of the elastic shear force
     bridge             1 when the pair also holds a liquid bridge
+In a periodic cell (dem.cell) the particles are drawn wrapped into the cell, a pair's line
+runs from particle i to the image of j it interacts with (so lines through a face stick out
+of the cell), and ``walls`` are the cell's faces: normal_stress is the cell's stress on that
+axis, force that stress times the face area, velocity the face's speed (low faces fixed at 0).
 A scene without bridges (or contacts) gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
 file without cells back; ParaView and VTK can.
 
@@ -51,6 +55,7 @@ import numpy as np
 
 from capillary.bridge_state import BridgeState
 from dem.atomic import replacing
+from dem.neighbors import branch_vectors
 from dem.validate import check_int
 
 #: The series written, each a .pvd collection of .vtu files.
@@ -120,8 +125,11 @@ def particle_mesh(sim):
     p = sim.particles
     count = len(p)
     coordination, contact_force, bridges = _contacts_per_particle(sim.contacts, count)
+    position = np.array(p.position)
+    if sim.walls.periodic:         # wrapped into the cell (the live list keeps its images)
+        position = np.mod(position, sim.walls.lengths())
     return meshio.Mesh(
-        np.array(p.position), [("vertex", np.arange(count, dtype=np.int64)[:, None])],
+        position, [("vertex", np.arange(count, dtype=np.int64)[:, None])],
         point_data={"id": np.arange(count, dtype=np.int64), "radius": np.array(p.radius),
                     "velocity": np.array(p.velocity),
                     "angular_velocity": np.array(p.angular_velocity),
@@ -130,7 +138,9 @@ def particle_mesh(sim):
 
 
 def wall_mesh(walls):
-    """The six walls as quads (4 points each, wall w's points are 4w..4w+3) spanning the box."""
+    """The six walls as quads (4 points each, wall w's points are 4w..4w+3) spanning the box;
+    of a periodic cell, its six faces, with the cell's stress on each axis as normal_stress,
+    that stress times the area as force and the faces' speeds (the low faces stay at 0)."""
     lo = walls.position[0::2]
     hi = walls.position[1::2]
     corners = np.array([[0, 0], [1, 0], [1, 1], [0, 1]])
@@ -143,18 +153,32 @@ def wall_mesh(walls):
         block[:, u] = np.where(corners[:, 0] == 0, lo[u], hi[u])
         block[:, v] = np.where(corners[:, 1] == 0, lo[v], hi[v])
     quads = np.arange(24, dtype=np.int64).reshape(6, 4)
+    if walls.periodic:
+        normal_stress = np.repeat(walls.stress(), 2)
+        velocity = np.zeros(6)
+        velocity[1::2] = walls.rate * walls.lengths()
+        force = normal_stress * walls.areas()
+    else:
+        normal_stress = walls.force / walls.areas()
+        velocity = np.array(walls.velocity)
+        force = np.array(walls.force)
     return meshio.Mesh(points, [("quad", quads)], cell_data={
-        "wall": [np.arange(6, dtype=np.int64)],
-        "normal_stress": [walls.force / walls.areas()],
-        "force": [np.array(walls.force)],
-        "velocity": [np.array(walls.velocity)]})
+        "wall": [np.arange(6, dtype=np.int64)], "normal_stress": [normal_stress],
+        "force": [force], "velocity": [velocity]})
 
 
-def _lines(position, first, second):
-    """(points, line cells) of segments between the centres ``first`` -> ``second``."""
-    count = len(first)
-    points = (np.concatenate([position[first], position[second]]) if count
-              else np.zeros((0, 3)))
+def _lines(sim, mask):
+    """(points, line cells) of segments from centre i to centre j of the pairs ``mask`` of
+    ``sim.contacts`` (in a periodic cell, from i wrapped into the cell to the image of j)."""
+    contacts, position = sim.contacts, sim.particles.position
+    index = np.flatnonzero(mask)
+    count = len(index)
+    start = position[contacts.pair_i[index]]
+    end = start + branch_vectors(position, contacts, sim.walls.period, index)
+    if sim.walls.periodic:
+        shift = np.mod(start, sim.walls.lengths()) - start
+        start, end = start + shift, end + shift
+    points = np.concatenate([start, end]) if count else np.zeros((0, 3))
     lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
     return points, lines
 
@@ -164,13 +188,11 @@ def bridge_mesh(sim):
     docstring; no points and no cells when there is no bridge."""
     contacts = sim.contacts
     if contacts is None or not BridgeState.present(contacts):
-        points, lines = _lines(sim.particles.position, np.zeros(0, np.int64),
-                               np.zeros(0, np.int64))
-        return meshio.Mesh(points, [("line", lines)])
+        return meshio.Mesh(np.zeros((0, 3)), [("line", np.zeros((0, 2), np.int64))])
     state = BridgeState.of(contacts)
     mask = state.mask()
     first, second = contacts.pair_i[mask], contacts.pair_j[mask]
-    points, lines = _lines(sim.particles.position, first, second)
+    points, lines = _lines(sim, mask)
     radius = sim.particles.radius
     i_smaller = radius[first] <= radius[second]
     on_i, on_j = state.filling_i[mask], state.filling_j[mask]
@@ -186,12 +208,9 @@ def contact_mesh(sim):
     force) and bridge (1 when the pair holds a liquid bridge)."""
     contacts = sim.contacts
     if contacts is None:
-        points, lines = _lines(sim.particles.position, np.zeros(0, np.int64),
-                               np.zeros(0, np.int64))
-        return meshio.Mesh(points, [("line", lines)])
+        return meshio.Mesh(np.zeros((0, 3)), [("line", np.zeros((0, 2), np.int64))])
     touching = contacts.overlap > 0.0
-    points, lines = _lines(sim.particles.position, contacts.pair_i[touching],
-                           contacts.pair_j[touching])
+    points, lines = _lines(sim, touching)
     bridge = (BridgeState.of(contacts).mask()[touching] if BridgeState.present(contacts)
               else np.zeros(int(np.count_nonzero(touching)), bool))
     return meshio.Mesh(points, [("line", lines)], cell_data={

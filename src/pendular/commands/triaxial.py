@@ -66,6 +66,10 @@ def add_arguments(parser):
     parser.add_argument("--max-strain", type=float, default=0.25,
                         help="final axial strain [-]")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
+    parser.add_argument("--periodic", action="store_true",
+                        help="a periodic cell instead of six walls: no wall layers; the cell's "
+                             "stress (Love-Weber, contacts and bridges) servoed laterally and "
+                             "its height driven at the strain rate")
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
     add_size_options(parser, PrepareConfig.radius)
     parser.add_argument("--porosity", type=float, default=0.40,
@@ -161,7 +165,8 @@ def config_from(args):
                            young=args.young, friction_deg=args.friction, damping=args.damping,
                            prep_friction_deg=args.prep_friction,
                            timestep_safety=args.timestep_safety, confining=args.confining,
-                           seed=args.seed, skin_factor=args.skin_factor)
+                           seed=args.seed, skin_factor=args.skin_factor,
+                           periodic=args.periodic)
     shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
                         strain_rate=args.strain_rate, records=args.records)
     bridges = None
