@@ -182,7 +182,7 @@ def test_saturation_bridges_and_pendular_overlaps_against_hand_sums(wet_sample):
     wide = np.full(len(contacts), 31.0)    # caps 60 deg apart: 31 + 31 > 60
     assert pendular_overlap_counts(position, contacts.row_start, contacts.second_start,
                                    contacts.second_pair, contacts.pair_i, contacts.pair_j,
-                                   state, wide, wide).sum() == 3
+                                   contacts.image, np.zeros(3), state, wide, wide).sum() == 3
 
 
 def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_sample):

@@ -378,7 +378,7 @@ def servoed_simulation(particles, walls, config, target, threads=None):
     """A static sample's simulation: dry scene at the test friction, six walls servoed at
     ``target`` [Pa]. Used to continue from a saved sample."""
     dt = timestep(particles, config)
-    servo = StressServo("xyz", target, max_velocity=_servo_speed(walls, dt))
+    servo = StressServo("xyz", target, max_velocity=servo_speed(walls, dt))
     return dry_simulation(particles, walls, config, dt,
                           config.skin_factor * float(np.mean(particles.radius)),
                           config.friction_deg, [servo], threads)
@@ -450,7 +450,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
                                "grow radii", status=status)}
     _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
-    servo = StressServo("xyz", config.prep_stress, max_velocity=_servo_speed(sim.walls, sim.dt))
+    servo = StressServo("xyz", config.prep_stress, max_velocity=servo_speed(sim.walls, sim.dt))
     sim.controls = [servo]
     sim.dt = timestep(sim.particles, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
@@ -506,6 +506,6 @@ def _require(reached, phase, steps, status, config):
             f"(confining = {config.confining:g} Pa)")
 
 
-def _servo_speed(walls, dt):
+def servo_speed(walls, dt):
     """Servo speed cap [m/s]: a wall may travel 1e-4 of the box per time step ``dt`` [s]."""
     return 1e-4 * float(np.mean(walls.lengths())) / dt

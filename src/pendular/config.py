@@ -254,7 +254,9 @@ class TensionConfig:
     max_strain: largest axial extension [-]; residual: fraction of the peak below which the
     pull has ruptured [-]; grip_depth: grip thickness [diameters]; void_ratio_tolerance [-];
     vtk_frames: ParaView frames per pull (0: none); vtk_every: steps between frames instead
-    (None: from vtk_frames; 0: none); seed: random seed of the samples.
+    (None: from vtk_frames; 0: none); seed: random seed of the samples; periodic: samples in a
+    periodic cell pulled along z at zero lateral stress (no walls, no grips; the void ratio is
+    the whole cell's).
     """
 
     cases: list[tuple[float, float]] = field(
@@ -279,9 +281,13 @@ class TensionConfig:
     vtk_frames: int = 20
     vtk_every: int | None = None
     seed: int = 0
+    periodic: bool = False
 
     def __post_init__(self):
         self.cases = [(float(e), float(w)) for e, w in self.cases]
+        if not isinstance(self.periodic, (bool, np.bool_)):
+            raise ValueError(f"--periodic = {self.periodic!r}: valid values True or False")
+        self.periodic = bool(self.periodic)
         if not self.cases:
             raise ValueError("cases = [] is empty: give at least one (void ratio, water "
                              "content)")

@@ -56,11 +56,11 @@ from capillary import (BridgeTable, CapillaryBridges, gravimetric_water_content,
 from dem.atomic import write_json, write_text
 from dem.grading import grading
 from dem.measure import coordination, unbalanced_force
-from dem.preparation import PrepareConfig, equilibrated, prepare_sample
+from dem.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
 from dem.record import HistoryRecorder
 from dem.simulation import Simulation
 from dem.tension import Grip, core_void_ratio, grip_members, tensile_stress
-from dem.walls import ConstantStrainRate
+from dem.walls import ConstantStrainRate, StressServo
 from homogenize import packing_state, regular_packing
 
 from .config import TensionConfig, config_to_dict, inertial_number
@@ -114,11 +114,15 @@ def prepare_config(config: TensionConfig, prep_friction: float) -> PrepareConfig
                          radius_spread=config.radius_spread, psd=config.psd,
                          young=config.young, friction_deg=config.friction,
                          prep_friction_deg=prep_friction, confining=config.confining,
-                         seed=config.seed)
+                         seed=config.seed, periodic=config.periodic)
 
 
 def sample_void_ratio(sim: Simulation, radius: float) -> float:
-    """Void ratio of the core: the box less one diameter along each wall."""
+    """Void ratio of the core: the box less one diameter along each wall (a periodic cell,
+    which has no wall layers: the whole cell)."""
+    if sim.walls.periodic:
+        voids = sim.walls.volume() - sim.particles.solid_volume()
+        return voids / sim.particles.solid_volume()
     return core_void_ratio(sim.particles, sim.walls, 2.0 * radius, radius / 8.0)
 
 
@@ -182,11 +186,17 @@ def wetted_pairs(sim: Simulation, max_gap: float) -> tuple[np.ndarray, np.ndarra
         touching = sim.contacts.overlap > 0.0
         return sim.contacts.pair_i[touching], sim.contacts.pair_j[touching], None
     radius = particles.radius
-    pairs = cKDTree(particles.position).query_pairs(2.0 * radius.max() + max_gap,
-                                                    output_type="ndarray")
+    position, box = particles.position, None
+    if sim.walls.periodic:           # pairs through the faces, nearest image
+        box = sim.walls.lengths()
+        position = np.mod(position, box)
+    pairs = cKDTree(position, boxsize=box).query_pairs(2.0 * radius.max() + max_gap,
+                                                       output_type="ndarray")
     i, j = pairs[:, 0], pairs[:, 1]
-    gap = (np.linalg.norm(particles.position[j] - particles.position[i], axis=1)
-           - radius[i] - radius[j])
+    branch = position[j] - position[i]
+    if box is not None:
+        branch -= box * np.round(branch / box)
+    gap = np.linalg.norm(branch, axis=1) - radius[i] - radius[j]
     near = gap <= max_gap
     return i[near], j[near], np.maximum(gap[near], 0.0)
 
@@ -236,7 +246,9 @@ class Pull:
     """The pull of a sample held by its six walls' servo: z walls apart at constant strain
     rate, grips, recorder (with the bridges' columns when ``bridges`` is given) and ParaView
     writer (a frame every ``config.vtk_every`` steps, or ``config.vtk_frames`` frames over
-    --max-strain); ``run()`` pulls to rupture and returns (steps, history)."""
+    --max-strain); ``run()`` pulls to rupture and returns (steps, history). In a periodic cell:
+    the cell stretched along z at the strain rate, its x and y stress servoed at zero, no
+    grips; the tensile stress is minus the cell's z stress."""
 
     def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
                  config: TensionConfig, folder: str, progress: bool):
@@ -244,24 +256,30 @@ class Pull:
         self.rate = config.inertial_number / inertial_number(1.0, config.radius,
                                                            sim.particles.density, config.confining)
         self.extension = ConstantStrainRate("z", -self.rate, sim.walls.lengths()[2])
-        depth = config.radius * (1.0 + 2.0 * config.grip_depth)
-        self.grips = [Grip(wall, grip_members(sim.particles.position, sim.particles.radius,
-                                              sim.walls, wall, depth)) for wall in (4, 5)]
-        sim.controls = [self.extension, *self.grips]   # the x, y walls held where they are
-        for op in self.grips:            # the grips' pull of the current (wetted) state
-            op.apply(sim)
+        if sim.walls.periodic:
+            self.grips = []
+            lateral = StressServo("xy", 0.0, servo_speed(sim.walls, sim.dt))
+            sim.controls = [self.extension, lateral]
+        else:
+            depth = config.radius * (1.0 + 2.0 * config.grip_depth)
+            self.grips = [Grip(wall, grip_members(sim.particles.position, sim.particles.radius,
+                                                  sim.walls, wall, depth)) for wall in (4, 5)]
+            sim.controls = [self.extension, *self.grips]   # the x, y walls held where they are
+            for op in self.grips:            # the grips' pull of the current (wetted) state
+                op.apply(sim)
         self.steps = int(math.ceil(config.max_strain / (self.rate * sim.dt)))
         period = max(1, self.steps // RECORDS)
         columns = {
             "step": lambda s: s.step,
             "time": lambda s: s.time,
             "axial_strain": lambda s: self.extension.strain(s.walls),
-            "tensile_stress": lambda s: tensile_stress(self.grips, s.walls),
-            "grip_pull": lambda s: [grip.pull for grip in self.grips],
+            "tensile_stress": self.tensile_stress,
             "sigma_wall": lambda s: s.walls.stress(),
             "coordination": lambda s: coordination(s.contacts, len(s.particles)),
             "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
         }
+        if self.grips:
+            columns["grip_pull"] = lambda s: [grip.pull for grip in self.grips]
         if bridges is not None:
             solid = sim.particles.solid_volume()
             columns.update({
@@ -280,6 +298,13 @@ class Pull:
         if self.vtk_period > 0:
             self.vtk = VtkWriter(os.path.join(folder, "vtk"), self.vtk_period)
             sim.writers.append(self.vtk)
+
+    def tensile_stress(self, sim: Simulation) -> float:
+        """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
+        the cross-section (dem.tension.tensile_stress), or minus a periodic cell's z stress."""
+        if sim.walls.periodic:
+            return -float(sim.walls.stress()[2])
+        return tensile_stress(self.grips, sim.walls)
 
     def ruptured(self, sim: Simulation) -> bool:
         """The stress has stayed below the residual fraction of its positive peak for

@@ -73,6 +73,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="steps between ParaView frames of the pull, instead of "
                              "--vtk-frames (0: none)")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the samples")
+    parser.add_argument("--periodic", action="store_true",
+                        help="a periodic cell instead of six walls: no grips, the cell pulled "
+                             "along z at zero lateral stress; the void ratio is the whole cell's")
     parser.add_argument("--out", default="runs/direct_tension", help="output folder")
     add_run_options(parser, threads_default=1)
 
@@ -84,7 +87,8 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
     options = {name: getattr(args, name) for name in (
         "roughness", "form_gap", "particles", "contact_angle", "surface_tension",
         "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
-        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed")}
+        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed",
+        "periodic")}
     return TensionConfig(cases=cases, **sizes_from(args), **options)
 
 
