@@ -65,9 +65,9 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
-                                      gather_contact_bridges, pendular_overlap_counts,
-                                      refresh_contact_bridges,
+from capillary.bridge_kernels import (along_normals, bridges_across_gaps, contact_bridges,
+                                      exchange_liquid, gather_contact_bridges,
+                                      pendular_overlap_counts, refresh_contact_bridges,
                                       suction_bridges, suction_interfaces, volume_bridges,
                                       volume_interfaces)
 from capillary.bridge_state import BridgeState
@@ -169,6 +169,9 @@ class CapillaryBridges:
     exist.
     """
 
+    #: A buffer (pair_forces of bridges at contact), rebuilt on demand: not worth a checkpoint.
+    checkpoint_exclude = ("_contact_force",)
+
     def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
                  control="suction", persist=False, table_options=None, roughness=0.0,
                  liquid="reservoir"):
@@ -202,6 +205,7 @@ class CapillaryBridges:
         self.volume_table = None
         self.required_range = 0.0
         self.pair_force = np.zeros((0, 3))
+        self._contact_force = np.zeros((0, 3))      # pair_forces of bridges at contact
         self._table_arrays = None
         self._contacts = None
         self._bridges = 0
@@ -472,7 +476,10 @@ class CapillaryBridges:
         state = self.state(sim)
         if self.persist:
             return self.pair_force
-        return -state.force[:, None] * sim.contacts.normal
+        if len(self._contact_force) != len(state.force):
+            self._contact_force = np.zeros((len(state.force), 3))
+        along_normals(state.force, sim.contacts.normal, self._contact_force)
+        return self._contact_force
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each

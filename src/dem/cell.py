@@ -26,32 +26,53 @@ from .neighbors import branch_vector
 from .state import Box, _box_position, _check_box
 from .validate import check_array
 
+_NONE = np.zeros((0, 3))
+
 #: Fixed blocks of particles summed apart then together: a sum in the same order for any
 #: thread count (results thread-independent).
 SUM_BLOCKS = 64
 
 
 @numba.njit(cache=True, parallel=True)
-def pair_virial(position, row_start, pair_j, image, period, pair_force, normal_force, overlap,
-                with_stiffness):
+def pair_virial(position, row_start, pair_j, image, period, pair_force, other_force,
+                normal_force, overlap, with_stiffness):
     """(12,) sums over the pairs: [0:9] sum l_a f_b (row a, column b; l the branch vector
-    i -> j [m], f the force on j from i [N]) and, with ``with_stiffness``, [9:12] sum over the
-    touching pairs of kn (l_a n_a)^2 with kn = normal_force / overlap [N m]."""
+    i -> j [m], f the force on j from i [N]: ``pair_force`` plus ``other_force`` unless that
+    is empty, (0, 3)) and, with ``with_stiffness``, [9:12] sum over the touching pairs of
+    kn (l_a n_a)^2 with kn = normal_force / overlap [N m]."""
+    other = len(other_force) > 0
     count = len(row_start) - 1
     sums = np.zeros((SUM_BLOCKS, 12))
     for block in numba.prange(SUM_BLOCKS):
+        s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
+        k0 = k1 = k2 = 0.0
         for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
             for k in range(row_start[i], row_start[i + 1]):
                 l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
-                branch = (l0, l1, l2)
-                for a in range(3):
-                    for b in range(3):
-                        sums[block, 3 * a + b] += branch[a] * pair_force[k, b]
+                f0 = pair_force[k, 0]
+                f1 = pair_force[k, 1]
+                f2 = pair_force[k, 2]
+                if other:
+                    f0 += other_force[k, 0]
+                    f1 += other_force[k, 1]
+                    f2 += other_force[k, 2]
+                s00 += l0 * f0
+                s01 += l0 * f1
+                s02 += l0 * f2
+                s10 += l1 * f0
+                s11 += l1 * f1
+                s12 += l1 * f2
+                s20 += l2 * f0
+                s21 += l2 * f1
+                s22 += l2 * f2
                 if with_stiffness and overlap[k] > 0.0:
-                    kn = normal_force[k] / overlap[k]
-                    inverse_squared = 1.0 / (l0 * l0 + l1 * l1 + l2 * l2)
-                    for a in range(3):
-                        sums[block, 9 + a] += kn * branch[a] ** 4 * inverse_squared
+                    weight = normal_force[k] / (overlap[k] * (l0 * l0 + l1 * l1 + l2 * l2))
+                    k0 += weight * l0 ** 4
+                    k1 += weight * l1 ** 4
+                    k2 += weight * l2 ** 4
+        row = sums[block]
+        row[0], row[1], row[2], row[3], row[4], row[5] = s00, s01, s02, s10, s11, s12
+        row[6], row[7], row[8], row[9], row[10], row[11] = s20, s21, s22, k0, k1, k2
     total = np.zeros(12)
     for block in range(SUM_BLOCKS):
         for c in range(12):
@@ -165,12 +186,21 @@ class PeriodicCell(Box):
         total = np.zeros(12)
         if contacts is not None and len(contacts):
             period = self.period
+            contact, others = None, []
             for op in sim.forces:
-                if hasattr(op, "pair_forces"):
-                    total += pair_virial(sim.particles.position, contacts.row_start,
-                                         contacts.pair_j, contacts.image, period,
-                                         op.pair_forces(sim), contacts.normal_force,
-                                         contacts.overlap, isinstance(op, ContactForces))
+                if isinstance(op, ContactForces) and contact is None:
+                    contact = op.pair_forces(sim)
+                elif hasattr(op, "pair_forces"):
+                    others.append(op.pair_forces(sim))
+            # one pass for the contacts (with their stiffness) and a first other force
+            passes = [(force, _NONE, False) for force in others]
+            if contact is not None:
+                passes = [(contact, others[0] if others else _NONE, True)] + passes[1:]
+            for pair_force, other_force, with_stiffness in passes:
+                total += pair_virial(sim.particles.position, contacts.row_start,
+                                     contacts.pair_j, contacts.image, period, pair_force,
+                                     other_force, contacts.normal_force, contacts.overlap,
+                                     with_stiffness)
         volume = self.volume()
         self.stress_tensor[:] = total[:9].reshape(3, 3) / volume
         self.stiffness[:] = total[9:] / volume
