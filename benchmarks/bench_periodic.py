@@ -1,0 +1,69 @@
+"""Cost of the periodic cell in the triaxial shear: periodic against walled, dry and wet, same run.
+
+    python benchmarks/bench_periodic.py [--sizes 1000,10000] [--threads 1]
+        [--suction 30000] [--steps 3000] [--warmup 1000] [--out FILE]
+
+For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, cached under
+.cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
+(suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
+four shears are timed in alternating chunks after ``warmup`` steps, so a change of machine load
+hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step.
+"""
+
+import argparse
+import json
+
+import numba
+
+from bench_capillary import shear_simulation, time_alternately  # benchmarks/ (this folder)
+from bench_triaxial import write_results
+from dem.preparation import PrepareConfig
+from pendular.yade import cached_sample
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--sizes", default="1000,10000")
+    parser.add_argument("--threads", default="1")
+    parser.add_argument("--suction", type=float, default=30000.0, help="matric suction [Pa]")
+    parser.add_argument("--steps", type=int, default=3000)
+    parser.add_argument("--warmup", type=int, default=1000)
+    parser.add_argument("--confining", type=float, default=750.0)
+    parser.add_argument("--out", default=None, help="JSON file for the results")
+    args = parser.parse_args(argv)
+    rows = []
+    for count in (int(s) for s in args.sizes.split(",")):
+        samples = {}
+        for box, periodic in (("walled", False), ("periodic", True)):
+            config = PrepareConfig(particles=count, confining=args.confining, periodic=periodic)
+            samples[box] = (config, *cached_sample(config)[:2])
+        for threads in (int(t) for t in args.threads.split(",")):
+            numba.set_num_threads(threads)
+            runs = {f"{box} {kind}": shear_simulation(config, particles, walls, threads,
+                                                      suction)
+                    for box, (config, particles, walls) in samples.items()
+                    for kind, suction in (("dry", 0.0), ("wet", args.suction))}
+            elapsed, _ = time_alternately({name: run[0] for name, run in runs.items()},
+                                          args.steps, args.warmup)
+            speed = {name: count * args.steps / seconds for name, seconds in elapsed.items()}
+            row = {"particles": count, "threads": threads, "suction": args.suction,
+                   "particle_steps_per_s": speed,
+                   "periodic_over_walled_cost": {
+                       kind: speed[f"walled {kind}"] / speed[f"periodic {kind}"]
+                       for kind in ("dry", "wet")}}
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    print(f"\n{'particles':>9} {'threads':>7} {'walled dry':>10} {'periodic dry':>12} "
+          f"{'ratio':>6} {'walled wet':>10} {'periodic wet':>12} {'ratio':>6}  [M particle-steps/s]")
+    for row in rows:
+        speed, ratio = row["particle_steps_per_s"], row["periodic_over_walled_cost"]
+        print(f"{row['particles']:9d} {row['threads']:7d} {speed['walled dry'] * 1e-6:10.2f} "
+              f"{speed['periodic dry'] * 1e-6:12.2f} {ratio['dry']:6.2f} "
+              f"{speed['walled wet'] * 1e-6:10.2f} {speed['periodic wet'] * 1e-6:12.2f} "
+              f"{ratio['wet']:6.2f}")
+    if args.out:
+        write_results(args.out, rows)
+
+
+if __name__ == "__main__":
+    main()
