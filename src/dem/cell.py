@@ -130,7 +130,7 @@ class PeriodicCell(Box):
     periodic = True
 
     def __post_init__(self):
-        self.position = _check_box(self.position)
+        self.position = _check_box("periodic cell position", self.position)
         if np.any(self.position[0::2] != 0.0):
             raise ValueError(f"periodic cell position = {self.position.tolist()} m: the low "
                              "faces must sit at 0 (valid: [0, L] on every axis)")

@@ -96,12 +96,12 @@ class Box:
         return np.repeat(face, 2)
 
 
-def _check_box(position):
-    position = check_array("box position", position, length=6)
+def _check_box(name, position):
+    position = check_array(name, position, length=6)
     lo, hi = position[0::2], position[1::2]
     if (hi <= lo).any():
-        raise ValueError(f"box position = {position.tolist()} m: each high face must lie above "
-                         f"its low face (valid range hi > lo on every axis)")
+        raise ValueError(f"{name} = {position.tolist()} m: each high face must lie above its "
+                         f"low face (valid range hi > lo on every axis)")
     return position
 
 
@@ -134,7 +134,7 @@ class Walls(Box):
     moment: np.ndarray = field(default_factory=lambda: np.zeros(6))
 
     def __post_init__(self):
-        self.position = _check_box(self.position)
+        self.position = _check_box("walls position", self.position)
         for name in ("velocity", "force", "stiffness", "moment"):
             setattr(self, name, check_array(f"walls {name}", getattr(self, name), length=6))
 
