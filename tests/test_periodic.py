@@ -9,7 +9,7 @@ import pytest
 
 from capillary import CapillaryBridges
 from capillary.bridge_state import ACROSS_GAP, BridgeState
-from dem.cell import PeriodicCell
+from dem.cell import PeriodicCell, pair_virial, resultant_virial
 from dem.contact_law import ContactForces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList, build_contacts
@@ -95,6 +95,7 @@ def test_simple_cubic_lattice_has_the_stress_of_the_hand_computation(overlap):
     position = np.array(np.meshgrid(grid, grid, grid, indexing="ij")).reshape(3, -1).T
     sim = periodic_scene(position, RADIUS, n * spacing)
     sim.evaluate_forces()
+    sim.walls.update_stiffness(sim)
     kn = normal_stiffness(YOUNG, RADIUS, RADIUS)
     delta = 2.0 * RADIUS - spacing
     assert np.count_nonzero(sim.contacts.overlap > 0) == 3 * n ** 3
@@ -175,6 +176,28 @@ def test_a_periodic_preparation_is_deterministic_and_thread_independent():
     np.testing.assert_allclose(report["sigma_wall"], 750.0, rtol=0.011)
 
 
+def test_the_cell_stress_from_resultants_is_the_pair_by_pair_sum():
+    """resultant_virial (the particles' resultants and the pairs through a face) gives the
+    Love–Weber sum of pair_virial (every pair's branch vector times its force) on a static
+    packing and on one whose particles are off balance."""
+    sim, _ = _periodic_prep(1)
+    for shaken in (False, True):
+        if shaken:
+            sim.particles.position += np.random.default_rng(0).normal(0.0, 0.01 * RADIUS,
+                                                                      (150, 3))
+        sim.evaluate_forces()
+        c, p = sim.contacts, sim.particles
+        assert np.count_nonzero(c.image.any(axis=1) & (c.overlap > 0.0)) > 20
+        by_pairs = pair_virial(p.position, c.row_start, c.pair_j, c.image, sim.walls.period,
+                               c.force)
+        by_resultants = resultant_virial(p.position, p.force, c.row_start, c.image,
+                                         sim.walls.period, c.force, np.zeros((0, 3)))
+        np.testing.assert_allclose(by_resultants, by_pairs, rtol=1e-9,
+                                   atol=1e-9 * np.abs(by_pairs).max())
+        np.testing.assert_allclose(sim.walls.stress_tensor.ravel() * sim.walls.volume(),
+                                   by_pairs, rtol=1e-9, atol=1e-9 * np.abs(by_pairs).max())
+
+
 def test_a_periodic_sample_round_trips_and_is_refused_for_walls(tmp_path):
     sim, _ = _periodic_prep(1)
     path = tmp_path / "sample.h5"
@@ -205,14 +228,17 @@ def periodic_wet_triaxial(tmp_path_factory):
 
 
 def test_periodic_wet_triaxial_holds_the_lateral_stress_and_balances(periodic_wet_triaxial):
-    """The cell's lateral stress stays within 1 % of 750 Pa; the Love–Weber stress of the
-    contacts and bridges recorded beside it is the cell's stress."""
+    """The cell's lateral stress stays within 2 % of 750 Pa (a 300-sphere wet sample has
+    collapse events of 1-2 %; 2,000 spheres stay within 0.6 %, docs/periodic.md) and within
+    0.2 % on average; the Love–Weber stress of the contacts and bridges recorded beside it is
+    the cell's stress."""
     import pendular
 
     out, summary = periodic_wet_triaxial
     history = pendular.read_history(str(out))
     lateral = history["sigma_wall"].values[3:, :2]
-    assert np.max(np.abs(lateral - 750.0)) < 7.5
+    assert np.max(np.abs(lateral - 750.0)) < 15.0
+    assert np.mean(np.abs(lateral - 750.0)) < 1.5
     assert summary["stress_balance_error"] < 1e-3
     assert summary["peak_q"] > 3000.0 and 0.0 < summary["saturation_at_peak"] < 0.1
 

@@ -12,8 +12,9 @@ rate * l to the relative velocity of a pair of branch vector l (YADE's periodic 
 
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
-each step, with the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per unit strain] that
-the stress servo uses as a wall servo uses the stiffness of the wall's contacts.
+each step. The stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
+unit strain] as a wall servo reads the stiffness of the wall's contacts; the servo refreshes it
+(``update_stiffness``) when it refreshes its own.
 """
 
 from dataclasses import dataclass, field
@@ -21,7 +22,6 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .contact_law import ContactForces
 from .neighbors import branch_vector
 from .state import Box, _box_position, _check_box
 from .validate import check_array
@@ -34,48 +34,111 @@ SUM_BLOCKS = 64
 
 
 @numba.njit(cache=True, parallel=True)
-def pair_virial(position, row_start, pair_j, image, period, pair_force, other_force,
-                normal_force, overlap, with_stiffness):
-    """(12,) sums over the pairs: [0:9] sum l_a f_b (row a, column b; l the branch vector
-    i -> j [m], f the force on j from i [N]: ``pair_force`` plus ``other_force`` unless that
-    is empty, (0, 3)) and, with ``with_stiffness``, [9:12] sum over the touching pairs of
-    kn (l_a n_a)^2 with kn = normal_force / overlap [N m]."""
+def resultant_virial(position, force, row_start, image, period, pair_force, other_force):
+    """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
+    f the force on j from i: ``pair_force`` plus ``other_force`` unless that is empty, (0, 3))
+    when ``force`` (N, 3) [N] is each particle's resultant of those pair forces, from
+
+        sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
+
+    (l = x_j - x_i + image L; the second sum runs over the pairs through a face only): one
+    pass over the particles and a scan of the images instead of a pass over every pair."""
     other = len(other_force) > 0
     count = len(row_start) - 1
-    sums = np.zeros((SUM_BLOCKS, 12))
+    sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
         s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
+        for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
+            x0 = position[p, 0]
+            x1 = position[p, 1]
+            x2 = position[p, 2]
+            f0 = force[p, 0]
+            f1 = force[p, 1]
+            f2 = force[p, 2]
+            for k in range(row_start[p], row_start[p + 1]):
+                if image[k, 0] == 0 and image[k, 1] == 0 and image[k, 2] == 0:
+                    continue
+                g0 = pair_force[k, 0]
+                g1 = pair_force[k, 1]
+                g2 = pair_force[k, 2]
+                if other:
+                    g0 += other_force[k, 0]
+                    g1 += other_force[k, 1]
+                    g2 += other_force[k, 2]
+                a0 = image[k, 0] * period[0]
+                a1 = image[k, 1] * period[1]
+                a2 = image[k, 2] * period[2]
+                s00 += a0 * g0
+                s01 += a0 * g1
+                s02 += a0 * g2
+                s10 += a1 * g0
+                s11 += a1 * g1
+                s12 += a1 * g2
+                s20 += a2 * g0
+                s21 += a2 * g1
+                s22 += a2 * g2
+            s00 += x0 * f0
+            s01 += x0 * f1
+            s02 += x0 * f2
+            s10 += x1 * f0
+            s11 += x1 * f1
+            s12 += x1 * f2
+            s20 += x2 * f0
+            s21 += x2 * f1
+            s22 += x2 * f2
+        row = sums[block]
+        row[0], row[1], row[2], row[3], row[4] = s00, s01, s02, s10, s11
+        row[5], row[6], row[7], row[8] = s12, s20, s21, s22
+    total = np.zeros(9)
+    for block in range(SUM_BLOCKS):
+        for c in range(9):
+            total[c] += sums[block, c]
+    return total
+
+
+@numba.njit(cache=True, parallel=True)
+def pair_virial(position, row_start, pair_j, image, period, pair_force):
+    """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
+    f = ``pair_force`` the force on j from i), pair by pair."""
+    count = len(row_start) - 1
+    sums = np.zeros((SUM_BLOCKS, 9))
+    for block in numba.prange(SUM_BLOCKS):
+        for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
+            for k in range(row_start[i], row_start[i + 1]):
+                branch = branch_vector(position, i, pair_j[k], image, k, period)
+                for a in range(3):
+                    for b in range(3):
+                        sums[block, 3 * a + b] += branch[a] * pair_force[k, b]
+    total = np.zeros(9)
+    for block in range(SUM_BLOCKS):
+        for c in range(9):
+            total[c] += sums[block, c]
+    return total
+
+
+@numba.njit(cache=True, parallel=True)
+def contact_stiffness(position, row_start, pair_j, image, period, normal_force, overlap):
+    """(3,) sum over the touching pairs of kn (l_a n_a)^2 [N m], kn = normal_force / overlap
+    the spring stiffness, l the branch vector and n = l / |l|."""
+    count = len(row_start) - 1
+    sums = np.zeros((SUM_BLOCKS, 3))
+    for block in numba.prange(SUM_BLOCKS):
         k0 = k1 = k2 = 0.0
         for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
             for k in range(row_start[i], row_start[i + 1]):
+                if overlap[k] <= 0.0:
+                    continue
                 l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
-                f0 = pair_force[k, 0]
-                f1 = pair_force[k, 1]
-                f2 = pair_force[k, 2]
-                if other:
-                    f0 += other_force[k, 0]
-                    f1 += other_force[k, 1]
-                    f2 += other_force[k, 2]
-                s00 += l0 * f0
-                s01 += l0 * f1
-                s02 += l0 * f2
-                s10 += l1 * f0
-                s11 += l1 * f1
-                s12 += l1 * f2
-                s20 += l2 * f0
-                s21 += l2 * f1
-                s22 += l2 * f2
-                if with_stiffness and overlap[k] > 0.0:
-                    weight = normal_force[k] / (overlap[k] * (l0 * l0 + l1 * l1 + l2 * l2))
-                    k0 += weight * l0 ** 4
-                    k1 += weight * l1 ** 4
-                    k2 += weight * l2 ** 4
-        row = sums[block]
-        row[0], row[1], row[2], row[3], row[4], row[5] = s00, s01, s02, s10, s11, s12
-        row[6], row[7], row[8], row[9], row[10], row[11] = s20, s21, s22, k0, k1, k2
-    total = np.zeros(12)
+                weight = normal_force[k] / (overlap[k] * (l0 * l0 + l1 * l1 + l2 * l2))
+                k0 += weight * l0 ** 4
+                k1 += weight * l1 ** 4
+                k2 += weight * l2 ** 4
+        sums[block, 0] = k0
+        sums[block, 1] = k1
+        sums[block, 2] = k2
+    total = np.zeros(3)
     for block in range(SUM_BLOCKS):
-        for c in range(12):
+        for c in range(3):
             total[c] += sums[block, c]
     return total
 
@@ -179,32 +242,37 @@ class PeriodicCell(Box):
         return particles.position + self.wraps * self.lengths()
 
     def after_forces(self, sim):
-        """The stress and stiffness of this step's pair forces (every force operation with
-        ``pair_forces(sim)``; the contact law's also give the stiffness); the stretching rate
-        returns to zero until a control sets it."""
+        """The stress of this step's pair forces (every force operation has
+        ``pair_forces(sim)``: from the particles' resultants and the pairs through a face,
+        resultant_virial; otherwise pair by pair over the operations that have it); the
+        stretching rate returns to zero until a control sets it."""
         contacts = sim.contacts
-        total = np.zeros(12)
+        total = np.zeros(9)
         if contacts is not None and len(contacts):
-            period = self.period
-            contact, others = None, []
-            for op in sim.forces:
-                if isinstance(op, ContactForces) and contact is None:
-                    contact = op.pair_forces(sim)
-                elif hasattr(op, "pair_forces"):
-                    others.append(op.pair_forces(sim))
-            # one pass for the contacts (with their stiffness) and a first other force
-            passes = [(force, _NONE, False) for force in others]
-            if contact is not None:
-                passes = [(contact, others[0] if others else _NONE, True)] + passes[1:]
-            for pair_force, other_force, with_stiffness in passes:
-                total += pair_virial(sim.particles.position, contacts.row_start,
-                                     contacts.pair_j, contacts.image, period, pair_force,
-                                     other_force, contacts.normal_force, contacts.overlap,
-                                     with_stiffness)
-        volume = self.volume()
-        self.stress_tensor[:] = total[:9].reshape(3, 3) / volume
-        self.stiffness[:] = total[9:] / volume
+            p, period = sim.particles, self.period
+            forces = [op.pair_forces(sim) for op in sim.forces if hasattr(op, "pair_forces")]
+            if len(forces) == len(sim.forces) and len(forces) <= 2:
+                total = resultant_virial(p.position, p.force, contacts.row_start,
+                                         contacts.image, period, forces[0],
+                                         forces[1] if len(forces) == 2 else _NONE)
+            else:       # a force that is not a pair force: resultants are not the pairs' sum
+                for pair_force in forces:
+                    total += pair_virial(p.position, contacts.row_start, contacts.pair_j,
+                                         contacts.image, period, pair_force)
+        self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
         self.rate[:] = 0.0
+
+    def update_stiffness(self, sim):
+        """``stiffness`` (3,) [Pa] of the current contacts, S_a = (1/V) sum kn (l_a n_a)^2
+        (what the stress servo reads; a pass over the pairs, so the servo asks for it only
+        when it refreshes)."""
+        c = sim.contacts
+        if c is None or not len(c):
+            self.stiffness[:] = 0.0
+            return
+        self.stiffness[:] = contact_stiffness(sim.particles.position, c.row_start, c.pair_j,
+                                              c.image, self.period, c.normal_force,
+                                              c.overlap) / self.volume()
 
     def stretch(self, axis, shift, dt):
         """Change the length of ``axis`` by ``shift`` [m] over the step ``dt`` [s] (the

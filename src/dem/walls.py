@@ -87,11 +87,15 @@ class StressServo:
     scale_max_velocity: the cap of axis a is max_velocity * 3 L_a / (L_x + L_y + L_z) (YADE's
         max_vel1/2/3) instead of max_velocity;
     stiffness_every: K_wall is refreshed every ``stiffness_every`` calls of the servo and at
-        each of its first 100 calls (YADE's stiffnessUpdateInterval, 10) instead of every step.
+        each of its first 100 calls (YADE's stiffnessUpdateInterval, 10) instead of every step;
+        a periodic cell's stiffness every max(stiffness_every, CELL_STIFFNESS_EVERY) calls.
     """
 
     #: Calls during which the stiffness is refreshed every step (YADE: scene->iter < 100).
     STIFFNESS_WARMUP = 100
+    #: Fewest calls between refreshes of a periodic cell's stiffness after the warm-up: a sum
+    #: over every contact, as costly as the force gather (YADE's stiffnessUpdateInterval).
+    CELL_STIFFNESS_EVERY = 10
 
     def __init__(self, axes, target, max_velocity, gain=0.75, memory=0.8,
                  scale_max_velocity=False, stiffness_every=1):
@@ -111,9 +115,14 @@ class StressServo:
 
     def apply(self, sim):
         walls = sim.walls
-        refresh = self.calls < self.STIFFNESS_WARMUP or self.calls % self.stiffness_every == 0
+        every = self.stiffness_every
+        if walls.periodic:
+            every = max(every, self.CELL_STIFFNESS_EVERY)
+        refresh = self.calls < self.STIFFNESS_WARMUP or self.calls % every == 0
         self.calls += 1
         if walls.periodic:          # slots 0 .. len(axes) - 1 of stiffness and previous
+            if refresh:
+                walls.update_stiffness(sim)
             servo_cell(walls.position, walls.rate, walls.stress_tensor,
                        walls.stiffness, self.stiffness, self.previous, self._axis_index,
                        self.target, self.gain, self.memory, self.max_velocity,

@@ -45,7 +45,11 @@ import shutil
 import time
 from concurrent.futures import ThreadPoolExecutor
 
+import numpy as np
+
 from dem.atomic import write_json
+from dem.cell import PeriodicCell
+from dem.contact_law import normal_stiffness
 from dem.preparation import PrepareConfig, servoed_simulation
 from dem.state import Particles, Walls
 from dem.walls import ConstantStrainRate, StressServo
@@ -66,22 +70,30 @@ OUTPUTS = ("crosscheck.json", "crosscheck.png", "yade_history.txt", "yade_result
 #: Summary fields printed by the command.
 SHOWN = ("peak_q_rel_diff", "saturation_rel_diff", "volumetric_strain_at_peak_diff",
          "start_sigma_rel_diff", "cost_ratio_yade_over_pendular")
+#: Settings of YADE's controller copied from its result into the ``yade`` summary.
+YADE_CONTROLLER = ("controller", "stress_damping", "strain_damping", "max_vel",
+                   "stiffness_update_interval", "dyn_cell", "stress_mask", "goal",
+                   "max_strain_rate", "grow_damping", "glob_update")
 SETUP = ("pendular prepares and settles the sample at the confining stress (wetted: bridges at "
          "every contact, settled again); both codes shear the exported packing from rest with "
          "contacts and bridges formed afresh")
 
 
 def crosscheck_config(particles=1000, suction=0.0, confining=750.0, max_strain=0.25,
-                      records=200, mimic_yade=False, settle_steps=200000, seed=0, **sizes):
+                      records=200, mimic_yade=False, settle_steps=200000, seed=0,
+                      periodic=False, **sizes):
     """The TriaxialConfig of a cross-check: the thesis-default sample (Table 5.2) of
     ``particles`` spheres at ``confining`` [Pa] from ``seed``, of the ``sizes`` given
-    (PrepareConfig's radius, radius_spread, psd); suction-controlled exact bridges at
+    (PrepareConfig's radius, radius_spread, psd), in a periodic cell if ``periodic`` (YADE:
+    PeriTriaxController) or six walls (TriaxialStressController); suction-controlled exact
+    bridges at
     ``suction`` [Pa] (0: dry; surface tension capillary.SURFACE_TENSION, contact angle 0);
     the shear to ``max_strain`` with ``records`` rows, with YADE's wall-control choices if
     ``mimic_yade``; at most ``settle_steps`` steps (wet_steps) to bring the (wetted) sample to
     rest before the export."""
     return TriaxialConfig(
-        sample=PrepareConfig(particles=particles, confining=confining, seed=seed, **sizes),
+        sample=PrepareConfig(particles=particles, confining=confining, seed=seed,
+                             periodic=periodic, **sizes),
         shear=ShearConfig(max_strain=max_strain, records=records,
                           **(YADE_CHOICES if mimic_yade else {})),
         bridges=BridgeConfig(suction) if suction else None,
@@ -96,7 +108,7 @@ def mimics_yade(shear):
 def check_mirrored(config):
     """ValueError naming the setting when ``config`` asks for something the YADE side cannot
     reproduce (its capillary law has exact, suction-controlled bridges from the default
-    tables; the sample is a prepared one)."""
+    tables, in six walls only; the sample is a prepared one)."""
     if config.sample_path is not None:
         raise ValueError(f"sample_path = {config.sample_path!r}: the cross-check prepares its "
                          "own (cached) sample; valid: None")
@@ -106,6 +118,12 @@ def check_mirrored(config):
     bridges = config.bridges
     if bridges is None:
         return
+    if config.sample.periodic:
+        raise ValueError(f"suction = {bridges.suction:g} Pa with a periodic cell: YADE's "
+                         "PeriTriaxController servoes the stress of the contact forces alone "
+                         "(utils.getStress; the capillary forces are apart, utils."
+                         "getCapillaryStress) while pendular's cell servo holds both; valid: "
+                         "0 (dry) with a periodic cell")
     for name, value, valid in (("model", bridges.model, "exact"),
                                ("control", bridges.control, "suction"),
                                ("table_resolution", bridges.table_resolution, None)):
@@ -114,11 +132,26 @@ def check_mirrored(config):
                              f"only with {name} = {valid!r}")
 
 
+def check_packing(config, packing):
+    """FileNotFoundError or ValueError naming ``packing`` when it is not the export of a
+    cross-check (DIR/packing.txt) with the box of ``config``: a '# box_lo ... box_hi ...'
+    line, its low corner at 0 for a periodic cell."""
+    if not os.path.isfile(packing):
+        raise FileNotFoundError(f"packing = {packing!r}: no such file")
+    lo = read_spheres(packing)[2]
+    if lo is None:
+        raise ValueError(f"packing = {packing!r}: no '# box_lo ... box_hi ...' line; valid: "
+                         "DIR/packing.txt of an earlier cross-check")
+    if config.sample.periodic and np.any(lo != 0.0):
+        raise ValueError(f"packing = {packing!r}: box_lo = {lo.tolist()} m is not a periodic "
+                         "cell's corner 0; valid: DIR/packing.txt of a periodic cross-check")
+
+
 def static_packing(config, path, *, settle=True, threads=1, progress=True):
     """Load (or prepare) the cached sample of ``config``, bring it to rest at the confining
     stress (wetted if ``config.bridges``; ``settle=False``: as loaded), write it to ``path``
-    (dem.yade_io.write_spheres); return the settle report (steps, time, wall stresses and, wet,
-    Sr and bridges)."""
+    (dem.yade_io.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
+    return the settle report (steps, time, wall or cell stresses and, wet, Sr and bridges)."""
     sample = config.sample
     particles, walls, _ = cached_sample(sample, progress=progress, threads=threads)
     sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
@@ -138,6 +171,8 @@ def static_packing(config, path, *, settle=True, threads=1, progress=True):
             raise NotStatic(f"{error} (cross-check: --settle-steps)") from None
     else:
         sim.evaluate_forces()
+    if sim.walls.periodic:
+        sim.walls.wrap(sim.particles)   # centres in [0, L), the cell YADE is given
     write_spheres(path, sim.particles.position, sim.particles.radius, sim.walls.lo,
                   sim.walls.hi)
     report = {"settle_steps": steps, "settle_time_s": time.perf_counter() - started,
@@ -149,15 +184,38 @@ def static_packing(config, path, *, settle=True, threads=1, progress=True):
 
 def pendular_shear(config, packing, threads=1):
     """The shear of the exported ``packing`` by pendular: (Simulation, TriaxialShear), not yet
-    run; the same scene as a triaxial test's shear, started from the packing at rest."""
+    run; the same scene as a triaxial test's shear (walls or, with ``config.sample.periodic``,
+    the periodic cell of the packing's box), started from the packing at rest."""
     sample = config.sample
     position, radius, lo, hi = read_spheres(packing)
-    sim = servoed_simulation(Particles(position, radius, sample.density), Walls.box(lo, hi),
-                             sample, sample.confining, threads=threads)
+    box = (PeriodicCell if sample.periodic else Walls).box(lo, hi)
+    sim = servoed_simulation(Particles(position, radius, sample.density), box, sample,
+                             sample.confining, threads=threads)
     if config.bridges is not None:
         sim.forces.append(config.bridges.build())
     shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius, sample.density)
     return sim, shear
+
+
+def cell_grow_damping(sim, gain, sample):
+    """PeriTriaxController.growDamping [-] that gives YADE's cell servo the gain ``gain`` of
+    pendular's on the scene ``sim`` (a periodic cell, forces evaluated) of ``sample`` (its
+    young and shear_ratio). Per step, YADE changes the strain of axis a by (1 - growDamping)
+    (sigma - target) A_a / k_a, A_a the cell's face normal to a [m^2] and k_a the mean over
+    the contacts of |n_a| kn + (1 - |n_a|) ks [N/m]: a compliance whose units do not balance,
+    at pendular's micrometre spheres hundreds of times below the cell's own 1 / S_a
+    (dem.cell), while pendular changes it by gain (sigma - target) / S_a. Matched on the mean
+    of x and y at the start of the shear (negative: YADE's term amplified)."""
+    contacts = sim.contacts
+    touching = contacts.touching()
+    radius = sim.particles.radius
+    kn = normal_stiffness(sample.young, radius[contacts.pair_i[touching]],
+                          radius[contacts.pair_j[touching]])[:, None]
+    normal = np.abs(contacts.normal[touching, :2])
+    mean_stiffness = (normal * kn + (1.0 - normal) * sample.shear_ratio * kn).mean(axis=0)
+    lx, ly, lz = sim.walls.lengths()
+    area = np.array([ly * lz, lx * lz])
+    return float(1.0 - gain * np.mean(mean_stiffness / (sim.walls.stiffness[:2] * area)))
 
 
 def yade_settings(config, packing, sim, shear, folder):
@@ -172,12 +230,20 @@ def yade_settings(config, packing, sim, shear, folder):
         "friction_deg": sample.friction_deg, "density": sample.density,
         "damping": sample.damping, "dt": sim.dt, "confining": sample.confining,
         "strain_rate": shear.rate, "steps": yade_axial.steps_to(config.shear.max_strain, sim.dt),
+        "periodic": sample.periodic,
         "warmup_steps": 0, "record_every": shear.recorder.period, "record_initial": True,
         "skin": sample.skin_factor * sample.radius,
         "stress_damping": 1.0 - lateral.gain, "strain_damping": 0.0,
         "max_vel": lateral.max_velocity,
         "history": os.path.join(folder, "yade_history.txt"),
         "output": os.path.join(folder, "yade_result.json")}
+    if sample.periodic:
+        # PeriTriaxController's stress and stiffness from the contacts every step: between
+        # evaluations it predicts the stress by a formula whose units do not balance, which at
+        # micrometre spheres drives the lateral strain rates from cap to cap; and its gain
+        # made pendular's (docs/yade_crosscheck.md, "Periodic cell")
+        settings["glob_update"] = 1
+        settings["stress_damping"] = cell_grow_damping(sim, lateral.gain, sample)
     bridges = config.bridges
     if bridges is not None:
         settings["capillary"] = {"suction": bridges.suction,
@@ -187,9 +253,13 @@ def yade_settings(config, packing, sim, shear, folder):
     return settings
 
 
-def code_summary(history, particles, steps, seconds):
-    """Peak and start-of-shear values of one code's history, with its cost per step."""
+def code_summary(history, particles, steps, seconds, confining):
+    """Peak and start-of-shear values of one code's history, with its cost per step and the
+    largest relative deviation of its lateral stresses from ``confining`` [Pa] over the
+    records (how well its servo holds them)."""
     summary = summarize(history)
+    lateral = history["sigma_wall"][:, :2]
+    summary["lateral_stress_max_rel_error"] = float(np.abs(lateral / confining - 1.0).max())
     peak = summary.pop("peak_index")
     for name in ("volumetric_strain", "porosity", "bridges"):
         if name in history:
@@ -269,8 +339,8 @@ def run_crosscheck(config, out, *, settle=True, packing=None, concurrent=False, 
     out = os.path.abspath(out)
     if packing is not None:
         packing = os.fspath(packing)
-    if packing is not None and not os.path.isfile(packing):
-        raise FileNotFoundError(f"packing = {packing!r}: no such file")
+    if packing is not None:
+        check_packing(config, packing)
     with OutputFolder(out, "crosscheck") as folder:
         for name in OUTPUTS:
             folder.claim(name)
@@ -306,13 +376,18 @@ def _shear_both(config, out, packing, settled, concurrent, threads, progress):
                   attributes={"mimic_yade": mimic, "dt": sim.dt, "strain_rate": shear.rate})
     theirs = yade_history(settings["history"], box_volume)
     count = len(sim.particles)
-    pendular = code_summary(ours, count, shear.steps, pendular_seconds)
-    yade = code_summary(theirs, count, yade_result["steps"], yade_result["wall_time_s"])
+    confining = config.confining
+    pendular = code_summary(ours, count, shear.steps, pendular_seconds, confining)
+    yade = code_summary(theirs, count, yade_result["steps"], yade_result["wall_time_s"],
+                        confining)
     yade["version"] = yade_result["yade_version"]
+    yade["controller"] = {key: value for key, value in yade_result.items()
+                          if key in YADE_CONTROLLER}
     servo = sim.operation(StressServo)
     result = {
-        "particles": count, "suction": config.suction, "confining": config.confining,
-        "max_strain": config.shear.max_strain, "mimic_yade": mimic,
+        "particles": count, "suction": config.suction, "confining": confining,
+        "periodic": config.sample.periodic, "max_strain": config.shear.max_strain,
+        "mimic_yade": mimic,
         "threads": threads, "concurrent": concurrent,
         "dt": sim.dt, "strain_rate": shear.rate, "damping": config.sample.damping,
         "servo": {"gain": servo.gain, "memory": servo.memory,

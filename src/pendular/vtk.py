@@ -55,7 +55,6 @@ import numpy as np
 
 from capillary.bridge_state import BridgeState
 from dem.atomic import replacing
-from dem.neighbors import branch_vectors
 from dem.validate import check_int
 
 #: The series written, each a .pvd collection of .vtu files.
@@ -174,10 +173,11 @@ def _lines(sim, mask):
     index = np.flatnonzero(mask)
     count = len(index)
     start = position[contacts.pair_i[index]]
-    end = start + branch_vectors(position, contacts, sim.walls.period, index)
-    if sim.walls.periodic:
-        shift = np.mod(start, sim.walls.lengths()) - start
-        start, end = start + shift, end + shift
+    end = position[contacts.pair_j[index]]
+    if sim.walls.periodic:         # from i in the cell to the image of j it interacts with
+        lengths = sim.walls.lengths()
+        shift = np.mod(start, lengths) - start
+        start, end = start + shift, end + contacts.image[index] * lengths + shift
     points = np.concatenate([start, end]) if count else np.zeros((0, 3))
     lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
     return points, lines

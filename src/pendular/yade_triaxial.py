@@ -27,6 +27,13 @@
 #   by 3 L_a / (L_x + L_y + L_z)), stiffness_update_interval 10
 #   (TriaxialStressController.stiffnessUpdateInterval, YADE's default; the wall stiffness is
 #   also refreshed at each of the first 100 iterations).
+#   periodic (optional, default false): a periodic cell [0, L] (O.periodic, O.cell.setBox to
+#     box_hi; box_lo must be 0) instead of six walls, driven by PeriTriaxController (below);
+#     stress_damping is then its growDamping (below 0 amplifies the controller's stiffness
+#     term: pendular.crosscheck.cell_grow_damping), max_vel caps the lateral strain rates at
+#     2 max_vel / L_a (pendular's per-step cap on both faces of the cell), glob_update its
+#     globUpdate (YADE's default 5: steps between evaluations of the cell's stress and
+#     stiffness, predicted in between).
 #   capillary (optional, wet test): {"suction": s [Pa], "files": folder holding the capillary
 #     files M(r=1) ... M(r=10) (capillary.write_yade), "surface_tension": 0.073 N/m,
 #     "persist": false, "detection_factor": 1.0}. Adds YADE's capillary law
@@ -44,17 +51,26 @@
 #   [-> Law2_ScGeom_CapillaryPhys_Capillarity (wet test)]
 #   -> TriaxialStressController (x, y servoed at -confining, z at strain rate -strain_rate)
 #   -> NewtonIntegrator(damping) [-> PyRunner recording the history]
+# Periodic: no walls (no box bounds nor box-sphere geometry), and PeriTriaxController(dynCell=
+#   False, stressMask=0b011, goal=(-confining, -confining, z strain goal)) instead of the
+#   TriaxialStressController. x, y: the cell's velocity gradient is set each step from the
+#   stress error (goal - stress) * area / mean contact stiffness / dt, then
+#   (1 - growDamping) * that + 0.8 * previous, clipped to maxStrainRate. z is a strain goal
+#   (log(L / L0)) beyond the final strain, so its rate stays at maxStrainRate = strain_rate (the
+#   true strain rate, on the current length) for all ``steps``. The cell's stress is
+#   utils.getStress() (Love-Weber over the cell, tension positive, negated here).
 #
 # History (plot.saveDataTxt columns, a row every record_every iterations, from iteration 0 (its
 # wall forces are those of the initial packing) if record_initial (default false), and the final
-# state): i, t, eps_axial (1 - L_z / L_z0), sx, sy, sz [Pa], lx, ly, lz (inner box lengths [m]),
-# porosity, unbalanced; the wet test adds saturation and menisci (as in the output JSON).
+# state): i, t, eps_axial (1 - L_z / L_z0), sx, sy, sz [Pa], lx, ly, lz (inner box or cell
+# lengths [m]), porosity, unbalanced; the wet test adds saturation and menisci (as in the output
+# JSON).
 #
 # Output JSON: particles, steps, wall_time_s, particle_steps_per_s, threads, yade_version,
 # sigma_wall [sx, sy, sz] Pa (compression positive, force on each wall pair / current face
-# area), porosity, coordination (2 Nc / N over sphere-sphere contacts), unbalanced_force
-# (utils.unbalancedForce), and the settings used; wet test: menisci (count), water_volume [m^3]
-# and saturation (water / (box volume - solid volume)).
+# area; periodic: the cell's stress), porosity, coordination (2 Nc / N over sphere-sphere
+# contacts), unbalanced_force (utils.unbalancedForce), and the settings used; wet test: menisci
+# (count), water_volume [m^3] and saturation (water / (box volume - solid volume)).
 
 import json
 import math
@@ -67,7 +83,7 @@ from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Bo
                   Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                   Ip2_FrictMat_FrictMat_CapillaryPhys, Ip2_FrictMat_FrictMat_FrictPhys,
                   Law2_ScGeom_CapillaryPhys_Capillarity, Law2_ScGeom_FrictPhys_CundallStrack,
-                  NewtonIntegrator, PyRunner, TriaxialStressController)
+                  NewtonIntegrator, PeriTriaxController, PyRunner, TriaxialStressController)
 import yade.config
 
 REQUIRED = ("spheres", "young", "poisson", "friction_deg", "density", "damping", "dt",
@@ -149,16 +165,54 @@ def build_scene(config):
         young=E, poisson=float(config["poisson"]), density=float(config["density"]),
         frictionAngle=0.0, label="walls"))
 
-    # aabbWalls puts the inner faces exactly on lo / hi and returns minX, maxX, minY, maxY,
-    # minZ, maxZ; appended first they get ids 0..5, TriaxialStressController's default ids.
-    thickness = 0.1 * min(h - l for l, h in zip(lo, hi))
-    walls = utils.aabbWalls([lo, hi], thickness=thickness, oversizeFactor=1.5, material=wall_mat)
-    wall_ids = O.bodies.append(walls)
+    if config.get("periodic"):
+        if any(l != 0.0 for l in lo):
+            fail(f"periodic: box_lo {lo} must be 0 (the cell is [0, L])")
+        O.periodic = True
+        O.cell.setBox(*hi)
+        thickness, wall_ids = 0.0, []
+    else:
+        # aabbWalls puts the inner faces exactly on lo / hi and returns minX, maxX, minY, maxY,
+        # minZ, maxZ; appended first they get ids 0..5, TriaxialStressController's default ids.
+        thickness = 0.1 * min(h - l for l, h in zip(lo, hi))
+        walls = utils.aabbWalls([lo, hi], thickness=thickness, oversizeFactor=1.5,
+                                material=wall_mat)
+        wall_ids = O.bodies.append(walls)
     spheres = ymport.textExt(config["spheres"], format="x_y_z_r", material=sphere_mat)
     if not spheres:
         fail(f"{config['spheres']}: no sphere read")
     sphere_ids = O.bodies.append(spheres)
     return lo, hi, thickness, wall_ids, sphere_ids
+
+
+def cell_controller(config, size, confining, rate):
+    """PeriTriaxController of the periodic shear: x, y at the confining stress (goals in YADE's
+    signs, tension positive), z compressed at the true strain rate ``rate`` [1/s] for the whole
+    run (its log-strain goal twice the final one); lateral strain rates capped at
+    2 max_vel / L_a [1/s] (``size``: the cell's lengths [m])."""
+    dt = float(config["dt"])
+    if not 0.0 < rate * dt < 1.0:
+        fail(f"strain_rate * dt = {rate * dt!r} must lie in (0, 1) for a periodic cell")
+    steps = int(config["warmup_steps"]) + int(config["steps"])
+    max_vel = float(config.get("max_vel", 1.0))
+    return PeriTriaxController(
+        label="triax", dynCell=False, stressMask=0b011,
+        goal=(-confining, -confining, 2.0 * steps * math.log1p(-rate * dt)),
+        maxStrainRate=(2.0 * max_vel / size[0], 2.0 * max_vel / size[1], rate),
+        growDamping=float(config.get("stress_damping", 0.25)),
+        globUpdate=int(config.get("glob_update", 5)))
+
+
+def controller_settings(triax, periodic):
+    """The controller's settings, for the output JSON."""
+    if periodic:
+        return {"controller": "PeriTriaxController", "dyn_cell": triax.dynCell,
+                "stress_mask": triax.stressMask, "goal": list(triax.goal),
+                "max_strain_rate": list(triax.maxStrainRate),
+                "grow_damping": triax.growDamping, "glob_update": triax.globUpdate}
+    return {"controller": "TriaxialStressController", "stress_damping": triax.stressDamping,
+            "strain_damping": triax.strainDamping, "max_vel": triax.max_vel,
+            "stiffness_update_interval": triax.stiffnessUpdateInterval}
 
 
 def main(config_path):
@@ -172,17 +226,24 @@ def main(config_path):
     confining = float(config["confining"])
     rate = float(config["strain_rate"])
 
-    triax = TriaxialStressController(
-        label="triax", internalCompaction=False, thickness=thickness,
-        wall_left_id=wall_ids[0], wall_right_id=wall_ids[1], wall_bottom_id=wall_ids[2],
-        wall_top_id=wall_ids[3], wall_back_id=wall_ids[4], wall_front_id=wall_ids[5],
-        # goal1/2/3 act on x/y/z; bit i of stressMask makes goal(i+1) a stress, else a strain
-        # rate; YADE's signs are tension positive, so compression is negative.
-        stressMask=0b011, goal1=-confining, goal2=-confining, goal3=-rate,
-        stressDamping=float(config.get("stress_damping", 0.25)),
-        strainDamping=float(config.get("strain_damping", 0.0)),
-        max_vel=float(config.get("max_vel", 1.0)),
-        stiffnessUpdateInterval=int(config.get("stiffness_update_interval", 10)))
+    periodic = bool(config.get("periodic"))
+    if periodic:
+        triax = cell_controller(config, hi, confining, rate)
+    else:
+        triax = TriaxialStressController(
+            label="triax", internalCompaction=False, thickness=thickness,
+            wall_left_id=wall_ids[0], wall_right_id=wall_ids[1], wall_bottom_id=wall_ids[2],
+            wall_top_id=wall_ids[3], wall_back_id=wall_ids[4], wall_front_id=wall_ids[5],
+            # goal1/2/3 act on x/y/z; bit i of stressMask makes goal(i+1) a stress, else a
+            # strain rate; YADE's signs are tension positive, so compression is negative.
+            stressMask=0b011, goal1=-confining, goal2=-confining, goal3=-rate,
+            stressDamping=float(config.get("stress_damping", 0.25)),
+            strainDamping=float(config.get("strain_damping", 0.0)),
+            max_vel=float(config.get("max_vel", 1.0)),
+            stiffnessUpdateInterval=int(config.get("stiffness_update_interval", 10)))
+    # a periodic cell has no walls: no box bounds, no box-sphere geometry
+    box_bound = [] if periodic else [Bo1_Box_Aabb()]
+    box_geometry = [] if periodic else [Ig2_Box_Sphere_ScGeom()]
     wet = config.get("capillary")
     if wet:
         wet = capillary_settings(wet)
@@ -190,10 +251,10 @@ def main(config_path):
         factor = wet["detection_factor"]
         O.engines = [
             ForceResetter(),
-            InsertionSortCollider([Bo1_Sphere_Aabb(aabbEnlargeFactor=factor), Bo1_Box_Aabb()],
+            InsertionSortCollider([Bo1_Sphere_Aabb(aabbEnlargeFactor=factor)] + box_bound,
                                   verletDist=0.5 * skin),
-            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(interactionDetectionFactor=factor),
-                             Ig2_Box_Sphere_ScGeom()],
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(interactionDetectionFactor=factor)]
+                            + box_geometry,
                             [Ip2_FrictMat_FrictMat_CapillaryPhys()],
                             [Law2_ScGeom_FrictPhys_CundallStrack(neverErase=wet["persist"])]),
             Law2_ScGeom_CapillaryPhys_Capillarity(
@@ -205,8 +266,8 @@ def main(config_path):
     else:
         O.engines = [
             ForceResetter(),
-            InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=0.5 * skin),
-            InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            InsertionSortCollider([Bo1_Sphere_Aabb()] + box_bound, verletDist=0.5 * skin),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom()] + box_geometry,
                             [Ip2_FrictMat_FrictMat_FrictPhys()],
                             [Law2_ScGeom_FrictPhys_CundallStrack()]),
             triax,
@@ -217,7 +278,11 @@ def main(config_path):
     sphere_set = set(sphere_ids)
 
     def wall_state():
-        """Inner box lengths [m] and wall stresses [Pa, compression positive]."""
+        """Inner box (or cell) lengths [m] and wall (or cell) stresses [Pa, compression
+        positive]."""
+        if periodic:
+            stress = utils.getStress()  # Love-Weber over the cell volume, tension positive
+            return list(O.cell.size), [-stress[a, a] for a in range(3)]
         p = [O.bodies[i].state.pos for i in wall_ids]
         lengths = [p[2 * a + 1][a] - p[2 * a][a] - thickness for a in range(3)]
         areas = [lengths[1] * lengths[2], lengths[0] * lengths[2], lengths[0] * lengths[1]]
@@ -226,6 +291,12 @@ def main(config_path):
         return lengths, sigma
 
     solid = sum(4.0 / 3.0 * math.pi * r ** 3 for r in radii)
+
+    def porosity(lengths):
+        """Porosity of the box (the controller's) or of the cell."""
+        if periodic:
+            return 1.0 - solid / (lengths[0] * lengths[1] * lengths[2])
+        return triax.porosity
 
     def wet_state(lengths):
         """Menisci between spheres, their water volume [m^3] and the degree of saturation."""
@@ -239,7 +310,7 @@ def main(config_path):
         lengths, sigma = wall_state()
         row = {"i": O.iter, "t": O.time, "eps_axial": 1.0 - lengths[2] / depth0,
                "sx": sigma[0], "sy": sigma[1], "sz": sigma[2], "lx": lengths[0],
-               "ly": lengths[1], "lz": lengths[2], "porosity": triax.porosity,
+               "ly": lengths[1], "lz": lengths[2], "porosity": porosity(lengths),
                "unbalanced": utils.unbalancedForce()}
         if wet:
             state = wet_state(lengths)
@@ -272,7 +343,7 @@ def main(config_path):
         "threads": O.numThreads,
         "yade_version": yade.config.version,
         "sigma_wall": sigma,
-        "porosity": triax.porosity,
+        "porosity": porosity(lengths),
         "coordination": 2.0 * sphere_contacts / n,
         "unbalanced_force": utils.unbalancedForce(),
         "axial_strain": 1.0 - lengths[2] / depth0,
@@ -281,10 +352,7 @@ def main(config_path):
         "time": O.time,
         "dt": O.dt,
         "verlet_dist": 0.5 * skin,
-        "stress_damping": triax.stressDamping,
-        "strain_damping": triax.strainDamping,
-        "max_vel": triax.max_vel,
-        "stiffness_update_interval": triax.stiffnessUpdateInterval,
+        **controller_settings(triax, periodic),
         "engines": [type(e).__name__ for e in O.engines],
     }
     if wet:

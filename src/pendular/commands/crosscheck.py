@@ -3,7 +3,8 @@
 pendular prepares (cached) and settles the sample at --confining (wet with --suction > 0:
 bridges at every contact) and exports it to DIR/packing.txt; both codes shear that packing from
 rest with x, y servoed and z compressed at the strain rate of pendular's default inertial
-number, with the same time step, damping and servo settings (pendular.crosscheck). Writes
+number, with the same time step, damping and servo settings (pendular.crosscheck); with
+--periodic in a periodic cell (YADE: PeriTriaxController) instead of six walls. Writes
 DIR/crosscheck.json (both codes' peak and start-of-shear values and their differences),
 DIR/crosscheck.png, DIR/yade_history.txt and DIR/pendular_history.h5. Stresses compression
 positive [Pa]. Needs ``yade`` on PATH; docs/yade_crosscheck.md lists the differences.
@@ -31,6 +32,9 @@ def add_arguments(parser):
     add_size_options(parser, PrepareConfig.radius)
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/crosscheck", help="output folder")
+    parser.add_argument("--periodic", action="store_true",
+                        help="a periodic cell instead of six walls: pendular's cell servo "
+                             "against YADE's PeriTriaxController")
     parser.add_argument("--mimic-yade", action="store_true",
                         help="pendular takes YADE's wall-control choices (pendular.config."
                              "YADE_CHOICES)")
@@ -75,7 +79,7 @@ def config_from(args):
                              confining=args.confining, max_strain=args.max_strain,
                              records=args.records, mimic_yade=args.mimic_yade,
                              settle_steps=max(args.settle_steps, 1), seed=args.seed,
-                             **sizes_from(args))
+                             periodic=args.periodic, **sizes_from(args))
 
 
 def run(args):
