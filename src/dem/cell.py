@@ -33,6 +33,17 @@ _NONE = np.zeros((0, 3))
 SUM_BLOCKS = 64
 
 
+@numba.njit(cache=True)
+def _sum_blocks(sums):
+    """Column sums of the per-block sums, block after block (the same order for any thread
+    count)."""
+    total = np.zeros(sums.shape[1])
+    for block in range(sums.shape[0]):
+        for c in range(sums.shape[1]):
+            total[c] += sums[block, c]
+    return total
+
+
 @numba.njit(cache=True, parallel=True)
 def resultant_virial(position, force, row_start, image, period, pair_force, other_force):
     """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
@@ -89,11 +100,7 @@ def resultant_virial(position, force, row_start, image, period, pair_force, othe
         row = sums[block]
         row[0], row[1], row[2], row[3], row[4] = s00, s01, s02, s10, s11
         row[5], row[6], row[7], row[8] = s12, s20, s21, s22
-    total = np.zeros(9)
-    for block in range(SUM_BLOCKS):
-        for c in range(9):
-            total[c] += sums[block, c]
-    return total
+    return _sum_blocks(sums)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -109,11 +116,7 @@ def pair_virial(position, row_start, pair_j, image, period, pair_force):
                 for a in range(3):
                     for b in range(3):
                         sums[block, 3 * a + b] += branch[a] * pair_force[k, b]
-    total = np.zeros(9)
-    for block in range(SUM_BLOCKS):
-        for c in range(9):
-            total[c] += sums[block, c]
-    return total
+    return _sum_blocks(sums)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -136,11 +139,7 @@ def contact_stiffness(position, row_start, pair_j, image, period, normal_force, 
         sums[block, 0] = k0
         sums[block, 1] = k1
         sums[block, 2] = k2
-    total = np.zeros(3)
-    for block in range(SUM_BLOCKS):
-        for c in range(3):
-            total[c] += sums[block, c]
-    return total
+    return _sum_blocks(sums)
 
 
 @numba.njit(cache=True)

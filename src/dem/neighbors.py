@@ -72,6 +72,23 @@ def branch_vector(position, i, j, image, k, period):
 
 
 @numba.njit(cache=True)
+def _cell_members(cell_of, cell_count):
+    """(cell_start, cell_particles): the particles of each cell in CSR order, cell c holding
+    cell_particles[cell_start[c]:cell_start[c + 1]] in index order."""
+    cell_start = np.zeros(cell_count + 1, np.int64)
+    for p in range(len(cell_of)):
+        cell_start[cell_of[p] + 1] += 1
+    for c in range(cell_count):
+        cell_start[c + 1] += cell_start[c]
+    fill = cell_start[:-1].copy()
+    cell_particles = np.empty(len(cell_of), np.int64)
+    for p in range(len(cell_of)):
+        cell_particles[fill[cell_of[p]]] = p
+        fill[cell_of[p]] += 1
+    return cell_start, cell_particles
+
+
+@numba.njit(cache=True)
 def _cell_grid(position, cell_size):
     """Sort particles into a regular grid of cells of at least ``cell_size`` covering them.
 
@@ -100,17 +117,7 @@ def _cell_grid(position, cell_size):
             c = min(max(c, 0), dims[axis] - 1)
             index = index * dims[axis] + c
         cell_of[p] = index
-    cell_count = dims[0] * dims[1] * dims[2]
-    cell_start = np.zeros(cell_count + 1, np.int64)
-    for p in range(count):
-        cell_start[cell_of[p] + 1] += 1
-    for c in range(cell_count):
-        cell_start[c + 1] += cell_start[c]
-    fill = cell_start[:-1].copy()
-    cell_particles = np.empty(count, np.int64)
-    for p in range(count):
-        cell_particles[fill[cell_of[p]]] = p
-        fill[cell_of[p]] += 1
+    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
     return dims, cell_of, cell_start, cell_particles
 
 
@@ -184,11 +191,12 @@ def build_pairs(position, radius, skin):
 @numba.njit(cache=True)
 def _periodic_grid(position, cell_size, period):
     """Sort particles (wrapped into [0, period)) into cells of edge at least ``cell_size``
-    tiling the periodic box, at least 3 a side (so the 27 cells around a cell are distinct)."""
+    tiling the periodic box (build_contacts makes sure of at least 3 a side, so that the 27
+    cells around a cell are distinct)."""
     count = position.shape[0]
     dims = np.empty(3, np.int64)
     for axis in range(3):
-        dims[axis] = max(3, int(period[axis] / cell_size))
+        dims[axis] = int(period[axis] / cell_size)
     cell_of = np.empty(count, np.int64)
     for p in range(count):
         index = 0
@@ -197,17 +205,7 @@ def _periodic_grid(position, cell_size, period):
             c = min(max(c, 0), dims[axis] - 1)
             index = index * dims[axis] + c
         cell_of[p] = index
-    cell_count = dims[0] * dims[1] * dims[2]
-    cell_start = np.zeros(cell_count + 1, np.int64)
-    for p in range(count):
-        cell_start[cell_of[p] + 1] += 1
-    for c in range(cell_count):
-        cell_start[c + 1] += cell_start[c]
-    fill = cell_start[:-1].copy()
-    cell_particles = np.empty(count, np.int64)
-    for p in range(count):
-        cell_particles[fill[cell_of[p]]] = p
-        fill[cell_of[p]] += 1
+    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
     return dims, cell_of, cell_start, cell_particles
 
 
