@@ -190,7 +190,7 @@ def test_the_cell_stress_from_resultants_is_the_pair_by_pair_sum():
         assert np.count_nonzero(c.image.any(axis=1) & (c.overlap > 0.0)) > 20
         by_pairs = pair_virial(p.position, c.row_start, c.pair_j, c.image, sim.walls.period,
                                c.force)
-        by_resultants = resultant_virial(p.position, p.force, c.row_start, c.image,
+        by_resultants = resultant_virial(p.position, p.force, c.through_face, c.image,
                                          sim.walls.period, c.force, np.zeros((0, 3)))
         np.testing.assert_allclose(by_resultants, by_pairs, rtol=1e-9,
                                    atol=1e-9 * np.abs(by_pairs).max())

@@ -45,17 +45,18 @@ def _sum_blocks(sums):
 
 
 @numba.njit(cache=True, parallel=True)
-def resultant_virial(position, force, row_start, image, period, pair_force, other_force):
+def resultant_virial(position, force, through_face, image, period, pair_force, other_force):
     """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
     f the force on j from i: ``pair_force`` plus ``other_force`` unless that is empty, (0, 3))
     when ``force`` (N, 3) [N] is each particle's resultant of those pair forces, from
 
         sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
 
-    (l = x_j - x_i + image L; the second sum runs over the pairs through a face only): one
-    pass over the particles and a scan of the images instead of a pass over every pair."""
+    (l = x_j - x_i + image L; the second sum runs over the pairs ``through_face`` only): a
+    pass over the particles and one over those pairs instead of a pass over every pair."""
     other = len(other_force) > 0
-    count = len(row_start) - 1
+    count = len(position)
+    faces = len(through_face)
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
         s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
@@ -66,28 +67,6 @@ def resultant_virial(position, force, row_start, image, period, pair_force, othe
             f0 = force[p, 0]
             f1 = force[p, 1]
             f2 = force[p, 2]
-            for k in range(row_start[p], row_start[p + 1]):
-                if image[k, 0] == 0 and image[k, 1] == 0 and image[k, 2] == 0:
-                    continue
-                g0 = pair_force[k, 0]
-                g1 = pair_force[k, 1]
-                g2 = pair_force[k, 2]
-                if other:
-                    g0 += other_force[k, 0]
-                    g1 += other_force[k, 1]
-                    g2 += other_force[k, 2]
-                a0 = image[k, 0] * period[0]
-                a1 = image[k, 1] * period[1]
-                a2 = image[k, 2] * period[2]
-                s00 += a0 * g0
-                s01 += a0 * g1
-                s02 += a0 * g2
-                s10 += a1 * g0
-                s11 += a1 * g1
-                s12 += a1 * g2
-                s20 += a2 * g0
-                s21 += a2 * g1
-                s22 += a2 * g2
             s00 += x0 * f0
             s01 += x0 * f1
             s02 += x0 * f2
@@ -97,6 +76,27 @@ def resultant_virial(position, force, row_start, image, period, pair_force, othe
             s20 += x2 * f0
             s21 += x2 * f1
             s22 += x2 * f2
+        for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
+            k = through_face[slot]
+            g0 = pair_force[k, 0]
+            g1 = pair_force[k, 1]
+            g2 = pair_force[k, 2]
+            if other:
+                g0 += other_force[k, 0]
+                g1 += other_force[k, 1]
+                g2 += other_force[k, 2]
+            a0 = image[k, 0] * period[0]
+            a1 = image[k, 1] * period[1]
+            a2 = image[k, 2] * period[2]
+            s00 += a0 * g0
+            s01 += a0 * g1
+            s02 += a0 * g2
+            s10 += a1 * g0
+            s11 += a1 * g1
+            s12 += a1 * g2
+            s20 += a2 * g0
+            s21 += a2 * g1
+            s22 += a2 * g2
         row = sums[block]
         row[0], row[1], row[2], row[3], row[4] = s00, s01, s02, s10, s11
         row[5], row[6], row[7], row[8] = s12, s20, s21, s22
@@ -209,8 +209,13 @@ class PeriodicCell(Box):
 
     @property
     def period(self):
-        """Shift of one periodic image (3,) [m]: the edge lengths."""
-        return self.lengths()
+        """Shift of one periodic image (3,) [m]: the edge lengths (a view of ``position``,
+        the low faces being at 0)."""
+        return self.position[1::2]
+
+    def volume(self):
+        """Volume of the cell [m^3]."""
+        return float(self.position[1] * self.position[3] * self.position[5])
 
     @property
     def affine_rate(self):
@@ -251,7 +256,7 @@ class PeriodicCell(Box):
             p, period = sim.particles, self.period
             forces = [op.pair_forces(sim) for op in sim.forces if hasattr(op, "pair_forces")]
             if len(forces) == len(sim.forces) and len(forces) <= 2:
-                total = resultant_virial(p.position, p.force, contacts.row_start,
+                total = resultant_virial(p.position, p.force, contacts.through_face,
                                          contacts.image, period, forces[0],
                                          forces[1] if len(forces) == 2 else _NONE)
             else:       # a force that is not a pair force: resultants are not the pairs' sum

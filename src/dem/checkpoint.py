@@ -84,7 +84,8 @@ DATASETS = {
         "force": ("N", "total contact force on j from i (K, 3)"),
         "torque_i": ("N m", "contact torque on i (K, 3)"),
         "torque_j": ("N m", "contact torque on j (K, 3)"),
-        "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L")},
+        "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L"),
+        "through_face": ("1", "the pairs whose image is not zero (through a periodic face)")},
     "": {"state": ("1", "pickled state of every operation and writer and the caller's "
                         "extra_state (bytes; see dem.checkpoint)")},
 }

@@ -32,7 +32,8 @@ class Contacts:
     extra: name -> (K, ...) per-pair state owned by other operations (e.g. capillary bridges),
     carried to the same pair by ``build_contacts``; absent pairs start at 0.
     image: (K, 3) int8 periodic image of j seen from i: the branch vector is
-    x_j - x_i + image * period (``branch_vector``; zeros inside walls).
+    x_j - x_i + image * period (``branch_vector``; zeros inside walls);
+    through_face: (F,) int64 the pairs whose image is not zero, in pair order.
     """
 
     pair_i: np.ndarray
@@ -49,10 +50,13 @@ class Contacts:
     torque_j: np.ndarray
     extra: dict = field(default_factory=dict)
     image: np.ndarray = None
+    through_face: np.ndarray = None
 
     def __post_init__(self):
         if self.image is None:
             self.image = np.zeros((len(self.pair_j), 3), np.int8)
+        if self.through_face is None:
+            self.through_face = np.flatnonzero(self.image.any(axis=1)).astype(np.int64)
 
     def __len__(self):
         return len(self.pair_i)
@@ -504,7 +508,10 @@ class NeighborList:
         # a periodic box that changed size by dL moves pairs across its faces by up to dL
         limit = 0.5 * self.skin
         if sim.walls.periodic and self._reference_lengths is not None:
-            limit -= 0.5 * float(np.max(np.abs(sim.walls.lengths() - self._reference_lengths)))
+            faces, reference = sim.walls.position, self._reference_lengths
+            limit -= 0.5 * max(abs(faces[1] - faces[0] - reference[0]),
+                               abs(faces[3] - faces[2] - reference[1]),
+                               abs(faces[5] - faces[4] - reference[2]))
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
                 or len(self._reference_radius) != len(p.radius) or limit <= 0.0
