@@ -2,7 +2,7 @@
 ``pendular crosscheck`` (``--help`` for options).
 
     python scenarios/yade_crosscheck.py [--particles N] [--suction PA] [--confining PA]
-        [--max-strain X] [--out DIR] [--mimic-yade] [--records N] [--threads T]
+        [--max-strain X] [--out DIR] [--periodic] [--mimic-yade] [--records N] [--threads T]
         [--settle-steps N] [--packing FILE] [--concurrent] [--quiet]
 
 Writes DIR/crosscheck.json, crosscheck.png, yade_history.txt and pendular_history.h5

@@ -17,6 +17,8 @@
    shear (same contacts, bridges, Sr, stresses), and only the shear's dynamics can differ.
    ``packing=FILE`` starts from a packing exported by an earlier cross-check of the same sample
    and suction instead (no settling).
+   Periodic (``crosscheck_config(periodic=True)``, dry only): the sample fills a periodic cell
+   (dem.cell), exported as its box [0, L] with the centres wrapped into it.
 3. Both shear it with x, y servoed at the confining stress and z compressed at the strain rate
    of ``config.shear`` (pendular.triaxial.TriaxialShear), with the same time step, local
    damping, servo gain (1 - stressDamping), memory (0.8) and wall speed cap (max_vel),
@@ -25,16 +27,20 @@
    of ``config.shear``: its defaults, or YADE's (pendular.config.YADE_CHOICES: axial rate on the
    current height, per-axis wall speed cap, wall stiffness refreshed every 10 steps) with
    ``crosscheck_config(mimic_yade=True)``. Each code runs until the engineering axial strain
-   reaches ``config.shear.max_strain``.
+   reaches ``config.shear.max_strain``. Periodic: YADE drives the cell with PeriTriaxController
+   (x, y stress goals, z at the true strain rate), its stress evaluated every step and its
+   servo given pendular's gain (``cell_grow_damping``); pendular with its cell servo.
 
 Writes DIR/crosscheck.json: ``pendular`` and ``yade`` summaries (peak q, p, axial and volumetric
 strain, Sr, bridges / menisci and porosity at the peak of q, the same at the start of the shear,
 steps, seconds_per_step and particle_steps_per_s of the shear measured in this run, recording
-included), ``peak_q_rel_diff`` and ``saturation_rel_diff`` ((pendular - YADE) / YADE at the
-peak), ``volumetric_strain_at_peak_diff`` (pendular - YADE), ``start_sigma_rel_diff`` and
-``start_saturation_rel_diff``, plus the settings and the configuration; DIR/crosscheck.png (q/p,
-volumetric strain and, wet, Sr against axial strain, both codes); DIR/yade_history.txt and
-DIR/pendular_history.h5. Stresses compression positive [Pa], strains compression positive.
+included, the largest relative deviation of the lateral stresses from the confining stress;
+YADE's controller settings), ``peak_q_rel_diff`` and ``saturation_rel_diff`` ((pendular -
+YADE) / YADE at the peak), ``volumetric_strain_at_peak_diff`` (pendular - YADE),
+``start_sigma_rel_diff`` and ``start_saturation_rel_diff``, plus the settings and the
+configuration; DIR/crosscheck.png (q/p, volumetric strain and, wet, Sr against axial strain,
+both codes); DIR/yade_history.txt and DIR/pendular_history.h5. Stresses compression positive
+[Pa], strains compression positive.
 """
 
 from __future__ import annotations
@@ -206,6 +212,7 @@ def cell_grow_damping(sim, gain, sample):
     at pendular's micrometre spheres hundreds of times below the cell's own 1 / S_a
     (dem.cell), while pendular changes it by gain (sigma - target) / S_a. Matched on the mean
     of x and y at the start of the shear (negative: YADE's term amplified)."""
+    sim.walls.update_stiffness(sim)
     contacts = sim.contacts
     touching = contacts.touching()
     radius = sim.particles.radius

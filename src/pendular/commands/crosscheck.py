@@ -63,6 +63,10 @@ def check(args):
         raise UsageError(f"--confining {args.confining} Pa is outside the valid range (0, inf)")
     if not 0.0 < args.max_strain < 0.9:
         raise UsageError(f"--max-strain {args.max_strain} is outside the valid range (0, 0.9)")
+    if args.periodic and args.suction > 0.0:
+        raise UsageError(f"--suction {args.suction} Pa with --periodic: YADE's "
+                         "PeriTriaxController servoes the stress of the contact forces alone "
+                         "(without the capillary forces); valid: 0 with --periodic")
     if args.records < 2:
         raise UsageError(f"--records {args.records} is outside the valid range [2, inf)")
     if not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
