@@ -92,8 +92,8 @@ def crosscheck_config(particles=1000, suction=0.0, confining=750.0, max_strain=0
     ``particles`` spheres at ``confining`` [Pa] from ``seed``, of the ``sizes`` given
     (PrepareConfig's radius, radius_spread, psd), in a periodic cell if ``periodic`` (YADE:
     PeriTriaxController) or six walls (TriaxialStressController); suction-controlled exact
-    bridges at
-    ``suction`` [Pa] (0: dry; surface tension capillary.SURFACE_TENSION, contact angle 0);
+    bridges at ``suction`` [Pa] (0: dry; surface tension capillary.SURFACE_TENSION, contact
+    angle 0);
     the shear to ``max_strain`` with ``records`` rows, with YADE's wall-control choices if
     ``mimic_yade``; at most ``settle_steps`` steps (wet_steps) to bring the (wetted) sample to
     rest before the export."""
