@@ -7,7 +7,9 @@ For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, 
 .cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
 (suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
 four shears are timed in alternating chunks after ``warmup`` steps, so a change of machine load
-hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step.
+hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step; the JSON rows add the
+neighbour-list rebuilds and pairs per particle of each shear (a periodic sample has no loose
+wall layers, so more pairs per particle).
 """
 
 import argparse
@@ -43,11 +45,13 @@ def main(argv=None):
                                                       suction)
                     for box, (config, particles, walls) in samples.items()
                     for kind, suction in (("dry", 0.0), ("wet", args.suction))}
-            elapsed, _ = time_alternately({name: run[0] for name, run in runs.items()},
-                                          args.steps, args.warmup)
+            elapsed, rebuilds = time_alternately({name: run[0] for name, run in runs.items()},
+                                                 args.steps, args.warmup)
             speed = {name: count * args.steps / seconds for name, seconds in elapsed.items()}
             row = {"particles": count, "threads": threads, "suction": args.suction,
-                   "particle_steps_per_s": speed,
+                   "particle_steps_per_s": speed, "rebuilds": rebuilds,
+                   "pairs_per_particle": {name: len(run[0].contacts) / count
+                                          for name, run in runs.items()},
                    "periodic_over_walled_cost": {
                        kind: speed[f"walled {kind}"] / speed[f"periodic {kind}"]
                        for kind in ("dry", "wet")}}

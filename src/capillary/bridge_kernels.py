@@ -145,16 +145,6 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 
 
 @numba.njit(cache=True, parallel=True)
-def along_normals(force, normal, out):
-    """The attractive force on j from i of bridges of magnitude ``force`` [N] along the
-    contact normals (unit i -> j): out = -force n (K, 3) [N]."""
-    for k in numba.prange(len(force)):
-        out[k, 0] = -force[k] * normal[k, 0]
-        out[k, 1] = -force[k] * normal[k, 1]
-        out[k, 2] = -force[k] * normal[k, 2]
-
-
-@numba.njit(cache=True, parallel=True)
 def suction_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
                     volume, force, filling_i, filling_j, pair_force, suction, surface_tension,
                     radius_ratios, suction_axis, distance_low, log_distance_rupture,

@@ -65,11 +65,10 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (along_normals, bridges_across_gaps, contact_bridges,
-                                      exchange_liquid, gather_contact_bridges,
-                                      pendular_overlap_counts, refresh_contact_bridges,
-                                      suction_bridges, suction_interfaces, volume_bridges,
-                                      volume_interfaces)
+from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
+                                      gather_contact_bridges, pendular_overlap_counts,
+                                      refresh_contact_bridges, suction_bridges,
+                                      suction_interfaces, volume_bridges, volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
@@ -169,9 +168,6 @@ class CapillaryBridges:
     exist.
     """
 
-    #: A buffer (pair_forces of bridges at contact), rebuilt on demand: not worth a checkpoint.
-    checkpoint_exclude = ("_contact_force",)
-
     def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
                  control="suction", persist=False, table_options=None, roughness=0.0,
                  liquid="reservoir"):
@@ -205,7 +201,6 @@ class CapillaryBridges:
         self.volume_table = None
         self.required_range = 0.0
         self.pair_force = np.zeros((0, 3))
-        self._contact_force = np.zeros((0, 3))      # pair_forces of bridges at contact
         self._table_arrays = None
         self._contacts = None
         self._bridges = 0
@@ -471,15 +466,14 @@ class CapillaryBridges:
             return math.nan
         return float(np.mean(state.suction[mask]))
 
-    def pair_forces(self, sim):
-        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
+    def pair_forces(self, sim, index=None):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step, of
+        the pairs ``index`` only if given."""
         state = self.state(sim)
+        index = slice(None) if index is None else index
         if self.persist:
-            return self.pair_force
-        if len(self._contact_force) != len(state.force):
-            self._contact_force = np.zeros((len(state.force), 3))
-        along_normals(state.force, sim.contacts.normal, self._contact_force)
-        return self._contact_force
+            return self.pair_force[index]
+        return -state.force[index, None] * sim.contacts.normal[index]
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each

@@ -26,8 +26,6 @@ from .neighbors import branch_vector
 from .state import Box, _box_position, _check_box
 from .validate import check_array
 
-_NONE = np.zeros((0, 3))
-
 #: Fixed blocks of particles summed apart then together: a sum in the same order for any
 #: thread count (results thread-independent).
 SUM_BLOCKS = 64
@@ -45,16 +43,16 @@ def _sum_blocks(sums):
 
 
 @numba.njit(cache=True, parallel=True)
-def resultant_virial(position, force, through_face, image, period, pair_force, other_force):
+def resultant_virial(position, force, through_face, image, period, face_force):
     """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
-    f the force on j from i: ``pair_force`` plus ``other_force`` unless that is empty, (0, 3))
-    when ``force`` (N, 3) [N] is each particle's resultant of those pair forces, from
+    f the force on j from i) when ``force`` (N, 3) [N] is each particle's resultant of the
+    pair forces, from
 
         sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
 
-    (l = x_j - x_i + image L; the second sum runs over the pairs ``through_face`` only): a
-    pass over the particles and one over those pairs instead of a pass over every pair."""
-    other = len(other_force) > 0
+    (l = x_j - x_i + image L; the second sum runs over the pairs ``through_face`` only, whose
+    forces are ``face_force`` (F, 3) [N]): a pass over the particles and one over those pairs
+    instead of a pass over every pair."""
     count = len(position)
     faces = len(through_face)
     sums = np.zeros((SUM_BLOCKS, 9))
@@ -78,16 +76,12 @@ def resultant_virial(position, force, through_face, image, period, pair_force, o
             s22 += x2 * f2
         for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
             k = through_face[slot]
-            g0 = pair_force[k, 0]
-            g1 = pair_force[k, 1]
-            g2 = pair_force[k, 2]
-            if other:
-                g0 += other_force[k, 0]
-                g1 += other_force[k, 1]
-                g2 += other_force[k, 2]
             a0 = image[k, 0] * period[0]
             a1 = image[k, 1] * period[1]
             a2 = image[k, 2] * period[2]
+            g0 = face_force[slot, 0]
+            g1 = face_force[slot, 1]
+            g2 = face_force[slot, 2]
             s00 += a0 * g0
             s01 += a0 * g1
             s02 += a0 * g2
@@ -247,22 +241,23 @@ class PeriodicCell(Box):
 
     def after_forces(self, sim):
         """The stress of this step's pair forces (every force operation has
-        ``pair_forces(sim)``: from the particles' resultants and the pairs through a face,
-        resultant_virial; otherwise pair by pair over the operations that have it); the
+        ``pair_forces(sim, index)``: from the particles' resultants and the pairs through a
+        face, resultant_virial; otherwise pair by pair over the operations that have it); the
         stretching rate returns to zero until a control sets it."""
         contacts = sim.contacts
         total = np.zeros(9)
         if contacts is not None and len(contacts):
             p, period = sim.particles, self.period
-            forces = [op.pair_forces(sim) for op in sim.forces if hasattr(op, "pair_forces")]
-            if len(forces) == len(sim.forces) and len(forces) <= 2:
-                total = resultant_virial(p.position, p.force, contacts.through_face,
-                                         contacts.image, period, forces[0],
-                                         forces[1] if len(forces) == 2 else _NONE)
+            pair_ops = [op for op in sim.forces if hasattr(op, "pair_forces")]
+            if len(pair_ops) == len(sim.forces):
+                face = contacts.through_face
+                face_force = sum(op.pair_forces(sim, face) for op in pair_ops)
+                total = resultant_virial(p.position, p.force, face, contacts.image, period,
+                                         np.ascontiguousarray(face_force, dtype=np.float64))
             else:       # a force that is not a pair force: resultants are not the pairs' sum
-                for pair_force in forces:
+                for op in pair_ops:
                     total += pair_virial(p.position, contacts.row_start, contacts.pair_j,
-                                         contacts.image, period, pair_force)
+                                         contacts.image, period, op.pair_forces(sim))
         self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
         self.rate[:] = 0.0
 

@@ -218,9 +218,10 @@ class ContactForces:
                                          unit="deg")
         self._tan_friction = float(np.tan(np.radians(self._friction_deg)))
 
-    def pair_forces(self, sim):
-        """Contact force on j from i per pair (K, 3) [N] of the last evaluation."""
-        return sim.contacts.force
+    def pair_forces(self, sim, index=None):
+        """Contact force on j from i (K, 3) [N] of the last evaluation, of the pairs ``index``
+        only if given."""
+        return sim.contacts.force if index is None else sim.contacts.force[index]
 
     def apply(self, sim):
         p = sim.particles
