@@ -470,10 +470,13 @@ class CapillaryBridges:
         """Capillary force on j from i per pair (K, 3) [N] as applied at the last step, of
         the pairs ``index`` only if given."""
         state = self.state(sim)
-        index = slice(None) if index is None else index
+        if index is None:
+            return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
         if self.persist:
-            return self.pair_force[index]
-        return -state.force[index, None] * sim.contacts.normal[index]
+            return np.take(self.pair_force, index, axis=0)
+        force = np.take(sim.contacts.normal, index, axis=0)
+        force *= -np.take(state.force, index)[:, None]
+        return force
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each

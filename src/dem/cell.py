@@ -251,9 +251,11 @@ class PeriodicCell(Box):
             pair_ops = [op for op in sim.forces if hasattr(op, "pair_forces")]
             if len(pair_ops) == len(sim.forces):
                 face = contacts.through_face
-                face_force = sum(op.pair_forces(sim, face) for op in pair_ops)
+                face_force = pair_ops[0].pair_forces(sim, face)
+                for op in pair_ops[1:]:
+                    face_force = face_force + op.pair_forces(sim, face)
                 total = resultant_virial(p.position, p.force, face, contacts.image, period,
-                                         np.ascontiguousarray(face_force, dtype=np.float64))
+                                         face_force)
             else:       # a force that is not a pair force: resultants are not the pairs' sum
                 for op in pair_ops:
                     total += pair_virial(p.position, contacts.row_start, contacts.pair_j,

@@ -221,7 +221,8 @@ class ContactForces:
     def pair_forces(self, sim, index=None):
         """Contact force on j from i (K, 3) [N] of the last evaluation, of the pairs ``index``
         only if given."""
-        return sim.contacts.force if index is None else sim.contacts.force[index]
+        force = sim.contacts.force
+        return force if index is None else np.take(force, index, axis=0)
 
     def apply(self, sim):
         p = sim.particles
