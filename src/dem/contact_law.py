@@ -8,7 +8,6 @@ Sphere–wall: frictionless, the wall acting as a virtual sphere of the same rad
 import numba
 import numpy as np
 
-from .neighbors import branch_vector
 from .validate import check_positive, check_range
 
 
@@ -34,7 +33,9 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
 
     image, period: each pair's periodic image and the box period (dem.neighbors.branch_vector;
     zeros inside walls); affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell,
-    whose velocity affine_rate * l adds to the relative velocity of a pair of branch l.
+    whose velocity affine_rate * l adds to the relative velocity of a pair of branch l. A
+    scene without images or stretching (walls) skips both terms (a branch taken the same way
+    by every pair: no cost).
 
     The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
     is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),
@@ -42,10 +43,18 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     velocity using the radii as lever arms (YADE's avoidGranularRatcheting), and finally capped
     at Fn tan(phi), the elastic part being kept on the cap when sliding.
     """
+    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
         j = pair_j[k]
-        d0, d1, d2 = branch_vector(position, i, j, image, k, period)
+        d0 = position[j, 0] - position[i, 0]
+        d1 = position[j, 1] - position[i, 1]
+        d2 = position[j, 2] - position[i, 2]
+        if periodic:        # as dem.neighbors.branch_vector
+            d0 += image[k, 0] * period[0]
+            d1 += image[k, 1] * period[1]
+            d2 += image[k, 2] * period[2]
         distance = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ri = radius[i]
         rj = radius[j]
@@ -94,12 +103,13 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
         wj0 = angular_velocity[j, 0]
         wj1 = angular_velocity[j, 1]
         wj2 = angular_velocity[j, 2]
-        v0 = (velocity[j, 0] - velocity[i, 0] + affine_rate[0] * d0
-              - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1))
-        v1 = (velocity[j, 1] - velocity[i, 1] + affine_rate[1] * d1
-              - rj * (wj2 * n0 - wj0 * n2) - ri * (wi2 * n0 - wi0 * n2))
-        v2 = (velocity[j, 2] - velocity[i, 2] + affine_rate[2] * d2
-              - rj * (wj0 * n1 - wj1 * n0) - ri * (wi0 * n1 - wi1 * n0))
+        v0 = velocity[j, 0] - velocity[i, 0] - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1)
+        v1 = velocity[j, 1] - velocity[i, 1] - rj * (wj2 * n0 - wj0 * n2) - ri * (wi2 * n0 - wi0 * n2)
+        v2 = velocity[j, 2] - velocity[i, 2] - rj * (wj0 * n1 - wj1 * n0) - ri * (wi0 * n1 - wi1 * n0)
+        if stretched:
+            v0 += affine_rate[0] * d0
+            v1 += affine_rate[1] * d1
+            v2 += affine_rate[2] * d2
         vn = v0 * n0 + v1 * n1 + v2 * n2
         fs0 -= ks * (v0 - vn * n0) * dt
         fs1 -= ks * (v1 - vn * n1) * dt
@@ -229,7 +239,8 @@ class ContactForces:
         c = sim.contacts
         box = sim.walls
         pair_forces(p.position, p.velocity, p.angular_velocity, p.radius, c.pair_i, c.pair_j,
-                    c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap, c.normal_force, c.force, c.torque_i,
-                    c.torque_j, self.young, self.shear_ratio, self._tan_friction, sim.dt)
+                    c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
+                    c.normal_force, c.force, c.torque_i, c.torque_j, self.young,
+                    self.shear_ratio, self._tan_friction, sim.dt)
         gather_pair_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
                            c.second_pair, p.force, p.torque)
