@@ -7,9 +7,9 @@ For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, 
 .cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
 (suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
 four shears are timed in alternating chunks after ``warmup`` steps, so a change of machine load
-hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step; the JSON rows add the
-neighbour-list rebuilds and pairs per particle of each shear (a periodic sample has no loose
-wall layers, so more pairs per particle).
+hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step; the
+JSON rows add the neighbour-list rebuilds and pairs per particle of each shear (a periodic
+sample has no loose wall layers, so more pairs per particle).
 """
 
 import argparse
@@ -58,7 +58,8 @@ def main(argv=None):
             rows.append(row)
             print(json.dumps(row), flush=True)
     print(f"\n{'particles':>9} {'threads':>7} {'walled dry':>10} {'periodic dry':>12} "
-          f"{'ratio':>6} {'walled wet':>10} {'periodic wet':>12} {'ratio':>6}  [M particle-steps/s]")
+          f"{'ratio':>6} {'walled wet':>10} {'periodic wet':>12} {'ratio':>6}  "
+          "[M particle-steps/s]")
     for row in rows:
         speed, ratio = row["particle_steps_per_s"], row["periodic_over_walled_cost"]
         print(f"{row['particles']:9d} {row['threads']:7d} {speed['walled dry'] * 1e-6:10.2f} "
