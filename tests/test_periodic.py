@@ -198,6 +198,26 @@ def test_the_cell_stress_from_resultants_is_the_pair_by_pair_sum():
                                    by_pairs, rtol=1e-9, atol=1e-9 * np.abs(by_pairs).max())
 
 
+class _NoForce:
+    """A force operation that is not a pair force (as a body force would be), adding nothing."""
+
+    def apply(self, sim):
+        pass
+
+
+def test_a_force_that_is_not_a_pair_force_sends_the_cell_stress_pair_by_pair():
+    """With a force that has no pair_forces among the scene's, the particles' resultants are
+    not the pairs' sum: the cell sums pair by pair, and gets the same stress here."""
+    sim, _ = _periodic_prep(1)
+    sim.forces.append(_NoForce())
+    sim.evaluate_forces()
+    c, p = sim.contacts, sim.particles
+    fast = resultant_virial(p.position, p.force, c.through_face, c.image, sim.walls.period,
+                            c.force[c.through_face]).reshape(3, 3) / sim.walls.volume()
+    np.testing.assert_allclose(sim.walls.stress_tensor, fast, rtol=1e-9,
+                               atol=1e-9 * np.abs(fast).max())
+
+
 def test_a_periodic_sample_round_trips_and_is_refused_for_walls(tmp_path):
     sim, _ = _periodic_prep(1)
     path = tmp_path / "sample.h5"
