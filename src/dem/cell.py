@@ -42,6 +42,20 @@ def _sum_blocks(sums):
     return total
 
 
+@numba.njit(cache=True, inline="always")
+def _add_outer(row, a0, a1, a2, b0, b1, b2):
+    """Add the outer product a (x) b, row by row, to the 9 entries of ``row``."""
+    row[0] += a0 * b0
+    row[1] += a0 * b1
+    row[2] += a0 * b2
+    row[3] += a1 * b0
+    row[4] += a1 * b1
+    row[5] += a1 * b2
+    row[6] += a2 * b0
+    row[7] += a2 * b1
+    row[8] += a2 * b2
+
+
 @numba.njit(cache=True, parallel=True)
 def resultant_virial(position, force, through_face, image, period, face_force):
     """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
@@ -57,43 +71,15 @@ def resultant_virial(position, force, through_face, image, period, face_force):
     faces = len(through_face)
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
-        s00 = s01 = s02 = s10 = s11 = s12 = s20 = s21 = s22 = 0.0
+        row = sums[block]
         for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
-            x0 = position[p, 0]
-            x1 = position[p, 1]
-            x2 = position[p, 2]
-            f0 = force[p, 0]
-            f1 = force[p, 1]
-            f2 = force[p, 2]
-            s00 += x0 * f0
-            s01 += x0 * f1
-            s02 += x0 * f2
-            s10 += x1 * f0
-            s11 += x1 * f1
-            s12 += x1 * f2
-            s20 += x2 * f0
-            s21 += x2 * f1
-            s22 += x2 * f2
+            _add_outer(row, position[p, 0], position[p, 1], position[p, 2], force[p, 0],
+                       force[p, 1], force[p, 2])
         for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
             k = through_face[slot]
-            a0 = image[k, 0] * period[0]
-            a1 = image[k, 1] * period[1]
-            a2 = image[k, 2] * period[2]
-            g0 = face_force[slot, 0]
-            g1 = face_force[slot, 1]
-            g2 = face_force[slot, 2]
-            s00 += a0 * g0
-            s01 += a0 * g1
-            s02 += a0 * g2
-            s10 += a1 * g0
-            s11 += a1 * g1
-            s12 += a1 * g2
-            s20 += a2 * g0
-            s21 += a2 * g1
-            s22 += a2 * g2
-        row = sums[block]
-        row[0], row[1], row[2], row[3], row[4] = s00, s01, s02, s10, s11
-        row[5], row[6], row[7], row[8] = s12, s20, s21, s22
+            _add_outer(row, image[k, 0] * period[0], image[k, 1] * period[1],
+                       image[k, 2] * period[2], face_force[slot, 0], face_force[slot, 1],
+                       face_force[slot, 2])
     return _sum_blocks(sums)
 
 
@@ -106,10 +92,9 @@ def pair_virial(position, row_start, pair_j, image, period, pair_force):
     for block in numba.prange(SUM_BLOCKS):
         for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
             for k in range(row_start[i], row_start[i + 1]):
-                branch = branch_vector(position, i, pair_j[k], image, k, period)
-                for a in range(3):
-                    for b in range(3):
-                        sums[block, 3 * a + b] += branch[a] * pair_force[k, b]
+                l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
+                _add_outer(sums[block], l0, l1, l2, pair_force[k, 0], pair_force[k, 1],
+                           pair_force[k, 2])
     return _sum_blocks(sums)
 
 

@@ -258,6 +258,33 @@ def _crowding_bound(cell, smallest):
     return math.floor((cell + 2.0 * core) ** 3 / (4.0 / 3.0 * math.pi * core ** 3))
 
 
+def _check_inside_cell(position, cell, source):
+    """ValueError naming the first centre outside the periodic cell ``cell``."""
+    outside = np.flatnonzero(np.any((position < cell.lo) | (position > cell.hi), axis=1))
+    if len(outside):
+        raise ValueError(
+            f"{source}: particle {int(outside[0])} (centre {position[outside[0]].tolist()} "
+            f"m) lies outside the periodic cell lo = {cell.lo.tolist()} m, hi = "
+            f"{cell.hi.tolist()} m; valid: every centre inside the cell")
+
+
+def _check_walls(position, radius, walls, source):
+    """ValueError naming the sphere that overlaps a wall by more than MAX_OVERLAP of its
+    radius (its centre outside the box, or too deep against a wall)."""
+    overlaps = _wall_overlaps(position, radius, walls)
+    wall, sphere = np.unravel_index(int(np.argmax(overlaps)), overlaps.shape)
+    if overlaps[wall, sphere] > MAX_OVERLAP:
+        place = ("its centre lies outside the box" if overlaps[wall, sphere] > 1.0
+                 else "its centre is inside the box")
+        raise ValueError(
+            f"{source}: particle {sphere} (radius {radius[sphere]:g} m, centre "
+            f"{position[sphere].tolist()} m) overlaps wall {WALL_NAMES[wall]} (at "
+            f"{walls.position[wall]:g} m) by {overlaps[wall, sphere]:.3g} of its radius, {place};"
+            f" valid range: overlaps up to {MAX_OVERLAP:g} of the radius (linear wall contact "
+            "law), box lo = "
+            f"{walls.lo.tolist()} m, hi = {walls.hi.tolist()} m")
+
+
 def check_packing(particles, walls, source="sample"):
     """ValueError naming ``source`` and the offending spheres unless the state can enter a
     simulation: finite values; every sphere inside the box, its overlap with each wall at most
@@ -277,26 +304,9 @@ def check_packing(particles, walls, source="sample"):
         raise ValueError(f"{source}: all {count} particles are at one point "
                          f"{position[0].tolist()} m: not a packing (a damaged or edited file)")
     if walls.periodic:
-        outside = np.flatnonzero(np.any((position < walls.lo) | (position > walls.hi), axis=1))
-        if len(outside):
-            raise ValueError(
-                f"{source}: particle {int(outside[0])} (centre {position[outside[0]].tolist()} "
-                f"m) lies outside the periodic cell lo = {walls.lo.tolist()} m, hi = "
-                f"{walls.hi.tolist()} m; valid: every centre inside the cell")
-        overlaps = np.zeros((6, count))
+        _check_inside_cell(position, walls, source)
     else:
-        overlaps = _wall_overlaps(position, radius, walls)
-    wall, sphere = np.unravel_index(int(np.argmax(overlaps)), overlaps.shape)
-    if overlaps[wall, sphere] > MAX_OVERLAP:
-        place = ("its centre lies outside the box" if overlaps[wall, sphere] > 1.0
-                 else "its centre is inside the box")
-        raise ValueError(
-            f"{source}: particle {sphere} (radius {radius[sphere]:g} m, centre "
-            f"{position[sphere].tolist()} m) overlaps wall {WALL_NAMES[wall]} (at "
-            f"{walls.position[wall]:g} m) by {overlaps[wall, sphere]:.3g} of its radius, {place};"
-            f" valid range: overlaps up to {MAX_OVERLAP:g} of the radius (linear wall contact "
-            "law), box lo = "
-            f"{walls.lo.tolist()} m, hi = {walls.hi.tolist()} m")
+        _check_walls(position, radius, walls, source)
     if count < 2:
         return
     cells, order, sorted_keys, dims, cell = _cell_list(position, radius)

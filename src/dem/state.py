@@ -1,4 +1,5 @@
-"""Simulation state in contiguous arrays: particles and the six axis-aligned walls."""
+"""Simulation state in contiguous arrays: particles and the box (six axis-aligned walls; the
+periodic cell of dem.cell shares the Box interface)."""
 
 from dataclasses import dataclass, field
 
