@@ -93,6 +93,25 @@ def _cell_members(cell_of, cell_count):
 
 
 @numba.njit(cache=True)
+def _sort_into_cells(position, lo, hi, dims):
+    """(dims, cell_of, cell_start, cell_particles) of the ``dims`` grid of cells spanning
+    [lo, hi): each particle's cell (x-major numbering) and the particles of each cell in CSR
+    order, in index order within a cell."""
+    count = position.shape[0]
+    cell_of = np.empty(count, np.int64)
+    for p in range(count):
+        index = 0
+        for axis in range(3):
+            width = (hi[axis] - lo[axis]) / dims[axis]
+            c = int((position[p, axis] - lo[axis]) / width)
+            c = min(max(c, 0), dims[axis] - 1)
+            index = index * dims[axis] + c
+        cell_of[p] = index
+    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
+    return dims, cell_of, cell_start, cell_particles
+
+
+@numba.njit(cache=True)
 def _cell_grid(position, cell_size):
     """Sort particles into a regular grid of cells of at least ``cell_size`` covering them.
 
@@ -112,17 +131,7 @@ def _cell_grid(position, cell_size):
         if dims[0] * dims[1] * dims[2] <= 4 * count + 27:
             break
         cell_size *= 1.25
-    cell_of = np.empty(count, np.int64)
-    for p in range(count):
-        index = 0
-        for axis in range(3):
-            width = (hi[axis] - lo[axis]) / dims[axis]
-            c = int((position[p, axis] - lo[axis]) / width)
-            c = min(max(c, 0), dims[axis] - 1)
-            index = index * dims[axis] + c
-        cell_of[p] = index
-    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
-    return dims, cell_of, cell_start, cell_particles
+    return _sort_into_cells(position, lo, hi, dims)
 
 
 @numba.njit(cache=True)
@@ -197,20 +206,10 @@ def _periodic_grid(position, cell_size, period):
     """Sort particles (wrapped into [0, period)) into cells of edge at least ``cell_size``
     tiling the periodic box (build_contacts makes sure of at least 3 a side, so that the 27
     cells around a cell are distinct)."""
-    count = position.shape[0]
     dims = np.empty(3, np.int64)
     for axis in range(3):
         dims[axis] = int(period[axis] / cell_size)
-    cell_of = np.empty(count, np.int64)
-    for p in range(count):
-        index = 0
-        for axis in range(3):
-            c = int(position[p, axis] / period[axis] * dims[axis])
-            c = min(max(c, 0), dims[axis] - 1)
-            index = index * dims[axis] + c
-        cell_of[p] = index
-    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
-    return dims, cell_of, cell_start, cell_particles
+    return _sort_into_cells(position, np.zeros(3), period, dims)
 
 
 @numba.njit(cache=True)
