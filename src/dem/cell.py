@@ -42,18 +42,24 @@ def _sum_blocks(sums):
     return total
 
 
+#: Nine zeros: the start of a sum of outer products (_add_outer).
+_ZERO9 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
 @numba.njit(cache=True, inline="always")
-def _add_outer(row, a0, a1, a2, b0, b1, b2):
-    """Add the outer product a (x) b, row by row, to the 9 entries of ``row``."""
-    row[0] += a0 * b0
-    row[1] += a0 * b1
-    row[2] += a0 * b2
-    row[3] += a1 * b0
-    row[4] += a1 * b1
-    row[5] += a1 * b2
-    row[6] += a2 * b0
-    row[7] += a2 * b1
-    row[8] += a2 * b2
+def _add_outer(total, a0, a1, a2, b0, b1, b2):
+    """``total`` (9 numbers, row by row) plus the outer product a (x) b: a tuple, so that a
+    sum over a loop stays in registers."""
+    return (total[0] + a0 * b0, total[1] + a0 * b1, total[2] + a0 * b2,
+            total[3] + a1 * b0, total[4] + a1 * b1, total[5] + a1 * b2,
+            total[6] + a2 * b0, total[7] + a2 * b1, total[8] + a2 * b2)
+
+
+@numba.njit(cache=True, inline="always")
+def _store(row, total):
+    """Write the 9 numbers of ``total`` into ``row``."""
+    for c in range(9):
+        row[c] = total[c]
 
 
 @numba.njit(cache=True, parallel=True)
@@ -71,15 +77,16 @@ def resultant_virial(position, force, through_face, image, period, face_force):
     faces = len(through_face)
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
-        row = sums[block]
+        total = _ZERO9
         for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
-            _add_outer(row, position[p, 0], position[p, 1], position[p, 2], force[p, 0],
-                       force[p, 1], force[p, 2])
+            total = _add_outer(total, position[p, 0], position[p, 1], position[p, 2],
+                               force[p, 0], force[p, 1], force[p, 2])
         for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
             k = through_face[slot]
-            _add_outer(row, image[k, 0] * period[0], image[k, 1] * period[1],
-                       image[k, 2] * period[2], face_force[slot, 0], face_force[slot, 1],
-                       face_force[slot, 2])
+            total = _add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
+                               image[k, 2] * period[2], face_force[slot, 0],
+                               face_force[slot, 1], face_force[slot, 2])
+        _store(sums[block], total)
     return _sum_blocks(sums)
 
 
@@ -90,11 +97,13 @@ def pair_virial(position, row_start, pair_j, image, period, pair_force):
     count = len(row_start) - 1
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
+        total = _ZERO9
         for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
             for k in range(row_start[i], row_start[i + 1]):
                 l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
-                _add_outer(sums[block], l0, l1, l2, pair_force[k, 0], pair_force[k, 1],
-                           pair_force[k, 2])
+                total = _add_outer(total, l0, l1, l2, pair_force[k, 0], pair_force[k, 1],
+                                   pair_force[k, 2])
+        _store(sums[block], total)
     return _sum_blocks(sums)
 
 
