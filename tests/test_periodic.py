@@ -9,7 +9,7 @@ import pytest
 
 from capillary import CapillaryBridges
 from capillary.bridge_state import ACROSS_GAP, BridgeState
-from dem.cell import PeriodicCell, pair_virial, resultant_virial
+from dem.cell import PeriodicCell, pair_virial, resultant_virial, resultant_virial_serial
 from dem.contact_law import ContactForces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList, build_contacts
@@ -192,6 +192,9 @@ def test_the_cell_stress_from_resultants_is_the_pair_by_pair_sum():
                                c.force)
         by_resultants = resultant_virial(p.position, p.force, c.through_face, c.image,
                                          sim.walls.period, c.force[c.through_face])
+        serial = resultant_virial_serial(p.position, p.force, c.through_face, c.image,
+                                         sim.walls.period, c.force[c.through_face])
+        assert np.array_equal(serial, by_resultants)     # the same blocks, in the same order
         np.testing.assert_allclose(by_resultants, by_pairs, rtol=1e-9,
                                    atol=1e-9 * np.abs(by_pairs).max())
         np.testing.assert_allclose(sim.walls.stress_tensor.ravel() * sim.walls.volume(),

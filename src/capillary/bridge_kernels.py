@@ -144,6 +144,18 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
         out[p, 2] += f2
 
 
+@numba.njit(cache=True)
+def contact_bridge_forces(force, normal, index):
+    """(B, 3) [N] force on j from i of the bridges of magnitude ``force`` along the contact
+    normals (gather_contact_bridges), of the pairs ``index`` only: -F n."""
+    out = np.empty((len(index), 3))
+    for slot in range(len(index)):
+        k = index[slot]
+        for c in range(3):
+            out[slot, c] = -force[k] * normal[k, c]
+    return out
+
+
 @numba.njit(cache=True, parallel=True)
 def suction_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
                     volume, force, filling_i, filling_j, pair_force, suction, surface_tension,

@@ -65,10 +65,11 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
-                                      gather_contact_bridges, pendular_overlap_counts,
-                                      refresh_contact_bridges, suction_bridges,
-                                      suction_interfaces, volume_bridges, volume_interfaces)
+from capillary.bridge_kernels import (bridges_across_gaps, contact_bridge_forces,
+                                      contact_bridges, exchange_liquid, gather_contact_bridges,
+                                      pendular_overlap_counts, refresh_contact_bridges,
+                                      suction_bridges, suction_interfaces, volume_bridges,
+                                      volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
@@ -474,9 +475,7 @@ class CapillaryBridges:
             return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
         if self.persist:
             return np.take(self.pair_force, index, axis=0)
-        force = np.take(sim.contacts.normal, index, axis=0)
-        force *= -np.take(state.force, index)[:, None]
-        return force
+        return contact_bridge_forces(state.force, sim.contacts.normal, index)
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each

@@ -62,6 +62,23 @@ def _store(row, total):
         row[c] = total[c]
 
 
+@numba.njit(cache=True, inline="always")
+def _block_virial(block, position, force, through_face, image, period, face_force, sums):
+    """Block ``block`` of resultant_virial's two sums, into ``sums[block]``."""
+    count = len(position)
+    faces = len(through_face)
+    total = _ZERO9
+    for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
+        total = _add_outer(total, position[p, 0], position[p, 1], position[p, 2],
+                           force[p, 0], force[p, 1], force[p, 2])
+    for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
+        k = through_face[slot]
+        total = _add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
+                           image[k, 2] * period[2], face_force[slot, 0],
+                           face_force[slot, 1], face_force[slot, 2])
+    _store(sums[block], total)
+
+
 @numba.njit(cache=True, parallel=True)
 def resultant_virial(position, force, through_face, image, period, face_force):
     """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
@@ -73,20 +90,20 @@ def resultant_virial(position, force, through_face, image, period, face_force):
     (l = x_j - x_i + image L; the second sum runs over the pairs ``through_face`` only, whose
     forces are ``face_force`` (F, 3) [N]): a pass over the particles and one over those pairs
     instead of a pass over every pair."""
-    count = len(position)
-    faces = len(through_face)
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
-        total = _ZERO9
-        for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
-            total = _add_outer(total, position[p, 0], position[p, 1], position[p, 2],
-                               force[p, 0], force[p, 1], force[p, 2])
-        for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
-            k = through_face[slot]
-            total = _add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                               image[k, 2] * period[2], face_force[slot, 0],
-                               face_force[slot, 1], face_force[slot, 2])
-        _store(sums[block], total)
+        _block_virial(block, position, force, through_face, image, period, face_force, sums)
+    return _sum_blocks(sums)
+
+
+@numba.njit(cache=True)
+def resultant_virial_serial(position, force, through_face, image, period, face_force):
+    """resultant_virial in one thread, with the same result (the same blocks in the same
+    order): a parallel loop run by one thread costs twice as much (1,000 spheres: 14 against
+    6 us)."""
+    sums = np.zeros((SUM_BLOCKS, 9))
+    for block in range(SUM_BLOCKS):
+        _block_virial(block, position, force, through_face, image, period, face_force, sums)
     return _sum_blocks(sums)
 
 
@@ -248,8 +265,9 @@ class PeriodicCell(Box):
                 face_force = pair_ops[0].pair_forces(sim, face)
                 for op in pair_ops[1:]:
                     face_force = face_force + op.pair_forces(sim, face)
-                total = resultant_virial(p.position, p.force, face, contacts.image, period,
-                                         face_force)
+                virial = (resultant_virial if numba.get_num_threads() > 1
+                          else resultant_virial_serial)
+                total = virial(p.position, p.force, face, contacts.image, period, face_force)
             else:       # a force that is not a pair force: resultants are not the pairs' sum
                 for op in pair_ops:
                     total += pair_virial(p.position, contacts.row_start, contacts.pair_j,
