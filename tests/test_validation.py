@@ -14,7 +14,8 @@ from capillary.yade_files import read_capillary_file
 from conftest import two_body_scene
 from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.contact_law import ContactForces
-from dem.integrate import Integrator, pwave_timestep
+from dem.integrate import Integrator
+from dem.timestep import pwave_timestep
 from dem.neighbors import NeighborList
 from dem.preparation import PrepareConfig, prepare_sample, random_cloud
 from dem.record import HistoryRecorder

@@ -1,9 +1,8 @@
-"""Leapfrog integration with Cundall's non-viscous local damping, and the critical time step."""
+"""Leapfrog integration with Cundall's non-viscous local damping (the time step: dem.timestep)."""
 
 import numba
-import numpy as np
 
-from .validate import check_array, check_positive, check_range
+from .validate import check_range
 
 
 @numba.njit(cache=True, inline="always")
@@ -40,14 +39,6 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
             t = _damped(torque[p, c], angular_velocity[p, c], torque[p, c] * inverse_inertia * dt,
                         damping)
             angular_velocity[p, c] += t * inverse_inertia * dt
-
-
-def pwave_timestep(radius, young, density):
-    """YADE's P-wave estimate min R / sqrt(E / rho) [s] (to be multiplied by a safety factor)."""
-    radius = check_array("radius", np.atleast_1d(radius), positive=True)
-    young = check_positive("young", young, "Pa")
-    density = check_positive("density", density, "kg/m^3")
-    return float(np.min(radius) / np.sqrt(young / density))
 
 
 class Integrator:

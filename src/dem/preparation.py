@@ -25,11 +25,12 @@ import numpy as np
 from .cell import PeriodicCell
 from .contact_law import ContactForces
 from .grading import check_grading_curve, check_spread, grading, sample_radii
-from .integrate import Integrator, pwave_timestep
+from .integrate import Integrator
 from .measure import coordination, porosity, unbalanced_force
 from .neighbors import NeighborList, spatial_order
 from .simulation import Simulation
 from .state import Particles, Walls
+from .timestep import TIMESTEP_RULES, critical_timestep, pwave_timestep
 from .validate import check_int, check_positive, check_range
 from .walls import StressServo, WallForces
 
@@ -260,6 +261,9 @@ class PrepareConfig:
     ((diameter [m], percent passing by mass), ...), the curve's own sizes, ``radius`` set on
     creation to their mean. Largest / smallest radius at most dem.grading.MAX_RADIUS_RATIO.
     ``periodic``: the sample fills a periodic cell (dem.cell) instead of a box of six walls.
+    The time step is ``timestep_safety`` times the estimate of ``timestep_rule`` (``timestep``):
+    'pwave', YADE's P-wave estimate of the smallest sphere; 'stiffness', the critical step of
+    the contacts (dem.timestep).
     """
 
     particles: int = 10000
@@ -274,6 +278,7 @@ class PrepareConfig:
     density: float = 2650.0
     damping: float = 0.2
     timestep_safety: float = 0.7
+    timestep_rule: str = "pwave"
     prep_stress: float = 5000.0
     confining: float = 750.0
     seed: int = 0
@@ -305,6 +310,9 @@ class PrepareConfig:
         self.damping = check_range("damping", self.damping, 0.0, 1.0, high_inclusive=False)
         self.timestep_safety = check_range("timestep_safety", self.timestep_safety, 0.0, 1.0,
                                            low_inclusive=False)
+        if self.timestep_rule not in TIMESTEP_RULES:
+            raise ValueError(f"timestep_rule = {self.timestep_rule!r}: valid values "
+                             f"{', '.join(TIMESTEP_RULES)}")
         self.prep_stress = check_positive("prep_stress", self.prep_stress, "Pa")
         self.confining = check_range("confining", self.confining, 0.0, 1e7, unit="Pa")
         self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
@@ -332,9 +340,37 @@ class PrepareConfig:
                             self.seed)
 
 
-def timestep(particles, config):
-    """dt = timestep_safety * P-wave estimate (YADE's PWaveTimeStep) [s]."""
-    return config.timestep_safety * pwave_timestep(particles.radius, config.young, config.density)
+def pwave_step(radius, config):
+    """timestep_safety times the P-wave estimate (YADE's PWaveTimeStep) of the spheres of
+    ``radius`` [m] with ``config``'s material [s]."""
+    return config.timestep_safety * pwave_timestep(radius, config.young, config.density)
+
+
+def timestep(sim, config):
+    """dt [s] = timestep_safety times the estimate of ``config.timestep_rule``: the P-wave
+    estimate of the current radii, or the critical step of the contacts of ``sim``
+    (dem.timestep.critical_timestep; the P-wave estimate while nothing touches)."""
+    if config.timestep_rule == "stiffness":
+        critical = critical_timestep(sim, config.young, config.shear_ratio)
+        if np.isfinite(critical):
+            return config.timestep_safety * critical
+    return pwave_step(sim.particles.radius, config)
+
+
+class GrowthTimeStep:
+    """A control of the radius growth under the 'stiffness' rule: dt = timestep_safety times
+    the P-wave estimate of the current radii, at every neighbour-list rebuild (the spheres grow
+    from 0.6 of their size and the step with them; a cloud whose contacts are still forming
+    has no contact network to read a critical step from)."""
+
+    def __init__(self, config):
+        self.config = config
+        self._rebuilds = None
+
+    def apply(self, sim):
+        if sim.neighbors.rebuilds != self._rebuilds:
+            self._rebuilds = sim.neighbors.rebuilds
+            sim.dt = pwave_step(sim.particles.radius, self.config)
 
 
 def static(unbalanced=0.01, tolerance=0.01):
@@ -377,11 +413,13 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
 def servoed_simulation(particles, walls, config, target, threads=None):
     """A static sample's simulation: dry scene at the test friction, six walls servoed at
     ``target`` [Pa]. Used to continue from a saved sample."""
-    dt = timestep(particles, config)
+    dt = pwave_step(particles.radius, config)
     servo = StressServo("xyz", target, max_velocity=servo_speed(walls, dt))
-    return dry_simulation(particles, walls, config, dt,
-                          config.skin_factor * float(np.mean(particles.radius)),
-                          config.friction_deg, [servo], threads)
+    sim = dry_simulation(particles, walls, config, dt,
+                         config.skin_factor * float(np.mean(particles.radius)),
+                         config.friction_deg, [servo], threads)
+    sim.dt = timestep(sim, config)
+    return sim
 
 
 def rescale(sim, factor):
@@ -427,9 +465,11 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     order = spatial_order(position, 2.0 * float(radii.max()))
     particles = Particles(position[order], cloud_radius[order], config.density)
     walls = (PeriodicCell if config.periodic else Walls).box(lo, hi)
-    growth = RadiusGrowth(config.prep_stress, max_rate=1e-4)
-    sim = dry_simulation(particles, walls, config, timestep(particles, config),
-                         config.skin_factor * config.radius, config.prep_friction_deg, [growth],
+    growth = [RadiusGrowth(config.prep_stress, max_rate=1e-4)]
+    if config.timestep_rule == "stiffness":
+        growth.append(GrowthTimeStep(config))
+    sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
+                         config.skin_factor * config.radius, config.prep_friction_deg, growth,
                          threads)
     writers = list(writers)
     sim.writers.extend(writers)
@@ -452,7 +492,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
     servo = StressServo("xyz", config.prep_stress, max_velocity=servo_speed(sim.walls, sim.dt))
     sim.controls = [servo]
-    sim.dt = timestep(sim.particles, config)
+    sim.dt = timestep(sim, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
@@ -479,11 +519,19 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         "sigma_wall": sim.walls.stress().tolist(),
         "steps": steps,
         "dt": sim.dt,
-        "timestep": f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)",
+        "timestep": timestep_description(config),
         "grading": grading(sim.particles.radius),
         "periodic": sim.walls.periodic,
     }
     return sim, report
+
+
+def timestep_description(config):
+    """How ``config`` sets the time step, in words (reports)."""
+    if config.timestep_rule == "stiffness":
+        return (f"{config.timestep_safety} x the critical time step of the contacts "
+                "(dem.timestep; radius growth: P-wave estimate of the current radii)")
+    return f"{config.timestep_safety} x P-wave time step min R / sqrt(E / rho)"
 
 
 def _enter(writers, phase):

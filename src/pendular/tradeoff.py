@@ -13,7 +13,8 @@ reference: time-step safety 0.35, inertial number 1e-4, bridge table 700 x 160 n
 knobs at their defaults. Each knob (``KNOB_FIELDS``: the field of the configuration it sets) is
 varied alone around the defaults:
 
-    timestep_safety, inertial_number, damping, particles, table_resolution (exact bridges),
+    timestep_safety, timestep_rule (P-wave estimate / critical step of the contacts, at the
+    default safety), inertial_number, damping, particles, table_resolution (exact bridges),
     bridges (exact / toroidal), records (history rows), skin_factor (neighbour list)
 
 For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, the
@@ -59,6 +60,7 @@ SUCTION = 30000.0
 CONFINING = 750.0
 #: Knob -> (part of the TriaxialConfig, field of that part) it sets.
 KNOB_FIELDS = {"timestep_safety": ("sample", "timestep_safety"),
+               "timestep_rule": ("sample", "timestep_rule"),
                "inertial_number": ("shear", "inertial_number"),
                "damping": ("sample", "damping"),
                "particles": ("sample", "particles"),
@@ -72,6 +74,7 @@ DEFAULT_TABLE = (350, 80)
 REFERENCE = {"timestep_safety": 0.35, "inertial_number": 1e-4, "table_resolution": (700, 160)}
 #: Settings of each knob (particles: multiples of the study's particles).
 KNOBS = {"timestep_safety": [0.3, 0.5, 0.7, 0.9],
+         "timestep_rule": ["pwave", "stiffness"],
          "inertial_number": [1e-4, 3e-4, 1e-3, 3e-3],
          "damping": [0.05, 0.1, 0.2, 0.4],
          "particles": [0.25, 0.5, 1.0, 2.0],

@@ -32,10 +32,11 @@ import numpy as np
 from dem.atomic import write_json
 from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.grading import grading
-from dem.integrate import pwave_timestep
+from dem.timestep import pwave_timestep
 from dem.integrity import checksum, config_hash
 from dem.measure import coordination, porosity, unbalanced_force
-from dem.preparation import PREPARATION_PHASES, prepare_sample, servoed_simulation, static
+from dem.preparation import (PREPARATION_PHASES, prepare_sample, servoed_simulation, static,
+                             timestep, timestep_description)
 from dem.record import HistoryRecorder
 from dem.sample import load_sample, save_sample
 from dem.validate import check_int
@@ -435,7 +436,8 @@ def parameters(config):
             "young": sample.young, "shear_ratio": sample.shear_ratio,
             "friction": sample.friction_deg, "prep_friction": sample.prep_friction_deg,
             "density": sample.density, "damping": sample.damping,
-            "timestep_safety": sample.timestep_safety, "prep_stress": sample.prep_stress,
+            "timestep_safety": sample.timestep_safety, "timestep_rule": sample.timestep_rule,
+            "prep_stress": sample.prep_stress,
             "confining": sample.confining, "seed": sample.seed, "skin_factor": sample.skin_factor,
             "max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
             "strain_rate": shear.strain_rate, "records": shear.records,
@@ -509,8 +511,7 @@ class TriaxialTest:
                        "coordination": coordination(sim.contacts, len(sim.particles)),
                        "sigma_wall": sim.walls.stress().tolist()})
         report.setdefault("steps", steps)
-        report.setdefault("timestep", f"{sample.timestep_safety} x P-wave time step "
-                                      "min R / sqrt(E / rho)")
+        report.setdefault("timestep", timestep_description(sample))
         return sim, report
 
     def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False):
@@ -611,6 +612,7 @@ class _ShearRun:
     def __init__(self, sim, config, out, before_shear, identity):
         self.sim, self.config, self.out, self.before_shear = sim, config, out, before_shear
         sample = config.sample
+        sim.dt = timestep(sim, sample)    # from the state the shear starts from (and resumes)
         self.shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius,
                                    sample.density)
         self.steps = self.shear.steps

@@ -1,9 +1,9 @@
 """Speed against accuracy: a wet triaxial (30 kPa, 750 Pa) run with one knob changed at a time
-(time-step safety, inertial number, damping, sample size, table resolution, exact or toroidal
-bridges, records, neighbour-list skin), each compared with a slow, fine reference on peak q, Sr
-and q'/p' at the peak. Every run uses one Numba thread. Writes tradeoff.json, tradeoff.md (table
-and recommendations for a quick look and a paper figure) and tradeoff.png (pendular.tradeoff);
-finished runs in DIR/runs/ with an equal configuration are reused."""
+(time-step safety and rule, inertial number, damping, sample size, table resolution, exact or
+toroidal bridges, records, neighbour-list skin), each compared with a slow, fine reference on
+peak q, Sr and q'/p' at the peak. Every run uses one Numba thread. Writes tradeoff.json,
+tradeoff.md (table and recommendations for a quick look and a paper figure) and tradeoff.png
+(pendular.tradeoff); finished runs in DIR/runs/ with an equal configuration are reused."""
 
 import sys
 

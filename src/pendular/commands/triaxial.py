@@ -18,6 +18,7 @@ import json
 import sys
 
 from dem.preparation import PrepareConfig
+from dem.timestep import TIMESTEP_RULES
 from dem.validate import check_range
 
 from ..cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
@@ -88,7 +89,10 @@ def add_arguments(parser):
     parser.add_argument("--strain-rate", type=float, default=None,
                         help="axial strain rate [1/s] (overrides --inertial-number)")
     parser.add_argument("--timestep-safety", type=float, default=0.7,
-                        help="time step as a fraction of the P-wave estimate [-]")
+                        help="time step as a fraction of the --timestep-rule estimate [-]")
+    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="pwave",
+                        help="time step estimate: the P-wave estimate of the smallest sphere, "
+                             "or the critical step of the contacts (dem.timestep)")
     parser.add_argument("--skin-factor", type=float, default=0.3,
                         help="Verlet skin of the neighbour list / radius (0, 2]")
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
@@ -164,7 +168,8 @@ def config_from(args):
                            **sizes_from(args),
                            young=args.young, friction_deg=args.friction, damping=args.damping,
                            prep_friction_deg=args.prep_friction,
-                           timestep_safety=args.timestep_safety, confining=args.confining,
+                           timestep_safety=args.timestep_safety,
+                           timestep_rule=args.timestep_rule, confining=args.confining,
                            seed=args.seed, skin_factor=args.skin_factor,
                            periodic=args.periodic)
     shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
