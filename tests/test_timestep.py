@@ -1,5 +1,8 @@
 """The critical time step (dem.timestep) against closed forms, the assembled stiffness and leapfrog."""
 
+import json
+
+import h5py
 import numpy as np
 import pytest
 import scipy.linalg
@@ -13,6 +16,7 @@ from dem.simulation import Simulation
 from dem.state import Particles, Walls
 from dem.timestep import critical_timestep, pwave_timestep
 from dem.walls import WallForces
+from pendular.cli import run_command
 
 SHEAR_RATIO = 0.3
 
@@ -150,3 +154,28 @@ def test_the_stiffness_rule_sets_the_step_from_the_contacts(small_sample):
                                               rule.density), rel=1e-12)
     with pytest.raises(ValueError, match="timestep_rule"):
         PrepareConfig(timestep_rule="courant")
+
+
+def test_the_triaxial_command_runs_with_the_stiffness_rule(tmp_path, capsys):
+    """``--timestep-rule stiffness``: the shear's step is 0.7 of the critical step of the
+    prepared packing, larger than the P-wave rule's, and said so in the summary's
+    configuration; an unknown rule ends in argparse's error line naming the option."""
+    out = tmp_path / "stiff"
+    assert run_command("triaxial", ["--particles", "120", "--max-strain", "0.004",
+                                    "--inertial-number", "2e-3", "--timestep-rule", "stiffness",
+                                    "--vtk-every", "0", "--quiet", "--out", str(out)],
+                       prog="triaxial.py") == 0
+    summary = json.loads((out / "summary.json").read_text())
+    table = PrepareConfig()         # the command's material: thesis Table 5.2
+    pwave = 0.7 * pwave_timestep(summary["grading"]["radius_min"], table.young, table.density)
+    assert summary["dt"] > 1.2 * pwave
+    with h5py.File(out / "history.h5") as history:
+        assert history.attrs["timestep_rule"] == "stiffness"
+        assert "critical time step" in history.attrs["timestep"]
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as stop:
+        run_command("triaxial", ["--timestep-rule", "courant", "--out", str(tmp_path / "x")],
+                    prog="triaxial.py")
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert stop.value.code == 2 and "error: argument --timestep-rule" in err[-1]
+    assert not any("Traceback" in line for line in err)
