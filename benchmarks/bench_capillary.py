@@ -51,16 +51,18 @@ def shear_simulation(config, particles, walls, threads, suction):
 
 
 def time_alternately(simulations, steps, warmup, chunks=6):
-    """({name: seconds}, {name: neighbour-list rebuilds}) of ``steps`` steps of each of the
-    named ``simulations`` after ``warmup`` steps, run in alternating chunks so that a change
-    of machine load hits them alike."""
+    """({name: seconds}, {name: neighbour-list rebuilds}) of ``steps`` steps (one count for
+    all, or {name: count}) of each of the named ``simulations`` after ``warmup`` steps, run in
+    alternating chunks so that a change of machine load hits them alike."""
     for sim in simulations.values():
         sim.run(warmup)
+    totals = steps if isinstance(steps, dict) else {name: steps for name in simulations}
     elapsed = {name: 0.0 for name in simulations}
     rebuilds = {name: sim.operation(NeighborList).rebuilds for name, sim in simulations.items()}
     for chunk in range(chunks):
-        count = steps // chunks + (1 if chunk < steps % chunks else 0)
         for name, sim in simulations.items():
+            total = totals[name]
+            count = total // chunks + (1 if chunk < total % chunks else 0)
             started = time.perf_counter()
             sim.run(count)
             elapsed[name] += time.perf_counter() - started
