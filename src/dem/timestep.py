@@ -17,8 +17,8 @@ min sqrt(m / K_aa) (the diagonal of K); Gershgorin's circle theorem would turn t
 into a bound. On a prepared 10,000-sphere sample at 750 Pa the critical step is 1.50 times
 the P-wave estimate min R / sqrt(E / rho), 1.67 times the diagonal estimate and 1.8 times the
 Gershgorin bound: both leave most of the stable range unused, hence the eigenvalue itself.
-Leapfrog on that packing, undamped, is steady at 0.95 of it and blows up at 1.1
-(tests/test_timestep.py). A scene runs at a safety factor times it, computed when a phase
+Leapfrog on a prepared 300-sphere packing, undamped, is steady at 0.95 of it and blows up at
+1.1 (tests/test_timestep.py). A scene runs at a safety factor times it, computed when a phase
 starts (dem.preparation.timestep): the factor leaves room for the local damping (up to
 1 + damping times the spring force) and for contacts that form during the phase.
 """
@@ -104,8 +104,9 @@ def stiffness_product(vector, position, radius, scale_u, scale_r, pair_i, pair_j
 def critical_timestep(sim, young, shear_ratio):
     """2 / omega_max [s]: the critical step of leapfrog for the contact springs of ``sim``
     (young [Pa], shear_ratio ks / kn) between its touching pairs and with its walls (module
-    docstring), rounded down to 3 significant digits (the same step on every machine and
-    thread count); inf when nothing touches. Reads the neighbour list ``sim.contacts``
+    docstring), rounded down to 3 significant digits (the last bits of the iteration, which
+    may differ between BLAS builds and thread counts, do not reach the step); inf when
+    nothing touches. Reads the neighbour list ``sim.contacts``
     (built if absent) and the positions."""
     if sim.contacts is None:
         sim.neighbors.apply(sim)
