@@ -103,9 +103,12 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
         wj0 = angular_velocity[j, 0]
         wj1 = angular_velocity[j, 1]
         wj2 = angular_velocity[j, 2]
-        v0 = velocity[j, 0] - velocity[i, 0] - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1)
-        v1 = velocity[j, 1] - velocity[i, 1] - rj * (wj2 * n0 - wj0 * n2) - ri * (wi2 * n0 - wi0 * n2)
-        v2 = velocity[j, 2] - velocity[i, 2] - rj * (wj0 * n1 - wj1 * n0) - ri * (wi0 * n1 - wi1 * n0)
+        v0 = (velocity[j, 0] - velocity[i, 0]
+              - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1))
+        v1 = (velocity[j, 1] - velocity[i, 1]
+              - rj * (wj2 * n0 - wj0 * n2) - ri * (wi2 * n0 - wi0 * n2))
+        v2 = (velocity[j, 2] - velocity[i, 2]
+              - rj * (wj0 * n1 - wj1 * n0) - ri * (wi0 * n1 - wi1 * n0))
         if stretched:
             v0 += affine_rate[0] * d0
             v1 += affine_rate[1] * d1

@@ -32,11 +32,10 @@ import numpy as np
 from dem.atomic import write_json
 from dem.checkpoint import CheckpointWriter, load_checkpoint
 from dem.grading import grading
-from dem.timestep import pwave_timestep
 from dem.integrity import checksum, config_hash
 from dem.measure import coordination, porosity, unbalanced_force
-from dem.preparation import (PREPARATION_PHASES, prepare_sample, servoed_simulation, static,
-                             timestep, timestep_description)
+from dem.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step, servoed_simulation,
+                             static, timestep, timestep_description)
 from dem.record import HistoryRecorder
 from dem.sample import load_sample, save_sample
 from dem.validate import check_int
@@ -391,7 +390,7 @@ def check_feasible(config, force=False):
     sample, shear = config.sample, config.shear
     rate = shear.rate(sample.radius, sample.density, sample.confining)
     number = inertial_number(rate, sample.radius, sample.density, sample.confining)
-    dt = sample.timestep_safety * pwave_timestep(sample.radius, sample.young, sample.density)
+    dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
     steps = shear.max_strain / (rate * dt)
     if not force and number > MAX_INERTIAL_NUMBER:
         raise ValueError(
