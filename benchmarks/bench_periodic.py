@@ -1,13 +1,14 @@
 """Cost of the periodic cell in the triaxial shear: periodic against walled, dry and wet, same run.
 
     python benchmarks/bench_periodic.py [--sizes 1000,10000] [--threads 1]
-        [--suction 30000] [--steps 3000] [--warmup 1000] [--out FILE]
+        [--suction 30000] [--steps 3000] [--warmup 1000] [--chunks 30] [--out FILE]
 
 For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, cached under
 .cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
 (suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
-four shears are timed in alternating chunks after ``warmup`` steps, so a change of machine load
-hits them alike. Prints particle-steps/s and the periodic / walled cost per particle-step; the
+four shears are timed in ``chunks`` alternating turns after ``warmup`` steps, so a change of
+machine load hits them alike (on the 2-core development VM the speed changes by up to 2x
+within minutes: use many short chunks). Prints particle-steps/s and the periodic / walled cost per particle-step; the
 JSON rows add the neighbour-list rebuilds and pairs per particle of each shear (a periodic
 sample has no loose wall layers, so more pairs per particle).
 """
@@ -30,6 +31,7 @@ def main(argv=None):
     parser.add_argument("--suction", type=float, default=30000.0, help="matric suction [Pa]")
     parser.add_argument("--steps", type=int, default=3000)
     parser.add_argument("--warmup", type=int, default=1000)
+    parser.add_argument("--chunks", type=int, default=30, help="alternating turns per shear")
     parser.add_argument("--confining", type=float, default=750.0)
     parser.add_argument("--out", default=None, help="JSON file for the results")
     args = parser.parse_args(argv)
@@ -46,7 +48,7 @@ def main(argv=None):
                     for box, (config, particles, walls) in samples.items()
                     for kind, suction in (("dry", 0.0), ("wet", args.suction))}
             elapsed, rebuilds = time_alternately({name: run[0] for name, run in runs.items()},
-                                                 args.steps, args.warmup)
+                                                 args.steps, args.warmup, args.chunks)
             speed = {name: count * args.steps / seconds for name, seconds in elapsed.items()}
             row = {"particles": count, "threads": threads, "suction": args.suction,
                    "particle_steps_per_s": speed, "rebuilds": rebuilds,

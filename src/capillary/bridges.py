@@ -20,7 +20,7 @@ the bridge state and looks a bridge up when it forms, and ``gather_contact_bridg
 cached magnitudes along the contact law's normals without building per-pair vectors (about
 0.15-0.2 of a dry step's cost for 10,000 spheres). Bridges across gaps (``persist``, volume
 control): ``suction_bridges`` / ``volume_bridges`` write per-pair force vectors ``pair_force``,
-gathered by ``dem.neighbors.gather_pair_vectors``.
+gathered by ``dem.neighbors.gather_pair_forces``.
 
 The capillary force is added on top of the mechanical contact force and does not enter the
 Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack caps the shear
@@ -65,18 +65,17 @@ import math
 
 import numpy as np
 
-from capillary.bridge_kernels import (bridges_across_gaps, contact_bridge_forces,
-                                      contact_bridges, exchange_liquid, gather_contact_bridges,
-                                      pendular_overlap_counts, refresh_contact_bridges,
-                                      suction_bridges, suction_interfaces, volume_bridges,
-                                      volume_interfaces)
+from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
+                                      gather_contact_bridges, pendular_overlap_counts,
+                                      refresh_contact_bridges, suction_bridges,
+                                      suction_interfaces, volume_bridges, volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
                                   check_pendular_suction)
 from capillary.volume_table import VolumeBridgeTable
 from dem.contact_law import ContactForces
-from dem.neighbors import gather_pair_vectors
+from dem.neighbors import gather_pair_forces
 from dem.validate import check_positive, check_range
 
 #: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
@@ -370,7 +369,8 @@ class CapillaryBridges:
                             b.filling_i, b.filling_j, self.suction, self.surface_tension,
                             *self._table_arrays)
             gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
-                                   c.second_pair, p.force)
+                                   c.second_pair, p.force, p.position, c.image, c.through_face,
+                                   sim.walls.period, sim.walls.virial_blocks)
             return
         if self.control == "suction":
             suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period,
@@ -389,7 +389,9 @@ class CapillaryBridges:
                     self._events, self._released, c.row_start, c.second_start, c.second_pair,
                     p.radius, c.pair_i, c.pair_j, b.state, b.volume, self.film,
                     self.liquid == "shared", *self.volume_table.volume_star_bounds())
-        gather_pair_vectors(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force)
+        gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force,
+                           p.position, c.image, c.through_face, sim.walls.period,
+                           sim.walls.virial_blocks)
         if self.persist:
             self._bridges = b.count()
 
@@ -467,15 +469,10 @@ class CapillaryBridges:
             return math.nan
         return float(np.mean(state.suction[mask]))
 
-    def pair_forces(self, sim, index=None):
-        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step, of
-        the pairs ``index`` only if given."""
+    def pair_forces(self, sim):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
         state = self.state(sim)
-        if index is None:
-            return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
-        if self.persist:
-            return np.take(self.pair_force, index, axis=0)
-        return contact_bridge_forces(state.force, sim.contacts.normal, index)
+        return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each

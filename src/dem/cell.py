@@ -12,7 +12,8 @@ rate * l to the relative velocity of a pair of branch vector l (YADE's periodic 
 
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
-each step. The stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
+each step from the sums that the forces' gathers add to ``virial_blocks`` (dem.virial). The
+stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
 unit strain] as a wall servo reads the stiffness of the wall's contacts; the servo refreshes it
 (``update_stiffness``) when it refreshes its own.
 """
@@ -25,86 +26,7 @@ import numpy as np
 from .neighbors import branch_vector
 from .state import Box, _box_position, _check_box
 from .validate import check_array
-
-#: Fixed blocks of particles summed apart then together: a sum in the same order for any
-#: thread count (results thread-independent).
-SUM_BLOCKS = 64
-
-
-@numba.njit(cache=True)
-def _sum_blocks(sums):
-    """Column sums of the per-block sums, block after block (the same order for any thread
-    count)."""
-    total = np.zeros(sums.shape[1])
-    for block in range(sums.shape[0]):
-        for c in range(sums.shape[1]):
-            total[c] += sums[block, c]
-    return total
-
-
-#: Nine zeros: the start of a sum of outer products (_add_outer).
-_ZERO9 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-
-
-@numba.njit(cache=True, inline="always")
-def _add_outer(total, a0, a1, a2, b0, b1, b2):
-    """``total`` (9 numbers, row by row) plus the outer product a (x) b: a tuple, so that a
-    sum over a loop stays in registers."""
-    return (total[0] + a0 * b0, total[1] + a0 * b1, total[2] + a0 * b2,
-            total[3] + a1 * b0, total[4] + a1 * b1, total[5] + a1 * b2,
-            total[6] + a2 * b0, total[7] + a2 * b1, total[8] + a2 * b2)
-
-
-@numba.njit(cache=True, inline="always")
-def _store(row, total):
-    """Write the 9 numbers of ``total`` into ``row``."""
-    for c in range(9):
-        row[c] = total[c]
-
-
-@numba.njit(cache=True, inline="always")
-def _block_virial(block, position, force, through_face, image, period, face_force, sums):
-    """Block ``block`` of resultant_virial's two sums, into ``sums[block]``."""
-    count = len(position)
-    faces = len(through_face)
-    total = _ZERO9
-    for p in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
-        total = _add_outer(total, position[p, 0], position[p, 1], position[p, 2],
-                           force[p, 0], force[p, 1], force[p, 2])
-    for slot in range(faces * block // SUM_BLOCKS, faces * (block + 1) // SUM_BLOCKS):
-        k = through_face[slot]
-        total = _add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                           image[k, 2] * period[2], face_force[slot, 0],
-                           face_force[slot, 1], face_force[slot, 2])
-    _store(sums[block], total)
-
-
-@numba.njit(cache=True, parallel=True)
-def resultant_virial(position, force, through_face, image, period, face_force):
-    """(9,) sum over the pairs of l_a f_b [N m] (row a, column b; l the branch vector i -> j,
-    f the force on j from i) when ``force`` (N, 3) [N] is each particle's resultant of the
-    pair forces, from
-
-        sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
-
-    (l = x_j - x_i + image L; the second sum runs over the pairs ``through_face`` only, whose
-    forces are ``face_force`` (F, 3) [N]): a pass over the particles and one over those pairs
-    instead of a pass over every pair."""
-    sums = np.zeros((SUM_BLOCKS, 9))
-    for block in numba.prange(SUM_BLOCKS):
-        _block_virial(block, position, force, through_face, image, period, face_force, sums)
-    return _sum_blocks(sums)
-
-
-@numba.njit(cache=True)
-def resultant_virial_serial(position, force, through_face, image, period, face_force):
-    """resultant_virial in one thread, with the same result (the same blocks in the same
-    order): a parallel loop run by one thread costs more (1,000 spheres: 15 against 10 us;
-    10,000: 55 against 50 us)."""
-    sums = np.zeros((SUM_BLOCKS, 9))
-    for block in range(SUM_BLOCKS):
-        _block_virial(block, position, force, through_face, image, period, face_force, sums)
-    return _sum_blocks(sums)
+from .virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds, sum_blocks
 
 
 @numba.njit(cache=True, parallel=True)
@@ -114,37 +36,55 @@ def pair_virial(position, row_start, pair_j, image, period, pair_force):
     count = len(row_start) - 1
     sums = np.zeros((SUM_BLOCKS, 9))
     for block in numba.prange(SUM_BLOCKS):
-        total = _ZERO9
-        for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
+        start, stop = block_bounds(count, block)
+        total = ZERO9
+        for i in range(start, stop):
             for k in range(row_start[i], row_start[i + 1]):
                 l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
-                total = _add_outer(total, l0, l1, l2, pair_force[k, 0], pair_force[k, 1],
-                                   pair_force[k, 2])
-        _store(sums[block], total)
-    return _sum_blocks(sums)
+                total = add_outer(total, l0, l1, l2, pair_force[k, 0], pair_force[k, 1],
+                                  pair_force[k, 2])
+        add_to_block(sums, block, total)
+    return sum_blocks(sums)
 
 
 @numba.njit(cache=True, parallel=True)
-def contact_stiffness(position, row_start, pair_j, image, period, normal_force, overlap):
-    """(3,) sum over the touching pairs of kn (l_a n_a)^2 [N m], kn = normal_force / overlap
-    the spring stiffness, l the branch vector and n = l / |l|."""
+def contact_stiffness(radius, row_start, pair_j, normal, normal_force, overlap):
+    """(3,) sum over the touching pairs of kn (l_a n_a)^2 = kn |l|^2 n_a^4 [N m], with
+    kn = normal_force / overlap the spring stiffness, n the contact normal of the last
+    evaluation and |l| = r_i + r_j - overlap the branch length. Pairs apart have no normal
+    force and add nothing (no branch: half the pairs touch, at random)."""
     count = len(row_start) - 1
     sums = np.zeros((SUM_BLOCKS, 3))
     for block in numba.prange(SUM_BLOCKS):
+        start, stop = block_bounds(count, block)
         k0 = k1 = k2 = 0.0
-        for i in range(count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS):
+        for i in range(start, stop):
             for k in range(row_start[i], row_start[i + 1]):
-                if overlap[k] <= 0.0:
-                    continue
-                l0, l1, l2 = branch_vector(position, i, pair_j[k], image, k, period)
-                weight = normal_force[k] / (overlap[k] * (l0 * l0 + l1 * l1 + l2 * l2))
-                k0 += weight * l0 ** 4
-                k1 += weight * l1 ** 4
-                k2 += weight * l2 ** 4
+                length = radius[i] + radius[pair_j[k]] - overlap[k]
+                spring_overlap = overlap[k] if overlap[k] > 0.0 else 1.0
+                weight = normal_force[k] * length * length / spring_overlap
+                s0 = normal[k, 0] * normal[k, 0]
+                s1 = normal[k, 1] * normal[k, 1]
+                s2 = normal[k, 2] * normal[k, 2]
+                k0 += weight * (s0 * s0)
+                k1 += weight * (s1 * s1)
+                k2 += weight * (s2 * s2)
         sums[block, 0] = k0
         sums[block, 1] = k1
         sums[block, 2] = k2
-    return _sum_blocks(sums)
+    return sum_blocks(sums)
+
+
+@numba.njit(cache=True)
+def store_cell_stress(virial_blocks, cell_position, stress_tensor):
+    """``stress_tensor`` (3, 3) [Pa] = the sum of ``virial_blocks`` (sum_blocks) over the
+    volume of the cell of faces ``cell_position`` (6,) [m]: one compiled call, since each NumPy
+    operation after the step's large kernels costs several microseconds."""
+    volume = cell_position[1] * cell_position[3] * cell_position[5]
+    total = sum_blocks(virial_blocks)
+    for a in range(3):
+        for b in range(3):
+            stress_tensor[a, b] = total[3 * a + b] / volume
 
 
 @numba.njit(cache=True)
@@ -185,7 +125,9 @@ class PeriodicCell(Box):
     rate: (3,) stretching rate L' / L of the current step, extension positive [1/s];
     stress_tensor: (3, 3) Love–Weber stress of every pair force at the last evaluation,
     compression positive [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
-    wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face).
+    wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face);
+    virial_blocks: (SUM_BLOCKS, 9) the pair forces' sums of l (x) f [N m] gathered since the
+    step began (dem.virial; zeroed with the forces).
     """
 
     position: np.ndarray
@@ -206,6 +148,7 @@ class PeriodicCell(Box):
                                          length=3)
         self.stiffness = check_array("cell stiffness", self.stiffness, length=3)
         self.wraps = np.asarray(self.wraps, dtype=np.int64).reshape(-1, 3)
+        self.virial_blocks = np.zeros((SUM_BLOCKS, 9))
 
     @classmethod
     def box(cls, lo, hi):
@@ -251,29 +194,22 @@ class PeriodicCell(Box):
         return particles.position + self.wraps * self.lengths()
 
     def after_forces(self, sim):
-        """The stress of this step's pair forces (every force operation has
-        ``pair_forces(sim, index)``: from the particles' resultants and the pairs through a
-        face, resultant_virial; otherwise pair by pair over the operations that have it); the
-        stretching rate returns to zero until a control sets it."""
+        """The stress of this step's pair forces: the sum their gathers left in
+        ``virial_blocks`` when every force operation is a pair force (has ``pair_forces(sim)``);
+        otherwise pair by pair over the operations that are. The stretching rate returns to
+        zero until a control sets it."""
         contacts = sim.contacts
-        total = np.zeros(9)
-        if contacts is not None and len(contacts):
-            p, period = sim.particles, self.period
-            pair_ops = [op for op in sim.forces if hasattr(op, "pair_forces")]
-            if len(pair_ops) == len(sim.forces):
-                face = contacts.through_face
-                face_force = pair_ops[0].pair_forces(sim, face)
-                for op in pair_ops[1:]:
-                    face_force = face_force + op.pair_forces(sim, face)
-                virial = (resultant_virial if numba.get_num_threads() > 1
-                          else resultant_virial_serial)
-                total = virial(p.position, p.force, face, contacts.image, period, face_force)
-            else:       # a force that is not a pair force: resultants are not the pairs' sum
-                for op in pair_ops:
-                    total += pair_virial(p.position, contacts.row_start, contacts.pair_j,
-                                         contacts.image, period, op.pair_forces(sim))
-        self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
-        self.rate[:] = 0.0
+        if all(hasattr(op, "pair_forces") for op in sim.forces):
+            store_cell_stress(self.virial_blocks, self.position, self.stress_tensor)
+        else:       # a force that is not a pair force: its gather adds no virial
+            total = np.zeros(9)
+            for op in sim.forces:
+                if hasattr(op, "pair_forces") and len(contacts):
+                    total += pair_virial(sim.particles.position, contacts.row_start,
+                                         contacts.pair_j, contacts.image, self.period,
+                                         op.pair_forces(sim))
+            self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
+        self.rate.fill(0.0)
 
     def update_stiffness(self, sim):
         """``stiffness`` (3,) [Pa] of the current contacts, S_a = (1/V) sum kn (l_a n_a)^2
@@ -283,8 +219,8 @@ class PeriodicCell(Box):
         if c is None or not len(c):
             self.stiffness[:] = 0.0
             return
-        self.stiffness[:] = contact_stiffness(sim.particles.position, c.row_start, c.pair_j,
-                                              c.image, self.period, c.normal_force,
+        self.stiffness[:] = contact_stiffness(sim.particles.radius, c.row_start, c.pair_j,
+                                              c.normal, c.normal_force,
                                               c.overlap) / self.volume()
 
     def stretch(self, axis, shift, dt):

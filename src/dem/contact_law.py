@@ -9,6 +9,8 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
+from .virial import (SUM_BLOCKS, ZERO9, add_face_forces, add_outer, add_to_block, block_bounds,
+                     face_slots, is_periodic)
 
 
 @numba.njit(cache=True, inline="always")
@@ -43,7 +45,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     velocity using the radii as lever arms (YADE's avoidGranularRatcheting), and finally capped
     at Fn tan(phi), the elastic part being kept on the cap when sliding.
     """
-    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+    periodic = is_periodic(period)
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
@@ -150,32 +152,48 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_pair_forces(pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
-                       second_pair, force, torque):
-    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j."""
-    for p in numba.prange(len(row_start) - 1):
-        f0 = f1 = f2 = t0 = t1 = t2 = 0.0
-        for k in range(row_start[p], row_start[p + 1]):
-            f0 -= pair_force[k, 0]
-            f1 -= pair_force[k, 1]
-            f2 -= pair_force[k, 2]
-            t0 += pair_torque_i[k, 0]
-            t1 += pair_torque_i[k, 1]
-            t2 += pair_torque_i[k, 2]
-        for slot in range(second_start[p], second_start[p + 1]):
-            k = second_pair[slot]
-            f0 += pair_force[k, 0]
-            f1 += pair_force[k, 1]
-            f2 += pair_force[k, 2]
-            t0 += pair_torque_j[k, 0]
-            t1 += pair_torque_j[k, 1]
-            t2 += pair_torque_j[k, 2]
-        force[p, 0] += f0
-        force[p, 1] += f1
-        force[p, 2] += f2
-        torque[p, 0] += t0
-        torque[p, 1] += t1
-        torque[p, 2] += t2
+def gather_contact_forces(pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
+                          second_pair, force, torque, position, image, through_face,
+                          period, virial):
+    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j; in a
+    periodic cell also the Love–Weber sum of l (x) F to ``virial`` (as
+    dem.neighbors.gather_pair_forces)."""
+    count = len(row_start) - 1
+    periodic = is_periodic(period)
+    for block in numba.prange(SUM_BLOCKS):
+        start, stop = block_bounds(count, block)
+        total = ZERO9
+        for p in range(start, stop):
+            f0 = f1 = f2 = t0 = t1 = t2 = 0.0
+            for k in range(row_start[p], row_start[p + 1]):
+                f0 -= pair_force[k, 0]
+                f1 -= pair_force[k, 1]
+                f2 -= pair_force[k, 2]
+                t0 += pair_torque_i[k, 0]
+                t1 += pair_torque_i[k, 1]
+                t2 += pair_torque_i[k, 2]
+            for slot in range(second_start[p], second_start[p + 1]):
+                k = second_pair[slot]
+                f0 += pair_force[k, 0]
+                f1 += pair_force[k, 1]
+                f2 += pair_force[k, 2]
+                t0 += pair_torque_j[k, 0]
+                t1 += pair_torque_j[k, 1]
+                t2 += pair_torque_j[k, 2]
+            force[p, 0] += f0
+            force[p, 1] += f1
+            force[p, 2] += f2
+            torque[p, 0] += t0
+            torque[p, 1] += t1
+            torque[p, 2] += t2
+            if periodic:
+                total = add_outer(total, position[p, 0], position[p, 1], position[p, 2],
+                                  f0, f1, f2)
+        if periodic:
+            first, last = face_slots(through_face, row_start, start, stop)
+            total = add_face_forces(total, through_face, first, last, image, period,
+                                    pair_force)
+            add_to_block(virial, block, total)
 
 
 @numba.njit(cache=True)
@@ -231,11 +249,9 @@ class ContactForces:
                                          unit="deg")
         self._tan_friction = float(np.tan(np.radians(self._friction_deg)))
 
-    def pair_forces(self, sim, index=None):
-        """Contact force on j from i (K, 3) [N] of the last evaluation, of the pairs ``index``
-        only if given."""
-        force = sim.contacts.force
-        return force if index is None else np.take(force, index, axis=0)
+    def pair_forces(self, sim):
+        """Contact force on j from i (K, 3) [N] of the last evaluation."""
+        return sim.contacts.force
 
     def apply(self, sim):
         p = sim.particles
@@ -245,5 +261,6 @@ class ContactForces:
                     c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
                     c.normal_force, c.force, c.torque_i, c.torque_j, self.young,
                     self.shear_ratio, self._tan_friction, sim.dt)
-        gather_pair_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
-                           c.second_pair, p.force, p.torque)
+        gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
+                              c.second_pair, p.force, p.torque, p.position, c.image,
+                              c.through_face, box.period, box.virial_blocks)

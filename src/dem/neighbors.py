@@ -17,6 +17,8 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
+from .virial import (SUM_BLOCKS, ZERO9, add_face_forces, add_outer, add_to_block, block_bounds,
+                     face_slots, is_periodic)
 
 
 @dataclass
@@ -328,15 +330,17 @@ def carry_history(old_row_start, old_pair_j, old_values, new_row_start, new_pair
 
 
 @numba.njit(cache=True)
-def moved_beyond(position, reference_position, radius, reference_radius, limit):
+def moved_beyond(position, reference_position, scale, radius, reference_radius, limit):
     """True when some particle's displacement plus radius growth since the last rebuild exceeds
-    ``limit`` [m]."""
+    ``limit`` [m]; the displacement from the reference position stretched by ``scale`` (3,)
+    (a periodic cell's L / L_ref: what its homogeneous stretching alone would have done; ones
+    inside walls)."""
     limit_squared = limit * limit
     for p in range(position.shape[0]):
         growth = max(radius[p] - reference_radius[p], 0.0)
-        d0 = position[p, 0] - reference_position[p, 0]
-        d1 = position[p, 1] - reference_position[p, 1]
-        d2 = position[p, 2] - reference_position[p, 2]
+        d0 = position[p, 0] - scale[0] * reference_position[p, 0]
+        d1 = position[p, 1] - scale[1] * reference_position[p, 1]
+        d2 = position[p, 2] - scale[2] * reference_position[p, 2]
         if growth == 0.0:
             if d0 * d0 + d1 * d1 + d2 * d2 > limit_squared:
                 return True
@@ -346,27 +350,43 @@ def moved_beyond(position, reference_position, radius, reference_radius, limit):
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_pair_vectors(pair_vector, row_start, second_start, second_pair, out):
-    """Add a per-pair 3-vector (K, 3) to particles (N, 3): -v to the first member i, +v to j.
+def gather_pair_forces(pair_force, row_start, second_start, second_pair, out, position, image,
+                       through_face, period, virial):
+    """Add per-pair forces (K, 3) [N], each the force on j from i, to particles (N, 3): -f to
+    the first member i, +f to j (action and reaction).
 
-    For a central pair force stored as "force on j from i" this applies action and reaction
-    (gather_pair_forces of the contact law does the same with torques). Each particle sums its
-    own pairs in a fixed order: deterministic for any thread count, without atomics.
+    Each particle sums its own pairs in a fixed order: deterministic for any thread count,
+    without atomics. In a periodic cell (``period`` not zero) the pass also adds the forces'
+    Love–Weber sum of l (x) f [N m] to ``virial`` (SUM_BLOCKS, 9) block by block
+    (dem.virial); walls pass an empty one.
     """
-    for p in numba.prange(len(row_start) - 1):
-        v0 = v1 = v2 = 0.0
-        for k in range(row_start[p], row_start[p + 1]):
-            v0 -= pair_vector[k, 0]
-            v1 -= pair_vector[k, 1]
-            v2 -= pair_vector[k, 2]
-        for slot in range(second_start[p], second_start[p + 1]):
-            k = second_pair[slot]
-            v0 += pair_vector[k, 0]
-            v1 += pair_vector[k, 1]
-            v2 += pair_vector[k, 2]
-        out[p, 0] += v0
-        out[p, 1] += v1
-        out[p, 2] += v2
+    count = len(row_start) - 1
+    periodic = is_periodic(period)
+    for block in numba.prange(SUM_BLOCKS):
+        start, stop = block_bounds(count, block)
+        total = ZERO9
+        for p in range(start, stop):
+            v0 = v1 = v2 = 0.0
+            for k in range(row_start[p], row_start[p + 1]):
+                v0 -= pair_force[k, 0]
+                v1 -= pair_force[k, 1]
+                v2 -= pair_force[k, 2]
+            for slot in range(second_start[p], second_start[p + 1]):
+                k = second_pair[slot]
+                v0 += pair_force[k, 0]
+                v1 += pair_force[k, 1]
+                v2 += pair_force[k, 2]
+            out[p, 0] += v0
+            out[p, 1] += v1
+            out[p, 2] += v2
+            if periodic:
+                total = add_outer(total, position[p, 0], position[p, 1], position[p, 2],
+                                  v0, v1, v2)
+        if periodic:
+            first, last = face_slots(through_face, row_start, start, stop)
+            total = add_face_forces(total, through_face, first, last, image, period,
+                                    pair_force)
+            add_to_block(virial, block, total)
 
 
 def branch_vectors(position, contacts, period, index=None):
@@ -459,8 +479,14 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         extra=extra, image=image)
 
 
+#: The displacement reference of walled scenes: no stretching (NeighborList.apply).
+_UNSTRETCHED = np.ones(3)
+
+
 class NeighborList:
-    """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2.
+    """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2
+    (in a periodic cell: moved relative to the cell's stretching, against a skin reduced by
+    what the stretching does to the pairs, ``apply``).
 
     skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
     The reach beyond touching is the largest ``reach(sim)`` [m] of the simulation's forces
@@ -477,6 +503,7 @@ class NeighborList:
         self._reference_position = None
         self._reference_radius = None
         self._reference_lengths = None
+        self._shortest_unlisted = 0.0
 
     def required_reach(self, sim):
         """Largest reach [m] the simulation's forces declare (0: contacts only)."""
@@ -499,22 +526,24 @@ class NeighborList:
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
         self._reference_lengths = box.lengths()
+        self._shortest_unlisted = 2.0 * float(p.radius.max()) + self.interaction_range + self.skin
         self.rebuilds += 1
 
     def apply(self, sim):
         p = sim.particles
         reach = self.required_reach(sim)
-        # a periodic box that changed size by dL moves pairs across its faces by up to dL
         limit = 0.5 * self.skin
+        scale = _UNSTRETCHED
         if sim.walls.periodic and self._reference_lengths is not None:
-            faces, reference = sim.walls.position, self._reference_lengths
-            limit -= 0.5 * max(abs(faces[1] - faces[0] - reference[0]),
-                               abs(faces[3] - faces[2] - reference[1]),
-                               abs(faces[5] - faces[4] - reference[2]))
+            # Particles ride the cell's stretching s = L / L_ref, which changes a branch vector
+            # l by (s - 1) l: displacements are measured from s x_ref, and the skin left for
+            # them shrinks by max|s - 1| times the shortest branch of a pair left out.
+            scale = sim.walls.lengths() / self._reference_lengths
+            limit -= 0.5 * float(np.max(np.abs(scale - 1.0))) * self._shortest_unlisted
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
                 or len(self._reference_radius) != len(p.radius) or limit <= 0.0
-                or moved_beyond(p.position, self._reference_position, p.radius,
+                or moved_beyond(p.position, self._reference_position, scale, p.radius,
                                 self._reference_radius, limit)):
             self.interaction_range = reach
             self.rebuild(sim)

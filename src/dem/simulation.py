@@ -10,7 +10,8 @@ shape)::
                integrator=Integrator(0.2),
                writers=[recorder])
 
-One step (``advance``): zero forces and torques, the neighbour list, every force, what the box
+One step (``advance``): zero forces and torques (and a periodic cell's virial sums, which the
+pair forces' gathers fill, dem.virial), the neighbour list, every force, what the box
 measures of them (a periodic cell: its stress), every control, the integrator; then step and
 time advance and the writers see the new state. The box is ``Walls`` (with ``WallForces``
 among the forces) or a ``dem.cell.PeriodicCell``.
@@ -85,6 +86,7 @@ class Simulation:
         measure of them), without moving anything: the first part of a step."""
         self.particles.force[:] = 0.0
         self.particles.torque[:] = 0.0
+        self.walls.virial_blocks.fill(0.0)
         self.neighbors.apply(self)
         for op in self.forces:
             op.apply(self)

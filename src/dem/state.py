@@ -68,6 +68,8 @@ class Box:
     also provides ``period`` (3,) [m]: what a pair's periodic image shifts its branch vector
     by per image (Contacts.image; zeros for walls), ``affine_rate`` (3,) [1/s]: the
     homogeneous stretching rate that carries the particles (zeros for walls),
+    ``virial_blocks`` (SUM_BLOCKS, 9) [N m]: where the pair forces' gathers add their
+    Love–Weber sums when ``period`` is not zero (dem.virial; walls: empty, never written),
     ``wrap(particles)`` (positions brought back into the box at a neighbour-list rebuild) and
     ``after_forces(sim)`` (what the box measures once the step's forces are known).
     """
@@ -115,6 +117,7 @@ def _box_position(lo, hi):
 
 
 _NO_SHIFT = np.zeros(3)
+_NO_VIRIAL = np.zeros((0, 9))
 
 
 @dataclass
@@ -152,6 +155,11 @@ class Walls(Box):
     def affine_rate(self):
         """Walls carry no particle: zeros (3,) [1/s]."""
         return _NO_SHIFT
+
+    @property
+    def virial_blocks(self):
+        """Walls gather no virial (period zero): an empty (0, 9) array."""
+        return _NO_VIRIAL
 
     def wrap(self, particles):
         """Nothing to wrap inside walls."""

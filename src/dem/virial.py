@@ -1,0 +1,84 @@
+"""Sums of outer products l (x) f over pair forces in fixed blocks: the Love–Weber virial of a
+periodic cell (Eq. 3.41), gathered in the same pass that adds the pair forces to particles.
+
+The sum over the pairs of l (x) f (l the branch vector i -> j, f the force on j from i) is
+
+    sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
+
+(l = x_j - x_i + image L, F_p the resultant of p's pair forces): a force's gather, which
+already visits each particle, adds x_p (x) its share of F_p and then, for the pairs through a
+face whose first member is in the block just gathered (a slice of Contacts.through_face, whose
+forces are still in cache), (image L) (x) f. Particles are split into SUM_BLOCKS fixed blocks;
+each block's sum is kept apart and the blocks are added in order (``sum_blocks``), so the
+result does not depend on the thread count. The virial costs a gather about 10 % (10,000
+spheres; testing each pair's image inside the pair loop instead cost 25 %).
+"""
+
+import numba
+import numpy as np
+
+#: Fixed blocks of particles summed apart then together: a sum in the same order for any
+#: thread count (results thread-independent).
+SUM_BLOCKS = 64
+
+#: Nine zeros: the start of a sum of outer products (add_outer).
+ZERO9 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@numba.njit(cache=True, inline="always")
+def block_bounds(count, block):
+    """First and one-past-last of the ``count`` items in block ``block`` of SUM_BLOCKS."""
+    return count * block // SUM_BLOCKS, count * (block + 1) // SUM_BLOCKS
+
+
+@numba.njit(cache=True, inline="always")
+def add_outer(total, a0, a1, a2, b0, b1, b2):
+    """``total`` (9 numbers, row by row) plus the outer product a (x) b: a tuple, so that a
+    sum over a loop stays in registers."""
+    return (total[0] + a0 * b0, total[1] + a0 * b1, total[2] + a0 * b2,
+            total[3] + a1 * b0, total[4] + a1 * b1, total[5] + a1 * b2,
+            total[6] + a2 * b0, total[7] + a2 * b1, total[8] + a2 * b2)
+
+
+@numba.njit(cache=True, inline="always")
+def face_slots(through_face, row_start, start, stop):
+    """First and one-past-last slot of ``through_face`` (sorted pair indices) holding pairs
+    whose first member is one of the particles start .. stop - 1 (CSR ``row_start``)."""
+    return (np.searchsorted(through_face, row_start[start]),
+            np.searchsorted(through_face, row_start[stop]))
+
+
+@numba.njit(cache=True, inline="always")
+def add_face_forces(total, through_face, first, last, image, period, pair_force):
+    """``total`` plus (image_k L) (x) f_k over the pairs k = through_face[first:last], f the
+    force on j from i (K, 3) [N]."""
+    for slot in range(first, last):
+        k = through_face[slot]
+        total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
+                          image[k, 2] * period[2], pair_force[k, 0], pair_force[k, 1],
+                          pair_force[k, 2])
+    return total
+
+
+@numba.njit(cache=True, inline="always")
+def add_to_block(sums, block, total):
+    """Add the 9 numbers of ``total`` to row ``block`` of ``sums`` (SUM_BLOCKS, 9)."""
+    for c in range(9):
+        sums[block, c] += total[c]
+
+
+@numba.njit(cache=True, inline="always")
+def is_periodic(period):
+    """Whether ``period`` (3,) [m] is a periodic cell's (walls: zeros)."""
+    return period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+
+
+@numba.njit(cache=True)
+def sum_blocks(sums):
+    """Column sums of the per-block sums, block after block (the same order for any thread
+    count)."""
+    total = np.zeros(sums.shape[1])
+    for block in range(sums.shape[0]):
+        for c in range(sums.shape[1]):
+            total[c] += sums[block, c]
+    return total
