@@ -53,10 +53,14 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
         d0 = position[j, 0] - position[i, 0]
         d1 = position[j, 1] - position[i, 1]
         d2 = position[j, 2] - position[i, 2]
-        if periodic:        # as dem.neighbors.branch_vector
-            d0 += image[k, 0] * period[0]
-            d1 += image[k, 1] * period[1]
-            d2 += image[k, 2] * period[2]
+        if periodic:        # as dem.neighbors.branch_vector, skipped for most pairs
+            m0 = image[k, 0]
+            m1 = image[k, 1]
+            m2 = image[k, 2]
+            if m0 != 0 or m1 != 0 or m2 != 0:
+                d0 += m0 * period[0]
+                d1 += m1 * period[1]
+                d2 += m2 * period[2]
         distance = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         ri = radius[i]
         rj = radius[j]

@@ -330,17 +330,28 @@ def carry_history(old_row_start, old_pair_j, old_values, new_row_start, new_pair
 
 
 @numba.njit(cache=True)
-def moved_beyond(position, reference_position, scale, radius, reference_radius, limit):
+def moved_beyond(position, reference_position, radius, reference_radius, limit, lengths,
+                 reference_lengths, shortest_unlisted):
     """True when some particle's displacement plus radius growth since the last rebuild exceeds
-    ``limit`` [m]; the displacement from the reference position stretched by ``scale`` (3,)
-    (a periodic cell's L / L_ref: what its homogeneous stretching alone would have done; ones
-    inside walls)."""
+    ``limit`` [m].
+
+    In a periodic cell of edges ``lengths`` (3,) [m], ``reference_lengths`` at the last
+    rebuild (walls: ones for both), the particles ride the cell's stretching s = L / L_ref,
+    which changes a branch vector l by (s - 1) l: displacements are measured from s x_ref, and
+    the limit shrinks by max|s - 1| / 2 times ``shortest_unlisted`` [m], the shortest branch of
+    a pair left out of the list."""
+    s0 = lengths[0] / reference_lengths[0]
+    s1 = lengths[1] / reference_lengths[1]
+    s2 = lengths[2] / reference_lengths[2]
+    limit -= 0.5 * max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) * shortest_unlisted
+    if limit <= 0.0:
+        return True
     limit_squared = limit * limit
     for p in range(position.shape[0]):
         growth = max(radius[p] - reference_radius[p], 0.0)
-        d0 = position[p, 0] - scale[0] * reference_position[p, 0]
-        d1 = position[p, 1] - scale[1] * reference_position[p, 1]
-        d2 = position[p, 2] - scale[2] * reference_position[p, 2]
+        d0 = position[p, 0] - s0 * reference_position[p, 0]
+        d1 = position[p, 1] - s1 * reference_position[p, 1]
+        d2 = position[p, 2] - s2 * reference_position[p, 2]
         if growth == 0.0:
             if d0 * d0 + d1 * d1 + d2 * d2 > limit_squared:
                 return True
@@ -479,7 +490,7 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         extra=extra, image=image)
 
 
-#: The displacement reference of walled scenes: no stretching (NeighborList.apply).
+#: The lengths moved_beyond compares in walled scenes: no stretching (NeighborList.apply).
 _UNSTRETCHED = np.ones(3)
 
 
@@ -532,18 +543,14 @@ class NeighborList:
     def apply(self, sim):
         p = sim.particles
         reach = self.required_reach(sim)
-        limit = 0.5 * self.skin
-        scale = _UNSTRETCHED
+        lengths = reference = _UNSTRETCHED
         if sim.walls.periodic and self._reference_lengths is not None:
-            # Particles ride the cell's stretching s = L / L_ref, which changes a branch vector
-            # l by (s - 1) l: displacements are measured from s x_ref, and the skin left for
-            # them shrinks by max|s - 1| times the shortest branch of a pair left out.
-            scale = sim.walls.lengths() / self._reference_lengths
-            limit -= 0.5 * float(np.max(np.abs(scale - 1.0))) * self._shortest_unlisted
+            lengths, reference = sim.walls.period, self._reference_lengths
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
-                or len(self._reference_radius) != len(p.radius) or limit <= 0.0
-                or moved_beyond(p.position, self._reference_position, scale, p.radius,
-                                self._reference_radius, limit)):
+                or len(self._reference_radius) != len(p.radius)
+                or moved_beyond(p.position, self._reference_position, p.radius,
+                                self._reference_radius, 0.5 * self.skin, lengths, reference,
+                                self._shortest_unlisted)):
             self.interaction_range = reach
             self.rebuild(sim)
