@@ -9,8 +9,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import (SUM_BLOCKS, ZERO9, add_face_forces, add_outer, add_to_block, block_bounds,
-                     face_slots, is_periodic)
+from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block, is_periodic
 
 
 @numba.njit(cache=True, inline="always")
@@ -194,10 +193,8 @@ def gather_contact_forces(pair_force, pair_torque_i, pair_torque_j, row_start, s
                 total = add_outer(total, position[p, 0], position[p, 1], position[p, 2],
                                   f0, f1, f2)
         if periodic:
-            first, last = face_slots(through_face, row_start, start, stop)
-            total = add_face_forces(total, through_face, first, last, image, period,
-                                    pair_force)
-            add_to_block(virial, block, total)
+            close_block(virial, block, total, through_face, row_start, start, stop, image,
+                        period, pair_force)
 
 
 @numba.njit(cache=True)

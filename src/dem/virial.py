@@ -61,6 +61,16 @@ def add_face_forces(total, through_face, first, last, image, period, pair_force)
 
 
 @numba.njit(cache=True, inline="always")
+def close_block(virial, block, total, through_face, row_start, start, stop, image, period,
+                pair_force):
+    """Add to row ``block`` of ``virial`` the block's sum ``total`` (its particles' x_p (x)
+    F_p) and the face terms of its pairs through a face (add_face_forces)."""
+    first, last = face_slots(through_face, row_start, start, stop)
+    add_to_block(virial, block, add_face_forces(total, through_face, first, last, image,
+                                                period, pair_force))
+
+
+@numba.njit(cache=True, inline="always")
 def add_to_block(sums, block, total):
     """Add the 9 numbers of ``total`` to row ``block`` of ``sums`` (SUM_BLOCKS, 9)."""
     for c in range(9):
