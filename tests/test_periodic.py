@@ -11,9 +11,9 @@ import pytest
 from capillary import CapillaryBridges
 from capillary.bridge_state import ACROSS_GAP, BridgeState
 from dem.cell import PeriodicCell, pair_virial
-from dem.contact_law import ContactForces, normal_stiffness
+from dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
 from dem.integrate import Integrator
-from dem.neighbors import NeighborList, build_contacts
+from dem.neighbors import NeighborList, build_contacts, gather_pair_forces
 from dem.preparation import PrepareConfig, prepare_sample, random_cloud
 from dem.sample import load_sample, save_sample
 from dem.simulation import Simulation
@@ -246,6 +246,14 @@ def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persis
         np.testing.assert_array_equal(stresses[1], stresses[0])
         np.testing.assert_allclose(stresses[0].ravel() * sim.walls.volume(), by_pairs,
                                    rtol=1e-9, atol=1e-9 * np.abs(by_pairs).max())
+        # the periodic gathers add the same forces as the walled ones, bit for bit
+        force, torque = np.zeros_like(p.force), np.zeros_like(p.torque)
+        gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
+                              c.second_pair, force, torque)
+        gather_pair_forces(bridges.pair_forces(sim), c.row_start, c.second_start,
+                           c.second_pair, force)
+        np.testing.assert_allclose(p.force, force, rtol=0, atol=1e-12 * np.abs(force).max())
+        np.testing.assert_array_equal(p.torque, torque)
 
 
 class _NoForce:

@@ -18,8 +18,7 @@ import numba
 import numpy as np
 
 from dem.neighbors import branch_vector
-from dem.virial import (SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds, face_slots,
-                       is_periodic)
+from dem.virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds, face_slots
 
 from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
 from capillary.table import lookup_interface, lookup_suction
@@ -120,50 +119,62 @@ def refresh_contact_bridges(radius, pair_i, pair_j, state, volume, force, fillin
                              suction_axis, distance_low, log_distance_rupture, log_values)
 
 
+@numba.njit(cache=True, inline="always")
+def _add_contact_bridges(p, force, normal, row_start, second_start, second_pair, out):
+    """Add to ``out[p]`` its bridges' forces (+F n where p is i, -F n where p is j) in a fixed
+    order; return what was added."""
+    f0 = f1 = f2 = 0.0
+    for k in range(row_start[p], row_start[p + 1]):
+        f = force[k]
+        f0 += f * normal[k, 0]
+        f1 += f * normal[k, 1]
+        f2 += f * normal[k, 2]
+    for slot in range(second_start[p], second_start[p + 1]):
+        k = second_pair[slot]
+        f = force[k]
+        f0 -= f * normal[k, 0]
+        f1 -= f * normal[k, 1]
+        f2 -= f * normal[k, 2]
+    out[p, 0] += f0
+    out[p, 1] += f1
+    out[p, 2] += f2
+    return f0, f1, f2
+
+
 @numba.njit(cache=True, parallel=True)
-def gather_contact_bridges(force, normal, row_start, second_start, second_pair, out, position,
-                           image, through_face, period, virial):
+def gather_contact_bridges(force, normal, row_start, second_start, second_pair, out):
     """Add bridge forces of magnitude ``force`` (0 where no bridge) along the contact normals
-    (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction); in a periodic
-    cell also their Love–Weber sum of l (x) f to ``virial`` (as
-    dem.neighbors.gather_pair_forces).
+    (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction).
 
     Branch-free (a pair without bridge adds 0 x its normal); each particle sums its own pairs
-    in a fixed order, as dem.neighbors.gather_pair_forces: deterministic without atomics.
+    in a fixed order, as dem.neighbors.gather_pair_forces: deterministic without atomics. In a
+    periodic cell use gather_contact_bridges_virial.
     """
+    for p in numba.prange(len(row_start) - 1):
+        _add_contact_bridges(p, force, normal, row_start, second_start, second_pair, out)
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_contact_bridges_virial(force, normal, row_start, second_start, second_pair, out,
+                                  position, image, through_face, period, virial):
+    """gather_contact_bridges in a periodic cell, which also adds the bridges' Love–Weber sum
+    of l (x) f to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
     count = len(row_start) - 1
-    periodic = is_periodic(period)
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
         total = ZERO9
         for p in range(start, stop):
-            f0 = f1 = f2 = 0.0
-            for k in range(row_start[p], row_start[p + 1]):
-                f = force[k]
-                f0 += f * normal[k, 0]
-                f1 += f * normal[k, 1]
-                f2 += f * normal[k, 2]
-            for slot in range(second_start[p], second_start[p + 1]):
-                k = second_pair[slot]
-                f = force[k]
-                f0 -= f * normal[k, 0]
-                f1 -= f * normal[k, 1]
-                f2 -= f * normal[k, 2]
-            out[p, 0] += f0
-            out[p, 1] += f1
-            out[p, 2] += f2
-            if periodic:
-                total = add_outer(total, position[p, 0], position[p, 1], position[p, 2],
-                                  f0, f1, f2)
-        if periodic:
-            first, last = face_slots(through_face, row_start, start, stop)
-            for slot in range(first, last):
-                k = through_face[slot]
-                f = -force[k]           # the force on j from i is -F n
-                total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                                  image[k, 2] * period[2], f * normal[k, 0], f * normal[k, 1],
-                                  f * normal[k, 2])
-            add_to_block(virial, block, total)
+            f0, f1, f2 = _add_contact_bridges(p, force, normal, row_start, second_start,
+                                              second_pair, out)
+            total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
+        first, last = face_slots(through_face, row_start, start, stop)
+        for slot in range(first, last):
+            k = through_face[slot]
+            f = -force[k]           # the force on j from i is -F n
+            total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
+                              image[k, 2] * period[2], f * normal[k, 0], f * normal[k, 1],
+                              f * normal[k, 2])
+        add_to_block(virial, block, total)
 
 
 @numba.njit(cache=True, parallel=True)

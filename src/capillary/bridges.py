@@ -66,16 +66,17 @@ import math
 import numpy as np
 
 from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
-                                      gather_contact_bridges, pendular_overlap_counts,
-                                      refresh_contact_bridges, suction_bridges,
-                                      suction_interfaces, volume_bridges, volume_interfaces)
+                                      gather_contact_bridges, gather_contact_bridges_virial,
+                                      pendular_overlap_counts, refresh_contact_bridges,
+                                      suction_bridges, suction_interfaces, volume_bridges,
+                                      volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
                                   check_pendular_suction)
 from capillary.volume_table import VolumeBridgeTable
 from dem.contact_law import ContactForces
-from dem.neighbors import gather_pair_forces
+from dem.neighbors import gather_pair_forces, gather_pair_forces_virial
 from dem.validate import check_positive, check_range
 
 #: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
@@ -368,9 +369,14 @@ class CapillaryBridges:
             contact_bridges(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
                             b.filling_i, b.filling_j, self.suction, self.surface_tension,
                             *self._table_arrays)
-            gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
-                                   c.second_pair, p.force, p.position, c.image, c.through_face,
-                                   sim.walls.period, sim.walls.virial_blocks)
+            if sim.walls.periodic:
+                gather_contact_bridges_virial(b.force, c.normal, c.row_start, c.second_start,
+                                              c.second_pair, p.force, p.position, c.image,
+                                              c.through_face, sim.walls.period,
+                                              sim.walls.virial_blocks)
+            else:
+                gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
+                                       c.second_pair, p.force)
             return
         if self.control == "suction":
             suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period,
@@ -389,9 +395,13 @@ class CapillaryBridges:
                     self._events, self._released, c.row_start, c.second_start, c.second_pair,
                     p.radius, c.pair_i, c.pair_j, b.state, b.volume, self.film,
                     self.liquid == "shared", *self.volume_table.volume_star_bounds())
-        gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair, p.force,
-                           p.position, c.image, c.through_face, sim.walls.period,
-                           sim.walls.virial_blocks)
+        if sim.walls.periodic:
+            gather_pair_forces_virial(self.pair_force, c.row_start, c.second_start,
+                                      c.second_pair, p.force, p.position, c.image,
+                                      c.through_face, sim.walls.period, sim.walls.virial_blocks)
+        else:
+            gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair,
+                               p.force)
         if self.persist:
             self._bridges = b.count()
 

@@ -154,47 +154,63 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
         torque_j[k, 2] = lever_j * t2
 
 
+@numba.njit(cache=True, inline="always")
+def _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
+                        second_pair, force, torque):
+    """Add to ``force[p]``, ``torque[p]`` its pairs' results (-F and torque_i where p is i, +F
+    and torque_j where p is j) in a fixed order; return the force added."""
+    f0 = f1 = f2 = t0 = t1 = t2 = 0.0
+    for k in range(row_start[p], row_start[p + 1]):
+        f0 -= pair_force[k, 0]
+        f1 -= pair_force[k, 1]
+        f2 -= pair_force[k, 2]
+        t0 += pair_torque_i[k, 0]
+        t1 += pair_torque_i[k, 1]
+        t2 += pair_torque_i[k, 2]
+    for slot in range(second_start[p], second_start[p + 1]):
+        k = second_pair[slot]
+        f0 += pair_force[k, 0]
+        f1 += pair_force[k, 1]
+        f2 += pair_force[k, 2]
+        t0 += pair_torque_j[k, 0]
+        t1 += pair_torque_j[k, 1]
+        t2 += pair_torque_j[k, 2]
+    force[p, 0] += f0
+    force[p, 1] += f1
+    force[p, 2] += f2
+    torque[p, 0] += t0
+    torque[p, 1] += t1
+    torque[p, 2] += t2
+    return f0, f1, f2
+
+
 @numba.njit(cache=True, parallel=True)
 def gather_contact_forces(pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
-                          second_pair, force, torque, position, image, through_face,
-                          period, virial):
-    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j; in a
-    periodic cell also the Love–Weber sum of l (x) F to ``virial`` (as
-    dem.neighbors.gather_pair_forces)."""
+                          second_pair, force, torque):
+    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j. In a
+    periodic cell use gather_contact_forces_virial."""
+    for p in numba.prange(len(row_start) - 1):
+        _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j, row_start,
+                            second_start, second_pair, force, torque)
+
+
+@numba.njit(cache=True, parallel=True)
+def gather_contact_forces_virial(pair_force, pair_torque_i, pair_torque_j, row_start,
+                                 second_start, second_pair, force, torque, position, image,
+                                 through_face, period, virial):
+    """gather_contact_forces in a periodic cell, which also adds the Love–Weber sum of
+    l (x) F to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
     count = len(row_start) - 1
-    periodic = is_periodic(period)
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
         total = ZERO9
         for p in range(start, stop):
-            f0 = f1 = f2 = t0 = t1 = t2 = 0.0
-            for k in range(row_start[p], row_start[p + 1]):
-                f0 -= pair_force[k, 0]
-                f1 -= pair_force[k, 1]
-                f2 -= pair_force[k, 2]
-                t0 += pair_torque_i[k, 0]
-                t1 += pair_torque_i[k, 1]
-                t2 += pair_torque_i[k, 2]
-            for slot in range(second_start[p], second_start[p + 1]):
-                k = second_pair[slot]
-                f0 += pair_force[k, 0]
-                f1 += pair_force[k, 1]
-                f2 += pair_force[k, 2]
-                t0 += pair_torque_j[k, 0]
-                t1 += pair_torque_j[k, 1]
-                t2 += pair_torque_j[k, 2]
-            force[p, 0] += f0
-            force[p, 1] += f1
-            force[p, 2] += f2
-            torque[p, 0] += t0
-            torque[p, 1] += t1
-            torque[p, 2] += t2
-            if periodic:
-                total = add_outer(total, position[p, 0], position[p, 1], position[p, 2],
-                                  f0, f1, f2)
-        if periodic:
-            close_block(virial, block, total, through_face, row_start, start, stop, image,
-                        period, pair_force)
+            f0, f1, f2 = _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j,
+                                             row_start, second_start, second_pair, force,
+                                             torque)
+            total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
+        close_block(virial, block, total, through_face, row_start, start, stop, image, period,
+                    pair_force)
 
 
 @numba.njit(cache=True)
@@ -262,6 +278,11 @@ class ContactForces:
                     c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
                     c.normal_force, c.force, c.torque_i, c.torque_j, self.young,
                     self.shear_ratio, self._tan_friction, sim.dt)
-        gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
-                              c.second_pair, p.force, p.torque, p.position, c.image,
-                              c.through_face, box.period, box.virial_blocks)
+        if box.periodic:
+            gather_contact_forces_virial(c.force, c.torque_i, c.torque_j, c.row_start,
+                                         c.second_start, c.second_pair, p.force, p.torque,
+                                         p.position, c.image, c.through_face, box.period,
+                                         box.virial_blocks)
+        else:
+            gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
+                                  c.second_pair, p.force, p.torque)
