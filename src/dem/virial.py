@@ -10,8 +10,9 @@ already visits each particle, adds x_p (x) its share of F_p and then, for the pa
 face whose first member is in the block just gathered (a slice of Contacts.through_face, whose
 forces are still in cache), (image L) (x) f. Particles are split into SUM_BLOCKS fixed blocks;
 each block's sum is kept apart and the blocks are added in order (``sum_blocks``), so the
-result does not depend on the thread count. The virial costs a gather about 10 % (10,000
-spheres; testing each pair's image inside the pair loop instead cost 25 %).
+result does not depend on the thread count. Walled scenes use the gathers without it. At
+10,000 spheres the virial adds 40-80 us to a gather of 300-400 us (testing each pair's image
+inside the pair loop instead added about 90 us).
 """
 
 import numba
