@@ -7,10 +7,10 @@ For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, 
 .cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
 (suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
 four shears are timed in ``chunks`` alternating turns after ``warmup`` steps, so a change of
-machine load hits them alike (on the 2-core development VM the speed changes by up to 2x
-within minutes: use many short chunks). Prints particle-steps/s and the periodic / walled cost per particle-step; the
-JSON rows add the neighbour-list rebuilds and pairs per particle of each shear (a periodic
-sample has no loose wall layers, so more pairs per particle).
+machine load hits them alike (on the 2-core development VM the speed changes by up to 2x within
+minutes: use many short chunks). Prints particle-steps/s and the periodic / walled cost per
+particle-step; the JSON rows add the neighbour-list rebuilds and pairs per particle of each
+shear (a periodic sample has no loose wall layers, so more pairs per particle).
 """
 
 import argparse
