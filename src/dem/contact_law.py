@@ -9,7 +9,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block, is_periodic
+from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block
 
 
 @numba.njit(cache=True, inline="always")
@@ -44,7 +44,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     velocity using the radii as lever arms (YADE's avoidGranularRatcheting), and finally capped
     at Fn tan(phi), the elastic part being kept on the cap when sliding.
     """
-    periodic = is_periodic(period)
+    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]

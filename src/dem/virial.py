@@ -78,12 +78,6 @@ def add_to_block(sums, block, total):
         sums[block, c] += total[c]
 
 
-@numba.njit(cache=True, inline="always")
-def is_periodic(period):
-    """Whether ``period`` (3,) [m] is a periodic cell's (walls: zeros)."""
-    return period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
-
-
 @numba.njit(cache=True)
 def sum_blocks(sums):
     """Column sums of the per-block sums, block after block (the same order for any thread
