@@ -172,7 +172,7 @@ def test_a_checkpoint_of_version_1_is_refused_naming_its_version(tmp_path):
         handle.attrs["version"] = 1
         stamp(handle, {"kind": "checkpoint", "format": FORMAT, "version": 1})
     fresh = two_body_scene(*scene)
-    with pytest.raises(ValueError, match="checkpoint version 1; this code reads version 2"):
+    with pytest.raises(ValueError, match="checkpoint version 1; this code reads version 3"):
         load_checkpoint(path, fresh)
     assert fresh.step == 0 and fresh.contacts is None
 

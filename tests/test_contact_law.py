@@ -111,3 +111,22 @@ def test_normal_stiffness_of_unequal_spheres():
     assert normal_stiffness(YOUNG, RADIUS, 2 * RADIUS) == pytest.approx(4.0 / 3.0 * YOUNG * RADIUS)
     assert sim.contacts.normal_force[0] == pytest.approx(expected, rel=1e-6)
     assert sim.particles.force[1, 0] == pytest.approx(expected, rel=1e-6)
+
+
+def test_contact_torques_act_at_the_middle_of_the_overlap():
+    """Spheres of radii R and 2 R overlapping by d with a shear force Fs (along y, normal along
+    x): the force acts at the middle of the overlap, so the torque on each is
+    -(r - d / 2) n x Fs, and the pair's moments about the origin cancel."""
+    overlap, shear = 1e-6, 1e-4
+    radius = np.array([RADIUS, 2 * RADIUS])
+    sim = two_body_scene([[0, 0, 0], [3 * RADIUS - overlap, 0, 0]], np.zeros((2, 3)),
+                         radius=radius, friction_deg=60.0)
+    sim.evaluate_forces()                       # the pair's normal is now current
+    sim.contacts.shear_force[0] = [0.0, shear, 0.0]
+    sim.evaluate_forces()
+    p = sim.particles
+    for member in (0, 1):
+        expected = -(radius[member] - 0.5 * overlap) * np.cross([1.0, 0, 0], [0, shear, 0])
+        np.testing.assert_allclose(p.torque[member], expected, rtol=1e-12, atol=0)
+    moment = p.torque.sum(axis=0) + np.cross(p.position, p.force).sum(axis=0)
+    assert np.abs(moment).max() < 1e-12 * RADIUS * shear

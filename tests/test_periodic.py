@@ -248,8 +248,8 @@ def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persis
                                    rtol=1e-9, atol=1e-9 * np.abs(by_pairs).max())
         # the periodic gathers add the walled ones' forces (torques bit for bit)
         force, torque = np.zeros_like(p.force), np.zeros_like(p.torque)
-        gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
-                              c.second_pair, force, torque)
+        gather_contact_forces(c.force, c.normal, c.overlap, p.radius, c.row_start,
+                              c.second_start, c.second_pair, force, torque)
         gather_pair_forces(bridges.pair_forces(sim), c.row_start, c.second_start,
                            c.second_pair, force)
         np.testing.assert_allclose(p.force, force, rtol=0, atol=1e-12 * np.abs(force).max())

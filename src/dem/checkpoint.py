@@ -28,8 +28,8 @@ to the loaded simulation's objects, so an operation that caches ``sim.contacts``
 
 ``load_checkpoint`` restores into a simulation built the same way (same operation types in
 the same places, in the same order; the scene's closures are not saved) and raises ValueError
-otherwise; a checkpoint of another format version (1: before the declared pipeline) is
-refused with its version.
+otherwise; a checkpoint of another format version (1: before the declared pipeline; 2:
+with per-pair torques, which the contact law no longer stores) is refused with its version.
 The file is written under a temporary name, flushed to disk (fsync) and renamed over the
 previous checkpoint, so a run killed at any moment (kill -9 included) leaves the previous
 checkpoint intact. Checkpoints hold pickles: load only files you trust.
@@ -49,7 +49,7 @@ from .neighbors import Contacts
 from .validate import check_int, reading
 
 FORMAT = "pendular-checkpoint"
-VERSION = 2
+VERSION = 3
 _SCALARS = (bool, int, float, str, np.generic)
 
 #: Units and description of the datasets of a checkpoint, by group (dataset attributes).
@@ -82,8 +82,6 @@ DATASETS = {
         "overlap": ("m", "r_i + r_j - |x_j - x_i| (negative: gap)"),
         "normal_force": ("N", "magnitude of the spring normal force (0 when apart)"),
         "force": ("N", "total contact force on j from i (K, 3)"),
-        "torque_i": ("N m", "contact torque on i (K, 3)"),
-        "torque_j": ("N m", "contact torque on j (K, 3)"),
         "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L"),
         "through_face": ("1", "the pairs whose image is not zero (through a periodic face)")},
     "": {"state": ("1", "pickled state of every operation and writer and the caller's "
@@ -293,7 +291,8 @@ def load_checkpoint(path, sim, expected_identity=None):
         if int(handle.attrs["version"]) != VERSION:
             raise ValueError(f"{path!r} has checkpoint version {handle.attrs['version']}; "
                              f"this code reads version {VERSION} only (version 1 was written "
-                             "before the declared pipeline): restart the run from its sample")
+                             "before the declared pipeline, 2 with per-pair torques): restart "
+                             "the run from its sample")
         _check_types(handle, sim)
         particle_arrays = _read_group(handle["particles"])
         particle_scalars = dict(handle["particles"].attrs)

@@ -28,9 +28,10 @@ def wall_contact_stiffness(young, radius):
 
 @numba.njit(cache=True, parallel=True)
 def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, image, period,
-                affine_rate, shear_force, normal, overlap, normal_force, force, torque_i,
-                torque_j, young, shear_ratio, tan_friction, dt):
-    """Evaluate every candidate pair; fill the per-pair arrays (force on j from i, torques).
+                affine_rate, shear_force, normal, overlap, normal_force, force, young,
+                shear_ratio, tan_friction, dt):
+    """Evaluate every candidate pair; fill the per-pair arrays (``force``: the force on j from
+    i; the torques follow from it, the normal and the overlap in the gather).
 
     image, period: each pair's periodic image and the box period (dem.neighbors.branch_vector;
     zeros inside walls); affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell,
@@ -73,8 +74,6 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
             for c in range(3):
                 shear_force[k, c] = 0.0
                 force[k, c] = 0.0
-                torque_i[k, c] = 0.0
-                torque_j[k, c] = 0.0
             continue
         n0 = d0 / distance
         n1 = d1 / distance
@@ -140,41 +139,53 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
         force[k, 0] = fn * n0 + fs0
         force[k, 1] = fn * n1 + fs1
         force[k, 2] = fn * n2 + fs2
-        # torques of the shear force about each centre, applied at the middle of the overlap
-        t0 = n1 * fs2 - n2 * fs1
-        t1 = n2 * fs0 - n0 * fs2
-        t2 = n0 * fs1 - n1 * fs0
-        lever_i = -(ri - 0.5 * gap_overlap)
-        lever_j = -(rj - 0.5 * gap_overlap)
-        torque_i[k, 0] = lever_i * t0
-        torque_i[k, 1] = lever_i * t1
-        torque_i[k, 2] = lever_i * t2
-        torque_j[k, 0] = lever_j * t0
-        torque_j[k, 1] = lever_j * t1
-        torque_j[k, 2] = lever_j * t2
 
 
 @numba.njit(cache=True, inline="always")
-def _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
+def _contact_torque(normal, overlap, k, radius_p, a0, a1, a2):
+    """Torque [N m] on a member of radius ``radius_p`` of pair k from the pair's force a (on j
+    from i): -(radius_p - overlap_k / 2) n_k x a (_add_contact_forces)."""
+    lever = 0.5 * overlap[k] - radius_p
+    return (lever * (normal[k, 1] * a2 - normal[k, 2] * a1),
+            lever * (normal[k, 2] * a0 - normal[k, 0] * a2),
+            lever * (normal[k, 0] * a1 - normal[k, 1] * a0))
+
+
+@numba.njit(cache=True, inline="always")
+def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
                         second_pair, force, torque):
-    """Add to ``force[p]``, ``torque[p]`` its pairs' results (-F and torque_i where p is i, +F
-    and torque_j where p is j) in a fixed order; return the force added."""
+    """Add to ``force[p]``, ``torque[p]`` its pairs' contact forces in a fixed order (-F where p
+    is i, +F where p is j; F the force on j from i) and their torques; return the force added.
+
+    F acts at the middle of the overlap, r_p - overlap / 2 from p's centre along +n (p is i,
+    force -F) or -n (p is j, force +F): either way its torque on p is
+    -(r_p - overlap / 2) n x F, which is n x (shear force) since n x n = 0 (YADE's
+    Law2_ScGeom_FrictPhys_CundallStrack). overlap and normal: this step's (pair_forces)."""
     f0 = f1 = f2 = t0 = t1 = t2 = 0.0
+    r = radius[p]
     for k in range(row_start[p], row_start[p + 1]):
-        f0 -= pair_force[k, 0]
-        f1 -= pair_force[k, 1]
-        f2 -= pair_force[k, 2]
-        t0 += pair_torque_i[k, 0]
-        t1 += pair_torque_i[k, 1]
-        t2 += pair_torque_i[k, 2]
+        a0 = pair_force[k, 0]
+        a1 = pair_force[k, 1]
+        a2 = pair_force[k, 2]
+        f0 -= a0
+        f1 -= a1
+        f2 -= a2
+        m0, m1, m2 = _contact_torque(normal, overlap, k, r, a0, a1, a2)
+        t0 += m0
+        t1 += m1
+        t2 += m2
     for slot in range(second_start[p], second_start[p + 1]):
         k = second_pair[slot]
-        f0 += pair_force[k, 0]
-        f1 += pair_force[k, 1]
-        f2 += pair_force[k, 2]
-        t0 += pair_torque_j[k, 0]
-        t1 += pair_torque_j[k, 1]
-        t2 += pair_torque_j[k, 2]
+        a0 = pair_force[k, 0]
+        a1 = pair_force[k, 1]
+        a2 = pair_force[k, 2]
+        f0 += a0
+        f1 += a1
+        f2 += a2
+        m0, m1, m2 = _contact_torque(normal, overlap, k, r, a0, a1, a2)
+        t0 += m0
+        t1 += m1
+        t2 += m2
     force[p, 0] += f0
     force[p, 1] += f1
     force[p, 2] += f2
@@ -185,19 +196,19 @@ def _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j, row_start, 
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_contact_forces(pair_force, pair_torque_i, pair_torque_j, row_start, second_start,
+def gather_contact_forces(pair_force, normal, overlap, radius, row_start, second_start,
                           second_pair, force, torque):
-    """Add per-pair results to particles: -F and torque_i to i, +F and torque_j to j. In a
+    """Add the contact forces and their torques to particles (_add_contact_forces). In a
     periodic cell use gather_contact_forces_virial."""
     for p in numba.prange(len(row_start) - 1):
-        _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j, row_start,
-                            second_start, second_pair, force, torque)
+        _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
+                            second_pair, force, torque)
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_contact_forces_virial(pair_force, pair_torque_i, pair_torque_j, row_start,
-                                 second_start, second_pair, force, torque, position, image,
-                                 through_face, period, virial):
+def gather_contact_forces_virial(pair_force, normal, overlap, radius, row_start, second_start,
+                                 second_pair, force, torque, position, image, through_face,
+                                 period, virial):
     """gather_contact_forces in a periodic cell, which also adds the Love–Weber sum of
     l (x) F to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
     count = len(row_start) - 1
@@ -205,9 +216,8 @@ def gather_contact_forces_virial(pair_force, pair_torque_i, pair_torque_j, row_s
         start, stop = block_bounds(count, block)
         total = ZERO9
         for p in range(start, stop):
-            f0, f1, f2 = _add_contact_forces(p, pair_force, pair_torque_i, pair_torque_j,
-                                             row_start, second_start, second_pair, force,
-                                             torque)
+            f0, f1, f2 = _add_contact_forces(p, pair_force, normal, overlap, radius, row_start,
+                                             second_start, second_pair, force, torque)
             total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
         close_block(virial, block, total, through_face, row_start, start, stop, image, period,
                     pair_force)
@@ -276,13 +286,13 @@ class ContactForces:
         box = sim.walls
         pair_forces(p.position, p.velocity, p.angular_velocity, p.radius, c.pair_i, c.pair_j,
                     c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
-                    c.normal_force, c.force, c.torque_i, c.torque_j, self.young,
-                    self.shear_ratio, self._tan_friction, sim.dt)
+                    c.normal_force, c.force, self.young, self.shear_ratio, self._tan_friction,
+                    sim.dt)
         if box.periodic:
-            gather_contact_forces_virial(c.force, c.torque_i, c.torque_j, c.row_start,
+            gather_contact_forces_virial(c.force, c.normal, c.overlap, p.radius, c.row_start,
                                          c.second_start, c.second_pair, p.force, p.torque,
                                          p.position, c.image, c.through_face, box.period,
                                          box.virial_blocks)
         else:
-            gather_contact_forces(c.force, c.torque_i, c.torque_j, c.row_start, c.second_start,
-                                  c.second_pair, p.force, p.torque)
+            gather_contact_forces(c.force, c.normal, c.overlap, p.radius, c.row_start,
+                                  c.second_start, c.second_pair, p.force, p.torque)

@@ -29,7 +29,7 @@ class Contacts:
     normal: (K, 3) unit vector i -> j at the last force evaluation (for rotating shear_force).
     overlap: (K,) r_i + r_j - |x_j - x_i| at the last evaluation [m] (negative = gap).
     normal_force: (K,) magnitude of the spring's normal force [N] (0 when apart).
-    force: (K, 3) total contact force on j from i [N]; torque_i, torque_j: (K, 3) [N m].
+    force: (K, 3) total contact force on j from i [N] (its torques: dem.contact_law).
     extra: name -> (K, ...) per-pair state owned by other operations (e.g. capillary bridges),
     carried to the same pair by ``build_contacts``; absent pairs start at 0.
     image: (K, 3) int8 periodic image of j seen from i: the branch vector is
@@ -47,8 +47,6 @@ class Contacts:
     overlap: np.ndarray
     normal_force: np.ndarray
     force: np.ndarray
-    torque_i: np.ndarray
-    torque_j: np.ndarray
     extra: dict = field(default_factory=dict)
     image: np.ndarray = None
     through_face: np.ndarray = None
@@ -495,8 +493,7 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         shear_force=np.ascontiguousarray(history[:, :3]),
         normal=np.ascontiguousarray(history[:, 3:6]),
         overlap=np.ascontiguousarray(history[:, 6]), normal_force=np.zeros(size),
-        force=np.zeros((size, 3)), torque_i=np.zeros((size, 3)), torque_j=np.zeros((size, 3)),
-        extra=extra, image=image)
+        force=np.zeros((size, 3)), extra=extra, image=image)
 
 
 #: The lengths moved_beyond compares in walled scenes: no stretching (NeighborList.apply).
