@@ -105,7 +105,7 @@ def time_yade(config, particles, walls, threads, steps, warmup, dt, rate, suctio
             "friction_deg": config.friction_deg, "density": config.density,
             "damping": config.damping, "dt": dt, "confining": config.confining,
             "strain_rate": rate, "steps": steps, "warmup_steps": warmup,
-            "record_every": steps, "skin": config.skin_factor * config.radius}
+            "record_every": steps}
         if suction:
             settings["capillary"] = {"suction": suction, "files": files,
                                      "surface_tension": SURFACE_TENSION}

@@ -59,7 +59,7 @@ def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
             "friction_deg": config.friction_deg, "density": config.density,
             "damping": config.damping, "dt": dt, "confining": config.confining,
             "strain_rate": rate, "steps": steps, "warmup_steps": warmup,
-            "record_every": steps, "skin": config.skin_factor * config.radius}, threads=threads)
+            "record_every": steps}, threads=threads)
     return result
 
 

@@ -263,7 +263,9 @@ class PrepareConfig:
     ``periodic``: the sample fills a periodic cell (dem.cell) instead of a box of six walls.
     The time step is ``timestep_safety`` times the estimate of ``timestep_rule`` (``timestep``):
     'pwave', YADE's P-wave estimate of the smallest sphere; 'stiffness', the critical step of
-    the contacts (dem.timestep).
+    the contacts (dem.timestep). ``skin_factor``: the neighbour list's Verlet skin / mean
+    radius, a speed knob only (results are bit-identical for any skin); 0.1 shears 5-8 %
+    faster than 0.3 at 1,000 and 10,000 spheres (fewer pairs, still rare rebuilds).
     """
 
     particles: int = 10000
@@ -282,7 +284,7 @@ class PrepareConfig:
     prep_stress: float = 5000.0
     confining: float = 750.0
     seed: int = 0
-    skin_factor: float = 0.3
+    skin_factor: float = 0.1
     equilibrium_unbalanced: float = 0.01
     stress_tolerance: float = 0.01
     unload_steps: int = 10000
@@ -435,6 +437,12 @@ def rescale(sim, factor):
     sim.operation(NeighborList).rebuild(sim)
 
 
+#: Least Verlet skin / radius of the radius growth, whose every sphere grows each step: the
+#: list is rebuilt as the surfaces move, so a thicker skin than the test's pays there (1,000
+#: spheres prepared in 3.3 s with 0.3 R, 3.8-4.7 s with 0.1 R). Results do not depend on it.
+GROWTH_SKIN_FACTOR = 0.3
+
+
 def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, writers=()):
     """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
 
@@ -469,8 +477,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     if config.timestep_rule == "stiffness":
         growth.append(GrowthTimeStep(config))
     sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
-                         config.skin_factor * config.radius, config.prep_friction_deg, growth,
-                         threads)
+                         max(config.skin_factor, GROWTH_SKIN_FACTOR) * config.radius,
+                         config.prep_friction_deg, growth, threads)
     writers = list(writers)
     sim.writers.extend(writers)
     done = equilibrated(config)
@@ -490,6 +498,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
                                "grow radii", status=status)}
     _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
+    sim.neighbors.skin = config.skin_factor * config.radius
     servo = StressServo("xyz", config.prep_stress, max_velocity=servo_speed(sim.walls, sim.dt))
     sim.controls = [servo]
     sim.dt = timestep(sim, config)

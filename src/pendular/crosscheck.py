@@ -239,7 +239,6 @@ def yade_settings(config, packing, sim, shear, folder):
         "strain_rate": shear.rate, "steps": yade_axial.steps_to(config.shear.max_strain, sim.dt),
         "periodic": sample.periodic,
         "warmup_steps": 0, "record_every": shear.recorder.period, "record_initial": True,
-        "skin": sample.skin_factor * sample.radius,
         "stress_damping": 1.0 - lateral.gain, "strain_damping": 0.0,
         "max_vel": lateral.max_velocity,
         "history": os.path.join(folder, "yade_history.txt"),

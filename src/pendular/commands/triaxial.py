@@ -93,7 +93,7 @@ def add_arguments(parser):
     parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="pwave",
                         help="time step estimate: the P-wave estimate of the smallest sphere, "
                              "or the critical step of the contacts (dem.timestep)")
-    parser.add_argument("--skin-factor", type=float, default=0.3,
+    parser.add_argument("--skin-factor", type=float, default=0.1,
                         help="Verlet skin of the neighbour list / radius (0, 2]")
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
                         help="bridge table nodes in suction and in distance (exact default "
