@@ -462,46 +462,59 @@ def volume_interfaces(position, radius, pair_i, pair_j, image, period, state, in
     return out
 
 
+@numba.njit(cache=True, inline="always")
+def _meniscus_caps(p, position, row_start, second_start, second_pair, pair_i, pair_j, image,
+                   period, state, filling_i, filling_j, caps):
+    """Write into the rows of ``caps`` the menisci of particle p: the unit direction from p to
+    the other sphere, the cosine and the sine of p's filling angle. Returns how many."""
+    first = row_start[p + 1] - row_start[p]
+    found = 0
+    for slot in range(first + second_start[p + 1] - second_start[p]):
+        if slot < first:
+            k = row_start[p] + slot
+            sign = 1.0
+            cap = filling_i[k]
+        else:
+            k = second_pair[second_start[p] + slot - first]
+            sign = -1.0
+            cap = filling_j[k]
+        if state[k] == NO_BRIDGE:
+            continue
+        d0, d1, d2 = branch_vector(position, pair_i[k], pair_j[k], image, k, period)
+        scale = sign / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        caps[found, 0] = d0 * scale
+        caps[found, 1] = d1 * scale
+        caps[found, 2] = d2 * scale
+        caps[found, 3] = math.cos(math.radians(cap))
+        caps[found, 4] = math.sin(math.radians(cap))
+        found += 1
+    return found
+
+
 @numba.njit(cache=True, parallel=True)
 def pendular_overlap_counts(position, row_start, second_start, second_pair, pair_i, pair_j,
                             image, period, state, filling_i, filling_j):
     """Per particle, the number of pairs of its menisci that overlap (SPEC section 4 pendular
     limit): two wetted caps whose normals are separated by less than the sum of their filling
-    angles (YADE's Law2_ScGeom_CapillaryPhys_Capillarity fusion test)."""
+    angles a + b (YADE's Law2_ScGeom_CapillaryPhys_Capillarity fusion test), i.e. whose
+    normals' dot product exceeds cos(a + b) (filling angles at most 90 deg: a + b <= 180 deg,
+    where the arc cosine falls). Each block of particles has its own scratch rows."""
     count = len(row_start) - 1
     overlaps = np.zeros(count, np.int64)
-    for p in numba.prange(count):
-        size = row_start[p + 1] - row_start[p] + second_start[p + 1] - second_start[p]
-        direction = np.empty((size, 3))
-        angle = np.empty(size)
-        found = 0
-        for slot in range(size):
-            if slot < row_start[p + 1] - row_start[p]:
-                k = row_start[p] + slot
-                sign = 1.0
-                cap = filling_i[k]
-            else:
-                k = second_pair[second_start[p] + slot - (row_start[p + 1] - row_start[p])]
-                sign = -1.0
-                cap = filling_j[k]
-            if state[k] == NO_BRIDGE:
-                continue
-            d0, d1, d2 = branch_vector(position, pair_i[k], pair_j[k], image, k, period)
-            direction[found, 0] = sign * d0
-            direction[found, 1] = sign * d1
-            direction[found, 2] = sign * d2
-            length = 0.0
-            for c in range(3):
-                length += direction[found, c] ** 2
-            length = math.sqrt(length)
-            for c in range(3):
-                direction[found, c] /= length
-            angle[found] = math.radians(cap)
-            found += 1
-        for a in range(found):
-            for b in range(a + 1, found):
-                cosine = (direction[a, 0] * direction[b, 0] + direction[a, 1] * direction[b, 1]
-                          + direction[a, 2] * direction[b, 2])
-                if math.acos(min(max(cosine, -1.0), 1.0)) < angle[a] + angle[b]:
-                    overlaps[p] += 1
+    widest = 0
+    for p in range(count):
+        widest = max(widest, row_start[p + 1] - row_start[p] + second_start[p + 1]
+                     - second_start[p])
+    for block in numba.prange(SUM_BLOCKS):
+        start, stop = block_bounds(count, block)
+        caps = np.empty((widest, 5))
+        for p in range(start, stop):
+            found = _meniscus_caps(p, position, row_start, second_start, second_pair, pair_i,
+                                   pair_j, image, period, state, filling_i, filling_j, caps)
+            for a in range(found):
+                for b in range(a + 1, found):
+                    cosine = (caps[a, 0] * caps[b, 0] + caps[a, 1] * caps[b, 1]
+                              + caps[a, 2] * caps[b, 2])
+                    if cosine > caps[a, 3] * caps[b, 3] - caps[a, 4] * caps[b, 4]:
+                        overlaps[p] += 1
     return overlaps
