@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from dem.neighbors import branch_vector
-from dem.virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds, face_slots
+from dem.virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds
 
 from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
 from capillary.table import lookup_interface, lookup_suction
@@ -156,7 +156,7 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 
 @numba.njit(cache=True, parallel=True)
 def gather_contact_bridges_virial(force, normal, row_start, second_start, second_pair, out,
-                                  position, image, through_face, period, virial):
+                                  position, image, through_face, face_start, period, virial):
     """gather_contact_bridges in a periodic cell, which also adds the bridges' Love–Weber sum
     of l (x) f to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
     count = len(row_start) - 1
@@ -167,8 +167,7 @@ def gather_contact_bridges_virial(force, normal, row_start, second_start, second
             f0, f1, f2 = _add_contact_bridges(p, force, normal, row_start, second_start,
                                               second_pair, out)
             total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
-        first, last = face_slots(through_face, row_start, start, stop)
-        for slot in range(first, last):
+        for slot in range(face_start[block], face_start[block + 1]):
             k = through_face[slot]
             f = -force[k]           # the force on j from i is -F n
             total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],

@@ -372,7 +372,7 @@ class CapillaryBridges:
             if sim.walls.periodic:
                 gather_contact_bridges_virial(b.force, c.normal, c.row_start, c.second_start,
                                               c.second_pair, p.force, p.position, c.image,
-                                              c.through_face, sim.walls.period,
+                                              c.through_face, c.face_start, sim.walls.period,
                                               sim.walls.virial_blocks)
             else:
                 gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
@@ -398,7 +398,8 @@ class CapillaryBridges:
         if sim.walls.periodic:
             gather_pair_forces_virial(self.pair_force, c.row_start, c.second_start,
                                       c.second_pair, p.force, p.position, c.image,
-                                      c.through_face, sim.walls.period, sim.walls.virial_blocks)
+                                      c.through_face, c.face_start, sim.walls.period,
+                                      sim.walls.virial_blocks)
         else:
             gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair,
                                p.force)

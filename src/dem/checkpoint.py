@@ -83,7 +83,9 @@ DATASETS = {
         "normal_force": ("N", "magnitude of the spring normal force (0 when apart)"),
         "force": ("N", "total contact force on j from i (K, 3)"),
         "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L"),
-        "through_face": ("1", "the pairs whose image is not zero (through a periodic face)")},
+        "through_face": ("1", "the pairs whose image is not zero (through a periodic face)"),
+        "face_start": ("1", "where each block of particles' share of through_face starts "
+                            "(dem.virial.face_block_starts)")},
     "": {"state": ("1", "pickled state of every operation and writer and the caller's "
                         "extra_state (bytes; see dem.checkpoint)")},
 }

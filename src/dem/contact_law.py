@@ -208,7 +208,7 @@ def gather_contact_forces(pair_force, normal, overlap, radius, row_start, second
 @numba.njit(cache=True, parallel=True)
 def gather_contact_forces_virial(pair_force, normal, overlap, radius, row_start, second_start,
                                  second_pair, force, torque, position, image, through_face,
-                                 period, virial):
+                                 face_start, period, virial):
     """gather_contact_forces in a periodic cell, which also adds the Love–Weber sum of
     l (x) F to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
     count = len(row_start) - 1
@@ -219,8 +219,7 @@ def gather_contact_forces_virial(pair_force, normal, overlap, radius, row_start,
             f0, f1, f2 = _add_contact_forces(p, pair_force, normal, overlap, radius, row_start,
                                              second_start, second_pair, force, torque)
             total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
-        close_block(virial, block, total, through_face, row_start, start, stop, image, period,
-                    pair_force)
+        close_block(virial, block, total, through_face, face_start, image, period, pair_force)
 
 
 @numba.njit(cache=True)
@@ -300,8 +299,8 @@ class ContactForces:
         if box.periodic:
             gather_contact_forces_virial(c.force, c.normal, c.overlap, p.radius, c.row_start,
                                          c.second_start, c.second_pair, p.force, p.torque,
-                                         p.position, c.image, c.through_face, box.period,
-                                         box.virial_blocks)
+                                         p.position, c.image, c.through_face, c.face_start,
+                                         box.period, box.virial_blocks)
         else:
             gather_contact_forces(c.force, c.normal, c.overlap, p.radius, c.row_start,
                                   c.second_start, c.second_pair, p.force, p.torque)

@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block
+from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block, face_block_starts
 
 
 @dataclass
@@ -34,7 +34,9 @@ class Contacts:
     carried to the same pair by ``build_contacts``; absent pairs start at 0.
     image: (K, 3) int8 periodic image of j seen from i: the branch vector is
     x_j - x_i + image * period (``branch_vector``; zeros inside walls);
-    through_face: (F,) int64 the pairs whose image is not zero, in pair order.
+    through_face: (F,) int64 the pairs whose image is not zero, in pair order; face_start:
+    (SUM_BLOCKS + 1,) int64 where each block of particles' share of them starts
+    (dem.virial.face_block_starts).
     """
 
     pair_i: np.ndarray
@@ -50,12 +52,15 @@ class Contacts:
     extra: dict = field(default_factory=dict)
     image: np.ndarray = None
     through_face: np.ndarray = None
+    face_start: np.ndarray = None
 
     def __post_init__(self):
         if self.image is None:
             self.image = np.zeros((len(self.pair_j), 3), np.int8)
         if self.through_face is None:
             self.through_face = np.flatnonzero(self.image.any(axis=1)).astype(np.int64)
+        if self.face_start is None:
+            self.face_start = face_block_starts(self.through_face, self.row_start)
 
     def __len__(self):
         return len(self.pair_i)
@@ -391,7 +396,7 @@ def gather_pair_forces(pair_force, row_start, second_start, second_pair, out):
 
 @numba.njit(cache=True, parallel=True)
 def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, out, position,
-                              image, through_face, period, virial):
+                              image, through_face, face_start, period, virial):
     """gather_pair_forces in a periodic cell, which also adds the forces' Love–Weber sum of
     l (x) f [N m] to ``virial`` (SUM_BLOCKS, 9), block by block (dem.virial). A kernel apart:
     the blocked loop in the walled kernel, even behind a branch, cost walls 5-15 %."""
@@ -403,8 +408,7 @@ def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, 
             v0, v1, v2 = _add_pair_forces(p, pair_force, row_start, second_start, second_pair,
                                           out)
             total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], v0, v1, v2)
-        close_block(virial, block, total, through_face, row_start, start, stop, image, period,
-                    pair_force)
+        close_block(virial, block, total, through_face, face_start, image, period, pair_force)
 
 
 def branch_vectors(position, contacts, period, index=None):

@@ -7,8 +7,8 @@ The sum over the pairs of l (x) f (l the branch vector i -> j, f the force on j 
 
 (l = x_j - x_i + image L, F_p the resultant of p's pair forces): a force's gather, which
 already visits each particle, adds x_p (x) its share of F_p and then, for the pairs through a
-face whose first member is in the block just gathered (a slice of Contacts.through_face, whose
-forces are still in cache), (image L) (x) f. Particles are split into SUM_BLOCKS fixed blocks;
+face whose first member is in the block just gathered (a slice of Contacts.through_face, from
+Contacts.face_start; their forces are still in cache), (image L) (x) f. Particles are split into SUM_BLOCKS fixed blocks;
 each block's sum is kept apart and the blocks are added in order (``sum_blocks``), so the
 result does not depend on the thread count. Walled scenes use the gathers without it. At
 10,000 spheres the virial adds 40-80 us to a gather of 300-400 us (testing each pair's image
@@ -41,12 +41,13 @@ def add_outer(total, a0, a1, a2, b0, b1, b2):
             total[6] + a2 * b0, total[7] + a2 * b1, total[8] + a2 * b2)
 
 
-@numba.njit(cache=True, inline="always")
-def face_slots(through_face, row_start, start, stop):
-    """First and one-past-last slot of ``through_face`` (sorted pair indices) holding pairs
-    whose first member is one of the particles start .. stop - 1 (CSR ``row_start``)."""
-    return (np.searchsorted(through_face, row_start[start]),
-            np.searchsorted(through_face, row_start[stop]))
+def face_block_starts(through_face, row_start):
+    """(SUM_BLOCKS + 1,) int64: the pairs through a face whose first member lies in block b of
+    the particles (block_bounds) are through_face[starts[b]:starts[b + 1]] (``through_face``
+    sorted pair indices, CSR ``row_start``). Computed once per neighbour list."""
+    count = len(row_start) - 1
+    firsts = row_start[[count * block // SUM_BLOCKS for block in range(SUM_BLOCKS + 1)]]
+    return np.searchsorted(through_face, firsts).astype(np.int64)
 
 
 @numba.njit(cache=True, inline="always")
@@ -62,13 +63,13 @@ def add_face_forces(total, through_face, first, last, image, period, pair_force)
 
 
 @numba.njit(cache=True, inline="always")
-def close_block(virial, block, total, through_face, row_start, start, stop, image, period,
-                pair_force):
+def close_block(virial, block, total, through_face, face_start, image, period, pair_force):
     """Add to row ``block`` of ``virial`` the block's sum ``total`` (its particles' x_p (x)
-    F_p) and the face terms of its pairs through a face (add_face_forces)."""
-    first, last = face_slots(through_face, row_start, start, stop)
-    add_to_block(virial, block, add_face_forces(total, through_face, first, last, image,
-                                                period, pair_force))
+    F_p) and the face terms of its pairs through a face (add_face_forces; ``face_start``:
+    face_block_starts)."""
+    add_to_block(virial, block, add_face_forces(total, through_face, face_start[block],
+                                                face_start[block + 1], image, period,
+                                                pair_force))
 
 
 @numba.njit(cache=True, inline="always")
