@@ -122,7 +122,7 @@ def refresh_contact_bridges(radius, pair_i, pair_j, state, volume, force, fillin
 @numba.njit(cache=True, inline="always")
 def _add_contact_bridges(p, force, normal, row_start, second_start, second_pair, out):
     """Add to ``out[p]`` its bridges' forces (+F n where p is i, -F n where p is j) in a fixed
-    order; return what was added."""
+    order."""
     f0 = f1 = f2 = 0.0
     for k in range(row_start[p], row_start[p + 1]):
         f = force[k]
@@ -138,7 +138,6 @@ def _add_contact_bridges(p, force, normal, row_start, second_start, second_pair,
     out[p, 0] += f0
     out[p, 1] += f1
     out[p, 2] += f2
-    return f0, f1, f2
 
 
 @numba.njit(cache=True, parallel=True)
@@ -156,17 +155,16 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 
 @numba.njit(cache=True, parallel=True)
 def gather_contact_bridges_virial(force, normal, row_start, second_start, second_pair, out,
-                                  position, image, through_face, face_start, period, virial):
-    """gather_contact_bridges in a periodic cell, which also adds the bridges' Love–Weber sum
-    of l (x) f to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
+                                  image, through_face, face_start, period, virial):
+    """gather_contact_bridges in a periodic cell, which also adds the face terms of the
+    bridges' Love–Weber sum to ``virial`` (as dem.virial.add_face_block, the force on j from
+    i being -F n)."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
-        total = ZERO9
         for p in range(start, stop):
-            f0, f1, f2 = _add_contact_bridges(p, force, normal, row_start, second_start,
-                                              second_pair, out)
-            total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
+            _add_contact_bridges(p, force, normal, row_start, second_start, second_pair, out)
+        total = ZERO9
         for slot in range(face_start[block], face_start[block + 1]):
             k = through_face[slot]
             f = -force[k]           # the force on j from i is -F n

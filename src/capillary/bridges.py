@@ -371,8 +371,8 @@ class CapillaryBridges:
                             *self._table_arrays)
             if sim.walls.periodic:
                 gather_contact_bridges_virial(b.force, c.normal, c.row_start, c.second_start,
-                                              c.second_pair, p.force, p.position, c.image,
-                                              c.through_face, c.face_start, sim.walls.period,
+                                              c.second_pair, p.force, c.image, c.through_face,
+                                              c.face_start, sim.walls.period,
                                               sim.walls.virial_blocks)
             else:
                 gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
@@ -397,9 +397,8 @@ class CapillaryBridges:
                     self.liquid == "shared", *self.volume_table.volume_star_bounds())
         if sim.walls.periodic:
             gather_pair_forces_virial(self.pair_force, c.row_start, c.second_start,
-                                      c.second_pair, p.force, p.position, c.image,
-                                      c.through_face, c.face_start, sim.walls.period,
-                                      sim.walls.virial_blocks)
+                                      c.second_pair, p.force, c.image, c.through_face,
+                                      c.face_start, sim.walls.period, sim.walls.virial_blocks)
         else:
             gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair,
                                p.force)

@@ -12,7 +12,8 @@ rate * l to the relative velocity of a pair of branch vector l (YADE's periodic 
 
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
-each step from the sums that the forces' gathers add to ``virial_blocks`` (dem.virial). The
+each step from the particles' forces and the face terms that the forces' gathers add to
+``virial_blocks`` (dem.virial). The
 stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
 unit strain] as a wall servo reads the stiffness of the wall's contacts; the servo refreshes it
 (``update_stiffness``) when it refreshes its own.
@@ -76,15 +77,21 @@ def contact_stiffness(radius, row_start, pair_j, normal, normal_force, overlap):
 
 
 @numba.njit(cache=True)
-def store_cell_stress(virial_blocks, cell_position, stress_tensor):
-    """``stress_tensor`` (3, 3) [Pa] = the sum of ``virial_blocks`` (sum_blocks) over the
-    volume of the cell of faces ``cell_position`` (6,) [m]: one compiled call, since each NumPy
-    operation after the step's large kernels costs several microseconds."""
+def store_cell_stress(virial_blocks, position, force, cell_position, stress_tensor):
+    """``stress_tensor`` (3, 3) [Pa] = (sum_p x_p (x) F_p + the face terms the gathers left in
+    ``virial_blocks``) over the volume of the cell of faces ``cell_position`` (6,) [m]
+    (dem.virial): every force being a pair force, ``force`` (N, 3) [N] is the resultant of
+    the pair forces. One compiled call, in particle order: each NumPy operation after the
+    step's large kernels costs several microseconds."""
     volume = cell_position[1] * cell_position[3] * cell_position[5]
-    total = sum_blocks(virial_blocks)
+    total = ZERO9
+    for p in range(position.shape[0]):
+        total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], force[p, 0],
+                          force[p, 1], force[p, 2])
+    faces = sum_blocks(virial_blocks)
     for a in range(3):
         for b in range(3):
-            stress_tensor[a, b] = total[3 * a + b] / volume
+            stress_tensor[a, b] = (total[3 * a + b] + faces[3 * a + b]) / volume
 
 
 @numba.njit(cache=True)
@@ -126,8 +133,8 @@ class PeriodicCell(Box):
     stress_tensor: (3, 3) Love–Weber stress of every pair force at the last evaluation,
     compression positive [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
     wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face);
-    virial_blocks: (SUM_BLOCKS, 9) the pair forces' sums of l (x) f [N m] gathered since the
-    step began (dem.virial; zeroed with the forces).
+    virial_blocks: (SUM_BLOCKS, 9) the face terms of the pair forces' sum of l (x) f [N m]
+    gathered since the step began (dem.virial; zeroed with the forces).
     """
 
     position: np.ndarray
@@ -194,13 +201,14 @@ class PeriodicCell(Box):
         return particles.position + self.wraps * self.lengths()
 
     def after_forces(self, sim):
-        """The stress of this step's pair forces: the sum their gathers left in
-        ``virial_blocks`` when every force operation is a pair force (has ``pair_forces(sim)``);
-        otherwise pair by pair over the operations that are. The stretching rate returns to
-        zero until a control sets it."""
+        """The stress of this step's pair forces: from the particles' forces and the face terms
+        the gathers left in ``virial_blocks`` (store_cell_stress) when every force operation
+        is a pair force (has ``pair_forces(sim)``); otherwise pair by pair over the operations
+        that are. The stretching rate returns to zero until a control sets it."""
         contacts = sim.contacts
         if all(hasattr(op, "pair_forces") for op in sim.forces):
-            store_cell_stress(self.virial_blocks, self.position, self.stress_tensor)
+            store_cell_stress(self.virial_blocks, sim.particles.position, sim.particles.force,
+                              self.position, self.stress_tensor)
         else:       # a force that is not a pair force: its gather adds no virial
             total = np.zeros(9)
             for op in sim.forces:

@@ -9,7 +9,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block
+from .virial import SUM_BLOCKS, add_face_block, block_bounds
 
 
 @numba.njit(cache=True, inline="always")
@@ -155,7 +155,7 @@ def _contact_torque(normal, overlap, k, radius_p, a0, a1, a2):
 def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
                         second_pair, force, torque):
     """Add to ``force[p]``, ``torque[p]`` its pairs' contact forces in a fixed order (-F where p
-    is i, +F where p is j; F the force on j from i) and their torques; return the force added.
+    is i, +F where p is j; F the force on j from i) and their torques.
 
     F acts at the middle of the overlap, r_p - overlap / 2 from p's centre along +n (p is i,
     force -F) or -n (p is j, force +F): either way its torque on p is
@@ -192,7 +192,6 @@ def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, secon
     torque[p, 0] += t0
     torque[p, 1] += t1
     torque[p, 2] += t2
-    return f0, f1, f2
 
 
 @numba.njit(cache=True, parallel=True)
@@ -207,19 +206,17 @@ def gather_contact_forces(pair_force, normal, overlap, radius, row_start, second
 
 @numba.njit(cache=True, parallel=True)
 def gather_contact_forces_virial(pair_force, normal, overlap, radius, row_start, second_start,
-                                 second_pair, force, torque, position, image, through_face,
-                                 face_start, period, virial):
-    """gather_contact_forces in a periodic cell, which also adds the Love–Weber sum of
-    l (x) F to ``virial`` (as dem.neighbors.gather_pair_forces_virial)."""
+                                 second_pair, force, torque, image, through_face, face_start,
+                                 period, virial):
+    """gather_contact_forces in a periodic cell, which also adds the face terms of the
+    forces' Love–Weber sum to ``virial`` (dem.virial.add_face_block)."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
-        total = ZERO9
         for p in range(start, stop):
-            f0, f1, f2 = _add_contact_forces(p, pair_force, normal, overlap, radius, row_start,
-                                             second_start, second_pair, force, torque)
-            total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], f0, f1, f2)
-        close_block(virial, block, total, through_face, face_start, image, period, pair_force)
+            _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
+                                second_pair, force, torque)
+        add_face_block(virial, block, through_face, face_start, image, period, pair_force)
 
 
 @numba.njit(cache=True)
@@ -299,8 +296,8 @@ class ContactForces:
         if box.periodic:
             gather_contact_forces_virial(c.force, c.normal, c.overlap, p.radius, c.row_start,
                                          c.second_start, c.second_pair, p.force, p.torque,
-                                         p.position, c.image, c.through_face, c.face_start,
-                                         box.period, box.virial_blocks)
+                                         c.image, c.through_face, c.face_start, box.period,
+                                         box.virial_blocks)
         else:
             gather_contact_forces(c.force, c.normal, c.overlap, p.radius, c.row_start,
                                   c.second_start, c.second_pair, p.force, p.torque)

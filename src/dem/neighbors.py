@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, ZERO9, add_outer, block_bounds, close_block, face_block_starts
+from .virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
 
 @dataclass
@@ -364,8 +364,7 @@ def moved_beyond(position, reference_position, radius, reference_radius, limit, 
 
 @numba.njit(cache=True, inline="always")
 def _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out):
-    """Add to ``out[p]`` its pair forces (-f where p is i, +f where p is j) in a fixed order;
-    return what was added."""
+    """Add to ``out[p]`` its pair forces (-f where p is i, +f where p is j) in a fixed order."""
     v0 = v1 = v2 = 0.0
     for k in range(row_start[p], row_start[p + 1]):
         v0 -= pair_force[k, 0]
@@ -379,7 +378,6 @@ def _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out):
     out[p, 0] += v0
     out[p, 1] += v1
     out[p, 2] += v2
-    return v0, v1, v2
 
 
 @numba.njit(cache=True, parallel=True)
@@ -395,20 +393,17 @@ def gather_pair_forces(pair_force, row_start, second_start, second_pair, out):
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, out, position,
-                              image, through_face, face_start, period, virial):
-    """gather_pair_forces in a periodic cell, which also adds the forces' Love–Weber sum of
-    l (x) f [N m] to ``virial`` (SUM_BLOCKS, 9), block by block (dem.virial). A kernel apart:
-    the blocked loop in the walled kernel, even behind a branch, cost walls 5-15 %."""
+def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, out, image,
+                              through_face, face_start, period, virial):
+    """gather_pair_forces in a periodic cell, which also adds the face terms of the forces'
+    Love–Weber sum [N m] to ``virial`` (SUM_BLOCKS, 9), block by block (dem.virial). A kernel
+    apart: the blocked loop in the walled kernel, even behind a branch, cost walls 5-15 %."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
-        total = ZERO9
         for p in range(start, stop):
-            v0, v1, v2 = _add_pair_forces(p, pair_force, row_start, second_start, second_pair,
-                                          out)
-            total = add_outer(total, position[p, 0], position[p, 1], position[p, 2], v0, v1, v2)
-        close_block(virial, block, total, through_face, face_start, image, period, pair_force)
+            _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out)
+        add_face_block(virial, block, through_face, face_start, image, period, pair_force)
 
 
 def branch_vectors(position, contacts, period, index=None):

@@ -1,18 +1,19 @@
 """Sums of outer products l (x) f over pair forces in fixed blocks: the Love–Weber virial of a
-periodic cell (Eq. 3.41), gathered in the same pass that adds the pair forces to particles.
+periodic cell (Eq. 3.41).
 
 The sum over the pairs of l (x) f (l the branch vector i -> j, f the force on j from i) is
 
     sum_pairs l (x) f = sum_p x_p (x) F_p + sum_pairs (image L) (x) f
 
-(l = x_j - x_i + image L, F_p the resultant of p's pair forces): a force's gather, which
-already visits each particle, adds x_p (x) its share of F_p and then, for the pairs through a
-face whose first member is in the block just gathered (a slice of Contacts.through_face, from
-Contacts.face_start; their forces are still in cache), (image L) (x) f. Particles are split into SUM_BLOCKS fixed blocks;
-each block's sum is kept apart and the blocks are added in order (``sum_blocks``), so the
-result does not depend on the thread count. Walled scenes use the gathers without it. At
-10,000 spheres the virial adds 40-80 us to a gather of 300-400 us (testing each pair's image
-inside the pair loop instead added about 90 us).
+(l = x_j - x_i + image L, F_p the resultant of p's pair forces). The first sum is taken once a
+step from the particles' total forces (dem.cell.store_cell_stress). The second has terms only
+for the pairs through a face: each force's gather, after a block of particles, adds those whose
+first member is in the block (a slice of Contacts.through_face, from Contacts.face_start;
+their forces are still in cache). Particles are split into SUM_BLOCKS fixed blocks; each
+block's sum is kept apart and the blocks are added in order (``sum_blocks``), so the result
+does not depend on the thread count. Walled scenes use the gathers without it. (Measured at
+1,000 spheres: x_p (x) F_p in each gather cost 2-4 us a gather, once a step about 2 us;
+testing each pair's image inside the pair loop instead cost more than the face slices.)
 """
 
 import numba
@@ -63,11 +64,11 @@ def add_face_forces(total, through_face, first, last, image, period, pair_force)
 
 
 @numba.njit(cache=True, inline="always")
-def close_block(virial, block, total, through_face, face_start, image, period, pair_force):
-    """Add to row ``block`` of ``virial`` the block's sum ``total`` (its particles' x_p (x)
-    F_p) and the face terms of its pairs through a face (add_face_forces; ``face_start``:
+def add_face_block(virial, block, through_face, face_start, image, period, pair_force):
+    """Add to row ``block`` of ``virial`` the face terms (add_face_forces) of the pairs through
+    a face whose first member lies in that block of particles (``face_start``:
     face_block_starts)."""
-    add_to_block(virial, block, add_face_forces(total, through_face, face_start[block],
+    add_to_block(virial, block, add_face_forces(ZERO9, through_face, face_start[block],
                                                 face_start[block + 1], image, period,
                                                 pair_force))
 
