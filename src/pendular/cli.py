@@ -60,10 +60,10 @@ def positive_int(name, low=0):
 
 def add_run_options(parser, threads_default=None):
     """Options every command shares: --threads (``threads_default``: None lets a run choose:
-    all of Numba's threads from 2,000 spheres on, else 1), --quiet."""
+    all of Numba's threads from 500 spheres on, else 1), --quiet."""
     parser.add_argument("--threads", type=positive_int("--threads", 1), default=threads_default,
                         help="Numba threads of a run" + (
-                            " (None: all from 2,000 spheres on, else 1)"
+                            " (None: all from 500 spheres on, else 1)"
                             if threads_default is None else ""))
     parser.add_argument("--quiet", action="store_true", help="no progress bars")
 
