@@ -159,7 +159,7 @@ def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, secon
 
     F acts at the middle of the overlap, r_p - overlap / 2 from p's centre along +n (p is i,
     force -F) or -n (p is j, force +F): either way its torque on p is
-    -(r_p - overlap / 2) n x F, which is n x (shear force) since n x n = 0 (YADE's
+    -(r_p - overlap / 2) n x F, the torque of the shear force alone since n x n = 0 (YADE's
     Law2_ScGeom_FrictPhys_CundallStrack). overlap and normal: this step's (pair_forces)."""
     f0 = f1 = f2 = t0 = t1 = t2 = 0.0
     r = radius[p]
