@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from dem.neighbors import branch_vector
-from dem.virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds
+from dem.virial import SUM_BLOCKS, ZERO9, add_face_term, add_to_block, block_bounds
 
 from capillary.bridge_state import ACROSS_GAP, AT_CONTACT, NO_BRIDGE
 from capillary.table import lookup_interface, lookup_suction
@@ -168,9 +168,8 @@ def gather_contact_bridges_virial(force, normal, row_start, second_start, second
         for slot in range(face_start[block], face_start[block + 1]):
             k = through_face[slot]
             f = -force[k]           # the force on j from i is -F n
-            total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                              image[k, 2] * period[2], f * normal[k, 0], f * normal[k, 1],
-                              f * normal[k, 2])
+            total = add_face_term(total, image, k, period, f * normal[k, 0], f * normal[k, 1],
+                                  f * normal[k, 2])
         add_to_block(virial, block, total)
 
 

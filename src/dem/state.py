@@ -68,8 +68,9 @@ class Box:
     also provides ``period`` (3,) [m]: what a pair's periodic image shifts its branch vector
     by per image (Contacts.image; zeros for walls), ``affine_rate`` (3,) [1/s]: the
     homogeneous stretching rate that carries the particles (zeros for walls),
-    ``virial_blocks`` (SUM_BLOCKS, 9) [N m]: where the pair forces' gathers add their
-    Love–Weber sums when ``period`` is not zero (dem.virial; walls: empty, never written),
+    ``virial_blocks`` (SUM_BLOCKS, 9) [N m]: where the pair forces' gathers add the face
+    terms of their Love–Weber sums when ``period`` is not zero (dem.virial; walls: empty,
+    never written),
     ``wrap(particles)`` (positions brought back into the box at a neighbour-list rebuild) and
     ``after_forces(sim)`` (what the box measures once the step's forces are known).
     """

@@ -52,14 +52,21 @@ def face_block_starts(through_face, row_start):
 
 
 @numba.njit(cache=True, inline="always")
+def add_face_term(total, image, k, period, f0, f1, f2):
+    """``total`` plus (image_k L) (x) f for pair k through a face, f [N] its force on j from i
+    (what its branch vector holds beyond x_j - x_i)."""
+    return add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
+                     image[k, 2] * period[2], f0, f1, f2)
+
+
+@numba.njit(cache=True, inline="always")
 def add_face_forces(total, through_face, first, last, image, period, pair_force):
     """``total`` plus (image_k L) (x) f_k over the pairs k = through_face[first:last], f the
     force on j from i (K, 3) [N]."""
     for slot in range(first, last):
         k = through_face[slot]
-        total = add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                          image[k, 2] * period[2], pair_force[k, 0], pair_force[k, 1],
-                          pair_force[k, 2])
+        total = add_face_term(total, image, k, period, pair_force[k, 0], pair_force[k, 1],
+                              pair_force[k, 2])
     return total
 
 
