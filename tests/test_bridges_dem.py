@@ -15,9 +15,11 @@ import pytest
 
 import capillary
 from capillary import BridgeState, CapillaryBridges
-from capillary.bridge_kernels import pendular_overlap_counts
+from capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
 from conftest import PrescribedGap, two_body_scene
+from dem.contact_law import NO_ATTRACTION, ContactForces, gather_contact_forces
 from dem.neighbors import NeighborList, build_contacts
+from dem.walls import WallForces
 from homogenize import capillary_force_stress, contact_stress
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -215,6 +217,39 @@ def test_bridges_survive_rebuilds_and_thread_count_does_not_change_results(wet_s
     assert np.array_equal(runs[0].particles.position, runs[1].particles.position)
     assert np.array_equal(BridgeState.of(runs[0].contacts).force,
                           BridgeState.of(runs[1].contacts).force)
+
+
+def test_bridges_at_contact_are_gathered_with_the_contact_forces(wet_sample):
+    """Bridges at contact join the contact law's gather (one pass over the pairs): the forces
+    are those of the two gathers apart, the torques bit for bit the contact law's alone; a
+    scene without the bridges, or with bridges across gaps, gathers the contacts alone."""
+    sim, _ = wet_sample
+    dried = copy.deepcopy(sim)
+    sim = copy.deepcopy(sim)
+    contact_law, bridges = sim.operation(ContactForces), sim.operation(CapillaryBridges)
+    assert contact_law.joined_by(sim) is bridges
+    sim.evaluate_forces()
+    c, p = sim.contacts, sim.particles
+    assert np.count_nonzero(BridgeState.of(c).force) > 100
+    force, torque = np.zeros_like(p.force), np.zeros_like(p.torque)
+    gather_contact_forces(c.force, NO_ATTRACTION, c.normal, c.overlap, p.radius, c.row_start,
+                          c.second_start, c.second_pair, force, torque)
+    walls_only = copy.deepcopy(sim)
+    walls_only.particles.force[:] = 0.0
+    walls_only.operation(WallForces).apply(walls_only)
+    force += walls_only.particles.force
+    dry_force = force.copy()
+    gather_contact_bridges(BridgeState.of(c).force, c.normal, c.row_start, c.second_start,
+                           c.second_pair, force)
+    np.testing.assert_allclose(p.force, force, rtol=0, atol=1e-12 * np.abs(force).max())
+    np.testing.assert_array_equal(p.torque, torque)
+    dried.forces.remove(dried.operation(CapillaryBridges))  # the contact law gathers alone
+    assert dried.operation(ContactForces).joined_by(dried) is None
+    dried.evaluate_forces()
+    np.testing.assert_allclose(dried.particles.force, dry_force, rtol=0,
+                               atol=1e-12 * np.abs(dry_force).max())
+    np.testing.assert_array_equal(dried.particles.torque, torque)
+    assert not CapillaryBridges(30000.0, GAMMA, persist=True).joins_contact_gather
 
 
 def test_extra_pair_arrays_are_carried_to_the_same_pair():

@@ -9,7 +9,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, add_face_block, block_bounds
+from .virial import SUM_BLOCKS, ZERO9, add_face_term, add_to_block, block_bounds
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,10 +152,26 @@ def _contact_torque(normal, overlap, k, radius_p, a0, a1, a2):
 
 
 @numba.njit(cache=True, inline="always")
-def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
-                        second_pair, force, torque):
+def _with_attraction(pair_force, attraction, normal, k):
+    """Pair k's force on j from i [N]: the contact force, less ``attraction[k]`` along the
+    normal when ``attraction`` (K,) [N] is not empty (a central pull, +a n on i, -a n on j)."""
+    a0 = pair_force[k, 0]
+    a1 = pair_force[k, 1]
+    a2 = pair_force[k, 2]
+    if len(attraction):
+        b = attraction[k]
+        a0 -= b * normal[k, 0]
+        a1 -= b * normal[k, 1]
+        a2 -= b * normal[k, 2]
+    return a0, a1, a2
+
+
+@numba.njit(cache=True, inline="always")
+def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_start,
+                        second_start, second_pair, force, torque):
     """Add to ``force[p]``, ``torque[p]`` its pairs' contact forces in a fixed order (-F where p
-    is i, +F where p is j; F the force on j from i) and their torques.
+    is i, +F where p is j; F the force on j from i) and their torques, with the central
+    ``attraction`` (_with_attraction; it has no torque) when there is one.
 
     F acts at the middle of the overlap, r_p - overlap / 2 from p's centre along +n (p is i,
     force -F) or -n (p is j, force +F): either way its torque on p is
@@ -164,28 +180,26 @@ def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, secon
     f0 = f1 = f2 = t0 = t1 = t2 = 0.0
     r = radius[p]
     for k in range(row_start[p], row_start[p + 1]):
-        a0 = pair_force[k, 0]
-        a1 = pair_force[k, 1]
-        a2 = pair_force[k, 2]
+        m0, m1, m2 = _contact_torque(normal, overlap, k, r, pair_force[k, 0], pair_force[k, 1],
+                                     pair_force[k, 2])
+        t0 += m0
+        t1 += m1
+        t2 += m2
+        a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
         f0 -= a0
         f1 -= a1
         f2 -= a2
-        m0, m1, m2 = _contact_torque(normal, overlap, k, r, a0, a1, a2)
+    for slot in range(second_start[p], second_start[p + 1]):
+        k = second_pair[slot]
+        m0, m1, m2 = _contact_torque(normal, overlap, k, r, pair_force[k, 0], pair_force[k, 1],
+                                     pair_force[k, 2])
         t0 += m0
         t1 += m1
         t2 += m2
-    for slot in range(second_start[p], second_start[p + 1]):
-        k = second_pair[slot]
-        a0 = pair_force[k, 0]
-        a1 = pair_force[k, 1]
-        a2 = pair_force[k, 2]
+        a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
         f0 += a0
         f1 += a1
         f2 += a2
-        m0, m1, m2 = _contact_torque(normal, overlap, k, r, a0, a1, a2)
-        t0 += m0
-        t1 += m1
-        t2 += m2
     force[p, 0] += f0
     force[p, 1] += f1
     force[p, 2] += f2
@@ -195,28 +209,34 @@ def _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, secon
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_contact_forces(pair_force, normal, overlap, radius, row_start, second_start,
-                          second_pair, force, torque):
-    """Add the contact forces and their torques to particles (_add_contact_forces). In a
-    periodic cell use gather_contact_forces_virial."""
+def gather_contact_forces(pair_force, attraction, normal, overlap, radius, row_start,
+                          second_start, second_pair, force, torque):
+    """Add the contact forces, the central ``attraction`` (K,) [N] if not empty, and the
+    torques to the particles (_add_contact_forces). In a periodic cell use
+    gather_contact_forces_virial."""
     for p in numba.prange(len(row_start) - 1):
-        _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
-                            second_pair, force, torque)
+        _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_start,
+                            second_start, second_pair, force, torque)
 
 
 @numba.njit(cache=True, parallel=True)
-def gather_contact_forces_virial(pair_force, normal, overlap, radius, row_start, second_start,
-                                 second_pair, force, torque, image, through_face, face_start,
-                                 period, virial):
+def gather_contact_forces_virial(pair_force, attraction, normal, overlap, radius, row_start,
+                                 second_start, second_pair, force, torque, image, through_face,
+                                 face_start, period, virial):
     """gather_contact_forces in a periodic cell, which also adds the face terms of the
-    forces' Love–Weber sum to ``virial`` (dem.virial.add_face_block)."""
+    forces' Love–Weber sum to ``virial`` (as dem.virial.add_face_block)."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
         for p in range(start, stop):
-            _add_contact_forces(p, pair_force, normal, overlap, radius, row_start, second_start,
-                                second_pair, force, torque)
-        add_face_block(virial, block, through_face, face_start, image, period, pair_force)
+            _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_start,
+                                second_start, second_pair, force, torque)
+        total = ZERO9
+        for slot in range(face_start[block], face_start[block + 1]):
+            k = through_face[slot]
+            a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
+            total = add_face_term(total, image, k, period, a0, a1, a2)
+        add_to_block(virial, block, total)
 
 
 @numba.njit(cache=True)
@@ -260,6 +280,10 @@ def wall_forces(position, radius, wall_position, young, force, wall_force, wall_
                 wall_moment[2 * axis + 1] += (r - high_overlap) * push
 
 
+#: No central attraction in a contact gather (ContactForces.gather).
+NO_ATTRACTION = np.zeros(0)
+
+
 class ContactForces:
     """Sphere–sphere linear contacts for every candidate pair of ``sim.contacts``.
 
@@ -286,6 +310,8 @@ class ContactForces:
         return sim.contacts.force
 
     def apply(self, sim):
+        """This step's pair forces, gathered onto the particles unless a later force
+        operation joins the gather (``joined_by``)."""
         p = sim.particles
         c = sim.contacts
         box = sim.walls
@@ -293,11 +319,33 @@ class ContactForces:
                     c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
                     c.normal_force, c.force, self.young, self.shear_ratio, self._tan_friction,
                     sim.dt)
+        if self.joined_by(sim) is None:
+            self.gather(sim)
+
+    def joined_by(self, sim):
+        """The force operation after this one in ``sim.forces`` whose ``joins_contact_gather``
+        is true (capillary bridges at contact: central forces along the contact normals), or
+        None. That operation gathers this step's contact forces with its own in one pass
+        over the pairs (``gather``), 5-15 % of a wet step less than two gathers."""
+        after = False
+        for op in sim.forces:
+            if op is self:
+                after = True
+            elif after and getattr(op, "joins_contact_gather", False):
+                return op
+        return None
+
+    def gather(self, sim, attraction=NO_ATTRACTION):
+        """Add this step's contact forces and their torques to the particles, with a central
+        ``attraction`` (K,) [N] along each contact normal (+a n on i, -a n on j) if given."""
+        p = sim.particles
+        c = sim.contacts
+        box = sim.walls
         if box.periodic:
-            gather_contact_forces_virial(c.force, c.normal, c.overlap, p.radius, c.row_start,
-                                         c.second_start, c.second_pair, p.force, p.torque,
-                                         c.image, c.through_face, c.face_start, box.period,
-                                         box.virial_blocks)
+            gather_contact_forces_virial(c.force, attraction, c.normal, c.overlap, p.radius,
+                                         c.row_start, c.second_start, c.second_pair, p.force,
+                                         p.torque, c.image, c.through_face, c.face_start,
+                                         box.period, box.virial_blocks)
         else:
-            gather_contact_forces(c.force, c.normal, c.overlap, p.radius, c.row_start,
-                                  c.second_start, c.second_pair, p.force, p.torque)
+            gather_contact_forces(c.force, attraction, c.normal, c.overlap, p.radius,
+                                  c.row_start, c.second_start, c.second_pair, p.force, p.torque)
