@@ -17,7 +17,7 @@ import capillary
 from capillary import BridgeState, CapillaryBridges
 from capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
 from conftest import PrescribedGap, two_body_scene
-from dem.contact_law import NO_ATTRACTION, ContactForces, gather_contact_forces
+from dem.contact_law import ContactForces, gather_contact_forces
 from dem.neighbors import NeighborList, build_contacts
 from dem.walls import WallForces
 from homogenize import capillary_force_stress, contact_stress
@@ -232,7 +232,7 @@ def test_bridges_at_contact_are_gathered_with_the_contact_forces(wet_sample):
     c, p = sim.contacts, sim.particles
     assert np.count_nonzero(BridgeState.of(c).force) > 100
     force, torque = np.zeros_like(p.force), np.zeros_like(p.torque)
-    gather_contact_forces(c.force, NO_ATTRACTION, c.normal, c.overlap, p.radius, c.row_start,
+    gather_contact_forces(c.force, None, c.normal, c.overlap, p.radius, c.row_start,
                           c.second_start, c.second_pair, force, torque)
     walls_only = copy.deepcopy(sim)
     walls_only.particles.force[:] = 0.0

@@ -11,7 +11,7 @@ import pytest
 from capillary import CapillaryBridges
 from capillary.bridge_state import ACROSS_GAP, BridgeState
 from dem.cell import PeriodicCell, pair_virial
-from dem.contact_law import NO_ATTRACTION, ContactForces, gather_contact_forces, normal_stiffness
+from dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
 from dem.integrate import Integrator
 from dem.neighbors import NeighborList, build_contacts, gather_pair_forces
 from dem.preparation import PrepareConfig, prepare_sample, random_cloud
@@ -248,7 +248,7 @@ def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persis
                                    rtol=1e-9, atol=1e-9 * np.abs(by_pairs).max())
         # the periodic gathers add the walled ones' forces (torques bit for bit)
         force, torque = np.zeros_like(p.force), np.zeros_like(p.torque)
-        gather_contact_forces(c.force, NO_ATTRACTION, c.normal, c.overlap, p.radius,
+        gather_contact_forces(c.force, None, c.normal, c.overlap, p.radius,
                               c.row_start, c.second_start, c.second_pair, force, torque)
         gather_pair_forces(bridges.pair_forces(sim), c.row_start, c.second_start,
                            c.second_pair, force)

@@ -154,11 +154,12 @@ def _contact_torque(normal, overlap, k, radius_p, a0, a1, a2):
 @numba.njit(cache=True, inline="always")
 def _with_attraction(pair_force, attraction, normal, k):
     """Pair k's force on j from i [N]: the contact force, less ``attraction[k]`` along the
-    normal when ``attraction`` (K,) [N] is not empty (a central pull, +a n on i, -a n on j)."""
+    normal unless ``attraction`` (K,) [N] is None (a central pull, +a n on i, -a n on j). A
+    None argument is a type of its own to Numba: the kernels compiled for it hold no test."""
     a0 = pair_force[k, 0]
     a1 = pair_force[k, 1]
     a2 = pair_force[k, 2]
-    if len(attraction):
+    if attraction is not None:
         b = attraction[k]
         a0 -= b * normal[k, 0]
         a1 -= b * normal[k, 1]
@@ -211,7 +212,7 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
 @numba.njit(cache=True, parallel=True)
 def gather_contact_forces(pair_force, attraction, normal, overlap, radius, row_start,
                           second_start, second_pair, force, torque):
-    """Add the contact forces, the central ``attraction`` (K,) [N] if not empty, and the
+    """Add the contact forces, the central ``attraction`` (K,) [N] unless None, and the
     torques to the particles (_add_contact_forces). In a periodic cell use
     gather_contact_forces_virial."""
     for p in numba.prange(len(row_start) - 1):
@@ -280,10 +281,6 @@ def wall_forces(position, radius, wall_position, young, force, wall_force, wall_
                 wall_moment[2 * axis + 1] += (r - high_overlap) * push
 
 
-#: No central attraction in a contact gather (ContactForces.gather).
-NO_ATTRACTION = np.zeros(0)
-
-
 class ContactForces:
     """Sphere–sphere linear contacts for every candidate pair of ``sim.contacts``.
 
@@ -335,7 +332,7 @@ class ContactForces:
                 return op
         return None
 
-    def gather(self, sim, attraction=NO_ATTRACTION):
+    def gather(self, sim, attraction=None):
         """Add this step's contact forces and their torques to the particles, with a central
         ``attraction`` (K,) [N] along each contact normal (+a n on i, -a n on j) if given."""
         p = sim.particles
