@@ -522,12 +522,16 @@ class NeighborList:
         self._shortest_unlisted = 0.0
 
     def required_reach(self, sim):
-        """Largest reach [m] the simulation's forces declare (0: contacts only)."""
+        """Largest reach [m] the simulation's forces declare (0: contacts only). A reach is
+        checked when it differs from the list's (the check formats its message: a few us a
+        step)."""
         reach = 0.0
         for op in sim.forces:
             if hasattr(op, "reach"):
-                reach = max(reach, check_range(f"{type(op).__name__}.reach", op.reach(sim),
-                                               0.0, unit="m"))
+                value = op.reach(sim)
+                if value != self.interaction_range:
+                    value = check_range(f"{type(op).__name__}.reach", value, 0.0, unit="m")
+                reach = max(reach, value)
         return reach
 
     def rebuild(self, sim):
