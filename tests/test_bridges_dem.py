@@ -250,6 +250,8 @@ def test_bridges_at_contact_are_gathered_with_the_contact_forces(wet_sample):
                                atol=1e-12 * np.abs(dry_force).max())
     np.testing.assert_array_equal(dried.particles.torque, torque)
     assert not CapillaryBridges(30000.0, GAMMA, persist=True).joins_contact_gather
+    with pytest.raises(ValueError, match=r"attraction has shape \(3,\)"):
+        contact_law.gather(sim, np.zeros(3))
 
 
 def test_extra_pair_arrays_are_carried_to_the_same_pair():

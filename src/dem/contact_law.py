@@ -338,6 +338,9 @@ class ContactForces:
         p = sim.particles
         c = sim.contacts
         box = sim.walls
+        if attraction is not None and attraction.shape != (len(c),):
+            raise ValueError(f"attraction has shape {attraction.shape}; the gather needs one "
+                             f"value per pair of the neighbour list, ({len(c)},)")
         if box.periodic:
             gather_contact_forces_virial(c.force, attraction, c.normal, c.overlap, p.radius,
                                          c.row_start, c.second_start, c.second_pair, p.force,
