@@ -71,7 +71,8 @@ def test_a_finished_run_is_reused_only_with_an_equal_configuration(tmp_path, mon
         def __init__(self, config):
             self.config = config
 
-        def run(self, out, progress, threads):
+        def run(self, out, progress, threads, plots):
+            assert plots is False       # the study times physics, not figures
             ran.append((self.config, threads))
             return {"steps": 10, "particle_steps_per_s": 1.0, "peak_q": 99.0,
                     "saturation_at_peak": 0.01, "peak_q_effective": 2.0,
@@ -160,6 +161,9 @@ def test_report_and_plot(quick_grid):
     assert (out / "tradeoff.png").stat().st_size > 0
     # each run keeps its configuration beside its timing
     timing = json.loads((out / "runs" / "reference" / "timing.json").read_text())
+    run = out / "runs" / "reference"        # its history and summary, no figures (untimed)
+    assert (run / "history.h5").is_file() and (run / "summary.json").is_file()
+    assert not (run / "triaxial.png").exists() and not (run / "plots").exists()
     assert timing["config"]["fields"]["shear"]["fields"]["inertial_number"] == 1e-4
 
 

@@ -17,8 +17,9 @@ varied alone around the defaults:
     default safety), inertial_number, damping, particles, table_resolution (exact bridges),
     bridges (exact / toroidal), records (history rows), skin_factor (neighbour list)
 
-For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, the
-sample's preparation excluded), its particle-steps per second, and the relative errors of peak
+For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, and
+writing the run's history and summary; the sample's preparation excluded, and no figures are
+drawn), its particle-steps per second, and the relative errors of peak
 q, of Sr at the peak of q and of q'/p' at the peak of q (Eq. 3.43) against the reference;
 ``error`` is the largest of the three. The noise floor: the reference settings run on
 NOISE_SEEDS other samples (seeds seed + 1, ...), whose errors against the reference are the
@@ -210,7 +211,7 @@ def run_variant(config, folder, sample):
         prepare_one(sample, config.sample_path)
     test = TriaxialTest(config)           # checks, and builds the bridge tables untimed
     wall, cpu = time.perf_counter(), time.process_time()
-    summary = test.run(folder, progress=False, threads=1)
+    summary = test.run(folder, progress=False, threads=1, plots=False)   # physics only
     wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     result = {"settings": settings(config), "particles": config.sample.particles,
               "wall_time_s": wall, "cpu_time_s": cpu, "steps": summary["steps"],
@@ -324,7 +325,8 @@ def write_markdown(path, study, reference, rows, noise, floor):
         f"peak q = {reference['peak_q']:.1f} Pa, Sr at peak = "
         f"{100 * reference['saturation_at_peak']:.3f} %, q'/p' at peak = "
         f"{reference['stress_ratio_at_peak']:.4f}; it took {reference['cpu_time_s']:.0f} s of "
-        "CPU. Times cover wetting and shear, not the sample's preparation; CPU time (the run's "
+        "CPU. Times cover wetting and shear and the run's history and summary, not the "
+        "sample's preparation nor figures; CPU time (the run's "
         "process time) is the speed measure, wall time also counts whatever else the machine "
         "was running.", "",
         "![time against error](tradeoff.png)", "",

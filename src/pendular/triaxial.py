@@ -513,9 +513,12 @@ class TriaxialTest:
         report.setdefault("timestep", timestep_description(sample))
         return sim, report
 
-    def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False):
+    def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False,
+            plots=True):
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
-        shear after this many steps as an interruption would (raises Interrupted).
+        shear after this many steps as an interruption would (raises Interrupted); ``plots``:
+        False leaves out triaxial.png and plots/ (a run timed for its physics, as the
+        trade-off study's: the figures cost about 2 s a run).
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same."""
@@ -524,7 +527,7 @@ class TriaxialTest:
         with OutputFolder(out, "triaxial") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, stop_after, vtk_prep)
+            return self._run(out, progress, threads, stop_after, vtk_prep, plots)
 
     def prep_writer(self, out, vtk_prep):
         """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
@@ -539,7 +542,7 @@ class TriaxialTest:
                          field_data=lambda s: {"mean_wall_stress":
                                                float(np.mean(s.walls.stress()))})
 
-    def _run(self, out, progress, threads, stop_after, vtk_prep=False):
+    def _run(self, out, progress, threads, stop_after, vtk_prep=False, plots=True):
         config = self.config
         started = time.perf_counter()
         frames = self.prep_writer(out, vtk_prep)
@@ -562,7 +565,7 @@ class TriaxialTest:
         run = _ShearRun(sim, config, out, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
-        return run.finish(progress, stop_after)
+        return run.finish(progress, stop_after, plots)
 
     @classmethod
     def resume(cls, out, *, progress=True, threads=None, stop_after=None):
@@ -647,9 +650,9 @@ class _ShearRun:
         self.shear_time = state["shear_time_s"]
         self._clock = time.perf_counter()
 
-    def finish(self, progress, stop_after):
+    def finish(self, progress, stop_after, plots=True):
         """Run the rest of the shear (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
-        and write the outputs; returns the summary."""
+        and write the outputs (the figures if ``plots``); returns the summary."""
         sim = self.sim
         remaining = self.steps - (sim.step - self.start_step)
         stop = stop_after is not None and stop_after < remaining
@@ -667,11 +670,11 @@ class _ShearRun:
                                  if self.checkpoint is not None else ""))
         if self.vtk is not None:
             self.vtk.close(sim)
-        return self.write_outputs()
+        return self.write_outputs(plots=plots)
 
-    def write_outputs(self, completed=True):
+    def write_outputs(self, completed=True, plots=True):
         """history.h5, summary.json (``completed``: whether the shear reached its final strain)
-        and, for a completed run, the plots."""
+        and, for a completed run, the plots unless ``plots`` is False."""
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
@@ -722,6 +725,8 @@ class _ShearRun:
                   f"Love-Weber stresses apart by more than {STRESS_BALANCE_BOUND:.0%} of p (up "
                   f"to {summary['stress_balance_error']:.1%}): the shear is not quasi-static "
                   "there (summary.json stress_balance_flagged)", file=sys.stderr)
+        if not plots:
+            return summary
         title = run_label(parameters(config), preparation["porosity"])
         plot_history(history, os.path.join(out, "triaxial.png"), title)
         write_plots(history, os.path.join(out, "plots"), title)
