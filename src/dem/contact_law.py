@@ -9,7 +9,7 @@ import numba
 import numpy as np
 
 from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, ZERO9, add_face_term, add_to_block, block_bounds
+from .virial import SUM_BLOCKS, add_face_block, block_bounds, pair_force_with_attraction
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,19 +152,14 @@ def _contact_torque(normal, overlap, k, radius_p, a0, a1, a2):
 
 
 @numba.njit(cache=True, inline="always")
-def _with_attraction(pair_force, attraction, normal, k):
-    """Pair k's force on j from i [N]: the contact force, less ``attraction[k]`` along the
-    normal unless ``attraction`` (K,) [N] is None (a central pull, +a n on i, -a n on j). A
-    None argument is a type of its own to Numba: the kernels compiled for it hold no test."""
-    a0 = pair_force[k, 0]
-    a1 = pair_force[k, 1]
-    a2 = pair_force[k, 2]
-    if attraction is not None:
-        b = attraction[k]
-        a0 -= b * normal[k, 0]
-        a1 -= b * normal[k, 1]
-        a2 -= b * normal[k, 2]
-    return a0, a1, a2
+def _pair_terms(pair_force, attraction, normal, overlap, k, radius_p):
+    """Pair k's force on j from i with the attraction (dem.virial.pair_force_with_attraction)
+    and the contact force's torque on a member of radius ``radius_p`` (_contact_torque; the
+    central attraction has none)."""
+    m0, m1, m2 = _contact_torque(normal, overlap, k, radius_p, pair_force[k, 0],
+                                 pair_force[k, 1], pair_force[k, 2])
+    a0, a1, a2 = pair_force_with_attraction(pair_force, attraction, normal, k)
+    return a0, a1, a2, m0, m1, m2
 
 
 @numba.njit(cache=True, inline="always")
@@ -172,7 +167,7 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
                         second_start, second_pair, force, torque):
     """Add to ``force[p]``, ``torque[p]`` its pairs' contact forces in a fixed order (-F where p
     is i, +F where p is j; F the force on j from i) and their torques, with the central
-    ``attraction`` (_with_attraction; it has no torque) when there is one.
+    ``attraction`` (dem.virial.pair_force_with_attraction; it has no torque) when there is one.
 
     F acts at the middle of the overlap, r_p - overlap / 2 from p's centre along +n (p is i,
     force -F) or -n (p is j, force +F): either way its torque on p is
@@ -181,26 +176,22 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
     f0 = f1 = f2 = t0 = t1 = t2 = 0.0
     r = radius[p]
     for k in range(row_start[p], row_start[p + 1]):
-        m0, m1, m2 = _contact_torque(normal, overlap, k, r, pair_force[k, 0], pair_force[k, 1],
-                                     pair_force[k, 2])
-        t0 += m0
-        t1 += m1
-        t2 += m2
-        a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
+        a0, a1, a2, m0, m1, m2 = _pair_terms(pair_force, attraction, normal, overlap, k, r)
         f0 -= a0
         f1 -= a1
         f2 -= a2
-    for slot in range(second_start[p], second_start[p + 1]):
-        k = second_pair[slot]
-        m0, m1, m2 = _contact_torque(normal, overlap, k, r, pair_force[k, 0], pair_force[k, 1],
-                                     pair_force[k, 2])
         t0 += m0
         t1 += m1
         t2 += m2
-        a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
+    for slot in range(second_start[p], second_start[p + 1]):
+        a0, a1, a2, m0, m1, m2 = _pair_terms(pair_force, attraction, normal, overlap,
+                                             second_pair[slot], r)
         f0 += a0
         f1 += a1
         f2 += a2
+        t0 += m0
+        t1 += m1
+        t2 += m2
     force[p, 0] += f0
     force[p, 1] += f1
     force[p, 2] += f2
@@ -232,12 +223,8 @@ def gather_contact_forces_virial(pair_force, attraction, normal, overlap, radius
         for p in range(start, stop):
             _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_start,
                                 second_start, second_pair, force, torque)
-        total = ZERO9
-        for slot in range(face_start[block], face_start[block + 1]):
-            k = through_face[slot]
-            a0, a1, a2 = _with_attraction(pair_force, attraction, normal, k)
-            total = add_face_term(total, image, k, period, a0, a1, a2)
-        add_to_block(virial, block, total)
+        add_face_block(virial, block, through_face, face_start, image, period, pair_force,
+                       attraction, normal)
 
 
 @numba.njit(cache=True)

@@ -403,7 +403,8 @@ def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, 
         start, stop = block_bounds(count, block)
         for p in range(start, stop):
             _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out)
-        add_face_block(virial, block, through_face, face_start, image, period, pair_force)
+        add_face_block(virial, block, through_face, face_start, image, period, pair_force,
+                       None, None)
 
 
 def branch_vectors(position, contacts, period, index=None):

@@ -60,24 +60,44 @@ def add_face_term(total, image, k, period, f0, f1, f2):
 
 
 @numba.njit(cache=True, inline="always")
-def add_face_forces(total, through_face, first, last, image, period, pair_force):
+def pair_force_with_attraction(pair_force, attraction, normal, k):
+    """Pair k's force on j from i [N]: ``pair_force[k]``, less ``attraction[k]`` along the
+    normal unless ``attraction`` (K,) [N] is None (a central pull, +a n on i, -a n on j:
+    capillary bridges at contact, dem.contact_law.ContactForces.gather). A None argument is a
+    type of its own to Numba: the kernels compiled for it hold no test."""
+    a0 = pair_force[k, 0]
+    a1 = pair_force[k, 1]
+    a2 = pair_force[k, 2]
+    if attraction is not None:
+        b = attraction[k]
+        a0 -= b * normal[k, 0]
+        a1 -= b * normal[k, 1]
+        a2 -= b * normal[k, 2]
+    return a0, a1, a2
+
+
+@numba.njit(cache=True, inline="always")
+def add_face_forces(total, through_face, first, last, image, period, pair_force, attraction,
+                    normal):
     """``total`` plus (image_k L) (x) f_k over the pairs k = through_face[first:last], f the
-    force on j from i (K, 3) [N]."""
+    force on j from i [N] (pair_force_with_attraction: ``pair_force`` (K, 3), less the
+    ``attraction`` along ``normal`` unless it is None)."""
     for slot in range(first, last):
         k = through_face[slot]
-        total = add_face_term(total, image, k, period, pair_force[k, 0], pair_force[k, 1],
-                              pair_force[k, 2])
+        f0, f1, f2 = pair_force_with_attraction(pair_force, attraction, normal, k)
+        total = add_face_term(total, image, k, period, f0, f1, f2)
     return total
 
 
 @numba.njit(cache=True, inline="always")
-def add_face_block(virial, block, through_face, face_start, image, period, pair_force):
+def add_face_block(virial, block, through_face, face_start, image, period, pair_force,
+                   attraction, normal):
     """Add to row ``block`` of ``virial`` the face terms (add_face_forces) of the pairs through
     a face whose first member lies in that block of particles (``face_start``:
     face_block_starts)."""
     add_to_block(virial, block, add_face_forces(ZERO9, through_face, face_start[block],
                                                 face_start[block + 1], image, period,
-                                                pair_force))
+                                                pair_force, attraction, normal))
 
 
 @numba.njit(cache=True, inline="always")
