@@ -50,14 +50,15 @@ def shear_simulation(config, particles, walls, threads, suction):
     return sim, bridges, rate
 
 
-def time_alternately(simulations, steps, warmup, chunks=6):
-    """({name: seconds}, {name: neighbour-list rebuilds}) of ``steps`` steps (one count for
-    all, or {name: count}) of each of the named ``simulations`` after ``warmup`` steps, run in
-    alternating chunks so that a change of machine load hits them alike."""
+def time_chunks(simulations, steps, warmup, chunks=6):
+    """({name: [seconds of each chunk]}, {name: neighbour-list rebuilds}) of ``steps`` steps
+    (one count for all, or {name: count}) of each of the named ``simulations`` after
+    ``warmup`` steps, run in ``chunks`` alternating turns so that a change of machine load
+    hits them alike (turn c of every simulation runs back to back)."""
     for sim in simulations.values():
         sim.run(warmup)
     totals = steps if isinstance(steps, dict) else {name: steps for name in simulations}
-    elapsed = {name: 0.0 for name in simulations}
+    seconds = {name: [] for name in simulations}
     rebuilds = {name: sim.operation(NeighborList).rebuilds for name, sim in simulations.items()}
     for chunk in range(chunks):
         for name, sim in simulations.items():
@@ -65,9 +66,15 @@ def time_alternately(simulations, steps, warmup, chunks=6):
             count = total // chunks + (1 if chunk < total % chunks else 0)
             started = time.perf_counter()
             sim.run(count)
-            elapsed[name] += time.perf_counter() - started
-    return elapsed, {name: sim.operation(NeighborList).rebuilds - rebuilds[name]
+            seconds[name].append(time.perf_counter() - started)
+    return seconds, {name: sim.operation(NeighborList).rebuilds - rebuilds[name]
                      for name, sim in simulations.items()}
+
+
+def time_alternately(simulations, steps, warmup, chunks=6):
+    """({name: seconds}, {name: neighbour-list rebuilds}): time_chunks' turns summed."""
+    seconds, rebuilds = time_chunks(simulations, steps, warmup, chunks)
+    return {name: sum(turns) for name, turns in seconds.items()}, rebuilds
 
 
 def time_pendular(config, particles, walls, threads, steps, warmup, suction):
