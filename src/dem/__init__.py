@@ -12,6 +12,14 @@ same run then does 10.0 M quiet (10.3 M with libgomp's default) and 4.5 M with a
 (one thread does 5.6 M there: with other jobs on the machine, one thread per run is still
 faster). OPENMP_DEFAULTS holds what was set, so that other programs started from here (YADE)
 run with their own.
+
+The kernels that take most of a step (pair forces, the contact gather, the leapfrog) are
+compiled with HOT_KERNEL_FASTMATH: fused multiply-adds and division by a reciprocal (LLVM's
+'contract' and 'arcp'), which change results at round-off (about 1e-14 of a force) and keep
+them the same for any thread count. Nothing that changes NaN, infinity or signed-zero
+handling, or reorders sums: a diverging run is still caught, and sums keep their order.
+Measured in one run against the strict kernels (10,000 spheres, dry shear): 9-10 % less time
+a step on 1 and 2 threads.
 """
 
 import os
@@ -19,6 +27,9 @@ import os
 import numba
 
 numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]
+
+#: Numba ``fastmath`` flags of the hot kernels (module docstring).
+HOT_KERNEL_FASTMATH = {"contract", "arcp"}
 
 #: OpenMP settings pendular applied because the environment had none (name -> value).
 OPENMP_DEFAULTS = {}

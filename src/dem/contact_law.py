@@ -8,6 +8,7 @@ Sphere–wall: frictionless, the wall acting as a virtual sphere of the same rad
 import numba
 import numpy as np
 
+from . import HOT_KERNEL_FASTMATH
 from .validate import check_positive, check_range
 from .virial import SUM_BLOCKS, add_face_block, block_bounds, pair_force_with_attraction
 
@@ -26,7 +27,7 @@ def wall_contact_stiffness(young, radius):
     return young * radius
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
 def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, image, period,
                 affine_rate, shear_force, normal, overlap, normal_force, force, young,
                 shear_ratio, tan_friction, dt):
@@ -200,7 +201,7 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
     torque[p, 2] += t2
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
 def gather_contact_forces(pair_force, attraction, normal, overlap, radius, row_start,
                           second_start, second_pair, force, torque):
     """Add the contact forces, the central ``attraction`` (K,) [N] unless None, and the
@@ -211,7 +212,7 @@ def gather_contact_forces(pair_force, attraction, normal, overlap, radius, row_s
                             second_start, second_pair, force, torque)
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
 def gather_contact_forces_virial(pair_force, attraction, normal, overlap, radius, row_start,
                                  second_start, second_pair, force, torque, image, through_face,
                                  face_start, period, virial):

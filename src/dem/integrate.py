@@ -2,6 +2,7 @@
 
 import numba
 
+from . import HOT_KERNEL_FASTMATH
 from .validate import check_range
 
 
@@ -18,7 +19,7 @@ def _damped(force, velocity, acceleration_dt, damping):
     return force * (1.0 - damping * sign)
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
 def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
              affine_rate, dt):
     """Advance velocities to t + dt/2 and positions to t + dt (spheres: no orientation needed).
