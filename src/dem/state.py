@@ -118,6 +118,11 @@ def _box_position(lo, hi):
 
 
 _NO_SHIFT = np.zeros(3)
+#: Zeros (3,) laid out as a periodic cell's ``period`` (a strided view of its (6,) faces), so
+#: that walled and periodic scenes call the kernels that take a period with one array type
+#: and share one compiled version of each (a second layout compiles them all again: 4-8 s a
+#: kernel at the first run).
+_NO_PERIOD = np.zeros(6)[1::2]
 _NO_VIRIAL = np.zeros((0, 9))
 
 
@@ -150,7 +155,7 @@ class Walls(Box):
     @property
     def period(self):
         """No periodic images: zeros (3,) [m]."""
-        return _NO_SHIFT
+        return _NO_PERIOD
 
     @property
     def affine_rate(self):
