@@ -117,7 +117,7 @@ def _box_position(lo, hi):
     return np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], dtype=np.float64)
 
 
-_NO_SHIFT = np.zeros(3)
+_NO_STRETCHING = np.zeros(3)
 #: Zeros (3,) laid out as a periodic cell's ``period`` (a strided view of its (6,) faces), so
 #: that walled and periodic scenes call the kernels that take a period with one array type
 #: and share one compiled version of each (a second layout compiles each again, about 4 s for
@@ -160,7 +160,7 @@ class Walls(Box):
     @property
     def affine_rate(self):
         """Walls carry no particle: zeros (3,) [1/s]."""
-        return _NO_SHIFT
+        return _NO_STRETCHING
 
     @property
     def virial_blocks(self):

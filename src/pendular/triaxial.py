@@ -542,7 +542,7 @@ class TriaxialTest:
                          field_data=lambda s: {"mean_wall_stress":
                                                float(np.mean(s.walls.stress()))})
 
-    def _run(self, out, progress, threads, stop_after, vtk_prep=False, plots=True):
+    def _run(self, out, progress, threads, stop_after, vtk_prep, plots):
         config = self.config
         started = time.perf_counter()
         frames = self.prep_writer(out, vtk_prep)
