@@ -19,6 +19,7 @@ from capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_co
 from conftest import PrescribedGap, two_body_scene
 from dem.contact_law import ContactForces, gather_contact_forces
 from dem.neighbors import NeighborList, build_contacts
+from dem.state import Walls
 from dem.walls import WallForces
 from homogenize import capillary_force_stress, contact_stress
 
@@ -184,7 +185,8 @@ def test_saturation_bridges_and_pendular_overlaps_against_hand_sums(wet_sample):
     wide = np.full(len(contacts), 31.0)    # caps 60 deg apart: 31 + 31 > 60
     assert pendular_overlap_counts(position, contacts.row_start, contacts.second_start,
                                    contacts.second_pair, contacts.pair_i, contacts.pair_j,
-                                   contacts.image, np.zeros(3), state, wide, wide).sum() == 3
+                                   contacts.image, Walls.box([-3.0] * 3, [3.0] * 3).period, state,
+                                   wide, wide).sum() == 3
 
 
 def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_sample):

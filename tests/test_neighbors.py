@@ -11,6 +11,7 @@ from conftest import RADIUS, two_body_scene
 from dem.contact_law import pair_forces
 from dem.neighbors import build_contacts, spatial_order
 from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
+from dem.state import Walls
 from dem.walls import ConstantStrainRate, StressServo
 from pendular.config import BridgeConfig
 
@@ -138,9 +139,10 @@ def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
     touching = np.array([[0.0, 0, 0], [1.999 * RADIUS, 0, 0]])
     contacts = build_contacts(touching, radius, 0.5 * RADIUS)
     still = np.zeros((2, 3))
+    walls = Walls.box([-1.0] * 3, [1.0] * 3)
 
     def evaluate(position, c):
-        pair_forces(position, still, still, radius, c.pair_i, c.pair_j, c.image, np.zeros(3),
+        pair_forces(position, still, still, radius, c.pair_i, c.pair_j, c.image, walls.period,
                     np.zeros(3), c.shear_force, c.normal, c.overlap, c.normal_force, c.force,
                     1e6, 0.3, 0.3, 1e-7)
 

@@ -213,7 +213,7 @@ def _periodic_grid(position, cell_size, period):
     dims = np.empty(3, np.int64)
     for axis in range(3):
         dims[axis] = int(period[axis] / cell_size)
-    return _sort_into_cells(position, np.zeros(3), period, dims)
+    return _sort_into_cells(position, np.zeros(3), period.copy(), dims)   # contiguous, as _cell_grid's
 
 
 @numba.njit(cache=True)
@@ -496,8 +496,12 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         force=np.zeros((size, 3)), extra=extra, image=image)
 
 
-#: The lengths moved_beyond compares in walled scenes: no stretching (NeighborList.apply).
-_UNSTRETCHED = np.ones(3)
+#: The lengths moved_beyond compares in walled scenes, no stretching (NeighborList.apply): the
+#: current ones laid out as a cell's period (a strided view, as dem.state._NO_PERIOD), the
+#: reference ones as the cell's contiguous copy at a rebuild, so that walled and periodic
+#: scenes share one compiled moved_beyond.
+_UNSTRETCHED = np.ones(6)[::2]
+_UNSTRETCHED_REFERENCE = np.ones(3)
 
 
 class NeighborList:
@@ -553,7 +557,7 @@ class NeighborList:
     def apply(self, sim):
         p = sim.particles
         reach = self.required_reach(sim)
-        lengths = reference = _UNSTRETCHED
+        lengths, reference = _UNSTRETCHED, _UNSTRETCHED_REFERENCE
         if sim.walls.periodic and self._reference_lengths is not None:
             lengths, reference = sim.walls.period, self._reference_lengths
         if (reach != self.interaction_range or sim.contacts is None

@@ -53,12 +53,16 @@ def check_int(name, value, low=0, high=None):
 
 
 def check_array(name, array, shape_tail=(), positive=False, length=None):
-    """Return ``array`` as contiguous float64 (a copy unless it already is one) after checking
-    its shape (``length`` rows if given, then ``shape_tail``), finiteness and sign."""
+    """Return ``array`` as contiguous, writable float64 (a copy unless it already is one)
+    after checking its shape (``length`` rows if given, then ``shape_tail``), finiteness and
+    sign. Always writable: a read-only view (``np.broadcast_to``) would both refuse in-place
+    updates and make every compiled kernel it reaches compile a second, read-only version."""
     try:
         data = np.ascontiguousarray(array, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{name} = {array!r} is not an array of numbers") from None
+    if not data.flags.writeable:
+        data = data.copy()
     if data.ndim != 1 + len(shape_tail) or data.shape[1:] != tuple(shape_tail):
         raise ValueError(f"{name} must have shape (N, {', '.join(map(str, shape_tail))}), got {data.shape}"
                          if shape_tail else f"{name} must be one-dimensional, got shape {data.shape}")
