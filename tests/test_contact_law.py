@@ -1,10 +1,13 @@
-"""Two-body tests of the linear contact law against closed forms."""
+"""Tests of the linear contact law: two bodies against closed forms, the pair loop's prefetch."""
 
 import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import normal_stiffness
+from dem.contact_law import normal_stiffness, pair_forces
+from dem.neighbors import build_contacts
+from dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
+from dem.state import Walls
 
 
 class CountContactSteps:
@@ -130,3 +133,32 @@ def test_contact_torques_act_at_the_middle_of_the_overlap():
         np.testing.assert_allclose(p.torque[member], expected, rtol=1e-12, atol=0)
     moment = p.torque.sum(axis=0) + np.cross(p.position, p.force).sum(axis=0)
     assert np.abs(moment).max() < 1e-12 * RADIUS * shear
+
+
+def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():
+    """The prefetch hint of large samples (dem.prefetch) reads ahead and changes nothing: a jammed
+    cloud of 2,000 spheres with random velocities and shear history, evaluated twice with and
+    without it (1 and 16 pairs ahead: the look-ahead's end of the list included)."""
+    rng = np.random.default_rng(7)
+    count = 2000
+    side = round(count ** (1 / 3)) + 1
+    lattice = np.stack(np.meshgrid(*[np.arange(side)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    position = (lattice[:count] * 1.9 * RADIUS + rng.normal(0, 0.05 * RADIUS, (count, 3)))
+    radius = RADIUS * rng.uniform(0.95, 1.05, count)
+    velocity = rng.normal(0, 1e-3, (count, 3))
+    spin = rng.normal(0, 1.0, (count, 3))
+    walls = Walls.box(position.min(0) - 2 * RADIUS, position.max(0) + 2 * RADIUS)
+    results = []
+    for ahead in (0, 1, PREFETCH_AHEAD):
+        c = build_contacts(position, radius, 0.2 * RADIUS)
+        c.shear_force[:] = np.random.default_rng(3).normal(0, 1e-6, c.shear_force.shape)
+        for _ in range(2):
+            pair_forces(position, velocity, spin, radius, c.pair_i, c.pair_j, c.image,
+                        walls.period, np.zeros(3), c.shear_force, c.normal, c.overlap,
+                        c.normal_force, c.force, YOUNG, 0.3, 0.3, 1e-6, ahead)
+        results.append(np.concatenate([c.force, c.shear_force, c.normal,
+                                       c.overlap[:, None], c.normal_force[:, None]], axis=1))
+    assert (results[0][:, -1] > 0).sum() > count      # many touching pairs
+    assert np.array_equal(results[0], results[1]) and np.array_equal(results[0], results[2])
+    assert prefetch_distance(PREFETCH_MIN_PAIRS - 1) == 0
+    assert prefetch_distance(PREFETCH_MIN_PAIRS) == PREFETCH_AHEAD

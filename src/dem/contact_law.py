@@ -9,6 +9,7 @@ import numba
 import numpy as np
 
 from . import HOT_KERNEL_FASTMATH
+from .prefetch import prefetch_distance, prefetch_row
 from .validate import check_positive, check_range
 from .virial import SUM_BLOCKS, add_face_block, block_bounds, pair_force_with_attraction
 
@@ -30,9 +31,12 @@ def wall_contact_stiffness(young, radius):
 @numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
 def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, image, period,
                 affine_rate, shear_force, normal, overlap, normal_force, force, young,
-                shear_ratio, tan_friction, dt):
+                shear_ratio, tan_friction, dt, prefetch_ahead):
     """Evaluate every candidate pair; fill the per-pair arrays (``force``: the force on j from
     i; the torques follow from it, the normal and the overlap in the gather).
+
+    prefetch_ahead: how many pairs ahead particle j's rows are asked of the cache (0: none;
+    dem.prefetch.prefetch_distance; no effect on results).
 
     image, period: each pair's periodic image and the box period (dem.neighbors.branch_vector;
     zeros inside walls); affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell,
@@ -48,7 +52,13 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     """
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
-    for k in numba.prange(len(pair_i)):
+    pair_count = len(pair_i)
+    for k in numba.prange(pair_count):
+        if prefetch_ahead > 0 and k + prefetch_ahead < pair_count:
+            ahead = pair_j[k + prefetch_ahead]
+            prefetch_row(position, ahead)
+            prefetch_row(velocity, ahead)
+            prefetch_row(angular_velocity, ahead)
         i = pair_i[k]
         j = pair_j[k]
         d0 = position[j, 0] - position[i, 0]
@@ -303,7 +313,7 @@ class ContactForces:
         pair_forces(p.position, p.velocity, p.angular_velocity, p.radius, c.pair_i, c.pair_j,
                     c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
                     c.normal_force, c.force, self.young, self.shear_ratio, self._tan_friction,
-                    sim.dt)
+                    sim.dt, prefetch_distance(len(c)))
         if self.joined_by(sim) is None:
             self.gather(sim)
 
