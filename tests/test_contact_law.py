@@ -143,7 +143,7 @@ def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():
     count = 2000
     side = round(count ** (1 / 3)) + 1
     lattice = np.stack(np.meshgrid(*[np.arange(side)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    position = (lattice[:count] * 1.9 * RADIUS + rng.normal(0, 0.05 * RADIUS, (count, 3)))
+    position = lattice[:count] * 1.9 * RADIUS + rng.normal(0, 0.05 * RADIUS, (count, 3))
     radius = RADIUS * rng.uniform(0.95, 1.05, count)
     velocity = rng.normal(0, 1e-3, (count, 3))
     spin = rng.normal(0, 1.0, (count, 3))

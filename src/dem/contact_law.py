@@ -35,14 +35,12 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     """Evaluate every candidate pair; fill the per-pair arrays (``force``: the force on j from
     i; the torques follow from it, the normal and the overlap in the gather).
 
-    prefetch_ahead: how many pairs ahead particle j's rows are asked of the cache (0: none;
-    dem.prefetch.prefetch_distance; no effect on results).
-
     image, period: each pair's periodic image and the box period (dem.neighbors.branch_vector;
     zeros inside walls); affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell,
     whose velocity affine_rate * l adds to the relative velocity of a pair of branch l. A
     scene without images or stretching (walls) skips both terms (a branch taken the same way
-    by every pair: no cost).
+    by every pair: no cost). prefetch_ahead: how many pairs ahead particle j's rows are asked
+    of the cache (0: none; dem.prefetch.prefetch_distance; no effect on results).
 
     The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
     is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),

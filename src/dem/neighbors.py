@@ -215,7 +215,8 @@ def _periodic_grid(position, cell_size, period):
     dims = np.empty(3, np.int64)
     for axis in range(3):
         dims[axis] = int(period[axis] / cell_size)
-    return _sort_into_cells(position, np.zeros(3), period.copy(), dims)   # contiguous, as _cell_grid's
+    # the period copied: contiguous, as _cell_grid's bounds (one compiled _sort_into_cells)
+    return _sort_into_cells(position, np.zeros(3), period.copy(), dims)
 
 
 @numba.njit(cache=True)
