@@ -132,6 +132,26 @@ def test_discrete_sums_of_one_bridge():
     assert effective_stress(total, chi, b, suction, air) == pytest.approx(total - air * np.eye(3) + psi)
 
 
+def test_discrete_sums_of_many_bridges_are_the_sums_of_the_rotated_tensors():
+    """chi and B summed as (sum a) I + sum (c - a) n n^T (axisymmetric_sum) equal the sums of the
+    per-bridge tensors turned onto their normals one by one (rotate_to_normal)."""
+    count = 500
+    rng = np.random.default_rng(5)
+    normal = random_normals(count, 9)
+    r1, r2 = rng.uniform(1e-5, 3e-5, count), rng.uniform(1e-5, 3e-5, count)
+    d1, d2 = rng.uniform(1, 40, count), rng.uniform(1, 40, count)
+    theta, gamma, volume, water = 12.0, 0.073, 1e-9, 1e-13
+    caps = wetted_cap_integral(r1, d1) + wetted_cap_integral(r2, d2)
+    lines = contact_line_integral(r1, d1, theta, gamma) + contact_line_integral(r2, d2, theta, gamma)
+    chi = effective_stress_parameter(normal, r1, r2, d1, d2, water, volume)
+    b = surface_tension_stress(normal, r1, r2, d1, d2, theta, gamma, volume)
+    expected_chi = (water * np.eye(3) + rotate_to_normal(caps, normal).sum(axis=0)) / volume
+    expected_b = rotate_to_normal(lines, normal).sum(axis=0) / volume
+    np.testing.assert_allclose(chi, expected_chi, rtol=1e-12, atol=1e-14 * np.abs(expected_chi).max())
+    np.testing.assert_allclose(b, expected_b, rtol=1e-12, atol=1e-14 * np.abs(expected_b).max())
+    assert np.abs(chi - np.diag(np.diag(chi))).max() > 1e-3 * np.abs(chi).max()    # not diagonal
+
+
 def test_discrete_sums_of_many_bridges_are_fast_and_checked():
     count = 30000
     rng = np.random.default_rng(2)

@@ -28,7 +28,8 @@ bridge (alpha = delta1 on R1, delta2 on R2):
 with V_w = n Sr V the water volume (sum of the bridge volumes) and s = u_a - u_w the matric
 suction. SI units, stresses compression positive, angles in degrees. The functions take plain
 arrays (one row per bridge) so that a recorder can pass the live bridge arrays; they are
-vectorised numpy (about 10 ms for 30,000 bridges).
+vectorised numpy, the sums built from each tensor's two diagonal values (axisymmetric_sum):
+chi and B of 25,000 bridges in 4 and 5 ms (9 and 11 ms summed from (K, 3, 3) tensors).
 """
 
 import numpy as np
@@ -52,6 +53,18 @@ def _axisymmetric(lateral, axial):
     return tensor
 
 
+def wetted_cap_diagonal(radius, filling_angle):
+    """(lateral, axial) [m^3]: the wetted-cap integral A = diag(lateral, lateral, axial) in the
+    bridge frame (wetted_cap_integral, Eq. 3.48), as arrays of the broadcast arguments."""
+    radius = check_values("radius", radius, 0.0, low_inclusive=False, unit="m")
+    filling_angle = check_values("filling_angle", filling_angle, 0.0, 180.0, unit="deg")
+    versine = _versine(filling_angle)
+    scale = np.pi * radius ** 3 / 3.0
+    lateral = scale * versine**2 * (3.0 - versine)  # (1 - c)^2 (2 + c), c = 1 - versine
+    axial = scale * 2.0 * versine * (3.0 - 3.0 * versine + versine**2)  # 2 (1 - c)(1 + c + c^2)
+    return lateral, axial
+
+
 def wetted_cap_integral(radius, filling_angle):
     """A_ij = ∫ R n_i n_j dΓ over a wetted cap of half-angle alpha, bridge frame (Eq. 3.48) [m^3].
 
@@ -59,22 +72,12 @@ def wetted_cap_integral(radius, filling_angle):
     cap area, and A = (4/3) pi R^3 I for the whole sphere (a = 180 deg, the saturated limit).
     radius [m] and filling_angle [deg] broadcast; returns shape (..., 3, 3).
     """
-    radius = check_values("radius", radius, 0.0, low_inclusive=False, unit="m")
-    filling_angle = check_values("filling_angle", filling_angle, 0.0, 180.0, unit="deg")
-    versine = _versine(filling_angle)
-    scale = np.pi * radius ** 3 / 3.0
-    lateral = scale * versine**2 * (3.0 - versine)  # (1 - c)^2 (2 + c), c = 1 - versine
-    axial = scale * 2.0 * versine * (3.0 - 3.0 * versine + versine**2)  # 2 (1 - c)(1 + c + c^2)
-    return _axisymmetric(lateral, axial)
+    return _axisymmetric(*wetted_cap_diagonal(radius, filling_angle))
 
 
-def contact_line_integral(radius, filling_angle, contact_angle, surface_tension):
-    """B'_ij = ∫ R gamma n_i e_j dl along the contact line of a cap, bridge frame (Eq. 3.49) [N m].
-
-    B' = pi R^2 gamma diag(-sin^2 a cos(a + theta), same, sin(2a) sin(a + theta)).
-    radius [m], filling_angle and contact_angle [deg], surface_tension [N/m] broadcast;
-    returns shape (..., 3, 3).
-    """
+def contact_line_diagonal(radius, filling_angle, contact_angle, surface_tension):
+    """(lateral, axial) [N m]: the contact-line integral B' = diag(lateral, lateral, axial) in
+    the bridge frame (contact_line_integral, Eq. 3.49), as arrays of the broadcast arguments."""
     radius = check_values("radius", radius, 0.0, low_inclusive=False, unit="m")
     alpha = np.radians(check_values("filling_angle", filling_angle, 0.0, 180.0, unit="deg"))
     wetting = alpha + np.radians(check_values("contact_angle", contact_angle, 0.0, 90.0,
@@ -84,7 +87,17 @@ def contact_line_integral(radius, filling_angle, contact_angle, surface_tension)
     scale = np.pi * radius ** 2 * surface_tension
     lateral = -scale * np.sin(alpha) ** 2 * np.cos(wetting)
     axial = scale * np.sin(2.0 * alpha) * np.sin(wetting)
-    return _axisymmetric(lateral, axial)
+    return lateral, axial
+
+
+def contact_line_integral(radius, filling_angle, contact_angle, surface_tension):
+    """B'_ij = ∫ R gamma n_i e_j dl along the contact line of a cap, bridge frame (Eq. 3.49) [N m].
+
+    B' = pi R^2 gamma diag(-sin^2 a cos(a + theta), same, sin(2a) sin(a + theta)).
+    radius [m], filling_angle and contact_angle [deg], surface_tension [N/m] broadcast;
+    returns shape (..., 3, 3).
+    """
+    return _axisymmetric(*contact_line_diagonal(radius, filling_angle, contact_angle, surface_tension))
 
 
 def rotation_onto(normal):
@@ -118,27 +131,18 @@ def rotate_to_normal(local_tensor, normal):
     return np.einsum("kia,kab,kjb->kij", rotation, local_tensor, rotation, optimize=True)
 
 
-_OFF_DIAGONAL = [1, 2, 3, 5, 6, 7]
-"""Flat indices of the off-diagonal entries of a 3x3 tensor."""
+def axisymmetric_sum(lateral, axial, normal):
+    """sum_k M_k diag(a_k, a_k, c_k) M_k^T (3, 3), M_k e_z = normal_k, for the per-bridge
+    ``lateral`` a_k and ``axial`` c_k (K,) of axisymmetric bridge-frame tensors (A, B', the
+    interface integral) and unit ``normal`` (K, 3).
 
-
-def _rotated_sum(local_tensor, normal):
-    """sum_k M_k X_k M_k^T (3, 3), M_k e_z = normal_k.
-
-    For axisymmetric X_k = diag(a_k, a_k, c_k) (A and B' of every bridge) the rotated tensor is
-    a_k I + (c_k - a_k) n_k n_k^T whatever M_k does about the normal, and the sum is the weighted
-    outer product (sum a_k) I + sum (c_k - a_k) n_k n_k^T: O(K) without building the rotations
-    (about 30 times faster than the einsum for the live DEM state's bridges). Other tensors
-    take the general path.
-    """
-    local_tensor = np.asarray(local_tensor, dtype=float)
-    flat = local_tensor.reshape(len(local_tensor), 9)
-    if np.array_equal(flat[:, 0], flat[:, 4]) and not np.any(flat[:, _OFF_DIAGONAL]):
-        normal = np.asarray(normal, dtype=float)
-        lateral = flat[:, 0]
-        return lateral.sum() * np.eye(3) + (normal * (flat[:, 8] - lateral)[:, None]).T @ normal
-    rotation = rotation_onto(normal)
-    return np.einsum("kia,kab,kjb->ij", rotation, local_tensor, rotation, optimize=True)
+    Each rotated tensor is a_k I + (c_k - a_k) n_k n_k^T whatever M_k does about the normal, so
+    the sum is (sum a_k) I + sum (c_k - a_k) n_k n_k^T: O(K) without building the rotations or
+    the (K, 3, 3) tensors (rotate_to_normal does, for one tensor per bridge; tests check the two
+    agree)."""
+    normal = np.asarray(normal, dtype=float)
+    lateral = np.asarray(lateral, dtype=float)
+    return lateral.sum() * np.eye(3) + (normal * (np.asarray(axial, float) - lateral)[:, None]).T @ normal
 
 
 def _bridge_arrays(normal, radius_1, radius_2, filling_angle_1, filling_angle_2, volume):
@@ -170,8 +174,10 @@ def effective_stress_parameter(normal, radius_1, radius_2, filling_angle_1, fill
     """
     normal, radius_1, radius_2, filling_angle_1, filling_angle_2 = _bridge_arrays(
         normal, radius_1, radius_2, filling_angle_1, filling_angle_2, volume)
-    caps = wetted_cap_integral(radius_1, filling_angle_1) + wetted_cap_integral(radius_2, filling_angle_2)
-    return (water_volume * np.eye(3) + _rotated_sum(caps, normal)) / volume
+    lateral_1, axial_1 = wetted_cap_diagonal(radius_1, filling_angle_1)
+    lateral_2, axial_2 = wetted_cap_diagonal(radius_2, filling_angle_2)
+    caps = axisymmetric_sum(lateral_1 + lateral_2, axial_1 + axial_2, normal)
+    return (water_volume * np.eye(3) + caps) / volume
 
 
 def surface_tension_stress(normal, radius_1, radius_2, filling_angle_1, filling_angle_2,
@@ -183,9 +189,9 @@ def surface_tension_stress(normal, radius_1, radius_2, filling_angle_1, filling_
     """
     normal, radius_1, radius_2, filling_angle_1, filling_angle_2 = _bridge_arrays(
         normal, radius_1, radius_2, filling_angle_1, filling_angle_2, volume)
-    lines = (contact_line_integral(radius_1, filling_angle_1, contact_angle, surface_tension)
-             + contact_line_integral(radius_2, filling_angle_2, contact_angle, surface_tension))
-    return _rotated_sum(lines, normal) / volume
+    lateral_1, axial_1 = contact_line_diagonal(radius_1, filling_angle_1, contact_angle, surface_tension)
+    lateral_2, axial_2 = contact_line_diagonal(radius_2, filling_angle_2, contact_angle, surface_tension)
+    return axisymmetric_sum(lateral_1 + lateral_2, axial_1 + axial_2, normal) / volume
 
 
 def interface_stress(normal, nn11, nn33, surface_tension, volume):
@@ -201,8 +207,7 @@ def interface_stress(normal, nn11, nn33, surface_tension, volume):
     normal = np.asarray(normal, dtype=float).reshape(-1, 3)
     nn11 = np.broadcast_to(np.asarray(nn11, dtype=float), (len(normal),))
     nn33 = np.broadcast_to(np.asarray(nn33, dtype=float), (len(normal),))
-    local = _axisymmetric(nn11 + nn33, 2.0 * nn11)
-    return surface_tension * _rotated_sum(local, normal) / volume
+    return surface_tension * axisymmetric_sum(nn11 + nn33, 2.0 * nn11, normal) / volume
 
 
 def capillary_stress(chi, tension_stress, suction):

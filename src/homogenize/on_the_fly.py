@@ -68,13 +68,13 @@ from capillary.bridge_state import BridgeState
 from dem.neighbors import branch_vectors
 from dem.validate import check_positive
 from homogenize.bridge_tensors import (
-    _rotated_sum,
+    axisymmetric_sum,
     capillary_stress,
     capillary_stress_anisotropy,
     effective_stress_parameter,
     interface_stress,
     surface_tension_stress,
-    wetted_cap_integral,
+    wetted_cap_diagonal,
 )
 from homogenize.contact_stress import pair_stress_sum
 from homogenize.fabric import fabric_tensor, principal_anisotropy
@@ -187,10 +187,11 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
             raise ValueError(f"suction has shape {suction.shape}; expected a scalar or "
                              f"({len(contacts)},), one per pair")
         own = suction[index]
-        weighted = own[:, None, None] * (wetted_cap_integral(radius_i, filling_i)
-                                         + wetted_cap_integral(radius_j, filling_j))
-        psi = (float(np.sum(own * bridge_volume)) * np.eye(3)
-               + _rotated_sum(weighted, normal)) / volume + tension
+        lateral_i, axial_i = wetted_cap_diagonal(radius_i, filling_i)
+        lateral_j, axial_j = wetted_cap_diagonal(radius_j, filling_j)
+        weighted = axisymmetric_sum(own * (lateral_i + lateral_j), own * (axial_i + axial_j),
+                                    normal)
+        psi = (float(np.sum(own * bridge_volume)) * np.eye(3) + weighted) / volume + tension
     interface = None
     if interfaces is not None:
         interfaces = np.asarray(interfaces, dtype=float)
