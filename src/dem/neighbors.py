@@ -55,12 +55,11 @@ class Contacts:
     face_start: np.ndarray = None
 
     def __post_init__(self):
-        if self.image is None:          # no images: none through a face (no scan of zeros)
+        if self.through_face is None:   # no images: none through a face (no scan of zeros)
+            self.through_face = (np.zeros(0, np.int64) if self.image is None else
+                                 np.flatnonzero(self.image.any(axis=1)).astype(np.int64))
+        if self.image is None:
             self.image = np.zeros((len(self.pair_j), 3), np.int8)
-            if self.through_face is None:
-                self.through_face = np.zeros(0, np.int64)
-        if self.through_face is None:
-            self.through_face = np.flatnonzero(self.image.any(axis=1)).astype(np.int64)
         if self.face_start is None:
             self.face_start = face_block_starts(self.through_face, self.row_start)
 

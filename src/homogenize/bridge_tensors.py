@@ -142,7 +142,17 @@ def axisymmetric_sum(lateral, axial, normal):
     agree)."""
     normal = np.asarray(normal, dtype=float)
     lateral = np.asarray(lateral, dtype=float)
-    return lateral.sum() * np.eye(3) + (normal * (np.asarray(axial, float) - lateral)[:, None]).T @ normal
+    weight = np.asarray(axial, dtype=float) - lateral
+    return lateral.sum() * np.eye(3) + (normal * weight[:, None]).T @ normal
+
+
+def wetted_caps_sum(normal, radius_1, radius_2, filling_angle_1, filling_angle_2, weight=1.0):
+    """sum_bridges w_k [Rot A(R1, delta1) + Rot A(R2, delta2)] (3, 3) [m^3 times w]: the sum of
+    Eq. 3.44 over both caps of each bridge, each bridge weighted by ``weight`` (a scalar or (K,),
+    e.g. each bridge's own suction; 1 for chi). Arguments as for effective_stress_parameter."""
+    lateral_1, axial_1 = wetted_cap_diagonal(radius_1, filling_angle_1)
+    lateral_2, axial_2 = wetted_cap_diagonal(radius_2, filling_angle_2)
+    return axisymmetric_sum(weight * (lateral_1 + lateral_2), weight * (axial_1 + axial_2), normal)
 
 
 def _bridge_arrays(normal, radius_1, radius_2, filling_angle_1, filling_angle_2, volume):
@@ -174,9 +184,7 @@ def effective_stress_parameter(normal, radius_1, radius_2, filling_angle_1, fill
     """
     normal, radius_1, radius_2, filling_angle_1, filling_angle_2 = _bridge_arrays(
         normal, radius_1, radius_2, filling_angle_1, filling_angle_2, volume)
-    lateral_1, axial_1 = wetted_cap_diagonal(radius_1, filling_angle_1)
-    lateral_2, axial_2 = wetted_cap_diagonal(radius_2, filling_angle_2)
-    caps = axisymmetric_sum(lateral_1 + lateral_2, axial_1 + axial_2, normal)
+    caps = wetted_caps_sum(normal, radius_1, radius_2, filling_angle_1, filling_angle_2)
     return (water_volume * np.eye(3) + caps) / volume
 
 

@@ -68,13 +68,12 @@ from capillary.bridge_state import BridgeState
 from dem.neighbors import branch_vectors
 from dem.validate import check_positive
 from homogenize.bridge_tensors import (
-    axisymmetric_sum,
     capillary_stress,
     capillary_stress_anisotropy,
     effective_stress_parameter,
     interface_stress,
     surface_tension_stress,
-    wetted_cap_diagonal,
+    wetted_caps_sum,
 )
 from homogenize.contact_stress import pair_stress_sum
 from homogenize.fabric import fabric_tensor, principal_anisotropy
@@ -187,10 +186,7 @@ def homogenize_bridges(particles, contacts, volume, *, suction, contact_angle, s
             raise ValueError(f"suction has shape {suction.shape}; expected a scalar or "
                              f"({len(contacts)},), one per pair")
         own = suction[index]
-        lateral_i, axial_i = wetted_cap_diagonal(radius_i, filling_i)
-        lateral_j, axial_j = wetted_cap_diagonal(radius_j, filling_j)
-        weighted = axisymmetric_sum(own * (lateral_i + lateral_j), own * (axial_i + axial_j),
-                                    normal)
+        weighted = wetted_caps_sum(*caps, weight=own)
         psi = (float(np.sum(own * bridge_volume)) * np.eye(3) + weighted) / volume + tension
     interface = None
     if interfaces is not None:
