@@ -1,13 +1,18 @@
-"""Tests of the linear contact law: two bodies against closed forms, the pair loop's prefetch."""
+"""Tests of the linear contact law: two bodies against closed forms, the pair loop's prefetch,
+the one-thread kernels against the multi-thread pair loop and gathers."""
 
+import numba
 import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import normal_stiffness, pair_forces
+from dem.contact_law import (add_face_terms, gather_contact_forces, gather_contact_forces_virial,
+                             normal_stiffness, pair_forces, scatter_contact_forces,
+                             scattered_pair_forces)
 from dem.neighbors import build_contacts
 from dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
 from dem.state import Walls
+from dem.virial import SUM_BLOCKS
 
 
 class CountContactSteps:
@@ -135,30 +140,108 @@ def test_contact_torques_act_at_the_middle_of_the_overlap():
     assert np.abs(moment).max() < 1e-12 * RADIUS * shear
 
 
-def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():
-    """The prefetch hint of large samples (dem.prefetch) reads ahead and changes nothing: a jammed
-    cloud of 2,000 spheres with random velocities and shear history, evaluated twice with and
-    without it (1 and 16 pairs ahead: the look-ahead's end of the list included)."""
-    rng = np.random.default_rng(7)
-    count = 2000
+def jammed_cloud(count=2000, seed=7):
+    """``count`` spheres on a lattice of spacing 1.9 R jiggled by 0.05 R, radii R (1 +- 0.05),
+    random velocities and spins: (position, radius, velocity, spin, lattice period (3,) [m])."""
+    rng = np.random.default_rng(seed)
     side = round(count ** (1 / 3)) + 1
     lattice = np.stack(np.meshgrid(*[np.arange(side)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    position = lattice[:count] * 1.9 * RADIUS + rng.normal(0, 0.05 * RADIUS, (count, 3))
+    position = (lattice[:count] + 0.5) * 1.9 * RADIUS + rng.normal(0, 0.05 * RADIUS, (count, 3))
     radius = RADIUS * rng.uniform(0.95, 1.05, count)
     velocity = rng.normal(0, 1e-3, (count, 3))
     spin = rng.normal(0, 1.0, (count, 3))
+    return position, radius, velocity, spin, np.full(3, side * 1.9 * RADIUS)
+
+
+def evaluate(kernel, position, velocity, spin, radius, contacts, period, *extra):
+    """The pair kernel ``kernel`` on ``contacts``, with ``extra`` arguments after the common
+    ones, after a first evaluation by pair_forces from a random shear history (so that the
+    kernel rotates the history with the normals of that evaluation)."""
+    c = contacts
+    c.shear_force[:] = np.random.default_rng(3).normal(0, 1e-6, c.shear_force.shape)
+    common = (position, velocity, spin, radius, c.pair_i, c.pair_j, c.image, period, np.zeros(3),
+              c.shear_force, c.normal, c.overlap, c.normal_force, c.force, YOUNG, 0.3, 0.3, 1e-6)
+    pair_forces(*common, 0)
+    kernel(*common, *extra)
+
+
+def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():
+    """The prefetch hint of large samples (dem.prefetch) reads ahead and changes nothing: a jammed
+    cloud of 2,000 spheres with random velocities and shear history, evaluated with and
+    without it (1 and 16 pairs ahead: the look-ahead's end of the list included)."""
+    position, radius, velocity, spin, _ = jammed_cloud()
     walls = Walls.box(position.min(0) - 2 * RADIUS, position.max(0) + 2 * RADIUS)
     results = []
     for ahead in (0, 1, PREFETCH_AHEAD):
         c = build_contacts(position, radius, 0.2 * RADIUS)
-        c.shear_force[:] = np.random.default_rng(3).normal(0, 1e-6, c.shear_force.shape)
-        for _ in range(2):
-            pair_forces(position, velocity, spin, radius, c.pair_i, c.pair_j, c.image,
-                        walls.period, np.zeros(3), c.shear_force, c.normal, c.overlap,
-                        c.normal_force, c.force, YOUNG, 0.3, 0.3, 1e-6, ahead)
+        evaluate(pair_forces, position, velocity, spin, radius, c, walls.period, ahead)
         results.append(np.concatenate([c.force, c.shear_force, c.normal,
                                        c.overlap[:, None], c.normal_force[:, None]], axis=1))
-    assert (results[0][:, -1] > 0).sum() > count      # many touching pairs
+    assert (results[0][:, -1] > 0).sum() > len(radius)      # many touching pairs
     assert np.array_equal(results[0], results[1]) and np.array_equal(results[0], results[2])
     assert prefetch_distance(PREFETCH_MIN_PAIRS - 1) == 0
     assert prefetch_distance(PREFETCH_MIN_PAIRS) == PREFETCH_AHEAD
+
+
+@pytest.mark.parametrize("periodic", [False, True], ids=["walls", "cell"])
+def test_one_thread_kernels_give_the_gathers_sums_bit_for_bit(periodic):
+    """On one thread the pair forces go straight to the particles: scattered_pair_forces (the
+    pair loop and the gather in one) and scatter_contact_forces (the gather with a central
+    attraction, as bridges at contact) add the same terms in the same order as the pair loop
+    and the gather on every thread Numba has, so forces, torques and a cell's face terms of
+    the virial are the same bit for bit (and results do not depend on the thread count). A
+    jammed cloud of 2,000 spheres, in walls and in a periodic cell whose faces it presses
+    through; each kernel prefetching (1 ahead) or not."""
+    position, radius, velocity, spin, lattice = jammed_cloud()
+    period = lattice if periodic else np.zeros(3)
+    count = len(radius)
+    attraction = None
+
+    def contacts():
+        return build_contacts(position, radius, 0.2 * RADIUS, period=lattice if periodic else None)
+
+    def gathered(c):
+        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+        if periodic:
+            gather_contact_forces_virial(c.force, attraction, c.normal, c.overlap, radius,
+                                         c.row_start, c.second_start, c.second_pair, force,
+                                         torque, c.image, c.through_face, c.face_start, period,
+                                         virial)
+        else:
+            gather_contact_forces(c.force, attraction, c.normal, c.overlap, radius, c.row_start,
+                                  c.second_start, c.second_pair, force, torque)
+        return force, torque, virial
+
+    def faces(c, virial):
+        if periodic:
+            add_face_terms(virial, c.through_face, c.face_start, c.image, period, c.force,
+                           attraction, c.normal)
+
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    reference = contacts()
+    evaluate(pair_forces, position, velocity, spin, radius, reference, period, 0)
+    assert np.count_nonzero(reference.overlap > 0) > count
+    assert not periodic or np.count_nonzero(reference.overlap[reference.through_face] > 0) > 100
+    expected = gathered(reference)
+    for ahead in (0, 1):
+        scattered = contacts()
+        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+        evaluate(scattered_pair_forces, position, velocity, spin, radius, scattered, period,
+                 ahead, force, torque)
+        faces(scattered, virial)
+        assert np.array_equal(scattered.force, reference.force)
+        for name, value, gathered_value in zip(("force", "torque", "virial"),
+                                               (force, torque, virial), expected):
+            assert np.array_equal(value, gathered_value), name
+
+    attraction = np.random.default_rng(5).uniform(0, 1e-4, len(reference))
+    expected = gathered(reference)
+    for ahead in (0, 1):
+        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+        scatter_contact_forces(reference.force, attraction, reference.normal, reference.overlap,
+                               radius, reference.pair_i, reference.pair_j, force, torque, ahead)
+        faces(reference, virial)
+        for name, value, gathered_value in zip(("force", "torque", "virial"),
+                                               (force, torque, virial), expected):
+            assert np.array_equal(value, gathered_value), name
+    assert np.abs(expected[0]).max() > 0 and np.abs(expected[1]).max() > 0
