@@ -195,13 +195,15 @@ def test_one_thread_kernels_give_the_gathers_sums_bit_for_bit(periodic):
     position, radius, velocity, spin, lattice = jammed_cloud()
     period = lattice if periodic else np.zeros(3)
     count = len(radius)
-    attraction = None
 
     def contacts():
         return build_contacts(position, radius, 0.2 * RADIUS, period=lattice if periodic else None)
 
-    def gathered(c):
-        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+    def zeros():
+        return np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+
+    def gathered(c, attraction):
+        force, torque, virial = zeros()
         if periodic:
             gather_contact_forces_virial(c.force, attraction, c.normal, c.overlap, radius,
                                          c.row_start, c.second_start, c.second_pair, force,
@@ -212,36 +214,40 @@ def test_one_thread_kernels_give_the_gathers_sums_bit_for_bit(periodic):
                                   c.second_start, c.second_pair, force, torque)
         return force, torque, virial
 
-    def faces(c, virial):
+    def add_faces(c, virial, attraction):
         if periodic:
             add_face_terms(virial, c.through_face, c.face_start, c.image, period, c.force,
                            attraction, c.normal)
 
-    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-    reference = contacts()
-    evaluate(pair_forces, position, velocity, spin, radius, reference, period, 0)
+    def assert_same(sums, expected):
+        for name, value, reference_value in zip(("force", "torque", "virial"), sums, expected):
+            assert np.array_equal(value, reference_value), name
+
+    caller_threads = numba.get_num_threads()
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)     # the gather on every thread
+    try:
+        reference = contacts()
+        evaluate(pair_forces, position, velocity, spin, radius, reference, period, 0)
+        attraction = np.random.default_rng(5).uniform(0, 1e-4, len(reference))  # bridges [N]
+        expected_dry = gathered(reference, None)
+        expected_wet = gathered(reference, attraction)
+    finally:
+        numba.set_num_threads(caller_threads)
     assert np.count_nonzero(reference.overlap > 0) > count
     assert not periodic or np.count_nonzero(reference.overlap[reference.through_face] > 0) > 100
-    expected = gathered(reference)
+    assert np.abs(expected_dry[1]).max() > 0 and not np.array_equal(expected_dry[0],
+                                                                     expected_wet[0])
     for ahead in (0, 1):
         scattered = contacts()
-        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+        force, torque, virial = zeros()
         evaluate(scattered_pair_forces, position, velocity, spin, radius, scattered, period,
                  ahead, force, torque)
-        faces(scattered, virial)
+        add_faces(scattered, virial, None)
         assert np.array_equal(scattered.force, reference.force)
-        for name, value, gathered_value in zip(("force", "torque", "virial"),
-                                               (force, torque, virial), expected):
-            assert np.array_equal(value, gathered_value), name
+        assert_same((force, torque, virial), expected_dry)
 
-    attraction = np.random.default_rng(5).uniform(0, 1e-4, len(reference))
-    expected = gathered(reference)
-    for ahead in (0, 1):
-        force, torque, virial = np.zeros((count, 3)), np.zeros((count, 3)), np.zeros((SUM_BLOCKS, 9))
+        force, torque, virial = zeros()
         scatter_contact_forces(reference.force, attraction, reference.normal, reference.overlap,
                                radius, reference.pair_i, reference.pair_j, force, torque, ahead)
-        faces(reference, virial)
-        for name, value, gathered_value in zip(("force", "torque", "virial"),
-                                               (force, torque, virial), expected):
-            assert np.array_equal(value, gathered_value), name
-    assert np.abs(expected[0]).max() > 0 and np.abs(expected[1]).max() > 0
+        add_faces(reference, virial, attraction)
+        assert_same((force, torque, virial), expected_wet)
