@@ -317,20 +317,28 @@ def second_index(row_start, pair_j, count):
 
 
 @numba.njit(cache=True, parallel=True)
-def carry_history(old_row_start, old_pair_j, old_values, new_row_start, new_pair_j, new_values):
-    """Copy per-pair rows of ``old_values`` to the same (i, j) pair in the new list; others stay 0."""
-    count = len(new_row_start) - 1
-    width = old_values.shape[1]
-    for i in numba.prange(count):
+def previous_pair_index(old_row_start, old_pair_j, new_row_start, new_pair_j):
+    """(K,) int64: for each pair of the new list, the index of the same (i, j) pair in the old
+    one, or -1 for a pair new to the list (both lists in CSR order, each row sorted by j)."""
+    index = np.empty(len(new_pair_j), np.int64)
+    for i in numba.prange(len(new_row_start) - 1):
         old = old_row_start[i]
         old_end = old_row_start[i + 1]
         for k in range(new_row_start[i], new_row_start[i + 1]):
             j = new_pair_j[k]
             while old < old_end and old_pair_j[old] < j:
                 old += 1
-            if old < old_end and old_pair_j[old] == j:
-                for c in range(width):
-                    new_values[k, c] = old_values[old, c]
+            index[k] = old if old < old_end and old_pair_j[old] == j else -1
+    return index
+
+
+@numba.njit(cache=True, parallel=True)
+def _carry_rows(old_values, index, new_values):
+    """Row k of ``new_values`` becomes row index[k] of ``old_values`` where index[k] >= 0."""
+    for k in numba.prange(len(index)):
+        if index[k] >= 0:
+            for c in range(old_values.shape[1]):
+                new_values[k, c] = old_values[index[k], c]
 
 
 @numba.njit(cache=True)
@@ -438,14 +446,14 @@ def spatial_order(position, cell_size):
     return np.argsort(code, kind="stable")
 
 
-def carry_pair_array(previous, values, row_start, pair_j):
-    """``values`` (one row per pair of ``previous``) moved to the pairs of a new list
-    (``row_start``, ``pair_j``); pairs absent before get zeros. Any dtype and trailing shape."""
-    carried = np.zeros((len(pair_j),) + values.shape[1:], dtype=values.dtype)
-    if len(previous) and len(pair_j):
-        old = np.ascontiguousarray(values).reshape(len(values), -1)
-        carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j,
-                      carried.reshape(len(pair_j), -1))
+def carry_pair_array(values, index, fill=0):
+    """``values`` (one row per pair of the old list) moved to the pairs of a new list, whose
+    pair k was pair index[k] of the old one (previous_pair_index; -1: new to the list, gets
+    ``fill``). Any dtype and trailing shape."""
+    carried = np.full((len(index),) + values.shape[1:], fill, dtype=values.dtype)
+    if len(index) and len(values):
+        _carry_rows(np.ascontiguousarray(values).reshape(len(values), -1), index,
+                    carried.reshape(len(index), -1))
     return carried
 
 
@@ -478,25 +486,23 @@ def build_contacts(position, radius, skin, previous=None, period=None):
     second_start, second_pair = second_index(row_start, pair_j, count)
     size = len(pair_j)
     # shear spring, normal and overlap of the last evaluation: a pair that was touching and
-    # is found apart at the first evaluation after the rebuild forgets its spring there
-    history = np.zeros((size, 7))
-    history[:, 6] = -np.inf
-    if previous is not None and len(previous):
-        old = np.concatenate([previous.shear_force, previous.normal, previous.overlap[:, None]],
-                             axis=1)
-        carry_history(previous.row_start, previous.pair_j, old, row_start, pair_j, history)
-    extra = {}
-    if previous is not None:
-        for name, values in previous.extra.items():
-            extra[name] = carry_pair_array(previous, values, row_start, pair_j)
+    # is found apart at the first evaluation after the rebuild forgets its spring there; a
+    # new pair has never touched (overlap -inf)
+    if previous is None:            # no history: empty arrays to carry from
+        shear_force, normal, overlap, extra = np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), {}
+    else:
+        shear_force, normal, overlap, extra = (previous.shear_force, previous.normal,
+                                               previous.overlap, previous.extra)
+    index = (previous_pair_index(previous.row_start, previous.pair_j, row_start, pair_j)
+             if len(overlap) else np.full(size, -1, np.int64))
     return Contacts(
         pair_i=pair_i, pair_j=pair_j, row_start=row_start,
         second_start=second_start, second_pair=second_pair,
-        shear_force=np.ascontiguousarray(history[:, :3]),
-        normal=np.ascontiguousarray(history[:, 3:6]),
-        overlap=np.ascontiguousarray(history[:, 6]), normal_force=np.zeros(size),
-        force=np.zeros((size, 3)), extra=extra, image=image)
-
+        shear_force=carry_pair_array(shear_force, index),
+        normal=carry_pair_array(normal, index),
+        overlap=carry_pair_array(overlap, index, -np.inf),
+        normal_force=np.zeros(size), force=np.zeros((size, 3)), image=image,
+        extra={name: carry_pair_array(values, index) for name, values in extra.items()})
 
 #: The lengths moved_beyond compares in walled scenes, no stretching (NeighborList.apply): the
 #: current ones laid out as a cell's period (a strided view, as dem.state._NO_PERIOD), the
