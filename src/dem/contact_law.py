@@ -85,21 +85,19 @@ def _evaluate_pair(k, position, velocity, angular_velocity, radius, pair_i, pair
     a2 = o0 * n1 - o1 * n0
     fs0, fs1, fs2 = (fs0 - (fs1 * a2 - fs2 * a1), fs1 - (fs2 * a0 - fs0 * a2),
                      fs2 - (fs0 * a1 - fs1 * a0))
-    spin = 0.5 * dt * (n0 * (angular_velocity[i, 0] + angular_velocity[j, 0])
-                       + n1 * (angular_velocity[i, 1] + angular_velocity[j, 1])
-                       + n2 * (angular_velocity[i, 2] + angular_velocity[j, 2]))
-    a0 = spin * n0
-    a1 = spin * n1
-    a2 = spin * n2
-    fs0, fs1, fs2 = (fs0 - (fs1 * a2 - fs2 * a1), fs1 - (fs2 * a0 - fs0 * a2),
-                     fs2 - (fs0 * a1 - fs1 * a0))
-    # relative velocity of j with respect to i at the contact point
     wi0 = angular_velocity[i, 0]
     wi1 = angular_velocity[i, 1]
     wi2 = angular_velocity[i, 2]
     wj0 = angular_velocity[j, 0]
     wj1 = angular_velocity[j, 1]
     wj2 = angular_velocity[j, 2]
+    spin = 0.5 * dt * (n0 * (wi0 + wj0) + n1 * (wi1 + wj1) + n2 * (wi2 + wj2))
+    a0 = spin * n0
+    a1 = spin * n1
+    a2 = spin * n2
+    fs0, fs1, fs2 = (fs0 - (fs1 * a2 - fs2 * a1), fs1 - (fs2 * a0 - fs0 * a2),
+                     fs2 - (fs0 * a1 - fs1 * a0))
+    # relative velocity of j with respect to i at the contact point
     v0 = (velocity[j, 0] - velocity[i, 0]
           - rj * (wj1 * n2 - wj2 * n1) - ri * (wi1 * n2 - wi2 * n1))
     v1 = (velocity[j, 1] - velocity[i, 1]
@@ -426,9 +424,7 @@ class ContactForces:
         joined = self.joined_by(sim) is not None
         if numba.get_num_threads() == 1 and not joined:
             scattered_pair_forces(*arguments, p.force, p.torque)
-            if box.periodic:
-                add_face_terms(box.virial_blocks, c.through_face, c.face_start, c.image,
-                               box.period, c.force, None, c.normal)
+            self._add_face_terms(sim, None)
             return
         pair_forces(*arguments)
         if not joined:
@@ -459,9 +455,7 @@ class ContactForces:
         if numba.get_num_threads() == 1:
             scatter_contact_forces(c.force, attraction, c.normal, c.overlap, p.radius, c.pair_i,
                                    c.pair_j, p.force, p.torque, prefetch_distance(len(c)))
-            if box.periodic:
-                add_face_terms(box.virial_blocks, c.through_face, c.face_start, c.image,
-                               box.period, c.force, attraction, c.normal)
+            self._add_face_terms(sim, attraction)
         elif box.periodic:
             gather_contact_forces_virial(c.force, attraction, c.normal, c.overlap, p.radius,
                                          c.row_start, c.second_start, c.second_pair, p.force,
@@ -470,3 +464,14 @@ class ContactForces:
         else:
             gather_contact_forces(c.force, attraction, c.normal, c.overlap, p.radius,
                                   c.row_start, c.second_start, c.second_pair, p.force, p.torque)
+
+    @staticmethod
+    def _add_face_terms(sim, attraction):
+        """In a periodic cell, the face terms of this step's pair forces (with ``attraction``)
+        that the multi-thread gather adds beside its sums (add_face_terms): for the one-thread
+        kernels, which scatter."""
+        box = sim.walls
+        if box.periodic:
+            c = sim.contacts
+            add_face_terms(box.virial_blocks, c.through_face, c.face_start, c.image, box.period,
+                           c.force, attraction, c.normal)
