@@ -1,14 +1,16 @@
 """Shear-phase speed of the dry triaxial: pendular against YADE on the same sample, same run.
 
     python benchmarks/bench_triaxial.py [--sizes 1000,10000] [--threads 1,2] [--steps 3000]
-        [--no-yade] [--out benchmarks/results_triaxial.json]
+        [--repeats 1] [--no-yade] [--out benchmarks/results_triaxial.json]
 
 For each size, a sample is prepared with pendular (thesis Ch. 5.2.2, 750 Pa; cached under
 .cache/), sheared with x, y servoed and z strained, and timed in particle-steps per second after
 a warm-up. The same packing is exported as a YADE sphere file and sheared by YADE 2023
 (pendular.yade_triaxial) with the equivalent engine list, time step and strain rate.
 Prints a table of particle-steps/s, the cost per particle-step and the ratio pendular / YADE
-for each thread count, and the fixed cost of a step: the step time of a FIXED_COST_SPHERES
+for each thread count (with ``--repeats R``, the two codes run R times each, alternately, and
+the table gives the medians and the ratio's median and range over the R turns: on a shared
+machine either code's speed drifts by tens of per cent within minutes), and the fixed cost of a step: the step time of a FIXED_COST_SPHERES
 scene with the same operations, which is nearly all Python, Numba dispatch and kernel launches
 (its share of a step at each size is the overhead outside the compiled work).
 """
@@ -17,6 +19,7 @@ import argparse
 import copy
 import json
 import os
+import statistics
 import tempfile
 import time
 
@@ -80,10 +83,14 @@ def main(argv=None):
     parser.add_argument("--threads", default="1,2")
     parser.add_argument("--steps", type=int, default=3000)
     parser.add_argument("--warmup", type=int, default=300)
+    parser.add_argument("--repeats", type=int, default=1,
+                        help="turns of each code, alternately (medians reported)")
     parser.add_argument("--confining", type=float, default=750.0)
     parser.add_argument("--no-yade", action="store_true")
     parser.add_argument("--out", default=None, help="JSON file for the results")
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats {args.repeats}: give at least 1")
     sizes = [int(s) for s in args.sizes.split(",")]
     threads = [int(t) for t in args.threads.split(",")]
     use_yade = not args.no_yade
@@ -99,33 +106,42 @@ def main(argv=None):
     for count in sizes:
         config, particles, walls, report = sample(count, args.confining)
         for thread_count in threads:
-            ours, dt, rate = time_pendular(config, particles, walls, thread_count, args.steps,
-                                           args.warmup)
-            step_time = ours["wall_time_s"] / args.steps
+            turns = []
+            for _ in range(args.repeats):
+                ours, dt, rate = time_pendular(config, particles, walls, thread_count,
+                                               args.steps, args.warmup)
+                yade = (time_yade(config, particles, walls, thread_count, args.steps,
+                                  args.warmup, dt, rate) if use_yade else None)
+                turns.append((ours, yade))
+            speeds = [ours["particle_steps_per_s"] for ours, _ in turns]
+            step_time = count / statistics.median(speeds)
             fixed_cost = fixed.get(ours["threads_used"], fixed[thread_count])
             row = {"particles": count, "threads": thread_count,
                    "threads_used": ours["threads_used"],
-                   "pendular": ours["particle_steps_per_s"],
+                   "pendular": statistics.median(speeds), "pendular_turns": speeds,
                    "cost_per_particle_step_ns": 1e9 * step_time / count,
                    "fixed_cost_per_step_us": 1e6 * fixed_cost,
                    "fixed_cost_share": fixed_cost / step_time,
                    "dt": dt, "strain_rate": rate, "porosity": report["porosity"]}
             if use_yade:
-                yade = time_yade(config, particles, walls, thread_count, args.steps,
-                                 args.warmup, dt, rate)
-                row["yade"] = yade["particle_steps_per_s"]
-                row["ratio"] = row["pendular"] / row["yade"]
+                yade_speeds = [yade["particle_steps_per_s"] for _, yade in turns]
+                ratios = [a / b for a, b in zip(speeds, yade_speeds)]
+                row.update(yade=statistics.median(yade_speeds), yade_turns=yade_speeds,
+                           ratio=statistics.median(ratios), ratio_range=[min(ratios),
+                                                                         max(ratios)])
             rows.append(row)
             print(json.dumps(row), flush=True)
     print(f"\n{'particles':>9} {'threads':>7} {'used':>4} {'pendular [Mps/s]':>17} "
           f"{'[ns/particle-step]':>19} {'fixed cost share':>16} {'YADE [Mps/s]':>13} "
-          f"{'ratio':>6}")
+          f"{'ratio':>6} {'ratio range':>12}")
     for row in rows:
         yade = f"{row['yade'] / 1e6:13.2f}" if "yade" in row else f"{'-':>13}"
         ratio = f"{row['ratio']:6.2f}" if "ratio" in row else f"{'-':>6}"
+        spread = (f"{row['ratio_range'][0]:5.2f}-{row['ratio_range'][1]:<6.2f}"
+                  if "ratio" in row and args.repeats > 1 else "")
         print(f"{row['particles']:9d} {row['threads']:7d} {row['threads_used']:4d} "
               f"{row['pendular'] / 1e6:17.2f} {row['cost_per_particle_step_ns']:19.0f} "
-              f"{row['fixed_cost_share']:16.1%} {yade} {ratio}")
+              f"{row['fixed_cost_share']:16.1%} {yade} {ratio} {spread}")
     print("fixed cost per step [us] (a " + str(FIXED_COST_SPHERES) + "-sphere scene): "
           + ", ".join(f"{t} thread(s) {1e6 * v:.1f}" for t, v in fixed.items()))
     if args.out:
