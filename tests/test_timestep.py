@@ -31,6 +31,8 @@ def exact_critical_step(sim, young=YOUNG, shear_ratio=SHEAR_RATIO):
     touching pairs and wall contacts of ``sim``: the relative displacement at a contact is
     u_j - u_i + r_i [n]x theta_i + r_j [n]x theta_j (the contact law's relative velocity),
     its spring kn n n^T + ks (I - n n^T)."""
+    if sim.contacts is None:
+        sim.neighbors.apply(sim)
     p, c = sim.particles, sim.contacts
     count = len(p.radius)
     stiffness = np.zeros((6 * count, 6 * count))
@@ -78,6 +80,8 @@ def test_a_free_pair_has_the_closed_form_critical_step():
     critical = 2.0 / np.sqrt(max(2.0 * kn, 7.0 * SHEAR_RATIO * kn) / mass)
     assert critical_timestep(sim, YOUNG, SHEAR_RATIO) == pytest.approx(_rounded(critical),
                                                                          rel=1e-12)
+    # a scene without a neighbour list is read, not changed: its first step evaluates forces
+    assert sim.contacts is None
     assert exact_critical_step(sim) == pytest.approx(critical, rel=1e-9)
     # with stiffer shear springs the rolling mode is the fastest
     stiff = critical_timestep(sim, YOUNG, 1.0)

@@ -28,7 +28,7 @@ import numpy as np
 import scipy.sparse.linalg
 
 from .contact_law import normal_stiffness, wall_contact_stiffness
-from .neighbors import branch_vector
+from .neighbors import branch_vector, build_contacts
 from .validate import check_array, check_positive
 
 #: How a scene's time step is chosen: the P-wave estimate of the smallest sphere, or the
@@ -106,11 +106,13 @@ def critical_timestep(sim, young, shear_ratio):
     (young [Pa], shear_ratio ks / kn) between its touching pairs and with its walls (module
     docstring), rounded down to 3 significant digits (the last bits of the iteration, which
     may differ between BLAS builds and thread counts, do not reach the step); inf when
-    nothing touches. Reads the neighbour list ``sim.contacts``
-    (built if absent) and the positions."""
-    if sim.contacts is None:
-        sim.neighbors.apply(sim)
+    nothing touches. Reads the neighbour list ``sim.contacts`` and the positions; a scene
+    without a list yet gets a list of its touching pairs for this call (``sim`` unchanged:
+    its first step still evaluates its forces from scratch)."""
     p, c, box = sim.particles, sim.contacts, sim.walls
+    if c is None:
+        c = build_contacts(p.position, p.radius, 0.0, period=box.period if box.periodic
+                           else None)
     count = len(p.radius)
     arguments = (p.position, p.radius, 1.0 / np.sqrt(p.mass), 1.0 / np.sqrt(p.inertia),
                  c.pair_i, c.pair_j, c.image, np.asarray(box.period, dtype=np.float64),
