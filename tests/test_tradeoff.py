@@ -178,3 +178,85 @@ def test_the_noise_floor_is_the_reference_on_other_samples(quick_grid):
             abs(row["peak_q"] - reference["peak_q"]) / reference["peak_q"], rel=1e-12)
         assert row["peak_q"] != reference["peak_q"]        # another sample, another peak
     assert data["noise_floor"]["error"] == max(r["error"] for r in noise)
+
+
+# ---------------------------------------------------------------- one knob across samples
+
+def test_a_seed_study_runs_every_setting_against_its_own_samples_reference(tmp_path):
+    study = tradeoff.SeedStudy(out=str(tmp_path), knob="timestep_rule", seeds=3,
+                               particles=300, seed=2)
+    runs = {name: (config, sample) for name, config, sample in study.runs()}
+    default_rule = tradeoff.Study(str(tmp_path)).default().sample.timestep_rule
+    other_rule = next(v for v in tradeoff.KNOBS["timestep_rule"] if v != default_rule)
+    for seed in (2, 3, 4):
+        reference, sample = runs[f"seed{seed}_reference"]
+        assert reference == tradeoff.Study(str(tmp_path), 300, seed=seed).reference()
+        for rule in tradeoff.KNOBS["timestep_rule"]:
+            config, on = runs[f"seed{seed}_timestep_rule={rule}"]
+            assert config.sample.timestep_rule == rule and config.sample.seed == seed
+            assert config.sample_path == reference.sample_path and on == sample   # paired
+        # the other rule also on a sample prepared with it
+        config, on = runs[f"seed{seed}_timestep_rule={other_rule}_prepared"]
+        assert on.timestep_rule == other_rule and on.seed == seed
+        assert config.sample_path != reference.sample_path
+    assert len(runs) == 3 * 4
+    # a knob of the shear alone: no samples of its own
+    shear = tradeoff.SeedStudy(out=str(tmp_path), knob="inertial_number", seeds=2)
+    assert not any(name.endswith("_prepared") for name, _, _ in shear.runs())
+
+
+def test_bad_seed_study_settings_are_refused_naming_them(tmp_path):
+    with pytest.raises(ValueError, match="knob = 'particles'"):
+        tradeoff.SeedStudy(out=str(tmp_path), knob="particles")
+    with pytest.raises(ValueError, match="seeds = 1 is outside the valid range"):
+        tradeoff.SeedStudy(out=str(tmp_path), knob="damping", seeds=1)
+    with pytest.raises(ValueError, match="jobs = 0 is outside the valid range"):
+        tradeoff.SeedStudy(out=str(tmp_path), knob="damping", jobs=0)
+
+
+def test_seed_rows_read_each_run_against_its_own_samples_reference(tmp_path):
+    """Hand-made results: paired errors against the same seed's reference, the references'
+    scatter, the samples prepared with a setting against the references' mean."""
+    study = tradeoff.SeedStudy(out=str(tmp_path), knob="damping", seeds=2, seed=0)
+
+    def result(q, sr, ratio, cpu=1.0):
+        return {"peak_q": q, "saturation_at_peak": sr, "stress_ratio_at_peak": ratio,
+                "cpu_time_s": cpu, "steps": 10, "wetting_steps": 0, "porosity": 0.4,
+                "coordination": 4.0}
+
+    results = {"seed0_reference": result(100.0, 0.02, 1.0),
+               "seed1_reference": result(110.0, 0.02, 1.0)}
+    for value in tradeoff.KNOBS["damping"]:
+        results[f"seed0_damping={value}"] = result(101.0, 0.02, 1.0)     # +1 %
+        results[f"seed1_damping={value}"] = result(110.0, 0.02, 1.0)     # 0 %
+        results[f"seed0_damping={value}_prepared"] = result(126.0, 0.02, 1.0)
+        results[f"seed1_damping={value}_prepared"] = result(126.0, 0.02, 1.0)
+    rows, scatter = tradeoff.seed_rows(study, results)
+    assert scatter["peak_q"]["mean"] == 105.0
+    assert scatter["peak_q"]["relative_sd"] == pytest.approx(math.sqrt(50.0) / 105.0)
+    paired = [r for r in rows if not r["prepared_with_it"]]
+    assert [r["value"] for r in paired] == tradeoff.KNOBS["damping"]
+    assert paired[0]["peak_q"]["paired"]["mean"] == pytest.approx(0.005)
+    assert paired[0]["peak_q"]["paired"]["largest"] == pytest.approx(0.01)
+    assert all(r["within_scatter"] for r in paired)
+    prepared = [r for r in rows if r["prepared_with_it"]]
+    assert prepared[0]["peak_q"]["against_references"]["mean"] == pytest.approx(0.2)
+    assert not any(r["within_scatter"] for r in prepared)    # 20 % off, sd 6.7 %
+
+
+def test_a_seed_study_from_the_command_line(tmp_path):
+    out = tmp_path / "seeds"
+    done = subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--knob",
+                           "timestep_rule", "--seeds", "2", "--particles", "200",
+                           "--max-strain", "0.01"], capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    data = json.loads((out / "seeds_timestep_rule.json").read_text())
+    assert len(data["runs"]) == 2 * 4 and len(data["rows"]) == 3
+    for row in data["rows"]:
+        assert 0.3 < row["porosity"] < 0.5 and row["cpu_time_s"] > 0
+    text = (out / "seeds_timestep_rule.md").read_text()
+    assert "Scatter between samples" in text and "prepared with it" in text
+    refused = subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--seeds", "3"],
+                             capture_output=True, text=True, timeout=300)
+    assert refused.returncode != 0
+    assert "error: --seeds" in refused.stderr.strip().splitlines()[-1]

@@ -46,12 +46,14 @@ import time
 from dataclasses import dataclass
 
 import numba
+import numpy as np
 
 from dem.atomic import write_json, write_text
 from dem.preparation import MAX_SEED, PrepareConfig
+from dem.sample import load_sample
 from dem.validate import check_int, check_range
 
-from .campaign import prepare_one, sample_made_with
+from .campaign import executor, prepare_one, sample_made_with
 from .config import BridgeConfig, ShearConfig, TriaxialConfig, config_json, config_to_dict
 from .outputs import OutputFolder
 from .plots import pyplot, save_figure
@@ -72,7 +74,8 @@ KNOB_FIELDS = {"timestep_safety": ("sample", "timestep_safety"),
 #: The exact bridge table of the default run (nodes in suction, in distance).
 DEFAULT_TABLE = (350, 80)
 #: What the slow, fine reference changes in the default run.
-REFERENCE = {"timestep_safety": 0.35, "inertial_number": 1e-4, "table_resolution": (700, 160)}
+REFERENCE = {"timestep_rule": "pwave", "timestep_safety": 0.35, "inertial_number": 1e-4,
+             "table_resolution": (700, 160)}
 #: Settings of each knob (particles: multiples of the study's particles).
 KNOBS = {"timestep_safety": [0.3, 0.5, 0.7, 0.9],
          "timestep_rule": ["pwave", "stiffness"],
@@ -428,3 +431,216 @@ def write_study(study, *, docs=None, log=None):
         for path in paths.values():
             shutil.copy(path, docs)
     return data
+
+
+# ---------------------------------------------------------------- one knob across samples
+
+#: Knobs that also set how a sample is prepared: the seed study runs each of their values on
+#: samples prepared with it too (the whole chain that value gives).
+PREPARATION_KNOBS = ("timestep_safety", "timestep_rule", "damping")
+#: The quantities compared, (result field, label).
+QUANTITIES = (("peak_q", "peak q"), ("saturation_at_peak", "Sr at peak"),
+              ("stress_ratio_at_peak", "q'/p' at peak"))
+
+
+@dataclass
+class SeedStudy:
+    """``knob`` across ``seeds`` samples (seeds seed ... seed + seeds - 1) of ``particles``
+    spheres, which the one-sample Study cannot tell from chaos: on each sample the reference
+    and every setting of the knob (KNOBS), each compared with the same sample's reference
+    (paired: the knob's effect without the scatter between samples); the references'
+    scatter across samples; and, for a knob of the preparation (PREPARATION_KNOBS), each
+    setting also on samples prepared with it. ``jobs`` runs at a time, one thread each."""
+
+    out: str
+    knob: str
+    seeds: int = 6
+    particles: int = 2000
+    max_strain: float = 0.15
+    seed: int = 0
+    jobs: int = 1
+
+    def __post_init__(self):
+        if self.knob not in KNOBS or self.knob == "particles":
+            raise ValueError(f"knob = {self.knob!r}: valid knobs are "
+                             f"{', '.join(k for k in KNOBS if k != 'particles')}")
+        self.seeds = check_int("seeds", self.seeds, low=2, high=100)
+        self.jobs = check_int("jobs", self.jobs, low=1)
+        Study(self.out, self.particles, self.max_strain, self.seed)   # checks the rest
+        self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
+
+    def study(self, seed):
+        return Study(self.out, self.particles, self.max_strain, seed)
+
+    def runs(self):
+        """(name, configuration, PrepareConfig of its sample) of every run: per seed the
+        reference, each setting on the default sample and, for a knob of the preparation,
+        each setting other than the default's on a sample prepared with it."""
+        runs = []
+        for seed in range(self.seed, self.seed + self.seeds):
+            study = self.study(seed)
+            default = study.default()
+            runs.append((f"seed{seed}_reference", study.reference(),
+                         study.sample(self.particles, seed)))
+            for value in KNOBS[self.knob]:
+                config, _ = study.variant(self.knob, value)
+                name = f"seed{seed}_{self.knob}={text(value)}".replace(",", "x")
+                runs.append((name, config, study.sample(self.particles, seed)))
+                if self.knob in PREPARATION_KNOBS and value != setting(default, self.knob):
+                    sample = config.sample
+                    path = os.path.join(os.path.abspath(self.out), "samples",
+                                        f"n{self.particles}_seed{seed}_{name.split('_', 1)[1]}.h5")
+                    runs.append((f"{name}_prepared", dataclasses.replace(config, sample_path=path),
+                                 sample))
+        return runs
+
+
+def _run_named(name, config, sample, out):
+    return name, run_variant(config, os.path.join(out, "runs", name), sample)
+
+
+def _prepare_missing(path, sample):
+    if not sample_made_with(path, sample):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        prepare_one(sample, path)
+    return path
+
+
+def run_seed_study(study, log=None):
+    """Every run of the SeedStudy ``study`` (its samples prepared first, as many at a time as
+    its jobs): {name: result}, each result with its sample's porosity and coordination."""
+    log = log or (lambda message: None)
+    runs = study.runs()
+    samples = {config.sample_path: sample for _, config, sample in runs}
+    results = {}
+    with executor(study.jobs) as pool:
+        submit = (lambda f, *a: pool.submit(f, *a)) if pool else _now
+        for future in [submit(_prepare_missing, p, s) for p, s in samples.items()]:
+            log(f"sample {os.path.basename(_result(future))}")
+        for future in [submit(_run_named, name, config, sample, study.out)
+                       for name, config, sample in runs]:
+            name, result = _result(future)
+            log(f"{name}: peak q {result['peak_q']:.1f} Pa")
+            results[name] = result
+    for name, config, _ in runs:
+        report = load_sample(config.sample_path)[2]
+        results[name].update(porosity=report["porosity"], coordination=report["coordination"])
+    return results
+
+
+def _now(function, *arguments):
+    return function(*arguments)
+
+
+def _result(future):
+    return future.result() if hasattr(future, "result") else future
+
+
+def _stats(values):
+    return {"mean": float(np.mean(values)), "sd": float(np.std(values, ddof=1)),
+            "largest": float(np.max(np.abs(values)))}
+
+
+def seed_rows(study, results):
+    """(rows, scatter): per setting (and setting on samples prepared with it), over the
+    samples: CPU time, steps, the samples' porosity and coordination and, per quantity,
+    ``paired`` (on the default samples): the statistics (_stats) of its relative error against
+    the same sample's reference, and ``against_references``: of its relative difference from
+    the references' mean. ``scatter``: the references' mean and relative standard deviation
+    across samples, per quantity. ``within_scatter``: every quantity's mean error (paired, or
+    against the references for a setting's own samples) within that standard deviation."""
+    seeds = range(study.seed, study.seed + study.seeds)
+    reference = [results[f"seed{s}_reference"] for s in seeds]
+    scatter = {}
+    for field, _ in QUANTITIES:
+        values = [r[field] for r in reference]
+        scatter[field] = {"mean": float(np.mean(values)),
+                          "relative_sd": float(np.std(values, ddof=1) / abs(np.mean(values)))}
+    rows = []
+    for value in KNOBS[study.knob]:
+        for prepared in (False, True):
+            suffix = f"{study.knob}={text(value)}".replace(",", "x") + ("_prepared" * prepared)
+            own = [results.get(f"seed{s}_{suffix}") for s in seeds]
+            if None in own:
+                continue
+            row = {"value": value, "prepared_with_it": prepared,
+                   "cpu_time_s": float(np.mean([r["cpu_time_s"] for r in own])),
+                   "steps": float(np.mean([r["steps"] + r["wetting_steps"] for r in own])),
+                   "porosity": float(np.mean([r["porosity"] for r in own])),
+                   "coordination": float(np.mean([r["coordination"] for r in own]))}
+            for field, _ in QUANTITIES:
+                row[field] = {"against_references": _stats(
+                    [r[field] / scatter[field]["mean"] - 1.0 for r in own])}
+                if not prepared:
+                    row[field]["paired"] = _stats(
+                        [r[field] / ref[field] - 1.0 for r, ref in zip(own, reference)])
+            measure = "against_references" if prepared else "paired"
+            row["within_scatter"] = all(abs(row[f][measure]["mean"]) <= scatter[f]["relative_sd"]
+                                        for f, _ in QUANTITIES)
+            rows.append(row)
+    return rows, scatter
+
+
+def write_seed_study(study, log=None):
+    """Run the SeedStudy ``study``; write seeds_<knob>.json and seeds_<knob>.md in its
+    folder; returns the JSON content."""
+    if not isinstance(study, SeedStudy):
+        raise TypeError(f"study must be a pendular.tradeoff.SeedStudy, got "
+                        f"{type(study).__name__}")
+    stem = f"seeds_{study.knob}"
+    with OutputFolder(study.out, "tradeoff") as folder:
+        paths = {ext: folder.claim(f"{stem}.{ext}") for ext in ("json", "md")}
+        results = run_seed_study(study, log)
+        rows, scatter = seed_rows(study, results)
+        data = {"arguments": dataclasses.asdict(study), "suction": SUCTION,
+                "confining": CONFINING, "reference_settings": REFERENCE, "rows": rows,
+                "reference_scatter": scatter, "runs": results}
+        write_json(paths["json"], data)
+        write_seed_markdown(paths["md"], study, rows, scatter)
+    return data
+
+
+def write_seed_markdown(path, study, rows, scatter):
+    def cell(stats):
+        return (f"{100 * stats['mean']:+.2f} ± {100 * stats['sd']:.2f} % "
+                f"({100 * stats['largest']:.2f})")
+
+    labels = " | ".join(label for _, label in QUANTITIES)
+    lines = [f"# {study.knob} across {study.seeds} samples (pendular tradeoff --knob)", "",
+             f"`pendular tradeoff --out DIR --knob {study.knob} --seeds {study.seeds} "
+             f"--particles {study.particles} --max-strain {study.max_strain}`: the wet "
+             f"triaxial of the trade-off study (suction {SUCTION:g} Pa, lateral {CONFINING:g} "
+             f"Pa) on {study.seeds} samples (seeds {study.seed}-{study.seed + study.seeds - 1}), "
+             "one Numba thread per run. On each sample: the reference (time-step safety "
+             "0.35 of the P-wave estimate, inertial number 1e-4, table 700 x 160) and every "
+             f"setting of {study.knob}.", "",
+             "**Same sample** (paired): each quantity's relative error against the same "
+             "sample's reference, mean ± standard deviation over the samples (largest). The "
+             "mean is the setting's systematic effect; the spread is the chaos of a granular "
+             "run, which any change of the step turns into another trajectory.", "",
+             f"| {study.knob} | CPU [s] | steps | {labels} | within the scatter |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    lines += [f"| {text(r['value'])} | {r['cpu_time_s']:.1f} | {r['steps']:.0f} | "
+              + " | ".join(cell(r[f]["paired"]) for f, _ in QUANTITIES)
+              + f" | {'yes' if r['within_scatter'] else 'no'} |"
+              for r in rows if not r["prepared_with_it"]]
+    lines += ["", "**Scatter between samples** (the references): "
+              + ", ".join(f"{label} {scatter[f]['mean']:.4g} ± "
+                          f"{100 * scatter[f]['relative_sd']:.2f} %" for f, label in QUANTITIES)
+              + ". A setting is within the scatter when the mean of its errors is within one "
+              "standard deviation of the references across samples, for all three.", ""]
+    if any(r["prepared_with_it"] for r in rows):
+        default = setting(study.study(study.seed).default(), study.knob)
+        chains = [r for r in rows if r["prepared_with_it"] or r["value"] == default]
+        lines += ["**Samples prepared with the setting** (the whole chain it gives, against "
+                  "the default's on its own samples; other samples, so not paired): each "
+                  "quantity against the references' mean, mean ± standard deviation over the "
+                  "samples (largest), and the samples' porosity and coordination.", "",
+                  f"| {study.knob} | samples | porosity | coordination | CPU [s] | {labels} |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|"]
+        lines += [f"| {text(r['value'])} | "
+                  f"{'prepared with it' if r['prepared_with_it'] else f'default ({default})'} | "
+                  f"{r['porosity']:.4f} | {r['coordination']:.2f} | {r['cpu_time_s']:.1f} | "
+                  + " | ".join(cell(r[f]["against_references"]) for f, _ in QUANTITIES) + " |"
+                  for r in chains]
+    write_text(path, "\n".join(lines) + "\n")

@@ -3,11 +3,14 @@
 toroidal bridges, records, neighbour-list skin), each compared with a slow, fine reference on
 peak q, Sr and q'/p' at the peak. Every run uses one Numba thread. Writes tradeoff.json,
 tradeoff.md (table and recommendations for a quick look and a paper figure) and tradeoff.png
-(pendular.tradeoff); finished runs in DIR/runs/ with an equal configuration are reused."""
+(pendular.tradeoff); finished runs in DIR/runs/ with an equal configuration are reused.
+With --knob K: that knob across --seeds samples instead (seeds_K.json, seeds_K.md: its error
+against each sample's own reference, the references' scatter between samples, and for a
+knob of the preparation the samples prepared with each setting), --jobs runs at a time."""
 
 import sys
 
-from ..tradeoff import Study, write_study
+from ..tradeoff import KNOBS, SeedStudy, Study, write_seed_study, write_study
 
 
 def add_arguments(parser):
@@ -20,6 +23,13 @@ def add_arguments(parser):
                         help="three knobs, three settings each (a smoke test)")
     parser.add_argument("--docs", metavar="FOLDER", default=None,
                         help="also copy tradeoff.json/.md/.png into FOLDER")
+    parser.add_argument("--knob", choices=[k for k in KNOBS if k != "particles"], default=None,
+                        help="study this knob across --seeds samples instead")
+    parser.add_argument("--seeds", type=int, default=None,
+                        help="samples of the --knob study (seeds SEED ... SEED + SEEDS - 1; "
+                             "default 6)")
+    parser.add_argument("--jobs", type=int, default=1,
+                        help="runs at a time in the --knob study (one thread each)")
 
 
 def _log(message):
@@ -27,6 +37,19 @@ def _log(message):
 
 
 def run(args):
+    if args.knob is not None:
+        if args.quick or args.docs:
+            raise ValueError("--knob studies one knob across samples: --quick and --docs "
+                             "belong to the one-sample study")
+        study = SeedStudy(out=args.out, knob=args.knob, seeds=6 if args.seeds is None
+                          else args.seeds, particles=args.particles,
+                          max_strain=args.max_strain, seed=args.seed, jobs=args.jobs)
+        data = write_seed_study(study, log=_log)
+        print(f"tradeoff: {len(data['runs'])} runs; outputs in {args.out} "
+              f"(seeds_{args.knob}.json, seeds_{args.knob}.md)")
+        return 0
+    if args.seeds is not None or args.jobs != 1:
+        raise ValueError("--seeds and --jobs belong to a --knob study: give --knob")
     study = Study(out=args.out, particles=args.particles, max_strain=args.max_strain,
                   seed=args.seed, quick=args.quick)
     data = write_study(study, docs=args.docs, log=_log)
