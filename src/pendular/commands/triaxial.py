@@ -90,9 +90,10 @@ def add_arguments(parser):
                         help="axial strain rate [1/s] (overrides --inertial-number)")
     parser.add_argument("--timestep-safety", type=float, default=0.7,
                         help="time step as a fraction of the --timestep-rule estimate [-]")
-    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="pwave",
-                        help="time step estimate: the P-wave estimate of the smallest sphere, "
-                             "or the critical step of the contacts (dem.timestep)")
+    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="stiffness",
+                        help="time step estimate: the critical step of the contacts "
+                             "(dem.timestep; default), or YADE's P-wave estimate of the "
+                             "smallest sphere")
     parser.add_argument("--skin-factor", type=float, default=0.1,
                         help="Verlet skin of the neighbour list / radius (0, 2]")
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
