@@ -10,9 +10,10 @@ a warm-up. The same packing is exported as a YADE sphere file and sheared by YAD
 Prints a table of particle-steps/s, the cost per particle-step and the ratio pendular / YADE
 for each thread count (with ``--repeats R``, the two codes run R times each, alternately, and
 the table gives the medians and the ratio's median and range over the R turns: on a shared
-machine either code's speed drifts by tens of per cent within minutes), and the fixed cost of a step: the step time of a FIXED_COST_SPHERES
-scene with the same operations, which is nearly all Python, Numba dispatch and kernel launches
-(its share of a step at each size is the overhead outside the compiled work).
+machine either code's speed drifts by tens of per cent within minutes), and the fixed cost
+of a step: the step time of a FIXED_COST_SPHERES scene with the same operations, which is
+nearly all Python, Numba dispatch and kernel launches (its share of a step at each size is the
+overhead outside the compiled work).
 """
 
 import argparse

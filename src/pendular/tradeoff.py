@@ -9,9 +9,9 @@ run is a pendular.triaxial.TriaxialTest of a configuration built from the defaul
 (``Study.default``: the defaults of ``pendular triaxial``, exact bridge table 350 x 80)
 with ``dataclasses.replace``; it starts from the same prepared sample (DIR/samples/, the
 sample-size knob prepares one per size), runs on one Numba thread, and is compared with the
-reference: time-step safety 0.35, inertial number 1e-4, bridge table 700 x 160 nodes, the other
-knobs at their defaults. Each knob (``KNOB_FIELDS``: the field of the configuration it sets) is
-varied alone around the defaults:
+reference: the P-wave rule at time-step safety 0.35, inertial number 1e-4, bridge table
+700 x 160 nodes, the other knobs at their defaults. Each knob (``KNOB_FIELDS``: the field of
+the configuration it sets) is varied alone around the defaults:
 
     timestep_safety, timestep_rule (P-wave estimate / critical step of the contacts, at the
     default safety), inertial_number, damping, particles, table_resolution (exact bridges),
@@ -31,9 +31,15 @@ particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_st
 peak_q_error, saturation_error, stress_ratio_error, error; ``noise``: the same for each other
 seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors),
 DIR/tradeoff.md with a recommendation per use (quick look, paper figure) and DIR/tradeoff.png;
-``docs`` copies the three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its timing.json (the
-result and the run's configuration); run again, a study reuses a finished run only when its
-stored configuration equals the wanted one (pendular.config.config_json).
+``docs`` copies the three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its
+timing.json (the result and the run's configuration); run again, a study reuses a finished
+run only when its stored configuration equals the wanted one (pendular.config.config_json).
+
+One sample cannot tell a knob's systematic effect from the chaos of a granular run (any change
+of the step makes another trajectory, a few per cent apart at the peak). ``SeedStudy`` (command
+``pendular tradeoff --out DIR --knob K [--seeds 6] [--jobs J]``) runs the reference and every
+setting of one knob on several samples and reads each setting against the same sample's
+reference (``seed_rows``); ``write_seed_study`` writes DIR/seeds_K.json and DIR/seeds_K.md.
 """
 
 from __future__ import annotations
@@ -470,6 +476,7 @@ class SeedStudy:
         self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
 
     def study(self, seed):
+        """The one-sample Study of the sample of ``seed`` (its default, reference, variants)."""
         return Study(self.out, self.particles, self.max_strain, seed)
 
     def runs(self):
@@ -529,10 +536,12 @@ def run_seed_study(study, log=None):
 
 
 def _now(function, *arguments):
+    """The submit of running here, one after the other: the value itself (see _result)."""
     return function(*arguments)
 
 
 def _result(future):
+    """The value of a pool's future, or of _now's."""
     return future.result() if hasattr(future, "result") else future
 
 
