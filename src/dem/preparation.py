@@ -264,9 +264,9 @@ class PrepareConfig:
     The time step is ``timestep_safety`` times the estimate of ``timestep_rule`` (``timestep``):
     'stiffness' (default), the critical step of the contacts (dem.timestep), 1.4-1.5 times
     the P-wave estimate on prepared samples; 'pwave', YADE's P-wave estimate of the smallest
-    sphere (the thesis's and pendular's default until 2026-11; across six 2,000-sphere samples
-    both give the same peaks within the scatter between samples, docs/seeds_timestep_rule.md).
-    ``skin_factor``: the neighbour list's Verlet skin / mean
+    sphere (the thesis's, and pendular's default until 2026-11-26; across six 2,000-sphere
+    samples both give the same peaks within the scatter between samples,
+    docs/seeds_timestep_rule.md). ``skin_factor``: the neighbour list's Verlet skin / mean
     radius, a speed knob only (results are bit-identical for any skin); 0.1 shears 5-8 %
     faster than 0.3 at 1,000 and 10,000 spheres (fewer pairs, still rare rebuilds).
     """
