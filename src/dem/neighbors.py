@@ -504,6 +504,7 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         normal_force=np.zeros(size), force=np.zeros((size, 3)), image=image,
         extra={name: carry_pair_array(values, index) for name, values in extra.items()})
 
+
 #: The lengths moved_beyond compares in walled scenes, no stretching (NeighborList.apply): the
 #: current ones laid out as a cell's period (a strided view, as dem.state._NO_PERIOD), the
 #: reference ones as the cell's contiguous copy at a rebuild, so that walled and periodic

@@ -200,8 +200,16 @@ class Study:
                 count)
 
 
-def sample_file(out, particles, seed):
-    return os.path.join(os.path.abspath(out), "samples", f"n{particles}_seed{seed}.h5")
+def sample_file(out, particles, seed, setting=""):
+    """The saved sample of ``particles`` spheres and ``seed`` in ``out``/samples (``setting``:
+    the name of the knob setting it was prepared with, setting_name; "" for the default's)."""
+    tail = f"_{setting}" if setting else ""
+    return os.path.join(os.path.abspath(out), "samples", f"n{particles}_seed{seed}{tail}.h5")
+
+
+def setting_name(knob, value):
+    """A knob's setting as a file or folder name: 'table_resolution=350x80'."""
+    return f"{knob}={text(value)}".replace(",", "x")
 
 
 # ---------------------------------------------------------------- runs
@@ -272,8 +280,7 @@ def measure(study, log=None):
     for knob, values in study.knobs().items():
         for value in values:
             config, value = study.variant(knob, value)
-            name = ("default" if config == default else
-                    f"{knob}={text(value)}".replace(",", "x"))
+            name = "default" if config == default else setting_name(knob, value)
             log(f"{knob} = {text(value)}")
             result = run(name, config)
             rows.append({"knob": knob, "value": value, **result, **errors(result, reference)})
@@ -492,14 +499,13 @@ class SeedStudy:
                          study.sample(self.particles, seed)))
             for value in KNOBS[self.knob]:
                 config, _ = study.variant(self.knob, value)
-                name = f"seed{seed}_{self.knob}={text(value)}".replace(",", "x")
+                name = f"seed{seed}_{setting_name(self.knob, value)}"
                 runs.append((name, config, study.sample(self.particles, seed)))
                 if self.knob in PREPARATION_KNOBS and value != setting(default, self.knob):
-                    sample = config.sample
-                    path = os.path.join(os.path.abspath(self.out), "samples",
-                                        f"n{self.particles}_seed{seed}_{name.split('_', 1)[1]}.h5")
+                    path = sample_file(self.out, self.particles, seed,
+                                       setting_name(self.knob, value))
                     runs.append((f"{name}_prepared", dataclasses.replace(config, sample_path=path),
-                                 sample))
+                                 config.sample))
         return runs
 
 
@@ -569,7 +575,7 @@ def seed_rows(study, results):
     rows = []
     for value in KNOBS[study.knob]:
         for prepared in (False, True):
-            suffix = f"{study.knob}={text(value)}".replace(",", "x") + ("_prepared" * prepared)
+            suffix = setting_name(study.knob, value) + ("_prepared" * prepared)
             own = [results.get(f"seed{s}_{suffix}") for s in seeds]
             if None in own:
                 continue
