@@ -115,11 +115,12 @@ def _evaluate_pair(k, position, velocity, angular_velocity, radius, pair_i, pair
     fn = kn * gap_overlap
     cap = fn * tan_friction
     magnitude = np.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
-    if magnitude > cap:
-        scale = cap / magnitude
-        fs0 *= scale
-        fs1 *= scale
-        fs2 *= scale
+    # a select, not a branch: whether a contact slides is unpredictable pair to pair (a fifth
+    # of a dry shear's contacts slide); x * 1.0 == x, so a sticking contact is unchanged
+    scale = cap / magnitude if magnitude > cap else 1.0
+    fs0 *= scale
+    fs1 *= scale
+    fs2 *= scale
     shear_force[k, 0] = fs0
     shear_force[k, 1] = fs1
     shear_force[k, 2] = fs2
