@@ -1,5 +1,6 @@
 """Verlet list against brute force; contact history survives rebuilds; the list reaches as
-far as the forces ask (``reach(sim)``)."""
+far as the forces ask (``reach(sim)``); the particles near the walls are every particle that
+can touch one."""
 
 import copy
 import dataclasses
@@ -7,9 +8,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from conftest import RADIUS, two_body_scene
+from conftest import RADIUS, YOUNG, two_body_scene
 from dem.contact_law import pair_forces
-from dem.neighbors import build_contacts, spatial_order
+from dem.neighbors import build_contacts, near_wall_particles, spatial_order
 from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from dem.state import Walls
 from dem.walls import ConstantStrainRate, StressServo
@@ -40,6 +41,40 @@ def test_pairs_match_brute_force_with_mixed_radii():
     for j in range(len(radius)):
         slots = contacts.second_pair[contacts.second_start[j]:contacts.second_start[j + 1]]
         assert set(slots.tolist()) == set(np.nonzero(contacts.pair_j == j)[0].tolist())
+
+
+def test_near_wall_particles_match_brute_force():
+    rng = np.random.default_rng(5)
+    lo, hi = np.array([0.0, -0.2, 0.1]), np.array([1.0, 0.3, 0.8])
+    position = lo + rng.random((500, 3)) * (hi - lo)
+    radius = rng.uniform(0.01, 0.04, 500)
+    margin = 0.02
+    gap = np.minimum(position - lo, hi - position).min(axis=1) - radius
+    walls = np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]])
+    near = near_wall_particles(position, radius, walls, margin)
+    assert near.tolist() == np.flatnonzero(gap < margin).tolist()
+    assert 0 < len(near) < 500
+    contacts = build_contacts(position, radius, margin, walls=walls, wall_margin=margin)
+    assert np.array_equal(contacts.near_wall, near)
+    assert np.array_equal(build_contacts(position, radius, margin).near_wall, np.arange(500))
+
+
+def test_a_wall_moved_beyond_half_the_skin_rebuilds_the_list():
+    """A sphere at rest 0.3 R off the x+ wall is not near it (skin 0.2 R); the wall pushed
+    0.4 R inward (more than skin / 2) rebuilds the list, and the sphere feels the wall: kn = E R
+    times the overlap 0.1 R. A move of skin / 2 or less keeps the list."""
+    sim = two_body_scene([[1.0 - 1.3 * RADIUS, 0.0, 0.0]], np.zeros((1, 3)))
+    sim.evaluate_forces()
+    assert sim.contacts.near_wall.tolist() == [] and sim.particles.force[0, 0] == 0.0
+    rebuilds = sim.neighbors.rebuilds
+    sim.walls.position[1] -= 0.1 * RADIUS
+    sim.evaluate_forces()
+    assert sim.neighbors.rebuilds == rebuilds and sim.particles.force[0, 0] == 0.0
+    sim.walls.position[1] -= 0.3 * RADIUS
+    sim.evaluate_forces()
+    assert sim.neighbors.rebuilds == rebuilds + 1
+    assert sim.contacts.near_wall.tolist() == [0]
+    assert sim.particles.force[0, 0] == pytest.approx(-YOUNG * RADIUS * 0.1 * RADIUS, rel=1e-9)
 
 
 def test_history_is_carried_to_the_same_pair_after_a_rebuild():

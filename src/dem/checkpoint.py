@@ -85,7 +85,9 @@ DATASETS = {
         "image": ("1", "periodic image of j seen from i (K, 3): branch x_j - x_i + image * L"),
         "through_face": ("1", "the pairs whose image is not zero (through a periodic face)"),
         "face_start": ("1", "where each block of particles' share of through_face starts "
-                            "(dem.virial.face_block_starts)")},
+                            "(dem.virial.face_block_starts)"),
+        "near_wall": ("1", "the particles within the skin of a wall at the last rebuild "
+                           "(the wall forces visit only these; absent: every particle)")},
     "": {"state": ("1", "pickled state of every operation and writer and the caller's "
                         "extra_state (bytes; see dem.checkpoint)")},
 }

@@ -37,6 +37,9 @@ class Contacts:
     through_face: (F,) int64 the pairs whose image is not zero, in pair order; face_start:
     (SUM_BLOCKS + 1,) int64 where each block of particles' share of them starts
     (dem.virial.face_block_starts).
+    near_wall: (M,) int64 ascending, the particles that may touch a wall before the next
+    rebuild (``near_wall_particles``: gap to a wall below the skin at the rebuild; the wall
+    forces visit only these); default every particle (a list built without walls).
     """
 
     pair_i: np.ndarray
@@ -53,8 +56,11 @@ class Contacts:
     image: np.ndarray = None
     through_face: np.ndarray = None
     face_start: np.ndarray = None
+    near_wall: np.ndarray = None
 
     def __post_init__(self):
+        if self.near_wall is None:
+            self.near_wall = np.arange(len(self.row_start) - 1, dtype=np.int64)
         if self.through_face is None:   # no images: none through a face (no scan of zeros)
             self.through_face = (np.zeros(0, np.int64) if self.image is None else
                                  np.flatnonzero(self.image.any(axis=1)).astype(np.int64))
@@ -372,6 +378,34 @@ def moved_beyond(position, reference_position, radius, reference_radius, limit, 
     return False
 
 
+@numba.njit(cache=True)
+def near_wall_particles(position, radius, wall_position, margin):
+    """Indices (ascending, int64) of the particles whose gap to some wall, distance minus
+    radius, is below ``margin`` [m]; wall_position (6,) [m] as dem.state.Walls. Every other
+    particle stays off the walls while no particle moves or grows more than margin / 2 and no
+    wall moves more than margin / 2 (NeighborList.apply)."""
+    near = np.empty(position.shape[0], np.int64)
+    count = 0
+    for p in range(position.shape[0]):
+        reach = radius[p] + margin
+        for axis in range(3):
+            if (position[p, axis] - wall_position[2 * axis] < reach
+                    or wall_position[2 * axis + 1] - position[p, axis] < reach):
+                near[count] = p
+                count += 1
+                break
+    return near[:count].copy()
+
+
+@numba.njit(cache=True)
+def walls_moved_beyond(wall_position, reference_wall_position, limit):
+    """True when some wall moved more than ``limit`` [m] since ``reference_wall_position``."""
+    for w in range(6):
+        if abs(wall_position[w] - reference_wall_position[w]) > limit:
+            return True
+    return False
+
+
 @numba.njit(cache=True, inline="always")
 def _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out):
     """Add to ``out[p]`` its pair forces (-f where p is i, +f where p is j) in a fixed order."""
@@ -457,13 +491,16 @@ def carry_pair_array(values, index, fill=0):
     return carried
 
 
-def build_contacts(position, radius, skin, previous=None, period=None):
+def build_contacts(position, radius, skin, previous=None, period=None, walls=None,
+                   wall_margin=0.0):
     """Build the neighbour list (pairs with gap < ``skin``); carry shear history, normals,
     overlaps (new pairs: -inf, never touched) and every ``extra`` per-pair array from
     ``previous`` if given. ``period`` (3,) [m]: a periodic box [0, period) holding the
     positions, pairs through the nearest image (ValueError if the box is narrower than 3
-    times 2 max(radius) + skin on an axis). FloatingPointError if a position is not finite (a
-    diverged simulation would otherwise get a meaningless list)."""
+    times 2 max(radius) + skin on an axis). ``walls`` (6,) [m]: wall planes, whose particles
+    within ``wall_margin`` [m] make Contacts.near_wall (None: every particle).
+    FloatingPointError if a position is not finite (a diverged simulation would otherwise get
+    a meaningless list)."""
     if not np.isfinite(position).all():
         particle = int(np.argwhere(~np.isfinite(position))[0, 0])
         raise FloatingPointError(
@@ -502,7 +539,9 @@ def build_contacts(position, radius, skin, previous=None, period=None):
         normal=carry_pair_array(normal, index),
         overlap=carry_pair_array(overlap, index, -np.inf),
         normal_force=np.zeros(size), force=np.zeros((size, 3)), image=image,
-        extra={name: carry_pair_array(values, index) for name, values in extra.items()})
+        extra={name: carry_pair_array(values, index) for name, values in extra.items()},
+        near_wall=None if walls is None else near_wall_particles(position, radius, walls,
+                                                                 wall_margin))
 
 
 #: The lengths moved_beyond compares in walled scenes, no stretching (NeighborList.apply): the
@@ -516,7 +555,8 @@ _UNSTRETCHED_REFERENCE = np.ones(3)
 class NeighborList:
     """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2
     (in a periodic cell: moved relative to the cell's stretching, against a skin reduced by
-    what the stretching does to the pairs, ``apply``).
+    what the stretching does to the pairs, ``apply``) or a wall more than skin / 2; the
+    particles within the skin of a wall at a rebuild are the wall forces' (Contacts.near_wall).
 
     skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
     The reach beyond touching is the largest ``reach(sim)`` [m] of the simulation's forces
@@ -533,6 +573,7 @@ class NeighborList:
         self._reference_position = None
         self._reference_radius = None
         self._reference_lengths = None
+        self._reference_walls = None
         self._shortest_unlisted = 0.0
 
     def required_reach(self, sim):
@@ -556,10 +597,13 @@ class NeighborList:
         box.wrap(p)
         sim.contacts = build_contacts(p.position, p.radius, self.skin + self.interaction_range,
                                       previous=sim.contacts,
-                                      period=box.period if box.periodic else None)
+                                      period=box.period if box.periodic else None,
+                                      walls=None if box.periodic else box.position,
+                                      wall_margin=self.skin)
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
         self._reference_lengths = box.lengths()
+        self._reference_walls = box.position.copy()
         self._shortest_unlisted = 2.0 * float(p.radius.max()) + self.interaction_range + self.skin
         self.rebuilds += 1
 
@@ -572,6 +616,9 @@ class NeighborList:
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
                 or len(self._reference_radius) != len(p.radius)
+                or (not sim.walls.periodic
+                    and walls_moved_beyond(sim.walls.position, self._reference_walls,
+                                           0.5 * self.skin))
                 or moved_beyond(p.position, self._reference_position, p.radius,
                                 self._reference_radius, 0.5 * self.skin, lengths, reference,
                                 self._shortest_unlisted)):

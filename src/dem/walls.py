@@ -67,8 +67,8 @@ class WallForces:
 
     def apply(self, sim):
         p = sim.particles
-        wall_forces(p.position, p.radius, sim.walls.position, self.young, p.force,
-                    sim.walls.force, sim.walls.stiffness, sim.walls.moment)
+        wall_forces(p.position, p.radius, sim.contacts.near_wall, sim.walls.position,
+                    self.young, p.force, sim.walls.force, sim.walls.stiffness, sim.walls.moment)
 
 
 class StressServo:
