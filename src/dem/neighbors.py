@@ -147,7 +147,9 @@ def _cell_grid(position, cell_size):
 
 @numba.njit(cache=True)
 def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles, out):
-    """Write into ``out`` the sorted j > p within r_p + r_j + skin; return how many."""
+    """Write into ``out`` the sorted j > p within r_p + r_j + skin (nothing if ``out`` is
+    empty: count only); return how many."""
+    store = len(out) > 0
     found = 0
     cell = cell_of[p]
     cz = cell % dims[2]
@@ -175,40 +177,35 @@ def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_par
                     d1 = position[q, 1] - position[p, 1]
                     d2 = position[q, 2] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                        # insertion keeps the row sorted by j
-                        k = found
-                        while k > 0 and out[k - 1] > q:
-                            out[k] = out[k - 1]
-                            k -= 1
-                        out[k] = q
+                        if store:       # insertion keeps the row sorted by j
+                            k = found
+                            while k > 0 and out[k - 1] > q:
+                                out[k] = out[k - 1]
+                                k -= 1
+                            out[k] = q
                         found += 1
     return found
 
 
 @numba.njit(cache=True, parallel=True)
 def build_pairs(position, radius, skin):
-    """Half Verlet list (i < j, |x_i - x_j| < r_i + r_j + skin) as CSR arrays (row_start, pair_j)."""
+    """Half Verlet list (i < j, |x_i - x_j| < r_i + r_j + skin) as CSR arrays (row_start, pair_j):
+    one pass counts each row, a second sorts each row in place (no scratch rows)."""
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
     dims, cell_of, cell_start, cell_particles = _cell_grid(position, cell_size)
-    max_row = 0
-    for c in range(len(cell_start) - 1):
-        max_row = max(max_row, cell_start[c + 1] - cell_start[c])
-    max_row *= 27
+    nothing = np.empty(0, np.int64)
     row_count = np.zeros(count, np.int64)
     for p in numba.prange(count):
-        scratch = np.empty(max_row, np.int64)
         row_count[p] = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start,
-                                     cell_particles, scratch)
+                                     cell_particles, nothing)
     row_start = np.zeros(count + 1, np.int64)
     for p in range(count):
         row_start[p + 1] = row_start[p] + row_count[p]
     pair_j = np.empty(row_start[count], np.int64)
     for p in numba.prange(count):
-        scratch = np.empty(max_row, np.int64)
-        found = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
-                              scratch)
-        pair_j[row_start[p]:row_start[p] + found] = scratch[:found]
+        _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
+                      pair_j[row_start[p]:row_start[p + 1]])
     return row_start, pair_j
 
 
@@ -224,48 +221,55 @@ def _periodic_grid(position, cell_size, period):
     return _sort_into_cells(position, np.zeros(3), period.copy(), dims)
 
 
+@numba.njit(cache=True, inline="always")
+def _wrap_cell(c, dim):
+    """(cell index, image) of cell coordinate ``c`` in a periodic row of ``dim`` cells,
+    c in [-1, dim]."""
+    if c < 0:
+        return c + dim, -1
+    if c >= dim:
+        return c - dim, 1
+    return c, 0
+
+
 @numba.njit(cache=True)
 def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
                            cell_particles, out, out_image):
     """As _neighbors_of in a periodic box: the sorted j > p within r_p + r_j + skin of p
-    through the nearest image, written with that image into ``out`` and ``out_image``."""
+    through the nearest image, written with that image into ``out`` and ``out_image``
+    (nothing if ``out`` is empty: count only)."""
+    store = len(out) > 0
     found = 0
     cell = cell_of[p]
-    centre = (cell // (dims[1] * dims[2]), (cell // dims[2]) % dims[1], cell % dims[2])
-    shift = np.zeros(3, np.int64)
-    neighbour = np.zeros(3, np.int64)
+    cz = cell % dims[2]
+    cy = (cell // dims[2]) % dims[1]
+    cx = cell // (dims[1] * dims[2])
     for dx in range(-1, 2):
+        x, sx = _wrap_cell(cx + dx, dims[0])
         for dy in range(-1, 2):
+            y, sy = _wrap_cell(cy + dy, dims[1])
             for dz in range(-1, 2):
-                offset = (dx, dy, dz)
-                for axis in range(3):
-                    c = centre[axis] + offset[axis]
-                    shift[axis] = 0
-                    if c < 0:
-                        c += dims[axis]
-                        shift[axis] = -1
-                    elif c >= dims[axis]:
-                        c -= dims[axis]
-                        shift[axis] = 1
-                    neighbour[axis] = c
-                c = (neighbour[0] * dims[1] + neighbour[1]) * dims[2] + neighbour[2]
+                z, sz = _wrap_cell(cz + dz, dims[2])
+                c = (x * dims[1] + y) * dims[2] + z
                 for slot in range(cell_start[c], cell_start[c + 1]):
                     q = cell_particles[slot]
                     if q <= p:
                         continue
                     reach = radius[p] + radius[q] + skin
-                    d0 = position[q, 0] + shift[0] * period[0] - position[p, 0]
-                    d1 = position[q, 1] + shift[1] * period[1] - position[p, 1]
-                    d2 = position[q, 2] + shift[2] * period[2] - position[p, 2]
+                    d0 = position[q, 0] + sx * period[0] - position[p, 0]
+                    d1 = position[q, 1] + sy * period[1] - position[p, 1]
+                    d2 = position[q, 2] + sz * period[2] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                        k = found
-                        while k > 0 and out[k - 1] > q:
-                            out[k] = out[k - 1]
-                            out_image[k] = out_image[k - 1]
-                            k -= 1
-                        out[k] = q
-                        for axis in range(3):
-                            out_image[k, axis] = shift[axis]
+                        if store:
+                            k = found
+                            while k > 0 and out[k - 1] > q:
+                                out[k] = out[k - 1]
+                                out_image[k] = out_image[k - 1]
+                                k -= 1
+                            out[k] = q
+                            out_image[k, 0] = sx
+                            out_image[k, 1] = sy
+                            out_image[k, 2] = sz
                         found += 1
     return found
 
@@ -278,29 +282,21 @@ def build_periodic_pairs(position, radius, skin, period):
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
     dims, cell_of, cell_start, cell_particles = _periodic_grid(position, cell_size, period)
-    max_row = 0
-    for c in range(len(cell_start) - 1):
-        max_row = max(max_row, cell_start[c + 1] - cell_start[c])
-    max_row *= 27
+    nothing = np.empty(0, np.int64)
+    no_image = np.empty((0, 3), np.int8)
     row_count = np.zeros(count, np.int64)
     for p in numba.prange(count):
-        scratch = np.empty(max_row, np.int64)
-        scratch_image = np.empty((max_row, 3), np.int8)
         row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
-                                              cell_start, cell_particles, scratch,
-                                              scratch_image)
+                                              cell_start, cell_particles, nothing, no_image)
     row_start = np.zeros(count + 1, np.int64)
     for p in range(count):
         row_start[p + 1] = row_start[p] + row_count[p]
     pair_j = np.empty(row_start[count], np.int64)
     image = np.empty((row_start[count], 3), np.int8)
     for p in numba.prange(count):
-        scratch = np.empty(max_row, np.int64)
-        scratch_image = np.empty((max_row, 3), np.int8)
-        found = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
-                                       cell_start, cell_particles, scratch, scratch_image)
-        pair_j[row_start[p]:row_start[p] + found] = scratch[:found]
-        image[row_start[p]:row_start[p] + found] = scratch_image[:found]
+        _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
+                               cell_particles, pair_j[row_start[p]:row_start[p + 1]],
+                               image[row_start[p]:row_start[p + 1]])
     return row_start, pair_j, image
 
 
