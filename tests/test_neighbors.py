@@ -10,7 +10,7 @@ import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
 from dem.contact_law import pair_forces
-from dem.neighbors import build_contacts, near_wall_particles, spatial_order
+from dem.neighbors import ROW_CAPACITY, build_contacts, near_wall_particles, spatial_order
 from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from dem.state import Walls
 from dem.walls import ConstantStrainRate, StressServo
@@ -41,6 +41,36 @@ def test_pairs_match_brute_force_with_mixed_radii():
     for j in range(len(radius)):
         slots = contacts.second_pair[contacts.second_start[j]:contacts.second_start[j + 1]]
         assert set(slots.tolist()) == set(np.nonzero(contacts.pair_j == j)[0].tolist())
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_a_row_longer_than_the_search_buffer_is_complete(periodic):
+    """A large sphere (index 0) ringed by 3 * ROW_CAPACITY small ones on its surface: its row
+    overflows the search's buffer and is searched again; the list is brute force's. In a
+    periodic cell the cluster straddles a corner, so the row's pairs cross the faces."""
+    rng = np.random.default_rng(11)
+    count = 3 * ROW_CAPACITY
+    direction = rng.normal(size=(count, 3))
+    direction /= np.linalg.norm(direction, axis=1)[:, None]
+    radius = np.concatenate([[0.1], np.full(count, 0.01)])
+    position = np.concatenate([[[0.0, 0.0, 0.0]], 0.111 * direction])
+    skin = 0.005
+    if periodic:
+        edge = 1.0
+        position = np.mod(position, edge)
+        contacts = build_contacts(position, radius, skin, period=np.full(3, edge))
+        delta = position[None, :, :] - position[:, None, :]
+        delta -= edge * np.round(delta / edge)              # minimum image
+        reach = radius[:, None] + radius[None, :] + skin
+        expected = set(zip(*[a.tolist() for a in np.nonzero(
+            np.triu(np.linalg.norm(delta, axis=2) < reach, k=1))]))
+        assert contacts.image[contacts.pair_i == 0].any()
+    else:
+        contacts = build_contacts(position, radius, skin)
+        expected = brute_force_pairs(position, radius, skin)
+    assert contacts.row_start[1] - contacts.row_start[0] == count > ROW_CAPACITY
+    assert set(zip(contacts.pair_i.tolist(), contacts.pair_j.tolist())) == expected
+    assert np.all(np.diff(contacts.pair_j[:count]) > 0)
 
 
 def test_near_wall_particles_match_brute_force():

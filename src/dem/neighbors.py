@@ -86,6 +86,11 @@ def branch_vector(position, i, j, image, k, period):
             position[j, 2] - position[i, 2] + image[k, 2] * period[2])
 
 
+#: Pairs of a row kept by the one search of build_pairs (a longer row is searched again): a
+#: sphere of a packing has 2-6 neighbours j > i within a skin of 0.1 R.
+ROW_CAPACITY = 16
+
+
 @numba.njit(cache=True)
 def _cell_members(cell_of, cell_count):
     """(cell_start, cell_particles): the particles of each cell in CSR order, cell c holding
@@ -147,9 +152,9 @@ def _cell_grid(position, cell_size):
 
 @numba.njit(cache=True)
 def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles, out):
-    """Write into ``out`` the sorted j > p within r_p + r_j + skin (nothing if ``out`` is
-    empty: count only); return how many."""
-    store = len(out) > 0
+    """Count the j > p within r_p + r_j + skin; return how many. While ``out`` has room they
+    are written into it, sorted (all of them if it is long enough: compare the count)."""
+    room = len(out)
     found = 0
     cell = cell_of[p]
     cz = cell % dims[2]
@@ -177,7 +182,7 @@ def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_par
                     d1 = position[q, 1] - position[p, 1]
                     d2 = position[q, 2] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                        if store:       # insertion keeps the row sorted by j
+                        if found < room:        # insertion keeps the row sorted by j
                             k = found
                             while k > 0 and out[k - 1] > q:
                                 out[k] = out[k - 1]
@@ -190,23 +195,35 @@ def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_par
 @numba.njit(cache=True, parallel=True)
 def build_pairs(position, radius, skin):
     """Half Verlet list (i < j, |x_i - x_j| < r_i + r_j + skin) as CSR arrays (row_start, pair_j):
-    one pass counts each row, a second sorts each row in place (no scratch rows)."""
+    one search keeps each row in a buffer of ROW_CAPACITY, then the rows are copied into the
+    list; a longer row is searched again, into its place in the list."""
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
     dims, cell_of, cell_start, cell_particles = _cell_grid(position, cell_size)
-    nothing = np.empty(0, np.int64)
-    row_count = np.zeros(count, np.int64)
+    kept = np.empty((count, ROW_CAPACITY), np.int64)
+    row_count = np.empty(count, np.int64)
     for p in numba.prange(count):
         row_count[p] = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start,
-                                     cell_particles, nothing)
-    row_start = np.zeros(count + 1, np.int64)
-    for p in range(count):
-        row_start[p + 1] = row_start[p] + row_count[p]
+                                     cell_particles, kept[p])
+    row_start = _row_starts(row_count)
     pair_j = np.empty(row_start[count], np.int64)
     for p in numba.prange(count):
-        _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
-                      pair_j[row_start[p]:row_start[p + 1]])
+        start, stop = row_start[p], row_start[p + 1]
+        if stop - start <= ROW_CAPACITY:
+            pair_j[start:stop] = kept[p, :stop - start]
+        else:
+            _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
+                          pair_j[start:stop])
     return row_start, pair_j
+
+
+@numba.njit(cache=True)
+def _row_starts(row_count):
+    """CSR row starts (N + 1,) of rows of ``row_count`` (N,) entries."""
+    row_start = np.zeros(len(row_count) + 1, np.int64)
+    for p in range(len(row_count)):
+        row_start[p + 1] = row_start[p] + row_count[p]
+    return row_start
 
 
 @numba.njit(cache=True)
@@ -235,10 +252,10 @@ def _wrap_cell(c, dim):
 @numba.njit(cache=True)
 def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
                            cell_particles, out, out_image):
-    """As _neighbors_of in a periodic box: the sorted j > p within r_p + r_j + skin of p
-    through the nearest image, written with that image into ``out`` and ``out_image``
-    (nothing if ``out`` is empty: count only)."""
-    store = len(out) > 0
+    """As _neighbors_of in a periodic box: the j > p within r_p + r_j + skin of p through
+    the nearest image, written sorted with that image into ``out`` and ``out_image`` while
+    they have room; returns how many."""
+    room = len(out)
     found = 0
     cell = cell_of[p]
     cz = cell % dims[2]
@@ -260,7 +277,7 @@ def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cel
                     d1 = position[q, 1] + sy * period[1] - position[p, 1]
                     d2 = position[q, 2] + sz * period[2] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
-                        if store:
+                        if found < room:
                             k = found
                             while k > 0 and out[k - 1] > q:
                                 out[k] = out[k - 1]
@@ -282,21 +299,24 @@ def build_periodic_pairs(position, radius, skin, period):
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
     dims, cell_of, cell_start, cell_particles = _periodic_grid(position, cell_size, period)
-    nothing = np.empty(0, np.int64)
-    no_image = np.empty((0, 3), np.int8)
-    row_count = np.zeros(count, np.int64)
+    kept = np.empty((count, ROW_CAPACITY), np.int64)
+    kept_image = np.empty((count, ROW_CAPACITY, 3), np.int8)
+    row_count = np.empty(count, np.int64)
     for p in numba.prange(count):
         row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
-                                              cell_start, cell_particles, nothing, no_image)
-    row_start = np.zeros(count + 1, np.int64)
-    for p in range(count):
-        row_start[p + 1] = row_start[p] + row_count[p]
+                                              cell_start, cell_particles, kept[p],
+                                              kept_image[p])
+    row_start = _row_starts(row_count)
     pair_j = np.empty(row_start[count], np.int64)
     image = np.empty((row_start[count], 3), np.int8)
     for p in numba.prange(count):
-        _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
-                               cell_particles, pair_j[row_start[p]:row_start[p + 1]],
-                               image[row_start[p]:row_start[p + 1]])
+        start, stop = row_start[p], row_start[p + 1]
+        if stop - start <= ROW_CAPACITY:
+            pair_j[start:stop] = kept[p, :stop - start]
+            image[start:stop] = kept_image[p, :stop - start]
+        else:
+            _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
+                                   cell_particles, pair_j[start:stop], image[start:stop])
     return row_start, pair_j, image
 
 
@@ -335,12 +355,17 @@ def previous_pair_index(old_row_start, old_pair_j, new_row_start, new_pair_j):
 
 
 @numba.njit(cache=True, parallel=True)
-def _carry_rows(old_values, index, new_values):
-    """Row k of ``new_values`` becomes row index[k] of ``old_values`` where index[k] >= 0."""
+def _carry_rows(old_values, index, fill, new_values):
+    """Row k of ``new_values`` becomes row index[k] of ``old_values``, or ``fill[0]`` throughout
+    where index[k] is -1."""
     for k in numba.prange(len(index)):
-        if index[k] >= 0:
+        source = index[k]
+        if source >= 0:
             for c in range(old_values.shape[1]):
-                new_values[k, c] = old_values[index[k], c]
+                new_values[k, c] = old_values[source, c]
+        else:
+            for c in range(new_values.shape[1]):
+                new_values[k, c] = fill[0]
 
 
 @numba.njit(cache=True)
@@ -480,10 +505,12 @@ def carry_pair_array(values, index, fill=0):
     """``values`` (one row per pair of the old list) moved to the pairs of a new list, whose
     pair k was pair index[k] of the old one (previous_pair_index; -1: new to the list, gets
     ``fill``). Any dtype and trailing shape."""
-    carried = np.full((len(index),) + values.shape[1:], fill, dtype=values.dtype)
-    if len(index) and len(values):
-        _carry_rows(np.ascontiguousarray(values).reshape(len(values), -1), index,
-                    carried.reshape(len(index), -1))
+    shape = (len(index),) + values.shape[1:]
+    if not (len(index) and len(values)):
+        return np.full(shape, fill, dtype=values.dtype)
+    carried = np.empty(shape, dtype=values.dtype)
+    _carry_rows(np.ascontiguousarray(values).reshape(len(values), -1), index,
+                np.full(1, fill, dtype=values.dtype), carried.reshape(len(index), -1))
     return carried
 
 
