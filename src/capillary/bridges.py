@@ -65,13 +65,14 @@ reservoir-wetted sample to a closed model; then bridges + films + lost = the liq
 
 import math
 
+import numba
 import numpy as np
 
 from capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
                                       gather_contact_bridges, gather_contact_bridges_virial,
                                       pendular_overlap_counts, refresh_contact_bridges,
-                                      suction_bridges, suction_interfaces, volume_bridges,
-                                      volume_interfaces)
+                                      serial_contact_bridges, suction_bridges,
+                                      suction_interfaces, volume_bridges, volume_interfaces)
 from capillary.bridge_state import BridgeState
 from capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from capillary.validation import (check_bridge_stiffness, check_contact_angle,
@@ -368,9 +369,10 @@ class CapillaryBridges:
                                         self.surface_tension, *self._table_arrays)
             self._applied_suction = self.suction
         if self.control == "suction" and not self.persist:
-            contact_bridges(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
-                            b.filling_i, b.filling_j, self.suction, self.surface_tension,
-                            *self._table_arrays)
+            follow = contact_bridges if numba.get_num_threads() > 1 else serial_contact_bridges
+            follow(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
+                   b.filling_i, b.filling_j, self.suction, self.surface_tension,
+                   *self._table_arrays)
             contact_law = self._joined_contact_law(sim)
             if contact_law is not None:
                 contact_law.gather(sim, b.force)

@@ -28,17 +28,35 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
     affine_rate * x carrying every particle on top of its own; zeros inside walls."""
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for p in numba.prange(position.shape[0]):
-        dt_mass = dt / mass[p]          # [s/kg], once: 17 % off the integration (measured)
-        dt_inertia = dt / inertia[p]
-        for c in range(3):
-            f = _damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
-            velocity[p, c] += f * dt_mass
-            if stretched:
-                position[p, c] += (velocity[p, c] + affine_rate[c] * position[p, c]) * dt
-            else:
-                position[p, c] += velocity[p, c] * dt
-            t = _damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
-            angular_velocity[p, c] += t * dt_inertia
+        _advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+                 affine_rate, stretched, dt)
+
+
+@numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
+def serial_leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+                    affine_rate, dt):
+    """leapfrog on one thread, without the parallel launch (2-3 us a call; same results)."""
+    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
+    for p in range(position.shape[0]):
+        _advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+                 affine_rate, stretched, dt)
+
+
+@numba.njit(cache=True, inline="always")
+def _advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+             affine_rate, stretched, dt):
+    """Particle p's leapfrog step (leapfrog)."""
+    dt_mass = dt / mass[p]          # [s/kg], once: 17 % off the integration (measured)
+    dt_inertia = dt / inertia[p]
+    for c in range(3):
+        f = _damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
+        velocity[p, c] += f * dt_mass
+        if stretched:
+            position[p, c] += (velocity[p, c] + affine_rate[c] * position[p, c]) * dt
+        else:
+            position[p, c] += velocity[p, c] * dt
+        t = _damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
+        angular_velocity[p, c] += t * dt_inertia
 
 
 class Integrator:
@@ -49,5 +67,6 @@ class Integrator:
 
     def apply(self, sim):
         p = sim.particles
-        leapfrog(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass, p.inertia,
-                 self.damping, sim.walls.affine_rate, sim.dt)
+        step = leapfrog if numba.get_num_threads() > 1 else serial_leapfrog
+        step(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass, p.inertia,
+             self.damping, sim.walls.affine_rate, sim.dt)
