@@ -382,8 +382,9 @@ def wall_forces(position, radius, near_wall, wall_position, young, force, wall_f
     wall_force[w] is the compressive normal force the particles exert on wall w [N],
     wall_stiffness[w] the sum of its contacts' kn [N/m] (used by the stress servo) and
     wall_moment[w] the sum of (centre-to-wall distance) * force [N m] (Love–Weber, Eq. 3.41).
-    Serial: a pass over the particles near the walls (a tenth of a 10,000-sphere sample; over
-    every particle, skipping those off the walls, it took 4-5 % of a two-thread step).
+    Serial: a pass over the particles near the walls (a fifth of a 10,000-sphere sample, a
+    tenth of a 100,000; over every particle, skipping those off the walls, it took 4-5 % of a
+    two-thread step at 10,000).
     """
     wall_force[:] = 0.0
     wall_stiffness[:] = 0.0
