@@ -107,6 +107,19 @@ def test_a_wall_moved_beyond_half_the_skin_rebuilds_the_list():
     assert sim.particles.force[0, 0] == pytest.approx(-YOUNG * RADIUS * 0.1 * RADIUS, rel=1e-9)
 
 
+def test_a_list_without_wall_reference_rebuilds():
+    """A neighbour list restored from a checkpoint written before the walls' reference was
+    kept (its state without ``_reference_walls``) rebuilds at its next step instead of failing."""
+    sim = two_body_scene([[0.0, 0.0, 0.0], [3 * RADIUS, 0.0, 0.0]], np.zeros((2, 3)))
+    sim.advance()
+    rebuilds = sim.neighbors.rebuilds
+    sim.neighbors._reference_walls = None
+    sim.advance()
+    assert sim.neighbors.rebuilds == rebuilds + 1
+    sim.advance()
+    assert sim.neighbors.rebuilds == rebuilds + 1
+
+
 def test_history_is_carried_to_the_same_pair_after_a_rebuild():
     rng = np.random.default_rng(4)
     position = rng.random((300, 3))

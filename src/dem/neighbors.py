@@ -638,6 +638,7 @@ class NeighborList:
             lengths, reference = sim.walls.period, self._reference_lengths
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
+                or self._reference_walls is None      # a checkpoint from before it was kept
                 or len(self._reference_radius) != len(p.radius)
                 or (not sim.walls.periodic
                     and walls_moved_beyond(sim.walls.position, self._reference_walls,
