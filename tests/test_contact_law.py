@@ -159,8 +159,9 @@ def evaluate(kernel, position, velocity, spin, radius, contacts, period, *extra)
     kernel rotates the history with the normals of that evaluation)."""
     c = contacts
     c.shear_force[:] = np.random.default_rng(3).normal(0, 1e-6, c.shear_force.shape)
-    common = (position, velocity, spin, radius, c.pair_i, c.pair_j, c.image, period, np.zeros(3),
-              c.shear_force, c.normal, c.overlap, c.normal_force, c.force, YOUNG, 0.3, 0.3, 1e-6)
+    common = (position, velocity, spin, radius, c.row_start, c.pair_i, c.pair_j, c.image, period,
+              np.zeros(3), c.shear_force, c.normal, c.overlap, c.normal_force, c.force, YOUNG,
+              0.3, 0.3, 1e-6)
     pair_forces(*common, 0)
     kernel(*common, *extra)
 
@@ -248,6 +249,6 @@ def test_one_thread_kernels_give_the_gathers_sums_bit_for_bit(periodic):
 
         force, torque, virial = zeros()
         scatter_contact_forces(reference.force, attraction, reference.normal, reference.overlap,
-                               radius, reference.pair_i, reference.pair_j, force, torque, ahead)
+                               radius, reference.row_start, reference.pair_j, force, torque, ahead)
         add_faces(reference, virial, attraction)
         assert_same((force, torque, virial), expected_wet)
