@@ -298,10 +298,19 @@ def gather_contact_forces_virial(pair_force, attraction, normal, overlap, radius
 
 
 @numba.njit(cache=True, inline="always")
-def _add_to_second(j, a0, a1, a2, c0, c1, c2, n0, n1, n2, overlap_k, radius, force, torque):
-    """Add a pair's force on its second member j, a [N] (with any attraction: _pair_terms),
-    to ``force[j]``, and the torque of its contact force c [N] (_contact_torque, normal n,
-    overlap ``overlap_k``) to ``torque[j]``."""
+def _row_sums(i, force, torque):
+    """Particle i's force and torque as one tuple of six sums, which a row loop carries in
+    registers through i's row (_scatter_to_both) and stores at its end (_store_row_sums)."""
+    return force[i, 0], force[i, 1], force[i, 2], torque[i, 0], torque[i, 1], torque[i, 2]
+
+
+@numba.njit(cache=True, inline="always")
+def _scatter_to_both(sums, j, a0, a1, a2, c0, c1, c2, n0, n1, n2, overlap_k, radius_i, radius,
+                     force, torque):
+    """A pair's terms on both members: -a and the torque of its contact force c on the first
+    member (of radius ``radius_i``) taken into its ``sums`` (_row_sums; returned), +a and
+    c's torque on the second member j added to ``force[j]`` and ``torque[j]`` (a [N] with any
+    attraction, _pair_terms; normal n, overlap ``overlap_k`` [m]; _add_contact_forces)."""
     m0, m1, m2 = _contact_torque(n0, n1, n2, overlap_k, radius[j], c0, c1, c2)
     force[j, 0] += a0
     force[j, 1] += a1
@@ -309,6 +318,15 @@ def _add_to_second(j, a0, a1, a2, c0, c1, c2, n0, n1, n2, overlap_k, radius, for
     torque[j, 0] += m0
     torque[j, 1] += m1
     torque[j, 2] += m2
+    m0, m1, m2 = _contact_torque(n0, n1, n2, overlap_k, radius_i, c0, c1, c2)
+    return (sums[0] - a0, sums[1] - a1, sums[2] - a2, sums[3] + m0, sums[4] + m1,
+            sums[5] + m2)
+
+
+@numba.njit(cache=True, inline="always")
+def _store_row_sums(i, sums, force, torque):
+    """Store particle i's ``sums`` (_row_sums) in its rows of ``force`` and ``torque``."""
+    force[i, 0], force[i, 1], force[i, 2], torque[i, 0], torque[i, 1], torque[i, 2] = sums
 
 
 @numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
@@ -324,34 +342,16 @@ def scatter_contact_forces(pair_force, attraction, normal, overlap, radius, row_
         stop = row_start[i + 1]
         if start == stop:
             continue
-        ri = radius[i]
-        f0, f1, f2 = force[i, 0], force[i, 1], force[i, 2]
-        t0, t1, t2 = torque[i, 0], torque[i, 1], torque[i, 2]
+        radius_i = radius[i]
+        sums = _row_sums(i, force, torque)
         for k in range(start, stop):
             _prefetch_second(k, pair_j, prefetch_ahead, (force, torque))
             a0, a1, a2 = pair_force_with_attraction(pair_force, attraction, normal, k)
-            c0 = pair_force[k, 0]
-            c1 = pair_force[k, 1]
-            c2 = pair_force[k, 2]
-            n0 = normal[k, 0]
-            n1 = normal[k, 1]
-            n2 = normal[k, 2]
-            overlap_k = overlap[k]
-            m0, m1, m2 = _contact_torque(n0, n1, n2, overlap_k, ri, c0, c1, c2)
-            f0 -= a0
-            f1 -= a1
-            f2 -= a2
-            t0 += m0
-            t1 += m1
-            t2 += m2
-            _add_to_second(pair_j[k], a0, a1, a2, c0, c1, c2, n0, n1, n2, overlap_k, radius,
-                           force, torque)
-        force[i, 0] = f0
-        force[i, 1] = f1
-        force[i, 2] = f2
-        torque[i, 0] = t0
-        torque[i, 1] = t1
-        torque[i, 2] = t2
+            sums = _scatter_to_both(sums, pair_j[k], a0, a1, a2, pair_force[k, 0],
+                                    pair_force[k, 1], pair_force[k, 2], normal[k, 0],
+                                    normal[k, 1], normal[k, 2], overlap[k], radius_i, radius,
+                                    force, torque)
+        _store_row_sums(i, sums, force, torque)
 
 
 @numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
@@ -374,9 +374,7 @@ def scattered_pair_forces(position, velocity, angular_velocity, radius, row_star
         if start == stop:
             continue
         first = _first_member(i, position, velocity, angular_velocity, radius)
-        ri = first[9]
-        f0, f1, f2 = particle_force[i, 0], particle_force[i, 1], particle_force[i, 2]
-        t0, t1, t2 = particle_torque[i, 0], particle_torque[i, 1], particle_torque[i, 2]
+        sums = _row_sums(i, particle_force, particle_torque)
         for k in range(start, stop):
             _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity,
                                                          particle_force, particle_torque))
@@ -386,21 +384,9 @@ def scattered_pair_forces(position, velocity, angular_velocity, radius, row_star
                 periodic, affine_rate, stretched, shear_force, normal, overlap, normal_force,
                 force, young, shear_ratio, tan_friction, dt)
             if touching:
-                m0, m1, m2 = _contact_torque(n0, n1, n2, overlap_k, ri, a0, a1, a2)
-                f0 -= a0
-                f1 -= a1
-                f2 -= a2
-                t0 += m0
-                t1 += m1
-                t2 += m2
-                _add_to_second(j, a0, a1, a2, a0, a1, a2, n0, n1, n2, overlap_k, radius,
-                               particle_force, particle_torque)
-        particle_force[i, 0] = f0
-        particle_force[i, 1] = f1
-        particle_force[i, 2] = f2
-        particle_torque[i, 0] = t0
-        particle_torque[i, 1] = t1
-        particle_torque[i, 2] = t2
+                sums = _scatter_to_both(sums, j, a0, a1, a2, a0, a1, a2, n0, n1, n2, overlap_k,
+                                        first[9], radius, particle_force, particle_torque)
+        _store_row_sums(i, sums, particle_force, particle_torque)
 
 
 @numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
