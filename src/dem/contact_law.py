@@ -12,8 +12,8 @@ counting (``_nrt=False``; they allocate nothing): a serial loop that hands array
 loop does not (measured at 10,000 spheres: 94 against 42 ns a pair for the same evaluation).
 They run row by row, the first member's state and sums in registers through its row (measured
 2026-11-26 against the pair-by-pair loop, whole one-thread shear steps in alternating turns:
-dry 0.977 at 1,000 spheres, 1.00 at 10,000, 0.986 at 100,000; wet 0.94-0.96 at 1,000, 0.98
-at 10,000).
+dry 0.95-0.98 at 1,000 spheres, 0.98-1.01 at 10,000, 0.986 at 100,000; wet 0.94-0.96 at
+1,000, 0.98 at 10,000).
 """
 
 import numba
@@ -239,9 +239,9 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
 
     Order: the terms are added one by one to p's force and torque in pair order, the order in
     which a loop over the pairs meets them (scatter_contact_forces), so that the one-thread
-    kernels give the same sums: first the pairs in which p is the second member (their first member
-    is below p, so they come before p's own in the CSR list; second_pair holds them in pair
-    order), then p's own."""
+    kernels give the same sums: first the pairs in which p is the second member (their first
+    member is below p, so they come before p's own in the CSR list; second_pair holds them in
+    pair order), then p's own."""
     f0, f1, f2 = force[p, 0], force[p, 1], force[p, 2]
     t0, t1, t2 = torque[p, 0], torque[p, 1], torque[p, 2]
     r = radius[p]
