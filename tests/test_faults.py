@@ -12,6 +12,7 @@ Option cases run in-process through pendular.cli.run_command (they are refused b
 runs); runs and signals are subprocesses of 60 spheres.
 """
 
+import ctypes
 import json
 import os
 import shutil
@@ -24,8 +25,9 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import zero_bytes
+from conftest import RADIUS, two_body_scene, zero_bytes
 from dem.integrity import stamp, verify
+from dem.interrupt import catching_interrupts
 from pendular.cli import run_command
 from pendular.outputs import OutputFolder
 
@@ -275,6 +277,41 @@ def test_sigint_during_the_preparation_ends_in_one_line(tmp_path):
     assert "Traceback" not in err
     assert err.strip().splitlines()[-1] == "triaxial.py: interrupted", err
     assert not (out / "sample.h5").exists()
+
+
+def test_an_interrupt_python_discards_still_stops_the_run_at_its_next_check(monkeypatch):
+    """A SIGINT that lands inside a callback from C code (the first run's Ctrl-C while Numba
+    writes a kernel to its cache: llvmlite's ctypes hook) raises KeyboardInterrupt there, and
+    Python prints and discards it. Under the command line's handler (dem.interrupt) it stays
+    pending, and Simulation.run raises it after its next chunk of steps; outside, it is
+    lost."""
+    @ctypes.CFUNCTYPE(None)
+    def callback_from_c():
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(1000):      # the handler runs between two of these bytecodes
+            pass
+
+    def scene():
+        return two_body_scene([[0.0, 0.0, 0.0], [2.5 * RADIUS, 0.0, 0.0]], [[0.0] * 3] * 2)
+
+    discarded = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: discarded.append(
+        unraisable.exc_type))
+    sim = scene()
+    with catching_interrupts():
+        callback_from_c()          # returns: Python discarded the KeyboardInterrupt
+        assert discarded == [KeyboardInterrupt]
+        with pytest.raises(KeyboardInterrupt):
+            sim.run(500, check_every=100)
+    assert sim.step == 100
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler     # restored
+    sim = scene()
+    with catching_interrupts():
+        pass                       # nothing pending from before
+    with pytest.raises(KeyboardInterrupt):
+        with catching_interrupts():
+            raise KeyboardInterrupt
+    assert sim.run(300, check_every=100) == 300
 
 
 # ---------------------------------------------------------------- stress bookkeeping

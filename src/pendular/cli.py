@@ -16,6 +16,7 @@ import sys
 import numba
 
 from dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
+from dem.interrupt import catching_interrupts
 
 from . import __version__
 
@@ -132,7 +133,8 @@ def run_command(name, argv, prog=None):
     parser, module = command_parser(name, prog)
     args = parser.parse_args(argv)
     try:
-        return module.run(args) or 0
+        with catching_interrupts():
+            return module.run(args) or 0
     except (UsageError, ValueError, FileNotFoundError, IsADirectoryError,
             NotADirectoryError, PermissionError) as error:
         parser.exit(2, f"{parser.prog}: error: {error}\n")
