@@ -159,11 +159,11 @@ def evaluate(kernel, position, velocity, spin, radius, contacts, period, *extra)
     kernel rotates the history with the normals of that evaluation)."""
     c = contacts
     c.shear_force[:] = np.random.default_rng(3).normal(0, 1e-6, c.shear_force.shape)
-    common = (position, velocity, spin, radius, c.row_start, c.pair_i, c.pair_j, c.image, period,
-              np.zeros(3), c.shear_force, c.normal, c.overlap, c.normal_force, c.force, YOUNG,
-              0.3, 0.3, 1e-6)
-    pair_forces(*common, 0)
-    kernel(*common, *extra)
+    per_pair = (c.image, period, np.zeros(3), c.shear_force, c.normal, c.overlap,
+                c.normal_force, c.force, YOUNG, 0.3, 0.3, 1e-6)
+    pair_forces(position, velocity, spin, radius, c.pair_i, c.pair_j, *per_pair, 0)
+    pairs = (c.pair_i if kernel is pair_forces else c.row_start, c.pair_j)  # rows: one thread
+    kernel(position, velocity, spin, radius, *pairs, *per_pair, *extra)
 
 
 def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():

@@ -220,9 +220,9 @@ def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
     walls = Walls.box([-1.0] * 3, [1.0] * 3)
 
     def evaluate(position, c):
-        pair_forces(position, still, still, radius, c.row_start, c.pair_i, c.pair_j, c.image,
-                    walls.period, np.zeros(3), c.shear_force, c.normal, c.overlap,
-                    c.normal_force, c.force, 1e6, 0.3, 0.3, 1e-7, 0)
+        pair_forces(position, still, still, radius, c.pair_i, c.pair_j, c.image, walls.period,
+                    np.zeros(3), c.shear_force, c.normal, c.overlap, c.normal_force, c.force,
+                    1e6, 0.3, 0.3, 1e-7, 0)
 
     evaluate(touching, contacts)
     contacts.shear_force[0] = [0.0, 1e-6, 0.0]           # a loaded spring

@@ -144,22 +144,21 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
 
 
 @numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
-def pair_forces(position, velocity, angular_velocity, radius, row_start, pair_i, pair_j, image,
-                period, affine_rate, shear_force, normal, overlap, normal_force, force, young,
+def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, image, period,
+                affine_rate, shear_force, normal, overlap, normal_force, force, young,
                 shear_ratio, tan_friction, dt, prefetch_ahead):
     """Evaluate every candidate pair; fill the per-pair arrays (``force``: the force on j from
     i; the torques follow from it, the normal and the overlap in the gather).
 
-    row_start, pair_i, pair_j: the pairs (dem.neighbors.Contacts: pairs k of first member i
-    are row_start[i] <= k < row_start[i + 1]); this loop takes them one by one (pair_i), the
-    one-thread kernels row by row (a prange over the rows measured 8 % slower at 10,000
-    spheres on two threads). image, period: each pair's periodic image and the box period
-    (dem.neighbors.branch_vector; zeros inside walls); affine_rate (3,) [1/s]: the
-    homogeneous stretching of a periodic cell, whose velocity affine_rate * l adds to the
-    relative velocity of a pair of branch l. A scene without images or stretching (walls)
-    skips both terms (a branch taken the same way by every pair: no cost). prefetch_ahead:
-    how many pairs ahead particle j's rows are asked of the cache (0: none;
-    dem.prefetch.prefetch_distance; no effect on results).
+    pair_i, pair_j: the pairs (dem.neighbors.Contacts), taken one by one; the one-thread
+    kernels take them row by row, from row_start instead of pair_i (a prange over the rows
+    measured 8 % slower at 10,000 spheres on two threads). image, period: each pair's
+    periodic image and the box period (dem.neighbors.branch_vector; zeros inside walls);
+    affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell, whose velocity
+    affine_rate * l adds to the relative velocity of a pair of branch l. A scene without
+    images or stretching (walls) skips both terms (a branch taken the same way by every pair:
+    no cost). prefetch_ahead: how many pairs ahead particle j's rows are asked of the cache
+    (0: none; dem.prefetch.prefetch_distance; no effect on results).
 
     The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
     is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),
@@ -178,8 +177,8 @@ def pair_forces(position, velocity, angular_velocity, radius, row_start, pair_i,
 
 
 @numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
-def serial_pair_forces(position, velocity, angular_velocity, radius, row_start, pair_i, pair_j,
-                       image, period, affine_rate, shear_force, normal, overlap, normal_force,
+def serial_pair_forces(position, velocity, angular_velocity, radius, row_start, pair_j, image,
+                       period, affine_rate, shear_force, normal, overlap, normal_force,
                        force, young, shear_ratio, tan_friction, dt, prefetch_ahead):
     """pair_forces on one thread, row by row (particle i's state read once for its row,
     _first_member): no parallel launch (2-3 us a call) and a plain loop (the same results)."""
@@ -355,8 +354,8 @@ def scatter_contact_forces(pair_force, attraction, normal, overlap, radius, row_
 
 
 @numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
-def scattered_pair_forces(position, velocity, angular_velocity, radius, row_start, pair_i,
-                          pair_j, image, period, affine_rate, shear_force, normal, overlap,
+def scattered_pair_forces(position, velocity, angular_velocity, radius, row_start, pair_j,
+                          image, period, affine_rate, shear_force, normal, overlap,
                           normal_force, force, young, shear_ratio, tan_friction, dt,
                           prefetch_ahead, particle_force, particle_torque):
     """pair_forces then gather_contact_forces on one thread, in one loop over the rows: each
@@ -475,19 +474,20 @@ class ContactForces:
         p = sim.particles
         c = sim.contacts
         box = sim.walls
-        arguments = (p.position, p.velocity, p.angular_velocity, p.radius, c.row_start,
-                     c.pair_i, c.pair_j, c.image, box.period, box.affine_rate, c.shear_force,
-                     c.normal, c.overlap, c.normal_force, c.force, self.young,
-                     self.shear_ratio, self._tan_friction, sim.dt, prefetch_distance(len(c)))
+        kinematics = (p.position, p.velocity, p.angular_velocity, p.radius)
+        per_pair = (c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
+                    c.normal_force, c.force, self.young, self.shear_ratio, self._tan_friction,
+                    sim.dt, prefetch_distance(len(c)))
         joined = self.joined_by(sim) is not None
         if numba.get_num_threads() > 1:
-            pair_forces(*arguments)
+            pair_forces(*kinematics, c.pair_i, c.pair_j, *per_pair)
             if not joined:
                 self.gather(sim)
         elif joined:
-            serial_pair_forces(*arguments)
+            serial_pair_forces(*kinematics, c.row_start, c.pair_j, *per_pair)
         else:
-            scattered_pair_forces(*arguments, p.force, p.torque)
+            scattered_pair_forces(*kinematics, c.row_start, c.pair_j, *per_pair, p.force,
+                                  p.torque)
             self._add_face_terms(sim, None)
 
     def joined_by(self, sim):
