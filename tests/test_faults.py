@@ -12,7 +12,6 @@ Option cases run in-process through pendular.cli.run_command (they are refused b
 runs); runs and signals are subprocesses of 60 spheres.
 """
 
-import ctypes
 import json
 import os
 import shutil
@@ -27,7 +26,7 @@ import numpy as np
 import pytest
 from numba.core import event
 
-from conftest import RADIUS, two_body_scene, zero_bytes
+from conftest import zero_bytes
 from dem.integrity import stamp, verify
 from dem.interrupt import catching_interrupts
 from pendular.cli import run_command
@@ -239,23 +238,31 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 
 
 # ---------------------------------------------------------------- signals
-def test_sigint_during_the_shear_keeps_the_history_so_far(tmp_path):
-    out, log = tmp_path / "out", tmp_path / "stderr.txt"
-    argv = ["--particles", "60", "--max-strain", "0.1", "--inertial-number", "2e-4",
-            "--vtk-frames", "0", "--out", str(out)]
+def interrupt_script(tmp_path, argv, progress_line):
+    """Run scenarios/triaxial.py with ``argv``, send SIGINT half a second after ``progress_line``
+    first appears on its stderr; returns (exit status, stderr)."""
+    log = tmp_path / "stderr.txt"
     with open(log, "w") as stderr:
         # a child of a shell started with & ignores SIGINT: give it the default disposition
         process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=tmp_path, text=True,
                                    stdout=subprocess.DEVNULL, stderr=stderr,
                                    preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
         started = time.monotonic()
-        while "shear:" not in log.read_text() and time.monotonic() - started < 120:
-            time.sleep(0.05)      # the shear's progress line (its kernels may still compile)
+        while progress_line not in log.read_text() and time.monotonic() - started < 120:
+            time.sleep(0.05)
         time.sleep(0.5)
         process.send_signal(signal.SIGINT)
         process.wait(timeout=60)
-    err = log.read_text()
-    assert process.returncode == 130, err
+    return process.returncode, log.read_text()
+
+
+def test_sigint_during_the_shear_keeps_the_history_so_far(tmp_path):
+    out = tmp_path / "out"
+    # the shear's progress line (its kernels may still be compiling)
+    status, err = interrupt_script(tmp_path, ["--particles", "60", "--max-strain", "0.1",
+                                              "--inertial-number", "2e-4", "--vtk-frames", "0",
+                                              "--out", str(out)], "shear:")
+    assert status == 130, err
     assert "Traceback" not in err and "interrupted at step" in err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is False
@@ -264,73 +271,40 @@ def test_sigint_during_the_shear_keeps_the_history_so_far(tmp_path):
 
 
 def test_sigint_during_the_preparation_ends_in_one_line(tmp_path):
-    out, log = tmp_path / "out", tmp_path / "stderr.txt"
-    argv = ["--particles", "5000", "--max-strain", "0.01", "--vtk-frames", "0", "--out", str(out)]
-    with open(log, "w") as stderr:
-        process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=tmp_path, text=True,
-                                   stdout=subprocess.DEVNULL, stderr=stderr,
-                                   preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-        started = time.monotonic()
-        while "grow radii" not in log.read_text() and time.monotonic() - started < 120:
-            time.sleep(0.05)          # the progress line of the radius growth (about 10 s)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGINT)
-        process.wait(timeout=60)
-    err = log.read_text()
-    assert process.returncode == 130, err
+    out = tmp_path / "out"
+    # the progress line of the radius growth (about 10 s)
+    status, err = interrupt_script(tmp_path, ["--particles", "5000", "--max-strain", "0.01",
+                                              "--vtk-frames", "0", "--out", str(out)],
+                                   "grow radii")
+    assert status == 130, err
     assert "Traceback" not in err
     assert err.strip().splitlines()[-1] == "triaxial.py: interrupted", err
     assert not (out / "sample.h5").exists()
 
 
-def test_an_interrupt_python_discards_still_stops_the_run_at_its_next_check(monkeypatch):
-    """A SIGINT that lands inside a callback from C code (the first run's Ctrl-C while Numba
-    writes a kernel to its cache: llvmlite's ctypes hook) raises KeyboardInterrupt there, and
-    Python discards it (printing a traceback). Under the command line's handler
-    (dem.interrupt) it stays pending, silently, and Simulation.run raises it after its next
-    chunk of steps; outside, it is lost."""
-    @ctypes.CFUNCTYPE(None)
-    def callback_from_c():
-        os.kill(os.getpid(), signal.SIGINT)
-        for _ in range(1000):      # the handler runs between two of these bytecodes
-            pass
-
-    def scene():
-        return two_body_scene([[0.0, 0.0, 0.0], [2.5 * RADIUS, 0.0, 0.0]], [[0.0] * 3] * 2)
-
-    discarded = []                 # what Python would print as "Exception ignored"
-    monkeypatch.setattr(sys, "unraisablehook", lambda unraisable: discarded.append(
-        unraisable.exc_type))
-    sim = scene()
-    callback_from_c()              # the default handler: the interrupt is lost
-    assert discarded == [KeyboardInterrupt]
-    assert sim.run(300, check_every=100) == 300
-    sim = scene()
-    with catching_interrupts():
-        callback_from_c()
-        assert discarded == [KeyboardInterrupt]        # nothing more printed
-        with pytest.raises(KeyboardInterrupt):
-            sim.run(500, check_every=100)
-    assert sim.step == 100
-    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler     # restored
-    assert sys.unraisablehook is not None and sys.unraisablehook.__name__ == "<lambda>"
-    sim = scene()
-    with pytest.raises(KeyboardInterrupt):
-        with catching_interrupts():
-            raise KeyboardInterrupt
-    assert sim.run(300, check_every=100) == 300   # nothing left pending
+@pytest.fixture
+def python_sigint():
+    """Python's own SIGINT handler in this process, as in a command started from a terminal
+    (a test run started in the background by a shell ignores SIGINT)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
-def test_an_interrupt_while_numba_compiles_waits_for_the_kernel_to_be_whole():
+def interrupt_this_process():
+    os.kill(os.getpid(), signal.SIGINT)
+    for _ in range(1000):      # the handler runs between two of these bytecodes
+        pass
+
+
+def test_an_interrupt_while_numba_compiles_waits_for_the_kernel_to_be_whole(python_sigint):
     """A SIGINT in the middle of a compile (sent here as the compile starts) raised there, as
     Python's own handler does, leaves no kernel: the half-made one of a real run fails to be
-    cached or crashes the process at exit. Under the command line's handler it is raised as
-    Numba's compiler lock is released, the kernel compiled whole."""
+    cached, or the interrupt is lost. Under the command line's handler it is raised as Numba's
+    compiler lock is released, the kernel compiled whole; elsewhere at once, and once."""
     class InterruptTheCompile(event.Listener):
         def on_start(self, started):
-            os.kill(os.getpid(), signal.SIGINT)
-            for _ in range(1000):      # the handler runs between two of these bytecodes
-                pass
+            interrupt_this_process()
 
         def on_end(self, ended):
             pass
@@ -347,6 +321,11 @@ def test_an_interrupt_while_numba_compiles_waits_for_the_kernel_to_be_whole():
                 whole(1.0, 2.0)
     assert not broken.signatures
     assert len(whole.signatures) == 1 and whole(1.0, 2.0) == 3.0
+    with catching_interrupts():
+        with pytest.raises(KeyboardInterrupt):
+            interrupt_this_process()
+        assert numba.njit(add)(1.0, 2.0) == 3.0      # a caught interrupt is not raised again
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
 
 
 # ---------------------------------------------------------------- stress bookkeeping

@@ -25,7 +25,6 @@ import time
 import numba
 from tqdm import tqdm
 
-from .interrupt import raise_pending
 from .state import Box, Particles
 from .validate import check_int, check_positive
 
@@ -115,9 +114,7 @@ class Simulation:
         """Advance ``steps`` steps, or fewer if ``until(sim)`` becomes true (checked every
         ``check_every`` steps). ``progress`` is a label for a progress bar; ``status(sim)``
         returns a dict shown beside it (an open-ended run, with ``until``, shows the steps
-        taken and its status, not a fraction of the step limit). Returns the steps taken.
-        Between chunks it raises a pending interrupt (dem.interrupt: a Ctrl-C that Python
-        discarded, under the command line's handler)."""
+        taken and its status, not a fraction of the step limit). Returns the steps taken."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
         bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
@@ -132,7 +129,6 @@ class Simulation:
                 for _ in range(chunk):
                     self.advance()
                 taken += chunk
-                raise_pending()     # a Ctrl-C that Python discarded (dem.interrupt)
                 bar.update(chunk)
                 if status is not None and time.perf_counter() - started > 1.0:
                     bar.set_postfix(status(self), refresh=False)
