@@ -32,10 +32,10 @@ class _AfterCompiling(event.Listener):
     """Numba's compiler-lock events: raises a pending interrupt once the outermost compile
     (or cache load) has released the lock."""
 
-    def on_start(self, event):
+    def on_start(self, started):
         pass
 
-    def on_end(self, event):
+    def on_end(self, ended):
         global _pending
         if _pending and not global_compiler_lock.is_locked():
             _pending = False

@@ -148,7 +148,9 @@ def run_command(name, argv, prog=None):
     except KeyboardInterrupt:
         parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
     except SystemError as error:
-        # Ctrl-C while Numba loads a cached kernel reaches us wrapped in a SystemError
+        # Ctrl-C in Python code that Numba's C dispatcher calls can reach us wrapped in a
+        # SystemError (seen while it loaded a cached kernel, before dem.interrupt deferred
+        # interrupts under the compiler lock; it also calls Python outside the lock)
         if not caused_by_interrupt(error):
             raise
         parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
