@@ -359,8 +359,8 @@ def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
 
 
 def test_an_interrupt_wrapped_by_numba_is_an_interrupt(capsys, monkeypatch):
-    """Ctrl-C while Numba unpickles a cached kernel surfaces as a SystemError whose cause is
-    the KeyboardInterrupt: it ends like any interrupt (exit 130, one line)."""
+    """Ctrl-C that Numba's C dispatcher reports as a SystemError whose cause is the
+    KeyboardInterrupt (dem.interrupt) ends like any interrupt (exit 130, one line)."""
     from pendular.commands import triaxial as command
 
     def interrupted_while_loading(args):

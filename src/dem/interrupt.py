@@ -7,7 +7,10 @@ kernel's object code discards it (Python prints "Exception ignored" and goes on)
 half-made kernel then fails to be cached ("no compiled object yet", a traceback), or the
 interrupt is lost and the run goes on to its end. So while this thread holds Numba's compiler
 lock the handler only leaves the interrupt pending, and it is raised as the lock is released,
-the kernel whole; anywhere else it is raised at once, as by Python's own handler.
+the kernel whole; anywhere else it is raised at once, as by Python's own handler. An
+interrupt that Numba's C dispatcher reports wrapped in a SystemError (it calls Python code
+outside the lock too; seen while it loaded a cached kernel, before the deferral) leaves the
+context as the KeyboardInterrupt it is.
 """
 
 import signal
@@ -44,9 +47,10 @@ class _AfterCompiling(event.Listener):
 
 class catching_interrupts:
     """Context: SIGINT handled by this module's handler inside it (deferred while Numba
-    compiles); the previous handler restored after, nothing pending on entry or exit. A process
-    that ignores SIGINT (a command started in the background by a shell) keeps ignoring it, and
-    outside the main thread (where Python takes no signal handler) nothing changes."""
+    compiles), an interrupt wrapped in a SystemError raised as a KeyboardInterrupt; the
+    previous handler restored after, nothing pending on entry or exit. A process that ignores
+    SIGINT (a command started in the background by a shell) keeps ignoring it, and outside the
+    main thread (where Python takes no signal handler) nothing changes."""
 
     def __enter__(self):
         global _pending
@@ -60,10 +64,21 @@ class catching_interrupts:
                 event.register("numba:compiler_lock", self._after_compiling)
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, exc_type, error, traceback):
         global _pending
         if self._previous is not None:
             event.unregister("numba:compiler_lock", self._after_compiling)
             signal.signal(signal.SIGINT, self._previous)
         _pending = False
+        if isinstance(error, SystemError) and _caused_by_interrupt(error):
+            raise KeyboardInterrupt from error
         return False
+
+
+def _caused_by_interrupt(error):
+    """Whether a KeyboardInterrupt is among the causes (or contexts) of ``error``."""
+    while error is not None:
+        if isinstance(error, KeyboardInterrupt):
+            return True
+        error = error.__cause__ or error.__context__
+    return False

@@ -147,22 +147,6 @@ def run_command(name, argv, prog=None):
                        "options' magnitudes (particles, radius, young, rates, resolutions)\n")
     except KeyboardInterrupt:
         parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
-    except SystemError as error:
-        # Ctrl-C in Python code that Numba's C dispatcher calls can reach us wrapped in a
-        # SystemError (seen while it loaded a cached kernel, before dem.interrupt deferred
-        # interrupts under the compiler lock; it also calls Python outside the lock)
-        if not caused_by_interrupt(error):
-            raise
-        parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
-
-
-def caused_by_interrupt(error):
-    """Whether a KeyboardInterrupt is among the causes (or contexts) of ``error``."""
-    while error is not None:
-        if isinstance(error, KeyboardInterrupt):
-            return True
-        error = error.__cause__ or error.__context__
-    return False
 
 
 def main(argv=None, prog=None):
