@@ -169,7 +169,8 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for k in numba.prange(len(pair_i)):
-        _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity))
+        _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity),
+                         radius)
         _evaluate_pair(k, _first_member(pair_i[k], position, velocity, angular_velocity, radius),
                        pair_j[k], position, velocity, angular_velocity, radius, image, period,
                        periodic, affine_rate, stretched, shear_force, normal, overlap,
@@ -187,21 +188,23 @@ def serial_pair_forces(position, velocity, angular_velocity, radius, row_start, 
     for i in range(len(row_start) - 1):
         first = _first_member(i, position, velocity, angular_velocity, radius)
         for k in range(row_start[i], row_start[i + 1]):
-            _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity))
+            _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity),
+                         radius)
             _evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
                            image, period, periodic, affine_rate, stretched, shear_force, normal,
                            overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
 
 
 @numba.njit(cache=True, inline="always")
-def _prefetch_second(k, pair_j, prefetch_ahead, arrays):
-    """Ask for the rows of ``arrays`` (a tuple of (N, 3) arrays) of the second member of the
-    pair ``prefetch_ahead`` pairs after pair k (if prefetch_ahead > 0 and there is one:
-    dem.prefetch)."""
+def _prefetch_second(k, pair_j, prefetch_ahead, arrays, radius):
+    """Ask for the rows of ``arrays`` (a tuple of (N, 3) arrays) and the ``radius`` of the
+    second member of the pair ``prefetch_ahead`` pairs after pair k (if prefetch_ahead > 0 and
+    there is one: dem.prefetch)."""
     if prefetch_ahead > 0 and k + prefetch_ahead < len(pair_j):
         ahead = pair_j[k + prefetch_ahead]
         for rows in arrays:
             prefetch_row(rows, ahead)
+        prefetch_row(radius, ahead)
 
 
 @numba.njit(cache=True, inline="always")
@@ -344,7 +347,7 @@ def scatter_contact_forces(pair_force, attraction, normal, overlap, radius, row_
         radius_i = radius[i]
         sums = _row_sums(i, force, torque)
         for k in range(start, stop):
-            _prefetch_second(k, pair_j, prefetch_ahead, (force, torque))
+            _prefetch_second(k, pair_j, prefetch_ahead, (force, torque), radius)
             a0, a1, a2 = pair_force_with_attraction(pair_force, attraction, normal, k)
             sums = _scatter_to_both(sums, pair_j[k], a0, a1, a2, pair_force[k, 0],
                                     pair_force[k, 1], pair_force[k, 2], normal[k, 0],
@@ -376,7 +379,7 @@ def scattered_pair_forces(position, velocity, angular_velocity, radius, row_star
         sums = _row_sums(i, particle_force, particle_torque)
         for k in range(start, stop):
             _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity,
-                                                         particle_force, particle_torque))
+                                                         particle_force, particle_torque), radius)
             j = pair_j[k]
             touching, a0, a1, a2, n0, n1, n2, overlap_k = _evaluate_pair(
                 k, first, j, position, velocity, angular_velocity, radius, image, period,

@@ -14,6 +14,11 @@ in alternating turns of one run: the pair kernel alone, 16 ahead, ns per pair, 1
 2 threads: 30,000 spheres 0.889 / 0.904 of the time without, 100,000 0.890 / 0.931. The same
 hint in the contact gather (the rows of the pairs of which a particle is the second member)
 paid only at 100,000 spheres (-16 %) and cost 11 % at 30,000 on one thread: not used.
+The pair loops also ask for j's radius (an item of a 1-D array; 2026-11-26, evening): the
+one-thread fused pair kernel alone at 100,000 spheres 0.945 / 0.958 of the time without, at
+30,000 1.00; whole one-thread steps (benchmarks/bench_sizes.py, the two codes in alternating
+processes) 100,000 spheres 180 / 168 -> 168 / 163 ns a particle-step, 30,000 within noise;
+two threads within the run-to-run scatter (+-10 %).
 """
 
 import llvmlite.binding
@@ -37,12 +42,14 @@ _PREFETCH_NAME = ("llvm.prefetch.p0" if llvmlite.binding.llvm_version_info >= (1
 @intrinsic
 def prefetch_row(typingctx, array, row):
     """Ask the cache for the start of ``array[row]`` (a 2-D C-contiguous array's row: 24 bytes
-    of float64 triples lie in one or two cache lines), for reading, kept in all cache levels."""
+    of float64 triples lie in one or two cache lines; a 1-D array's item), for reading, kept in
+    all cache levels."""
     def codegen(context, builder, signature, args):
         array_type = signature.args[0]
         data = context.make_array(array_type)(context, builder, args[0])
         zero = context.get_constant(types.intp, 0)
-        pointer = cgutils.get_item_pointer(context, builder, array_type, data, [args[1], zero])
+        index = [args[1], zero][:array_type.ndim]
+        pointer = cgutils.get_item_pointer(context, builder, array_type, data, index)
         byte_pointer = ir.IntType(8).as_pointer()
         int32 = ir.IntType(32)
         function = cgutils.get_or_insert_function(
@@ -52,7 +59,7 @@ def prefetch_row(typingctx, array, row):
                                 ir.Constant(int32, 3), ir.Constant(int32, 1)])
         return context.get_dummy_value()
 
-    if not (isinstance(array, types.Array) and array.ndim == 2
+    if not (isinstance(array, types.Array) and array.ndim in (1, 2)
             and isinstance(row, types.Integer)):
         return None
     return types.void(array, row), codegen
