@@ -157,8 +157,8 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell, whose velocity
     affine_rate * l adds to the relative velocity of a pair of branch l. A scene without
     images or stretching (walls) skips both terms (a branch taken the same way by every pair:
-    no cost). prefetch_ahead: how many pairs ahead particle j's rows are asked of the cache
-    (0: none; dem.prefetch.prefetch_distance; no effect on results).
+    no cost). prefetch_ahead: how many pairs ahead particle j's rows and radius are asked of
+    the cache (0: none; dem.prefetch.prefetch_distance; no effect on results).
 
     The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
     is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),
@@ -189,7 +189,7 @@ def serial_pair_forces(position, velocity, angular_velocity, radius, row_start, 
         first = _first_member(i, position, velocity, angular_velocity, radius)
         for k in range(row_start[i], row_start[i + 1]):
             _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity),
-                         radius)
+                             radius)
             _evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
                            image, period, periodic, affine_rate, stretched, shear_force, normal,
                            overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
@@ -338,7 +338,7 @@ def scatter_contact_forces(pair_force, attraction, normal, overlap, radius, row_
     to its two particles, the same sums in the same order (_add_contact_forces; particle i's
     own in registers through its row, as scattered_pair_forces), the pair arrays read once
     and in order instead of twice, once through the transposed index. prefetch_ahead: as
-    pair_forces', for particle j's force and torque rows."""
+    pair_forces', for particle j's force and torque rows and radius."""
     for i in range(len(row_start) - 1):
         start = row_start[i]
         stop = row_start[i + 1]
