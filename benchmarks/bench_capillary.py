@@ -11,7 +11,7 @@ at the start of the shear, as YADE's law is here). Both runs first take ``warmup
 sample compacts under the capillary forces), then are timed in alternating chunks so that a
 change of machine load hits both alike. YADE 2023 runs the same sample, time step and strain
 rate with and without its capillary law, reading capillary files M(r=1) ... M(r=10) written
-by capillary.write_yade (350 suctions x 80 distances, cached under .cache/). Prints
+by pendular.capillary.write_yade (350 suctions x 80 distances, cached under .cache/). Prints
 particle-steps/s, the wet/dry cost ratios of both codes and pendular / YADE (wet).
 """
 
@@ -25,11 +25,11 @@ import time
 import numpy as np
 
 from bench_triaxial import write_results  # benchmarks/ (the script's folder)
-from capillary import SURFACE_TENSION, CapillaryBridges
-from dem.neighbors import NeighborList
-from dem.preparation import servoed_simulation
-from dem.yade_io import write_spheres
-from homogenize.on_the_fly import capillary_force_stress
+from pendular.capillary import SURFACE_TENSION, CapillaryBridges
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import servoed_simulation
+from pendular.dem.yade_io import write_spheres
+from pendular.homogenize.on_the_fly import capillary_force_stress
 from pendular.config import ShearConfig
 from pendular.triaxial import TriaxialShear
 from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)

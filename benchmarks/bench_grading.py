@@ -19,7 +19,7 @@ import numba
 
 from bench_capillary import shear_simulation, time_alternately  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from dem.preparation import PrepareConfig
+from pendular.dem.preparation import PrepareConfig
 from pendular.yade import cached_sample
 
 

@@ -4,7 +4,7 @@
         [--suction 30000] [--steps 3000] [--warmup 1000] [--chunks 30] [--out FILE]
 
 For each size two samples are prepared with pendular (thesis Ch. 5.2.2, 750 Pa, cached under
-.cache/): in six walls and in a periodic cell (dem.cell). Each is sheared dry and wet
+.cache/): in six walls and in a periodic cell (pendular.dem.cell). Each is sheared dry and wet
 (suction-controlled exact bridges at every contact, as benchmarks/bench_capillary.py), and the
 four shears are timed in ``chunks`` alternating turns after ``warmup`` steps, so a change of
 machine load hits them alike (on the 2-core development VM the speed changes by up to 2x within
@@ -24,7 +24,7 @@ import numpy as np
 
 from bench_capillary import shear_simulation, time_chunks  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from dem.preparation import PrepareConfig
+from pendular.dem.preparation import PrepareConfig
 from pendular.yade import cached_sample
 
 

@@ -13,7 +13,7 @@ import time
 
 import numba
 
-import capillary
+from pendular import capillary
 
 
 def main():

@@ -26,8 +26,8 @@ import time
 
 import numba
 
-from dem.preparation import servoed_simulation
-from dem.yade_io import write_spheres
+from pendular.dem.preparation import servoed_simulation
+from pendular.dem.yade_io import write_spheres
 from pendular.config import ShearConfig
 from pendular.triaxial import TriaxialShear
 from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)
@@ -36,7 +36,7 @@ from pendular.yade import find_yade, run_yade_triaxial
 
 def time_pendular(config, particles, walls, threads, steps, warmup, force_threads=False):
     """Shear-phase speed with ``threads`` Numba threads available; the Simulation's own policy
-    decides how many it uses (one below dem.simulation.SERIAL_BELOW particles) unless
+    decides how many it uses (one below pendular.dem.simulation.SERIAL_BELOW particles) unless
     ``force_threads``."""
     numba.set_num_threads(threads)
     sim = servoed_simulation(copy.deepcopy(particles), copy.deepcopy(walls), config,

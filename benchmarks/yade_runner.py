@@ -14,7 +14,7 @@ import tempfile
 
 import numpy as np
 
-from dem.yade_io import read_plot_data, write_spheres
+from pendular.dem.yade_io import read_plot_data, write_spheres
 from pendular.yade import find_yade, random_packing, run_yade_triaxial  # noqa: F401
 
 

@@ -8,13 +8,13 @@ import h5py
 import numpy as np
 import pytest
 
-from dem.contact_law import ContactForces, normal_stiffness
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.preparation import PrepareConfig, prepare_sample
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import WallForces
+from pendular.dem.contact_law import ContactForces, normal_stiffness
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import WallForces
 
 RADIUS = 1e-3
 DENSITY = 2650.0

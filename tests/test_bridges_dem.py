@@ -1,4 +1,4 @@
-"""Capillary bridges in the DEM (capillary.bridges): pair laws against the exact solver and
+"""Capillary bridges in the DEM (pendular.capillary.bridges): pair laws against the exact solver and
 the tables, force bookkeeping, saturation, neighbour-list reach, the wet triaxial scenario."""
 
 import copy
@@ -13,15 +13,15 @@ import numba
 import numpy as np
 import pytest
 
-import capillary
-from capillary import BridgeState, CapillaryBridges
-from capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
+from pendular import capillary
+from pendular.capillary import BridgeState, CapillaryBridges
+from pendular.capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
 from conftest import PrescribedGap, two_body_scene
-from dem.contact_law import ContactForces, gather_contact_forces
-from dem.neighbors import NeighborList, build_contacts
-from dem.state import Walls
-from dem.walls import WallForces
-from homogenize import capillary_force_stress, contact_stress
+from pendular.dem.contact_law import ContactForces, gather_contact_forces
+from pendular.dem.neighbors import NeighborList, build_contacts
+from pendular.dem.state import Walls
+from pendular.dem.walls import WallForces
+from pendular.homogenize import capillary_force_stress, contact_stress
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAMMA = capillary.SURFACE_TENSION
@@ -194,7 +194,7 @@ def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_samp
     sim, bridges = wet_sample
     sim = copy.deepcopy(sim)
     bridges = sim.operation(CapillaryBridges)
-    from dem.measure import unbalanced_force
+    from pendular.dem.measure import unbalanced_force
     sim.run(30000, until=lambda s: unbalanced_force(s.particles, s.contacts) < 2e-4,
             check_every=500)
     capillary_stress = capillary_force_stress(sim, bridges)
@@ -332,7 +332,7 @@ def test_dry_triaxial_runs_no_capillary_physics(tmp_path):
     code = ("import sys; from pendular.cli import main; "
             "main(['triaxial', '--particles', '60', '--max-strain', '0.002', "
             f"'--inertial-number', '2e-3', '--quiet', '--out', {str(tmp_path)!r}], 'x'); "
-            "import capillary.bridge_kernels as k; "
+            "import pendular.capillary.bridge_kernels as k; "
             "ran = [n for n in ('contact_bridges', 'suction_bridges', 'volume_bridges', "
             "'gather_contact_bridges') if getattr(k, n).signatures]; "
             "print('RAN', ran)")

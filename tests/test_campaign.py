@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from dem.preparation import PrepareConfig
+from pendular.dem.preparation import PrepareConfig
 from pendular.campaign import (Campaign, Run, options_argv, run_name, run_progress,
                                sweep_from_table, table_rows, write_campaign_csv)
 from pendular.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict

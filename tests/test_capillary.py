@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-import capillary
-from capillary.verification import reference_bridge
+from pendular import capillary
+from pendular.capillary.verification import reference_bridge
 
 # (radius_ratio, contact_angle, suction_star, filling_angle) spanning the solver's range
 CASES = [

@@ -1,4 +1,4 @@
-"""Checkpoints (dem.checkpoint): bit-identical resume, atomic writes under kill -9, checks."""
+"""Checkpoints (pendular.dem.checkpoint): bit-identical resume, atomic writes under kill -9, checks."""
 
 import copy
 import os
@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 
 from conftest import two_body_scene
-from dem.checkpoint import FORMAT, CheckpointWriter, load_checkpoint, save_checkpoint
-from dem.integrity import stamp
-from dem.neighbors import NeighborList
-from dem.preparation import PrepareConfig, prepare_sample
-from dem.integrate import Integrator
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import StressServo
+from pendular.dem.checkpoint import FORMAT, CheckpointWriter, load_checkpoint, save_checkpoint
+from pendular.dem.integrity import stamp
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.dem.integrate import Integrator
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import StressServo
 from pendular.config import ShearConfig
 from pendular.triaxial import TriaxialShear
 
@@ -219,7 +219,7 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     code = (f"import sys; sys.path.insert(0, {TESTS!r}); import test_checkpoint; "
             f"test_checkpoint.checkpoint_forever({path!r})")
     child = subprocess.Popen([sys.executable, "-c", code])
-    temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # dem.atomic.replacing
+    temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # pendular.dem.atomic.replacing
     try:
         deadline = time.monotonic() + 60.0
         while not os.path.exists(path):
@@ -243,9 +243,9 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
 
 def test_samples_and_checkpoints_describe_their_datasets(prepared, tmp_path):
     """Every dataset of a sample and of a checkpoint has units and a description (an array
-    dem.checkpoint does not declare: units "unknown"); both files carry pendular_version and
+    pendular.dem.checkpoint does not declare: units "unknown"); both files carry pendular_version and
     schema_version, written before the checksum, so that they still load."""
-    from dem.sample import DATASETS, load_sample, save_sample
+    from pendular.dem.sample import DATASETS, load_sample, save_sample
 
     _, sample = prepared
     sim = copy.deepcopy(sample)

@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
-from capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
-from capillary.meniscus import solve_bridge
-from homogenize import (capillary_force_stress, contact_line_integral, homogenize_bridges,
+from pendular.capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
+from pendular.capillary.meniscus import solve_bridge
+from pendular.homogenize import (capillary_force_stress, contact_line_integral, homogenize_bridges,
                         interface_stress, wetted_cap_integral)
-from homogenize.on_the_fly import CapillaryHomogenization
+from pendular.homogenize.on_the_fly import CapillaryHomogenization
 
 GAMMA = SURFACE_TENSION
 R2 = 1e-4
@@ -21,7 +21,7 @@ R2 = 1e-4
 
 def bridge_terms(bridge, contact_angle):
     """(psi of the bridge over V = 1 m^3 in its frame, interface term, (1/V) d F e_z e_z) of an
-    exact capillary.meniscus.Bridge between spheres R2 / r and R2."""
+    exact pendular.capillary.meniscus.Bridge between spheres R2 / r and R2."""
     r1 = R2 / bridge.radius_ratio
     suction = bridge.suction * GAMMA / R2
     caps = wetted_cap_integral(r1, bridge.delta1) + wetted_cap_integral(R2, bridge.delta2)
@@ -126,7 +126,7 @@ def test_packing_psi_plus_interface_is_the_capillary_love_weber_stress(small_sam
     psi, interface = homogenization.psi(sim), homogenization.psi_interface(sim)
     index = np.flatnonzero(BridgeState.of(sim.contacts).mask())
     own = own_dipoles(sim, bridges, index).sum(axis=0)
-    # the tables' accuracy: 0.15 % in force, 0.4 % in volume near rupture (docs/capillary.md)
+    # the tables' accuracy: 0.15 % in force, 0.4 % in volume near rupture (docs/pendular.capillary.md)
     assert np.allclose(psi + interface, own, rtol=0, atol=3e-3 * np.abs(own).max())
     love_weber = -capillary_force_stress(sim, bridges)
     c, radius = sim.contacts, sim.particles.radius

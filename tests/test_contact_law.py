@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import (add_face_terms, gather_contact_forces, gather_contact_forces_virial,
+from pendular.dem.contact_law import (add_face_terms, gather_contact_forces, gather_contact_forces_virial,
                              normal_stiffness, pair_forces, scatter_contact_forces,
                              scattered_pair_forces)
-from dem.neighbors import build_contacts
-from dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
-from dem.state import Walls
-from dem.virial import SUM_BLOCKS
+from pendular.dem.neighbors import build_contacts
+from pendular.dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
+from pendular.dem.state import Walls
+from pendular.dem.virial import SUM_BLOCKS
 
 
 class CountContactSteps:
@@ -167,7 +167,7 @@ def evaluate(kernel, position, velocity, spin, radius, contacts, period, *extra)
 
 
 def test_prefetching_pair_loop_gives_the_same_forces_bit_for_bit():
-    """The prefetch hint of large samples (dem.prefetch) reads ahead and changes nothing: a jammed
+    """The prefetch hint of large samples (pendular.dem.prefetch) reads ahead and changes nothing: a jammed
     cloud of 2,000 spheres with random velocities and shear history, evaluated with and
     without it (1 and 16 pairs ahead: the look-ahead's end of the list included)."""
     position, radius, velocity, spin, _ = jammed_cloud()

@@ -1,4 +1,4 @@
-"""The direct-tension test (pendular.tension, dem.tension, capillary.wetting): wetting to a
+"""The direct-tension test (pendular.tension, pendular.dem.tension, pendular.capillary.wetting): wetting to a
 water content, grips, strength, and its command line."""
 
 import copy
@@ -12,11 +12,11 @@ import sys
 import numpy as np
 import pytest
 
-from capillary import BridgeTable, formation_suction
-from dem.measure import unbalanced_force
-from dem.preparation import prepare_sample
-from dem.state import Particles, Walls
-from dem.tension import Grip, grip_members
+from pendular.capillary import BridgeTable, formation_suction
+from pendular.dem.measure import unbalanced_force
+from pendular.dem.preparation import prepare_sample
+from pendular.dem.state import Particles, Walls
+from pendular.dem.tension import Grip, grip_members
 from pendular import tension as direct_tension
 from pendular.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
@@ -203,7 +203,7 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
 def test_prediction_is_chapter4s_kim_comparison(args):
     """pendular.tension's prediction of Kim's cases is Table 4.5's exact, theta = 0 column of
     pendular.chapter4 (same reference data, same packing choice)."""
-    from homogenize import regular_packing
+    from pendular.homogenize import regular_packing
     from pendular import chapter4
     from pendular.reference import KIM_2001, KIM_RADIUS, KIM_SEPARATION, comparison_packing
 

@@ -2,14 +2,14 @@
 
 import numpy as np
 
-from dem.measure import elastic_energy, kinetic_energy
-from dem.preparation import random_cloud
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.contact_law import ContactForces, normal_stiffness
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.walls import WallForces
+from pendular.dem.measure import elastic_energy, kinetic_energy
+from pendular.dem.preparation import random_cloud
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.contact_law import ContactForces, normal_stiffness
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.walls import WallForces
 
 
 class SpringEnergyProbe:

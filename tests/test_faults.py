@@ -27,8 +27,8 @@ import pytest
 from numba.core import event
 
 from conftest import zero_bytes
-from dem.integrity import stamp, verify
-from dem.interrupt import catching_interrupts
+from pendular.dem.integrity import stamp, verify
+from pendular.dem.interrupt import catching_interrupts
 from pendular.cli import run_command
 from pendular.outputs import OutputFolder
 
@@ -360,7 +360,7 @@ def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
 
 def test_an_interrupt_wrapped_by_numba_is_an_interrupt(capsys, monkeypatch):
     """Ctrl-C that Numba's C dispatcher reports as a SystemError whose cause is the
-    KeyboardInterrupt (dem.interrupt) ends like any interrupt (exit 130, one line)."""
+    KeyboardInterrupt (pendular.dem.interrupt) ends like any interrupt (exit 130, one line)."""
     from pendular.commands import triaxial as command
 
     def interrupted_while_loading(args):

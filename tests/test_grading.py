@@ -7,9 +7,9 @@ import numba
 import numpy as np
 import pytest
 
-from dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grading_curve, sample_radii,
+from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grading_curve, sample_radii,
                          size_at_passing)
-from dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.cli import run_command
 from pendular.config import config_from_dict, config_json, config_to_dict
 

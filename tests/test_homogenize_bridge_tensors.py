@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.integrate import dblquad, quad
 
-import homogenize
-from homogenize import (
+from pendular import homogenize
+from pendular.homogenize import (
     capillary_stress,
     contact_line_integral,
     effective_stress,

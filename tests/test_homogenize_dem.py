@@ -1,4 +1,4 @@
-"""On-the-fly homogenisation of the DEM state (homogenize.on_the_fly, issue 3 items 1 and 4):
+"""On-the-fly homogenisation of the DEM state (pendular.homogenize.on_the_fly, issue 3 items 1 and 4):
 regular lattices against the unit-cell calculation, the wet and dry triaxial histories."""
 
 import itertools
@@ -11,13 +11,13 @@ import h5py
 import numpy as np
 import pytest
 
-from dem.contact_law import ContactForces
-from dem.neighbors import NeighborList
-from capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
-from dem.integrate import Integrator
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from homogenize import (
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.neighbors import NeighborList
+from pendular.capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
+from pendular.dem.integrate import Integrator
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.homogenize import (
     bridges_in_region,
     contact_line_integral,
     homogenize_bridges,
@@ -171,7 +171,7 @@ def test_recorder_columns_follow_the_bridge_operation_volume_control_included():
     control), caches one evaluation per record and survives a deep copy of the simulation."""
     import copy
 
-    from homogenize import CapillaryHomogenization
+    from pendular.homogenize import CapillaryHomogenization
 
     packing = regular_packing("bcc")
     for control in ("suction", "volume"):

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from homogenize import packing_state, regular_packing
+from pendular.homogenize import packing_state, regular_packing
 from pendular.reference import CHAPTER4_SURFACE_TENSION as GAMMA
 
 RADIUS = 1e-4

@@ -1,6 +1,6 @@
 """Fault injection on what pendular reads back (issue 12): checksums and identities
-(dem.integrity), physical checks of samples (dem.sample), cached bridge tables rebuilt when
-tampered (capillary.table, capillary.volume_table), and output folders (pendular.outputs)."""
+(pendular.dem.integrity), physical checks of samples (pendular.dem.sample), cached bridge tables rebuilt when
+tampered (pendular.capillary.table, pendular.capillary.volume_table), and output folders (pendular.outputs)."""
 
 import json
 import os
@@ -10,12 +10,12 @@ import h5py
 import numpy as np
 import pytest
 
-from capillary.table import BridgeTable
-from capillary.volume_table import VolumeBridgeTable
+from pendular.capillary.table import BridgeTable
+from pendular.capillary.volume_table import VolumeBridgeTable
 from conftest import zero_bytes
-from dem.integrity import checksum, config_hash, stamp, verify
-from dem.sample import MAX_OVERLAP, check_consistent, load_sample, save_sample
-from dem.state import Particles, Walls
+from pendular.dem.integrity import checksum, config_hash, stamp, verify
+from pendular.dem.sample import MAX_OVERLAP, check_consistent, load_sample, save_sample
+from pendular.dem.state import Particles, Walls
 
 RADIUS = 1e-3
 DENSITY = 2650.0

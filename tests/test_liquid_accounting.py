@@ -5,8 +5,8 @@ films, and bridges + films + lost = the liquid at closing to round-off."""
 import numpy as np
 import pytest
 
-import capillary
-from capillary import BridgeState, CapillaryBridges
+from pendular import capillary
+from pendular.capillary import BridgeState, CapillaryBridges
 from conftest import RADIUS, two_body_scene
 
 GAMMA = capillary.SURFACE_TENSION

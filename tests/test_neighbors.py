@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import pair_forces
-from dem.neighbors import ROW_CAPACITY, build_contacts, near_wall_particles, spatial_order
-from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
-from dem.state import Walls
-from dem.walls import ConstantStrainRate, StressServo
+from pendular.dem.contact_law import pair_forces
+from pendular.dem.neighbors import ROW_CAPACITY, build_contacts, near_wall_particles, spatial_order
+from pendular.dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
+from pendular.dem.state import Walls
+from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.config import BridgeConfig
 
 

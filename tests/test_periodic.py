@@ -1,4 +1,4 @@
-"""Periodic cell (dem.cell): pairs through the faces, the cell's stress and servo, affine
+"""Periodic cell (pendular.dem.cell): pairs through the faces, the cell's stress and servo, affine
 stretching, conservation, determinism, samples, and the triaxial and tension commands."""
 
 import copy
@@ -8,17 +8,17 @@ import numba
 import numpy as np
 import pytest
 
-from capillary import CapillaryBridges
-from capillary.bridge_state import ACROSS_GAP, BridgeState
-from dem.cell import PeriodicCell, pair_virial
-from dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList, build_contacts, gather_pair_forces
-from dem.preparation import PrepareConfig, prepare_sample, random_cloud
-from dem.sample import load_sample, save_sample
-from dem.simulation import Simulation
-from dem.state import Particles
-from dem.walls import ConstantStrainRate, StressServo
+from pendular.capillary import CapillaryBridges
+from pendular.capillary.bridge_state import ACROSS_GAP, BridgeState
+from pendular.dem.cell import PeriodicCell, pair_virial
+from pendular.dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList, build_contacts, gather_pair_forces
+from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.sample import load_sample, save_sample
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles
+from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular import TriaxialConfig, TriaxialTest
 from pendular.config import BridgeConfig, ShearConfig
 
@@ -219,7 +219,7 @@ def test_a_periodic_preparation_is_deterministic_and_thread_independent():
 @pytest.mark.parametrize("persist", [False, True])
 def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persist):
     """The Love–Weber sum that the contact and bridge gathers add up (each particle's position
-    times its resultant, plus the pairs through a face, dem.virial) is the sum of pair_virial
+    times its resultant, plus the pairs through a face, pendular.dem.virial) is the sum of pair_virial
     (every pair's branch vector times its force) on a static packing and on one whose
     particles are off balance, with bridges at contacts and across gaps, on 1 and 2 threads
     alike."""

@@ -1,17 +1,17 @@
-"""The step pipeline of dem.simulation.Simulation: order of a step, the read-only list of
+"""The step pipeline of pendular.dem.simulation.Simulation: order of a step, the read-only list of
 operations, lookup by type, and scene changes through the public lists."""
 
 import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import ContactForces
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.record import HistoryRecorder
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import StressServo, WallForces
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import StressServo, WallForces
 
 
 class Logged:

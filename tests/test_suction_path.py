@@ -5,10 +5,10 @@ shorter), new bridges form at contact only, so drying and wetting differ."""
 import numpy as np
 import pytest
 
-import capillary
-from capillary import BridgeState, CapillaryBridges
+from pendular import capillary
+from pendular.capillary import BridgeState, CapillaryBridges
 from conftest import RADIUS, Still, two_body_scene
-from dem.neighbors import NeighborList
+from pendular.dem.neighbors import NeighborList
 
 GAMMA = capillary.SURFACE_TENSION
 

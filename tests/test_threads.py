@@ -9,14 +9,14 @@ import numba
 import numpy as np
 import pytest
 
-from capillary import CapillaryBridges
-from dem.contact_law import ContactForces, normal_stiffness
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.preparation import random_cloud
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import WallForces
+from pendular.capillary import CapillaryBridges
+from pendular.dem.contact_law import ContactForces, normal_stiffness
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import random_cloud
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import WallForces
 from test_energy import SpringEnergyProbe
 
 RADIUS, YOUNG, DENSITY, EDGE = 1e-3, 1e6, 2650.0, 0.016

@@ -1,4 +1,4 @@
-"""The critical time step (dem.timestep) against closed forms, the assembled stiffness and leapfrog."""
+"""The critical time step (pendular.dem.timestep) against closed forms, the assembled stiffness and leapfrog."""
 
 import json
 
@@ -8,14 +8,14 @@ import pytest
 import scipy.linalg
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from dem.contact_law import ContactForces, normal_stiffness
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.preparation import PrepareConfig, timestep
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.timestep import critical_timestep, pwave_timestep
-from dem.walls import WallForces
+from pendular.dem.contact_law import ContactForces, normal_stiffness
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import PrepareConfig, timestep
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.timestep import critical_timestep, pwave_timestep
+from pendular.dem.walls import WallForces
 from pendular.cli import run_command
 
 SHEAR_RATIO = 0.3

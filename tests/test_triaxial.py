@@ -11,8 +11,8 @@ import numba
 import numpy as np
 import pytest
 
-from dem.preparation import PrepareConfig, prepare_sample
-from homogenize import contact_stress
+from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.homogenize import contact_stress
 from pendular.config import ShearConfig
 from pendular.triaxial import TriaxialShear, summarize
 
@@ -52,7 +52,7 @@ def test_love_weber_contact_stress_equals_wall_stress_in_equilibrium(small_sampl
 
 
 def _unbalanced(sim):
-    from dem.measure import unbalanced_force
+    from pendular.dem.measure import unbalanced_force
     return unbalanced_force(sim.particles, sim.contacts)
 
 

@@ -8,17 +8,17 @@ import numba
 import numpy as np
 import pytest
 
-import capillary
-from capillary import BridgeState, CapillaryBridges, sample_radius_ratios
+from pendular import capillary
+from pendular.capillary import BridgeState, CapillaryBridges, sample_radius_ratios
 from conftest import PrescribedGap, Still, two_body_scene
-from dem.contact_law import ContactForces
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.preparation import random_cloud
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import WallForces
-from homogenize import capillary_force_stress, homogenize_bridges
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import random_cloud
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import WallForces
+from pendular.homogenize import capillary_force_stress, homogenize_bridges
 
 GAMMA = capillary.SURFACE_TENSION
 SMALL = 1e-3                      # R1 [m]

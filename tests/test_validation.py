@@ -5,27 +5,27 @@ import h5py
 import numpy as np
 import pytest
 
-import capillary
-from capillary import CapillaryBridges
-from capillary.table import BridgeTable
-from capillary.toroidal_table import toroidal_table
-from capillary.validation import check_filling_angle, check_radius_ratio, check_suction
-from capillary.yade_files import read_capillary_file
+from pendular import capillary
+from pendular.capillary import CapillaryBridges
+from pendular.capillary.table import BridgeTable
+from pendular.capillary.toroidal_table import toroidal_table
+from pendular.capillary.validation import check_filling_angle, check_radius_ratio, check_suction
+from pendular.capillary.yade_files import read_capillary_file
 from conftest import two_body_scene
-from dem.checkpoint import CheckpointWriter, load_checkpoint
-from dem.contact_law import ContactForces
-from dem.integrate import Integrator
-from dem.timestep import pwave_timestep
-from dem.neighbors import NeighborList
-from dem.preparation import PrepareConfig, prepare_sample, random_cloud
-from dem.record import HistoryRecorder
-from dem.sample import load_sample
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
+from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.integrate import Integrator
+from pendular.dem.timestep import pwave_timestep
+from pendular.dem.neighbors import NeighborList
+from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.sample import load_sample
+from pendular.dem.simulation import Simulation
+from pendular.dem.state import Particles, Walls
 from pendular.vtk import VtkWriter
-from dem.walls import StressServo
-from dem.yade_io import read_plot_data, read_spheres, write_spheres
-from homogenize import (capillary_stress, contact_line_integral, fabric_tensor,
+from pendular.dem.walls import StressServo
+from pendular.dem.yade_io import read_plot_data, read_spheres, write_spheres
+from pendular.homogenize import (capillary_stress, contact_line_integral, fabric_tensor,
                         wetted_cap_integral)
 
 NAN = float("nan")
@@ -39,7 +39,7 @@ def scene():
 
 
 CASES = {
-    # dem.state
+    # pendular.dem.state
     "radius negative": (lambda: Particles(np.zeros((2, 3)), [1e-3, -1e-3], 2650.0), "radius"),
     "radius nan": (lambda: Particles(np.zeros((2, 3)), [1e-3, NAN], 2650.0), "radius"),
     "radius count": (lambda: Particles(np.zeros((2, 3)), [1e-3], 2650.0), "radius"),
@@ -58,7 +58,7 @@ CASES = {
     "walls nan": (lambda: Walls(position=[0, 1, 0, 1, 0, NAN]), "walls position"),
     "box inverted": (lambda: Walls.box([0, 0, 0], [1, -1, 1]), "box_hi"),
     "box shape": (lambda: Walls.box([0, 0], [1, 1]), "cannot reshape"),
-    # dem.preparation
+    # pendular.dem.preparation
     "particles one": (lambda: PrepareConfig(particles=1), "particles"),
     "particles fraction": (lambda: PrepareConfig(particles=2.5), "particles"),
     "particles text": (lambda: PrepareConfig(particles="many"), "particles"),

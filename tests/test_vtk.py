@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import two_body_scene
-from dem.preparation import PrepareConfig, prepare_sample
-from capillary import BridgeState
+from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.capillary import BridgeState
 from pendular.vtk import VtkWriter
 
 

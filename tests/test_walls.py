@@ -1,4 +1,4 @@
-"""The wall servo's law (YADE's TriaxialStressController, dem.walls.StressServo) against a hand
+"""The wall servo's law (YADE's TriaxialStressController, pendular.dem.walls.StressServo) against a hand
 computation, step by step."""
 
 from types import SimpleNamespace
@@ -6,8 +6,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from dem.state import Walls
-from dem.walls import StressServo
+from pendular.dem.state import Walls
+from pendular.dem.walls import StressServo
 
 
 def _scene(lo, hi, force, stiffness):

@@ -5,10 +5,10 @@ water volume shared over contacts and gaps."""
 import numpy as np
 import pytest
 
-import capillary
-from capillary import BridgeState, BridgeTable, CapillaryBridges, formation_suction
+from pendular import capillary
+from pendular.capillary import BridgeState, BridgeTable, CapillaryBridges, formation_suction
 from conftest import Still, two_body_scene
-from dem.simulation import Simulation
+from pendular.dem.simulation import Simulation
 
 GAMMA = capillary.SURFACE_TENSION
 RADIUS = 1e-3                     # the larger sphere R2 [m]
@@ -80,7 +80,7 @@ def test_the_formation_suction_shares_the_water_over_contacts_and_gaps():
 
 
 def test_wetting_without_a_gap_wets_the_contacts_only(tmp_path):
-    from dem.preparation import PrepareConfig, prepare_sample
+    from pendular.dem.preparation import PrepareConfig, prepare_sample
     from pendular.tension import wetted_pairs
 
     sim, _ = prepare_sample(PrepareConfig(particles=150, confining=750.0, unload_steps=400),

@@ -24,7 +24,7 @@ import sys
 import numpy as np
 import pytest
 
-from dem.yade_io import read_spheres, write_spheres
+from pendular.dem.yade_io import read_spheres, write_spheres
 from pendular import crosscheck
 from pendular.config import YADE_CHOICES
 from pendular.io import read_history

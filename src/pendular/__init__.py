@@ -1,7 +1,9 @@
 """pendular: discrete elements for wet granular media in the pendular regime.
 
-The public face of the engine (layers, each importing only those to its left:
-dem <- capillary <- homogenize <- pendular <- scenarios):
+One namespace; its sub-packages are layers, each importing only those to its left:
+``pendular.dem`` (the engine) <- ``pendular.capillary`` (liquid bridges) <-
+``pendular.homogenize`` (effective stress) <- the procedures, studies and command line of
+``pendular`` itself <- scenarios. The public names below are imported on first use:
 
 - scenes: ``Simulation`` (state plus the declared step pipeline), ``Particles``, ``Walls``,
   ``NeighborList``, ``ContactForces``, ``WallForces``, ``StressServo``, ``ConstantStrainRate``,
@@ -16,35 +18,60 @@ dem <- capillary <- homogenize <- pendular <- scenarios):
 Units are SI, stresses compression positive.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from importlib import import_module
 
-try:
-    __version__ = version("pendular")
-except PackageNotFoundError:      # a source tree that was not installed
-    __version__ = "0+unknown"
+#: Public name -> the module that defines it. Imported on first use, so that ``import
+#: pendular.dem`` (or the command line) loads only what it needs.
+_EXPORTS = {
+    "CapillaryBridges": "pendular.capillary",
+    "ContactForces": "pendular.dem.contact_law",
+    "Integrator": "pendular.dem.integrate",
+    "NeighborList": "pendular.dem.neighbors",
+    "PrepareConfig": "pendular.dem.preparation",
+    "prepare_sample": "pendular.dem.preparation",
+    "HistoryRecorder": "pendular.dem.record",
+    "Simulation": "pendular.dem.simulation",
+    "Particles": "pendular.dem.state",
+    "Walls": "pendular.dem.state",
+    "ConstantStrainRate": "pendular.dem.walls",
+    "StressServo": "pendular.dem.walls",
+    "WallForces": "pendular.dem.walls",
+    "Campaign": "pendular.campaign",
+    "Run": "pendular.campaign",
+    "BridgeConfig": "pendular.config",
+    "ShearConfig": "pendular.config",
+    "SwccConfig": "pendular.config",
+    "TensionConfig": "pendular.config",
+    "TriaxialConfig": "pendular.config",
+    "read_history": "pendular.io",
+    "read_summary": "pendular.io",
+    "SwccTest": "pendular.swcc",
+    "TensionTest": "pendular.tension",
+    "TriaxialShear": "pendular.triaxial",
+    "TriaxialTest": "pendular.triaxial",
+    "equilibrate": "pendular.triaxial",
+    "summarize": "pendular.triaxial",
+    "wet": "pendular.triaxial",
+}
 
-from capillary import CapillaryBridges
-from dem.contact_law import ContactForces
-from dem.integrate import Integrator
-from dem.neighbors import NeighborList
-from dem.preparation import PrepareConfig, prepare_sample
-from dem.record import HistoryRecorder
-from dem.simulation import Simulation
-from dem.state import Particles, Walls
-from dem.walls import ConstantStrainRate, StressServo, WallForces
+__all__ = sorted([*_EXPORTS, "__version__"])
 
-from .campaign import Campaign, Run
-from .config import BridgeConfig, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig
-from .io import read_history, read_summary
-from .swcc import SwccTest
-from .tension import TensionTest
-from .triaxial import TriaxialShear, TriaxialTest, equilibrate, summarize, wet
 
-__all__ = [
-    "BridgeConfig", "Campaign", "CapillaryBridges", "ConstantStrainRate", "ContactForces",
-    "HistoryRecorder", "Integrator", "NeighborList", "Particles", "PrepareConfig", "Run",
-    "ShearConfig", "Simulation", "StressServo", "SwccConfig", "SwccTest", "TensionConfig",
-    "TensionTest",
-    "TriaxialConfig", "TriaxialShear", "TriaxialTest", "WallForces", "Walls", "__version__",
-    "equilibrate", "prepare_sample", "read_history", "read_summary", "summarize", "wet",
-]
+def __getattr__(name):
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            value = version("pendular")
+        except PackageNotFoundError:      # a source tree that was not installed
+            value = "0+unknown"
+    elif name in _EXPORTS:
+        value = getattr(import_module(_EXPORTS[name]), name)
+    else:
+        raise AttributeError(f"module 'pendular' has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return __all__

@@ -57,10 +57,11 @@ from typing import Any, Callable, Union
 
 from tqdm import tqdm
 
-from dem.atomic import replacing
-from dem.preparation import PrepareConfig, prepare_sample
-from dem.sample import save_sample
-from dem.validate import check_int
+from pendular.dem.atomic import replacing
+from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.dem.sample import save_sample
+from pendular.dem.threads import use_threads
+from pendular.dem.validate import check_int
 
 from .config import (TensionConfig, TriaxialConfig, config_from_dict, config_json,
                      config_to_dict)
@@ -117,9 +118,7 @@ class CampaignResult:
 def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False) -> dict:
     """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads, its output
     and progress bars in ``folder``/log.txt (with the traceback if it fails); its summary."""
-    import numba
-
-    numba.set_num_threads(threads)
+    use_threads(threads)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
@@ -135,9 +134,7 @@ def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = Fals
 def prepare_one(sample: PrepareConfig, path: str, threads: int = 1) -> str:
     """Worker: prepare the sample of ``sample`` (a PrepareConfig) and save it at ``path`` with
     its configuration (``{"sample": config_to_dict(sample)}``)."""
-    import numba
-
-    numba.set_num_threads(threads)
+    use_threads(threads)
     sim, report = prepare_sample(sample, progress=False, threads=threads)
     save_sample(path, sim, report, {"sample": config_to_dict(sample)},
                 identity={"seed": sample.seed})

@@ -16,10 +16,10 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from dem.atomic import write_text
-from dem.validate import check_int
-from homogenize import packing_state, regular_packing
-from homogenize.cell_bridge import largest_filling_angle
+from pendular.dem.atomic import write_text
+from pendular.dem.validate import check_int
+from pendular.homogenize import packing_state, regular_packing
+from pendular.homogenize.cell_bridge import largest_filling_angle
 
 from .plots import pyplot, save_figure
 from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_PACKINGS, KIM_RADIUS,

@@ -3,7 +3,7 @@
 ``chapter5_campaign(Chapter5Grid(...), out, jobs=..., scheduler=...)``; command
 ``pendular chapter5`` (its default grid is the table pendular/campaigns/chapter5.toml).
 
-One sample is prepared per confining stress (dem.preparation.prepare_sample: radius growth to
+One sample is prepared per confining stress (pendular.dem.preparation.prepare_sample: radius growth to
 5 kPa, then unloaded to the test value, the same seed for all) and saved as
 DIR/samples/c{confining}.h5. Every (suction, confining) test (dry when the suction is 0) then
 starts from its sample (TriaxialConfig.sample_path) in DIR/runs/s{suction}_c{confining}/, with
@@ -21,7 +21,7 @@ p_effective_complete_at_peak; a dry run's effective values are its net ones) and
 keyed by suction (str), each {phi_deg, cohesion} fitted to (p, q) at peak, {phi_eff_deg,
 cohesion_eff} to (p', q') at peak (Eq. 3.43) and {phi_eff_complete_deg, cohesion_eff_complete}
 to those of the complete effective stress (psi plus the liquid-gas interface term,
-homogenize.on_the_fly), each also fitted through the origin (cohesion 0: phi_c0_deg,
+pendular.homogenize.on_the_fly), each also fitted through the origin (cohesion 0: phi_c0_deg,
 phi_eff_c0_deg, phi_eff_complete_c0_deg; an effective stress that takes the capillary
 cohesion in leaves none) (pendular.envelope), where a suction has at least two confining
 stresses. DIR/report.md compares with thesis Table 5.3 and
@@ -39,8 +39,8 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from dem.atomic import write_json, write_text
-from dem.preparation import PrepareConfig
+from pendular.dem.atomic import write_json, write_text
+from pendular.dem.preparation import PrepareConfig
 
 from .campaign import Campaign, Run, read_table, write_campaign_csv
 from .chapter5_figures import campaign_figures

@@ -11,8 +11,8 @@ import os
 import h5py
 import numpy as np
 
-from homogenize.fabric import principal_anisotropy
-from homogenize.invariants import deviator_stress, mean_stress
+from pendular.homogenize.fabric import principal_anisotropy
+from pendular.homogenize.invariants import deviator_stress, mean_stress
 
 from .plots import pyplot, save_figure
 
@@ -34,7 +34,7 @@ def load_histories(out, runs):
 
 def invariants(sigma):
     """(p, q) [Pa] of (rows, 3) principal stresses or (rows, 3, 3) tensors (their diagonals),
-    z axial (homogenize.invariants)."""
+    z axial (pendular.homogenize.invariants)."""
     sigma = np.asarray(sigma)
     if sigma.ndim == 3:
         sigma = np.diagonal(sigma, axis1=1, axis2=2)
@@ -170,7 +170,7 @@ def plot_anisotropy(path, history, suction, confining):
 
 
 def _line(phi_deg, cohesion, p_max):
-    """p and q of the Mohr–Coulomb line q = M p + q0 (dem.envelope) over [0, p_max]."""
+    """p and q of the Mohr–Coulomb line q = M p + q0 (pendular.dem.envelope) over [0, p_max]."""
     sin_phi = math.sin(math.radians(phi_deg))
     slope = 6 * sin_phi / (3 - sin_phi)
     q0 = cohesion * 6 * math.cos(math.radians(phi_deg)) / (3 - sin_phi)

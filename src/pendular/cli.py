@@ -15,8 +15,9 @@ import sys
 
 import numba
 
-from dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
-from dem.interrupt import catching_interrupts
+from pendular.dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
+from pendular.dem.interrupt import catching_interrupts
+from pendular.dem.threads import configure as configure_threading, use_threads
 
 from . import __version__
 
@@ -82,7 +83,7 @@ def add_executor_options(parser):
 
 def add_size_options(parser, default_radius):
     """Sphere-size options of commands that prepare a sample: --radius (the mean radius,
-    ``default_radius`` [m] when not given), --radius-spread, --psd (dem.grading)."""
+    ``default_radius`` [m] when not given), --radius-spread, --psd (pendular.dem.grading)."""
     parser.add_argument("--radius", type=float, default=None,
                         help=f"sphere radius [m], the mean radius of a graded sample (default "
                              f"{default_radius:g})")
@@ -111,12 +112,13 @@ def sizes_from(args):
 
 def set_threads(threads):
     """Apply --threads (error naming it outside [1, NUMBA_NUM_THREADS])."""
+    configure_threading()
     if threads is None:
         return
     if not 1 <= threads <= numba.config.NUMBA_NUM_THREADS:
         raise UsageError(f"--threads {threads} is outside the valid range "
                          f"[1, {numba.config.NUMBA_NUM_THREADS}]")
-    numba.set_num_threads(threads)
+    use_threads(threads)
 
 
 def command_parser(name, prog=None):

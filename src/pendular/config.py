@@ -16,10 +16,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
-from dem.preparation import MAX_SEED, PrepareConfig
-from dem.validate import check_int, check_positive, check_range
-from homogenize import packing_state, regular_packing
+from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.dem.preparation import MAX_SEED, PrepareConfig
+from pendular.dem.validate import check_int, check_positive, check_range
+from pendular.homogenize import packing_state, regular_packing
 
 from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS, KIM_SEPARATION,
                         SPECIFIC_GRAVITY, comparison_packing)
@@ -157,7 +157,7 @@ class BridgeConfig:
     def build(self, suction=None):
         """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
         water content, ``suction`` [Pa] is the formation suction found at wetting."""
-        from capillary import CapillaryBridges   # a dry run never builds one
+        from pendular.capillary import CapillaryBridges   # a dry run never builds one
 
         if suction is None:
             if self.suction is None:
@@ -176,9 +176,9 @@ class BridgeConfig:
 class TriaxialConfig:
     """A drained triaxial test (thesis Ch. 5.2.3): sample, optional bridges, shear, outputs.
 
-    sample: preparation and material (dem.preparation.PrepareConfig; its ``confining`` [Pa] is
+    sample: preparation and material (pendular.dem.preparation.PrepareConfig; its ``confining`` [Pa] is
     the lateral stress of the shear); bridges: None for a dry test; shear: ShearConfig;
-    sample_path: start from this saved sample (dem.sample) instead of preparing one;
+    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
     vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
     instead (None: from vtk_frames);
@@ -246,8 +246,8 @@ class TensionConfig:
     void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
     form_gap: at wetting, bridges also form across gaps up to form_gap x radius [-] (0: at
     contacts only; the default 1 reaches past the rupture distance of Kim's bridges, so they
-    form wherever they can; capillary.wetting); particles, radius [m] (the mean radius),
-    radius_spread [-] and psd (grading curve) as in dem.preparation.PrepareConfig,
+    form wherever they can; pendular.capillary.wetting); particles, radius [m] (the mean radius),
+    radius_spread [-] and psd (grading curve) as in pendular.dem.preparation.PrepareConfig,
     contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
     confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
     wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
@@ -345,7 +345,7 @@ class SwccConfig:
     """The soil-water characteristic curve of a sample (pendular.swcc): drying through
     ``suctions`` then wetting back, at the sample's confining stress.
 
-    sample: preparation and material (dem.preparation.PrepareConfig; its ``confining`` [Pa]
+    sample: preparation and material (pendular.dem.preparation.PrepareConfig; its ``confining`` [Pa]
     holds during the path); suctions [Pa]: the path's stages, ascending and distinct, at least
     two; surface_tension [N/m]; contact_angle [deg]; form_gap: at wetting, bridges also form
     across gaps up to form_gap mean radii (0: at contacts only); stage_steps: most steps per

@@ -8,7 +8,7 @@
    walls at the confining stress and, wet (``config.bridges``), given capillary bridges at
    every contact (suction control, exact tables); it is run until static
    (pendular.triaxial.equilibrate, at most ``config.wet_steps`` steps).
-2. This static (wetted) packing is exported (DIR/packing.txt, dem.yade_io.write_spheres:
+2. This static (wetted) packing is exported (DIR/packing.txt, pendular.dem.yade_io.write_spheres:
    centres, radii, wall box). Both codes start the shear from it in the same state: velocities
    zero, contacts found afresh (no shear-spring history), every touching pair getting a bridge
    at the first step (YADE: Law2_ScGeom_CapillaryPhys_Capillarity with menisci created at
@@ -18,7 +18,7 @@
    ``packing=FILE`` starts from a packing exported by an earlier cross-check of the same sample
    and suction instead (no settling).
    Periodic (``crosscheck_config(periodic=True)``, dry only): the sample fills a periodic cell
-   (dem.cell), exported as its box [0, L] with the centres wrapped into it.
+   (pendular.dem.cell), exported as its box [0, L] with the centres wrapped into it.
 3. Both shear it with x, y servoed at the confining stress and z compressed at the strain rate
    of ``config.shear`` (pendular.triaxial.TriaxialShear), with the same time step, local
    damping, servo gain (1 - stressDamping), memory (0.8) and wall speed cap (max_vel),
@@ -53,14 +53,14 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from dem.atomic import write_json
-from dem.cell import PeriodicCell
-from dem.contact_law import normal_stiffness
-from dem.preparation import PrepareConfig, servoed_simulation
-from dem.state import Particles, Walls
-from dem.walls import ConstantStrainRate, StressServo
-from dem.yade_io import read_spheres, write_spheres
-from homogenize.invariants import stress_ratio
+from pendular.dem.atomic import write_json
+from pendular.dem.cell import PeriodicCell
+from pendular.dem.contact_law import normal_stiffness
+from pendular.dem.preparation import PrepareConfig, servoed_simulation
+from pendular.dem.state import Particles, Walls
+from pendular.dem.walls import ConstantStrainRate, StressServo
+from pendular.dem.yade_io import read_spheres, write_spheres
+from pendular.homogenize.invariants import stress_ratio
 
 from .config import YADE_CHOICES, BridgeConfig, ShearConfig, TriaxialConfig, config_to_dict
 from .io import write_history
@@ -156,7 +156,7 @@ def check_packing(config, packing):
 def static_packing(config, path, *, settle=True, threads=1, progress=True):
     """Load (or prepare) the cached sample of ``config``, bring it to rest at the confining
     stress (wetted if ``config.bridges``; ``settle=False``: as loaded), write it to ``path``
-    (dem.yade_io.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
+    (pendular.dem.yade_io.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
     return the settle report (steps, time, wall or cell stresses and, wet, Sr and bridges)."""
     sample = config.sample
     particles, walls, _ = cached_sample(sample, progress=progress, threads=threads)
@@ -210,7 +210,7 @@ def cell_grow_damping(sim, gain, sample):
     (sigma - target) A_a / k_a, A_a the cell's face normal to a [m^2] and k_a the mean over
     the contacts of |n_a| kn + (1 - |n_a|) ks [N/m]: a compliance whose units do not balance,
     at pendular's micrometre spheres hundreds of times below the cell's own 1 / S_a
-    (dem.cell), while pendular changes it by gain (sigma - target) / S_a. Matched on the mean
+    (pendular.dem.cell), while pendular changes it by gain (sigma - target) / S_a. Matched on the mean
     of x and y at the start of the shear (negative: YADE's term amplified)."""
     sim.walls.update_stiffness(sim)
     contacts = sim.contacts

@@ -7,7 +7,7 @@ Around a small wet base case (60 spheres of R = 0.024 mm, E = 1e6 Pa, dt = 0.7 x
 parameter at a time takes values across its range and a few out of it: suction, contact angle,
 radius, Young's modulus, time-step safety factor, particle count, confining stress and water
 content (volume-controlled bridges formed at a given suction). Each case prepares a dry sample
-(dem.preparation.prepare_sample, short), adds capillary.CapillaryBridges, runs a few
+(pendular.dem.preparation.prepare_sample, short), adds capillary.CapillaryBridges, runs a few
 thousand steps with the six walls servoed at the confining stress and checks the state; the
 particle-count sweep builds 10,000 and 100,000 spheres on a lattice and runs a handful of steps.
 
@@ -28,12 +28,12 @@ import traceback
 
 import numpy as np
 
-from capillary import CapillaryBridges
-from dem.atomic import replacing
-from dem.measure import kinetic_energy
-from dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
-from dem.state import Particles, Walls
-from homogenize import capillary_force_stress, contact_stress
+from pendular.capillary import CapillaryBridges
+from pendular.dem.atomic import replacing
+from pendular.dem.measure import kinetic_energy
+from pendular.dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
+from pendular.dem.state import Particles, Walls
+from pendular.homogenize import capillary_force_stress, contact_stress
 
 #: The base case; every case changes one of these (``water`` is the formation suction [Pa] of
 #: volume-controlled bridges, None for suction control).

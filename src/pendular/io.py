@@ -16,7 +16,7 @@ import os
 import h5py
 import numpy as np
 
-from dem.atomic import replacing
+from pendular.dem.atomic import replacing
 
 from .schema import DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION, SUMMARY_UNITS
 

@@ -22,7 +22,7 @@ import json
 import os
 import shutil
 
-from dem.atomic import write_json
+from pendular.dem.atomic import write_json
 
 LOCK = ".pendular.lock"
 MANIFEST = ".pendular-outputs.json"

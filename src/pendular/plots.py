@@ -8,8 +8,8 @@ import os
 
 import numpy as np
 
-from dem.atomic import replacing
-from homogenize.invariants import deviator_stress, stress_ratio
+from pendular.dem.atomic import replacing
+from pendular.homogenize.invariants import deviator_stress, stress_ratio
 
 
 def pyplot():

@@ -29,7 +29,7 @@ KIM_2001 = [
     (0.72, 0.0047, 412.61), (0.72, 0.0104, 584.53), (0.72, 0.0211, 699.14),
     (0.58, 0.0043, 492.84), (0.58, 0.0104, 716.33), (0.58, 0.0201, 962.75),
 ]
-#: A grading of Kim's F-75 sand ((diameter [m], percent passing by mass), dem.grading): the
+#: A grading of Kim's F-75 sand ((diameter [m], percent passing by mass), pendular.dem.grading): the
 #: thesis (§4.4.1.2) gives Kim's uniformity Cu = 2 and mean radius 0.11 mm (ASTM D422, read as
 #: D50 = 0.22 mm); no sieve curve is in our sources, so the curve is linear in log d from
 #: 0.11 to 0.44 mm, whose D50 is 0.22 mm and Cu = D60 / D10 = 4^0.5 = 2.

@@ -13,7 +13,7 @@ Columns by test (pendular.triaxial.history_columns, pendular.tension):
 - triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
   pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
   and, with exact bridges, psi_interface and sigma_effective_complete
-  (homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
+  (pendular.homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
   liquid_bridges, liquid_film, liquid_lost;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dem.grading import GRADING_UNITS
+from pendular.dem.grading import GRADING_UNITS
 
 #: Version of the history/summary layout (attributes, dimension names).
 SCHEMA_VERSION = 1

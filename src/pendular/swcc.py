@@ -2,7 +2,7 @@
 
 ``SwccTest(SwccConfig(...)).run(out)``:
 
-1. a sample prepared as in thesis Ch. 5.2.2 (dem.preparation), its walls servoed at the
+1. a sample prepared as in thesis Ch. 5.2.2 (pendular.dem.preparation), its walls servoed at the
    confining stress;
 2. wetted at the lowest suction of the path with suction-controlled bridges that persist
    across gaps up to their rupture distance (capillary.CapillaryBridges, ``persist``): at every
@@ -35,17 +35,17 @@ import time
 
 import numpy as np
 
-from capillary import CapillaryBridges, sample_radius_ratios
-from dem.atomic import write_json
-from dem.grading import GRADING_UNITS, grading
-from dem.measure import coordination, porosity
-from dem.preparation import prepare_sample
-from dem.record import HistoryRecorder
-from dem.sample import save_sample
-from dem.walls import ConstantStrainRate
-from homogenize import packing_state, regular_packing
-from homogenize.on_the_fly import CapillaryHomogenization
-from homogenize.regular_packing import KINDS
+from pendular.capillary import CapillaryBridges, sample_radius_ratios
+from pendular.dem.atomic import write_json
+from pendular.dem.grading import GRADING_UNITS, grading
+from pendular.dem.measure import coordination, porosity
+from pendular.dem.preparation import prepare_sample
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.sample import save_sample
+from pendular.dem.walls import ConstantStrainRate
+from pendular.homogenize import packing_state, regular_packing
+from pendular.homogenize.on_the_fly import CapillaryHomogenization
+from pendular.homogenize.regular_packing import KINDS
 
 from .config import SwccConfig, config_to_dict
 from .io import write_history
@@ -179,7 +179,7 @@ def hysteresis(stages):
 
 
 def regular_packing_curves(config, suctions):
-    """Sr of the Chapter 4 regular packings (bridges at every contact, homogenize.packing_state)
+    """Sr of the Chapter 4 regular packings (bridges at every contact, pendular.homogenize.packing_state)
     of spheres of the sample's mean radius at each suction of the path: {kind: [Sr or None
     beyond the pendular limit]}."""
     curves = {}

@@ -7,7 +7,7 @@ default Kim's six cases: F-75 sand, R = 0.11 mm, e = 0.72 at w = 0.47, 1.04, 2.1
 e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric, Gs = 2.65). Each case:
 
 1. Sample (one per void ratio, shared by its water contents): equal spheres prepared as thesis
-   Ch. 5.2.2 (dem.preparation, radius growth to 5 kPa, friction set, walls servoed at
+   Ch. 5.2.2 (pendular.dem.preparation, radius growth to 5 kPa, friction set, walls servoed at
    --confining). The void ratio is that of the core, the box less one diameter along every wall
    (the layers along flat walls are looser: with 2,000 spheres the whole box's e is about 0.09
    higher; Kim's samples are thousands of grains across). It is reached by tuning the friction
@@ -18,11 +18,11 @@ e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric, Gs = 2.65). Each case:
    their formation suction, found so that the bridges hold V_w = w Gs V_s. The grains are rough:
    the menisci of touching grains are --roughness R apart (default Kim's H/R = 0.09, the
    separation of thesis Ch. 4's prediction; 0 for smooth spheres). The suction is found by
-   capillary.formation_suction; contacts made while the sample settles under the bridges
+   pendular.capillary.formation_suction; contacts made while the sample settles under the bridges
    get bridges too, so the suction is corrected until w is within 1 %. Walls servoed at
    --confining until static.
 3. Pull: the particles within --grip-depth diameters of each z wall (surface to wall) move
-   rigidly with it (dem.tension.Grip), the two z walls move apart at a constant strain rate
+   rigidly with it (pendular.dem.tension.Grip), the two z walls move apart at a constant strain rate
    (from --inertial-number I = rate d sqrt(rho / confining)), the lateral walls stay where they
    are. The tensile stress is the mean force of the specimen on the two grips over the
    cross-section, positive in tension (the compression-positive axial stress's opposite);
@@ -31,7 +31,7 @@ e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric, Gs = 2.65). Each case:
    nearly uniformly between the held lateral walls and soften slowly: docs/direct_tension.md).
 
 Outputs in --out: tension.json (per case: void ratios, water content, saturation, bridges,
-formation suction, tensile strength, Kim's measurement, homogenize.packing_state's prediction
+formation suction, tensile strength, Kim's measurement, pendular.homogenize.packing_state's prediction
 psi_xx (isotropic BCC for e >= 0.65, FCP below, H/R = 0.09, as docs/chapter4.md) and relative
 differences), report.md (the table), plots/ (tensile stress against axial extension per case,
 strength against w beside Kim and the prediction), and per case cases/<case>/history.h5
@@ -51,17 +51,17 @@ from dataclasses import asdict
 import numpy as np
 from scipy.spatial import cKDTree
 
-from capillary import (BridgeTable, CapillaryBridges, gravimetric_water_content,
+from pendular.capillary import (BridgeTable, CapillaryBridges, gravimetric_water_content,
                        sample_radius_ratios)
-from dem.atomic import write_json, write_text
-from dem.grading import grading
-from dem.measure import coordination, unbalanced_force
-from dem.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
-from dem.record import HistoryRecorder
-from dem.simulation import Simulation
-from dem.tension import Grip, core_void_ratio, grip_members, tensile_stress
-from dem.walls import ConstantStrainRate, StressServo
-from homogenize import packing_state, regular_packing
+from pendular.dem.atomic import write_json, write_text
+from pendular.dem.grading import grading
+from pendular.dem.measure import coordination, unbalanced_force
+from pendular.dem.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.simulation import Simulation
+from pendular.dem.tension import Grip, core_void_ratio, grip_members, tensile_stress
+from pendular.dem.walls import ConstantStrainRate, StressServo
+from pendular.homogenize import packing_state, regular_packing
 
 from .config import TensionConfig, config_to_dict, inertial_number
 from .io import write_history
@@ -207,7 +207,7 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
     copy of ``dry`` (and across every gap up to config.form_gap radii) holding water content
     ``water_content`` (fraction) once static, the formation suction corrected for the contacts
     the bridges add (the wetting law itself, formation suction at a water volume, is
-    capillary.formation_suction)."""
+    pendular.capillary.formation_suction)."""
     particles = dry.particles
     target = water_content * config.specific_gravity * particles.solid_volume()
     max_gap = config.form_gap * config.radius
@@ -301,7 +301,7 @@ class Pull:
 
     def tensile_stress(self, sim: Simulation) -> float:
         """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
-        the cross-section (dem.tension.tensile_stress), or minus a periodic cell's z stress."""
+        the cross-section (pendular.dem.tension.tensile_stress), or minus a periodic cell's z stress."""
         if sim.walls.periodic:
             return -float(sim.walls.stress()[2])
         return tensile_stress(self.grips, sim.walls)
@@ -329,7 +329,7 @@ class Pull:
 
 def prediction(config: TensionConfig, void_ratio: float,
                water_content: float) -> tuple[float, str, float]:
-    """(psi_xx [Pa], label, void ratio of the packing) of homogenize.packing_state for the
+    """(psi_xx [Pa], label, void ratio of the packing) of pendular.homogenize.packing_state for the
     comparison packing at this water content (exact bridges, H/R = 0.09)."""
     kind, label = comparison_packing(void_ratio)
     packing = regular_packing(kind, separation=KIM_SEPARATION)

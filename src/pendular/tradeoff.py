@@ -51,13 +51,13 @@ import shutil
 import time
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
-from dem.atomic import write_json, write_text
-from dem.preparation import MAX_SEED, PrepareConfig
-from dem.sample import load_sample
-from dem.validate import check_int, check_range
+from pendular.dem.atomic import write_json, write_text
+from pendular.dem.preparation import MAX_SEED, PrepareConfig
+from pendular.dem.sample import load_sample
+from pendular.dem.threads import use_threads
+from pendular.dem.validate import check_int, check_range
 
 from .campaign import executor, prepare_one, sample_made_with
 from .config import BridgeConfig, ShearConfig, TriaxialConfig, config_json, config_to_dict
@@ -430,7 +430,7 @@ def write_study(study, *, docs=None, log=None):
         raise TypeError(f"study must be a pendular.tradeoff.Study, got {type(study).__name__}")
     if docs is not None and not os.path.isdir(docs):
         raise ValueError(f"docs = {docs!r} is not a folder")
-    numba.set_num_threads(1)
+    use_threads(1)
     with OutputFolder(study.out, "tradeoff") as folder:
         paths = {name.rsplit(".", 1)[1]: folder.claim(name) for name in OUTPUTS}
         reference, rows, noise = measure(study, log)

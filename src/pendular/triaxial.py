@@ -14,7 +14,7 @@ Building blocks, usable alone for a custom loading path (README "Using it"):
 ``vtk_prep``, vtk_prep/: ParaView frames of the preparation and wetting);
 ``TriaxialTest.resume(out)`` continues an interrupted run from its checkpoint bit-identically.
 
-Stresses compression positive [Pa], q and p as homogenize.invariants; strains compression
+Stresses compression positive [Pa], q and p as pendular.homogenize.invariants; strains compression
 positive, volumetric strain positive in contraction (SPEC §1).
 """
 
@@ -29,19 +29,19 @@ import time
 import numba
 import numpy as np
 
-from dem.atomic import write_json
-from dem.checkpoint import CheckpointWriter, load_checkpoint
-from dem.grading import grading
-from dem.integrity import checksum, config_hash
-from dem.measure import coordination, porosity, unbalanced_force
-from dem.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step, servoed_simulation,
+from pendular.dem.atomic import write_json
+from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
+from pendular.dem.grading import grading
+from pendular.dem.integrity import checksum, config_hash
+from pendular.dem.measure import coordination, porosity, unbalanced_force
+from pendular.dem.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step, servoed_simulation,
                              static, timestep, timestep_description)
-from dem.record import HistoryRecorder
-from dem.sample import load_sample, save_sample
-from dem.validate import check_int
-from dem.walls import ConstantStrainRate, StressServo
-from homogenize import contact_stress, fabric_tensor, principal_anisotropy
-from homogenize.invariants import deviator_stress, lateral_stress, mean_stress
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.sample import load_sample, save_sample
+from pendular.dem.validate import check_int
+from pendular.dem.walls import ConstantStrainRate, StressServo
+from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
+from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 
 from .config import TriaxialConfig, config_from_dict, config_to_dict, inertial_number
 from .io import write_history
@@ -79,7 +79,7 @@ OUTPUTS = ("history.h5", "summary.json", "triaxial.png", "plots", "vtk", "sample
            "checkpoint.h5", "vtk_prep")
 
 #: Phases of the vtk_prep/ series, by the code in each frame's field data ``phase``: those of
-#: dem.preparation.prepare_sample, then "sample" (a loaded sample equilibrated at the confining
+#: pendular.dem.preparation.prepare_sample, then "sample" (a loaded sample equilibrated at the confining
 #: stress) and "wetting" (bridges added, equilibrated again).
 PREP_PHASES = (*PREPARATION_PHASES, "sample", "wetting")
 
@@ -188,7 +188,7 @@ def wet_sample(sim, config, *, progress=None):
 
 def _wet_at_water_content(dry, config, thresholds, progress):
     """wet_sample at config.bridges.water_content (volume-controlled bridges at contacts)."""
-    from capillary import BridgeTable, gravimetric_water_content, sample_radius_ratios
+    from pendular.capillary import BridgeTable, gravimetric_water_content, sample_radius_ratios
 
     bridges_config = config.bridges
     particles = dry.particles
@@ -257,7 +257,7 @@ def capillary_operation(sim):
 def history_columns(sim, axial, reference_volume, bridges=None):
     """Recorded columns of a triaxial history (name -> function of sim); pendular.schema
     declares their units. A wet scene adds the capillary and homogenised columns of
-    homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
 
     def contact_fabric(s):
         return fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0)   # Eq. 4.1
@@ -276,7 +276,7 @@ def history_columns(sim, axial, reference_volume, bridges=None):
         "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
     }
     if bridges is not None:
-        from homogenize.on_the_fly import CapillaryHomogenization
+        from pendular.homogenize.on_the_fly import CapillaryHomogenization
 
         columns.update(CapillaryHomogenization(bridges).quantities())
         if bridges.liquid != "reservoir":             # a closed amount of liquid
@@ -332,7 +332,7 @@ def summarize(history):
     ``p_effective_at_peak``: q' and p' of the effective stress (Eq. 3.43) at the peak of q,
     and with the exact bridge model ``peak_q_effective_complete`` and
     ``p_effective_complete_at_peak``: those of the complete effective stress (psi plus the
-    liquid-gas interface term, homogenize.on_the_fly)."""
+    liquid-gas interface term, pendular.homogenize.on_the_fly)."""
     sigma = history["sigma_wall"]
     q = deviator_stress(sigma)
     peak = int(np.argmax(q))
@@ -474,7 +474,7 @@ class TriaxialTest:
         check_feasible(config, force=force)
         if config.bridges is not None and config.bridges.suction is not None:
             # check the bridges against the sample's radii before any preparation
-            from capillary import sample_radius_ratios
+            from pendular.capillary import sample_radius_ratios
 
             radii = config.sample.radii()
             config.bridges.build().load_tables(float(radii.min()), float(radii.max()),
@@ -600,7 +600,7 @@ class TriaxialTest:
 
 
 def run_identity(config, sample_file):
-    """What a checkpoint of this run must carry (dem.integrity): the configuration's hash, the
+    """What a checkpoint of this run must carry (pendular.dem.integrity): the configuration's hash, the
     seed and the checksum of the sample the shear started from."""
     return {"config_hash": config_hash(config_to_dict(config)), "seed": config.sample.seed,
             "sample_checksum": checksum(sample_file)}

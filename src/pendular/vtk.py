@@ -18,7 +18,7 @@ point data (SI units):
     bridges            number of liquid bridges (capillary.BridgeState; 0 in a dry scene)
 
 ``walls.pvd`` / ``walls_NNNNNN.vtu``: the six walls as quads spanning the box, cell data
-    wall               index 0..5 (x-, x+, y-, y+, z-, z+; ``dem.state.WALL_NAMES``)
+    wall               index 0..5 (x-, x+, y-, y+, z-, z+; ``pendular.dem.state.WALL_NAMES``)
     normal_stress      [Pa] force / area, compression positive
     force              [N] normal force of the particles on the wall, compression positive
     velocity           [m/s] outward wall speed of the last step
@@ -34,7 +34,7 @@ pair between the two centres (YADE's interaction network), cell data
     normal_force       [N] spring normal force (compressive, >= 0)
     shear_force        [N] magnitude of the elastic shear force
     bridge             1 when the pair also holds a liquid bridge
-In a periodic cell (dem.cell) the particles are drawn wrapped into the cell, a pair's line
+In a periodic cell (pendular.dem.cell) the particles are drawn wrapped into the cell, a pair's line
 runs from particle i to the image of j it interacts with (so lines through a face stick out
 of the cell), and ``walls`` are the cell's faces: normal_stress is the cell's stress on that
 axis, force that stress times the face area, velocity the face's speed (low faces fixed at 0).
@@ -42,7 +42,7 @@ A scene without bridges (or contacts) gets empty, valid files (0 points, 0 cells
 file without cells back; ParaView and VTK can.
 
 A writer given ``phases`` (names) also writes a frame whenever its ``phase`` attribute changes
-(set by whoever drives the simulation, e.g. dem.preparation.prepare_sample), and every frame's
+(set by whoever drives the simulation, e.g. pendular.dem.preparation.prepare_sample), and every frame's
 field data holds ``phase``: the index of the current phase in ``phases`` (the triaxial test's
 ``vtk_prep/`` series: pendular.triaxial.PREP_PHASES).
 """
@@ -53,9 +53,9 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from capillary.bridge_state import BridgeState
-from dem.atomic import replacing
-from dem.validate import check_int
+from pendular.capillary.bridge_state import BridgeState
+from pendular.dem.atomic import replacing
+from pendular.dem.validate import check_int
 
 #: The series written, each a .pvd collection of .vtu files.
 SERIES = ("particles", "walls", "bridges", "contacts")

@@ -1,7 +1,7 @@
 """Wetting a static sample to a gravimetric water content with volume-controlled bridges.
 
 The formation suction of the bridges is the one at which suction-controlled bridges at the
-wetted pairs hold the water (capillary.formation_suction); while the wetted sample settles, new
+wetted pairs hold the water (pendular.capillary.formation_suction); while the wetted sample settles, new
 contacts form bridges of that suction from the reservoir, so the water held drifts from the
 target: the formation suction is corrected and the wetting started again from the dry sample
 until the water held is within WATER_TOLERANCE of the target (at most WETTINGS tries). Used by
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import copy
 
-from capillary import formation_suction
+from pendular.capillary import formation_suction
 
 #: Largest relative difference between the water held after wetting and the target [-].
 WATER_TOLERANCE = 0.01

@@ -8,8 +8,8 @@ executable on PATH (Debian/Ubuntu package ``yade``, tested with 2023.02a).
 
 Shared by the cross-check (pendular.crosscheck) and the benchmarks (benchmarks/bench_*.py):
 
-- ``cached_sample(config)``: a prepared sample (dem.preparation.prepare_sample), saved once in
-  the cache folder (capillary.cache_directory: $PENDULAR_CACHE or ~/.cache/pendular) with its
+- ``cached_sample(config)``: a prepared sample (pendular.dem.preparation.prepare_sample), saved once in
+  the cache folder (pendular.capillary.cache_directory: $PENDULAR_CACHE or ~/.cache/pendular) with its
   configuration and prepared again when the configuration differs;
 - ``yade_capillary_files(contact_angle)``: YADE's capillary files M(r=1) ... M(r=10) of the
   exact bridge tables (capillary.BridgeTable.write_yade), written once into the cache folder;
@@ -29,11 +29,11 @@ import time
 
 import numpy as np
 
-import capillary
-from dem import OPENMP_DEFAULTS
-from dem.preparation import PREPARATION_VERSION, PrepareConfig, prepare_sample
-from dem.sample import load_sample, save_sample
-from dem.yade_io import read_plot_data
+from pendular import capillary
+from pendular.dem.threads import OPENMP_DEFAULTS
+from pendular.dem.preparation import PREPARATION_VERSION, PrepareConfig, prepare_sample
+from pendular.dem.sample import load_sample, save_sample
+from pendular.dem.yade_io import read_plot_data
 
 from .campaign import sample_made_with
 from .config import config_json, config_to_dict
@@ -59,7 +59,7 @@ def yade_environment(extra=None):
     """os.environ for a YADE subprocess: without VIRTUAL_ENV, PYTHONPATH and PYTHONHOME, which
     make YADE's system Python load a virtual environment's packages (numpy, matplotlib) built
     for another interpreter, and without the OpenMP settings pendular made for itself
-    (dem.OPENMP_DEFAULTS: YADE runs as a user would run it); plus ``extra`` variables."""
+    (pendular.dem.threads.OPENMP_DEFAULTS: YADE runs as a user would run it); plus ``extra`` variables."""
     environment = {key: value for key, value in os.environ.items()
                    if key not in ("VIRTUAL_ENV", "PYTHONPATH", "PYTHONHOME", *OPENMP_DEFAULTS)}
     environment.update(extra or {})
@@ -124,14 +124,14 @@ def yade_history(path, box_volume):
 # ---------------------------------------------------------------- cached inputs
 
 def cache_folder():
-    """Where prepared samples and YADE's capillary files are kept (capillary.cache_directory)."""
+    """Where prepared samples and YADE's capillary files are kept (pendular.capillary.cache_directory)."""
     return str(capillary.cache_directory())
 
 
 def cached_sample(config, *, progress=True, threads=None):
     """(Particles, Walls, preparation report) of the sample of ``config`` (a PrepareConfig),
     prepared once (thesis Ch. 5.2.2, at config.confining; ``threads``: Numba threads of the
-    preparation, dem.simulation's policy by default) and saved in the cache folder under a name
+    preparation, pendular.dem.simulation's policy by default) and saved in the cache folder under a name
     keyed by its configuration, which the saved sample holds and is checked against."""
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")

@@ -17,7 +17,7 @@ import math
 
 import numba
 
-from dem.preparation import PrepareConfig
+from pendular.dem.preparation import PrepareConfig
 
 from ..cli import UsageError, add_size_options, positive_int, set_threads, sizes_from
 from ..crosscheck import SHOWN, crosscheck_config, run_crosscheck

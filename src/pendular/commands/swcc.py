@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import sys
 
-from dem.preparation import PrepareConfig
+from pendular.dem.preparation import PrepareConfig
 
 from ..cli import UsageError, add_run_options, add_size_options, set_threads, sizes_from
 from ..config import SwccConfig

@@ -17,9 +17,9 @@ import argparse
 import json
 import sys
 
-from dem.preparation import PrepareConfig
-from dem.timestep import TIMESTEP_RULES
-from dem.validate import check_range
+from pendular.dem.preparation import PrepareConfig
+from pendular.dem.timestep import TIMESTEP_RULES
+from pendular.dem.validate import check_range
 
 from ..cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
                    set_threads, sizes_from)
@@ -92,7 +92,7 @@ def add_arguments(parser):
                         help="time step as a fraction of the --timestep-rule estimate [-]")
     parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="stiffness",
                         help="time step estimate: the critical step of the contacts "
-                             "(dem.timestep; default), or YADE's P-wave estimate of the "
+                             "(pendular.dem.timestep; default), or YADE's P-wave estimate of the "
                              "smallest sphere")
     parser.add_argument("--skin-factor", type=float, default=0.1,
                         help="Verlet skin of the neighbour list / radius (0, 2]")

@@ -1,0 +1,68 @@
+"""Liquid bridges between spheres: exact Young-Laplace solutions, tables, toroidal approximation.
+
+Units (SPEC section 1): R2 >= R1, r = R2/R1, u* = s R2/gamma, d* = D/R2, V* = V/R2**3,
+F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
+
+- solve_bridge(r, theta, u*, delta1): exact bridge from its filling angle (pendular.capillary.meniscus).
+- bridge_at_distance / rupture_distance / lowest_distance: suction-controlled (pendular.capillary.suction_control).
+- bridge_with_volume / rupture_distance_for_volume / volume_contour: volume-controlled (pendular.capillary.volume_control).
+- BridgeTable + lookup_suction, VolumeBridgeTable + lookup_volume: tables for Numba kernels.
+- write_yade / read_yade: YADE capillary files M(r=...) (pendular.capillary.yade_files).
+- toroidal_bridge: thesis Appendix A (pendular.capillary.toroidal).
+- CapillaryBridges: the bridge operation of wet DEM scenes (pendular.capillary.bridges), its per-pair
+  BridgeState (pendular.capillary.bridge_state) and kernels (pendular.capillary.bridge_kernels).
+- formation_suction, gravimetric_water_content: wetting at a water content (pendular.capillary.wetting).
+"""
+
+from pendular.capillary.bridge_state import BridgeState
+from pendular.capillary.bridges import (BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION, CapillaryBridges,
+                               sample_radius_ratios, table_radius_ratios)
+from pendular.capillary.meniscus import Bridge, solve_bridge
+from pendular.capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
+from pendular.capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
+from pendular.capillary.toroidal import ToroidalBridge, toroidal_bridge
+from pendular.capillary.validation import MAX_RADIUS_RATIO
+from pendular.capillary.volume_control import (
+    CONTACT_SUCTION_MAX,
+    bridge_with_volume,
+    rupture_distance_for_volume,
+    volume_contour,
+)
+from pendular.capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
+from pendular.capillary.wetting import formation_suction, gravimetric_water_content
+from pendular.capillary.yade_files import YadeCapillaryFile, read_yade, write_yade
+
+__all__ = [
+    "BRIDGE_MODELS",
+    "Bridge",
+    "BridgeState",
+    "CapillaryBridges",
+    "LIQUID_MODELS",
+    "SURFACE_TENSION",
+    "formation_suction",
+    "gravimetric_water_content",
+    "sample_radius_ratios",
+    "table_radius_ratios",
+    "BridgeTable",
+    "CONTACT_SUCTION_MAX",
+    "FIELDS",
+    "MAX_RADIUS_RATIO",
+    "ToroidalBridge",
+    "VOLUME_FIELDS",
+    "VolumeBridgeTable",
+    "YADE_RADIUS_RATIOS",
+    "YadeCapillaryFile",
+    "bridge_at_distance",
+    "bridge_with_volume",
+    "cache_directory",
+    "lookup_suction",
+    "lookup_volume",
+    "lowest_distance",
+    "read_yade",
+    "rupture_distance",
+    "rupture_distance_for_volume",
+    "solve_bridge",
+    "toroidal_bridge",
+    "volume_contour",
+    "write_yade",
+]

@@ -1,0 +1,534 @@
+"""Liquid bridges in the DEM: the capillary operation of wet scenes (thesis Ch. 5, SPEC section 4).
+
+A wet scene lists ``CapillaryBridges`` among its forces after the contact law and the wall
+springs (``sim.forces.append(bridges)``; YADE's order: InteractionLoop,
+Law2_ScGeom_CapillaryPhys_Capillarity, TriaxialStressController, NewtonIntegrator); a dry scene
+never builds it. Bridges that persist across gaps declare how far the neighbour list must reach
+(``reach(sim)``, their largest rupture distance). Each step:
+
+1. per pair (parallel over pairs): a bridge forms when the spheres touch (overlap > 0, from
+   the contact law of the same step) and breaks when contact is lost (the thesis's choice) or,
+   with ``persist``, where no bridge exists at that gap: the table says no solution (suction
+   control), or the volume-controlled rupture distance is passed (volume control). Its force
+   F [N] acts along the branch vector, attractive: the force on j from i is -F n (n unit i -> j);
+2. the forces are gathered per particle, -f to i and +f to j, each particle summing its own
+   pairs in a fixed order (deterministic for any thread count, no atomics).
+
+The kernels are pendular.capillary.bridge_kernels. Default (suction control, bridges only at contact):
+``contact_bridges`` only reads overlap and
+the bridge state and looks a bridge up when it forms; the contact law's gather then adds the
+cached magnitudes along its normals with the contact forces, in the same pass over the pairs
+(``joins_contact_gather``, pendular.dem.contact_law.ContactForces.gather; ``gather_contact_bridges``
+when the scene has no contact law). A wet step at 10,000 spheres costs 1.0-1.1 times a dry
+one (1.1-1.2 with a gather of its own). Bridges across gaps (``persist``, volume
+control): ``suction_bridges`` / ``volume_bridges`` write per-pair force vectors ``pair_force``,
+gathered by ``pendular.dem.neighbors.gather_pair_forces``.
+
+The capillary force is added on top of the mechanical contact force and does not enter the
+Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack caps the shear
+force with ``phys->normalForce`` (the spring's force only), and
+Law2_ScGeom_CapillaryPhys_Capillarity adds fCap separately through ``scene->forces.addForce``
+(YADE 2023 sources, pkg/dem/ElasticContactLaw.cpp and
+pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bridges (YADE's
+capillary law skips pairs of different shapes), and ``contacts.force`` stays the mechanical
+force, so that pendular.homogenize.contact_stress is Eq. 3.41's contact stress.
+
+Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
+d* = max(gap, 0) / R2 (overlaps read the table's contact values, as YADE does), F = F* 2 pi gamma
+R2, V = V* R2^3, filling angles delta1 on the smaller sphere and delta2 on the larger one. At
+d* = 0 a bridge's force, volume and filling angles depend only on the radii (suction control)
+or on the radii and its volume (volume control): they are looked up once when the bridge forms
+(or comes back into contact) and cached in its per-pair arrays, so a bridge at contact costs
+no lookup per step; only bridges across a gap (``persist``, volume control) are looked up
+each step.
+
+Per-pair state: pendular.capillary.bridge_state.BridgeState (state, volume, force, filling_i,
+filling_j, suction), kept in ``sim.contacts.extra`` and carried across neighbour-list rebuilds.
+
+Volume control: a bridge forms at contact with the volume of the suction-controlled bridge at
+contact at ``suction`` (the formation suction, the same for bridges that form later), then keeps
+that volume; its force and suction follow from (V*, d*) and it ruptures at the
+volume-controlled rupture distance (capillary.VolumeBridgeTable). Bridges persist across gaps.
+
+The liquid of volume-controlled bridges (``liquid``; docs/hydro_mechanical.md):
+"reservoir" (default): new contacts take their bridge's liquid from outside, a ruptured
+bridge's goes back there (a sample in contact with a water supply, the wetting phase);
+"shared" and "lost": the amount is closed (a fixed water content). On rupture, "shared" gives
+half of the bridge's liquid to each of its two grains, split equally among that grain's
+remaining bridges, or held on the grain as a film when it has none (Mani, Kadau & Herrmann
+2012; MercuryDPM's liquid migration); "lost" removes it, counted in ``liquid_lost``. A new
+contact forms a bridge only from the films of its two grains. ``close_liquid`` switches a
+reservoir-wetted sample to a closed model; then bridges + films + lost = the liquid at closing
+(``liquid_balance``) to round-off.
+"""
+
+
+import math
+
+import numba
+import numpy as np
+
+from pendular.capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
+                                      gather_contact_bridges, gather_contact_bridges_virial,
+                                      pendular_overlap_counts, refresh_contact_bridges,
+                                      serial_contact_bridges, suction_bridges,
+                                      suction_interfaces, volume_bridges, volume_interfaces)
+from pendular.capillary.bridge_state import BridgeState
+from pendular.capillary.table import YADE_RADIUS_RATIOS, BridgeTable
+from pendular.capillary.validation import (check_bridge_stiffness, check_contact_angle,
+                                  check_pendular_suction)
+from pendular.capillary.volume_table import VolumeBridgeTable
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.neighbors import gather_pair_forces, gather_pair_forces_virial
+from pendular.dem.validate import check_positive, check_range
+
+#: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
+SURFACE_TENSION = 0.073
+#: Bridge models: exact Young–Laplace tables, or the toroidal approximation (Appendix A).
+BRIDGE_MODELS = ("exact", "toroidal")
+#: How bridges are controlled: imposed suction, or constant volume.
+CONTROLS = ("suction", "volume")
+#: Where the liquid of volume-controlled bridges comes from and goes (``liquid``): an outside
+#: reservoir, or a closed amount shared among the grains' bridges on rupture, or lost on rupture.
+LIQUID_MODELS = ("reservoir", "shared", "lost")
+
+
+def table_radius_ratios(largest_ratio):
+    """YADE's radius ratios 1 ... 10 up to the first one covering ``largest_ratio``."""
+    if largest_ratio > YADE_RADIUS_RATIOS[-1] * (1.0 + 1e-12):
+        raise ValueError(f"radius ratio R2/R1 = {largest_ratio:g} of the sample is outside the "
+                         f"valid range [1, {YADE_RADIUS_RATIOS[-1]:g}] of the bridge tables")
+    for index, ratio in enumerate(YADE_RADIUS_RATIOS):
+        if ratio >= largest_ratio * (1.0 - 1e-12):
+            return YADE_RADIUS_RATIOS[:index + 1]
+    return YADE_RADIUS_RATIOS
+
+
+#: Largest number of distinct pair radius ratios that get a table node each (exact lookups).
+EXACT_RATIO_NODES = 24
+#: Spacing factor of the geometric radius-ratio nodes of a sample with more distinct ratios.
+RATIO_NODE_FACTOR = 1.1
+
+
+def sample_radius_ratios(radii):
+    """Radius-ratio nodes of the bridge tables of a sample with these sphere radii [m].
+
+    Equal spheres only: (1.0,), the first of YADE's nodes (as ``table_radius_ratios(1)``).
+    Otherwise the tables are exact for every pair of the sample, not interpolated between
+    YADE's ratios 1, 1.1, 1.25, ..., 5, 10 (linear interpolation in r between those costs about
+    1 % in force between 2 and 3 and 5 % between 5 and 10 mid-range, 5 % and 14 % near
+    rupture, up to 3 % in rupture distance; docs/pendular.capillary.md): a node at each distinct ratio
+    R2/R1 of two radii of the sample (and 1 if two spheres have the same radius), computed as
+    the bridge kernels compute a pair's ratio (max / min of the two radii), so every pair
+    reads its own node exactly, up to
+    EXACT_RATIO_NODES nodes; beyond that (a continuous size distribution) geometric nodes
+    1 = r_0 < ... < r_n = the sample's largest ratio rounded up to 0.01 (so that samples of one
+    grading share their cached tables), r_(k+1) / r_k <= RATIO_NODE_FACTOR,
+    interpolated within 0.15 % in force, 0.4 % in volume and 0.06 % in rupture distance up to
+    0.9 of the rupture distance (0.4 % and 0.7 % at 0.99 of it). Building a node takes about
+    0.5 s (suction table) and 4 s (volume table, one core), once: tables are cached by their
+    nodes. ValueError beyond YADE's largest ratio 10.
+    """
+    sizes, counts = np.unique(np.asarray(radii, dtype=np.float64), return_counts=True)
+    if sizes.size == 0 or not sizes[0] > 0.0:
+        raise ValueError(f"radii = {sizes.tolist()[:3]}... must be positive (at least one sphere)")
+    if sizes.size == 1:
+        return table_radius_ratios(1.0)
+    largest = float(sizes[-1] / sizes[0])
+    table_radius_ratios(largest)                  # range check
+    if sizes.size - 1 <= EXACT_RATIO_NODES:      # else more distinct ratios than that anyway
+        ratios = {float(sizes[b] / sizes[a]) for a in range(sizes.size)
+                  for b in range(a + 1, sizes.size)}
+        if np.any(counts > 1):
+            ratios.add(1.0)
+        if len(ratios) <= EXACT_RATIO_NODES:
+            return tuple(sorted(ratios))
+    # the last node rounded up to 3 digits: samples of one grading share their cached tables
+    largest = min(math.ceil(largest * 100.0) / 100.0, YADE_RADIUS_RATIOS[-1])
+    n = math.ceil(math.log(largest) / math.log(RATIO_NODE_FACTOR) - 1e-9)
+    return (1.0, *(largest ** (k / n) for k in range(1, n)), largest)
+
+
+class CapillaryBridges:
+    """Capillary bridges between touching spheres (SPEC section 4); an operation ``apply(sim)``.
+
+    suction [Pa] >= 0: imposed matric suction (suction control), or the suction at which bridges
+        form (volume control);
+    surface_tension [N/m] > 0 (thesis Ch. 5: 0.073); contact_angle [deg] in [0, 90);
+    model: "exact" (Young–Laplace tables, capillary.BridgeTable) or "toroidal" (thesis
+        Appendix A, equal spheres only);
+    control: "suction" (default, thesis Ch. 5) or "volume" (each bridge keeps its volume);
+    persist: suction control only: bridges live up to the rupture distance instead of breaking
+        when contact is lost (volume-controlled bridges always persist up to rupture);
+    roughness: volume control only: meniscus separation of touching spheres H / R2 in [0, 0.5]
+        (rough grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
+    liquid: volume control only: "reservoir", "shared" or "lost" (LIQUID_MODELS, module
+        docstring);
+    table_options: keyword arguments of BridgeTable.cached (model 'exact') or
+        pendular.capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
+
+    Add it to a scene's forces after the contact and wall forces; ``reach(sim)`` tells the
+    neighbour list how far bridges across gaps reach. Radii must not change while bridges
+    exist.
+    """
+
+    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
+                 control="suction", persist=False, table_options=None, roughness=0.0,
+                 liquid="reservoir"):
+        self.suction = check_range("suction", suction, 0.0, unit="Pa")
+        self.surface_tension = check_positive("surface_tension", surface_tension, "N/m")
+        self.contact_angle = check_contact_angle(contact_angle)
+        if model not in BRIDGE_MODELS:
+            raise ValueError(f"model = {model!r} is not one of {BRIDGE_MODELS}")
+        if control not in CONTROLS:
+            raise ValueError(f"control = {control!r} is not one of {CONTROLS}")
+        if control == "volume" and model != "exact":
+            raise ValueError("volume-controlled bridges need model='exact'")
+        self.model = model
+        self.control = control
+        self.persist = bool(persist) or control == "volume"
+        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
+        if self.roughness > 0.0 and control != "volume":
+            raise ValueError(f"roughness = {self.roughness:g} needs control='volume' (suction-"
+                             "controlled bridges are between smooth spheres: roughness 0)")
+        if liquid not in LIQUID_MODELS:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
+        if liquid != "reservoir" and control != "volume":
+            raise ValueError(f"liquid = {liquid!r} needs control='volume' (suction-controlled "
+                             "bridges exchange liquid with a reservoir at the imposed suction)")
+        self.liquid = liquid
+        self.liquid_initial = None       # [m^3] at closing (None: open liquid)
+        self.liquid_lost = 0.0           # [m^3] since closing
+        self.film = None                 # (N,) [m^3] liquid held on each grain
+        self.table_options = dict(table_options or {})
+        self.suction_table = None
+        self.volume_table = None
+        self.required_range = 0.0
+        self.pair_force = np.zeros((0, 3))
+        self._table_arrays = None
+        self._contacts = None
+        self._bridges = 0
+        self._radius_bounds = None
+        self._checked_stiffness = False
+        self._state = None
+        self._applied_suction = None
+
+    # ---------------------------------------------------------------- set-up, once per sample
+    def reach(self, sim):
+        """Largest gap [m] at which a bridge of this operation may exist (0 unless bridges
+        persist): the neighbour list holds every pair closer than that."""
+        if sim.contacts is None or sim.contacts is not self._contacts:
+            self._prepare(sim)                # radii change only with a rebuild
+        return self.required_range
+
+    def _prepare(self, sim):
+        """Check the contact stiffness against the bridges (once) and load the tables for the
+        scene's radii."""
+        if not self._checked_stiffness:
+            for contact_law in (op for op in sim.forces if isinstance(op, ContactForces)):
+                check_bridge_stiffness(contact_law.young, float(sim.particles.radius.min()),
+                                       self.surface_tension)
+            self._checked_stiffness = True
+        radius = sim.particles.radius
+        low, high = float(radius.min()), float(radius.max())
+        if self._radius_bounds is not None and self._radius_bounds[:2] == (low, high):
+            return                            # same spheres: the tables of the last rebuild
+        nodes = sample_radius_ratios(radius) if self.model == "exact" else None
+        self.load_tables(low, high, radius_ratios=nodes)
+
+    def load_tables(self, low, high, radius_ratios=None):
+        """Check the input against spheres of radii in [low, high] [m] and load (or build and
+        cache) the tables; ValueError naming the parameter when out of range.
+
+        radius_ratios: the exact tables' ratio nodes (``sample_radius_ratios`` of the scene's
+        radii, which ``reach``/``apply`` pass); default YADE's ratios up to high / low
+        (``table_radius_ratios``). table_options' radius_ratios, if given, win.
+        """
+        low = check_positive("smallest radius", low, "m")
+        high = check_range("largest radius", high, low, unit="m")
+        if radius_ratios is None and self.model == "exact":
+            radius_ratios = table_radius_ratios(high / low)
+        if self._radius_bounds == (low, high, radius_ratios):
+            return
+        ratio = high / low
+        options = dict(self.table_options)
+        if self.model == "toroidal":
+            if ratio > 1.0:
+                raise ValueError(f"model='toroidal' needs equal spheres; the radii range from "
+                                 f"{low:g} to {high:g} m (use model='exact')")
+            from pendular.capillary.toroidal_table import toroidal_table
+
+            suction_star_high = self.suction * high / self.surface_tension
+            options.setdefault("suction_max", max(suction_star_high * 1.001, 1e-3))
+            self.suction_table = toroidal_table(self.contact_angle, **options)
+        else:
+            options.setdefault("radius_ratios", radius_ratios)
+            self.suction_table = BridgeTable.cached(self.contact_angle, **options)
+        self._check_suction(self.suction, low, high)
+        if self.control == "volume":
+            self.volume_table = VolumeBridgeTable.cached(
+                self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
+        self._table_arrays = self.suction_table.arrays()
+        self._radius_bounds = (low, high, radius_ratios)
+        self.required_range = self._rupture_range(low, high)
+
+    def _check_suction(self, suction, low, high):
+        """ValueError naming ``suction`` [Pa] unless the loaded table covers it for spheres of
+        radii [low, high] [m] and bridges at contact stay pendular."""
+        suction_star_high = suction * high / self.surface_tension
+        if suction_star_high > self.suction_table.suction_max:
+            raise ValueError(
+                f"suction = {suction:g} Pa is outside the valid range [0, "
+                f"{self.suction_table.suction_max * self.surface_tension / high:g}] Pa for these "
+                f"spheres: u* = s R2/gamma = {suction_star_high:g} (R2 = {high:g} m, gamma = "
+                f"{self.surface_tension:g} N/m) exceeds the table's "
+                f"{self.suction_table.suction_max:g}")
+        check_pendular_suction(self.suction_table, suction, low, self.surface_tension)
+
+    def set_suction(self, suction):
+        """Impose a new suction [Pa] from the next step on (suction control; a path of drying
+        and wetting): bridges at contact are looked up again at it, bridges across a gap
+        (``persist``) follow it and rupture where the new rupture distance is shorter than their
+        gap, new bridges form at contact only, so drying and wetting differ (hysteresis). The
+        neighbour list's reach follows the lowest suction imposed so far, so no persisting
+        bridge leaves it. ValueError naming ``suction`` outside the table or the pendular
+        regime."""
+        if self.control != "suction":
+            raise ValueError(f"control = {self.control!r}: set_suction needs control = "
+                             "'suction' (volume-controlled bridges have their own suctions)")
+        suction = check_range("suction", suction, 0.0, unit="Pa")
+        if self._radius_bounds is not None:
+            low, high = self._radius_bounds[:2]
+            self._check_suction(suction, low, high)
+        self.suction = suction
+        if self._radius_bounds is not None:
+            self.required_range = max(self.required_range, self._rupture_range(low, high))
+
+    def _rupture_range(self, low, high):
+        """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).
+
+        The rupture distance d*_rupture(u*) decreases with u*, and u* = s R2/gamma >= s Rmin/gamma,
+        so Rmax * max_r d*_rupture(r, s Rmin/gamma) bounds D (5 % margin). Volume control: the
+        largest volume forms at the smallest suction; d*_rupture grows with the volume.
+        """
+        if not self.persist:
+            return 0.0
+        table = self.suction_table
+        xi = math.log1p(self.suction * low / self.surface_tension / table.suction_scale)
+        nodes = np.log1p(table.suction / table.suction_scale)
+        ruptures = [np.interp(xi, nodes, row) for row in table.distance_rupture]
+        if self.control == "suction":
+            return 1.05 * high * max(ruptures)
+        volumes = [table.lookup(r, self.suction * low / self.surface_tension, 0.0)[2]
+                   for r in table.radius_ratios]
+        largest = []
+        vtable = self.volume_table
+        for index, axis in enumerate(vtable.volume_axes):
+            volume_nodes = np.linspace(axis[0], axis[1], vtable.n_volume)
+            largest.append(np.interp(math.log(max(volumes)), volume_nodes,
+                                     vtable.distance_rupture[index]))
+        return 1.05 * high * max(largest)
+
+    # ---------------------------------------------------------------- every step
+    def _attach(self, sim):
+        """Per-pair arrays for a new neighbour list (after a rebuild): create or pick them up."""
+        contacts = sim.contacts
+        state = BridgeState.of(contacts)
+        carried = state.count()
+        if carried < self._bridges:
+            raise RuntimeError(
+                f"{self._bridges - carried} liquid bridge(s) left the neighbour list at a "
+                f"rebuild: its reach ({sim.neighbors.interaction_range:g} m plus skin) is "
+                f"shorter than the rupture distance ({self.required_range:g} m)")
+        self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
+        if self.control == "volume":
+            self._released = np.zeros(len(contacts))
+            self._events = np.zeros(len(contacts), np.int8)
+            if self.film is None or len(self.film) != len(sim.particles):
+                self.film = np.zeros(len(sim.particles))
+        self._contacts = contacts
+        self._state = state
+
+    def _sync(self, sim):
+        """Tables, stiffness check and per-pair arrays for the current radii and neighbour
+        list."""
+        if sim.contacts is self._contacts:
+            return
+        self._prepare(sim)
+        self._attach(sim)
+
+    def apply(self, sim):
+        self._sync(sim)
+        p = sim.particles
+        c = sim.contacts
+        b = self._state
+        if self.control == "suction" and self._applied_suction != self.suction:
+            if self._applied_suction is not None:          # set_suction: bridges at contact
+                refresh_contact_bridges(p.radius, c.pair_i, c.pair_j, b.state, b.volume,
+                                        b.force, b.filling_i, b.filling_j, self.suction,
+                                        self.surface_tension, *self._table_arrays)
+            self._applied_suction = self.suction
+        if self.control == "suction" and not self.persist:
+            follow = contact_bridges if numba.get_num_threads() > 1 else serial_contact_bridges
+            follow(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
+                   b.filling_i, b.filling_j, self.suction, self.surface_tension,
+                   *self._table_arrays)
+            contact_law = self._joined_contact_law(sim)
+            if contact_law is not None:
+                contact_law.gather(sim, b.force)
+            elif sim.walls.periodic:
+                gather_contact_bridges_virial(b.force, c.normal, c.row_start, c.second_start,
+                                              c.second_pair, p.force, c.image, c.through_face,
+                                              c.face_start, sim.walls.period,
+                                              sim.walls.virial_blocks)
+            else:
+                gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
+                                       c.second_pair, p.force)
+            return
+        if self.control == "suction":
+            suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period,
+                            c.overlap, c.normal, b.state, b.volume, b.force, b.filling_i,
+                            b.filling_j, self.pair_force, self.suction, self.surface_tension,
+                            *self._table_arrays)
+        else:
+            closed = self.liquid != "reservoir"
+            events = volume_bridges(
+                p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period, c.overlap,
+                c.normal, b.state, b.volume, b.force, b.filling_i, b.filling_j, b.suction,
+                self.pair_force, self.suction, self.surface_tension, self.roughness, self._table_arrays,
+                self.volume_table.arrays(), closed, self.film, self._released, self._events)
+            if events:
+                self.liquid_lost += exchange_liquid(
+                    self._events, self._released, c.row_start, c.second_start, c.second_pair,
+                    p.radius, c.pair_i, c.pair_j, b.state, b.volume, self.film,
+                    self.liquid == "shared", *self.volume_table.volume_star_bounds())
+        if sim.walls.periodic:
+            gather_pair_forces_virial(self.pair_force, c.row_start, c.second_start,
+                                      c.second_pair, p.force, c.image, c.through_face,
+                                      c.face_start, sim.walls.period, sim.walls.virial_blocks)
+        else:
+            gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair,
+                               p.force)
+        if self.persist:
+            self._bridges = b.count()
+
+    @property
+    def joins_contact_gather(self):
+        """Whether the contact law's gather adds these bridges' forces
+        (pendular.dem.contact_law.ContactForces.joined_by): bridges at contact only (suction control,
+        not ``persist``) pull along the contact normals, so one pass over the pairs gathers
+        both."""
+        return self.control == "suction" and not self.persist
+
+    def _joined_contact_law(self, sim):
+        """The ContactForces of ``sim.forces`` whose gather waits for this operation, or None
+        (the bridges gather themselves)."""
+        for op in sim.forces:
+            if isinstance(op, ContactForces) and op.joined_by(sim) is self:
+                return op
+        return None
+
+    def form_across_gaps(self, sim, max_gap):
+        """Wetting where the liquid would be (volume control, or suction control with
+        ``persist``): besides the bridges that form at contact, give every pair of the
+        neighbour list apart by a gap in (0, ``max_gap``] [m] the bridge of the (formation)
+        suction at its own gap (bridge_kernels.bridges_across_gaps); returns how many formed.
+        Pairs beyond the rupture distance of that suction get none, so the neighbour list
+        (``reach``) holds every pair that can."""
+        if not self.persist:
+            raise ValueError(f"control = {self.control!r}, persist = False: bridges across gaps "
+                             "form at wetting with control = 'volume' or persist = True only")
+        max_gap = check_positive("max_gap", max_gap, "m")
+        self._sync(sim)
+        b, c = self._state, sim.contacts
+        return int(bridges_across_gaps(sim.particles.radius, c.pair_i, c.pair_j, c.overlap,
+                                       b.state, b.volume, self.suction, self.surface_tension,
+                                       self.roughness, max_gap, self._table_arrays))
+
+    def close_liquid(self, sim, liquid="shared"):
+        """From now on the liquid is a closed amount (volume control; ``liquid`` "shared" or
+        "lost", module docstring): the bridges' liquid now is ``liquid_initial`` [m^3], and
+        every later exchange is accounted for (``liquid_balance``)."""
+        if self.control != "volume":
+            raise ValueError(f"control = {self.control!r}: a closed amount of liquid needs "
+                             "control = 'volume'")
+        if liquid not in LIQUID_MODELS[1:]:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS[1:]}")
+        self._sync(sim)
+        self.liquid = liquid
+        self.liquid_lost = 0.0
+        self.liquid_initial = self.water_volume(sim.contacts) + float(np.sum(self.film))
+
+    def liquid_balance(self, sim):
+        """(liquid in bridges, on grains as film, lost) [m^3] and the relative error of
+        bridges + film + lost against ``liquid_initial`` (NaN while the liquid is open)."""
+        self._sync(sim)
+        bridges = self.water_volume(sim.contacts)
+        film = 0.0 if self.film is None else float(np.sum(self.film))
+        if self.liquid_initial is None:
+            return bridges, film, self.liquid_lost, math.nan
+        error = abs(bridges + film + self.liquid_lost - self.liquid_initial) / self.liquid_initial
+        return bridges, film, self.liquid_lost, error
+
+    # ---------------------------------------------------------------- measures (record time)
+    def state(self, sim):
+        """The BridgeState of the current neighbour list."""
+        self._sync(sim)
+        return self._state
+
+    def count(self, sim):
+        """Number of bridges."""
+        return self.state(sim).count()
+
+    def water_volume(self, contacts):
+        """Total liquid volume of the bridges of ``contacts`` [m^3]."""
+        return float(np.sum(BridgeState.of(contacts).volume))
+
+    def saturation(self, sim):
+        """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume minus the
+        solid volume."""
+        self._sync(sim)
+        voids = sim.walls.volume() - sim.particles.solid_volume()
+        return self.water_volume(sim.contacts) / voids
+
+    def mean_suction(self, sim):
+        """The imposed suction [Pa] (suction control) or the bridges' mean suction (volume
+        control; NaN without bridges)."""
+        state = self.state(sim)
+        if self.control == "suction":
+            return self.suction
+        mask = state.mask()
+        if not mask.any():
+            return math.nan
+        return float(np.mean(state.suction[mask]))
+
+    def pair_forces(self, sim):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
+        state = self.state(sim)
+        return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
+
+    def interfaces(self, sim, index):
+        """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each
+        bridge of the pairs ``index``, in its bridge frame (bridge_kernels.suction_interfaces,
+        volume_interfaces). ValueError for the toroidal model, whose table holds no interface."""
+        if self.model != "exact":
+            raise ValueError(f"model = {self.model!r}: the liquid-gas interface is tabulated for "
+                             "model = 'exact' only")
+        state = self.state(sim)
+        index = np.ascontiguousarray(index, dtype=np.int64)
+        p, c = sim.particles, sim.contacts
+        if self.control == "volume":
+            return volume_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
+                                     sim.walls.period, state.state, index, state.volume,
+                                     self.roughness, self.volume_table.arrays())
+        return suction_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
+                                  sim.walls.period, state.state, index, self.suction,
+                                  self.surface_tension, self._table_arrays)
+
+    def pendular_overlaps(self, sim):
+        """Number of pairs of overlapping menisci on a same particle, summed over particles."""
+        b = self.state(sim)
+        c = sim.contacts
+        return int(np.sum(pendular_overlap_counts(
+            sim.particles.position, c.row_start, c.second_start, c.second_pair, c.pair_i,
+            c.pair_j, c.image, sim.walls.period, b.state, b.filling_i, b.filling_j)))

@@ -1,0 +1,107 @@
+"""Input checks for the capillary package: each names the parameter, its value and the valid range."""
+
+import math
+
+from pendular.dem.contact_law import normal_stiffness
+from pendular.dem.validate import check_positive, finite_number  # noqa: F401  (shared checks)
+
+MAX_RADIUS_RATIO = 20.0
+"""Largest R2/R1 the exact solver accepts (its accuracy is verified up to this value)."""
+
+
+def check_radius_ratio(radius_ratio, largest=MAX_RADIUS_RATIO):
+    """r = R2/R1 in [1, largest]."""
+    radius_ratio = finite_number("radius_ratio", radius_ratio, f"[1, {largest}]")
+    if not 1.0 <= radius_ratio <= largest:
+        raise ValueError(
+            f"radius_ratio = {radius_ratio} is outside the valid range [1, {largest}] (R2/R1 with R2 >= R1)"
+        )
+    return radius_ratio
+
+
+def check_contact_angle(contact_angle):
+    """theta in [0, 90) degrees."""
+    contact_angle = finite_number("contact_angle", contact_angle, "[0, 90) deg")
+    if not 0.0 <= contact_angle < 90.0:
+        raise ValueError(f"contact_angle = {contact_angle} deg is outside the valid range [0, 90) deg")
+    return contact_angle
+
+
+def check_suction(suction_star):
+    """u* = s R2/gamma >= 0."""
+    suction_star = finite_number("suction_star", suction_star, "[0, inf)")
+    if suction_star < 0.0:
+        raise ValueError(
+            f"suction_star = {suction_star} is outside the valid range [0, inf) (matric suction s R2/gamma)"
+        )
+    return suction_star
+
+
+def check_filling_angle(filling_angle, contact_angle):
+    """delta1 in (0, 90 - theta] degrees."""
+    filling_angle = finite_number("filling_angle", filling_angle, f"(0, {90.0 - contact_angle}] deg")
+    if not 0.0 < filling_angle <= 90.0 - contact_angle:
+        raise ValueError(
+            f"filling_angle = {filling_angle} deg is outside the valid range (0, {90.0 - contact_angle}] deg "
+            f"(0 < delta1 <= 90 - contact_angle)"
+        )
+    return filling_angle
+
+
+def check_distance(distance_star):
+    """A finite gap D/R2 (negative = overlap)."""
+    return finite_number("distance_star", distance_star, "(-inf, inf), negative for overlaps")
+
+
+#: Largest filling angle [deg] of a bridge at contact: the pendular limit of the loosest regular
+#: packing (simple cubic, neighbours 90 deg apart: 45 deg; 30 deg for FCP, thesis Ch. 4). Beyond
+#: it the menisci of neighbouring contacts merge in any packing: no longer the pendular regime.
+PENDULAR_FILLING_ANGLE = 45.0
+
+#: Largest overlap / radius that the force of one bridge at contact may cause (linear springs).
+MAX_BRIDGE_OVERLAP = 0.05
+
+
+def _widest_filling_angle(table, suction_star):
+    """Largest filling angle [deg] of the table's bridges at contact, u* = s R/gamma with R the
+    smallest radius: a pair of ratio r has R2 >= r R, so its u* = s R2/gamma >= r u* (every
+    radius ratio of the table, each at its smallest u*; the filling angles fall as u* grows)."""
+    return max(max(table.lookup(ratio, min(ratio * suction_star, table.suction_max), 0.0)[3:])
+               for ratio in table.radius_ratios)
+
+
+def check_pendular_suction(table, suction, radius, surface_tension):
+    """ValueError naming ``suction`` [Pa] when a bridge at contact between spheres of radius
+    >= ``radius`` [m] (surface_tension [N/m]) would have a filling angle above
+    PENDULAR_FILLING_ANGLE; ``table``: the BridgeTable of the contact angle."""
+    scale = radius / surface_tension
+    angle = _widest_filling_angle(table, suction * scale)
+    if angle <= PENDULAR_FILLING_ANGLE:
+        return
+    # the filling angle falls as u* grows: bisect (in ln u*) for the lowest admissible suction
+    low, high = max(suction * scale, 1e-9), table.suction_max
+    for _ in range(60):
+        middle = (low * high) ** 0.5
+        low, high = (middle, high) if _widest_filling_angle(table, middle) > PENDULAR_FILLING_ANGLE \
+            else (low, middle)
+    raise ValueError(
+        f"suction = {suction:g} Pa is outside the valid range [{high / scale:.4g}, inf) Pa of the "
+        f"pendular regime for radius = {radius:g} m (contact angle {table.contact_angle:g} deg): a "
+        f"bridge at contact would have a filling angle of {angle:.1f} deg, above the pendular "
+        f"limit of {PENDULAR_FILLING_ANGLE:g} deg where the menisci of neighbouring contacts merge")
+
+
+def check_bridge_stiffness(young, radius, surface_tension):
+    """ValueError naming ``young`` [Pa] and ``radius`` [m] when the force of a bridge at contact
+    (at most 2 pi gamma R, surface_tension gamma [N/m]) would press spheres of normal stiffness
+    kn = E R (pendular.dem.contact_law.normal_stiffness) together by more than MAX_BRIDGE_OVERLAP of
+    their radius: overlap / R = 2 pi gamma R / (kn R)."""
+    overlap = 2.0 * math.pi * surface_tension / normal_stiffness(young, radius, radius)
+    if overlap > MAX_BRIDGE_OVERLAP:
+        bound = 2.0 * math.pi * surface_tension / MAX_BRIDGE_OVERLAP
+        raise ValueError(
+            f"young = {young:g} Pa with radius = {radius:g} m is outside the valid range "
+            f"young * radius >= {bound:g} N/m for bridges of surface_tension = "
+            f"{surface_tension:g} N/m: a bridge at contact (force up to 2 pi gamma R) would "
+            f"overlap the spheres by {overlap:.0%} of their radius (limit "
+            f"{MAX_BRIDGE_OVERLAP:.0%})")
