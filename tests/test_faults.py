@@ -238,48 +238,159 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 
 
 # ---------------------------------------------------------------- signals
-def interrupt_script(tmp_path, argv, progress_line):
-    """Run scenarios/triaxial.py with ``argv``, send SIGINT half a second after ``progress_line``
-    first appears on its stderr; returns (exit status, stderr)."""
-    log = tmp_path / "stderr.txt"
+# Each run waits at a known phase (pendular.dem.interrupt.pause_point, PENDULAR_TEST_PAUSE_AT)
+# until the test's signal arrives there: nothing races the machine's speed.
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A finished run of 60 spheres (folder) with a checkpoint."""
+    out = tmp_path_factory.mktemp("finished") / "run"
+    done = script(TINY + ["--checkpoint-every", "100", "--out", str(out)], cwd=out.parent)
+    assert done.returncode == 0, done.stderr
+    assert json.loads((out / "summary.json").read_text())["completed"] is True
+    return out
+
+
+def interrupt_at(phase, argv, cwd, signum=signal.SIGINT):
+    """Run scenarios/triaxial.py with ``argv``, paused at ``phase``, and send it ``signum``
+    there; returns (exit status, stderr without the pause's line)."""
+    log = cwd / f"stderr-{phase}.txt"
+    environment = dict(os.environ, PENDULAR_TEST_PAUSE_AT=phase)
+    paused = f"paused at {phase}\n"
     with open(log, "w") as stderr:
         # a child of a shell started with & ignores SIGINT: give it the default disposition
-        process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=tmp_path, text=True,
-                                   stdout=subprocess.DEVNULL, stderr=stderr,
+        process = subprocess.Popen([sys.executable, SCRIPT, *argv], cwd=cwd, text=True,
+                                   env=environment, stdout=subprocess.DEVNULL, stderr=stderr,
                                    preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-        started = time.monotonic()
-        while progress_line not in log.read_text() and time.monotonic() - started < 120:
-            time.sleep(0.05)
-        time.sleep(0.5)
-        process.send_signal(signal.SIGINT)
-        process.wait(timeout=60)
-    return process.returncode, log.read_text()
+        try:
+            waited = time.monotonic()
+            while paused not in log.read_text() and process.poll() is None:
+                assert time.monotonic() - waited < 600, "the run never reached " + phase
+                time.sleep(0.05)
+            process.send_signal(signum)
+            process.wait(timeout=300)
+        finally:
+            if process.poll() is None:
+                process.kill()
+    err = log.read_text()
+    assert paused in err, err
+    return process.returncode, err.replace(paused, "")
 
 
-def test_sigint_during_the_shear_keeps_the_history_so_far(tmp_path):
+def last_line(err):
+    assert "Traceback" not in err, err
+    return err.strip().splitlines()[-1]
+
+
+def outputs(folder):
+    """File name -> bytes of a run's results (what must survive a failed run intact)."""
+    return {name: (folder / name).read_bytes() for name in ("summary.json", "history.h5",
+                                                            "sample.h5", "triaxial.png")}
+
+
+WET = ["--suction", "30000"]
+
+
+@pytest.mark.parametrize("phase, extra", [("import", []), ("prepare", []), ("wet", WET)])
+def test_ctrl_c_before_the_shear_exits_in_one_line_leaving_the_phase_reached(phase, extra,
+                                                                            tmp_path):
     out = tmp_path / "out"
-    # the shear's progress line (its kernels may still be compiling)
-    status, err = interrupt_script(tmp_path, ["--particles", "60", "--max-strain", "0.1",
-                                              "--inertial-number", "2e-4", "--vtk-frames", "0",
-                                              "--out", str(out)], "shear:")
-    assert status == 130, err
-    assert "Traceback" not in err and "interrupted at step" in err
+    status, err = interrupt_at(phase, TINY + extra + ["--out", str(out)], tmp_path)
+    assert status == 130 and last_line(err) == "triaxial.py: interrupted", err
+    if phase == "import":            # nothing had started: no folder
+        assert not out.exists()
+        return
+    assert json.loads((out / "summary.json").read_text()) == {
+        "completed": False, "phase": phase, "interrupted": True}
+    assert not (out / "sample.h5").exists() and not (out / ".pendular-earlier").exists()
+
+
+def test_ctrl_c_during_the_shear_keeps_the_history_so_far(tmp_path):
+    out = tmp_path / "out"
+    status, err = interrupt_at("shear", TINY + ["--out", str(out)], tmp_path)
+    assert status == 130 and "interrupted at step" in last_line(err), err
     summary = json.loads((out / "summary.json").read_text())
-    assert summary["completed"] is False
+    assert summary["completed"] is False and summary["phase"] == "shear"
     with h5py.File(out / "history.h5", "r") as handle:
-        assert len(handle["history/step"]) >= 2
+        steps = handle["history/step"][()]
+    assert len(steps) >= 2 and steps[-1] - steps[0] < summary["steps"]
 
 
-def test_sigint_during_the_preparation_ends_in_one_line(tmp_path):
+def test_ctrl_c_while_the_results_are_written_leaves_them_whole(tmp_path):
+    """Between history.h5 and summary.json: both are written, then the run ends (130)."""
     out = tmp_path / "out"
-    # the progress line of the radius growth (about 10 s)
-    status, err = interrupt_script(tmp_path, ["--particles", "5000", "--max-strain", "0.01",
-                                              "--vtk-frames", "0", "--out", str(out)],
-                                   "grow radii")
+    status, err = interrupt_at("write", TINY + ["--out", str(out)], tmp_path)
+    assert status == 130 and last_line(err) == "triaxial.py: interrupted", err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["completed"] is True and "phase" not in summary
+    with h5py.File(out / "history.h5", "r") as handle:
+        assert handle["history/axial_strain"][-1] == pytest.approx(0.005, rel=0.02)
+
+
+@pytest.mark.parametrize("phase", ["prepare", "shear"])
+def test_ctrl_c_in_a_used_folder_keeps_the_earlier_results(phase, finished, tmp_path):
+    out = tmp_path / "run"
+    shutil.copytree(finished, out)
+    before = outputs(out)
+    status, err = interrupt_at(phase, TINY + ["--seed", "1", "--out", str(out)], tmp_path)
     assert status == 130, err
-    assert "Traceback" not in err
-    assert err.strip().splitlines()[-1] == "triaxial.py: interrupted", err
-    assert not (out / "sample.h5").exists()
+    if phase == "shear":
+        assert last_line(err).endswith(f"the earlier results in {out} are kept")
+    assert outputs(out) == before and not (out / ".pendular-earlier").exists()
+    assert json.loads((out / ".pendular-outputs.json").read_text())["finished"] is True
+
+
+def test_a_run_that_fails_keeps_the_earlier_results_or_says_where_it_stopped(finished,
+                                                                             tmp_path):
+    """--wet-steps 1: the equilibrium after wetting is not reached (exit 2, one line)."""
+    out = tmp_path / "run"
+    shutil.copytree(finished, out)
+    before = outputs(out)
+    failing = TINY + WET + ["--wet-steps", "1"]
+    done = script(failing + ["--out", str(out)], cwd=tmp_path)
+    refused(done.returncode, done.stderr, "equilibrium after wetting", "--wet-steps")
+    assert outputs(out) == before and not (out / ".pendular-earlier").exists()
+    fresh = tmp_path / "fresh"
+    done = script(failing + ["--out", str(fresh)], cwd=tmp_path)
+    assert done.returncode == 2, done.stderr
+    summary = json.loads((fresh / "summary.json").read_text())
+    assert summary["completed"] is False and summary["phase"] == "wet"
+    assert "equilibrium after wetting" in summary["error"]
+
+
+def test_a_bad_sample_into_a_used_folder_touches_nothing(finished, tmp_path, capsys):
+    out = tmp_path / "run"
+    shutil.copytree(finished, out)
+    before = {path: path.read_bytes() for path in out.rglob("*") if path.is_file()}
+    damaged = tmp_path / "damaged.h5"
+    shutil.copy(finished / "sample.h5", damaged)
+    zero_bytes(str(damaged), "position", 32)
+    refused(*command(TINY + ["--sample", str(damaged), "--out", str(out)], capsys),
+            str(damaged), "checksum mismatch")
+    assert {path: path.read_bytes() for path in out.rglob("*") if path.is_file()} == before
+
+
+def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_path):
+    """kill -9 during the shear leaves the earlier results aside and the new run's checkpoint
+    in place: --resume finishes the new run (the earlier results go then); a new run instead
+    first puts the earlier results back, and keeps them if it fails."""
+    argv = TINY + ["--seed", "1", "--checkpoint-every", "100"]
+    for then in ("resume", "replace"):
+        out = tmp_path / then
+        shutil.copytree(finished, out)
+        before = outputs(out)
+        status, _ = interrupt_at("shear", argv + ["--out", str(out)], tmp_path, signal.SIGKILL)
+        assert status == -signal.SIGKILL and (out / ".pendular-earlier").is_dir()
+        if then == "resume":
+            done = script(["--resume", str(out), "--quiet"], cwd=tmp_path)
+            assert done.returncode == 0, done.stderr
+            assert "earlier results there were replaced" in done.stderr
+            assert json.loads((out / "summary.json").read_text())["completed"] is True
+            assert outputs(out)["summary.json"] != before["summary.json"]
+        else:
+            done = script(TINY + WET + ["--wet-steps", "1", "--out", str(out)], cwd=tmp_path)
+            assert done.returncode == 2, done.stderr
+            assert outputs(out) == before
+        assert not (out / ".pendular-earlier").exists()
 
 
 @pytest.fixture

@@ -4,7 +4,8 @@ Each command lives in ``pendular.commands.<name>`` with ``add_arguments(parser)`
 ``run(args)``; scenarios/*.py call ``main`` with their command's name. A failure a user can
 cause (bad option, bad or missing file, unusable output folder) ends in one line
 ``<prog>: error: <what is wrong>`` and exit status 2, never a traceback; an interrupted run exits
-with 130.
+with 130, in one line, whenever Ctrl-C comes (while Python imports the command's modules too:
+this module imports only the standard library at its top, and the rest inside ``main``).
 """
 
 from __future__ import annotations
@@ -12,14 +13,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-
-import numba
-
-from pendular.dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD, read_grading_curve
-from pendular.dem.interrupt import catching_interrupts
-from pendular.dem.threads import configure as configure_threading, use_threads
-
-from . import __version__
 
 #: Command name -> (module under pendular.commands, one-line description).
 COMMANDS = {
@@ -87,6 +80,8 @@ def add_size_options(parser, default_radius):
     parser.add_argument("--radius", type=float, default=None,
                         help=f"sphere radius [m], the mean radius of a graded sample (default "
                              f"{default_radius:g})")
+    from pendular.dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD
+
     parser.add_argument("--radius-spread", type=float, default=0.0,
                         help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
                              f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
@@ -102,6 +97,8 @@ def sizes_from(args):
     radius not given is left to the configuration's default."""
     if args.psd is not None and args.radius is not None:
         raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
+    from pendular.dem.grading import read_grading_curve
+
     sizes = {"radius_spread": args.radius_spread}
     if args.radius is not None:
         sizes["radius"] = args.radius
@@ -112,6 +109,10 @@ def sizes_from(args):
 
 def set_threads(threads):
     """Apply --threads (error naming it outside [1, NUMBA_NUM_THREADS])."""
+    import numba
+
+    from pendular.dem.threads import configure as configure_threading, use_threads
+
     configure_threading()
     if threads is None:
         return
@@ -132,7 +133,12 @@ def command_parser(name, prog=None):
 
 def run_command(name, argv, prog=None):
     """Parse ``argv`` for command ``name`` and run it; returns the exit status."""
+    import numba
+
+    from pendular.dem.interrupt import catching_interrupts, pause_point
+
     parser, module = command_parser(name, prog)
+    pause_point("import")
     args = parser.parse_args(argv)
     try:
         with catching_interrupts():
@@ -153,10 +159,20 @@ def run_command(name, argv, prog=None):
 
 def main(argv=None, prog=None):
     """``pendular <command> ...``; with ``prog`` (a scenario's file name) and argv starting
-    with the command, that command alone."""
-    argv = list(sys.argv[1:] if argv is None else argv)
+    with the command, that command alone. Ctrl-C before the command runs (while its modules
+    are imported) also ends in one line, with exit status 130."""
+    try:
+        return _main(list(sys.argv[1:] if argv is None else argv), prog)
+    except KeyboardInterrupt:
+        print(f"{prog or 'pendular'}: interrupted", file=sys.stderr)
+        return INTERRUPTED
+
+
+def _main(argv, prog):
     if prog is not None:
         return run_command(argv[0], argv[1:], prog)
+    from . import __version__
+
     parser = argparse.ArgumentParser(
         prog="pendular", formatter_class=argparse.RawDescriptionHelpFormatter,
         description="DEM of wet granular media in the pendular regime (Khosravani 2014).",

@@ -9,10 +9,18 @@
   included, so a stale lock never blocks);
 - keeps a manifest ``DIR/.pendular-outputs.json`` of the files the run owns (``claim``).
 
-A run into a used folder clears what the previous run owned: at start, every file the
-previous manifest lists is removed (a dry run into an old wet run's folder leaves no stale
-plots or VTK frames), unless ``keep=True`` (resume: the files are kept and stay owned). Files
-not listed in a manifest (the user's own, or a run older than manifests) are never touched.
+A run into a used folder never leaves it with less than it had. At start, the files the
+previous manifest lists (and the manifest) are moved aside into ``DIR/.pendular-earlier/``;
+the new run writes into the folder itself. When it succeeds (or ``commit`` says its results are
+whole) the earlier files are deleted, so a dry run into an old wet run's folder leaves no stale
+plots or VTK frames, and one line on stderr says that earlier results were replaced. When it
+fails or is interrupted and the earlier run had finished, the new run's files are removed and
+the earlier ones put back (``earlier_results`` tells the run so beforehand); an earlier run
+that had not finished is replaced by the new partial one. A folder left with files aside by a
+killed run (kill -9) is put back in order by the next run that enters it: a resume keeps them
+aside until it succeeds, a new run first restores them. ``keep=True`` (resume): the files are
+kept and stay owned. Files not listed in a manifest (the user's own, or a run older than
+manifests) are never touched.
 """
 
 import datetime
@@ -21,11 +29,14 @@ import fcntl
 import json
 import os
 import shutil
+import sys
 
 from pendular.dem.atomic import write_json
 
 LOCK = ".pendular.lock"
 MANIFEST = ".pendular-outputs.json"
+#: Where the files of the previous run wait while a new run writes (module docstring).
+EARLIER = ".pendular-earlier"
 FORMAT = "pendular-outputs"
 VERSION = 1
 
@@ -39,10 +50,31 @@ def _relative(path, relpath):
     text = os.fspath(relpath)
     name = os.path.normpath(text)
     if (not text or os.path.isabs(text) or name == os.curdir or name == os.pardir
-            or name.startswith(os.pardir + os.sep) or name in (LOCK, MANIFEST)):
+            or name.startswith(os.pardir + os.sep) or name.split(os.sep)[0] in (LOCK, MANIFEST,
+                                                                                EARLIER)):
         raise _refuse(path, f"cannot own {text!r}: valid names are relative paths inside the "
-                            f"folder other than {LOCK} and {MANIFEST}")
+                            f"folder other than {LOCK}, {MANIFEST} and {EARLIER}")
     return name
+
+
+def _move(source, target, name):
+    """Move ``name`` from folder ``source`` to folder ``target`` (absent ones are skipped)."""
+    origin = os.path.join(source, name)
+    if os.path.lexists(origin):
+        destination = os.path.join(target, name)
+        os.makedirs(os.path.dirname(destination), exist_ok=True)
+        _remove(target, name)
+        os.replace(origin, destination)
+
+
+def _manifest(folder):
+    """The manifest of ``folder`` (dict), {} if none or unreadable."""
+    try:
+        with open(os.path.join(folder, MANIFEST)) as handle:
+            data = json.load(handle)
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
 
 
 def _remove(folder, name):
@@ -61,8 +93,10 @@ class OutputFolder:
 
     ``keep``: keep the files a previous run owned (resume) instead of removing them.
     Inside the block, ``claim(relpath)`` records a file (or folder) the run writes and returns
-    its full path; ``files`` lists what the run owns. ValueError naming the path for a path
-    that cannot be an output folder or a folder in use by another run.
+    its full path; ``files`` lists what the run owns; ``earlier_results``: whether a finished
+    earlier run waits aside (it comes back if this run fails); ``commit()``: this run's results
+    are whole, the earlier ones go now. ValueError naming the path for a path that cannot be
+    an output folder or a folder in use by another run.
     """
 
     def __init__(self, path, command, keep=False):
@@ -80,6 +114,8 @@ class OutputFolder:
         self.keep = bool(keep)
         self.files = []
         self.removed = []
+        self.earlier_results = False
+        self._committed = False
         self._lock = None
 
     # ------------------------------------------------------------ entering
@@ -126,14 +162,9 @@ class OutputFolder:
             return " ".join(str(part) for part in self.command)
         return str(self.command)
 
-    def _previous(self):
-        """Files owned by the previous run (its manifest), [] if none or unreadable."""
-        try:
-            with open(os.path.join(self.path, MANIFEST)) as handle:
-                data = json.load(handle)
-            files = data["files"]
-        except (OSError, ValueError, KeyError, TypeError):
-            return []
+    def _owned(self, folder):
+        """Files the manifest of ``folder`` lists, inside it ([] if none or unreadable)."""
+        files = _manifest(folder).get("files")
         owned = []
         for name in files if isinstance(files, list) else []:
             try:
@@ -142,17 +173,40 @@ class OutputFolder:
                 continue
         return owned
 
+    def _restore_earlier(self):
+        """Put the files set aside back in place of the current ones (module docstring)."""
+        aside = os.path.join(self.path, EARLIER)
+        for name in self._owned(self.path):
+            _remove(self.path, name)
+        for name in [*self._owned(aside), MANIFEST]:
+            _move(aside, self.path, name)
+        shutil.rmtree(aside)
+
+    def _set_aside(self):
+        """Move the previous run's files and manifest into EARLIER; returns their names."""
+        aside = os.path.join(self.path, EARLIER)
+        owned = [name for name in self._owned(self.path)
+                 if os.path.lexists(os.path.join(self.path, name))]
+        if not owned:
+            return []
+        self.earlier_results = _manifest(self.path).get("finished") is True
+        os.makedirs(aside)
+        for name in sorted(owned, key=len):       # a folder before the files it holds
+            _move(self.path, aside, name)
+        _move(self.path, aside, MANIFEST)
+        return owned
+
     def __enter__(self):
         self._create()
         self._acquire()
         try:
-            previous = self._previous()
+            aside = os.path.isdir(os.path.join(self.path, EARLIER))
             if self.keep:
-                self.files = sorted(set(previous))
+                self.files = sorted(set(self._owned(self.path)))
             else:
-                for name in previous:
-                    _remove(self.path, name)
-                    self.removed.append(name)
+                if aside:                          # left by a killed run
+                    self._restore_earlier()
+                self.removed = self._set_aside()
                 self.files = []
             self._write(finished=False)
         except BaseException:
@@ -173,6 +227,16 @@ class OutputFolder:
             self._write(finished=False)
         return os.path.join(self.path, name)
 
+    def commit(self):
+        """This run's results are whole: the earlier ones set aside are deleted now (a later
+        failure, e.g. Ctrl-C while plotting, no longer brings them back)."""
+        aside = os.path.join(self.path, EARLIER)
+        if os.path.isdir(aside):
+            shutil.rmtree(aside)
+            print(f"{self.path}: the earlier results there were replaced", file=sys.stderr)
+        self.earlier_results = False
+        self._committed = True
+
     def _write(self, finished):
         write_json(os.path.join(self.path, MANIFEST), {
             "format": FORMAT, "version": VERSION, "command": self.command, "pid": os.getpid(),
@@ -189,6 +253,12 @@ class OutputFolder:
     def __exit__(self, kind, value, traceback):
         try:
             self._write(finished=kind is None)
+            if kind is None:
+                self.commit()
+            elif self.earlier_results and not self._committed:
+                self._restore_earlier()
+            elif not self.keep:
+                shutil.rmtree(os.path.join(self.path, EARLIER), ignore_errors=True)
         finally:
             self._release()
         return False

@@ -33,6 +33,7 @@ from pendular.dem.atomic import write_json
 from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.dem.integrity import checksum, config_hash
+from pendular.dem.interrupt import deferred_interrupts, pause_point, pausing_at
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step, servoed_simulation,
                              static, timestep, timestep_description)
@@ -91,6 +92,10 @@ class NotStatic(ValueError):
 class Interrupted(Exception):
     """A run stopped before its end (Ctrl-C, or ``stop_after``); the checkpoint, if any, is
     where ``TriaxialTest.resume`` starts."""
+
+
+#: Phases of a triaxial run, in order, as a partial summary.json names the one reached.
+RUN_PHASES = ("prepare", "wet", "shear", "write")
 
 
 # ---------------------------------------------------------------- building blocks
@@ -524,10 +529,12 @@ class TriaxialTest:
         many steps, False (default) or 0 none. Output only: the results are the same."""
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
+        if self.config.sample_path is not None:       # checked before the folder is touched
+            load_sample(self.config.sample_path, expected=self.config.sample)
         with OutputFolder(out, "triaxial") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, stop_after, vtk_prep, plots)
+            return self._run(folder, progress, threads, stop_after, vtk_prep, plots)
 
     def prep_writer(self, out, vtk_prep):
         """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
@@ -542,27 +549,38 @@ class TriaxialTest:
                          field_data=lambda s: {"mean_wall_stress":
                                                float(np.mean(s.walls.stress()))})
 
-    def _run(self, out, progress, threads, stop_after, vtk_prep, plots):
-        config = self.config
-        started = time.perf_counter()
-        frames = self.prep_writer(out, vtk_prep)
-        writers = () if frames is None else (frames,)
-        sim, preparation = self.start(progress, threads, writers)
-        prepared = time.perf_counter()
-        wetting = {}
-        if config.bridges is not None:
-            # the water-content wetting restarts from copies of the dry sample: no frames
-            with watched(sim, writers if config.bridges.suction is not None else (), "wetting"):
-                sim, _, wetting = wet_sample(sim, config, progress="wet" if progress else None)
-        if frames is not None:
-            frames.close(sim)           # the state the shear starts from
+    def _run(self, folder, progress, threads, stop_after, vtk_prep, plots):
+        config, out = self.config, folder.path
+        phase = "prepare"
+        try:
+            started = time.perf_counter()
+            frames = self.prep_writer(out, vtk_prep)
+            writers = () if frames is None else (frames,)
+            pause_point(phase)
+            sim, preparation = self.start(progress, threads, writers)
+            prepared = time.perf_counter()
+            wetting = {}
+            if config.bridges is not None:
+                phase = "wet"
+                pause_point(phase)
+                # the water-content wetting restarts from copies of the dry sample: no frames
+                with watched(sim, writers if config.bridges.suction is not None else (),
+                             "wetting"):
+                    sim, _, wetting = wet_sample(sim, config,
+                                                 progress="wet" if progress else None)
+            if frames is not None:
+                frames.close(sim)           # the state the shear starts from
+        except BaseException as error:
+            if not folder.earlier_results:       # else the earlier results come back
+                unfinished_summary(out, phase, error)
+            raise
         before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
                                "wetting": wetting, "preparation_time_s": prepared - started,
                                "pre_shear_time_s": time.perf_counter() - started})
         sample_file = os.path.join(out, "sample.h5")
         save_sample(sample_file, sim, preparation, before_shear,
                     identity={"seed": config.sample.seed})
-        run = _ShearRun(sim, config, out, before_shear, run_identity(config, sample_file))
+        run = _ShearRun(sim, config, folder, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
         return run.finish(progress, stop_after, plots)
@@ -577,7 +595,7 @@ class TriaxialTest:
             if not os.path.exists(path):
                 raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
                                  "with checkpoint_every > 0?)")
-        with OutputFolder(out, "triaxial --resume", keep=True):
+        with OutputFolder(out, "triaxial --resume", keep=True) as folder:
             particles, walls, _, before_shear = load_sample(sample_file)
             config = config_from_dict(before_shear.get("config"), sample_file)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
@@ -586,7 +604,7 @@ class TriaxialTest:
                 sim.forces.append(config.bridges.build(
                     before_shear["wetting"].get("formation_suction_pa")))
             identity = run_identity(config, sample_file)
-            run = _ShearRun(sim, config, out, before_shear, identity)
+            run = _ShearRun(sim, config, folder, before_shear, identity)
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
             if state.get("phase") != "shear" or state["steps"] != run.steps:
                 raise ValueError(f"{checkpoint} does not belong to this run's shear")
@@ -597,6 +615,18 @@ class TriaxialTest:
                                  f"[{start}, {end}] of this run's shear (an edited checkpoint)")
             run.resumed(state)
             return run.finish(progress, stop_after)
+
+
+def unfinished_summary(out, phase, error):
+    """Write ``out``/summary.json of a run stopped in ``phase`` (one of RUN_PHASES) before its
+    shear by ``error`` (an exception, KeyboardInterrupt for Ctrl-C): ``completed`` false, the
+    phase, and whether it was interrupted or what failed."""
+    summary = {"completed": False, "phase": phase,
+               "interrupted": isinstance(error, KeyboardInterrupt)}
+    if not summary["interrupted"]:
+        summary["error"] = str(error) or type(error).__name__
+    with deferred_interrupts():
+        write_json(os.path.join(out, "summary.json"), summary)
 
 
 def run_identity(config, sample_file):
@@ -611,8 +641,10 @@ class _ShearRun:
     checkpoint), so that a resumed run builds the same simulation; ``finish`` runs the
     remaining steps and writes the outputs."""
 
-    def __init__(self, sim, config, out, before_shear, identity):
-        self.sim, self.config, self.out, self.before_shear = sim, config, out, before_shear
+    def __init__(self, sim, config, folder, before_shear, identity):
+        self.sim, self.config, self.before_shear = sim, config, before_shear
+        self.folder, self.out = folder, folder.path
+        out = folder.path
         sample = config.sample
         sim.dt = timestep(sim, sample)    # from the state the shear starts from (and resumes)
         self.shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius,
@@ -652,18 +684,27 @@ class _ShearRun:
 
     def finish(self, progress, stop_after, plots=True):
         """Run the rest of the shear (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
-        and write the outputs (the figures if ``plots``); returns the summary."""
+        and write the outputs (the figures if ``plots``); returns the summary. Interrupted, it
+        keeps the history so far (summary ``completed`` false), unless the folder holds the
+        finished results of an earlier run, which are then kept instead."""
         sim = self.sim
         remaining = self.steps - (sim.step - self.start_step)
         stop = stop_after is not None and stop_after < remaining
+        steps = stop_after if stop else remaining
         self._clock = time.perf_counter()
         try:
-            sim.run(stop_after if stop else remaining,
-                    progress="shear" if progress else None, status=self.shear.status)
+            if pausing_at("shear"):          # tests: Ctrl-C halfway through the shear
+                sim.run(steps // 2, progress=None)
+                steps -= steps // 2
+                pause_point("shear")
+            sim.run(steps, progress="shear" if progress else None, status=self.shear.status)
         except KeyboardInterrupt:
             stop = True
         self.shear_time += time.perf_counter() - self._clock
-        if stop:        # keep what was sheared: the history so far, its summary not completed
+        if stop:
+            if self.folder.earlier_results:
+                raise Interrupted(f"interrupted at step {sim.step}; the earlier results in "
+                                  f"{self.out} are kept")
             self.write_outputs(completed=False)
             raise Interrupted(f"interrupted at step {sim.step}; history so far in {self.out}"
                               + (f"; continue with --resume {self.out}"
@@ -714,11 +755,16 @@ class _ShearRun:
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
                            "strain_rate": rate, "vtk_every": self.vtk_period})
-        write_history(os.path.join(out, "history.h5"), history, self.before_shear["config"],
-                      attributes=attributes)
-        write_json(os.path.join(out, "summary.json"), summary)
+        if not completed:
+            summary["phase"] = "shear"
+        with deferred_interrupts():       # history and summary are written whole, or not at all
+            write_history(os.path.join(out, "history.h5"), history,
+                          self.before_shear["config"], attributes=attributes)
+            pause_point("write")
+            write_json(os.path.join(out, "summary.json"), summary)
         if not completed:
             return summary
+        self.folder.commit()
         flagged = summary["stress_balance_flagged"]
         if flagged:
             print(f"warning: {len(flagged)} of {len(history['step'])} records have wall and "
