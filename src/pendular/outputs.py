@@ -21,6 +21,11 @@ killed run (kill -9) is put back in order by the next run that enters it: a resu
 aside until it succeeds, a new run first restores them. ``keep=True`` (resume): the files are
 kept and stay owned. Files not listed in a manifest (the user's own, or a run older than
 manifests) are never touched.
+
+A run that fails or is interrupted with no finished earlier results to fall back on leaves its
+partial results, and, if it owns a ``summary.json`` it had not written yet, one that says so:
+``completed`` false, the ``phase`` the run had reached (its ``phase`` attribute), and whether
+it was ``interrupted`` or the ``error`` that stopped it.
 """
 
 import datetime
@@ -32,11 +37,14 @@ import shutil
 import sys
 
 from pendular.dem.atomic import write_json
+from pendular.dem.interrupt import deferred_interrupts
 
 LOCK = ".pendular.lock"
 MANIFEST = ".pendular-outputs.json"
 #: Where the files of the previous run wait while a new run writes (module docstring).
 EARLIER = ".pendular-earlier"
+#: The summary a failed or interrupted run leaves when it wrote none (module docstring).
+SUMMARY = "summary.json"
 FORMAT = "pendular-outputs"
 VERSION = 1
 
@@ -93,7 +101,8 @@ class OutputFolder:
 
     ``keep``: keep the files a previous run owned (resume) instead of removing them.
     Inside the block, ``claim(relpath)`` records a file (or folder) the run writes and returns
-    its full path; ``files`` lists what the run owns; ``earlier_results``: whether a finished
+    its full path; ``files`` lists what the run owns; ``phase``: the phase the run is in (set
+    by the run, named by the summary of a run that stops); ``earlier_results``: whether a finished
     earlier run waits aside (it comes back if this run fails); ``commit()``: this run's results
     are whole, the earlier ones go now. ValueError naming the path for a path that cannot be
     an output folder or a folder in use by another run.
@@ -114,6 +123,7 @@ class OutputFolder:
         self.keep = bool(keep)
         self.files = []
         self.removed = []
+        self.phase = None
         self.earlier_results = False
         self._committed = False
         self._lock = None
@@ -244,6 +254,18 @@ class OutputFolder:
             "finished": finished, "files": self.files}, default=str)
 
     # ------------------------------------------------------------ leaving
+    def _summarize_stop(self, error):
+        """The summary of a run stopped by ``error`` that wrote none (module docstring)."""
+        path = os.path.join(self.path, SUMMARY)
+        if SUMMARY not in self.files or os.path.exists(path):
+            return
+        summary = {"completed": False, "phase": self.phase,
+                   "interrupted": isinstance(error, KeyboardInterrupt)}
+        if not summary["interrupted"]:
+            summary["error"] = str(error) or type(error).__name__
+        with deferred_interrupts():
+            write_json(path, summary)
+
     def _release(self):
         if self._lock is not None:
             fcntl.flock(self._lock, fcntl.LOCK_UN)
@@ -257,8 +279,10 @@ class OutputFolder:
                 self.commit()
             elif self.earlier_results and not self._committed:
                 self._restore_earlier()
-            elif not self.keep:
-                shutil.rmtree(os.path.join(self.path, EARLIER), ignore_errors=True)
+            else:
+                self._summarize_stop(value)
+                if not self.keep:
+                    shutil.rmtree(os.path.join(self.path, EARLIER), ignore_errors=True)
         finally:
             self._release()
         return False

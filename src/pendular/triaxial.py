@@ -94,10 +94,6 @@ class Interrupted(Exception):
     where ``TriaxialTest.resume`` starts."""
 
 
-#: Phases of a triaxial run, in order, as a partial summary.json names the one reached.
-RUN_PHASES = ("prepare", "wet", "shear", "write")
-
-
 # ---------------------------------------------------------------- building blocks
 
 def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check_every=200,
@@ -469,7 +465,8 @@ class TriaxialTest:
     into ``out``: history.h5, summary.json, triaxial.png, plots/, vtk/ (ParaView), sample.h5
     (the sample the shear starts from, with the configuration), with checkpoint_every
     checkpoint.h5 and, with ``vtk_prep``, vtk_prep/ (ParaView frames of the preparation and
-    wetting). Returns the summary (dict).
+    wetting). Returns the summary (dict). A run stopped before its end (pendular.outputs)
+    names in summary.json the phase it reached: "prepare", "wet", "shear" or "write".
     """
 
     def __init__(self, config: TriaxialConfig, *, force=False):
@@ -551,29 +548,23 @@ class TriaxialTest:
 
     def _run(self, folder, progress, threads, stop_after, vtk_prep, plots):
         config, out = self.config, folder.path
-        phase = "prepare"
-        try:
-            started = time.perf_counter()
-            frames = self.prep_writer(out, vtk_prep)
-            writers = () if frames is None else (frames,)
-            pause_point(phase)
-            sim, preparation = self.start(progress, threads, writers)
-            prepared = time.perf_counter()
-            wetting = {}
-            if config.bridges is not None:
-                phase = "wet"
-                pause_point(phase)
-                # the water-content wetting restarts from copies of the dry sample: no frames
-                with watched(sim, writers if config.bridges.suction is not None else (),
-                             "wetting"):
-                    sim, _, wetting = wet_sample(sim, config,
-                                                 progress="wet" if progress else None)
-            if frames is not None:
-                frames.close(sim)           # the state the shear starts from
-        except BaseException as error:
-            if not folder.earlier_results:       # else the earlier results come back
-                unfinished_summary(out, phase, error)
-            raise
+        started = time.perf_counter()
+        frames = self.prep_writer(out, vtk_prep)
+        writers = () if frames is None else (frames,)
+        folder.phase = "prepare"
+        pause_point(folder.phase)
+        sim, preparation = self.start(progress, threads, writers)
+        prepared = time.perf_counter()
+        wetting = {}
+        if config.bridges is not None:
+            folder.phase = "wet"
+            pause_point(folder.phase)
+            # the water-content wetting restarts from copies of the dry sample: no frames
+            with watched(sim, writers if config.bridges.suction is not None else (), "wetting"):
+                sim, _, wetting = wet_sample(sim, config, progress="wet" if progress else None)
+        if frames is not None:
+            frames.close(sim)           # the state the shear starts from
+        folder.phase = "shear"
         before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
                                "wetting": wetting, "preparation_time_s": prepared - started,
                                "pre_shear_time_s": time.perf_counter() - started})
@@ -615,18 +606,6 @@ class TriaxialTest:
                                  f"[{start}, {end}] of this run's shear (an edited checkpoint)")
             run.resumed(state)
             return run.finish(progress, stop_after)
-
-
-def unfinished_summary(out, phase, error):
-    """Write ``out``/summary.json of a run stopped in ``phase`` (one of RUN_PHASES) before its
-    shear by ``error`` (an exception, KeyboardInterrupt for Ctrl-C): ``completed`` false, the
-    phase, and whether it was interrupted or what failed."""
-    summary = {"completed": False, "phase": phase,
-               "interrupted": isinstance(error, KeyboardInterrupt)}
-    if not summary["interrupted"]:
-        summary["error"] = str(error) or type(error).__name__
-    with deferred_interrupts():
-        write_json(os.path.join(out, "summary.json"), summary)
 
 
 def run_identity(config, sample_file):
@@ -757,14 +736,16 @@ class _ShearRun:
                            "strain_rate": rate, "vtk_every": self.vtk_period})
         if not completed:
             summary["phase"] = "shear"
+        self.folder.phase = "write"
         with deferred_interrupts():       # history and summary are written whole, or not at all
             write_history(os.path.join(out, "history.h5"), history,
                           self.before_shear["config"], attributes=attributes)
             pause_point("write")
             write_json(os.path.join(out, "summary.json"), summary)
+            if completed:
+                self.folder.commit()
         if not completed:
             return summary
-        self.folder.commit()
         flagged = summary["stress_balance_flagged"]
         if flagged:
             print(f"warning: {len(flagged)} of {len(history['step'])} records have wall and "
