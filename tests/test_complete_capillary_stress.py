@@ -126,7 +126,7 @@ def test_packing_psi_plus_interface_is_the_capillary_love_weber_stress(small_sam
     psi, interface = homogenization.psi(sim), homogenization.psi_interface(sim)
     index = np.flatnonzero(BridgeState.of(sim.contacts).mask())
     own = own_dipoles(sim, bridges, index).sum(axis=0)
-    # the tables' accuracy: 0.15 % in force, 0.4 % in volume near rupture (docs/pendular.capillary.md)
+    # the tables' accuracy: 0.15 % in force, 0.4 % in volume near rupture (docs/capillary.md)
     assert np.allclose(psi + interface, own, rtol=0, atol=3e-3 * np.abs(own).max())
     love_weber = -capillary_force_stress(sim, bridges)
     c, radius = sim.contacts, sim.particles.radius

@@ -117,7 +117,7 @@ def sample_radius_ratios(radii):
     Otherwise the tables are exact for every pair of the sample, not interpolated between
     YADE's ratios 1, 1.1, 1.25, ..., 5, 10 (linear interpolation in r between those costs about
     1 % in force between 2 and 3 and 5 % between 5 and 10 mid-range, 5 % and 14 % near
-    rupture, up to 3 % in rupture distance; docs/pendular.capillary.md): a node at each distinct ratio
+    rupture, up to 3 % in rupture distance; docs/capillary.md): a node at each distinct ratio
     R2/R1 of two radii of the sample (and 1 if two spheres have the same radius), computed as
     the bridge kernels compute a pair's ratio (max / min of the two radii), so every pair
     reads its own node exactly, up to

@@ -1,4 +1,4 @@
-"""Accuracy measurements published in docs/pendular.capillary.md; run `python -m pendular.capillary.verification`.
+"""Accuracy measurements published in docs/capillary.md; run `python -m pendular.capillary.verification`.
 
 - reference_bridge: an independent integration of the meridian (scipy solve_ivp in arc length,
   no use of the force invariant), the reference for the exact solver;

@@ -43,7 +43,7 @@ class VolumeContour:
     before, where the solver's family stops (delta1 reaching 90 - theta for large radius
     ratios, or, for theta > 0 at strongly negative suction, where the meniscus meets sphere 2
     tangentially and the first-contact solution changes branch); the last distance is then a
-    lower bound of the rupture distance (docs/pendular.capillary.md gives its size).
+    lower bound of the rupture distance (docs/capillary.md gives its size).
     """
 
     radius_ratio: float

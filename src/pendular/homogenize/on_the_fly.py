@@ -45,7 +45,7 @@ Volume-controlled bridges carry their own suction (``BridgeState.suction``): psi
 each bridge's s_k [V_k delta_ij + Rot A] over V plus B, which equals chi s + B when every
 bridge has the suction s; chi is Eq. 3.44 either way.
 
-The complete capillary stress (docs/pendular.capillary.md "The complete capillary stress"). Eq. 3.46
+The complete capillary stress (docs/capillary.md "The complete capillary stress"). Eq. 3.46
 sums the water pressure on the wetted caps and the surface tension along the contact lines,
 but not the tension carried by the liquid-gas interface itself. Averaging the stress of every
 phase (solids, water, air and the interface as a membrane of tension gamma) over V adds
