@@ -1,19 +1,26 @@
 """Campaigns (pendular.campaign): a TOML sweep through `pendular campaign` (runs, campaign.csv,
-reuse), the library API (runs built with dataclasses.replace, a failing run), refusals."""
+reuse), the library API (runs built with dataclasses.replace, a failing run), refusals (bad or
+empty tables, --jobs, a folder in use, damaged results of an earlier campaign)."""
 
 import csv
 import dataclasses
+import json
 import os
 import subprocess
 import sys
 import time
 
+import h5py
 import pytest
 
+import pendular.campaign as campaign_module
 from pendular.dem.preparation import PrepareConfig
-from pendular.campaign import (Campaign, Run, options_argv, run_name, run_progress,
-                               sweep_from_table, table_rows, write_campaign_csv)
+from pendular.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs, executor,
+                               finished_summary, max_jobs, options_argv, run_name,
+                               run_progress, sweep_from_table, table_rows, write_campaign_csv)
+from pendular.cli import run_command
 from pendular.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict
+from pendular.outputs import OutputFolder
 
 TABLE = """
 command = "triaxial"
@@ -31,6 +38,25 @@ confining = [250, 750]
 def pendular(*arguments, check=True):
     return subprocess.run([sys.executable, "-m", "pendular.cli", *arguments],
                           capture_output=True, text=True, check=check, timeout=600)
+
+
+def command(name, argv, capsys):
+    """(exit status, stderr) of ``pendular NAME ARGV`` run in-process."""
+    try:
+        status = run_command(name, [str(a) for a in argv])
+    except SystemExit as stop:
+        status = stop.code
+    return status, capsys.readouterr().err
+
+
+def refused(status, err, *words):
+    """One ``error:`` line, exit status 2, naming ``words``; returns the line."""
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert status == 2 and "Traceback" not in err, err
+    assert len(lines) == 1 and ": error: " in lines[0], err
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+    return lines[0]
 
 
 def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
@@ -117,6 +143,15 @@ def test_campaign_refuses_bad_runs_before_running(tmp_path):
     assert not (tmp_path / "c" / "runs").exists()
 
 
+def test_a_run_of_a_table_refused_before_running_names_the_table(tmp_path, capsys):
+    table = tmp_path / "fast.toml"
+    table.write_text('[fixed]\nparticles = 60\n[sweep]\ninertial_number = [0.5]\n')
+    status, err = command("campaign", [table, "--out", tmp_path / "o", "--quiet"], capsys)
+    refused(status, err, f"table = {str(table)!r}: run inertial_number0.5: strain rate",
+            "quasi-static")
+    assert not (tmp_path / "o" / "runs").exists()
+
+
 def test_table_rows_cartesian_and_explicit():
     command, rows, varied = table_rows({"fixed": {"particles": 10},
                                         "sweep": {"suction": [0, 1], "seed": [1, 2, 3]}}, "t")
@@ -129,8 +164,8 @@ def test_table_rows_cartesian_and_explicit():
     assert rows == [{"particles": 100, "void_ratio": 0.7}, {"particles": 200, "name": "x"}]
     assert [run_name(r, v) for r, v in zip(rows, varied)] == ["void_ratio0.7", "x"]
     assert options_argv({"max_strain": 0.02, "persist_bridges": True, "quiet": False,
-                         "table_resolution": [350, 80]}) == [
-        "--max-strain", "0.02", "--persist-bridges", "--table-resolution", "350,80"]
+                         "table_resolution": [350, 80], "sample": "-s.h5"}) == [
+        "--max-strain=0.02", "--persist-bridges", "--table-resolution=350,80", "--sample=-s.h5"]
 
 
 def test_tables_build_validated_configs(tmp_path):
@@ -142,6 +177,8 @@ def test_tables_build_validated_configs(tmp_path):
     assert runs[1].config.bridges.suction == 2000.0 and runs[1].config.bridges.persist
     assert runs[0].config.bridges.model == "toroidal" and runs[0].config.sample.particles == 200
     assert runs[0].config.sample_path == str(tmp_path / "s.h5")      # relative to the table
+    table.write_text('[fixed]\nparticles = 200\nsample = "-s.h5"\n')   # a value, not an option
+    assert sweep_from_table(table)[1][0].config.sample_path == str(tmp_path / "-s.h5")
     table.write_text('command = "tension"\n[fixed]\nparticles = 300\n'
                      '[sweep]\nwater_content = [0.5, 1.0]\n')
     command, runs = sweep_from_table(table)
@@ -151,28 +188,192 @@ def test_tables_build_validated_configs(tmp_path):
 
 
 @pytest.mark.parametrize("text, message", [
-    ('[fixed]\nbogus_option = 1\n', "triaxial has no option(s) --bogus-option"),
-    ('[sweep]\nout = ["a", "b"]\n', "no option(s) --out in a table (out: set by the campaign)"),
+    # empty: each would run the command's default test (10,000 spheres to 25 %)
+    ("", "bad.toml' is empty; valid: [fixed] options with [sweep] lists or [[runs]] rows"),
+    ('[sweep]\n', "[sweep] is empty; valid: a non-empty list per swept option"),
+    ('runs = []\n', "runs = [] holds no run; valid: one [[runs]] table per run"),
+    ('[fixed]\n', "bad.toml' sets no option, so each run would be the triaxial command's "
+                  "default test"),
+    ('command = "tension"\n', "sets no option, so each run would be the tension command's"),
+    ('[[runs]]\nname = "a"\n', "sets no option"),
+    # unreadable
+    (b'[fixed]\nparticles = 300\nname = "\xff"\n', "bad.toml' is not a TOML table: byte 0xff at "
+                                                    "line 3, column 9 is not UTF-8 text"),
+    ('this is not toml', "bad.toml' is not a valid TOML table: "),
+    ('[fixed]\nparticles = 3 4\n', "(at line 2, column 15)"),
+    # the table's layout
     ('command = "dance"\n', "command = 'dance' is not one of"),
+    ('colour = "red"\n', "unknown table key(s) colour"),
     ('[sweep]\nsuction = 5\n', "sweep.suction = 5 is not a non-empty list"),
-    ('[fixed]\nparticles = -3\n', "run run: particles"),
-    ('[fixed]\nparticles = "many"\n', "argument --particles: invalid int value: 'many'"),
     ('[fixed]\nseed = 1\n[sweep]\nseed = [1, 2]\n', "seed both in [fixed] and in [sweep]"),
     ('[[runs]]\nseed = 1\n[[runs]]\nseed = 1\n', "runs seed1 repeat a folder name"),
     ('[[runs]]\nsuction = 1\n[sweep]\nseed = [1]\n', "not both"),
-    ('colour = "red"\n', "unknown table key(s) colour"),
-    ('this is not toml', "not a readable TOML table"),
+    ("[sweep]\n" + "".join(f"k{i} = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10]\n" for i in range(5)),
+     f"100000 runs (10 k0 x 10 k1 x 10 k2 x 10 k3 x 10 k4); valid: at most {MAX_RUNS} runs"),
+    # keys: each named with its section
+    ('[fixed]\nbogus_option = 1\n', "bogus_option ([fixed]): not an option of triaxial in a "
+                                     "table; see 'pendular triaxial --help'"),
+    ('[sweep]\nout = ["a", "b"]\n', "out ([sweep]: set by the campaign): not an option"),
+    ('[fixed]\nmax-strain = 0.1\n', "max-strain ([fixed]: write max_strain)"),
+    ('[fixed]\nparticles = -3\n', "run run: particles = -3 ([fixed]): particles = -3 is "
+                                   "outside the valid range"),
+    ('[fixed]\nparticles = "many"\n', 'run run: particles = "many" ([fixed]): argument '
+                                       "--particles: invalid int value: 'many'"),
+    ('[fixed]\nparticles = false\n', "particles = false ([fixed]): --particles takes a value, "
+                                      "not true or false"),
+    ('[fixed]\npersist_bridges = 1\n', "persist_bridges = 1 ([fixed]): a flag, true or false "
+                                        "expected"),
+    ('[fixed]\nparticles = 300\n[sweep]\nsuction = [1000, -5]\n',
+     "run suction-5: suction = -5 ([sweep]): --suction = -5.0 Pa is outside the valid range"),
+    ('[fixed]\nwater_content = 5\n[sweep]\nsuction = [0, 1000]\n',
+     "run suction1000: water_content = 5 ([fixed]), suction = 1000 ([sweep]): --suction and "
+     "--water-content: give one"),
+    ('[[runs]]\nseed = 1\n[[runs]]\nvtk_every = 5\nvtk_frames = 3\n',
+     "vtk_every = 5 (row 2 of [[runs]]), vtk_frames = 3 (row 2 of [[runs]]): argument "
+     "--vtk-frames: not allowed with argument --vtk-every"),
+    ('[[runs]]\nname = "a/b"\nseed = 1\n', 'name = "a/b" (row 1 of [[runs]]): run name '
+                                            "'a/b' is not a folder name"),
+    ('[[runs]]\nname = [1]\nseed = 1\n', "name = [1] (row 1 of [[runs]]): a folder name"),
 ])
-def test_bad_tables_are_refused_naming_what_is_wrong(tmp_path, text, message):
+def test_bad_tables_are_refused_naming_what_is_wrong(tmp_path, capsys, text, message):
     table = tmp_path / "bad.toml"
-    table.write_text(text)
+    if isinstance(text, bytes):
+        table.write_bytes(text)
+    else:
+        table.write_text(text)
     with pytest.raises(ValueError) as error:
         sweep_from_table(table)
+    assert str(error.value).startswith(f"table = {str(table)!r}")
     assert message in str(error.value)
-    result = pendular("campaign", str(table), "--out", str(tmp_path / "o"), check=False)
-    assert result.returncode == 2 and result.stderr.count("error:") == 1, result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+    status, err = command("campaign", [table, "--out", tmp_path / "o"], capsys)
+    refused(status, err, f"pendular campaign: error: table = {str(table)!r}", message)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_table_path_that_is_not_a_file_is_refused(tmp_path, capsys):
+    for path, message in ((tmp_path / "none.toml", "cannot be read: No such file or directory"),
+                          (tmp_path, "is not a file; valid: a TOML file"),
+                          ("/dev/zero", "is not a file; valid: a TOML file")):
+        status, err = command("campaign", [path, "--out", tmp_path / "o"], capsys)
+        refused(status, err, f"table = {str(path)!r} {message}")
+
+
+def test_relative_psd_and_sample_paths_are_the_tables(tmp_path, monkeypatch):
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    table = tmp_path / "t.toml"
+    table.write_text('[fixed]\nparticles = 300\npsd = "grading.csv"\n')
+    with pytest.raises(ValueError, match="psd = \"grading.csv\" \\(\\[fixed\\]\\): psd file "
+                                         + repr(str(tmp_path / "grading.csv"))):
+        sweep_from_table(table)
+
+
+TINY = '[fixed]\nparticles = 60\nmax_strain = 0.002\ninertial_number = 2e-3\nvtk_every = 0\n'
+
+
+def test_jobs_beyond_the_machine_are_refused_naming_jobs(tmp_path, capsys):
+    high = max_jobs()
+    assert high == campaign_module.JOBS_PER_CPU * (os.cpu_count() or 1)
+    assert check_jobs(1) == 1 and check_jobs(high) == high
+    for jobs in (0, high + 1, 10**20, 1.5, True):
+        with pytest.raises(ValueError, match=r"--jobs .* valid range \[1, " + str(high) + r"\]"):
+            check_jobs(jobs)
+    with pytest.raises(ValueError, match="--jobs 100000000000000000000 is outside"):
+        with executor(10**20):
+            pass
+    table = tmp_path / "t.toml"
+    table.write_text(TINY)
+    big = "99999999999999999999"
+    status, err = command("campaign", [table, "--out", tmp_path / "o", "--jobs", big], capsys)
+    refused(status, err, f"--jobs {big} is outside the valid range [1, {high}] "
+                         f"({campaign_module.JOBS_PER_CPU} processes per CPU of this machine")
+    assert not (tmp_path / "o").exists()
+    status, err = command("campaign", [table, "--out", tmp_path / "o", "--jobs", high + 1],
+                          capsys)
+    refused(status, err, f"--jobs {high + 1} is outside the valid range [1, {high}]")
+    # the other commands with --jobs reach the same check before anything runs
+    for name, argv in (("chapter5", ["--particles", "60", "--suctions", "0", "--confining",
+                                     "500", "--max-strain", "0.001", "--quiet"]),
+                       ("tradeoff", ["--knob", "damping", "--seeds", "2", "--particles", "60"])):
+        status, err = command(name, [*argv, "--out", tmp_path / name, "--jobs", big], capsys)
+        refused(status, err, f"pendular {name}: error: --jobs", f"valid range [1, {high}]")
+
+
+def test_a_campaign_into_a_folder_in_use_is_refused(tmp_path, capsys, monkeypatch):
+    table = tmp_path / "t.toml"
+    table.write_text(TINY)
+    out = tmp_path / "o"
+    with OutputFolder(out, "another campaign"):
+        status, err = command("campaign", [table, "--out", out, "--quiet"], capsys)
+    refused(status, err, f"out = {str(out)!r}: the folder is in use by another pendular run",
+            "another campaign")
+    assert not (out / "campaign.csv").exists() and not (out / "runs").exists()
+
+    # a campaign holds its folder while its runs go (no run needed to see it)
+    def run(self, where, **options):
+        with pytest.raises(ValueError, match="in use by another pendular run .*campaign"):
+            with OutputFolder(out, "a second campaign"):
+                pass
+        return CampaignResult(self.runs, summaries={r.name: {"peak_q": 1.5} for r in self.runs})
+
+    monkeypatch.setattr(Campaign, "run", run)
+    assert command("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
+    with open(out / "campaign.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [(r["run"], r["status"], r["peak_q"]) for r in rows] == [("run", "run", "1.5")]
+    with open(out / ".pendular-outputs.json") as handle:
+        manifest = json.load(handle)
+    assert manifest["command"] == ["campaign", str(table)] and "campaign.csv" in manifest["files"]
+    with OutputFolder(out, "after it"):          # released at the end
+        pass
+
+
+def test_damaged_results_of_an_earlier_campaign_are_run_again(tmp_path, capsys, monkeypatch):
+    triaxial = TriaxialConfig(sample=PrepareConfig(particles=100))
+    folder = tmp_path / "triaxial"
+    folder.mkdir()
+    with h5py.File(folder / "sample.h5", "w") as handle:
+        handle.attrs["config"] = json.dumps({"config": config_to_dict(triaxial)})
+    whole = {"peak_axial_stress": 3.0, "peak_q": 2.0, "p_at_peak": 1.0,
+             "axial_strain_at_peak": 0.1, "completed": True}
+    for damaged in ("[1]", '"x"', "{}", "{", "[" * 100000, json.dumps({**whole, "peak_q": "x"}),
+                    json.dumps({**whole, "completed": False})):
+        (folder / "summary.json").write_text(damaged)
+        assert finished_summary(triaxial, str(folder)) is None, damaged
+    (folder / "summary.json").write_text(json.dumps(whole))
+    assert finished_summary(triaxial, str(folder)) == whole
+    with h5py.File(folder / "sample.h5", "w") as handle:
+        handle.attrs["config"] = 5                  # not JSON text
+    assert finished_summary(triaxial, str(folder)) is None
+
+    tension = TensionConfig(cases=[(0.72, 0.01)], particles=100)
+    stored = config_to_dict(tension)
+    folder = tmp_path / "tension"
+    folder.mkdir()
+    for damaged in ('"x"', "[1]", json.dumps({"config": stored}),
+                    json.dumps({"config": stored, "cases": [5]}),
+                    json.dumps({"config": stored, "cases": "x"}),
+                    json.dumps({"config": [1], "cases": [{"case": "a"}]})):
+        (folder / "tension.json").write_text(damaged)
+        assert finished_summary(tension, str(folder)) is None, damaged
+    (folder / "tension.json").write_text(json.dumps({"config": stored, "cases": [
+        {"case": "a", "tensile_strength_pa": 9.0, "grading": {}}]}))
+    assert finished_summary(tension, str(folder)) == {"case": "a", "tensile_strength_pa": 9.0}
+
+    # through the command: the damaged run is run again (here a stand-in), no traceback
+    table = tmp_path / "t.toml"
+    table.write_text('command = "tension"\n[fixed]\nparticles = 100\nvoid_ratio = 0.72\n'
+                     'water_content = 1\n')
+    out = tmp_path / "o"
+    (out / "runs" / "run").mkdir(parents=True)
+    (out / "runs" / "run" / "tension.json").write_text('"damaged"')
+    ran = []
+    monkeypatch.setattr(campaign_module, "run_one",
+                        lambda config, folder, *rest: ran.append(folder) or {"case": "new"})
+    assert command("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
+    assert ran == [str(out / "runs" / "run")]
+    with open(out / "campaign.csv") as handle:
+        assert [(r["status"], r["case"]) for r in csv.DictReader(handle)] == [("run", "new")]
 
 
 def test_run_progress_reads_the_last_bar_of_a_log(tmp_path):

@@ -9,7 +9,9 @@ with ``dataclasses.replace``)::
 
 ``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
 progress bars), with ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned
-processes or on the Dask cluster of ``scheduler``. A run whose folder holds a finished result
+processes (at most JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``. It does not
+lock ``out``: a command holds it as its pendular.outputs.OutputFolder around the campaign, so
+that a second campaign into it is refused. A run whose folder holds a finished result
 of an equal configuration (``pendular.config.config_json`` of the configuration stored with it:
 sample.h5 of a triaxial, tension.json of a tension test) is reused, so an interrupted campaign
 goes on where it stopped; so is a shared sample (``samples``) saved with an equal
@@ -35,7 +37,10 @@ run one void ratio and one water content).
 Any option of the command can be fixed or swept; each run's configuration is built by the
 command's own option parser and ``config_from``, so it is validated as on the command line.
 Flags take true/false, list values are joined with commas (``table_resolution = [350, 80]``),
-a relative ``sample`` path is relative to the table's folder.
+relative ``sample`` and ``psd`` paths are relative to the table's folder. A table must set at
+least one option (an empty table, ``[sweep]`` or ``runs = []`` is refused: it would run the
+command's default test) and hold at most MAX_RUNS runs. Every refusal names the table and the
+key, with its section (``[fixed]``, ``[sweep]``, ``row 2 of [[runs]]``).
 """
 
 from __future__ import annotations
@@ -43,12 +48,14 @@ from __future__ import annotations
 import concurrent.futures
 import contextlib
 import csv
-import dataclasses
 import itertools
 import json
+import math
 import multiprocessing
+import numbers
 import os
 import re
+import stat
 import threading
 import traceback
 from collections.abc import Iterable, Sequence
@@ -74,6 +81,18 @@ PROGRESS_PERIOD = 5.0
 RunConfig = Union[TriaxialConfig, TensionConfig]
 #: Options a parameter table cannot set: the campaign decides them.
 CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep")
+#: Options of a table that are paths, relative to the table's folder.
+PATH_OPTIONS = ("sample", "psd")
+#: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra
+#: swept list), and its cartesian product would fill the memory before anything runs.
+MAX_RUNS = 10000
+#: Most local processes per CPU (--jobs): each run is compute-bound with its own interpreter,
+#: Numba runtime and sample in memory, so beyond the CPUs processes only share them; a few per
+#: CPU leave room for runs waiting on their files, more only multiply the memory.
+JOBS_PER_CPU = 4
+#: Keys of a triaxial summary.json that every finished run has (numbers); a summary without
+#: them is damaged and its run is done again.
+SUMMARY_KEYS = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak")
 
 
 @dataclass
@@ -93,6 +112,10 @@ class Run:
         if not isinstance(self.config, (TriaxialConfig, TensionConfig)):
             raise TypeError(f"run {self.name}: config must be a TriaxialConfig or TensionConfig,"
                             f" got {type(self.config).__name__}")
+
+
+class RunRefused(ValueError):
+    """A run of a campaign refused before anything runs (its message starts with the run)."""
 
 
 @dataclass
@@ -160,7 +183,7 @@ def stored_config(path: str, key: str) -> dict | None:
     try:
         with h5py.File(path, "r") as handle:
             return json.loads(handle.attrs["config"]).get(key)
-    except (OSError, KeyError, ValueError, AttributeError):
+    except (OSError, KeyError, ValueError, TypeError, AttributeError, RecursionError):
         return None
 
 
@@ -172,7 +195,7 @@ def same_config(stored: dict | None, config: Any) -> bool:
         return False
     try:
         stored = config_to_dict(config_from_dict(stored))
-    except (ValueError, TypeError):
+    except (ValueError, TypeError, KeyError, AttributeError, ArithmeticError, RecursionError):
         return False
     return json.dumps(stored, sort_keys=True) == config_json(config)
 
@@ -183,7 +206,8 @@ def sample_made_with(path: str, sample: PrepareConfig) -> bool:
 
 
 def finished_summary(config: RunConfig, folder: str) -> dict | None:
-    """The summary of a run of ``folder`` that finished with an equal configuration, or None."""
+    """The summary of a run of ``folder`` that finished with an equal configuration, or None
+    (also for a damaged summary: the run is done again)."""
     if isinstance(config, TriaxialConfig):
         summary_path = os.path.join(folder, "summary.json")
         stored = stored_config(os.path.join(folder, "sample.h5"), "config")
@@ -195,24 +219,49 @@ def finished_summary(config: RunConfig, folder: str) -> dict | None:
     try:
         with open(summary_path) as handle:
             summary = json.load(handle)
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(summary, dict):
         return None
     if isinstance(config, TensionConfig):
         stored = summary.get("config")
     if not same_config(stored, config):
         return None
     if isinstance(config, TriaxialConfig):
-        return summary if summary.get("completed", True) else None
-    return tension_summary(summary)
+        whole = all(isinstance(summary.get(key), (int, float))
+                    and not isinstance(summary.get(key), bool) for key in SUMMARY_KEYS)
+        return summary if whole and summary.get("completed", True) is True else None
+    try:
+        return tension_summary(summary)
+    except (KeyError, IndexError, TypeError, AttributeError):
+        return None
 
 
 # ---------------------------------------------------------------- execution
 
+def max_jobs() -> int:
+    """The most local processes (--jobs) on this machine: JOBS_PER_CPU per CPU."""
+    return JOBS_PER_CPU * (os.cpu_count() or 1)
+
+
+def check_jobs(jobs: int) -> int:
+    """``jobs`` (--jobs) as an int in [1, max_jobs()]; ValueError naming --jobs and the range."""
+    high = max_jobs()
+    valid = (f"valid range [1, {high}] ({JOBS_PER_CPU} processes per CPU of this machine; "
+             "more only slow every run down)")
+    if isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral):
+        raise ValueError(f"--jobs {jobs!r} is not an integer; {valid}")
+    if not 1 <= jobs <= high:
+        raise ValueError(f"--jobs {jobs} is outside the {valid}")
+    return int(jobs)
+
+
 @contextlib.contextmanager
 def executor(jobs: int, scheduler: str | None = None):
     """Where the runs go: None (here, one after the other), a spawn process pool of ``jobs``
-    workers, or the concurrent.futures executor of the Dask cluster at ``scheduler``. On an
-    exception (Ctrl-C) the runs not started are cancelled."""
+    workers (check_jobs), or the concurrent.futures executor of the Dask cluster at
+    ``scheduler``. On an exception (Ctrl-C) the runs not started are cancelled."""
+    jobs = check_jobs(jobs)
     if scheduler is not None:
         try:
             from dask.distributed import Client
@@ -366,11 +415,12 @@ class Campaign:
     def run(self, out: str, *, jobs: int = 1, scheduler: str | None = None, threads: int = 1,
             quiet: bool = False) -> CampaignResult:
         """Run every run into ``out``/runs/<name> (reusing finished ones) with ``threads``
-        Numba threads each, in ``jobs`` local processes or on the Dask cluster at
-        ``scheduler`` (its workers must see ``out`` at the same path). Every configuration
+        Numba threads each, in ``jobs`` local processes (check_jobs) or on the Dask cluster
+        at ``scheduler`` (its workers must see ``out`` at the same path). Every configuration
         still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
-        tables), so a bad one is refused before anything runs."""
-        jobs = check_int("jobs", jobs, low=1)
+        tables), so a bad one is refused before anything runs. The caller holds ``out``
+        (an OutputFolder, module docstring)."""
+        jobs = check_jobs(jobs)
         threads = check_int("threads", threads, low=1)
         out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
         result = CampaignResult(self.runs)
@@ -387,7 +437,7 @@ class Campaign:
                 try:
                     TriaxialTest(run.config, force=run.force)
                 except ValueError as error:
-                    raise ValueError(f"run {run.name}: {error}") from None
+                    raise RunRefused(f"run {run.name}: {error}") from None
         preparations = [(sample, path) for sample, path in self.samples
                         if not sample_made_with(path, sample)]
         for _, path in preparations:
@@ -421,22 +471,46 @@ class Campaign:
 # ---------------------------------------------------------------- parameter tables
 
 def read_table(path: str | os.PathLike) -> dict:
-    """The TOML table at ``path`` as a dict (ValueError naming the path when unreadable)."""
+    """The TOML table at ``path`` as a dict; ValueError naming the path (and the line of a
+    TOML or UTF-8 error) when it is not a readable TOML file."""
     try:
         import tomllib
     except ModuleNotFoundError:        # Python 3.10
         import tomli as tomllib
+    source = f"table = {os.fspath(path)!r}"
     try:
-        with open(path, "rb") as handle:
-            return tomllib.load(handle)
-    except (OSError, tomllib.TOMLDecodeError) as error:
-        raise ValueError(f"table = {os.fspath(path)!r} is not a readable TOML table: "
-                         f"{error}") from None
+        regular = stat.S_ISREG(os.stat(path).st_mode)     # a device or a pipe may never end
+        if regular:
+            with open(path, "rb") as handle:
+                data = handle.read()
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{source} cannot be read: "
+                         f"{getattr(error, 'strerror', None) or error}") from None
+    if not regular:
+        raise ValueError(f"{source} is not a file; valid: a TOML file")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        column = error.start - data.rfind(b"\n", 0, error.start)
+        raise ValueError(f"{source} is not a TOML table: byte 0x{data[error.start]:02x} at "
+                         f"line {line}, column {column} is not UTF-8 text; valid: a UTF-8 "
+                         "TOML file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ValueError(f"{source} is not a valid TOML table: {error}") from None
+    except RecursionError:
+        raise ValueError(f"{source} is not a TOML table pendular can read: its values are "
+                         "nested too deep") from None
 
 
 def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str]]]:
     """(command, [options dict per run], [the keys each run varies]) of a parameter table
     (module docstring); ValueError starting with ``source``."""
+    valid = "valid: [fixed] options with [sweep] lists or [[runs]] rows"
+    if not table:
+        raise ValueError(f"{source} is empty; {valid}")
     unknown = set(table) - {"command", "fixed", "sweep", "runs"}
     if unknown:
         raise ValueError(f"{source}: unknown table key(s) {', '.join(sorted(unknown))}; valid: "
@@ -453,6 +527,11 @@ def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str
     explicit = table.get("runs", [])
     if not isinstance(explicit, list) or not all(isinstance(r, dict) for r in explicit):
         raise ValueError(f"{source}: runs must be an array of tables ([[runs]])")
+    if "sweep" in table and not sweep:
+        raise ValueError(f"{source}: [sweep] is empty; valid: a non-empty list per swept "
+                         "option, e.g. suction = [0, 30000]")
+    if "runs" in table and not explicit:
+        raise ValueError(f"{source}: runs = [] holds no run; valid: one [[runs]] table per run")
     if sweep and explicit:
         raise ValueError(f"{source}: give [sweep] or [[runs]], not both")
     for name, values in sweep.items():
@@ -461,13 +540,22 @@ def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str
     both = sorted(set(fixed) & set(sweep))
     if both:
         raise ValueError(f"{source}: {', '.join(both)} both in [fixed] and in [sweep]")
+    count = math.prod(len(values) for values in sweep.values()) if sweep else len(explicit)
+    if count > MAX_RUNS:
+        sizes = " x ".join(f"{len(values)} {name}" for name, values in sweep.items())
+        raise ValueError(f"{source}: {count} runs ({sizes or '[[runs]] rows'}); valid: at "
+                         f"most {MAX_RUNS} runs in a table")
     if sweep:
         names = list(sweep)
-        rows = [dict(zip(names, combination))
-                for combination in itertools.product(*(sweep[n] for n in names))]
+        own = [dict(zip(names, combination))
+               for combination in itertools.product(*(sweep[n] for n in names))]
     else:
-        rows = [dict(row) for row in explicit] or [{}]
-    return command, [{**fixed, **row} for row in rows], [list(row) for row in rows]
+        own = [dict(row) for row in explicit] or [{}]
+    rows = [{**fixed, **row} for row in own]
+    if not any(set(row) - {"name"} for row in rows):
+        raise ValueError(f"{source} sets no option, so each run would be the {command} "
+                         f"command's default test; {valid}")
+    return command, rows, [list(row) for row in own]
 
 
 def run_name(row: dict, varied: Sequence[str]) -> str:
@@ -491,7 +579,7 @@ def _text(value: Any) -> str:
 
 def options_argv(options: dict) -> list[str]:
     """Command-line options of a table row (underscores -> dashes; true flags; lists joined
-    with commas)."""
+    with commas; ``--option=value``, so that a value starting with '-' stays a value)."""
     argv = []
     for key, value in options.items():
         flag = "--" + key.replace("_", "-")
@@ -500,8 +588,16 @@ def options_argv(options: dict) -> list[str]:
         elif value is False:
             continue
         else:
-            argv += [flag, ",".join(map(str, value)) if isinstance(value, list) else str(value)]
+            text = ",".join(map(str, value)) if isinstance(value, list) else str(value)
+            argv.append(f"{flag}={text}")
     return argv
+
+
+def _mentions(text: str, key: str) -> bool:
+    """Whether the error ``text`` names the option ``key`` (as --key-with-dashes or key)."""
+    flag = "--" + key.replace("_", "-")
+    return re.search(rf"(?<![\w-])({re.escape(flag)}|{re.escape(key)})(?![\w-])",
+                     text) is not None
 
 
 class _Refused(Exception):
@@ -511,42 +607,79 @@ class _Refused(Exception):
 def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
     """(command, [Run]) of the TOML table at ``path``; each run's configuration is parsed and
     validated by the command's own options (ValueError naming the table, the run and the
-    option)."""
+    table key with its section)."""
     from .cli import UsageError, command_parser
 
     source = f"table = {os.fspath(path)!r}"
-    command, rows, varied = table_rows(read_table(path), source)
+    table = read_table(path)
+    command, rows, varied = table_rows(table, source)
     parser, module = command_parser(command)
 
     def refuse(message):
         raise _Refused(message)
 
     parser.error = refuse
+    actions = {action.dest: action for action in parser._actions}
     known = set(vars(parser.parse_args([]))) - set(CAMPAIGN_OPTIONS)
-    keys = {key for row in rows for key in row} - {"name"}
-    unknown = sorted(keys - known)
+
+    def where(index, key):
+        """The section of the table that gives run ``index`` its ``key``."""
+        if key not in varied[index]:
+            return "[fixed]"
+        return "[sweep]" if table.get("sweep") else f"row {index + 1} of [[runs]]"
+
+    def setting(index, key):
+        return f"{key} = {json.dumps(rows[index][key], default=str)} ({where(index, key)})"
+
+    unknown = {}
+    for index, row in enumerate(rows):
+        for key in row:
+            if key != "name" and key not in known:
+                unknown.setdefault(key, index)
     if unknown:
-        reserved = [k for k in unknown if k in CAMPAIGN_OPTIONS]
-        raise ValueError(f"{source}: {command} has no option(s) "
-                         f"{', '.join('--' + k.replace('_', '-') for k in unknown)} in a table"
-                         + (f" ({', '.join(reserved)}: set by the campaign)" if reserved else "")
-                         + f"; see 'pendular {command} --help'")
+        described = []
+        for key, index in unknown.items():
+            note = ("set by the campaign" if key in CAMPAIGN_OPTIONS else
+                    f"write {key.replace('-', '_')}" if key.replace("-", "_") in known else "")
+            described.append(f"{key} ({where(index, key)}{': ' + note if note else ''})")
+        raise ValueError(f"{source}: {', '.join(described)}: not an option of {command} in a "
+                         f"table; see 'pendular {command} --help'")
     folder = os.path.dirname(os.path.abspath(os.fspath(path)))
     runs = []
-    for row, keys in zip(rows, varied):
+    for index, (row, keys) in enumerate(zip(rows, varied)):
         name = run_name(row, keys)
-        options = {k: v for k, v in row.items() if k != "name"}
+        if "name" in row and (isinstance(row["name"], bool)
+                              or not isinstance(row["name"], (str, int))):
+            raise ValueError(f"{source}: {setting(index, 'name')}: a folder name (a string) "
+                             "expected")
+        options = {}
+        for key, value in row.items():
+            if key == "name":
+                continue
+            if actions[key].nargs == 0 and not isinstance(value, bool):
+                raise ValueError(f"{source}: run {name}: {setting(index, key)}: a flag, true "
+                                 "or false expected")
+            if actions[key].nargs != 0 and isinstance(value, bool):
+                raise ValueError(f"{source}: run {name}: {setting(index, key)}: "
+                                 f"--{key.replace('_', '-')} takes a value, not true or false")
+            if key in PATH_OPTIONS and isinstance(value, str) and not os.path.isabs(value):
+                value = os.path.join(folder, value)
+            options[key] = value
         try:
             args = parser.parse_args(options_argv(options))
             config = module.config_from(args)
-        except _Refused as error:
-            raise ValueError(f"{source}: run {name}: {error}") from None
-        except (ValueError, UsageError) as error:      # the command's own checks
-            raise ValueError(f"{source}: run {name}: {error}") from None
-        sample = getattr(config, "sample_path", None)
-        if sample is not None and not os.path.isabs(sample):
-            config = dataclasses.replace(config, sample_path=os.path.join(folder, sample))
-        runs.append(Run(name, config, force=bool(getattr(args, "force", False))))
+        except (_Refused, ValueError, UsageError, ArithmeticError) as error:
+            # the command's own checks name its options: point at the table keys that set them
+            named = [key for key in options if _mentions(str(error), key)] or list(options)
+            raise ValueError(f"{source}: run {name}: "
+                             f"{', '.join(setting(index, key) for key in named)}: "
+                             f"{error}") from None
+        try:
+            runs.append(Run(name, config, force=bool(getattr(args, "force", False))))
+        except ValueError as error:
+            raise ValueError(f"{source}: "
+                             f"{setting(index, 'name') if 'name' in row else 'run ' + name}: "
+                             f"{error}") from None
     names = [run.name for run in runs]
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
