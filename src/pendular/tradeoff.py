@@ -59,7 +59,7 @@ from pendular.dem.sample import load_sample
 from pendular.dem.threads import use_threads
 from pendular.dem.validate import check_int, check_range
 
-from .campaign import executor, prepare_one, sample_made_with
+from .campaign import check_jobs, executor, prepare_one, sample_made_with
 from .config import BridgeConfig, ShearConfig, TriaxialConfig, config_json, config_to_dict
 from .outputs import OutputFolder
 from .plots import pyplot, save_figure
@@ -479,7 +479,7 @@ class SeedStudy:
             raise ValueError(f"knob = {self.knob!r}: valid knobs are "
                              f"{', '.join(k for k in KNOBS if k != 'particles')}")
         self.seeds = check_int("seeds", self.seeds, low=2, high=100)
-        self.jobs = check_int("jobs", self.jobs, low=1)
+        self.jobs = check_jobs(self.jobs)
         Study(self.out, self.particles, self.max_strain, self.seed)   # checks the rest
         self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
 

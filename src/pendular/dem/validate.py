@@ -42,11 +42,14 @@ def check_positive(name, value, unit=""):
 def check_int(name, value, low=0, high=None):
     """Return ``value`` as int after checking it is an integer in [low, high]."""
     valid_range = f"[{low}, {'inf' if high is None else high}]"
-    number = finite_number(name, value, f"integers in {valid_range}")
-    if isinstance(value, bool) or not number.is_integer():
-        raise ValueError(f"{name} = {value!r} is not an integer; valid range integers in "
-                         f"{valid_range}")
-    number = int(number)
+    if isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_)):
+        number = int(value)                   # exact, also beyond float's 2**53
+    else:
+        number = finite_number(name, value, f"integers in {valid_range}")
+        if isinstance(value, bool) or not number.is_integer():
+            raise ValueError(f"{name} = {value!r} is not an integer; valid range integers in "
+                             f"{valid_range}")
+        number = int(number)
     if number < low or (high is not None and number > high):
         raise ValueError(f"{name} = {value!r} is outside the valid range {valid_range}")
     return number
