@@ -210,7 +210,7 @@ def test_bad_seed_study_settings_are_refused_naming_them(tmp_path):
         tradeoff.SeedStudy(out=str(tmp_path), knob="particles")
     with pytest.raises(ValueError, match="seeds = 1 is outside the valid range"):
         tradeoff.SeedStudy(out=str(tmp_path), knob="damping", seeds=1)
-    with pytest.raises(ValueError, match="jobs = 0 is outside the valid range"):
+    with pytest.raises(ValueError, match="--jobs 0 is outside the valid range"):
         tradeoff.SeedStudy(out=str(tmp_path), knob="damping", jobs=0)
 
 
