@@ -4,13 +4,15 @@ tampered (pendular.capillary.table, pendular.capillary.volume_table), and output
 
 import json
 import os
+import re
 import types
 
 import h5py
 import numpy as np
 import pytest
 
-from pendular.capillary.table import BridgeTable
+from pendular.capillary.suction_control import bridge_at_distance
+from pendular.capillary.table import NODE_TOLERANCE, BridgeTable, distance_fraction, spot_nodes
 from pendular.capillary.volume_table import VolumeBridgeTable
 from conftest import zero_bytes
 from pendular.dem.integrity import checksum, config_hash, stamp, verify
@@ -246,8 +248,14 @@ def _nan_node(handle):
     handle["values"][0, 2, 1, 0] = np.nan
 
 
+def _farther_rupture(handle):
+    handle["distance_rupture"][...] = 1.5 * handle["distance_rupture"][()]
+
+
 @pytest.mark.parametrize("tamper, restamp, reason", [
     (_doubled_forces, False, "checksum mismatch"),
+    (_doubled_forces, True, "from the exact solver"),
+    (_farther_rupture, True, "rupture distance d*"),
     (_fewer_nodes, True, "values has shape"),
     (_fewer_nodes, False, "checksum mismatch"),
     (_nan_node, True, "NaN or infinite nodes"),
@@ -268,6 +276,54 @@ def test_a_tampered_table_cache_is_rebuilt(tmp_path, capsys, tamper, restamp, re
     assert np.array_equal(first.values, again.values)
     verify(path, kind="table cache")        # the rebuilt file replaced the tampered one
     assert np.array_equal(BridgeTable.load(path).values, first.values)
+
+
+def test_a_restamped_table_with_doubled_forces_is_rebuilt_with_exact_forces(
+        tmp_path, monkeypatch, capsys):
+    """A valid checksum over doubled forces: the spot check against the exact solver finds
+    it, says so in one line and rebuilds the table in the cache folder ($PENDULAR_CACHE)."""
+    monkeypatch.setenv("PENDULAR_CACHE", str(tmp_path))
+    BridgeTable.cached(0.0, **SUCTION_OPTIONS)
+    (path,) = tmp_path.glob("bridge_table_*.h5")
+    edit(str(path), _doubled_forces)
+    assert verify(str(path), kind="table cache")       # the checksum alone passes it
+    capsys.readouterr()
+    table = BridgeTable.cached(0.0, **SUCTION_OPTIONS)
+    err = capsys.readouterr().err
+    (warning,) = [line for line in err.splitlines() if line.startswith("warning:")]
+    found, exact = map(float, re.search(r"force = (\S+) in the file, (\S+) from the exact "
+                                        r"solver", warning).groups())
+    assert str(path) in warning and found == pytest.approx(2.0 * exact, rel=1e-9)
+    # every interior node of the rebuilt table holds the exact solver's force, in memory and
+    # on disk
+    suction, n_distance = table.suction, table.n_distance
+    on_disk = BridgeTable.load(str(path))
+    for k in range(1, table.n_suction):
+        low, rupture = table.distance_low[0, k], table.distance_rupture[0, k]
+        for j in range(1, n_distance - 1):
+            distance = low + (rupture - low) * distance_fraction(j / (n_distance - 1))
+            force = bridge_at_distance(1.0, 0.0, suction[k], distance).force
+            assert table.values[0, k, j, 0] == pytest.approx(force, rel=1e-12)
+            assert on_disk.values[0, k, j, 0] == table.values[0, k, j, 0]
+    capsys.readouterr()
+    BridgeTable.cached(0.0, **SUCTION_OPTIONS)         # now used as it is
+    assert capsys.readouterr().err == ""
+
+
+def test_a_valid_table_passes_the_spot_check_at_every_node(tmp_path):
+    """The spot check never rebuilds a valid table: every node of a built table agrees with
+    the exact solver far within NODE_TOLERANCE (the same kernels solve both)."""
+    table = BridgeTable.build(20.0, radius_ratios=(1.0, 2.0), n_suction=5, n_distance=4,
+                              suction_max=50.0)
+    table.check_nodes(count=2 * 5 * 4)
+    assert len(spot_nodes(table.values.shape[:3], 2 * 5 * 4)) > 20
+    nodes = spot_nodes((10, 350, 80))
+    assert {i for i, _, _ in nodes} == set(range(10))        # every radius ratio
+    assert all(0 <= k < 350 and 0 <= j < 80 for _, k, j in nodes)
+    table.values[1, 3, 2, 4] *= 1.0 + 10 * NODE_TOLERANCE
+    with pytest.raises(ValueError, match=r"node r = 2, u\* = \S+, distance index 2 of 4: "
+                                         r"nn11 = \S+ in the file, \S+ from the exact solver"):
+        table.check_nodes(count=2 * 5 * 4)
 
 
 def test_an_old_table_cache_without_checksum_is_rebuilt(tmp_path, capsys):
@@ -293,6 +349,14 @@ def test_a_tampered_volume_table_cache_is_rebuilt(tmp_path, capsys):
     again = VolumeBridgeTable.cached(0.0, **options)
     assert "NaN" in capsys.readouterr().err
     assert np.array_equal(first.values, again.values)
+    edit(str(path), _doubled_forces)            # a valid checksum over doubled forces
+    again = VolumeBridgeTable.cached(0.0, **options)
+    (warning,) = capsys.readouterr().err.splitlines()[:1]
+    assert re.search(r"rebuilding it: node r = 1, V\* = \S+, distance index \d of 3: force = "
+                     r"\S+ in the file, \S+ from the exact solver", warning), warning
+    assert np.array_equal(first.values, again.values)
+    assert np.array_equal(VolumeBridgeTable.load(path).values, first.values)
+    again.check_nodes(count=3 * 3)              # the built table agrees at every node
 
 
 # ---------------------------------------------------------------- output folders

@@ -27,7 +27,12 @@ import numba
 import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
-from pendular.capillary.suction_control import rupture_point, stable_filling_angle
+from pendular.capillary.suction_control import (
+    bridge_at_distance,
+    bridge_from_kernel,
+    rupture_point,
+    stable_filling_angle,
+)
 from pendular.capillary.validation import check_contact_angle, check_positive, check_radius_ratio
 from pendular.dem.atomic import replacing
 from pendular.dem.integrity import stamp, verify
@@ -41,6 +46,15 @@ FIELDS = ("force", "volume", "delta1", "delta2", "nn11", "nn33")
 
 TABLE_FORMAT = 1
 """Version of the table layout and solver, part of the cache key."""
+
+NODE_TOLERANCE = 1e-6
+"""Largest relative difference between a cached table's node and the exact solver's solution
+of it (``spot_nodes``): nodes are solved by the same kernels, so a valid cache agrees to
+round-off, and an edited or wrongly built one differs far more."""
+
+SPOT_NODES = 6
+"""Nodes of a cached table solved again when it is loaded (at least one per radius ratio): a
+handful of exact solves, well under a second."""
 
 
 def cache_directory():
@@ -78,9 +92,11 @@ def cached_table(path, identity, load, check, build):
     """The table cached at ``path`` if it passes every check, else ``build()`` saved there.
 
     Checks: checksum and ``identity`` (pendular.dem.integrity.verify), ``load(path)``, then
-    ``check(table)`` (ValueError when its nodes do not match the key or are not finite). A
-    file that fails is rebuilt, never used, with a one-line warning on stderr saying why; a
-    build says on stderr what it builds and how long it took (seconds to minutes)."""
+    ``check(table)`` (ValueError when its nodes do not match the key, are not finite or differ
+    from the exact solver at the spot-checked nodes: a checksum only proves the file unchanged
+    since it was stamped). A file that fails is rebuilt, never used, with a one-line warning
+    on stderr saying why; a build says on stderr what it builds and how long it took (seconds
+    to minutes)."""
     path = Path(path)
     if path.exists():
         try:
@@ -122,6 +138,29 @@ def check_table_nodes(table, shapes, settings):
             if not np.isfinite(array).all():
                 raise ValueError(f"lookup array {index} holds {int(np.sum(~np.isfinite(array)))} "
                                  "NaN or infinite nodes")
+
+
+def spot_nodes(shape, count=SPOT_NODES):
+    """Indices (i_r, i_axis, j) of the nodes of a grid of ``shape`` (n_r, n_axis, n_distance)
+    that a cached table's check solves again: max(count, n_r) nodes, every radius ratio in
+    turn, the other two indices spread over their axes (additive recurrences of irrational
+    steps), duplicates dropped; the same nodes for the same shape."""
+    n_r, n_axis, n_distance = shape
+    nodes = []
+    for m in range(max(count, n_r)):
+        node = (m % n_r, int((0.5 + m * 0.6180339887498949) % 1.0 * n_axis),
+                int((0.5 + m * 0.41421356237309515) % 1.0 * n_distance))
+        if node not in nodes:
+            nodes.append(node)
+    return nodes
+
+
+def compare_node(where, name, found, exact, scale=0.0):
+    """ValueError unless the stored ``found`` agrees with the ``exact`` solution within
+    NODE_TOLERANCE relative to max(|exact|, ``scale``); ``where`` names the node."""
+    if not abs(found - exact) <= NODE_TOLERANCE * max(abs(exact), scale):
+        raise ValueError(f"node {where}: {name} = {found:.10g} in the file, {exact:.10g} from "
+                         f"the exact solver (valid: within a relative {NODE_TOLERANCE:g})")
 
 
 @numba.njit(cache=True)
@@ -420,11 +459,38 @@ class BridgeTable:
                 {name: parameters[name] for name in ("contact_angle", "radius_ratios", "suction_scale",
                                                      "suction_max")},
             )
+            table.check_nodes()
 
         return cached_table(
             path, cache_identity("suction", parameters), cls.load, check,
             lambda: cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale),
         )
+
+    def check_nodes(self, count=SPOT_NODES):
+        """ValueError naming the first of the ``spot_nodes`` whose rupture distance, smallest
+        distance or quantities differ from the exact solver's (pendular.capillary.suction_control:
+        rupture_point, bridge_at_distance) beyond NODE_TOLERANCE. Exact tables only (a toroidal
+        table holds the toroidal approximation)."""
+        theta = math.radians(self.contact_angle)
+        largest = 0.5 * math.pi - theta
+        suction = self.suction
+        n_distance = self.n_distance
+        for i, k, j in spot_nodes(self.values.shape[:3], count):
+            r, u = float(self.radius_ratios[i]), float(suction[k])
+            delta1_rupture, d_rupture = rupture_point(r, theta, u)
+            d_low = max(0.0, bridge_kernel(r, theta, u, largest)[0])
+            where = f"r = {r:g}, u* = {u:.6g}, distance index {j} of {n_distance}"
+            compare_node(where, "rupture distance d*", self.distance_rupture[i, k], d_rupture)
+            compare_node(where, "smallest distance d*", self.distance_low[i, k], d_low, d_rupture)
+            if j == 0:
+                bridge = bridge_from_kernel(r, self.contact_angle, u, delta1_rupture)
+            elif j == n_distance - 1 and d_low > 0.0:
+                bridge = bridge_from_kernel(r, self.contact_angle, u, largest)
+            else:
+                distance = d_low + (d_rupture - d_low) * distance_fraction(j / (n_distance - 1))
+                bridge = bridge_at_distance(r, self.contact_angle, u, distance)
+            for field, found in zip(FIELDS, self.values[i, k, j]):
+                compare_node(where, field, found, getattr(bridge, field))
 
     def arrays(self):
         """(radius_ratios, suction_axis = [suction_scale, xi step, suction_max], distance_low,

@@ -20,6 +20,7 @@ import numpy as np
 from pendular.capillary.meniscus import bridge_kernel
 from pendular.capillary.suction_control import contact_filling_angle
 from pendular.capillary.table import (
+    SPOT_NODES,
     TABLE_FORMAT,
     YADE_RADIUS_RATIOS,
     along_axis,
@@ -29,10 +30,12 @@ from pendular.capillary.table import (
     cache_key,
     cached_table,
     check_table_nodes,
+    compare_node,
     distance_cell,
     distance_fraction,
     grid_position,
     radius_ratio_bracket,
+    spot_nodes,
 )
 from pendular.capillary.validation import check_contact_angle, check_radius_ratio
 from pendular.dem.atomic import replacing
@@ -58,13 +61,18 @@ def contact_volume_range(radius_ratio, contact_angle):
     return volumes[0], volumes[1]
 
 
+def volume_axis(radius_ratio, contact_angle):
+    """(ln V*_min, ln V*_max) tabulated for a radius ratio: contact_volume_range, a round-off
+    inside so that the contact end of each volume is found by bracketing."""
+    smallest, largest = contact_volume_range(radius_ratio, contact_angle)
+    return math.log(smallest) + 1e-9, math.log(largest) - 1e-9
+
+
 def build_volume_rows(radius_ratio, contact_angle, n_volume, n_distance):
     """Nodes of one radius ratio: (ln V* bounds, distance_low (n_V,), distance_rupture (n_V,),
     values (n_V, n_distance, 6))."""
     theta = math.radians(contact_angle)
-    smallest, largest = contact_volume_range(radius_ratio, contact_angle)
-    # stay strictly inside the range so that the contact end is found by bracketing
-    log_bounds = (math.log(smallest) + 1e-9, math.log(largest) - 1e-9)
+    log_bounds = volume_axis(radius_ratio, contact_angle)
     distance_low = np.empty(n_volume)
     distance_rupture = np.empty(n_volume)
     values = np.empty((n_volume, n_distance, len(VOLUME_FIELDS)))
@@ -251,11 +259,44 @@ class VolumeBridgeTable:
                  "distance_rupture": (n_r, parameters["n_volume"])},
                 {name: parameters[name] for name in ("contact_angle", "radius_ratios")},
             )
+            table.check_nodes()
 
         return cached_table(
             path, cache_identity("volume", parameters), cls.load, check,
             lambda: cls.build(contact_angle, radius_ratios, n_volume, n_distance),
         )
+
+    def check_nodes(self, count=SPOT_NODES):
+        """ValueError naming the first of the ``spot_nodes`` whose stored state is not the exact
+        bridge (pendular.capillary.meniscus.bridge_kernel at the node's own u* and delta1) of the
+        node's volume and distance, or whose radius ratio's volume range differs from
+        ``volume_axis``, beyond NODE_TOLERANCE (a relative tolerance)."""
+        theta = math.radians(self.contact_angle)
+        n_volume, n_distance = self.n_volume, self.n_distance
+        checked_axes = set()
+        for i, m, j in spot_nodes(self.values.shape[:3], count):
+            r = float(self.radius_ratios[i])
+            if i not in checked_axes:
+                checked_axes.add(i)
+                for name, found, exact in zip(("ln V*_min", "ln V*_max"), self.volume_axes[i],
+                                              volume_axis(r, self.contact_angle)):
+                    compare_node(f"r = {r:g}", f"volume range {name}", found, exact, 1.0)
+            volume = math.exp(np.linspace(*self.volume_axes[i], n_volume)[m])
+            low, rupture = self.distance_low[i, m], self.distance_rupture[i, m]
+            if j == 0:
+                distance = rupture
+            elif j == n_distance - 1:
+                distance = low
+            else:
+                distance = low + (rupture - low) * distance_fraction(j / (n_distance - 1))
+            force, suction, delta1, delta2, nn11, nn33 = self.values[i, m, j]
+            exact = bridge_kernel(r, theta, suction, math.radians(delta1))
+            where = f"r = {r:g}, V* = {volume:.6g}, distance index {j} of {n_distance}"
+            compare_node(where, "distance d*", distance, exact[0], abs(rupture))
+            for name, found, solved in (("volume", volume, exact[1]), ("force", force, exact[2]),
+                                        ("delta2", delta2, math.degrees(exact[3])),
+                                        ("nn11", nn11, exact[4]), ("nn33", nn33, exact[5])):
+                compare_node(where, name, found, solved)
 
     def arrays(self):
         """(radius_ratios, volume_axes = [[ln V*_min, ln V*_max]] per radius ratio, distance_low,

@@ -20,7 +20,9 @@ The state of an operation is its ``vars(op)``: arrays, scalars and any picklable
 (``StressServo.previous``, the NeighborList's reference positions and rebuild count,
 ``HistoryRecorder.rows``, a writer's list of frames ...). Values that cannot be pickled
 (functions such as the recorder's quantities) are configuration that the scene rebuilds: they
-are skipped, listed in the ``skipped`` attribute, and the freshly built operation keeps its own.
+are skipped at saving, listed in the ``skipped`` attribute, and the freshly built operation
+keeps its own (at loading nothing is skipped: a saved value that cannot be restored is an
+error).
 An operation may name attributes not worth saving in a class attribute ``checkpoint_exclude``.
 References to the simulation's own objects (the simulation, particles, walls, contacts, their
 arrays, ``contacts.extra``, other operations) are saved as references and point, after loading,
@@ -30,13 +32,21 @@ to the loaded simulation's objects, so an operation that caches ``sim.contacts``
 the same places, in the same order; the scene's closures are not saved) and raises ValueError
 otherwise; a checkpoint of another format version (1: before the declared pipeline; 2:
 with per-pair torques, which the contact law no longer stores) is refused with its version.
+A checksum only proves a file unchanged since it was stamped, so the content is checked before
+use as well: arrays of the right dtype, shape and finiteness, pair indices within the particles
+and consistent with their CSR indices (a bad index would crash a compiled kernel), and an
+operation state that unpickles, fits the pipeline and holds values of the types the freshly
+built operations hold; anything else is refused with one ValueError naming the file.
 The file is written under a temporary name, flushed to disk (fsync) and renamed over the
 previous checkpoint, so a run killed at any moment (kill -9 included) leaves the previous
 checkpoint intact. Checkpoints hold pickles: load only files you trust.
 """
 
+import dataclasses
 import io
 import json
+import math
+import numbers
 import os
 import pickle
 
@@ -45,8 +55,9 @@ import numpy as np
 
 from .atomic import replacing
 from .integrity import software_version, stamp, verify
-from .neighbors import Contacts
+from .neighbors import Contacts, second_index
 from .validate import check_int, reading
+from .virial import SUM_BLOCKS, face_block_starts
 
 FORMAT = "pendular-checkpoint"
 VERSION = 3
@@ -266,7 +277,14 @@ def _read_group(group):
 
 
 def _check_types(handle, sim):
-    saved_pipeline = json.loads(handle.attrs["pipeline"])
+    try:
+        saved_pipeline = json.loads(handle.attrs["pipeline"])
+    except json.JSONDecodeError as error:
+        raise ValueError(f"checkpoint {handle.filename!r}: its pipeline attribute is not JSON "
+                         f"({error})") from None
+    if not isinstance(saved_pipeline, dict):
+        raise ValueError(f"checkpoint {handle.filename!r}: its pipeline attribute is not a JSON "
+                         "object of the operation types by kind")
     for kind, ops in _pipeline(sim).items():
         saved = saved_pipeline.get(kind)
         current = [_type_name(op) for op in ops]
@@ -277,15 +295,270 @@ def _check_types(handle, sim):
                 "the checkpointed one was built")
 
 
+#: Per-pair arrays of Contacts: name -> (dtype, trailing shape); each holds one row per pair.
+_PAIR_ARRAYS = {
+    "pair_i": (np.int64, ()), "pair_j": (np.int64, ()), "second_pair": (np.int64, ()),
+    "shear_force": (np.float64, (3,)), "normal": (np.float64, (3,)),
+    "overlap": (np.float64, ()), "normal_force": (np.float64, ()),
+    "force": (np.float64, (3,)), "image": (np.int8, (3,))}
+
+#: Index arrays of Contacts that are not per pair: name -> expected length (None: any), from
+#: the particle count.
+_INDEX_ARRAYS = {"row_start": lambda count: count + 1, "second_start": lambda count: count + 1,
+                 "through_face": lambda count: None, "face_start": lambda count: SUM_BLOCKS + 1,
+                 "near_wall": lambda count: None}
+
+
+def _first(mask):
+    """Index (a tuple, one entry per axis) of the first True of ``mask``."""
+    return tuple(int(i) for i in np.argwhere(mask)[0])
+
+
+def _check_array(source, name, value, dtype, shape, finite=True):
+    """ValueError unless ``value`` is an array of ``dtype`` and ``shape`` (None: any length on
+    that axis), its floating-point entries finite if ``finite``."""
+    if not isinstance(value, np.ndarray):
+        raise ValueError(f"{source}: {name} is a {type(value).__name__}, not an array of "
+                         f"{np.dtype(dtype)}")
+    if value.dtype != np.dtype(dtype):
+        raise ValueError(f"{source}: {name} holds {value.dtype}; valid: {np.dtype(dtype)}")
+    if value.ndim != len(shape) or any(want is not None and got != want
+                                       for got, want in zip(value.shape, shape)):
+        wanted = "(" + ", ".join("any" if n is None else str(n) for n in shape) + \
+            ("," if len(shape) == 1 else "") + ")"
+        raise ValueError(f"{source}: {name} has shape {value.shape}; valid: {wanted}")
+    if finite and value.dtype.kind == "f" and not np.isfinite(value).all():
+        index = _first(~np.isfinite(value))
+        raise ValueError(f"{source}: {name}{list(index)} = {value[index]} is not finite")
+
+
+def _check_owned(source, owner, arrays, scalars, current, count, per_particle):
+    """The arrays and scalars of ``owner`` (particles, walls) against those of the ``current``
+    object: the same array names, each of the same dtype and trailing shape and finite, with
+    one row per particle (``count``) if ``per_particle``, else as many rows as the current one
+    or one per particle (a periodic cell's wraps); each scalar of the current one's kind."""
+    expected = {name for name, value in vars(current).items() if isinstance(value, np.ndarray)}
+    odd = sorted(expected ^ set(arrays))
+    if odd:
+        where = "is missing" if odd[0] in expected else f"is not an array of {owner}"
+        raise ValueError(f"{source}: {owner}/{odd[0]} {where}")
+    for name, value in arrays.items():
+        fresh = getattr(current, name)
+        if fresh.ndim == 0:
+            shape = ()
+        elif per_particle:
+            shape = (count,) + fresh.shape[1:]
+        else:
+            rows = count if np.shape(value)[:1] == (count,) else fresh.shape[0]
+            shape = (rows,) + fresh.shape[1:]
+        _check_array(source, f"{owner}/{name}", value, fresh.dtype, shape)
+    for name, value in scalars.items():
+        reason = _unfit(getattr(current, name, None), value)
+        if reason is None and isinstance(value, numbers.Real) and not math.isfinite(value):
+            reason = "not finite"
+        if reason is not None:
+            raise ValueError(f"{source}: {owner} attribute {name} = {value!r}: {reason}")
+
+
+def _check_clock(source, step, time, dt):
+    """(step, time [s], dt [s]) of a checkpoint as int, float, float; ValueError unless the
+    step is an integer >= 0, the time finite >= 0 and dt finite > 0."""
+    def real(value):
+        return isinstance(value, numbers.Real) and math.isfinite(value)
+
+    for name, value, good, valid in (
+            ("step", step, isinstance(step, numbers.Integral) and step >= 0, "an integer >= 0"),
+            ("time", time, real(time) and time >= 0.0, "[0, inf) s"),
+            ("dt", dt, real(dt) and dt > 0.0, "(0, inf) s")):
+        if not good:
+            shown = value.item() if isinstance(value, np.generic) else value
+            raise ValueError(f"{source}: {name} = {shown!r} is outside the valid range {valid}")
+    return int(step), float(time), float(dt)
+
+
+def _check_particles(source, arrays, scalars, particles):
+    """The particle count of a checkpoint after checking its particle arrays; ValueError."""
+    position = arrays.get("position")
+    if not isinstance(position, np.ndarray) or position.ndim != 2 or len(position) == 0:
+        raise ValueError(f"{source}: particles/position is not an array (N, 3) of at least one "
+                         "sphere")
+    count = len(position)
+    _check_owned(source, "particles", arrays, scalars, particles, count, True)
+    for name in ("radius", "mass", "inertia"):
+        if name in arrays and not (arrays[name] > 0.0).all():
+            index = _first(~(arrays[name] > 0.0))
+            raise ValueError(f"{source}: particles/{name}{list(index)} = {arrays[name][index]} "
+                             "is outside the valid range (0, inf)")
+    density = scalars.get("density")
+    if density is not None and not density > 0.0:
+        raise ValueError(f"{source}: particles density = {density} is outside the valid range "
+                         "(0, inf) kg/m^3")
+    return count
+
+
+def _check_contacts(source, arrays, extra, count):
+    """ValueError unless the contact arrays of a checkpoint form a valid neighbour list of
+    ``count`` particles (pendular.dem.neighbors.Contacts): dtypes and shapes, finite per-pair
+    state, 0 <= i < j < count, CSR indices that match the pairs, and per-pair ``extra``
+    arrays of numbers with one row per pair."""
+    unknown = sorted(set(arrays) - set(_PAIR_ARRAYS) - set(_INDEX_ARRAYS))
+    if unknown:
+        raise ValueError(f"{source}: contacts/{unknown[0]} is not an array of "
+                         "pendular.dem.neighbors.Contacts")
+    missing = sorted(item.name for item in dataclasses.fields(Contacts)
+                     if item.default is dataclasses.MISSING
+                     and item.default_factory is dataclasses.MISSING and item.name not in arrays)
+    if missing:
+        raise ValueError(f"{source}: contacts/{missing[0]} is missing")
+    pair_i = arrays["pair_i"]
+    _check_array(source, "contacts/pair_i", pair_i, np.int64, (None,))
+    pairs = len(pair_i)
+    for name, (dtype, tail) in _PAIR_ARRAYS.items():
+        if name in arrays:          # overlap: -inf for a pair never touched, checked below
+            _check_array(source, f"contacts/{name}", arrays[name], dtype, (pairs,) + tail,
+                         finite=name != "overlap")
+    for name, length in _INDEX_ARRAYS.items():
+        if name in arrays:
+            _check_array(source, f"contacts/{name}", arrays[name], np.int64, (length(count),))
+    pair_j = arrays["pair_j"]
+    for name, values in (("pair_i", pair_i), ("pair_j", pair_j)):
+        outside = (values < 0) | (values >= count)
+        if outside.any():
+            (k,) = _first(outside)
+            raise ValueError(f"{source}: contacts/{name}[{k}] = {values[k]} is outside the valid "
+                             f"range [0, {count}) of the checkpoint's {count} particles")
+    if (pair_i >= pair_j).any():
+        (k,) = _first(pair_i >= pair_j)
+        raise ValueError(f"{source}: pair {k} joins particles i = {pair_i[k]}, j = {pair_j[k]}; "
+                         f"valid: 0 <= i < j < {count} (each pair stored once, i < j)")
+    overlap = arrays["overlap"]
+    if (np.isnan(overlap) | (overlap == np.inf)).any():
+        (k,) = _first(np.isnan(overlap) | (overlap == np.inf))
+        raise ValueError(f"{source}: contacts/overlap[{k}] = {overlap[k]}; valid: a finite "
+                         "overlap [m], or -inf for a pair that never touched")
+    row_start = arrays["row_start"]
+    if row_start[0] != 0 or row_start[-1] != pairs or (np.diff(row_start) < 0).any() or \
+            not np.array_equal(pair_i, np.repeat(np.arange(count), np.diff(row_start))):
+        raise ValueError(f"{source}: contacts/row_start does not index the pairs by their first "
+                         f"particle (CSR over {count} particles and {pairs} pairs)")
+    same_row = pair_i[1:] == pair_i[:-1]
+    if (pair_j[1:][same_row] <= pair_j[:-1][same_row]).any():
+        k = int(np.flatnonzero(same_row & (pair_j[1:] <= pair_j[:-1]))[0]) + 1
+        raise ValueError(f"{source}: pair {k} (i = {pair_i[k]}, j = {pair_j[k]}) is out of "
+                         "order: the pairs of a particle are sorted by j, each once")
+    second_start, second_pair = second_index(row_start, pair_j, count)
+    if not (np.array_equal(arrays["second_start"], second_start)
+            and np.array_equal(arrays["second_pair"], second_pair)):
+        raise ValueError(f"{source}: contacts/second_start and second_pair do not index the "
+                         "pairs by their second particle")
+    image = arrays.get("image")
+    through_face = (np.zeros(0, np.int64) if image is None
+                    else np.flatnonzero(image.any(axis=1)).astype(np.int64))
+    if "through_face" in arrays and not np.array_equal(arrays["through_face"], through_face):
+        raise ValueError(f"{source}: contacts/through_face is not the list of the pairs whose "
+                         "periodic image is not zero")
+    if "face_start" in arrays and not np.array_equal(
+            arrays["face_start"], face_block_starts(through_face, row_start)):
+        raise ValueError(f"{source}: contacts/face_start does not match through_face and "
+                         "row_start")
+    near_wall = arrays.get("near_wall")
+    if near_wall is not None and len(near_wall) and (
+            near_wall[0] < 0 or near_wall[-1] >= count or (np.diff(near_wall) <= 0).any()):
+        raise ValueError(f"{source}: contacts/near_wall is not an ascending list of particle "
+                         f"indices in [0, {count})")
+    for name, values in extra.items():
+        if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf" or \
+                values.ndim == 0 or len(values) != pairs:
+            raise ValueError(f"{source}: contacts/extra/{name} holds {np.asarray(values).dtype} "
+                             f"of shape {np.shape(values)}; valid: numbers, one row per pair "
+                             f"({pairs}, ...)")
+        if values.dtype.kind == "f" and not np.isfinite(values).all():
+            index = _first(~np.isfinite(values))
+            raise ValueError(f"{source}: contacts/extra/{name}{list(index)} = {values[index]} "
+                             "is not finite")
+
+
+def _unfit(fresh, value):
+    """Why ``value`` cannot replace an operation's attribute ``fresh`` (the value its freshly
+    built operation holds), or None: an array for an array (same dtype and trailing shape),
+    a boolean for a boolean, a number for a number, else an instance of the same type. None on
+    either side fits (attributes set when first needed, caches cleared)."""
+    if fresh is None or value is None:
+        return None
+    if isinstance(fresh, np.ndarray):
+        if not isinstance(value, np.ndarray):
+            return f"of type {type(value).__name__}, not an array"
+        if value.dtype != fresh.dtype or value.ndim != fresh.ndim or \
+                value.shape[1:] != fresh.shape[1:]:
+            return (f"an array of {value.dtype} and shape {value.shape}; this simulation's is "
+                    f"{fresh.dtype} of shape {fresh.shape}")
+        return None
+    if isinstance(fresh, (bool, np.bool_)):
+        return None if isinstance(value, (bool, np.bool_)) else f"{value!r}, not a boolean"
+    if isinstance(fresh, numbers.Number):
+        if isinstance(value, numbers.Number) and not isinstance(value, (bool, np.bool_)):
+            return None
+        return f"{value!r}, not a number"
+    if not isinstance(value, type(fresh)):
+        return f"of type {type(value).__name__}, not {type(fresh).__name__}"
+    return None
+
+
+def _operation_states(source, blob, references, sim):
+    """The unpickled state tree of a checkpoint after checking that it fits ``sim``'s pipeline:
+    a state per operation, each attribute of the type the operation holds (an attribute absent
+    from the state, e.g. one added to the operation after the checkpoint was written, keeps
+    the operation's own value); ValueError naming the file otherwise. Nothing of ``sim`` is
+    changed."""
+    try:
+        tree = _Unpickler(io.BytesIO(blob), references).load()
+    except Exception as error:      # garbage bytes raise any of pickle's many errors
+        raise ValueError(f"{source}: the saved state of its operations (dataset 'state') cannot "
+                         f"be restored: {type(error).__name__}: {error}") from None
+    pipeline = _pipeline(sim)
+    if not isinstance(tree, dict) or set(tree) != {"extra_state", *pipeline}:
+        found = sorted(map(str, tree)) if isinstance(tree, dict) else type(tree).__name__
+        raise ValueError(f"{source}: the saved state of its operations holds {found}; valid: "
+                         f"{sorted(['extra_state', *pipeline])}")
+    for kind, ops in pipeline.items():
+        states = tree[kind]
+        if not isinstance(states, list) or len(states) != len(ops):
+            found = len(states) if isinstance(states, list) else type(states).__name__
+            raise ValueError(f"{source}: the saved state of its {kind} holds {found} entries; "
+                             f"this simulation has {len(ops)} {kind}")
+        for index, (op, state) in enumerate(zip(ops, states)):
+            owner = f"{kind}[{index}] {type(op).__name__}"
+            if not isinstance(state, dict) or not all(isinstance(name, str) for name in state):
+                raise ValueError(f"{source}: the saved state of {owner} is of type "
+                                 f"{type(state).__name__}, not attributes by name")
+            current = vars(op)
+            exclude = set(getattr(op, "checkpoint_exclude", ()))
+            for name, value in state.items():
+                if name in exclude:         # kept from the operation, not restored
+                    continue
+                defined = getattr(type(op), name, None)
+                if name not in current and (name.startswith("__") or callable(defined)
+                                            or isinstance(defined, property)):
+                    raise ValueError(f"{source}: the saved state of {owner} names {name!r}, "
+                                     "a method or property of its class, not an attribute")
+                reason = _unfit(current.get(name), value)
+                if reason is not None:
+                    raise ValueError(f"{source}: the saved {owner}.{name} cannot be restored: "
+                                     f"it is {reason}")
+    return tree
+
+
 def load_checkpoint(path, sim, expected_identity=None):
     """Restore the state saved by ``save_checkpoint`` into ``sim``; return its ``extra_state``.
 
     The file's checksum is verified first, and its identity against ``expected_identity``
     (ValueError naming the path: edited or damaged, another run's, or older than checksums).
     ``sim`` must have neighbour list, forces, controls, integrator and writers of the same
-    types in the same order (ValueError otherwise, before anything is changed). Particles,
+    types in the same order, and the content must be valid (module docstring): ValueError
+    naming the file and what is wrong otherwise, before anything is changed. Particles,
     walls, contacts, step, time, dt and the saved attributes of every operation and writer are
-    replaced; attributes skipped at saving keep the values of ``sim``'s own operations.
+    replaced; attributes skipped at saving, or excluded (``checkpoint_exclude``), keep the
+    values of ``sim``'s own operations.
     """
     path = os.fspath(path)
     verify(path, expected_identity, kind="checkpoint")
@@ -302,21 +575,23 @@ def load_checkpoint(path, sim, expected_identity=None):
         particle_scalars = dict(handle["particles"].attrs)
         wall_arrays = _read_group(handle["walls"])
         wall_scalars = dict(handle["walls"].attrs)
-        contacts = None
-        if bool(handle.attrs["has_contacts"]):
+        has_contacts = bool(handle.attrs["has_contacts"])
+        if has_contacts:
+            contact_arrays = _read_group(handle["contacts"])
             extra = _read_group(handle["contacts/extra"])
-            try:
-                contacts = Contacts(**_read_group(handle["contacts"]), extra=extra)
-            except TypeError as error:
-                raise ValueError(f"contacts of checkpoint {path!r} do not match "
-                                 f"pendular.dem.neighbors.Contacts: {error}") from None
         blob = handle["state"][()].tobytes()
-        step = int(handle.attrs["step"])
-        time = float(handle.attrs["time"])
-        dt = float(handle.attrs["dt"])
+        step, time, dt = (handle.attrs[name] for name in ("step", "time", "dt"))
 
+    source = f"checkpoint {path!r}"
+    step, time, dt = _check_clock(source, step, time, dt)
+    count = _check_particles(source, particle_arrays, particle_scalars, sim.particles)
+    _check_owned(source, "walls", wall_arrays, wall_scalars, sim.walls, count, False)
+    contacts = None
+    if has_contacts:
+        _check_contacts(source, contact_arrays, extra, count)
+        contacts = Contacts(**contact_arrays, extra=extra)
     references = _references(sim, particle_arrays, wall_arrays, contacts)
-    tree = _Unpickler(io.BytesIO(blob), references).load()
+    tree = _operation_states(source, blob, references, sim)
 
     for obj, arrays, scalars in ((sim.particles, particle_arrays, particle_scalars),
                                  (sim.walls, wall_arrays, wall_scalars)):
@@ -330,8 +605,10 @@ def load_checkpoint(path, sim, expected_identity=None):
     sim.dt = dt
     for kind, ops in _pipeline(sim).items():
         for op, state in zip(ops, tree[kind]):
+            exclude = set(getattr(op, "checkpoint_exclude", ()))
             for name, value in state.items():
-                setattr(op, name, value)
+                if name not in exclude:     # saved by a pendular that did not exclude it
+                    setattr(op, name, value)
     return tree["extra_state"]
 
 
@@ -340,8 +617,12 @@ class CheckpointWriter:
 
     Append it after the other writers, so that the checkpoint holds the record of its own step.
     ``extra_state``: None, a picklable value, or a function of sim returning one; ``identity``:
-    see ``save_checkpoint``.
+    see ``save_checkpoint``. Only the count of checkpoints written is restored on resuming:
+    the resumed run's own path, period, extra_state and identity hold (a run folder copied and
+    resumed writes its checkpoints into itself, not into the folder it was copied from).
     """
+
+    checkpoint_exclude = ("path", "period", "extra_state", "identity")
 
     def __init__(self, path, period, extra_state=None, identity=None):
         self.path = os.fspath(path)
