@@ -121,7 +121,7 @@ def test_triaxial_scenario_writes_its_outputs(tmp_path):
     (["--porosity", "0.7"], "porosity"),
     (["--friction", "95"], "friction"),
     (["--confining", "nan"], "confining"),
-    (["--max-strain", "inf"], "max_strain"),
+    (["--max-strain", "inf"], "--max-strain"),
     (["--suction", "-5"], "suction"),
     (["--bogus"], "unrecognized arguments"),
 ])

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
-from pendular.dem.preparation import MAX_SEED, PrepareConfig
+from pendular.dem.preparation import MAX_PARTICLES, MAX_SEED, PrepareConfig, pwave_step
+from pendular.dem.timestep import pwave_timestep
 from pendular.dem.validate import check_int, check_positive, check_range
 from pendular.homogenize import packing_state, regular_packing
 
@@ -37,11 +38,40 @@ WETTING_PROTOCOLS = ("isotropic", "at-shear", "constant-volume")
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
 
+#: Largest final axial strain of a triaxial shear [-]: laboratory tests end by 20-30 %
+#: (ISO 17892-9 and ASTM D7181 stop at 15-20 % or at the critical state; the thesis shears to
+#: 25 %); at 50 % the sample is half its height and its servoed lateral walls span twice its
+#: cross-section, no test any more (the particles crush into each other beyond).
+MAX_AXIAL_STRAIN = 0.5
+#: Smallest final axial strain [-]: below, the walls move less than a contact's overlap.
+MIN_AXIAL_STRAIN = 1e-6
+#: Why MAX_AXIAL_STRAIN (the end of the error refusing more).
+AXIAL_STRAIN_LIMIT = ("a triaxial test ends by 20-30 % axial strain (the thesis's 25 %); at "
+                      "half its height the sample is no test any more")
+#: Most history rows of a shear (each a few hundred bytes; one a step at most).
+MAX_RECORDS = 10_000_000
+#: Fewest spheres of a triaxial test or an SWCC: their stresses and saturation are averages
+#: over the sample's contacts and bridges, and 50 spheres hold about 100-150 of them (a few
+#: spheres give a "peak" of one contact); the trade-off study's quarter samples are 50.
+MIN_SAMPLE_PARTICLES = 50
+#: Why a sample needs MIN_SAMPLE_PARTICLES (the end of the error refusing fewer).
+AVERAGES = ("its stresses and saturation are averages over the sample's contacts and bridges, "
+            "which a few spheres do not give")
+#: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
+#: void ratio is the core's, the box less a diameter along each wall; at 100 spheres the box
+#: is about 4.5 diameters across and the core 2.5.
+MIN_TENSION_PARTICLES = 100
+#: Most spheres of a direct tension sample (each void ratio is tuned over up to
+#: pendular.tension.PREPARATIONS preparations of it).
+MAX_TENSION_PARTICLES = 1_000_000
+
 
 @dataclass
 class ShearConfig:
-    """Shear phase of a triaxial test. ``strain_rate`` [1/s] defaults to the one giving
-    ``inertial_number`` I = rate * 2R * sqrt(rho / confining) (GDR MiDi 2004).
+    """Shear phase of a triaxial test to the axial strain ``max_strain`` [-] (at most
+    MAX_AXIAL_STRAIN). ``strain_rate`` [1/s] defaults to the one giving ``inertial_number``
+    I = rate * 2R * sqrt(rho / confining) (GDR MiDi 2004); ``records``: history rows (at most
+    one a step).
 
     Wall-control options, pendular's choice by default; ``YADE_CHOICES`` holds YADE's
     (TriaxialStressController, docs/yade_crosscheck.md):
@@ -63,13 +93,13 @@ class ShearConfig:
     servo_stiffness_every: int = 1
 
     def __post_init__(self):
-        # below 1e-6 the walls move less than a contact's overlap: no test to speak of
-        self.max_strain = check_range("max_strain", self.max_strain, 1e-6, 0.9)
+        self.max_strain = check_range("max_strain", self.max_strain, MIN_AXIAL_STRAIN,
+                                      MAX_AXIAL_STRAIN)
         self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
                                            low_inclusive=False)
         if self.strain_rate is not None:
             self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
-        self.records = check_int("records", self.records, low=2, high=10_000_000)
+        self.records = check_int("records", self.records, low=2, high=MAX_RECORDS)
         if self.servo_max_velocity is not None:
             self.servo_max_velocity = check_positive("servo_max_velocity",
                                                      self.servo_max_velocity, "m/s")
@@ -177,7 +207,8 @@ class TriaxialConfig:
     """A drained triaxial test (thesis Ch. 5.2.3): sample, optional bridges, shear, outputs.
 
     sample: preparation and material (pendular.dem.preparation.PrepareConfig; its ``confining`` [Pa] is
-    the lateral stress of the shear); bridges: None for a dry test; shear: ShearConfig;
+    the lateral stress of the shear; at least MIN_SAMPLE_PARTICLES spheres); bridges: None for
+    a dry test; shear: ShearConfig;
     sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
     vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
@@ -207,6 +238,8 @@ class TriaxialConfig:
         if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
             raise TypeError(f"bridges must be a BridgeConfig or None, got "
                             f"{type(self.bridges).__name__}")
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES,
+                        "a triaxial test", AVERAGES)
         if self.sample.confining <= 0.0:
             # the shear's lateral stress: the inertial number and the servo need it > 0
             raise ValueError(f"confining = {self.sample.confining:g} Pa is outside the valid "
@@ -227,6 +260,15 @@ class TriaxialConfig:
     def confining(self):
         """Lateral stress of the shear [Pa] (the sample's confining stress)."""
         return self.sample.confining
+
+    def shear_steps(self):
+        """Steps of the shear estimated before anything runs [-]: max_strain over the strain
+        rate times the P-wave step of the mean radius (pendular.dem.preparation.pwave_step). An
+        upper bound for equal spheres: the 'stiffness' rule's step is 1.4-1.5 times longer on
+        prepared samples, so the shear takes that much fewer."""
+        sample, shear = self.sample, self.shear
+        rate = shear.rate(sample.radius, sample.density, sample.confining)
+        return shear.max_strain / (rate * pwave_step(sample.radius, sample))
 
     @property
     def suction(self):
@@ -252,11 +294,13 @@ class TensionConfig:
     confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
     wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
     max_strain: largest axial extension [-]; residual: fraction of the peak below which the
-    pull has ruptured [-]; grip_depth: grip thickness [diameters]; void_ratio_tolerance [-];
-    vtk_frames: ParaView frames per pull (0: none); vtk_every: steps between frames instead
-    (None: from vtk_frames; 0: none); seed: random seed of the samples; periodic: samples in a
-    periodic cell pulled along z at zero lateral stress (no walls, no grips; the void ratio is
-    the whole cell's).
+    pull has ruptured [-]; grip_depth: grip thickness [diameters] (walls only);
+    void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull (0: none); vtk_every: steps
+    between frames instead (None: from vtk_frames; 0: none), both at most the pull's steps
+    (``pull_steps``); seed: random seed of the samples; periodic: samples in a periodic cell
+    pulled along z at zero lateral stress (no walls, no grips: a grip_depth other than the
+    default is refused; the void ratio is the whole cell's). Cases are distinct by their
+    folder names (``case_name``); particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES].
     """
 
     cases: list[tuple[float, float]] = field(
@@ -294,7 +338,17 @@ class TensionConfig:
         for e, _ in self.cases:
             # denser than random close packing or looser than the loosest growth: unreachable
             check_range("--void-ratio", e, 0.5, 1.2)
-        check_range("--particles", self.particles, 100, 1e6)
+        names = [case_name(e, w) for e, w in self.cases]
+        for k, name in enumerate(names):
+            if name in names[:k]:        # one folder, one sample per void ratio: run once
+                (e0, w0), (e1, w1) = self.cases[names.index(name)], self.cases[k]
+                raise ValueError(
+                    f"--void-ratio / --water-content: the cases (e {e0:g}, w {100 * w0:g} %) "
+                    f"and (e {e1:g}, w {100 * w1:g} %) share the folder {name}: give each "
+                    "case once, void ratios 0.01 or water contents 0.01 % apart")
+        self.particles = check_particles(
+            self.particles, MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES, "direct tension",
+            "the grips hold a layer at each z wall and the void ratio is the core's")
         check_range("--form-gap", self.form_gap, 0.0, 1.0)
         if self.psd is not None or self.radius_spread:
             sizes = PrepareConfig(particles=int(self.particles), radius=self.radius,
@@ -316,10 +370,18 @@ class TensionConfig:
         check_range("--residual", self.residual, 0.0, 1.0, low_inclusive=False,
                     high_inclusive=False)
         check_range("--grip-depth", self.grip_depth, 0.0, 3.0)
+        if self.periodic and self.grip_depth != TensionConfig.grip_depth:
+            raise ValueError(f"--grip-depth = {self.grip_depth:g} does not apply to --periodic: "
+                             "a periodic cell has no walls, so no grips")
         check_range("--void-ratio-tolerance", self.void_ratio_tolerance, 0.001, 0.1)
         check_range("--vtk-frames", self.vtk_frames, 0, 1000)
+        steps = self.pull_steps()
+        check_steps_count("--vtk-frames", self.vtk_frames, steps,
+                          f"the pull to --max-strain {self.max_strain:g}")
         if self.vtk_every is not None:
             self.vtk_every = check_int("--vtk-every", self.vtk_every)
+            check_steps_count("--vtk-every", self.vtk_every, steps,
+                              f"the pull to --max-strain {self.max_strain:g}")
         check_int("--seed", self.seed, high=MAX_SEED)
         for e, w in self.cases:
             limit = self.pendular_limit(e)
@@ -328,6 +390,17 @@ class TensionConfig:
                                  f"range (0, {100.0 * limit:.3g}] %: the pendular regime ends "
                                  "at the pendular limit of the "
                                  f"{comparison_packing(e)[1]} packing")
+
+    def pull_steps(self):
+        """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
+        the strain rate times the P-wave step of the mean radius (pendular.dem.preparation
+        .pwave_step; the pull runs at the 'stiffness' rule's step, 1.4-1.5 times longer on
+        prepared samples); a pull that ruptures stops sooner."""
+        sample = PrepareConfig          # the tension samples' density and time-step safety
+        rate = self.inertial_number / inertial_number(1.0, self.radius, sample.density,
+                                                      self.confining)
+        dt = sample.timestep_safety * pwave_timestep(self.radius, self.young, sample.density)
+        return self.max_strain / (rate * dt)
 
     def pendular_limit(self, void_ratio):
         """Gravimetric water content [-] at the pendular limit of the regular packing compared
@@ -346,10 +419,11 @@ class SwccConfig:
     ``suctions`` then wetting back, at the sample's confining stress.
 
     sample: preparation and material (pendular.dem.preparation.PrepareConfig; its ``confining`` [Pa]
-    holds during the path); suctions [Pa]: the path's stages, ascending and distinct, at least
-    two; surface_tension [N/m]; contact_angle [deg]; form_gap: at wetting, bridges also form
-    across gaps up to form_gap mean radii (0: at contacts only); stage_steps: most steps per
-    stage to reach equilibrium; record_every: steps between history records.
+    holds during the path; at least MIN_SAMPLE_PARTICLES spheres); suctions [Pa]: the path's
+    stages, ascending and distinct, at least two; surface_tension [N/m]; contact_angle [deg];
+    form_gap: at wetting, bridges also form across gaps up to form_gap mean radii (0: at
+    contacts only); stage_steps: most steps per stage to reach equilibrium; record_every: steps
+    between history records.
     """
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
@@ -364,6 +438,8 @@ class SwccConfig:
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
             raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, "an SWCC",
+                        AVERAGES)
         self.suctions = [check_positive("--suctions", value, "Pa") for value in self.suctions]
         if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
                                                                    self.suctions[1:])):
@@ -381,6 +457,33 @@ class SwccConfig:
         self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
                                      high=100_000_000)
         self.record_every = check_int("--record-every", self.record_every, low=1)
+
+
+def check_particles(particles, low, high, test, why):
+    """``particles`` as an int; ValueError naming --particles outside [low, high], the sample
+    sizes of ``test`` (e.g. 'a triaxial test'), saying ``why`` (the reason for ``low``)."""
+    count = check_int("--particles", particles)
+    if not low <= count <= high:
+        raise ValueError(f"--particles = {count} is outside the valid range [{low}, {high}] "
+                         f"for {test}: {why}")
+    return count
+
+
+def check_steps_count(name, value, steps, phase, low=0):
+    """ValueError naming ``name`` (an option counting frames or rows of a phase, or the steps
+    between them, e.g. '--vtk-frames') when ``value`` exceeds ``steps``, the phase's estimated
+    steps: one a step at most. ``phase``: what runs them, e.g. 'the shear'; ``low``: the
+    option's own least value, for the valid range."""
+    most = max(low, 1, int(steps))
+    if value > most:
+        raise ValueError(f"{name} = {value} is outside the valid range [{low}, {most}]: "
+                         f"{phase} has about {most} steps")
+
+
+def case_name(void_ratio, water_content):
+    """Folder name of a tension case (void ratio [-], water content [-, a fraction]), e.g.
+    'e0.72_w1.04'."""
+    return f"e{void_ratio:.2f}_w{100 * water_content:.2f}"
 
 
 # ---------------------------------------------------------------- JSON form

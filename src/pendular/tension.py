@@ -63,7 +63,7 @@ from pendular.dem.tension import Grip, core_void_ratio, grip_members, tensile_st
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize import packing_state, regular_packing
 
-from .config import TensionConfig, config_to_dict, inertial_number
+from .config import TensionConfig, case_name, config_to_dict, inertial_number
 from .io import write_history
 from .outputs import OutputFolder
 from .plots import pyplot, save_figure
@@ -347,11 +347,6 @@ def kim_measured(void_ratio: float, water_content: float) -> float | None:
     return None
 
 
-def case_name(void_ratio: float, water_content: float) -> str:
-    """Folder name of a case, e.g. 'e0.72_w1.04'."""
-    return f"e{void_ratio:.2f}_w{100 * water_content:.2f}"
-
-
 def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_ratio: float,
              water_content: float, out: str, progress: bool,
              arguments: dict | None = None) -> tuple[dict, dict]:
@@ -456,6 +451,15 @@ def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> No
     save_figure(figure, path)
 
 
+def case_line(summary: dict) -> str:
+    """The progress line of a finished case (``run_case``'s summary): its strength beside
+    Kim's measurement, when he made one, and packing_state's prediction."""
+    kim = summary["kim_measured_pa"]
+    measured = "no Kim measurement" if kim is None else f"Kim {kim:.1f} Pa"
+    return (f"  {summary['case']}: tensile strength {summary['tensile_strength_pa']:.1f} Pa "
+            f"({measured}, packing_state {summary['packing_state_pa']:.1f} Pa)")
+
+
 def _percent(value):
     return "" if value is None else f"{100 * value:+.0f} %"
 
@@ -529,10 +533,7 @@ class TensionTest:
                 summaries.append(summary)
                 histories[summary["case"]] = history
                 if progress:
-                    print(f"  {summary['case']}: tensile strength "
-                          f"{summary['tensile_strength_pa']:.1f} Pa (Kim "
-                          f"{summary['kim_measured_pa']}, packing_state "
-                          f"{summary['packing_state_pa']:.1f})", flush=True)
+                    print(case_line(summary), flush=True)
         output = {"arguments": arguments,
                   "cases_requested": [list(case) for case in config.cases],
                   "config": config_to_dict(config),

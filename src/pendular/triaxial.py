@@ -44,6 +44,7 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 
+from .guards import SampleCrushed, SampleGuard
 from .config import TriaxialConfig, config_from_dict, config_to_dict, inertial_number
 from .io import write_history
 from .outputs import OutputFolder
@@ -318,6 +319,8 @@ class TriaxialShear:
             origin=sim.step, end=sim.step + self.steps)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
+        sim.writers.append(SampleGuard(self.recorder.period, describe=lambda s: (
+            f"axial strain {self.axial.strain(s.walls):.3g}")))
 
     def status(self, sim):
         """Progress-bar fields: strain, axial and lateral stress, q/p."""
@@ -392,7 +395,7 @@ def check_feasible(config, force=False):
     rate = shear.rate(sample.radius, sample.density, sample.confining)
     number = inertial_number(rate, sample.radius, sample.density, sample.confining)
     dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
-    steps = shear.max_strain / (rate * dt)
+    steps = config.shear_steps()
     if not force and number > MAX_INERTIAL_NUMBER:
         raise ValueError(
             f"strain rate {rate:.3g} 1/s gives the inertial number I = {number:.3g}, outside "
@@ -597,7 +600,10 @@ class TriaxialTest:
             identity = run_identity(config, sample_file)
             run = _ShearRun(sim, config, folder, before_shear, identity)
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
-            if state.get("phase") != "shear" or state["steps"] != run.steps:
+            if (not isinstance(state, dict) or state.get("phase") != "shear"
+                    or state.get("steps") != run.steps
+                    or not isinstance(state.get("start_step"), int)
+                    or not isinstance(state.get("shear_time_s"), (int, float))):
                 raise ValueError(f"{checkpoint} does not belong to this run's shear")
             start, end = state["start_step"], state["start_step"] + run.steps
             if not start <= sim.step <= end:
@@ -679,6 +685,11 @@ class _ShearRun:
             sim.run(steps, progress="shear" if progress else None, status=self.shear.status)
         except KeyboardInterrupt:
             stop = True
+        except SampleCrushed as error:
+            self.shear_time += time.perf_counter() - self._clock
+            if not self.folder.earlier_results:
+                self.write_outputs(completed=False, error=str(error))
+            raise
         self.shear_time += time.perf_counter() - self._clock
         if stop:
             if self.folder.earlier_results:
@@ -692,9 +703,10 @@ class _ShearRun:
             self.vtk.close(sim)
         return self.write_outputs(plots=plots)
 
-    def write_outputs(self, completed=True, plots=True):
-        """history.h5, summary.json (``completed``: whether the shear reached its final strain)
-        and, for a completed run, the plots unless ``plots`` is False."""
+    def write_outputs(self, completed=True, plots=True, error=None):
+        """history.h5, summary.json (``completed``: whether the shear reached its final strain;
+        ``error``: what stopped it, if not an interruption) and, for a completed run, the plots
+        unless ``plots`` is False."""
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
@@ -736,6 +748,8 @@ class _ShearRun:
                            "strain_rate": rate, "vtk_every": self.vtk_period})
         if not completed:
             summary["phase"] = "shear"
+        if error is not None:
+            summary["error"] = error
         self.folder.phase = "write"
         with deferred_interrupts():       # history and summary are written whole, or not at all
             write_history(os.path.join(out, "history.h5"), history,

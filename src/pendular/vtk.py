@@ -234,6 +234,9 @@ class VtkWriter:
     each new phase and stores the phase's index as field data ``phase``.
     """
 
+    #: Not restored from a checkpoint: a resumed run writes into its own folder.
+    checkpoint_exclude = ("folder",)
+
     def __init__(self, folder, period, compression="zlib", field_data=None, time_axis=None,
                  phases=None):
         self.folder = os.fspath(folder)

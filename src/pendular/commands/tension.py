@@ -20,13 +20,18 @@ from ..tension import TensionTest, cases_of, report_lines
 
 
 def _numbers(name, text):
-    """Floats of a comma-separated option; UsageError naming it."""
+    """Distinct floats of a comma-separated option; UsageError naming it (a value given twice
+    would run the same cases twice into one folder)."""
     if text is None:
         return None
     try:
-        return [float(item) for item in text.split(",")]
+        values = [float(item) for item in text.split(",")]
     except ValueError:
         raise UsageError(f"{name} = {text!r} is not a comma-separated list of numbers") from None
+    for k, value in enumerate(values):
+        if value in values[:k]:
+            raise UsageError(f"{name} = {text!r} repeats {value:g}: give each value once")
+    return values
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -47,7 +52,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_size_options(parser, KIM_RADIUS)
     parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
     parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
-                        help="surface tension [N/m]")
+                        help="surface tension [N/m] (thesis Chapter 4's, which the comparison "
+                             "with Kim and packing_state uses; triaxial and swcc default to "
+                             "Chapter 5's 0.073)")
     parser.add_argument("--specific-gravity", type=float, default=SPECIFIC_GRAVITY,
                         help="specific gravity Gs of the grains [-]")
     parser.add_argument("--confining", type=float, default=100.0,
@@ -61,9 +68,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="largest axial extension of the pull [-]")
     parser.add_argument("--residual", type=float, default=0.2,
                         help="fraction of the peak below which the pull has ruptured [-]")
-    parser.add_argument("--grip-depth", type=float, default=1.0,
+    parser.add_argument("--grip-depth", type=float, default=None,
                         help="grip thickness: particles whose surface is within this many "
-                             "diameters of a z wall [diameters]")
+                             "diameters of a z wall [diameters] (default "
+                             f"{TensionConfig.grip_depth:g}; not with --periodic, which has no "
+                             "grips)")
     parser.add_argument("--void-ratio-tolerance", type=float, default=0.01,
                         help="largest |e - target| accepted from the preparation [-]")
     frames = parser.add_mutually_exclusive_group()
@@ -84,11 +93,15 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
     """The TensionConfig of parsed options (ValueError naming the option)."""
     cases = cases_of(_numbers("--void-ratio", args.void_ratio),
                      _numbers("--water-content", args.water_content))
+    if args.periodic and args.grip_depth is not None:
+        raise UsageError(f"--grip-depth = {args.grip_depth:g} does not apply to --periodic: a "
+                         "periodic cell has no walls, so no grips")
     options = {name: getattr(args, name) for name in (
         "roughness", "form_gap", "particles", "contact_angle", "surface_tension",
         "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
         "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed",
         "periodic")}
+    options = {name: value for name, value in options.items() if value is not None}
     return TensionConfig(cases=cases, **sizes_from(args), **options)
 
 

@@ -19,15 +19,19 @@ import sys
 
 from pendular.dem.preparation import PrepareConfig
 from pendular.dem.timestep import TIMESTEP_RULES
-from pendular.dem.validate import check_range
+from pendular.dem.validate import check_int, check_range
 
 from ..cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
                    set_threads, sizes_from)
-from ..config import WETTING_PROTOCOLS, BridgeConfig, ShearConfig, TriaxialConfig
+from ..config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MAX_RECORDS, MIN_AXIAL_STRAIN,
+                      WETTING_PROTOCOLS, BridgeConfig, ShearConfig, TriaxialConfig,
+                      check_steps_count)
 from ..triaxial import Interrupted, TriaxialTest
 
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after", "force")
+#: Options of the preparation alone, which a run from a prepared --sample does not use.
+PREPARATION_OPTIONS = ("porosity", "prep_friction")
 #: Summary keys printed at the end.
 SHOWN = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak", "peak_q_effective",
          "p_effective_at_peak", "peak_q_effective_complete", "p_effective_complete_at_peak",
@@ -65,7 +69,7 @@ def add_arguments(parser):
     parser.add_argument("--wet-steps", type=int, default=200000,
                         help="most steps to equilibrate the wetted (or loaded) sample [-]")
     parser.add_argument("--max-strain", type=float, default=0.25,
-                        help="final axial strain [-]")
+                        help=f"final axial strain [-], at most {MAX_AXIAL_STRAIN:g}")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--periodic", action="store_true",
                         help="a periodic cell instead of six walls: no wall layers; the cell's "
@@ -74,12 +78,13 @@ def add_arguments(parser):
     parser.add_argument("--out", default="runs/triaxial", help="output folder")
     add_size_options(parser, PrepareConfig.radius)
     parser.add_argument("--porosity", type=float, default=0.40,
-                        help="porosity of the initial cloud box [-] (0.30-0.60)")
+                        help="porosity of the initial cloud box [-] (0.30-0.60; not with "
+                             "--sample)")
     parser.add_argument("--friction", type=float, default=18.0,
                         help="contact friction [deg]")
     parser.add_argument("--prep-friction", type=float, default=0.5,
                         help="contact friction during the radius growth [deg] (thesis 0.5; "
-                             "higher gives a looser sample)")
+                             "higher gives a looser sample; not with --sample)")
     parser.add_argument("--young", type=float, default=1e6,
                         help="YADE young E [Pa], kn = E R")
     parser.add_argument("--damping", type=float, default=0.2,
@@ -99,7 +104,9 @@ def add_arguments(parser):
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
                         help="bridge table nodes in suction and in distance (exact default "
                              "350,80; toroidal 64,80)")
-    parser.add_argument("--records", type=int, default=500, help="history rows over the test")
+    parser.add_argument("--records", type=int, default=None,
+                        help=f"history rows over the test (default {ShearConfig.records}; at "
+                             "most one a step)")
     parser.add_argument("--force", action="store_true",
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
@@ -109,7 +116,8 @@ def add_arguments(parser):
                              f"{TriaxialConfig.vtk_frames} frames; 0: no ParaView output)")
     frames.add_argument("--vtk-frames", type=positive_int("--vtk-frames"), default=None,
                         help="ParaView frames over the shear (0: none; default "
-                             f"{TriaxialConfig.vtk_frames}); instead of --vtk-every")
+                             f"{TriaxialConfig.vtk_frames}; at most one a step); instead of "
+                             "--vtk-every")
     parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
                         type=positive_int("--vtk-prep", low=1),
                         help="also write ParaView frames of the preparation and wetting into "
@@ -147,6 +155,11 @@ def table_resolution(text):
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
     check_range("--suction", args.suction, 0.0, unit="Pa")
+    if not MIN_AXIAL_STRAIN <= args.max_strain <= MAX_AXIAL_STRAIN:      # NaN included
+        raise UsageError(f"--max-strain = {args.max_strain:g} is outside the valid range "
+                         f"[{MIN_AXIAL_STRAIN:g}, {MAX_AXIAL_STRAIN:g}]: {AXIAL_STRAIN_LIMIT}")
+    if args.records is not None:
+        check_int("--records", args.records, low=2, high=MAX_RECORDS)
     water = args.water_content
     if water is not None and args.suction > 0.0:
         raise UsageError("--suction and --water-content: give one (at a water content the "
@@ -165,6 +178,15 @@ def config_from(args):
     if args.suction == 0.0 and water is None and any(wet_only.values()):
         raise UsageError(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet "
                          "test: give --suction > 0")
+    if args.sample is not None:
+        defaults = _defaults()
+        preparation = [name for name in PREPARATION_OPTIONS
+                       if getattr(args, name) != getattr(defaults, name)]
+        if preparation:
+            raise UsageError(f"{', '.join('--' + n.replace('_', '-') for n in preparation)} "
+                             f"do(es) not apply with --sample {args.sample}: the sample is "
+                             "already prepared (only its equilibrium and the shear run); leave "
+                             "out --sample to prepare one")
     sample = PrepareConfig(particles=args.particles, porosity=args.porosity,
                            **sizes_from(args),
                            young=args.young, friction_deg=args.friction, damping=args.damping,
@@ -173,8 +195,9 @@ def config_from(args):
                            timestep_rule=args.timestep_rule, confining=args.confining,
                            seed=args.seed, skin_factor=args.skin_factor,
                            periodic=args.periodic)
+    records = {} if args.records is None else {"records": args.records}
     shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
-                        strain_rate=args.strain_rate, records=args.records)
+                        strain_rate=args.strain_rate, **records)
     bridges = None
     options = {"surface_tension": args.surface_tension, "contact_angle": args.contact_angle,
                "model": args.bridges, "liquid": args.liquid}
@@ -189,9 +212,18 @@ def config_from(args):
                                table_resolution=table_resolution(args.table_resolution),
                                **options)
     frames = {} if args.vtk_frames is None else {"vtk_frames": args.vtk_frames}
-    return TriaxialConfig(sample=sample, shear=shear, bridges=bridges, sample_path=args.sample,
-                          wet_steps=args.wet_steps, vtk_every=args.vtk_every,
-                          checkpoint_every=args.checkpoint_every, wetting=args.wetting, **frames)
+    config = TriaxialConfig(sample=sample, shear=shear, bridges=bridges, sample_path=args.sample,
+                            wet_steps=args.wet_steps, vtk_every=args.vtk_every,
+                            checkpoint_every=args.checkpoint_every, wetting=args.wetting,
+                            **frames)
+    # counts given beyond the shear's steps would silently give one a step (the defaults may)
+    steps = config.shear_steps()
+    phase = f"the shear to --max-strain {config.shear.max_strain:g}"
+    if args.vtk_frames is not None:
+        check_steps_count("--vtk-frames", args.vtk_frames, steps, phase)
+    if args.records is not None:
+        check_steps_count("--records", args.records, steps, phase, low=2)
+    return config
 
 
 def run(args):

@@ -16,6 +16,7 @@ tables cover pairs up to that ratio (capillary, YADE's capillary files).
 """
 
 import csv
+import os
 
 import numpy as np
 
@@ -62,24 +63,34 @@ def check_grading_curve(curve, name="psd"):
 
 
 def read_grading_curve(path):
-    """The grading curve in the CSV file ``path``: rows diameter [m], percent passing by mass
-    (a header row and blank or '#' lines are skipped). ValueError naming the path."""
+    """The grading curve in the CSV file ``path``: rows of two values, diameter [m] and
+    percent passing by mass (a header row first, blank and '#' lines and empty trailing cells
+    are skipped). ValueError naming the path and the row (its line in the file) of a value
+    that is not a number, or of a third value (which the curve would otherwise drop)."""
+    path = os.fspath(path)
     try:
         with open(path, newline="") as handle:
-            rows = [row for row in csv.reader(handle)
+            reader = csv.reader(handle)
+            rows = [(reader.line_num, row) for row in reader
                     if row and row[0].strip() and not row[0].lstrip().startswith("#")]
-    except (OSError, UnicodeDecodeError) as error:
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
         raise ValueError(f"psd file {path!r} cannot be read: "
                          f"{getattr(error, 'strerror', None) or error}") from None
     points = []
-    for number, row in enumerate(rows):
+    for number, (line, row) in enumerate(rows):
+        while len(row) > 2 and not row[-1].strip():
+            row = row[:-1]
         try:
-            points.append((float(row[0]), float(row[1])))
+            point = (float(row[0]), float(row[1]))
         except (ValueError, IndexError):
             if number == 0:
                 continue                     # a header
-            raise ValueError(f"psd file {path!r}: row {number + 1} {row!r} is not "
+            raise ValueError(f"psd file {path!r}: row {line} {row!r} is not "
                              "'diameter [m], percent passing'") from None
+        if len(row) > 2:
+            raise ValueError(f"psd file {path!r}: row {line} {row!r} has {len(row)} values; "
+                             "valid: 2, 'diameter [m], percent passing'")
+        points.append(point)
     return check_grading_curve(points, name=f"psd file {path!r}")
 
 
