@@ -10,7 +10,6 @@ Solid lines: exact Young-Laplace bridges; dashed: toroidal approximation (Append
 """
 
 import math
-import os
 import time
 
 import numpy as np
@@ -21,6 +20,7 @@ from pendular.dem.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.cell_bridge import largest_filling_angle
 
+from .outputs import OutputFolder
 from .plots import pyplot, save_figure
 from .reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_PACKINGS, KIM_RADIUS,
                         KIM_SEPARATION, SPECIFIC_GRAVITY, TABLE_4_1_PRINTED)
@@ -195,7 +195,7 @@ def kim_comparison():
 
 # ---------------------------------------------------------------- figures
 
-def fig_4_6(plt, out):
+def fig_4_6(plt, folder):
     fig, ax = plt.subplots(figsize=(5, 4))
     l_primes = np.linspace(2.0, 2.0 * math.sqrt(2.0), 200)
     ax.plot(l_primes, [regular_packing("bcc", lp).porosity for lp in l_primes], "k-", label="BCC")
@@ -203,10 +203,10 @@ def fig_4_6(plt, out):
     ax.axhline(regular_packing("fcp").porosity, color="C3", ls=":", label="FCP")
     ax.set(xlim=(2, 3), ylim=(0.25, 0.5), xlabel="l'", ylabel="porosity (n)", title="Fig. 4.6")
     ax.legend()
-    save(fig, out, "fig4_06_porosity.png")
+    save(fig, folder, "fig4_06_porosity.png")
 
 
-def fig_4_7(plt, out, points):
+def fig_4_7(plt, folder, points):
     fig, ax = plt.subplots(figsize=(5.5, 4))
     for kind, color in (("scp", "C0"), ("fcp", "C3")):
         packing = regular_packing(kind)
@@ -220,7 +220,7 @@ def fig_4_7(plt, out, points):
     ax.set(xlim=(0, 25), ylim=(0.1, 1e6), xlabel="degree of saturation (Sr %)", ylabel="matric suction (kPa)",
            title="Fig. 4.7: H = theta = 0 (solid exact, dashed toroidal)")
     ax.legend(fontsize=8)
-    save(fig, out, "fig4_07_swcc_particle_size.png")
+    save(fig, folder, "fig4_07_swcc_particle_size.png")
 
 
 def two_panels(plt, title):
@@ -229,7 +229,7 @@ def two_panels(plt, title):
     return fig, axes
 
 
-def fig_4_8(plt, out, points):
+def fig_4_8(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.8: wetting angle (drying theta = 0, wetting theta = 30 deg), H = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (30, 40)):
         packing = regular_packing(kind)
@@ -241,10 +241,10 @@ def fig_4_8(plt, out, points):
         ax.set(xlim=(0, xmax), ylim=(0.01, 100), xlabel="degree of saturation (%)",
                ylabel="dimensionless matric suction s R / gamma", title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
         ax.legend()
-    save(fig, out, "fig4_08_swcc_contact_angle.png")
+    save(fig, folder, "fig4_08_swcc_contact_angle.png")
 
 
-def fig_4_9(plt, out, points):
+def fig_4_9(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.9: separation distance, theta = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
         for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2")):
@@ -256,10 +256,10 @@ def fig_4_9(plt, out, points):
         ax.set(xlim=(0, xmax), ylim=(0.1, 100), xlabel="degree of saturation (Sr %)",
                ylabel="dimensionless matric suction s R / gamma", title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
         ax.legend()
-    save(fig, out, "fig4_09_swcc_separation.png")
+    save(fig, folder, "fig4_09_swcc_separation.png")
 
 
-def fig_4_10(plt, out, points):
+def fig_4_10(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.10: isotropic chi_ij, theta = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
         for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2"), (0.2, "C3")):
@@ -271,10 +271,10 @@ def fig_4_10(plt, out, points):
         ax.set(xlim=(0, xmax), ylim=(0, 0.7), xlabel="degree of saturation (%)", ylabel="chi_ij",
                title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
         ax.legend()
-    save(fig, out, "fig4_10_chi.png")
+    save(fig, folder, "fig4_10_chi.png")
 
 
-def fig_stress_components(plt, out, points, kind, number, xmin):
+def fig_stress_components(plt, folder, points, kind, number, xmin):
     fig, axes = two_panels(plt, f"Fig. {number}: {kind.upper()}, R = 0.1 mm, H = 0")
     packing = regular_packing(kind)
     for theta, color in zip((0.0, 10.0, 20.0, 30.0), ("C0", "C1", "C2", "C3")):
@@ -288,10 +288,10 @@ def fig_stress_components(plt, out, points, kind, number, xmin):
         ax.set(xlim=(xmin, 1e4), xlabel="matric suction (kPa)", ylabel=name, title=f"({panel})")
         ax.set_ylim(bottom=0.0)
         ax.legend()
-    save(fig, out, f"fig{number.replace('.', '_')}_{kind}_stresses.png")
+    save(fig, folder, f"fig{number.replace('.', '_')}_{kind}_stresses.png")
 
 
-def fig_4_14(plt, out, points):
+def fig_4_14(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.14: total capillary stress, R = 0.1 mm, theta = 30 deg, H = 0")
     for ax, kind, xmin in zip(axes, ("scp", "fcp"), (0.01, 1.0)):
         packing = regular_packing(kind)
@@ -306,10 +306,10 @@ def fig_4_14(plt, out, points):
                title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
         ax.set_ylim(bottom=0.0)
         ax.legend()
-    save(fig, out, "fig4_14_total_capillary_stress.png")
+    save(fig, folder, "fig4_14_total_capillary_stress.png")
 
 
-def fig_4_15(plt, out, points):
+def fig_4_15(plt, folder, points):
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for kind, name, color in (("fcp", "FCP", "C3"), ("bcc", "isotropic BCC", "C0")):
         packing = regular_packing(kind, separation=KIM_SEPARATION)
@@ -326,10 +326,10 @@ def fig_4_15(plt, out, points):
     ax.set(xlim=(0, 3.5), ylim=(0, 1200), xlabel="gravimetric water content w (%)", ylabel="tensile strength (Pa)",
            title=f"Fig. 4.15: R = {KIM_RADIUS * 1e3} mm, H/R = {KIM_SEPARATION}")
     ax.legend(fontsize=7)
-    save(fig, out, "fig4_15_tensile_strength.png")
+    save(fig, folder, "fig4_15_tensile_strength.png")
 
 
-def fig_4_17(plt, out, points):
+def fig_4_17(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.17: BCC l' = 2.7, R = 0.1 mm, H = theta = 0: principal capillary stresses")
     packing = regular_packing("bcc", 2.7)
     for method, style in METHODS.items():
@@ -344,10 +344,10 @@ def fig_4_17(plt, out, points):
         ax.set(xlim=(1, 1e4), xlabel="matric suction (kPa)", ylabel="capillary stress (kPa)", title=direction)
         ax.axhline(0.0, color="0.7", lw=0.8)
         ax.legend()
-    save(fig, out, "fig4_17_bcc_principal_stresses.png")
+    save(fig, folder, "fig4_17_bcc_principal_stresses.png")
 
 
-def fig_4_19(plt, out, points):
+def fig_4_19(plt, folder, points):
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for l_prime, color in zip((2.7, 2.6, 2.5, 2.4, 4.0 / math.sqrt(3.0), 2.1), ("C0", "C1", "C2", "C3", "C4", "C5")):
         packing = regular_packing("bcc", l_prime)
@@ -358,36 +358,38 @@ def fig_4_19(plt, out, points):
     ax.set(xlim=(0, 20), ylim=(-0.4, 0.8), xlabel="degree of saturation (%)", ylabel="anisotropy factor a_psi",
            title="Fig. 4.19: BCC, theta = H = 0")
     ax.legend(fontsize=8)
-    save(fig, out, "fig4_19_anisotropy.png")
+    save(fig, folder, "fig4_19_anisotropy.png")
 
 
-def save(fig, out, name):
-    save_figure(fig, os.path.join(out, name))
+def save(fig, folder, name):
+    """Write ``fig`` as ``name`` into the OutputFolder ``folder`` (which then owns it)."""
+    save_figure(fig, folder.claim(name))
     print(f"  wrote {name}", flush=True)
 
 
 def write_chapter4(out: str, points: int = 40) -> None:
     """Tables (printed and DIR/chapter4_tables.txt) and figures of thesis Chapter 4 into
-    ``out``; ``points`` states per curve (10-400)."""
+    ``out`` (pendular.outputs.OutputFolder: ValueError naming the path when it cannot be an
+    output folder); ``points`` states per curve (10-400)."""
     check_int("points", points, low=10, high=400)
-    os.makedirs(out, exist_ok=True)
-    start = time.time()
-    sections = [table_4_1(), pendular_limits(), high_suction_limits(), crossovers(), anisotropy_at_limits(),
-                kim_comparison()]
-    text = "\n\n".join("\n".join(lines) for lines in sections)
-    print(text, flush=True)
-    write_text(os.path.join(out, "chapter4_tables.txt"), text + "\n")
+    with OutputFolder(out, "chapter4") as folder:
+        start = time.time()
+        sections = [table_4_1(), pendular_limits(), high_suction_limits(), crossovers(),
+                    anisotropy_at_limits(), kim_comparison()]
+        text = "\n\n".join("\n".join(lines) for lines in sections)
+        print(text, flush=True)
+        write_text(folder.claim("chapter4_tables.txt"), text + "\n")
 
-    plt = pyplot()
-    fig_4_6(plt, out)
-    fig_4_7(plt, out, points)
-    fig_4_8(plt, out, points)
-    fig_4_9(plt, out, points)
-    fig_4_10(plt, out, points)
-    fig_stress_components(plt, out, points, "scp", "4.12", 0.01)
-    fig_stress_components(plt, out, points, "fcp", "4.13", 1.0)
-    fig_4_14(plt, out, points)
-    fig_4_15(plt, out, points)
-    fig_4_17(plt, out, points)
-    fig_4_19(plt, out, points)
+        plt = pyplot()
+        fig_4_6(plt, folder)
+        fig_4_7(plt, folder, points)
+        fig_4_8(plt, folder, points)
+        fig_4_9(plt, folder, points)
+        fig_4_10(plt, folder, points)
+        fig_stress_components(plt, folder, points, "scp", "4.12", 0.01)
+        fig_stress_components(plt, folder, points, "fcp", "4.13", 1.0)
+        fig_4_14(plt, folder, points)
+        fig_4_15(plt, folder, points)
+        fig_4_17(plt, folder, points)
+        fig_4_19(plt, folder, points)
     print(f"done in {time.time() - start:.0f} s; outputs in {out}")

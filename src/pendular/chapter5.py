@@ -46,10 +46,14 @@ from .campaign import Campaign, Run, read_table, write_campaign_csv
 from .chapter5_figures import campaign_figures
 from .config import BridgeConfig, ShearConfig, TriaxialConfig
 from .envelope import mohr_coulomb_fit
+from .outputs import OutputFolder
 from .reference import DRY_FRICTION_DEG, FIG_5_5, TABLE_5_3
 
 #: Strain at which Sr is also reported (Fig. 5.5's horizontal axis ends there).
 LATE_STRAIN = 0.20
+#: What a campaign owns in its folder (pendular.outputs); its samples/ and runs/ are kept and
+#: reused by the next campaign there.
+OUTPUTS = ("campaign.json", "campaign.csv", "report.md", "plots")
 #: The Chapter 5 grid shipped with pendular (a campaign table).
 TABLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "campaigns", "chapter5.toml")
 
@@ -133,6 +137,23 @@ def sample_path(out, confining):
 
 def run_folder(out, suction, confining):
     return os.path.join(out, "runs", f"s{label(suction)}_c{label(confining)}")
+
+
+def check_history(folder):
+    """ValueError naming ``folder``/history.h5 when it is missing or cannot be read (a run
+    reused with a damaged history), with the remedy."""
+    path = os.path.join(folder, "history.h5")
+    remedy = f"delete the run folder {folder} to run it again"
+    if not os.path.isfile(path):
+        raise ValueError(f"history = {path!r}: no such file: {remedy}")
+    try:
+        with h5py.File(path, "r") as handle:
+            history = handle["history"]
+            for name in history:
+                history[name][()]
+    except (OSError, KeyError, TypeError, ValueError) as error:
+        raise ValueError(f"history = {path!r} is not a readable pendular history ({error}): "
+                         f"{remedy}") from None
 
 
 def saturation_at(folder, strain):
@@ -302,24 +323,31 @@ def chapter5_campaign(grid: Chapter5Grid, out: str, *, jobs: int = 1,
     tests = [(s, c) for s in grid.suctions for c in grid.confining]
     runs = [Run(os.path.basename(run_folder(out, s, c)), grid.run(s, c, out)) for s, c in tests]
     samples = [(grid.sample(c), sample_path(out, c)) for c in grid.confining]
-    result = Campaign(runs, samples).run(out, jobs=jobs, scheduler=scheduler, threads=threads,
-                                         quiet=quiet)
-    write_campaign_csv(os.path.join(out, "campaign.csv"), result)
-    result.check()
-    rows = [run_row(s, c, result.summaries[run.name], run_folder(out, s, c), out)
-            for (s, c), run in zip(tests, runs)]
-    fits = envelopes(rows)
-    arguments = {"particles": grid.particles, "suctions": grid.suctions,
-                 "confining": grid.confining, "jobs": jobs, "out": os.fspath(given_out),
-                 "seed": grid.seed, "max_strain": grid.max_strain,
-                 "inertial_number": grid.inertial_number, "prep_friction": grid.prep_friction,
-                 "scheduler": scheduler}
-    campaign = {"arguments": arguments, "runs": rows, "envelopes": fits,
-                "thesis": {"table_5_3": [{"suction": s, "confining": c, "peak_axial_stress": v}
-                                         for (s, c), v in TABLE_5_3.items()],
-                           "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
-                           "dry_friction_deg": DRY_FRICTION_DEG}}
-    write_json(os.path.join(out, "campaign.json"), campaign)
-    figures = campaign_figures(out, rows, fits, label, LATE_STRAIN)
-    write_report(os.path.join(out, "report.md"), rows, fits, grid, figures, out)
+    # keep: the samples and finished runs of an earlier campaign there are reused
+    with OutputFolder(given_out, "chapter5", keep=True) as folder:
+        for name in OUTPUTS:
+            folder.claim(name)
+        result = Campaign(runs, samples).run(out, jobs=jobs, scheduler=scheduler,
+                                             threads=threads, quiet=quiet)
+        write_campaign_csv(os.path.join(out, "campaign.csv"), result)
+        result.check()
+        for s, c in tests:                  # reused runs too: the figures read them all
+            check_history(run_folder(out, s, c))
+        rows = [run_row(s, c, result.summaries[run.name], run_folder(out, s, c), out)
+                for (s, c), run in zip(tests, runs)]
+        fits = envelopes(rows)
+        arguments = {"particles": grid.particles, "suctions": grid.suctions,
+                     "confining": grid.confining, "jobs": jobs, "out": os.fspath(given_out),
+                     "seed": grid.seed, "max_strain": grid.max_strain,
+                     "inertial_number": grid.inertial_number,
+                     "prep_friction": grid.prep_friction, "scheduler": scheduler}
+        campaign = {"arguments": arguments, "runs": rows, "envelopes": fits,
+                    "thesis": {"table_5_3": [{"suction": s, "confining": c,
+                                              "peak_axial_stress": v}
+                                             for (s, c), v in TABLE_5_3.items()],
+                               "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
+                               "dry_friction_deg": DRY_FRICTION_DEG}}
+        write_json(os.path.join(out, "campaign.json"), campaign)
+        figures = campaign_figures(out, rows, fits, label, LATE_STRAIN)
+        write_report(os.path.join(out, "report.md"), rows, fits, grid, figures, out)
     return campaign, len(result.reused)

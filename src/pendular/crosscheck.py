@@ -143,7 +143,9 @@ def check_packing(config, packing):
     cross-check (DIR/packing.txt) with the box of ``config``: a '# box_lo ... box_hi ...'
     line, its low corner at 0 for a periodic cell."""
     if not os.path.isfile(packing):
-        raise FileNotFoundError(f"packing = {packing!r}: no such file")
+        what = "is a folder" if os.path.isdir(packing) else "no such file"
+        raise FileNotFoundError(f"packing = {packing!r}: {what}; valid: DIR/packing.txt of an "
+                                "earlier cross-check")
     lo = read_spheres(packing)[2]
     if lo is None:
         raise ValueError(f"packing = {packing!r}: no '# box_lo ... box_hi ...' line; valid: "
@@ -341,12 +343,11 @@ def run_crosscheck(config, out, *, settle=True, packing=None, concurrent=False, 
     if not isinstance(config, TriaxialConfig):
         raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
     check_mirrored(config)
-    find_yade()
     out = os.path.abspath(out)
     if packing is not None:
         packing = os.fspath(packing)
-    if packing is not None:
         check_packing(config, packing)
+    find_yade()
     with OutputFolder(out, "crosscheck") as folder:
         for name in OUTPUTS:
             folder.claim(name)

@@ -21,7 +21,6 @@ table. Stresses in Pa, compression positive.
 import copy
 import json
 import math
-import os
 import re
 import time
 import traceback
@@ -34,6 +33,8 @@ from pendular.dem.measure import kinetic_energy
 from pendular.dem.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from pendular.dem.state import Particles, Walls
 from pendular.homogenize import capillary_force_stress, contact_stress
+
+from .outputs import OutputFolder
 
 #: The base case; every case changes one of these (``water`` is the formation suction [Pa] of
 #: volume-controlled bridges, None for suction control).
@@ -294,13 +295,14 @@ def print_table(results, counts):
 
 def run_grid(out, quick=False):
     """Every case of the grid (``quick``: the subset) into ``out``/extremes.json, with the
-    table printed; returns the counts per status."""
-    os.makedirs(out, exist_ok=True)
-    started = time.perf_counter()
-    cache = SampleCache()
-    results = [evaluate(parameter, value, must_refuse, cache)
-               for parameter, value, must_refuse in cases(quick)]
-    counts = write_report(os.path.join(out, "extremes.json"), results, quick,
-                          time.perf_counter() - started)
+    table printed; returns the counts per status. ValueError naming ``out`` when it cannot be
+    an output folder (pendular.outputs.OutputFolder), before any case runs."""
+    with OutputFolder(out, "extremes --quick" if quick else "extremes") as folder:
+        report = folder.claim("extremes.json")
+        started = time.perf_counter()
+        cache = SampleCache()
+        results = [evaluate(parameter, value, must_refuse, cache)
+                   for parameter, value, must_refuse in cases(quick)]
+        counts = write_report(report, results, quick, time.perf_counter() - started)
     print_table(results, counts)
     return counts

@@ -52,7 +52,8 @@ from .io import write_history
 from .outputs import OutputFolder
 from .plots import pyplot, save_figure
 from .reference import FIG_5_5
-from .triaxial import equilibrate, history_columns, watched
+from .triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, equilibrate, equilibrium_status,
+                       history_columns, watched)
 
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
@@ -84,7 +85,15 @@ class SwccTest:
         if not isinstance(config, SwccConfig):
             raise TypeError(f"config must be a SwccConfig, got {type(config).__name__}")
         self.config = config
-        path_bridges(config, config.sample.radii())       # refuse a bad path before preparing
+        sample = config.sample
+        lowest = MIN_CONFINING_OVER_YOUNG * sample.young
+        if sample.confining < lowest:
+            raise ValueError(
+                f"--confining = {sample.confining:g} Pa is below its valid minimum {lowest:g} Pa "
+                f"({MIN_CONFINING_OVER_YOUNG:g} young, young = {sample.young:g} Pa): the "
+                "servoed walls never hold a lower confining stress (every stage would run to "
+                "--stage-steps)")
+        path_bridges(config, sample.radii())       # refuse a bad path before preparing
 
     def run(self, out, *, progress=True, threads=None):
         with OutputFolder(out, "swcc") as folder:
@@ -119,11 +128,7 @@ class SwccTest:
                     stages[branch].append(dict(stages["drying"][-1], steps=0))
                     continue
                 bridges.set_suction(suction)
-                steps = equilibrate(
-                    sim, unbalanced=config.sample.equilibrium_unbalanced,
-                    tolerance=config.sample.stress_tolerance, max_steps=config.stage_steps,
-                    progress=(f"{branch} {suction:g} Pa" if progress else None),
-                    phase=f"equilibrium at suction {suction:g} Pa ({branch})")
+                steps = self.stage(sim, suction, branch, progress)
                 recorder.record(sim)
                 stages[branch].append(self.stage_row(sim, bridges, homogenization, suction,
                                                      dry_volume, steps))
@@ -146,6 +151,23 @@ class SwccTest:
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
         return result
+
+    def stage(self, sim, suction, branch, progress):
+        """Run one stage of the path to equilibrium; its steps. NotStatic naming --stage-steps
+        when the stage ends at that limit first."""
+        sample = self.config.sample
+        limit = self.config.stage_steps
+        try:
+            return equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
+                               tolerance=sample.stress_tolerance, max_steps=limit,
+                               progress=(f"{branch} {suction:g} Pa" if progress else None))
+        except NotStatic:
+            reached = equilibrium_status(sample.equilibrium_unbalanced)(sim)
+            raise NotStatic(
+                f"--stage-steps = {limit}: the equilibrium at suction {suction:g} Pa ({branch}) "
+                "was not reached within this many steps ("
+                + ", ".join(f"{k} {v}" for k, v in reached.items())
+                + "): raise --stage-steps or check the settings") from None
 
     @staticmethod
     def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):

@@ -20,7 +20,8 @@ import numba
 from pendular.dem.preparation import PrepareConfig
 
 from ..cli import UsageError, add_size_options, positive_int, set_threads, sizes_from
-from ..crosscheck import SHOWN, crosscheck_config, run_crosscheck
+from ..crosscheck import (SHOWN, check_mirrored, check_packing, crosscheck_config,
+                          run_crosscheck)
 from ..yade import find_yade
 
 
@@ -59,7 +60,7 @@ def check(args):
         raise UsageError(f"--particles {args.particles} is outside the valid range [2, inf)")
     if not math.isfinite(args.suction) or args.suction < 0.0:
         raise UsageError(f"--suction {args.suction} Pa is outside the valid range [0, inf)")
-    if not args.confining > 0.0:
+    if not (math.isfinite(args.confining) and args.confining > 0.0):
         raise UsageError(f"--confining {args.confining} Pa is outside the valid range (0, inf)")
     if not 0.0 < args.max_strain < 0.9:
         raise UsageError(f"--max-strain {args.max_strain} is outside the valid range (0, 0.9)")
@@ -88,12 +89,16 @@ def config_from(args):
 
 def run(args):
     check(args)
+    config = config_from(args)          # every option checked before YADE is looked for
+    check_mirrored(config)
+    if args.packing is not None:
+        check_packing(config, args.packing)
     try:
         find_yade()
     except RuntimeError as error:
         raise UsageError(str(error)) from None
     set_threads(args.threads)
-    result = run_crosscheck(config_from(args), args.out, settle=args.settle_steps > 0,
+    result = run_crosscheck(config, args.out, settle=args.settle_steps > 0,
                             packing=args.packing, concurrent=args.concurrent,
                             threads=args.threads, progress=not args.quiet)
     print(json.dumps({k: result[k] for k in SHOWN}, indent=2))

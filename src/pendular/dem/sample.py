@@ -91,6 +91,21 @@ def _finite(source, name, values):
         raise ValueError(f"{source}: {name}{index} = {values[tuple(index)]} is not finite")
 
 
+def _json_attribute(source, handle, name):
+    """The JSON object stored in the file attribute ``name`` (ValueError naming ``source`` and
+    the attribute when it is not one)."""
+    text = handle.attrs[name]
+    try:
+        value = json.loads(text.decode() if isinstance(text, bytes) else text)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{source}: attribute {name!r} is not readable JSON ({error}): a "
+                         "damaged or foreign file; prepare the sample again") from None
+    if not isinstance(value, dict):
+        raise ValueError(f"{source}: attribute {name!r} holds a JSON {type(value).__name__}, "
+                         "not an object: a damaged or foreign file; prepare the sample again")
+    return value
+
+
 def load_sample(path, expected=None, expected_identity=None):
     """Read a sample written by ``save_sample``: (Particles, Walls or PeriodicCell, report dict,
     config dict).
@@ -108,8 +123,8 @@ def load_sample(path, expected=None, expected_identity=None):
                                                        "angular_velocity", "walls")}
         density = handle.attrs["density"]
         periodic = bool(handle.attrs.get("periodic", False))
-        report = json.loads(handle.attrs["report"])
-        config = json.loads(handle.attrs["config"])
+        report = _json_attribute(source, handle, "report")
+        config = _json_attribute(source, handle, "config")
     for name, values in arrays.items():
         if not np.issubdtype(np.asarray(values).dtype, np.number):
             raise ValueError(f"{source}: {name} holds {np.asarray(values).dtype}, not numbers")

@@ -52,11 +52,16 @@ def principal_anisotropy(tensor):
     T_z is the principal value whose principal axis is closest to the z axis (the axial
     direction of the packings and of the triaxial box), T_x the mean of the other two, so that
     a < 0 when the largest principal value lies in the x-y plane (the thesis's BCC with l' = 2.1).
-    Returns NaN when tr T = 0 (no bridges: the anisotropy is undefined).
+    Returns NaN when tr T = 0 (no bridges: the anisotropy is undefined). ValueError when T
+    holds a NaN or an infinity (the state it was measured on diverged).
     """
     tensor = np.asarray(tensor, dtype=float)
     if tensor.shape != (3, 3):
         raise ValueError(f"tensor has shape {tensor.shape}; expected (3, 3)")
+    if not np.all(np.isfinite(tensor)):
+        raise ValueError(f"tensor = {tensor.tolist()} is not finite, so neither is its "
+                         "anisotropy: the state it was measured on diverged (lower the time "
+                         "step, e.g. --timestep-safety, or check the forces)")
     trace = np.trace(tensor)
     if trace == 0.0:
         return np.nan
