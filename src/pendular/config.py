@@ -268,7 +268,12 @@ class TriaxialConfig:
         prepared samples, so the shear takes that much fewer."""
         sample, shear = self.sample, self.shear
         rate = shear.rate(sample.radius, sample.density, sample.confining)
-        return shear.max_strain / (rate * pwave_step(sample.radius, sample))
+        per_step = rate * pwave_step(sample.radius, sample)
+        if not per_step > 0.0:          # a rate or time step that underflows
+            raise ValueError(f"the strain per step, {per_step:g}, is not positive: the strain "
+                             "rate (--strain-rate / --inertial-number) or the time step "
+                             "(--timestep-safety) is too small to be represented")
+        return shear.max_strain / per_step
 
     @property
     def suction(self):

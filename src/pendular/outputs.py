@@ -135,6 +135,12 @@ class OutputFolder:
             kind = "a file" if os.path.isfile(path) else "not a folder (a device or special file)"
             raise _refuse(path, f"exists and is {kind}; valid: a folder, or a path where one "
                                 "can be created")
+        parent = os.path.dirname(os.path.abspath(path))
+        while not os.path.exists(parent):
+            parent = os.path.dirname(parent)
+        if not os.path.isdir(parent):
+            raise _refuse(path, f"cannot create the folder: {parent!r} is a file, not a folder; "
+                                "valid: a folder, or a path where one can be created")
         try:
             os.makedirs(path, exist_ok=True)
         except OSError as error:

@@ -134,7 +134,7 @@ def add_arguments(parser):
                              "configuration stored there (only --quiet and --threads may be "
                              "added)")
     # tests: stop the shear after this many steps as an interruption would (exit status 130)
-    parser.add_argument("--stop-after", type=positive_int("--stop-after"), default=None,
+    parser.add_argument("--stop-after", type=positive_int("--stop-after", low=1), default=None,
                         help=argparse.SUPPRESS)
 
 
