@@ -5,6 +5,7 @@ and Sr beside the thesis's, Mohr–Coulomb envelopes in net and effective stress
 override it. Finished runs with equal configurations are reused. Each run has --threads Numba
 threads (one by default) and its own log.txt with its progress."""
 
+from ..campaign import check_jobs
 from ..chapter5 import Chapter5Grid, chapter5_campaign
 from ..cli import UsageError, add_executor_options, set_threads
 
@@ -44,8 +45,7 @@ def run(args):
     if args.out == "":
         raise UsageError("--out '': an output folder is required")
     set_threads(args.threads)
-    if args.particles is not None and args.particles < 2:
-        raise UsageError(f"--particles {args.particles} is outside the valid range [2, inf)")
+    check_jobs(args.jobs)                # before the output folder is made
     grid = Chapter5Grid.from_table(
         suctions=None if args.suctions is None else _values("suctions")(args.suctions),
         confining=None if args.confining is None else _values("confining")(args.confining),

@@ -20,6 +20,8 @@ import numba
 from pendular.dem.preparation import PrepareConfig
 
 from ..cli import UsageError, add_size_options, positive_int, set_threads, sizes_from
+from ..config import (AVERAGES, AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MIN_AXIAL_STRAIN,
+                      MIN_SAMPLE_PARTICLES)
 from ..crosscheck import (SHOWN, check_mirrored, check_packing, crosscheck_config,
                           run_crosscheck)
 from ..yade import find_yade
@@ -56,14 +58,16 @@ def add_arguments(parser):
 
 def check(args):
     """UsageError naming the option outside its valid range."""
-    if args.particles < 2:
-        raise UsageError(f"--particles {args.particles} is outside the valid range [2, inf)")
+    if args.particles < MIN_SAMPLE_PARTICLES:
+        raise UsageError(f"--particles {args.particles} is outside the valid range "
+                         f"[{MIN_SAMPLE_PARTICLES}, inf): {AVERAGES}")
     if not math.isfinite(args.suction) or args.suction < 0.0:
         raise UsageError(f"--suction {args.suction} Pa is outside the valid range [0, inf)")
     if not (math.isfinite(args.confining) and args.confining > 0.0):
         raise UsageError(f"--confining {args.confining} Pa is outside the valid range (0, inf)")
-    if not 0.0 < args.max_strain < 0.9:
-        raise UsageError(f"--max-strain {args.max_strain} is outside the valid range (0, 0.9)")
+    if not MIN_AXIAL_STRAIN <= args.max_strain <= MAX_AXIAL_STRAIN:
+        raise UsageError(f"--max-strain {args.max_strain} is outside the valid range "
+                         f"[{MIN_AXIAL_STRAIN:g}, {MAX_AXIAL_STRAIN:g}]: {AXIAL_STRAIN_LIMIT}")
     if args.periodic and args.suction > 0.0:
         raise UsageError(f"--suction {args.suction} Pa with --periodic: YADE's "
                          "PeriTriaxController servoes the stress of the contact forces alone "
