@@ -78,6 +78,10 @@ def check_pendular_suction(table, suction, radius, surface_tension):
     angle = _widest_filling_angle(table, suction * scale)
     if angle <= PENDULAR_FILLING_ANGLE:
         return
+    if math.isnan(angle):
+        raise ValueError(f"contact_angle = {table.contact_angle:g} deg: the bridge table holds no "
+                         f"bridge at contact at suction = {suction:g} Pa (a meniscus this close "
+                         "to flat); valid: a smaller contact angle, e.g. up to 89 deg")
     # the filling angle falls as u* grows: bisect (in ln u*) for the lowest admissible suction
     low, high = max(suction * scale, 1e-9), table.suction_max
     for _ in range(60):
