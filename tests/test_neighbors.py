@@ -254,3 +254,32 @@ def test_a_shear_does_not_depend_on_the_skin(suction):
     (thin, thin_rebuilds), (thick, thick_rebuilds) = runs
     assert thin_rebuilds > 3 * thick_rebuilds
     assert np.array_equal(thin, thick)
+
+
+def test_a_preparation_does_not_depend_on_the_skin():
+    """The radius growth sets its time step at each rebuild (GrowthTimeStep), so it keeps a
+    skin of its own; the later phases run with the test's skin, whose rebuilds change nothing:
+    a thin and a thick skin prepare the same sample to the bit (when the growth took the
+    thicker of the two, its step changed at other steps and the samples ended a radius apart)."""
+    samples = []
+    for skin_factor in (0.05, 0.6):
+        sim, _ = prepare_sample(PrepareConfig(particles=80, skin_factor=skin_factor),
+                                progress=False)
+        samples.append((sim.particles.position, sim.walls.position, sim.neighbors.rebuilds))
+    (thin, thin_walls, thin_rebuilds), (thick, thick_walls, thick_rebuilds) = samples
+    assert thin_rebuilds > thick_rebuilds
+    assert np.array_equal(thin, thick) and np.array_equal(thin_walls, thick_walls)
+
+
+def test_a_thicker_skin_takes_effect_at_the_next_step():
+    """Two spheres 0.3 R apart are off a list of skin 0.2 R; the skin raised to 0.5 R rebuilds
+    the list at the next step (a list kept from the thinner skin would miss the pair until a
+    particle had moved 0.25 R), which then holds the pair."""
+    sim = two_body_scene([[0.0, 0.0, 0.0], [2.3 * RADIUS, 0.0, 0.0]], np.zeros((2, 3)))
+    sim.evaluate_forces()
+    assert len(sim.contacts) == 0
+    rebuilds = sim.neighbors.rebuilds
+    sim.neighbors.skin = 0.5 * RADIUS
+    sim.evaluate_forces()
+    assert sim.neighbors.rebuilds == rebuilds + 1
+    assert sim.contacts.pair_i.tolist() == [0] and sim.contacts.pair_j.tolist() == [1]

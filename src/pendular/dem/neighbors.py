@@ -581,7 +581,9 @@ class NeighborList:
     what the stretching does to the pairs, ``apply``) or a wall more than skin / 2; the
     particles within the skin of a wall at a rebuild are the wall forces' (Contacts.near_wall).
 
-    skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs.
+    skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs;
+    a new value takes effect through a rebuild at the next step (a list built with a thinner
+    skin could miss a pair under the thicker one's rebuild criterion).
     The reach beyond touching is the largest ``reach(sim)`` [m] of the simulation's forces
     (a force acting across gaps, e.g. a liquid bridge up to its rupture distance, declares it;
     forces without ``reach`` need touching pairs only), asked every step: the list holds pairs
@@ -597,6 +599,7 @@ class NeighborList:
         self._reference_radius = None
         self._reference_lengths = None
         self._reference_walls = None
+        self._reference_skin = None
         self._shortest_unlisted = 0.0
 
     def required_reach(self, sim):
@@ -627,6 +630,7 @@ class NeighborList:
         self._reference_radius = p.radius.copy()
         self._reference_lengths = box.lengths()
         self._reference_walls = box.position.copy()
+        self._reference_skin = self.skin
         self._shortest_unlisted = 2.0 * float(p.radius.max()) + self.interaction_range + self.skin
         self.rebuilds += 1
 
@@ -639,6 +643,7 @@ class NeighborList:
         if (reach != self.interaction_range or sim.contacts is None
                 or self._reference_position is None
                 or self._reference_walls is None      # a checkpoint from before it was kept
+                or self.skin != self._reference_skin
                 or len(self._reference_radius) != len(p.radius)
                 or (not sim.walls.periodic
                     and walls_moved_beyond(sim.walls.position, self._reference_walls,

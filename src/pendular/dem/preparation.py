@@ -165,8 +165,9 @@ PREPARATION_PHASES = ("growth", "friction", "unload", "equilibrate")
 
 #: Changes when the same PrepareConfig prepares a different sample (2: particles numbered
 #: along a space-filling curve; 3: a contact lost on a neighbour-list rebuild step forgets
-#: its shear spring); caches of prepared samples key on it.
-PREPARATION_VERSION = 3
+#: its shear spring; 4: the radius growth's skin no longer follows a skin_factor above 0.3);
+#: caches of prepared samples key on it.
+PREPARATION_VERSION = 4
 
 #: Largest count for which random_cloud falls back to pairwise insertion.
 PAIRWISE_CLOUD_MAX = 2000
@@ -267,7 +268,8 @@ class PrepareConfig:
     sphere (the thesis's, and pendular's default until 2026-11-26; across six 2,000-sphere
     samples both give the same peaks within the scatter between samples,
     docs/seeds_timestep_rule.md). ``skin_factor``: the neighbour list's Verlet skin / mean
-    radius, a speed knob only (results are bit-identical for any skin); 0.1 shears 5-8 %
+    radius, a speed knob only (between walls results are bit-identical for any skin; in a
+    periodic cell they differ at round-off, docs/periodic.md); 0.1 shears 5-8 %
     faster than 0.3 at 1,000 and 10,000 spheres (fewer pairs, still rare rebuilds).
     """
 
@@ -440,9 +442,10 @@ def rescale(sim, factor):
     sim.operation(NeighborList).rebuild(sim)
 
 
-#: Least Verlet skin / radius of the radius growth, whose every sphere grows each step: the
-#: list is rebuilt as the surfaces move, so a thicker skin than the test's pays there (1,000
-#: spheres prepared in 3.3 s with 0.3 R, 3.8-4.7 s with 0.1 R). Results do not depend on it.
+#: Verlet skin / radius of the radius growth, whatever ``skin_factor``: every sphere grows each
+#: step and the list is rebuilt as the surfaces move, so a thicker skin than the test's pays
+#: there (1,000 spheres prepared in 3.3 s with 0.3 R, 3.8-4.7 s with 0.1 R). One value for
+#: every sample: GrowthTimeStep sets the step at the rebuilds, so the sample depends on it.
 GROWTH_SKIN_FACTOR = 0.3
 
 
@@ -480,7 +483,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     if config.timestep_rule == "stiffness":
         growth.append(GrowthTimeStep(config))
     sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
-                         max(config.skin_factor, GROWTH_SKIN_FACTOR) * config.radius,
+                         GROWTH_SKIN_FACTOR * config.radius,
                          config.prep_friction_deg, growth, threads)
     writers = list(writers)
     sim.writers.extend(writers)
