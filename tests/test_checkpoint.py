@@ -57,7 +57,8 @@ def test_resumed_shear_is_bit_identical_to_an_uninterrupted_one(prepared, tmp_pa
     first.run(steps // 2)
     skipped = save_checkpoint(path, first, extra_state={"phase": "shear"})
     assert skipped == {"writers[0] HistoryRecorder": ["quantities"],     # closures: rebuilt
-                       "writers[1] CheckpointWriter": ["path", "period", "extra_state",
+                       "writers[1] SampleGuard": ["describe"],
+                       "writers[2] CheckpointWriter": ["path", "period", "extra_state",
                                                        "identity"]}
 
     resumed, resumed_history = sheared(prepared, path)
