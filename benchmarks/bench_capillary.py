@@ -27,13 +27,13 @@ import numpy as np
 from bench_triaxial import write_results  # benchmarks/ (the script's folder)
 from pendular.capillary import SURFACE_TENSION, CapillaryBridges
 from pendular.dem.neighbors import NeighborList
-from pendular.dem.preparation import servoed_simulation
-from pendular.dem.yade_io import write_spheres
+from pendular.procedures.preparation import servoed_simulation
+from pendular.interop.yade.formats import write_spheres
 from pendular.homogenize.on_the_fly import capillary_force_stress
-from pendular.config import ShearConfig
-from pendular.triaxial import TriaxialShear
-from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)
-from pendular.yade import find_yade, run_yade_triaxial, yade_capillary_files
+from pendular.procedures.config import ShearConfig
+from pendular.procedures.triaxial import TriaxialShear
+from pendular.interop.yade.runner import benchmark_sample as sample  # (config, particles, walls, report)
+from pendular.interop.yade.runner import find_yade, run_yade_triaxial, yade_capillary_files
 
 
 def shear_simulation(config, particles, walls, threads, suction):

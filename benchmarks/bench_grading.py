@@ -19,8 +19,8 @@ import numba
 
 from bench_capillary import shear_simulation, time_alternately  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from pendular.dem.preparation import PrepareConfig
-from pendular.yade import cached_sample
+from pendular.procedures.preparation import PrepareConfig
+from pendular.interop.yade.runner import cached_sample
 
 
 def time_wet_shears(samples, threads, steps, warmup, suction):

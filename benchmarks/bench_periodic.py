@@ -24,8 +24,8 @@ import numpy as np
 
 from bench_capillary import shear_simulation, time_chunks  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from pendular.dem.preparation import PrepareConfig
-from pendular.yade import cached_sample
+from pendular.procedures.preparation import PrepareConfig
+from pendular.interop.yade.runner import cached_sample
 
 
 def main(argv=None):

@@ -22,7 +22,7 @@ import numba
 
 from bench_capillary import shear_simulation, time_alternately  # benchmarks/ (this folder)
 from bench_triaxial import write_results
-from pendular.yade import benchmark_sample
+from pendular.interop.yade.runner import benchmark_sample
 
 
 def main(argv=None):

@@ -26,12 +26,12 @@ import time
 
 import numba
 
-from pendular.dem.preparation import servoed_simulation
-from pendular.dem.yade_io import write_spheres
-from pendular.config import ShearConfig
-from pendular.triaxial import TriaxialShear
-from pendular.yade import benchmark_sample as sample  # (config, particles, walls, report)
-from pendular.yade import find_yade, run_yade_triaxial
+from pendular.procedures.preparation import servoed_simulation
+from pendular.interop.yade.formats import write_spheres
+from pendular.procedures.config import ShearConfig
+from pendular.procedures.triaxial import TriaxialShear
+from pendular.interop.yade.runner import benchmark_sample as sample  # (config, particles, walls, report)
+from pendular.interop.yade.runner import find_yade, run_yade_triaxial
 
 
 def time_pendular(config, particles, walls, threads, steps, warmup, force_threads=False):

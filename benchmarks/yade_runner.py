@@ -1,10 +1,10 @@
-"""Self-check of the YADE driver (pendular.yade, pendular/yade_triaxial.py) on this machine.
+"""Self-check of the YADE driver (pendular.interop.yade.runner, pendular/interop/yade/scripts/triaxial.py) on this machine.
 
     python benchmarks/yade_runner.py [N]
 
 Writes a random packing of N spheres (default 1000, R = 0.024 mm), shears it with YADE with 1
 and 2 threads (about a minute on two cores) and prints both results. The runner itself is
-``pendular.yade`` (find_yade, run_yade_triaxial, random_packing), re-exported here.
+``pendular.interop.yade.runner`` (find_yade, run_yade_triaxial, random_packing), re-exported here.
 """
 
 import json
@@ -14,8 +14,8 @@ import tempfile
 
 import numpy as np
 
-from pendular.dem.yade_io import read_plot_data, write_spheres
-from pendular.yade import find_yade, random_packing, run_yade_triaxial  # noqa: F401
+from pendular.interop.yade.formats import read_plot_data, write_spheres
+from pendular.interop.yade.runner import find_yade, random_packing, run_yade_triaxial  # noqa: F401
 
 
 def self_check(count=1000):

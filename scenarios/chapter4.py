@@ -2,7 +2,7 @@
 
     python scenarios/chapter4.py [--out DIR] [--points N]
 
-Writes DIR/chapter4_tables.txt and the figures DIR/fig4_*.png (pendular.chapter4).
+Writes DIR/chapter4_tables.txt and the figures DIR/fig4_*.png (pendular.studies.chapter4).
 """
 
 import sys

@@ -7,7 +7,7 @@
 
 The grid defaults to the table src/pendular/campaigns/chapter5.toml (--suction is an alias of
 --suctions). Writes DIR/campaign.json, DIR/campaign.csv, DIR/report.md and DIR/plots/
-(pendular.chapter5); started again with the same DIR, finished runs are reused.
+(pendular.studies.chapter5); started again with the same DIR, finished runs are reused.
 """
 
 import sys

@@ -3,7 +3,7 @@
     python scenarios/direct_tension.py [--void-ratio E[,E...]] [--water-content W[,W...]]
         [--particles N] [--radius M] [--contact-angle DEG] [--roughness H_OVER_R] [--out DIR]
 
-Without --void-ratio / --water-content it runs Kim's six cases (pendular.tension).
+Without --void-ratio / --water-content it runs Kim's six cases (pendular.procedures.tension).
 """
 
 import sys

@@ -2,7 +2,7 @@
 
     python scenarios/extremes.py --out DIR [--quick]
 
-Writes DIR/extremes.json and prints the table (pendular.extremes).
+Writes DIR/extremes.json and prints the table (pendular.studies.extremes).
 """
 
 import sys

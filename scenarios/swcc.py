@@ -3,7 +3,7 @@
     python scenarios/swcc.py --particles N --confining PA --suctions S1,S2,... [--contact-angle DEG]
         [--form-gap F] [--out DIR]
 
-Writes swcc.json, swcc.png, history.h5 and sample.h5 into DIR (pendular.swcc).
+Writes swcc.json, swcc.png, history.h5 and sample.h5 into DIR (pendular.procedures.swcc).
 """
 
 import sys

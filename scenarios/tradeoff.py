@@ -3,7 +3,7 @@
     python scenarios/tradeoff.py --out DIR [--particles N] [--max-strain X] [--quick]
         [--docs FOLDER]
 
-Writes DIR/tradeoff.json, tradeoff.md and tradeoff.png (pendular.tradeoff).
+Writes DIR/tradeoff.json, tradeoff.md and tradeoff.png (pendular.studies.tradeoff).
 """
 
 import sys

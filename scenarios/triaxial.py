@@ -3,7 +3,7 @@
     python scenarios/triaxial.py [--particles N] [--confining PA] [--suction PA] [--out DIR] ...
     python scenarios/triaxial.py --resume DIR
 
-The test itself is pendular.triaxial.TriaxialTest; the options are pendular.commands.triaxial.
+The test itself is pendular.procedures.triaxial.TriaxialTest; the options are pendular.cli.commands.triaxial.
 """
 
 import sys

@@ -6,7 +6,7 @@
         [--settle-steps N] [--packing FILE] [--concurrent] [--quiet]
 
 Writes DIR/crosscheck.json, crosscheck.png, yade_history.txt and pendular_history.h5
-(pendular.crosscheck; docs/yade_crosscheck.md). Needs ``yade`` on PATH.
+(pendular.studies.crosscheck; docs/yade_crosscheck.md). Needs ``yade`` on PATH.
 """
 
 import sys

@@ -11,7 +11,7 @@ import pytest
 from pendular.dem.contact_law import ContactForces, normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
-from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces

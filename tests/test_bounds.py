@@ -1,6 +1,6 @@
 """Bounds of the runs (issue 36): what no test can reach is refused before anything runs, in
 one ``<prog>: error:`` line naming the option and its valid range (exit 2); a sample crushed
-during a run stops with pendular.guards.SampleCrushed instead of giving stresses of no
+during a run stops with pendular.procedures.guards.SampleCrushed instead of giving stresses of no
 meaning.
 
 Option cases run in-process through pendular.cli.run_command (refused before anything runs);
@@ -13,16 +13,16 @@ import numpy as np
 import pytest
 
 from pendular.cli import run_command
-from pendular.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES, MIN_TENSION_PARTICLES,
-                             ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name)
+from pendular.procedures.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES,
+    MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name)
 from pendular.dem.grading import read_grading_curve
 from pendular.dem.measure import porosity
-from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.walls import ConstantStrainRate
-from pendular.guards import (MAX_OVERLAP_OVER_RADIUS, MIN_POROSITY_EQUAL, SampleCrushed,
-                             SampleGuard, largest_overlap)
-from pendular.tension import case_line
-from pendular.triaxial import TriaxialShear, summarize
+from pendular.procedures.guards import (MAX_OVERLAP_OVER_RADIUS, MIN_POROSITY_EQUAL, SampleCrushed,
+    SampleGuard, largest_overlap)
+from pendular.procedures.tension import case_line
+from pendular.procedures.triaxial import TriaxialShear, summarize
 
 #: A short triaxial (the audit's) and a tension command line; each test adds to them.
 TRIAXIAL = ["--particles", "200", "--max-strain", "0.02", "--quiet"]
@@ -180,7 +180,7 @@ def test_tension_surface_tension_is_chapter4s():
     """The tension default stays thesis Chapter 4's 0.074 N/m (the value its comparison with
     Kim and packing_state uses), a constant apart from Chapter 5's 0.073."""
     from pendular.capillary import SURFACE_TENSION
-    from pendular.reference import CHAPTER4_SURFACE_TENSION
+    from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION
 
     assert TensionConfig().surface_tension == CHAPTER4_SURFACE_TENSION == 0.074
     assert SwccConfig().surface_tension == SURFACE_TENSION == 0.073

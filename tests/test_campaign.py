@@ -1,4 +1,4 @@
-"""Campaigns (pendular.campaign): a TOML sweep through `pendular campaign` (runs, campaign.csv,
+"""Campaigns (pendular.studies.campaign): a TOML sweep through `pendular campaign` (runs, campaign.csv,
 reuse), the library API (runs built with dataclasses.replace, a failing run), refusals (bad or
 empty tables, --jobs, a folder in use, damaged results of an earlier campaign)."""
 
@@ -13,14 +13,15 @@ import time
 import h5py
 import pytest
 
-import pendular.campaign as campaign_module
-from pendular.dem.preparation import PrepareConfig
-from pendular.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs, executor,
-                               finished_summary, max_jobs, options_argv, run_name,
-                               run_progress, sweep_from_table, table_rows, write_campaign_csv)
+import pendular.studies.campaign as campaign_module
+from pendular.procedures.preparation import PrepareConfig
+from pendular.cli.tables import options_argv, sweep_from_table
+from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs,
+                                       executor, finished_summary, max_jobs, run_name,
+                                       run_progress, table_rows, write_campaign_csv)
 from pendular.cli import run_command
-from pendular.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict
-from pendular.outputs import OutputFolder
+from pendular.procedures.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict
+from pendular.io.outputs import OutputFolder
 
 TABLE = """
 command = "triaxial"
@@ -390,7 +391,7 @@ def test_run_progress_reads_the_last_bar_of_a_log(tmp_path):
 
 
 def test_the_chapter5_grid_is_a_shipped_table():
-    import pendular.chapter5 as chapter5
+    import pendular.studies.chapter5 as chapter5
 
     assert os.path.isfile(chapter5.TABLE)
     command, runs = sweep_from_table(chapter5.TABLE)
@@ -403,8 +404,8 @@ def test_the_chapter5_grid_is_a_shipped_table():
 def test_a_run_stored_before_a_defaulted_field_existed_is_the_same_run():
     """Reuse across versions: a configuration stored before ``wetting`` existed equals one with
     its default (the former behaviour), not one with another value."""
-    from pendular.campaign import same_config
-    from pendular.config import BridgeConfig, TriaxialConfig, config_to_dict
+    from pendular.procedures.config import same_config
+    from pendular.procedures.config import BridgeConfig, TriaxialConfig, config_to_dict
 
     config = TriaxialConfig(bridges=BridgeConfig(30000.0))
     stored = config_to_dict(config)

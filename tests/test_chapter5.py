@@ -1,4 +1,4 @@
-"""The Chapter 5 campaign (pendular.chapter5): its grid, envelopes and report as library code;
+"""The Chapter 5 campaign (pendular.studies.chapter5): its grid, envelopes and report as library code;
 scenarios/chapter5.py on 2 suctions x 2 confining stresses in 2 processes, reused when started
 again; the library on a Dask cluster."""
 
@@ -13,9 +13,9 @@ import sys
 import numpy as np
 import pytest
 
-from pendular.chapter5 import Chapter5Grid, chapter5_campaign, envelopes, write_report
-from pendular.config import ShearConfig
-from pendular.reference import FIG_5_5, TABLE_5_3
+from pendular.studies.chapter5 import Chapter5Grid, chapter5_campaign, envelopes, write_report
+from pendular.procedures.config import ShearConfig
+from pendular.procedures.reference import FIG_5_5, TABLE_5_3
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
@@ -199,7 +199,7 @@ def test_campaign_figures(campaign):
 
 
 def test_directional_value_of_a_tensor_is_its_quadratic_form():
-    from pendular.chapter5_figures import directional
+    from pendular.studies.chapter5_figures import directional
 
     tensor = np.array([[2.0, 0.0, 0.5], [0.0, 7.0, 0.0], [0.5, 0.0, 3.0]])
     angles = np.linspace(0.0, 2 * np.pi, 13)

@@ -17,15 +17,15 @@ import pytest
 
 from conftest import two_body_scene
 from pendular.dem.checkpoint import FORMAT, CheckpointWriter, load_checkpoint, save_checkpoint
-from pendular.dem.integrity import stamp, verify
+from pendular.utils.integrity import stamp, verify
 from pendular.dem.neighbors import NeighborList
-from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.integrate import Integrator
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import StressServo
-from pendular.config import ShearConfig
-from pendular.triaxial import TriaxialShear
+from pendular.procedures.config import ShearConfig
+from pendular.procedures.triaxial import TriaxialShear
 
 TESTS = os.path.dirname(os.path.abspath(__file__))
 
@@ -230,7 +230,7 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     code = (f"import sys; sys.path.insert(0, {TESTS!r}); import test_checkpoint; "
             f"test_checkpoint.checkpoint_forever({path!r})")
     child = subprocess.Popen([sys.executable, "-c", code])
-    temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # pendular.dem.atomic.replacing
+    temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # pendular.utils.atomic.replacing
     try:
         deadline = time.monotonic() + 60.0
         while not os.path.exists(path):

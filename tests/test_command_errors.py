@@ -14,9 +14,9 @@ import h5py
 import numpy as np
 import pytest
 
-from pendular.chapter5 import check_history
+from pendular.studies.chapter5 import check_history
 from pendular.cli import run_command
-from pendular.dem.integrity import stamp, verify
+from pendular.utils.integrity import stamp, verify
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.state import Particles, Walls
 from pendular.homogenize.fabric import principal_anisotropy

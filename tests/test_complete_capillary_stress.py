@@ -12,7 +12,7 @@ import pytest
 from pendular.capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
 from pendular.capillary.meniscus import solve_bridge
 from pendular.homogenize import (capillary_force_stress, contact_line_integral, homogenize_bridges,
-                        interface_stress, wetted_cap_integral)
+    interface_stress, wetted_cap_integral)
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 
 GAMMA = SURFACE_TENSION

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
-from pendular.dem.contact_law import (add_face_terms, gather_contact_forces, gather_contact_forces_virial,
-                             normal_stiffness, pair_forces, scatter_contact_forces,
-                             scattered_pair_forces)
+from pendular.dem.contact_law import (add_face_terms, gather_contact_forces,
+    gather_contact_forces_virial, normal_stiffness, pair_forces, scatter_contact_forces,
+    scattered_pair_forces)
 from pendular.dem.neighbors import build_contacts
 from pendular.dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
 from pendular.dem.state import Walls

@@ -1,4 +1,4 @@
-"""The direct-tension test (pendular.tension, pendular.dem.tension, pendular.capillary.wetting): wetting to a
+"""The direct-tension test (pendular.procedures.tension, pendular.procedures.grips, pendular.capillary.wetting): wetting to a
 water content, grips, strength, and its command line."""
 
 import copy
@@ -14,13 +14,14 @@ import pytest
 
 from pendular.capillary import BridgeTable, formation_suction
 from pendular.dem.measure import unbalanced_force
-from pendular.dem.preparation import prepare_sample
+from pendular.procedures.preparation import prepare_sample
 from pendular.dem.state import Particles, Walls
-from pendular.dem.tension import Grip, grip_members
-from pendular import tension as direct_tension
-from pendular.water_content import WATER_TOLERANCE
+from pendular.procedures.grips import Grip, grip_members
+from pendular.procedures import tension as direct_tension
+from pendular.procedures.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
-from pendular.config import CONFIG_TYPES, TensionConfig, config_from_dict, config_to_dict
+from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from_dict,
+    config_to_dict)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAMMA = 0.074
@@ -201,11 +202,12 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
 
 
 def test_prediction_is_chapter4s_kim_comparison(args):
-    """pendular.tension's prediction of Kim's cases is Table 4.5's exact, theta = 0 column of
-    pendular.chapter4 (same reference data, same packing choice)."""
+    """pendular.procedures.tension's prediction of Kim's cases is Table 4.5's exact, theta = 0 column of
+    pendular.studies.chapter4 (same reference data, same packing choice)."""
     from pendular.homogenize import regular_packing
-    from pendular import chapter4
-    from pendular.reference import KIM_2001, KIM_RADIUS, KIM_SEPARATION, comparison_packing
+    from pendular.studies import chapter4
+    from pendular.procedures.reference import (KIM_2001, KIM_RADIUS, KIM_SEPARATION,
+        comparison_packing)
 
     for e, w, _ in KIM_2001:
         packing = regular_packing(comparison_packing(e)[0], separation=KIM_SEPARATION)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from pendular.envelope import mohr_coulomb_fit
+from pendular.studies.envelope import mohr_coulomb_fit
 
 
 def peaks_on_envelope(phi_deg, cohesion, lateral):

@@ -1,4 +1,4 @@
-"""The --quick extremes grid (pendular.extremes): no case fails, refusals name the parameter,
+"""The --quick extremes grid (pendular.studies.extremes): no case fails, refusals name the parameter,
 the JSON report is complete; and the command line."""
 
 import json
@@ -7,7 +7,7 @@ import os
 import subprocess
 import sys
 
-from pendular import extremes
+from pendular.studies import extremes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

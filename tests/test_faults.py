@@ -27,10 +27,10 @@ import pytest
 from numba.core import event
 
 from conftest import zero_bytes
-from pendular.dem.integrity import stamp, verify
-from pendular.dem.interrupt import catching_interrupts
+from pendular.utils.integrity import stamp, verify
+from pendular.utils.interrupt import catching_interrupts
 from pendular.cli import run_command
-from pendular.outputs import OutputFolder
+from pendular.io.outputs import OutputFolder
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "scenarios", "triaxial.py")
@@ -242,7 +242,7 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 
 
 # ---------------------------------------------------------------- signals
-# Each run waits at a known phase (pendular.dem.interrupt.pause_point, PENDULAR_TEST_PAUSE_AT)
+# Each run waits at a known phase (pendular.utils.interrupt.pause_point, PENDULAR_TEST_PAUSE_AT)
 # until the test's signal arrives there: nothing races the machine's speed.
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
@@ -445,7 +445,7 @@ def test_an_interrupt_while_numba_compiles_waits_for_the_kernel_to_be_whole(pyth
 
 # ---------------------------------------------------------------- stress bookkeeping
 def test_records_whose_wall_and_love_weber_stresses_drift_apart_are_flagged():
-    from pendular.triaxial import STRESS_BALANCE_BOUND, stress_balance_error, summarize
+    from pendular.procedures.triaxial import STRESS_BALANCE_BOUND, stress_balance_error, summarize
 
     records = 5
     wall = np.tile([1000.0, 1000.0, 3000.0], (records, 1))        # p = 5/3 kPa
@@ -475,8 +475,8 @@ def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
 
 def test_an_interrupt_wrapped_by_numba_is_an_interrupt(capsys, monkeypatch):
     """Ctrl-C that Numba's C dispatcher reports as a SystemError whose cause is the
-    KeyboardInterrupt (pendular.dem.interrupt) ends like any interrupt (exit 130, one line)."""
-    from pendular.commands import triaxial as command
+    KeyboardInterrupt (pendular.utils.interrupt) ends like any interrupt (exit 130, one line)."""
+    from pendular.cli.commands import triaxial as command
 
     def interrupted_while_loading(args):
         try:

@@ -7,11 +7,11 @@ import numba
 import numpy as np
 import pytest
 
-from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grading_curve, sample_radii,
-                         size_at_passing)
-from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grading_curve,
+    sample_radii, size_at_passing)
+from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.cli import run_command
-from pendular.config import config_from_dict, config_json, config_to_dict
+from pendular.procedures.config import config_from_dict, config_json, config_to_dict
 
 CURVE = ((30e-6, 0.0), (40e-6, 20.0), (50e-6, 60.0), (80e-6, 100.0))
 

@@ -9,21 +9,10 @@ import pytest
 from scipy.integrate import dblquad, quad
 
 from pendular import homogenize
-from pendular.homogenize import (
-    capillary_stress,
-    contact_line_integral,
-    effective_stress,
-    effective_stress_parameter,
-    fabric_density,
-    harmonic_effective_stress_parameter,
-    harmonic_surface_tension_stress,
-    principal_anisotropy,
-    rotate_to_normal,
-    rotation_onto,
-    surface_tension_stress,
-    thesis_rotation,
-    wetted_cap_integral,
-)
+from pendular.homogenize import (capillary_stress, contact_line_integral, effective_stress,
+    effective_stress_parameter, fabric_density, harmonic_effective_stress_parameter,
+    harmonic_surface_tension_stress, principal_anisotropy, rotate_to_normal, rotation_onto,
+    surface_tension_stress, thesis_rotation, wetted_cap_integral)
 
 CAPS = [(1.0, 5.0), (2e-4, 30.0), (0.7, 60.0), (1.3, 120.0)]  # radius, filling angle [deg]
 LINES = [(1.0, 10.0, 0.0), (2e-4, 30.0, 20.0), (0.5, 45.0, 40.0), (1.0, 3.0, 70.0)]  # radius, alpha, theta

@@ -17,13 +17,8 @@ from pendular.capillary import SURFACE_TENSION, BridgeState, CapillaryBridges
 from pendular.dem.integrate import Integrator
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
-from pendular.homogenize import (
-    bridges_in_region,
-    contact_line_integral,
-    homogenize_bridges,
-    packing_state,
-    regular_packing,
-)
+from pendular.homogenize import (bridges_in_region, contact_line_integral, homogenize_bridges,
+    packing_state, regular_packing)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RADIUS = 2.4e-5

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from pendular.homogenize import packing_state, regular_packing
-from pendular.reference import CHAPTER4_SURFACE_TENSION as GAMMA
+from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION as GAMMA
 
 RADIUS = 1e-4
 TABLE_4_1_PRINTED = {  # l': (n, Fx, Fz, a) as printed in the thesis

@@ -1,6 +1,6 @@
 """Fault injection on what pendular reads back (issue 12): checksums and identities
-(pendular.dem.integrity), physical checks of samples (pendular.dem.sample), cached bridge tables rebuilt when
-tampered (pendular.capillary.table, pendular.capillary.volume_table), and output folders (pendular.outputs)."""
+(pendular.utils.integrity), physical checks of samples (pendular.dem.sample), cached bridge tables rebuilt when
+tampered (pendular.capillary.table, pendular.capillary.volume_table), and output folders (pendular.io.outputs)."""
 
 import json
 import os
@@ -15,7 +15,7 @@ from pendular.capillary.suction_control import bridge_at_distance
 from pendular.capillary.table import NODE_TOLERANCE, BridgeTable, distance_fraction, spot_nodes
 from pendular.capillary.volume_table import VolumeBridgeTable
 from conftest import zero_bytes
-from pendular.dem.integrity import checksum, config_hash, stamp, verify
+from pendular.utils.integrity import checksum, config_hash, stamp, verify
 from pendular.dem.sample import MAX_OVERLAP, check_consistent, load_sample, save_sample
 from pendular.dem.state import Particles, Walls
 
@@ -362,7 +362,7 @@ def test_a_tampered_volume_table_cache_is_rebuilt(tmp_path, capsys):
 # ---------------------------------------------------------------- output folders
 @pytest.fixture
 def OutputFolder():
-    from pendular.outputs import OutputFolder
+    from pendular.io.outputs import OutputFolder
     return OutputFolder
 
 

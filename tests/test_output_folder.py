@@ -1,4 +1,4 @@
-"""A run's output folder never ends with less than it had (pendular.outputs.OutputFolder):
+"""A run's output folder never ends with less than it had (pendular.io.outputs.OutputFolder):
 the earlier results are set aside while a new run writes, and come back if it fails."""
 
 import json
@@ -6,7 +6,7 @@ import os
 
 import pytest
 
-from pendular.outputs import EARLIER, MANIFEST, OutputFolder
+from pendular.io.outputs import EARLIER, MANIFEST, OutputFolder
 
 
 def run_into(out, files, fail=None, phase=None, commit_first=False):

@@ -14,13 +14,13 @@ from pendular.dem.cell import PeriodicCell, pair_virial
 from pendular.dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList, build_contacts, gather_pair_forces
-from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular import TriaxialConfig, TriaxialTest
-from pendular.config import BridgeConfig, ShearConfig
+from pendular.procedures.config import BridgeConfig, ShearConfig
 
 from conftest import DENSITY, RADIUS, YOUNG
 

@@ -1,4 +1,4 @@
-"""Self-describing outputs (pendular.schema, pendular.io): every history column pendular
+"""Self-describing outputs (pendular.io.schema, pendular.io.history): every history column pendular
 writes is declared with units, a new column without them is refused, histories and summaries
 read back with their coordinates and units."""
 
@@ -9,9 +9,9 @@ import h5py
 import numpy as np
 import pytest
 
-from pendular.io import read_history, read_summary, write_history
-from pendular.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION,
-                             SUMMARY_UNITS, peak_reached)
+from pendular.io.history import read_history, read_summary, write_history
+from pendular.io.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION,
+    SUMMARY_UNITS, peak_reached)
 
 DRY = ["step", "time", "axial_strain", "volumetric_strain", "sigma_wall", "sigma_contact",
        "porosity", "coordination", "fabric", "anisotropy", "unbalanced_force"]
@@ -85,7 +85,7 @@ def test_every_declared_column_has_units_a_description_and_known_dimensions():
 
 def test_the_columns_the_triaxial_records_are_all_declared():
     from pendular.homogenize.on_the_fly import CapillaryHomogenization
-    from pendular.triaxial import history_columns
+    from pendular.procedures.triaxial import history_columns
 
     bridges = SimpleNamespace(saturation=None, mean_suction=None, count=None,
                               pendular_overlaps=None, model="exact")

@@ -11,7 +11,7 @@ from conftest import RADIUS, YOUNG, two_body_scene
 from pendular.dem.contact_law import ContactForces, normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
-from pendular.dem.preparation import PrepareConfig, timestep
+from pendular.procedures.preparation import PrepareConfig, timestep
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import critical_timestep, pwave_timestep

@@ -1,4 +1,4 @@
-"""The trade-off study (pendular.tradeoff): its runs are configurations built with
+"""The trade-off study (pendular.studies.tradeoff): its runs are configurations built with
 dataclasses.replace, reused only when their stored configuration is equal; and the quick grid
 through scenarios/tradeoff.py, whose table is consistent with its runs."""
 
@@ -11,8 +11,8 @@ import sys
 
 import pytest
 
-from pendular import tradeoff
-from pendular.config import config_to_dict
+from pendular.studies import tradeoff
+from pendular.procedures.config import config_to_dict
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "tradeoff.py")

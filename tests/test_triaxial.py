@@ -11,10 +11,10 @@ import numba
 import numpy as np
 import pytest
 
-from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.homogenize import contact_stress
-from pendular.config import ShearConfig
-from pendular.triaxial import TriaxialShear, summarize
+from pendular.procedures.config import ShearConfig
+from pendular.procedures.triaxial import TriaxialShear, summarize
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

@@ -17,16 +17,16 @@ from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
 from pendular.dem.timestep import pwave_timestep
 from pendular.dem.neighbors import NeighborList
-from pendular.dem.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import load_sample
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
-from pendular.vtk import VtkWriter
+from pendular.io.vtk import VtkWriter
 from pendular.dem.walls import StressServo
-from pendular.dem.yade_io import read_plot_data, read_spheres, write_spheres
+from pendular.interop.yade.formats import read_plot_data, read_spheres, write_spheres
 from pendular.homogenize import (capillary_stress, contact_line_integral, fabric_tensor,
-                        wetted_cap_integral)
+    wetted_cap_integral)
 
 NAN = float("nan")
 ONE = np.zeros((1, 3))
@@ -58,7 +58,7 @@ CASES = {
     "walls nan": (lambda: Walls(position=[0, 1, 0, 1, 0, NAN]), "walls position"),
     "box inverted": (lambda: Walls.box([0, 0, 0], [1, -1, 1]), "box_hi"),
     "box shape": (lambda: Walls.box([0, 0], [1, 1]), "cannot reshape"),
-    # pendular.dem.preparation
+    # pendular.procedures.preparation
     "particles one": (lambda: PrepareConfig(particles=1), "particles"),
     "particles fraction": (lambda: PrepareConfig(particles=2.5), "particles"),
     "particles text": (lambda: PrepareConfig(particles="many"), "particles"),

@@ -1,4 +1,4 @@
-"""ParaView series written by pendular.vtk.VtkWriter, read back with meshio (and as XML)."""
+"""ParaView series written by pendular.io.vtk.VtkWriter, read back with meshio (and as XML)."""
 
 import copy
 import os
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from conftest import two_body_scene
-from pendular.dem.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.capillary import BridgeState
-from pendular.vtk import VtkWriter
+from pendular.io.vtk import VtkWriter
 
 
 @pytest.fixture(scope="module")
@@ -195,7 +195,7 @@ def test_writer_input_is_checked(tmp_path):
 
 # ---------------------------------------------------------------- read back with VTK itself
 
-#: Point or cell arrays of each series (pendular.vtk docstring); bridges and contacts carry
+#: Point or cell arrays of each series (pendular.io.vtk docstring); bridges and contacts carry
 #: theirs only when they have cells.
 SERIES_ARRAYS = {
     "particles": ("point", {"id", "radius", "velocity", "angular_velocity", "contact_force",
@@ -234,7 +234,7 @@ def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder)
     the declared arrays, and field data step, time and axial_strain (shear: the .pvd time axis
     is the axial strain in %) or phase (preparation: every phase of a wet run, in order)."""
     pytest.importorskip("vtk")
-    from pendular.triaxial import PREP_PHASES
+    from pendular.procedures.triaxial import PREP_PHASES
 
     path = wet_triaxial_run / folder
     steps = None

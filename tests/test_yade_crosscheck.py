@@ -1,4 +1,4 @@
-"""YADE cross-check (pendular.crosscheck, scenarios/yade_crosscheck.py).
+"""YADE cross-check (pendular.studies.crosscheck, scenarios/yade_crosscheck.py).
 
 With a ``yade`` executable on PATH: 300 spheres, wet, 1 % axial strain. Both codes start the
 shear from the same exported packing, so the wall stresses and the degree of saturation at the
@@ -24,10 +24,10 @@ import sys
 import numpy as np
 import pytest
 
-from pendular.dem.yade_io import read_spheres, write_spheres
-from pendular import crosscheck
-from pendular.config import YADE_CHOICES
-from pendular.io import read_history
+from pendular.interop.yade.formats import read_spheres, write_spheres
+from pendular.studies import crosscheck
+from pendular.procedures.config import YADE_CHOICES
+from pendular.io.history import read_history
 
 HAVE_YADE = shutil.which("yade") is not None or shutil.which("yadedaily") is not None
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -102,7 +102,7 @@ def test_periodic_crosscheck_agrees(tmp_path):
 # ---------------------------------------------------------------- without YADE
 
 def pendular_as_yade(config):
-    """A stand-in for pendular.yade.run_yade_triaxial: pendular shears the driver's packing
+    """A stand-in for pendular.interop.yade.runner.run_yade_triaxial: pendular shears the driver's packing
     and writes the driver's history layout (box lengths chosen to give the same volume)."""
 
     def run(settings, threads=1, env=None):
@@ -227,7 +227,7 @@ def test_configuration_and_refusals():
 
 def test_command_refuses_a_wet_periodic_crosscheck():
     from pendular.cli import UsageError, command_parser
-    from pendular.commands.crosscheck import check, config_from
+    from pendular.cli.commands.crosscheck import check, config_from
 
     parser, _ = command_parser("crosscheck")
     assert config_from(parser.parse_args(["--periodic"])).sample.periodic
@@ -237,7 +237,7 @@ def test_command_refuses_a_wet_periodic_crosscheck():
 
 def test_the_crosscheck_takes_the_grading_options_of_the_triaxial_command(tmp_path):
     from pendular.cli import command_parser
-    from pendular.commands.crosscheck import config_from
+    from pendular.cli.commands.crosscheck import config_from
 
     curve = tmp_path / "psd.csv"
     curve.write_text("3e-5,0\n5e-5,50\n8e-5,100\n")

@@ -6,7 +6,8 @@ import gzip
 import numpy as np
 import pytest
 
-from pendular.dem.yade_io import read_plot_data, read_plot_headers, read_spheres, write_spheres
+from pendular.interop.yade.formats import (read_plot_data, read_plot_headers, read_spheres,
+    write_spheres)
 
 # Written by YADE 2023.02a itself:
 #   plot.addData(i=0, t=0.0, sz=1.5e3)

@@ -27,8 +27,8 @@ _EXPORTS = {
     "ContactForces": "pendular.dem.contact_law",
     "Integrator": "pendular.dem.integrate",
     "NeighborList": "pendular.dem.neighbors",
-    "PrepareConfig": "pendular.dem.preparation",
-    "prepare_sample": "pendular.dem.preparation",
+    "PrepareConfig": "pendular.procedures.preparation",
+    "prepare_sample": "pendular.procedures.preparation",
     "HistoryRecorder": "pendular.dem.record",
     "Simulation": "pendular.dem.simulation",
     "Particles": "pendular.dem.state",
@@ -36,22 +36,22 @@ _EXPORTS = {
     "ConstantStrainRate": "pendular.dem.walls",
     "StressServo": "pendular.dem.walls",
     "WallForces": "pendular.dem.walls",
-    "Campaign": "pendular.campaign",
-    "Run": "pendular.campaign",
-    "BridgeConfig": "pendular.config",
-    "ShearConfig": "pendular.config",
-    "SwccConfig": "pendular.config",
-    "TensionConfig": "pendular.config",
-    "TriaxialConfig": "pendular.config",
-    "read_history": "pendular.io",
-    "read_summary": "pendular.io",
-    "SwccTest": "pendular.swcc",
-    "TensionTest": "pendular.tension",
-    "TriaxialShear": "pendular.triaxial",
-    "TriaxialTest": "pendular.triaxial",
-    "equilibrate": "pendular.triaxial",
-    "summarize": "pendular.triaxial",
-    "wet": "pendular.triaxial",
+    "Campaign": "pendular.studies.campaign",
+    "Run": "pendular.studies.campaign",
+    "BridgeConfig": "pendular.procedures.config",
+    "ShearConfig": "pendular.procedures.config",
+    "SwccConfig": "pendular.procedures.config",
+    "TensionConfig": "pendular.procedures.config",
+    "TriaxialConfig": "pendular.procedures.config",
+    "read_history": "pendular.io.history",
+    "read_summary": "pendular.io.history",
+    "SwccTest": "pendular.procedures.swcc",
+    "TensionTest": "pendular.procedures.tension",
+    "TriaxialShear": "pendular.procedures.triaxial",
+    "TriaxialTest": "pendular.procedures.triaxial",
+    "equilibrate": "pendular.procedures.triaxial",
+    "summarize": "pendular.procedures.triaxial",
+    "wet": "pendular.procedures.triaxial",
 }
 
 __all__ = sorted([*_EXPORTS, "__version__"])
@@ -59,12 +59,9 @@ __all__ = sorted([*_EXPORTS, "__version__"])
 
 def __getattr__(name):
     if name == "__version__":
-        from importlib.metadata import PackageNotFoundError, version
+        from pendular.utils.version import software_version
 
-        try:
-            value = version("pendular")
-        except PackageNotFoundError:      # a source tree that was not installed
-            value = "0+unknown"
+        value = software_version()
     elif name in _EXPORTS:
         value = getattr(import_module(_EXPORTS[name]), name)
     else:

@@ -15,19 +15,17 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 """
 
 from pendular.capillary.bridge_state import BridgeState
-from pendular.capillary.bridges import (BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION, CapillaryBridges,
-                               sample_radius_ratios, table_radius_ratios)
+from pendular.capillary.bridges import (BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION,
+    CapillaryBridges, sample_radius_ratios, table_radius_ratios)
 from pendular.capillary.meniscus import Bridge, solve_bridge
-from pendular.capillary.suction_control import bridge_at_distance, lowest_distance, rupture_distance
-from pendular.capillary.table import FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory, lookup_suction
+from pendular.capillary.suction_control import (bridge_at_distance, lowest_distance,
+    rupture_distance)
+from pendular.capillary.table import (FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory,
+    lookup_suction)
 from pendular.capillary.toroidal import ToroidalBridge, toroidal_bridge
 from pendular.capillary.validation import MAX_RADIUS_RATIO
-from pendular.capillary.volume_control import (
-    CONTACT_SUCTION_MAX,
-    bridge_with_volume,
-    rupture_distance_for_volume,
-    volume_contour,
-)
+from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, bridge_with_volume,
+    rupture_distance_for_volume, volume_contour)
 from pendular.capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
 from pendular.capillary.wetting import formation_suction, gravimetric_water_content
 from pendular.capillary.yade_files import YadeCapillaryFile, read_yade, write_yade

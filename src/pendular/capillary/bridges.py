@@ -68,19 +68,18 @@ import math
 import numba
 import numpy as np
 
-from pendular.capillary.bridge_kernels import (bridges_across_gaps, contact_bridges, exchange_liquid,
-                                      gather_contact_bridges, gather_contact_bridges_virial,
-                                      pendular_overlap_counts, refresh_contact_bridges,
-                                      serial_contact_bridges, suction_bridges,
-                                      suction_interfaces, volume_bridges, volume_interfaces)
+from pendular.capillary.bridge_kernels import (bridges_across_gaps, contact_bridges,
+    exchange_liquid, gather_contact_bridges, gather_contact_bridges_virial,
+    pendular_overlap_counts, refresh_contact_bridges, serial_contact_bridges, suction_bridges,
+    suction_interfaces, volume_bridges, volume_interfaces)
 from pendular.capillary.bridge_state import BridgeState
 from pendular.capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from pendular.capillary.validation import (check_bridge_stiffness, check_contact_angle,
-                                  check_pendular_suction)
+    check_pendular_suction)
 from pendular.capillary.volume_table import VolumeBridgeTable
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.neighbors import gather_pair_forces, gather_pair_forces_virial
-from pendular.dem.validate import check_positive, check_range
+from pendular.utils.validate import check_positive, check_range
 
 #: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
 SURFACE_TENSION = 0.073

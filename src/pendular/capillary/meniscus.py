@@ -34,7 +34,8 @@ import numba
 import numpy as np
 
 from pendular.capillary.roots import brent_maximum, brent_root
-from pendular.capillary.validation import check_contact_angle, check_filling_angle, check_radius_ratio, check_suction
+from pendular.capillary.validation import (check_contact_angle, check_filling_angle,
+    check_radius_ratio, check_suction)
 
 GAUSS_ORDER = 32
 """Gauss–Legendre nodes on each of the two panels of the profile (sphere 1 to neck, neck to sphere 2)."""

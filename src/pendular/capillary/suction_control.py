@@ -16,7 +16,8 @@ import numpy as np
 
 from pendular.capillary.meniscus import Bridge, bridge_kernel
 from pendular.capillary.roots import brent_maximum, brent_root
-from pendular.capillary.validation import check_contact_angle, check_distance, check_radius_ratio, check_suction
+from pendular.capillary.validation import (check_contact_angle, check_distance, check_radius_ratio,
+    check_suction)
 
 SMALLEST_FILLING_ANGLE = 1e-7
 """Lower end (rad) of the filling-angle search for the rupture point."""

@@ -27,16 +27,12 @@ import numba
 import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
-from pendular.capillary.suction_control import (
-    bridge_at_distance,
-    bridge_from_kernel,
-    rupture_point,
-    stable_filling_angle,
-)
+from pendular.capillary.suction_control import (bridge_at_distance, bridge_from_kernel,
+    rupture_point, stable_filling_angle)
 from pendular.capillary.validation import check_contact_angle, check_positive, check_radius_ratio
-from pendular.dem.atomic import replacing
-from pendular.dem.integrity import stamp, verify
-from pendular.dem.validate import reading
+from pendular.utils.atomic import replacing
+from pendular.utils.integrity import stamp, verify
+from pendular.utils.validate import reading
 
 YADE_RADIUS_RATIOS = (1.0, 1.1, 1.25, 1.5, 1.75, 2.0, 3.0, 4.0, 5.0, 10.0)
 """Radius ratios of YADE's capillary files M(r=1) ... M(r=10)."""
@@ -64,7 +60,7 @@ def cache_directory():
 
 def save_atomically(table, path, identity=None):
     """table.save to path (atomic: concurrent runs never read a partial table), creating its
-    folder; stamped (pendular.dem.integrity: checksum and ``identity``) before it appears when
+    folder; stamped (pendular.utils.integrity: checksum and ``identity``) before it appears when
     ``identity`` is given."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -91,7 +87,7 @@ def cache_identity(kind, parameters):
 def cached_table(path, identity, load, check, build):
     """The table cached at ``path`` if it passes every check, else ``build()`` saved there.
 
-    Checks: checksum and ``identity`` (pendular.dem.integrity.verify), ``load(path)``, then
+    Checks: checksum and ``identity`` (pendular.utils.integrity.verify), ``load(path)``, then
     ``check(table)`` (ValueError when its nodes do not match the key, are not finite or differ
     from the exact solver at the spot-checked nodes: a checksum only proves the file unchanged
     since it was stamped). A file that fails is rebuilt, never used, with a one-line warning
@@ -509,7 +505,7 @@ class BridgeTable:
                                 float(distance_star))
 
     def save(self, path):
-        """Write the table to an HDF5 file, atomically (pendular.dem.atomic.replacing)."""
+        """Write the table to an HDF5 file, atomically (pendular.utils.atomic.replacing)."""
         with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
             h5.attrs["kind"] = "suction"
             h5.attrs["format"] = TABLE_FORMAT

@@ -3,7 +3,7 @@
 import math
 
 from pendular.dem.contact_law import normal_stiffness
-from pendular.dem.validate import check_positive, finite_number  # noqa: F401  (shared checks)
+from pendular.utils.validate import check_positive, finite_number  # noqa: F401  (shared checks)
 
 MAX_RADIUS_RATIO = 20.0
 """Largest R2/R1 the exact solver accepts (its accuracy is verified up to this value)."""

@@ -15,7 +15,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from pendular.capillary.meniscus import solve_bridge
-from pendular.capillary.suction_control import bridge_at_distance, rupture_point, stable_filling_angle
+from pendular.capillary.suction_control import (bridge_at_distance, rupture_point,
+    stable_filling_angle)
 from pendular.capillary.table import BridgeTable
 from pendular.capillary.toroidal import toroidal_bridge
 from pendular.capillary.volume_control import bridge_with_volume, volume_contour

@@ -22,7 +22,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from pendular.capillary.meniscus import Bridge, bridge_kernel
 from pendular.capillary.suction_control import contact_filling_angle
-from pendular.capillary.validation import check_contact_angle, check_distance, check_positive, check_radius_ratio
+from pendular.capillary.validation import (check_contact_angle, check_distance, check_positive,
+    check_radius_ratio)
 
 CONTACT_SUCTION_MAX = 15000.0
 """Largest u* at contact of the volume-controlled family (smallest volume covered)."""

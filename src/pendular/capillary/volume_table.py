@@ -19,33 +19,15 @@ import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
 from pendular.capillary.suction_control import contact_filling_angle
-from pendular.capillary.table import (
-    SPOT_NODES,
-    TABLE_FORMAT,
-    YADE_RADIUS_RATIOS,
-    along_axis,
-    bilinear,
-    cache_directory,
-    cache_identity,
-    cache_key,
-    cached_table,
-    check_table_nodes,
-    compare_node,
-    distance_cell,
-    distance_fraction,
-    grid_position,
-    radius_ratio_bracket,
-    spot_nodes,
-)
+from pendular.capillary.table import (SPOT_NODES, TABLE_FORMAT, YADE_RADIUS_RATIOS, along_axis,
+    bilinear, cache_directory, cache_identity, cache_key, cached_table, check_table_nodes,
+    compare_node, distance_cell, distance_fraction, grid_position, radius_ratio_bracket,
+    spot_nodes)
 from pendular.capillary.validation import check_contact_angle, check_radius_ratio
-from pendular.dem.atomic import replacing
-from pendular.dem.validate import reading
-from pendular.capillary.volume_control import (
-    CONTACT_SUCTION_MAX,
-    contour_point_at_distance,
-    suction_at,
-    trace_contour,
-)
+from pendular.utils.atomic import replacing
+from pendular.utils.validate import reading
+from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, contour_point_at_distance,
+    suction_at, trace_contour)
 
 VOLUME_FIELDS = ("force", "suction", "delta1", "delta2", "nn11", "nn33")
 """Quantities stored at each node, last axis of `values`: F*, u*, delta1 and delta2 (degrees), nn11, nn33."""
@@ -315,7 +297,7 @@ class VolumeBridgeTable:
         return lookup_volume(*self.arrays(), float(radius_ratio), float(volume_star), float(distance_star))
 
     def save(self, path):
-        """Write the table to an HDF5 file, atomically (pendular.dem.atomic.replacing)."""
+        """Write the table to an HDF5 file, atomically (pendular.utils.atomic.replacing)."""
         with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
             h5.attrs["kind"] = "volume"
             h5.attrs["format"] = TABLE_FORMAT

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from pendular.capillary.table import lookup_suction
-from pendular.dem.validate import check_positive
+from pendular.utils.validate import check_positive
 
 
 def gravimetric_water_content(water_volume, solid_volume, specific_gravity):

@@ -23,8 +23,8 @@ import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
 from pendular.capillary.suction_control import rupture_point, stable_filling_angle
-from pendular.dem.atomic import replacing
-from pendular.dem.validate import reading
+from pendular.utils.atomic import replacing
+from pendular.utils.validate import reading
 
 COLUMNS = ("distance", "suction", "volume", "force", "delta1", "delta2", "nn11", "nn33")
 

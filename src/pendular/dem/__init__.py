@@ -1,7 +1,7 @@
 """Soft-sphere discrete element engine (Numba): state, contacts, walls, integration.
 
 Importing it changes no process-wide setting: a run applies Numba's threading settings where it
-starts (``pendular.dem.threads.configure``).
+starts (``pendular.utils.threads.configure``).
 
 The kernels that take most of a step (pair forces, the contact gather, the leapfrog) are
 compiled with HOT_KERNEL_FASTMATH: fused multiply-adds and division by a reciprocal (LLVM's

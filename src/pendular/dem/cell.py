@@ -24,10 +24,11 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .neighbors import branch_vector
-from .state import Box, _box_position, _check_box
-from .validate import check_array
-from .virial import SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds, sum_blocks
+from pendular.dem.neighbors import branch_vector
+from pendular.dem.state import Box, _box_position, _check_box
+from pendular.utils.validate import check_array
+from pendular.dem.virial import (SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds,
+    sum_blocks)
 
 
 @numba.njit(cache=True, parallel=True)

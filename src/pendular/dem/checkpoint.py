@@ -53,11 +53,11 @@ import pickle
 import h5py
 import numpy as np
 
-from .atomic import replacing
-from .integrity import software_version, stamp, verify
-from .neighbors import Contacts, second_index
-from .validate import check_int, reading
-from .virial import SUM_BLOCKS, face_block_starts
+from pendular.utils.atomic import replacing
+from pendular.utils.integrity import software_version, stamp, verify
+from pendular.dem.neighbors import Contacts, second_index
+from pendular.utils.validate import check_int, reading
+from pendular.dem.virial import SUM_BLOCKS, face_block_starts
 
 FORMAT = "pendular-checkpoint"
 VERSION = 3
@@ -221,7 +221,7 @@ def save_checkpoint(path, sim, extra_state=None, identity=None):
 
     ``extra_state``: any picklable value (e.g. the scenario's phase), returned by
     ``load_checkpoint``; ``identity``: what made the run (dict, e.g. its configuration hash and
-    seed), stamped with a content checksum (pendular.dem.integrity) and checked by ``load_checkpoint``.
+    seed), stamped with a content checksum (pendular.utils.integrity) and checked by ``load_checkpoint``.
     Returns the names of the operation attributes not saved ({"forces[i] Type": [names]}).
     """
     path = os.fspath(path)

@@ -19,10 +19,11 @@ dry 0.95-0.98 at 1,000 spheres, 0.98-1.01 at 10,000, 0.986 at 100,000; wet 0.94-
 import numba
 import numpy as np
 
-from . import HOT_KERNEL_FASTMATH
-from .prefetch import prefetch_distance, prefetch_row
-from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, add_face_block, block_bounds, pair_force_with_attraction
+from pendular.dem import HOT_KERNEL_FASTMATH
+from pendular.dem.prefetch import prefetch_distance, prefetch_row
+from pendular.utils.validate import check_positive, check_range
+from pendular.dem.virial import (SUM_BLOCKS, add_face_block, block_bounds,
+    pair_force_with_attraction)
 
 
 @numba.njit(cache=True, inline="always")

@@ -20,7 +20,7 @@ import os
 
 import numpy as np
 
-from .validate import check_range
+from pendular.utils.validate import check_range
 
 #: Largest radius ratio of a sample (the capillary tables' range, YADE's M(r=10)).
 MAX_RADIUS_RATIO = 10.0

@@ -2,8 +2,8 @@
 
 import numba
 
-from . import HOT_KERNEL_FASTMATH
-from .validate import check_range
+from pendular.dem import HOT_KERNEL_FASTMATH
+from pendular.utils.validate import check_range
 
 
 @numba.njit(cache=True, inline="always")

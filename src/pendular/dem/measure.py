@@ -3,7 +3,7 @@
 import numba
 import numpy as np
 
-from .contact_law import normal_stiffness, wall_contact_stiffness
+from pendular.dem.contact_law import normal_stiffness, wall_contact_stiffness
 
 
 def porosity(particles, walls):

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from .validate import check_positive, check_range
-from .virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
+from pendular.utils.validate import check_positive, check_range
+from pendular.dem.virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
 
 @dataclass
@@ -616,7 +616,7 @@ class NeighborList:
         return reach
 
     def rebuild(self, sim):
-        """Rebuild the list now (``apply`` does when needed; pendular.dem.preparation.rescale after
+        """Rebuild the list now (``apply`` does when needed; pendular.procedures.preparation.rescale after
         scaling every length)."""
         p = sim.particles
         box = sim.walls

@@ -3,8 +3,8 @@
 import h5py
 import numpy as np
 
-from .atomic import replacing
-from .validate import check_int
+from pendular.utils.atomic import replacing
+from pendular.utils.validate import check_int
 
 
 class HistoryRecorder:

@@ -1,6 +1,6 @@
 """Save and load a prepared sample (positions, radii, walls, velocities) as HDF5.
 
-A sample file is stamped (pendular.dem.integrity: checksum and identity) and every sample that enters
+A sample file is stamped (pendular.utils.integrity: checksum and identity) and every sample that enters
 is checked before use (``check_packing``): finite values, every sphere inside the box, overlaps
 within what the linear contact law holds, not collapsed to one point; ``check_consistent``
 refuses a sample made with another radius, particle count or density than the run asks for.
@@ -19,12 +19,12 @@ import h5py
 import numba
 import numpy as np
 
-from .atomic import replacing
-from .grading import GRADING_UNITS, grading
-from .integrity import config_hash, software_version, stamp, verify
-from .cell import PeriodicCell
-from .state import WALL_NAMES, Particles, Walls
-from .validate import reading
+from pendular.utils.atomic import replacing
+from pendular.dem.grading import GRADING_UNITS, grading
+from pendular.utils.integrity import config_hash, software_version, stamp, verify
+from pendular.dem.cell import PeriodicCell
+from pendular.dem.state import WALL_NAMES, Particles, Walls
+from pendular.utils.validate import reading
 
 FORMAT = "pendular-sample"
 VERSION = 2
@@ -33,7 +33,7 @@ VERSION = 2
 MAX_OVERLAP = 0.2
 """Largest overlap a sample may hold, as a fraction of the smaller radius of the pair (of the
 sphere's radius against a wall). The linear springs (kn = 2 E R1 R2 / (R1 + R2), walls E R)
-are a small-overlap law; the stress / young limit of pendular.dem.preparation (0.02) keeps prepared
+are a small-overlap law; the stress / young limit of pendular.procedures.preparation (0.02) keeps prepared
 samples below about 0.16 R at the most loaded contact, so 0.2 R bounds every valid sample and
 refuses overlapped, edited or misplaced spheres."""
 
@@ -110,7 +110,7 @@ def load_sample(path, expected=None, expected_identity=None):
     """Read a sample written by ``save_sample``: (Particles, Walls or PeriodicCell, report dict,
     config dict).
 
-    The file's checksum and identity are verified first (pendular.dem.integrity.verify with
+    The file's checksum and identity are verified first (pendular.utils.integrity.verify with
     ``expected_identity``), then its state (``check_packing``) and, if ``expected`` is given (a
     dict or an object with ``radius`` [m], ``particles``, ``density`` [kg/m^3], e.g. the run's
     PrepareConfig), its consistency with the run (``check_consistent``). ValueError naming the

@@ -25,9 +25,9 @@ import time
 import numba
 from tqdm import tqdm
 
-from .state import Box, Particles
-from .validate import check_int, check_positive
-from .threads import configure as configure_threading
+from pendular.dem.state import Box, Particles
+from pendular.utils.validate import check_int, check_positive
+from pendular.utils.threads import configure as configure_threading
 
 #: Below this many particles a step is too short to pay for waking a second thread (quiet
 #: 2-core machine, 2026-11-25, dry and wet shear, 2 threads against 1 in one run: 0.72x at

@@ -5,7 +5,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .validate import check_array, check_positive
+from pendular.utils.validate import check_array, check_positive
 
 
 @dataclass

@@ -19,7 +19,7 @@ the P-wave estimate min R / sqrt(E / rho), 1.67 times the diagonal estimate and 
 Gershgorin bound: both leave most of the stable range unused, hence the eigenvalue itself.
 Leapfrog on a prepared 300-sphere packing, undamped, is steady at 0.95 of it and blows up at
 1.1 (tests/test_timestep.py). A scene runs at a safety factor times it, computed when a phase
-starts (pendular.dem.preparation.timestep): the factor leaves room for the local damping (up to
+starts (pendular.procedures.preparation.timestep): the factor leaves room for the local damping (up to
 1 + damping times the spring force) and for contacts that form during the phase.
 """
 
@@ -27,9 +27,9 @@ import numba
 import numpy as np
 import scipy.sparse.linalg
 
-from .contact_law import normal_stiffness, wall_contact_stiffness
-from .neighbors import branch_vector, build_contacts
-from .validate import check_array, check_positive
+from pendular.dem.contact_law import normal_stiffness, wall_contact_stiffness
+from pendular.dem.neighbors import branch_vector, build_contacts
+from pendular.utils.validate import check_array, check_positive
 
 #: How a scene's time step is chosen: the P-wave estimate of the smallest sphere, or the
 #: critical step of its contacts (either multiplied by a safety factor).

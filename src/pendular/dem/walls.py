@@ -6,9 +6,9 @@ A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, 
 import numba
 import numpy as np
 
-from .cell import servo_cell
-from .contact_law import wall_forces
-from .validate import check_int, check_positive, check_range
+from pendular.dem.cell import servo_cell
+from pendular.dem.contact_law import wall_forces
+from pendular.utils.validate import check_int, check_positive, check_range
 
 AXES = {"x": 0, "y": 1, "z": 2}
 

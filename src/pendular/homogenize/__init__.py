@@ -11,35 +11,17 @@
 - regular_packing, packing_state: SCP, BCC, FCP and their pendular states (Tables 4.1-4.4).
 """
 
-from .bridge_tensors import (
-    capillary_stress,
-    capillary_stress_anisotropy,
-    contact_line_integral,
-    effective_stress,
-    effective_stress_parameter,
-    interface_stress,
-    rotate_to_normal,
-    rotation_onto,
-    surface_tension_stress,
-    wetted_cap_integral,
-)
-from .contact_stress import contact_stress
-from .fabric import fabric_anisotropy, fabric_tensor, principal_anisotropy
-from .harmonic import (
-    fabric_density,
-    harmonic_effective_stress_parameter,
-    harmonic_surface_tension_stress,
-    thesis_rotation,
-)
-from .on_the_fly import (
-    BridgeStress,
-    CapillaryHomogenization,
-    bridges_in_region,
-    capillary_force_stress,
-    homogenize_bridges,
-)
-from .packing_state import PackingState, packing_state
-from .regular_packing import RegularPacking, regular_packing
+from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stress_anisotropy,
+    contact_line_integral, effective_stress, effective_stress_parameter, interface_stress,
+    rotate_to_normal, rotation_onto, surface_tension_stress, wetted_cap_integral)
+from pendular.homogenize.contact_stress import contact_stress
+from pendular.homogenize.fabric import fabric_anisotropy, fabric_tensor, principal_anisotropy
+from pendular.homogenize.harmonic import (fabric_density, harmonic_effective_stress_parameter,
+    harmonic_surface_tension_stress, thesis_rotation)
+from pendular.homogenize.on_the_fly import (BridgeStress, CapillaryHomogenization,
+    bridges_in_region, capillary_force_stress, homogenize_bridges)
+from pendular.homogenize.packing_state import PackingState, packing_state
+from pendular.homogenize.regular_packing import RegularPacking, regular_packing
 
 __all__ = [
     "BridgeStress",

@@ -34,7 +34,7 @@ chi and B of 25,000 bridges in 4 and 5 ms (9 and 11 ms summed from (K, 3, 3) ten
 
 import numpy as np
 
-from pendular.dem.validate import check_values
+from pendular.utils.validate import check_values
 from pendular.homogenize.fabric import principal_anisotropy
 
 

@@ -23,7 +23,7 @@ polynomial integrands from order 4 on.
 
 import numpy as np
 
-from pendular.dem.validate import finite_number
+from pendular.utils.validate import finite_number
 from pendular.homogenize.bridge_tensors import contact_line_integral, wetted_cap_integral
 
 ANISOTROPY_RANGE = (-0.5, 1.0)

@@ -66,15 +66,9 @@ import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
 from pendular.dem.neighbors import branch_vectors
-from pendular.dem.validate import check_positive
-from pendular.homogenize.bridge_tensors import (
-    capillary_stress,
-    capillary_stress_anisotropy,
-    effective_stress_parameter,
-    interface_stress,
-    surface_tension_stress,
-    wetted_caps_sum,
-)
+from pendular.utils.validate import check_positive
+from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stress_anisotropy,
+    effective_stress_parameter, interface_stress, surface_tension_stress, wetted_caps_sum)
 from pendular.homogenize.contact_stress import pair_stress_sum
 from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
 

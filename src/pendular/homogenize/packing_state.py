@@ -17,14 +17,10 @@ import math
 
 import numpy as np
 
-from pendular.dem.validate import check_positive, finite_number
+from pendular.utils.validate import check_positive, finite_number
 from pendular.homogenize import cell_bridge
-from pendular.homogenize.bridge_tensors import (
-    capillary_stress,
-    capillary_stress_anisotropy,
-    effective_stress_parameter,
-    surface_tension_stress,
-)
+from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stress_anisotropy,
+    effective_stress_parameter, surface_tension_stress)
 from pendular.homogenize.regular_packing import RegularPacking
 
 STATE_INPUTS = ("saturation", "suction", "water_content", "filling_angle")

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from pendular.dem.validate import finite_number
+from pendular.utils.validate import finite_number
 from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
 
 KINDS = ("scp", "bcc", "fcp")

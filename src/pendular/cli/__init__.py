@@ -1,0 +1,188 @@
+"""The ``pendular`` command: ``pendular <command> [options]`` (``pendular --help`` lists them).
+
+Each command lives in ``pendular.cli.commands.<name>`` with ``add_arguments(parser)`` and
+``run(args)``; scenarios/*.py call ``main`` with their command's name. A failure a user can
+cause (bad option, bad or missing file, unusable output folder) ends in one line
+``<prog>: error: <what is wrong>`` and exit status 2, never a traceback; an interrupted run exits
+with 130, in one line, whenever Ctrl-C comes (while Python imports the command's modules too:
+this module imports only the standard library at its top, and the rest inside ``main``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: Command name -> (module under pendular.cli.commands, one-line description).
+COMMANDS = {
+    "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
+    "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
+    "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
+    "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
+    "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
+    "campaign": ("campaign", "sweep of any command's options from a TOML parameter table"),
+    "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
+    "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),
+    "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),
+}
+
+#: Exit status of a run stopped by Ctrl-C or --stop-after.
+INTERRUPTED = 130
+
+
+class Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Help that shows every option's default after its text (units are in the text)."""
+
+
+class UsageError(Exception):
+    """A user's mistake found after parsing (printed as one ``error:`` line)."""
+
+
+def positive_int(name, low=0):
+    """argparse type: an integer >= ``low`` (the error names the option)."""
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} {text!r}: an integer expected") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"{name} {value} is outside the valid range "
+                                             f"[{low}, inf)")
+        return value
+    return parse
+
+
+def add_run_options(parser, threads_default=None):
+    """Options every command shares: --threads (``threads_default``: None lets a run choose:
+    all of Numba's threads from 500 spheres on, else 1), --quiet."""
+    parser.add_argument("--threads", type=positive_int("--threads", 1), default=threads_default,
+                        help="Numba threads of a run" + (
+                            " (None: all from 500 spheres on, else 1)"
+                            if threads_default is None else ""))
+    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+
+
+def add_executor_options(parser):
+    """Options of commands that run many tests: --jobs, --scheduler, and --threads (per run,
+    default 1), --quiet."""
+    parser.add_argument("--jobs", type=positive_int("--jobs", 1), default=1,
+                        help="parallel processes")
+    parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                        help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
+                             "instead of --jobs local processes")
+    add_run_options(parser, threads_default=1)
+
+
+def add_size_options(parser, default_radius):
+    """Sphere-size options of commands that prepare a sample: --radius (the mean radius,
+    ``default_radius`` [m] when not given), --radius-spread, --psd (pendular.dem.grading)."""
+    parser.add_argument("--radius", type=float, default=None,
+                        help=f"sphere radius [m], the mean radius of a graded sample (default "
+                             f"{default_radius:g})")
+    from pendular.dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD
+
+    parser.add_argument("--radius-spread", type=float, default=0.0,
+                        help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
+                             f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
+                             f"{MAX_RADIUS_RATIO:g})")
+    parser.add_argument("--psd", metavar="FILE", default=None,
+                        help="grading curve, CSV rows 'diameter [m], percent passing by mass' "
+                             "from 0 to 100 %% (a sieve analysis); sets the sizes instead of "
+                             "--radius")
+
+
+def sizes_from(args):
+    """The size settings (radius, radius_spread, psd) of parsed add_size_options options; a
+    radius not given is left to the configuration's default."""
+    if args.psd is not None and args.radius is not None:
+        raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
+    from pendular.dem.grading import read_grading_curve
+
+    sizes = {"radius_spread": args.radius_spread}
+    if args.radius is not None:
+        sizes["radius"] = args.radius
+    if args.psd is not None:
+        sizes["psd"] = read_grading_curve(args.psd)
+    return sizes
+
+
+def set_threads(threads):
+    """Apply --threads (error naming it outside [1, NUMBA_NUM_THREADS])."""
+    import numba
+
+    from pendular.utils.threads import configure as configure_threading, use_threads
+
+    configure_threading()
+    if threads is None:
+        return
+    if not 1 <= threads <= numba.config.NUMBA_NUM_THREADS:
+        raise UsageError(f"--threads {threads} is outside the valid range "
+                         f"[1, {numba.config.NUMBA_NUM_THREADS}]")
+    use_threads(threads)
+
+
+def command_parser(name, prog=None):
+    """(argparse parser of command ``name``, its module)."""
+    module = importlib.import_module(f"pendular.cli.commands.{COMMANDS[name][0]}")
+    parser = argparse.ArgumentParser(prog=prog or f"pendular {name}",
+                                     description=module.__doc__, formatter_class=Formatter)
+    module.add_arguments(parser)
+    return parser, module
+
+
+def run_command(name, argv, prog=None):
+    """Parse ``argv`` for command ``name`` and run it; returns the exit status."""
+    import numba
+
+    from pendular.utils.interrupt import catching_interrupts, pause_point
+
+    parser, module = command_parser(name, prog)
+    pause_point("import")
+    args = parser.parse_args(argv)
+    try:
+        with catching_interrupts():
+            return module.run(args) or 0
+    except (UsageError, ValueError, FileNotFoundError, IsADirectoryError,
+            NotADirectoryError, PermissionError) as error:
+        parser.exit(2, f"{parser.prog}: error: {error}\n")
+    except (ArithmeticError, MemoryError, numba.core.errors.NumbaError) as error:
+        # a value the configurations' ranges let through but this run cannot hold (the ranges
+        # refuse such values where they enter; this is the last line of defence)
+        first = str(error).strip().splitlines()[0] if str(error).strip() else ""
+        parser.exit(2, f"{parser.prog}: error: a setting is out of this run's reach "
+                       f"({type(error).__name__}{': ' + first if first else ''}): check the "
+                       "options' magnitudes (particles, radius, young, rates, resolutions)\n")
+    except KeyboardInterrupt:
+        parser.exit(INTERRUPTED, f"{parser.prog}: interrupted\n")
+
+
+def main(argv=None, prog=None):
+    """``pendular <command> ...``; with ``prog`` (a scenario's file name) and argv starting
+    with the command, that command alone. Ctrl-C before the command runs (while its modules
+    are imported) also ends in one line, with exit status 130."""
+    try:
+        return _main(list(sys.argv[1:] if argv is None else argv), prog)
+    except KeyboardInterrupt:
+        print(f"{prog or 'pendular'}: interrupted", file=sys.stderr)
+        return INTERRUPTED
+
+
+def _main(argv, prog):
+    if prog is not None:
+        return run_command(argv[0], argv[1:], prog)
+    from pendular.utils.version import software_version
+
+    parser = argparse.ArgumentParser(
+        prog="pendular", formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="DEM of wet granular media in the pendular regime (Khosravani 2014).",
+        epilog="commands:\n" + "\n".join(f"  {name:<11} {text}"
+                                         for name, (_, text) in COMMANDS.items())
+        + "\n\n'pendular <command> --help' shows a command's options with their defaults.")
+    parser.add_argument("--version", action="version", version=f"pendular {software_version()}")
+    parser.add_argument("command", choices=list(COMMANDS), metavar="command",
+                        help="one of: " + ", ".join(COMMANDS))
+    parser.add_argument("options", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    return run_command(args.command, args.options)
+

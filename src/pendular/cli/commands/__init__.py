@@ -1,0 +1,2 @@
+"""One module per ``pendular`` command: ``add_arguments(parser)`` and ``run(args)``.
+"""

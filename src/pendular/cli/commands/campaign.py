@@ -1,0 +1,57 @@
+"""Sweeps from a parameter table: ``pendular campaign TABLE.toml --out DIR``.
+
+The TOML table names the command (``command = "triaxial"``, the default, or ``"tension"``),
+holds fixed options in ``[fixed]`` and lists to sweep in ``[sweep]`` (every combination) or
+explicit ``[[runs]]`` rows; keys are the command's options with underscores
+(``max_strain = 0.02``), flags take true/false:
+
+    command = "triaxial"
+    [fixed]
+    particles = 300
+    max_strain = 0.02
+    [sweep]
+    suction = [0, 30000]
+    confining = [250, 750]
+
+Each run goes to DIR/runs/<name>/ (its outputs and log.txt), in --jobs local processes (at
+most 4 per CPU) with --threads Numba threads each, or on an existing Dask cluster with
+--scheduler; DIR/campaign.csv has one row per run with its options and summary. Started
+again, finished runs with equal configurations are reused. The campaign holds DIR while it
+runs: a second campaign or run into DIR is refused. A failed run does not stop the others; the
+command then ends with an error naming it (its traceback is in its log.txt).
+"""
+
+import os
+
+from pendular.cli.tables import sweep_from_table
+from pendular.studies.campaign import Campaign, RunRefused, check_jobs, write_campaign_csv
+from pendular.cli import UsageError, add_executor_options, set_threads
+from pendular.io.outputs import OutputFolder
+
+
+def add_arguments(parser):
+    parser.add_argument("table", help="TOML parameter table")
+    parser.add_argument("--out", default="runs/campaign", help="output folder")
+    add_executor_options(parser)
+
+
+def run(args):
+    if args.out == "":
+        raise UsageError("--out '': an output folder is required")
+    set_threads(args.threads)
+    check_jobs(args.jobs)
+    command, runs = sweep_from_table(args.table)
+    # keep: the finished runs of an earlier campaign there are reused; runs/ is never owned
+    with OutputFolder(args.out, ["campaign", args.table], keep=True) as folder:
+        csv_path = folder.claim("campaign.csv")
+        try:
+            result = Campaign(runs).run(os.path.abspath(args.out), jobs=args.jobs,
+                                        scheduler=args.scheduler, threads=args.threads,
+                                        quiet=args.quiet)
+        except RunRefused as error:
+            raise UsageError(f"table = {args.table!r}: {error}") from None
+        write_campaign_csv(csv_path, result)
+    print(f"campaign: {len(runs)} {command} runs ({len(result.reused)} reused, "
+          f"{len(result.failed)} failed); outputs in {args.out} (campaign.csv, runs/)")
+    result.check()
+    return 0

@@ -1,0 +1,21 @@
+"""Extremes grid: around a small wet base case, one input at a time (suction, contact angle,
+radius, stiffness, time step, particle count, confining stress, water content) takes values
+across its range and beyond; every case ends ok (finite, every check within its bound) or
+refused (an error naming the parameter, its value and the valid range), never failed. Writes
+DIR/extremes.json and prints the table; exit status 1 if a case failed (pendular.studies.extremes)."""
+
+from pendular.cli import add_run_options, set_threads
+from pendular.studies.extremes import run_grid
+
+
+def add_arguments(parser):
+    parser.add_argument("--out", required=True, help="output folder")
+    parser.add_argument("--quick", action="store_true", help="a small subset of the grid")
+    add_run_options(parser)
+
+
+def run(args):
+    set_threads(args.threads)
+    counts = run_grid(args.out, args.quick)
+    print(f"outputs in {args.out}")
+    return 1 if counts["failed"] else 0

@@ -1,0 +1,114 @@
+"""Direct tension of wet sand at fixed water content (Kim 2001; thesis Table 4.5).
+
+Without --void-ratio / --water-content it runs Kim's six cases (F-75 sand, R = 0.11 mm,
+e = 0.72 and 0.58, three water contents each): a sample per void ratio (core void ratio reached
+by tuning the growth friction), wetted with volume-controlled bridges to the gravimetric water
+content, pulled apart by grips at its z walls. Writes tension.json, report.md, plots/ and
+cases/<case>/history.h5 and vtk/ (pendular.procedures.tension).
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from pendular.cli import (UsageError, add_run_options, add_size_options, positive_int, set_threads,
+    sizes_from)
+from pendular.procedures.config import TensionConfig
+from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
+from pendular.procedures.reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
+from pendular.procedures.tension import TensionTest, cases_of, report_lines
+
+
+def _numbers(name, text):
+    """Distinct floats of a comma-separated option; UsageError naming it (a value given twice
+    would run the same cases twice into one folder)."""
+    if text is None:
+        return None
+    try:
+        values = [float(item) for item in text.split(",")]
+    except ValueError:
+        raise UsageError(f"{name} = {text!r} is not a comma-separated list of numbers") from None
+    for k, value in enumerate(values):
+        if value in values[:k]:
+            raise UsageError(f"{name} = {text!r} repeats {value:g}: give each value once")
+    return values
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--void-ratio", default=None,
+                        help="void ratio(s) of the core [-], comma separated (default: Kim's 0.72, "
+                             "0.58)")
+    parser.add_argument("--roughness", type=float, default=KIM_SEPARATION,
+                        help="meniscus separation of touching grains H/R [-] (default Kim's sand, "
+                             "as in the packing_state prediction; 0: smooth spheres)")
+    parser.add_argument("--water-content", default=None,
+                        help="gravimetric water content(s) [%%], comma separated (default: Kim's "
+                             "for his void ratios, else 0.5,1,2)")
+    parser.add_argument("--particles", type=int, default=2000, help="number of spheres [-]")
+    parser.add_argument("--form-gap", type=float, default=TensionConfig.form_gap,
+                        help="at wetting, bridges also form across gaps up to this many "
+                             "radii [-] (0: at contacts only; 1: wherever a bridge of the "
+                             "formation suction can exist, docs/direct_tension.md)")
+    add_size_options(parser, KIM_RADIUS)
+    parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
+    parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
+                        help="surface tension [N/m] (thesis Chapter 4's, which the comparison "
+                             "with Kim and packing_state uses; triaxial and swcc default to "
+                             "Chapter 5's 0.073)")
+    parser.add_argument("--specific-gravity", type=float, default=SPECIFIC_GRAVITY,
+                        help="specific gravity Gs of the grains [-]")
+    parser.add_argument("--confining", type=float, default=100.0,
+                        help="isotropic stress of preparation and wetting [Pa]")
+    parser.add_argument("--friction", type=float, default=18.0,
+                        help="contact friction during wetting and pull [deg]")
+    parser.add_argument("--young", type=float, default=1e6, help="YADE young E [Pa], kn = E R")
+    parser.add_argument("--inertial-number", type=float, default=1e-3,
+                        help="I = strain rate x d x sqrt(rho / confining) of the pull [-]")
+    parser.add_argument("--max-strain", type=float, default=0.1,
+                        help="largest axial extension of the pull [-]")
+    parser.add_argument("--residual", type=float, default=0.2,
+                        help="fraction of the peak below which the pull has ruptured [-]")
+    parser.add_argument("--grip-depth", type=float, default=None,
+                        help="grip thickness: particles whose surface is within this many "
+                             "diameters of a z wall [diameters] (default "
+                             f"{TensionConfig.grip_depth:g}; not with --periodic, which has no "
+                             "grips)")
+    parser.add_argument("--void-ratio-tolerance", type=float, default=0.01,
+                        help="largest |e - target| accepted from the preparation [-]")
+    frames = parser.add_mutually_exclusive_group()
+    frames.add_argument("--vtk-frames", type=int, default=TensionConfig.vtk_frames,
+                        help="ParaView frames per pull (0: none)")
+    frames.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
+                        help="steps between ParaView frames of the pull, instead of "
+                             "--vtk-frames (0: none)")
+    parser.add_argument("--seed", type=int, default=0, help="random seed of the samples")
+    parser.add_argument("--periodic", action="store_true",
+                        help="a periodic cell instead of six walls: no grips, the cell pulled "
+                             "along z at zero lateral stress; the void ratio is the whole cell's")
+    parser.add_argument("--out", default="runs/direct_tension", help="output folder")
+    add_run_options(parser, threads_default=1)
+
+
+def config_from(args: argparse.Namespace) -> TensionConfig:
+    """The TensionConfig of parsed options (ValueError naming the option)."""
+    cases = cases_of(_numbers("--void-ratio", args.void_ratio),
+                     _numbers("--water-content", args.water_content))
+    if args.periodic and args.grip_depth is not None:
+        raise UsageError(f"--grip-depth = {args.grip_depth:g} does not apply to --periodic: a "
+                         "periodic cell has no walls, so no grips")
+    options = {name: getattr(args, name) for name in (
+        "roughness", "form_gap", "particles", "contact_angle", "surface_tension",
+        "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
+        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed",
+        "periodic")}
+    options = {name: value for name, value in options.items() if value is not None}
+    return TensionConfig(cases=cases, **sizes_from(args), **options)
+
+
+def run(args: argparse.Namespace) -> int:
+    set_threads(args.threads)
+    config = config_from(args)
+    output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args))
+    print("\n".join(report_lines(output["cases"], config)))
+    print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}")
+    return 0

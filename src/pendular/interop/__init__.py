@@ -1,0 +1,2 @@
+"""Other programs' formats and runs.
+"""

@@ -1,0 +1,3 @@
+"""Results on disk: the history file read as xarray, the units schema, output folders, ParaView
+series, plots.
+"""

@@ -1,0 +1,190 @@
+"""What every recorded column and summary key holds: units, description, dimensions, equation.
+
+A history file's datasets are declared here once; ``pendular.io.history.write_history`` refuses a
+column that is not, so a new column cannot be written without its units. Units are SI strings
+("1" for dimensionless, "deg" for angles); stresses compression positive. Dimensions:
+``record`` (one row per record, always first), ``axis`` (x, y, z), ``component`` (x, y, z:
+the second index of a 3x3 tensor), ``grip`` (z-, z+: the grips of direct tension).
+
+Columns by test (pendular.procedures.triaxial.history_columns, pendular.procedures.tension):
+
+- triaxial, dry: step, time, axial_strain, volumetric_strain, sigma_wall, sigma_contact,
+  porosity, coordination, fabric, anisotropy, unbalanced_force;
+- triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
+  pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
+  and, with exact bridges, psi_interface and sigma_effective_complete
+  (pendular.homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
+  liquid_bridges, liquid_film, liquid_lost;
+- direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
+  coordination, unbalanced_force, and wet: bridges, water_content, saturation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pendular.dem.grading import GRADING_UNITS
+
+#: Version of the history/summary layout (attributes, dimension names).
+SCHEMA_VERSION = 1
+
+#: Labels of the dimensions after ``record`` (HDF5 dimension scales, xarray coordinates).
+DIMENSION_LABELS = {"axis": ("x", "y", "z"), "component": ("x", "y", "z"),
+                    "grip": ("z-", "z+")}
+
+#: Every dimension name, in the order of a 3x3 tensor's indices after the record.
+DIMENSIONS = ("record", *DIMENSION_LABELS)
+
+
+@dataclass(frozen=True)
+class Column:
+    """One recorded quantity: units (SI, "1" dimensionless), description, the dimensions after
+    ``record`` (names of DIMENSION_LABELS), dtype of the stored values, thesis equation."""
+
+    units: str
+    description: str
+    dims: tuple = ()
+    dtype: str = "float64"
+    equation: str = ""
+
+    @property
+    def shape(self):
+        """Shape of one record, e.g. (3, 3) for a tensor, () for a scalar."""
+        return tuple(len(DIMENSION_LABELS[dim]) for dim in self.dims)
+
+    @property
+    def is_integer(self):
+        return np.dtype(self.dtype).kind in "iu"
+
+
+_VECTOR = ("axis",)
+_TENSOR = ("axis", "component")
+
+#: Every history column pendular writes (triaxial dry and wet, direct tension).
+HISTORY_COLUMNS = {
+    "step": Column("1", "time step number", dtype="int64"),
+    "time": Column("s", "simulated time"),
+    "axial_strain": Column("1", "axial (z) engineering strain 1 - L/L0, compression positive "
+                                "(negative in direct tension)"),
+    "volumetric_strain": Column("1", "volumetric strain 1 - V/V0 of the box inside the walls, "
+                                     "contraction positive (V0 at the start of the shear)"),
+    "sigma_wall": Column("Pa", "mean normal stress on the two walls of each axis (total "
+                               "stress; in a periodic cell the Love-Weber stress of contacts "
+                               "and bridges over the cell), compression positive", _VECTOR),
+    "sigma_contact": Column("Pa", "Love-Weber stress of the mechanical contact forces (sphere "
+                                  "and wall contacts), compression positive", _TENSOR,
+                            equation="Eq. 3.41"),
+    "porosity": Column("1", "porosity of the box inside the walls"),
+    "coordination": Column("1", "mean number of sphere-sphere contacts per particle, 2 Nc / N"),
+    "fabric": Column("1", "contact fabric tensor (1/2Nc) sum over both orientations of n n",
+                     _TENSOR, equation="Eq. 4.1"),
+    "anisotropy": Column("1", "contact fabric anisotropy 5/2 (F_z - F_x) / tr F (principal "
+                              "values)", equation="Eq. 3.51"),
+    "unbalanced_force": Column("1", "mean resultant force on particles / mean contact force"),
+    "saturation": Column("1", "degree of saturation Sr = liquid volume / void volume"),
+    "suction": Column("Pa", "matric suction s = u_a - u_w (imposed, or the bridges' mean "
+                            "under volume control)"),
+    "sigma_capillary": Column("Pa", "Love-Weber stress of the capillary forces (tension "
+                                    "negative); sigma_wall = sigma_contact + sigma_capillary "
+                                    "in equilibrium", _TENSOR),
+    "bridges": Column("1", "number of liquid bridges", dtype="int64"),
+    "pendular_overlaps": Column("1", "pairs of overlapping menisci on one particle (beyond "
+                                     "the pendular limit)", dtype="int64"),
+    "chi": Column("1", "effective stress parameter tensor chi_ij", _TENSOR, equation="Eq. 3.44"),
+    "B": Column("Pa", "surface-tension stress tensor B_ij", _TENSOR, equation="Eq. 3.45"),
+    "psi": Column("Pa", "capillary stress psi_ij = chi_ij s + B_ij", _TENSOR,
+                  equation="Eq. 3.46"),
+    "sigma_effective": Column("Pa", "effective stress sigma'_ij = diag(sigma_wall) + psi_ij "
+                                    "(u_a = 0)", _TENSOR, equation="Eq. 3.43"),
+    "psi_interface": Column("Pa", "liquid-gas interface stress (gamma/V) sum ∫ (delta_ij - "
+                                  "n_i n_j) dS, which psi omits", _TENSOR,
+                            equation="Duriez et al. 2018"),
+    "sigma_effective_complete": Column("Pa", "complete effective stress diag(sigma_wall) + "
+                                             "psi_ij + psi_interface_ij (u_a = 0)", _TENSOR,
+                                       equation="Eq. 3.43 + interface term"),
+    "fabric_bridges": Column("1", "liquid-bridge fabric tensor (1/N_LB) sum n n", _TENSOR,
+                             equation="Eq. 3.53"),
+    "anisotropy_bridges": Column("1", "liquid-bridge fabric anisotropy 5/2 (F_z - F_x) / tr F "
+                                      "(NaN without bridges)", equation="Eq. 3.54"),
+    "a_psi": Column("1", "capillary stress anisotropy 5/2 (psi_z - psi_x) / tr psi (NaN "
+                         "without bridges)", equation="Eq. 4.5"),
+    "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
+                                    "water content)"),
+    "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "
+                                 "(closed liquid)"),
+    "liquid_lost": Column("m^3", "liquid of ruptured bridges removed (closed liquid, model "
+                                 "'lost'); bridges + film + lost = the liquid at the start of "
+                                 "the shear"),
+    "tensile_stress": Column("Pa", "mean pull of the grips over the cross-section, tension "
+                                   "positive"),
+    "grip_pull": Column("N", "force of the specimen on each grip, toward the specimen",
+                        ("grip",)),
+    "water_content": Column("1", "gravimetric water content w = V_w / (Gs V_s)"),
+}
+
+#: Units of a triaxial summary.json (pendular.procedures.triaxial.summarize and TriaxialTest).
+TRIAXIAL_SUMMARY_UNITS = {
+    "peak_axial_stress": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "lateral_stress": "Pa",
+    "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
+    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa",
+    "suction_at_peak": "Pa", "liquid_balance_error": "1", "liquid_lost_fraction": "1",
+    "liquid_initial": "m^3", "water_content": "1", "formation_suction_pa": "Pa",
+    "axial_strain_at_peak": "1",
+    "peak_index": "1", "saturation_at_peak": "1", "initial_porosity": "1",
+    "initial_coordination": "1", "wall_time_s": "s", "preparation_time_s": "s",
+    "shear_time_s": "s", "wetting_time_s": "s", "steps": "1", "preparation_steps": "1",
+    "particle_steps_per_s": "1/s", "dt": "s", "strain_rate": "1/s", "inertial_number": "1",
+    "max_unbalanced_force": "1", "mean_unbalanced_force": "1", "threads": "1",
+    "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
+    "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
+    "stress_balance_flagged": "record", "grading": GRADING_UNITS,
+}
+
+#: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
+TENSION_SUMMARY_UNITS = {
+    "void_ratio_target": "1", "void_ratio": "1", "void_ratio_box": "1", "void_ratio_wet": "1",
+    "prep_friction_deg": "deg", "water_content_target": "1", "formation_suction_pa": "Pa",
+    "water_content": "1", "saturation": "1", "bridges": "1", "coordination_wet": "1",
+    "unbalanced_force_wet": "1", "tensile_strength_pa": "Pa", "axial_extension_at_peak": "1",
+    "water_content_at_peak": "1", "bridges_at_peak": "1", "final_tensile_stress_pa": "Pa",
+    "final_axial_extension": "1", "kim_measured_pa": "Pa", "packing_state_pa": "Pa",
+    "relative_difference_to_kim": "1", "relative_difference_to_packing_state": "1",
+    "strain_rate": "1/s", "inertial_number": "1", "mean_unbalanced_force_to_peak": "1",
+    "unbalanced_force_at_peak": "1", "pull_steps": "1", "dt": "s", "wetting_time_s": "s",
+    "pull_time_s": "s",
+    "grading": GRADING_UNITS,
+}
+
+#: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
+#: of the columns a Chapter 5 campaign.json adds.
+OPTION_UNITS = {
+    "particles": "1", "radius": "m", "porosity": "1", "young": "Pa", "shear_ratio": "1",
+    "friction": "deg", "prep_friction": "deg", "density": "kg/m^3", "damping": "1",
+    "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
+    "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
+    "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
+    "checkpoint_every": "1", "contact_angle": "deg", "surface_tension": "N/m",
+    "roughness": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
+    "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
+    "saturation_at_20_percent": "1", "water_content_percent": "%",
+}
+
+#: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
+#: rows); keys not listed are text, flags or nested records. A summary.json carries the units
+#: of its own keys in its ``units`` block.
+SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS}
+
+
+def peak_reached(axial_strain, index, fraction=0.02):
+    """Whether the maximum at row ``index`` of a history is a peak: False when its strain lies
+    within the last ``fraction`` of the strain range (the test ended before the stress fell),
+    or when the strain did not move. Works for either sign of the strain (tension)."""
+    strain = np.asarray(axial_strain, dtype=float)
+    if strain.ndim != 1 or len(strain) == 0:
+        raise ValueError(f"axial_strain has shape {strain.shape}; expected one value per record")
+    span = strain[-1] - strain[0]
+    if not np.isfinite(span) or span == 0.0:
+        return False
+    return bool((strain[index] - strain[0]) / span < 1.0 - fraction)

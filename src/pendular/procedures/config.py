@@ -1,0 +1,586 @@
+"""Run configurations: typed dataclasses, validated once, saved into every output as JSON.
+
+A configuration says everything that changes a result; how a run is watched (output folder,
+progress bars, threads) is not part of it, so two runs with equal configurations give the same
+results. ``config_to_dict`` / ``config_from_dict`` write and read the nested dataclasses as
+plain JSON with ``CONFIG_SCHEMA_VERSION``; a file of another version is refused by name.
+A campaign builds variants with ``dataclasses.replace``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.procedures.preparation import MAX_PARTICLES, MAX_SEED, PrepareConfig, pwave_step
+from pendular.dem.timestep import pwave_timestep
+from pendular.utils.validate import check_int, check_positive, check_range
+from pendular.homogenize import packing_state, regular_packing
+
+from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
+    KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
+
+#: Most nodes (suction x distance) of a bridge table: about 1 kB of memory per node over the
+#: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
+MAX_TABLE_NODES = 200_000
+
+#: Largest surface tension of a wetting liquid [N/m] (water 0.0728, mercury 0.485).
+MAX_SURFACE_TENSION = 1.0
+
+#: How the bridges of a triaxial test appear (TriaxialConfig.wetting).
+WETTING_PROTOCOLS = ("isotropic", "at-shear", "constant-volume")
+
+#: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
+CONFIG_SCHEMA_VERSION = 2
+
+#: Largest final axial strain of a triaxial shear [-]: laboratory tests end by 20-30 %
+#: (ISO 17892-9 and ASTM D7181 stop at 15-20 % or at the critical state; the thesis shears to
+#: 25 %); at 50 % the sample is half its height and its servoed lateral walls span twice its
+#: cross-section, no test any more (the particles crush into each other beyond).
+MAX_AXIAL_STRAIN = 0.5
+#: Smallest final axial strain [-]: below, the walls move less than a contact's overlap.
+MIN_AXIAL_STRAIN = 1e-6
+#: Why MAX_AXIAL_STRAIN (the end of the error refusing more).
+AXIAL_STRAIN_LIMIT = ("a triaxial test ends by 20-30 % axial strain (the thesis's 25 %); at "
+                      "half its height the sample is no test any more")
+#: Most history rows of a shear (each a few hundred bytes; one a step at most).
+MAX_RECORDS = 10_000_000
+#: Fewest spheres of a triaxial test or an SWCC: their stresses and saturation are averages
+#: over the sample's contacts and bridges, and 50 spheres hold about 100-150 of them (a few
+#: spheres give a "peak" of one contact); the trade-off study's quarter samples are 50.
+MIN_SAMPLE_PARTICLES = 50
+#: Why a sample needs MIN_SAMPLE_PARTICLES (the end of the error refusing fewer).
+AVERAGES = ("its stresses and saturation are averages over the sample's contacts and bridges, "
+            "which a few spheres do not give")
+#: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
+#: void ratio is the core's, the box less a diameter along each wall; at 100 spheres the box
+#: is about 4.5 diameters across and the core 2.5.
+MIN_TENSION_PARTICLES = 100
+#: Most spheres of a direct tension sample (each void ratio is tuned over up to
+#: pendular.procedures.tension.PREPARATIONS preparations of it).
+MAX_TENSION_PARTICLES = 1_000_000
+
+
+@dataclass
+class ShearConfig:
+    """Shear phase of a triaxial test to the axial strain ``max_strain`` [-] (at most
+    MAX_AXIAL_STRAIN). ``strain_rate`` [1/s] defaults to the one giving ``inertial_number``
+    I = rate * 2R * sqrt(rho / confining) (GDR MiDi 2004); ``records``: history rows (at most
+    one a step).
+
+    Wall-control options, pendular's choice by default; ``YADE_CHOICES`` holds YADE's
+    (TriaxialStressController, docs/yade_crosscheck.md):
+    rate_on_current_length: the axial rate acts on the current height (true strain rate)
+        instead of the initial one (engineering strain rate);
+    servo_max_velocity: speed cap of the lateral walls [m/s] (None: the preparation servo's);
+    servo_scale_max_velocity: scale the cap per axis by 3 L_a / (L_x + L_y + L_z);
+    servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
+        the first 100) instead of every step.
+    """
+
+    max_strain: float = 0.25
+    inertial_number: float = 3e-4
+    strain_rate: float | None = None
+    records: int = 500
+    rate_on_current_length: bool = False
+    servo_max_velocity: float | None = None
+    servo_scale_max_velocity: bool = False
+    servo_stiffness_every: int = 1
+
+    def __post_init__(self):
+        self.max_strain = check_range("max_strain", self.max_strain, MIN_AXIAL_STRAIN,
+                                      MAX_AXIAL_STRAIN)
+        self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
+                                           low_inclusive=False)
+        if self.strain_rate is not None:
+            self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
+        self.records = check_int("records", self.records, low=2, high=MAX_RECORDS)
+        if self.servo_max_velocity is not None:
+            self.servo_max_velocity = check_positive("servo_max_velocity",
+                                                     self.servo_max_velocity, "m/s")
+        self.servo_stiffness_every = check_int("servo_stiffness_every",
+                                               self.servo_stiffness_every, low=1)
+
+    def rate(self, radius, density, confining):
+        """Axial strain rate [1/s]: the given one, or the one of the target inertial number at
+        the confining stress [Pa] for spheres of ``radius`` [m] and ``density`` [kg/m^3]."""
+        if self.strain_rate is not None:
+            return self.strain_rate
+        return self.inertial_number / inertial_number(1.0, radius, density, confining)
+
+
+#: ShearConfig options that reproduce YADE's TriaxialStressController (stiffnessUpdateInterval 10).
+YADE_CHOICES = {"rate_on_current_length": True, "servo_scale_max_velocity": True,
+                "servo_stiffness_every": 10}
+
+
+def inertial_number(strain_rate, radius, density, pressure):
+    """I = strain_rate * d * sqrt(rho / p), d = 2R (GDR MiDi 2004); SI units."""
+    return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
+
+
+@dataclass
+class BridgeConfig:
+    """Capillary bridges of a wet test (SPEC §4; capillary.CapillaryBridges).
+
+    suction [Pa] > 0 (suction control: imposed; volume control: at formation), or instead
+    water_content: gravimetric water content w (a fraction) that volume-controlled bridges
+    hold, their formation suction found at wetting (pendular.procedures.water_content) and the liquid
+    then a closed amount (``liquid``: 'shared' or 'lost', capillary.CapillaryBridges);
+    surface_tension [N/m]; contact_angle [deg] in [0, 90); model: 'exact' (Young–Laplace
+    tables) or 'toroidal' (thesis Appendix A, equal spheres); control: 'suction' or 'volume';
+    persist: suction-controlled bridges live to their rupture distance instead of breaking when
+    contact is lost; roughness: meniscus separation at contact H/R2 (volume control);
+    table_resolution: (nodes in suction, nodes in distance) of the tables, None for the model's
+    default.
+    """
+
+    suction: float | None = None
+    surface_tension: float = SURFACE_TENSION
+    contact_angle: float = 0.0
+    model: str = "exact"
+    control: str = "suction"
+    persist: bool = False
+    roughness: float = 0.0
+    table_resolution: tuple[int, int] | None = None
+    water_content: float | None = None
+    liquid: str = "shared"
+
+    def __post_init__(self):
+        if (self.suction is None) == (self.water_content is None):
+            raise ValueError("bridges: give one of suction (Pa) and water_content (a fraction)")
+        if self.suction is not None:
+            self.suction = check_positive("suction", self.suction, "Pa")
+        else:
+            self.water_content = check_range("--water-content", self.water_content, 0.0, 1.0,
+                                             low_inclusive=False)
+            if self.control != "volume" or self.model != "exact":
+                raise ValueError("--water-content needs volume-controlled exact bridges "
+                                 "(control='volume', model='exact')")
+        if self.liquid not in LIQUID_MODELS[1:]:
+            raise ValueError(f"--liquid = {self.liquid!r} is not one of {LIQUID_MODELS[1:]}")
+        self.surface_tension = check_range("surface_tension", self.surface_tension, 0.0,
+                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
+        self.contact_angle = check_range("contact_angle", self.contact_angle, 0.0, 90.0,
+                                         high_inclusive=False, unit="deg")
+        if self.model not in BRIDGE_MODELS:
+            raise ValueError(f"bridges = {self.model!r} is not one of {BRIDGE_MODELS}")
+        if self.table_resolution is not None:
+            if len(self.table_resolution) != 2:
+                raise ValueError(f"table_resolution = {self.table_resolution!r}: two integers "
+                                 "(nodes in suction, nodes in distance) expected")
+            self.table_resolution = tuple(check_int(name, value, low=4, high=MAX_TABLE_NODES // 4)
+                                          for name, value in
+                                          zip(("table_resolution[0]", "table_resolution[1]"),
+                                              self.table_resolution))
+            nodes = self.table_resolution[0] * self.table_resolution[1]
+            if nodes > MAX_TABLE_NODES:
+                raise ValueError(f"table_resolution = {self.table_resolution!r} has {nodes} nodes, "
+                                 f"outside the valid range [16, {MAX_TABLE_NODES}] (suction "
+                                 "nodes x distance nodes)")
+
+    def build(self, suction=None):
+        """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
+        water content, ``suction`` [Pa] is the formation suction found at wetting."""
+        from pendular.capillary import CapillaryBridges   # a dry run never builds one
+
+        if suction is None:
+            if self.suction is None:
+                raise ValueError("bridges at a water content: build(suction) needs the "
+                                 "formation suction found at wetting")
+            suction = self.suction
+        table_options = (None if self.table_resolution is None else
+                         dict(zip(("n_suction", "n_distance"), self.table_resolution)))
+        return CapillaryBridges(suction, surface_tension=self.surface_tension,
+                                contact_angle=self.contact_angle, model=self.model,
+                                control=self.control, persist=self.persist,
+                                roughness=self.roughness, table_options=table_options)
+
+
+@dataclass
+class TriaxialConfig:
+    """A drained triaxial test (thesis Ch. 5.2.3): sample, optional bridges, shear, outputs.
+
+    sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its ``confining`` [Pa] is
+    the lateral stress of the shear; at least MIN_SAMPLE_PARTICLES spheres); bridges: None for
+    a dry test; shear: ShearConfig;
+    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
+    wet_steps: most steps to equilibrate after wetting (or after loading a sample);
+    vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
+    instead (None: from vtk_frames);
+    checkpoint_every: steps between checkpoints of the shear (0: none);
+    wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.triaxial.wet_sample):
+    'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
+    (switched on at the first shear step), 'constant-volume' (added with the walls fixed,
+    equilibrated, then servoed to the confining stress).
+    """
+
+    sample: PrepareConfig = field(default_factory=PrepareConfig)
+    shear: ShearConfig = field(default_factory=ShearConfig)
+    bridges: BridgeConfig | None = None
+    sample_path: str | None = None
+    wet_steps: int = 200000
+    vtk_frames: int = 50
+    vtk_every: int | None = None
+    checkpoint_every: int = 0
+    wetting: str = "isotropic"
+
+    def __post_init__(self):
+        for name, kind in (("sample", PrepareConfig), ("shear", ShearConfig)):
+            if not isinstance(getattr(self, name), kind):
+                raise TypeError(f"{name} must be a {kind.__name__}, got "
+                                f"{type(getattr(self, name)).__name__}")
+        if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
+            raise TypeError(f"bridges must be a BridgeConfig or None, got "
+                            f"{type(self.bridges).__name__}")
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES,
+                        "a triaxial test", AVERAGES)
+        if self.sample.confining <= 0.0:
+            # the shear's lateral stress: the inertial number and the servo need it > 0
+            raise ValueError(f"confining = {self.sample.confining:g} Pa is outside the valid "
+                             f"range (0, 1e+07] Pa for a triaxial test")
+        self.wet_steps = check_int("wet_steps", self.wet_steps, low=1, high=100_000_000)
+        self.vtk_frames = check_int("vtk_frames", self.vtk_frames)
+        if self.vtk_every is not None:
+            self.vtk_every = check_int("vtk_every", self.vtk_every)
+        self.checkpoint_every = check_int("checkpoint_every", self.checkpoint_every)
+        if self.wetting not in WETTING_PROTOCOLS:
+            raise ValueError(f"--wetting = {self.wetting!r} is not one of {WETTING_PROTOCOLS}")
+        if self.wetting != "isotropic" and (self.bridges is None
+                                            or self.bridges.water_content is not None):
+            raise ValueError(f"--wetting = {self.wetting!r} needs a wet test at a suction "
+                             "(--suction > 0)")
+
+    @property
+    def confining(self):
+        """Lateral stress of the shear [Pa] (the sample's confining stress)."""
+        return self.sample.confining
+
+    def shear_steps(self):
+        """Steps of the shear estimated before anything runs [-]: max_strain over the strain
+        rate times the P-wave step of the mean radius (pendular.procedures.preparation.pwave_step). An
+        upper bound for equal spheres: the 'stiffness' rule's step is 1.4-1.5 times longer on
+        prepared samples, so the shear takes that much fewer."""
+        sample, shear = self.sample, self.shear
+        rate = shear.rate(sample.radius, sample.density, sample.confining)
+        per_step = rate * pwave_step(sample.radius, sample)
+        if not per_step > 0.0:          # a rate or time step that underflows
+            raise ValueError(f"the strain per step, {per_step:g}, is not positive: the strain "
+                             "rate (--strain-rate / --inertial-number) or the time step "
+                             "(--timestep-safety) is too small to be represented")
+        return shear.max_strain / per_step
+
+    @property
+    def suction(self):
+        """Matric suction [Pa]; 0 for a dry test, NaN at a water content (the suction is an
+        output)."""
+        if self.bridges is None:
+            return 0.0
+        return math.nan if self.bridges.suction is None else self.bridges.suction
+
+
+@dataclass
+class TensionConfig:
+    """Direct tension of wet sand at fixed water content (pendular.procedures.tension; Kim 2001, thesis
+    §4.4.1.2 and Table 4.5). Validated on creation (ValueError naming the command's option).
+
+    cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
+    void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
+    form_gap: at wetting, bridges also form across gaps up to form_gap x radius [-] (0: at
+    contacts only; the default 1 reaches past the rupture distance of Kim's bridges, so they
+    form wherever they can; pendular.capillary.wetting); particles, radius [m] (the mean radius),
+    radius_spread [-] and psd (grading curve) as in pendular.procedures.preparation.PrepareConfig,
+    contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
+    confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
+    wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
+    max_strain: largest axial extension [-]; residual: fraction of the peak below which the
+    pull has ruptured [-]; grip_depth: grip thickness [diameters] (walls only);
+    void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull (0: none); vtk_every: steps
+    between frames instead (None: from vtk_frames; 0: none), both at most the pull's steps
+    (``pull_steps``); seed: random seed of the samples; periodic: samples in a periodic cell
+    pulled along z at zero lateral stress (no walls, no grips: a grip_depth other than the
+    default is refused; the void ratio is the whole cell's). Cases are distinct by their
+    folder names (``case_name``); particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES].
+    """
+
+    cases: list[tuple[float, float]] = field(
+        default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
+    roughness: float = KIM_SEPARATION
+    form_gap: float = 1.0
+    particles: int = 2000
+    radius: float = KIM_RADIUS
+    radius_spread: float = 0.0
+    psd: tuple | None = None
+    contact_angle: float = 0.0
+    surface_tension: float = CHAPTER4_SURFACE_TENSION
+    specific_gravity: float = SPECIFIC_GRAVITY
+    confining: float = 100.0
+    friction: float = 18.0
+    young: float = 1e6
+    inertial_number: float = 1e-3
+    max_strain: float = 0.1
+    residual: float = 0.2
+    grip_depth: float = 1.0
+    void_ratio_tolerance: float = 0.01
+    vtk_frames: int = 20
+    vtk_every: int | None = None
+    seed: int = 0
+    periodic: bool = False
+
+    def __post_init__(self):
+        self.cases = [(float(e), float(w)) for e, w in self.cases]
+        if not isinstance(self.periodic, (bool, np.bool_)):
+            raise ValueError(f"--periodic = {self.periodic!r}: valid values True or False")
+        self.periodic = bool(self.periodic)
+        if not self.cases:
+            raise ValueError("cases = [] is empty: give at least one (void ratio, water "
+                             "content)")
+        for e, _ in self.cases:
+            # denser than random close packing or looser than the loosest growth: unreachable
+            check_range("--void-ratio", e, 0.5, 1.2)
+        names = [case_name(e, w) for e, w in self.cases]
+        for k, name in enumerate(names):
+            if name in names[:k]:        # one folder, one sample per void ratio: run once
+                (e0, w0), (e1, w1) = self.cases[names.index(name)], self.cases[k]
+                raise ValueError(
+                    f"--void-ratio / --water-content: the cases (e {e0:g}, w {100 * w0:g} %) "
+                    f"and (e {e1:g}, w {100 * w1:g} %) share the folder {name}: give each "
+                    "case once, void ratios 0.01 or water contents 0.01 % apart")
+        self.particles = check_particles(
+            self.particles, MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES, "direct tension",
+            "the grips hold a layer at each z wall and the void ratio is the core's")
+        check_range("--form-gap", self.form_gap, 0.0, 1.0)
+        if self.psd is not None or self.radius_spread:
+            sizes = PrepareConfig(particles=int(self.particles), radius=self.radius,
+                                  radius_spread=self.radius_spread, psd=self.psd,
+                                  seed=self.seed)
+            self.radius, self.psd = sizes.radius, sizes.psd
+        check_range("--radius", self.radius, 1e-6, 1e-2, unit="m")
+        check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
+                    unit="deg")
+        check_range("--surface-tension", self.surface_tension, 0.0, MAX_SURFACE_TENSION,
+                    low_inclusive=False, unit="N/m")
+        check_range("--specific-gravity", self.specific_gravity, 1.0, 10.0)
+        check_range("--roughness", self.roughness, 0.0, 0.5)
+        check_range("--confining", self.confining, 1.0, 1e5, unit="Pa")
+        check_range("--friction", self.friction, 0.0, 90.0, high_inclusive=False, unit="deg")
+        check_range("--young", self.young, 0.0, 1e12, low_inclusive=False, unit="Pa")
+        check_range("--inertial-number", self.inertial_number, 0.0, 0.01, low_inclusive=False)
+        check_range("--max-strain", self.max_strain, 0.0, 0.5, low_inclusive=False)
+        check_range("--residual", self.residual, 0.0, 1.0, low_inclusive=False,
+                    high_inclusive=False)
+        check_range("--grip-depth", self.grip_depth, 0.0, 3.0)
+        if self.periodic and self.grip_depth != TensionConfig.grip_depth:
+            raise ValueError(f"--grip-depth = {self.grip_depth:g} does not apply to --periodic: "
+                             "a periodic cell has no walls, so no grips")
+        check_range("--void-ratio-tolerance", self.void_ratio_tolerance, 0.001, 0.1)
+        check_range("--vtk-frames", self.vtk_frames, 0, 1000)
+        steps = self.pull_steps()
+        check_steps_count("--vtk-frames", self.vtk_frames, steps,
+                          f"the pull to --max-strain {self.max_strain:g}")
+        if self.vtk_every is not None:
+            self.vtk_every = check_int("--vtk-every", self.vtk_every)
+            check_steps_count("--vtk-every", self.vtk_every, steps,
+                              f"the pull to --max-strain {self.max_strain:g}")
+        check_int("--seed", self.seed, high=MAX_SEED)
+        for e, w in self.cases:
+            limit = self.pendular_limit(e)
+            if not 0.0 < w <= limit:
+                raise ValueError(f"--water-content = {100.0 * w:g} % is outside the valid "
+                                 f"range (0, {100.0 * limit:.3g}] %: the pendular regime ends "
+                                 "at the pendular limit of the "
+                                 f"{comparison_packing(e)[1]} packing")
+
+    def pull_steps(self):
+        """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
+        the strain rate times the P-wave step of the mean radius (pendular.procedures.preparation
+        .pwave_step; the pull runs at the 'stiffness' rule's step, 1.4-1.5 times longer on
+        prepared samples); a pull that ruptures stops sooner."""
+        sample = PrepareConfig          # the tension samples' density and time-step safety
+        rate = self.inertial_number / inertial_number(1.0, self.radius, sample.density,
+                                                      self.confining)
+        dt = sample.timestep_safety * pwave_timestep(self.radius, self.young, sample.density)
+        return self.max_strain / (rate * dt)
+
+    def pendular_limit(self, void_ratio):
+        """Gravimetric water content [-] at the pendular limit of the regular packing compared
+        with a sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION)."""
+        kind, _ = comparison_packing(void_ratio)
+        return packing_state(regular_packing(kind, separation=KIM_SEPARATION),
+                             radius=self.radius, contact_angle=self.contact_angle,
+                             surface_tension=self.surface_tension,
+                             filling_angle=regular_packing(kind).max_filling_angle,
+                             specific_gravity=self.specific_gravity).water_content
+
+
+@dataclass
+class SwccConfig:
+    """The soil-water characteristic curve of a sample (pendular.procedures.swcc): drying through
+    ``suctions`` then wetting back, at the sample's confining stress.
+
+    sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its ``confining`` [Pa]
+    holds during the path; at least MIN_SAMPLE_PARTICLES spheres); suctions [Pa]: the path's
+    stages, ascending and distinct, at least two; surface_tension [N/m]; contact_angle [deg];
+    form_gap: at wetting, bridges also form across gaps up to form_gap mean radii (0: at
+    contacts only); stage_steps: most steps per stage to reach equilibrium; record_every: steps
+    between history records.
+    """
+
+    sample: PrepareConfig = field(default_factory=PrepareConfig)
+    suctions: list[float] = field(default_factory=lambda: [3000.0, 10000.0, 30000.0,
+                                                           100000.0, 300000.0])
+    surface_tension: float = SURFACE_TENSION
+    contact_angle: float = 0.0
+    form_gap: float = 1.0
+    stage_steps: int = 200000
+    record_every: int = 1000
+
+    def __post_init__(self):
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, "an SWCC",
+                        AVERAGES)
+        self.suctions = [check_positive("--suctions", value, "Pa") for value in self.suctions]
+        if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
+                                                                   self.suctions[1:])):
+            raise ValueError(f"--suctions = {','.join(f'{s:g}' for s in self.suctions)}: at "
+                             "least two suctions [Pa], ascending and distinct, expected (the "
+                             "drying path; wetting goes back along it)")
+        if self.sample.confining <= 0.0:
+            raise ValueError(f"--confining = {self.sample.confining:g} Pa is outside the valid "
+                             "range (0, 1e+07] Pa for an SWCC at constant stress")
+        self.surface_tension = check_range("--surface-tension", self.surface_tension, 0.0,
+                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
+        self.contact_angle = check_range("--contact-angle", self.contact_angle, 0.0, 90.0,
+                                         high_inclusive=False, unit="deg")
+        self.form_gap = check_range("--form-gap", self.form_gap, 0.0, 1.0)
+        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
+                                     high=100_000_000)
+        self.record_every = check_int("--record-every", self.record_every, low=1)
+
+
+def check_particles(particles, low, high, test, why):
+    """``particles`` as an int; ValueError naming --particles outside [low, high], the sample
+    sizes of ``test`` (e.g. 'a triaxial test'), saying ``why`` (the reason for ``low``)."""
+    count = check_int("--particles", particles)
+    if not low <= count <= high:
+        raise ValueError(f"--particles = {count} is outside the valid range [{low}, {high}] "
+                         f"for {test}: {why}")
+    return count
+
+
+def check_steps_count(name, value, steps, phase, low=0):
+    """ValueError naming ``name`` (an option counting frames or rows of a phase, or the steps
+    between them, e.g. '--vtk-frames') when ``value`` exceeds ``steps``, the phase's estimated
+    steps: one a step at most. ``phase``: what runs them, e.g. 'the shear'; ``low``: the
+    option's own least value, for the valid range."""
+    most = max(low, 1, int(steps))
+    if value > most:
+        raise ValueError(f"{name} = {value} is outside the valid range [{low}, {most}]: "
+                         f"{phase} has about {most} steps")
+
+
+def case_name(void_ratio, water_content):
+    """Folder name of a tension case (void ratio [-], water content [-, a fraction]), e.g.
+    'e0.72_w1.04'."""
+    return f"e{void_ratio:.2f}_w{100 * water_content:.2f}"
+
+
+# ---------------------------------------------------------------- JSON form
+
+#: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
+CONFIG_TYPES = {kind.__name__: kind for kind in
+                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, TensionConfig,
+                 SwccConfig)}
+
+
+def config_to_dict(config):
+    """Plain-JSON form of a (nested) configuration dataclass, with its type and the schema
+    version: {"type": ..., "schema_version": ..., "fields": {...}}."""
+    def plain(value):
+        if dataclasses.is_dataclass(value):
+            return {"type": type(value).__name__,
+                    "fields": {f.name: plain(getattr(value, f.name))
+                               for f in dataclasses.fields(value)}}
+        if isinstance(value, tuple):
+            return list(value)
+        if isinstance(value, np.generic):
+            return value.item()
+        return value
+
+    data = plain(config)
+    data["schema_version"] = CONFIG_SCHEMA_VERSION
+    return data
+
+
+def config_from_dict(data, source="configuration"):
+    """The configuration dataclass of ``config_to_dict``'s output, validated; ValueError naming
+    ``source`` (e.g. a file path) for another schema version or a malformed layout."""
+    if not isinstance(data, dict) or "schema_version" not in data:
+        raise ValueError(f"{source}: no pendular configuration (schema_version missing); it was "
+                         "written by pendular before 0.2 — prepare the sample again")
+    if data["schema_version"] != CONFIG_SCHEMA_VERSION:
+        raise ValueError(f"{source}: configuration schema_version {data['schema_version']!r} "
+                         f"is not this pendular's {CONFIG_SCHEMA_VERSION}")
+
+    def build(value):
+        if isinstance(value, dict) and "type" in value and "fields" in value:
+            kind = CONFIG_TYPES.get(value["type"])
+            if kind is None:
+                raise ValueError(f"{source}: unknown configuration type {value['type']!r}")
+            names = {f.name for f in dataclasses.fields(kind)}
+            unknown = set(value["fields"]) - names
+            if unknown:
+                raise ValueError(f"{source}: {value['type']} has no field(s) {sorted(unknown)}")
+            fields = {k: build(v) for k, v in value["fields"].items()}
+            if "table_resolution" in fields and fields["table_resolution"] is not None:
+                fields["table_resolution"] = tuple(fields["table_resolution"])
+            return kind(**fields)
+        return value
+
+    return build({k: v for k, v in data.items() if k != "schema_version"})
+
+
+def config_json(config):
+    """The configuration as a JSON string (sorted keys: equal configurations, equal text)."""
+    return json.dumps(config_to_dict(config), sort_keys=True)
+
+
+def stored_config(path: str, key: str) -> dict | None:
+    """The configuration dict stored under ``key`` in the config attribute of a pendular HDF5
+    file (sample.h5), or None when absent or unreadable."""
+    import h5py
+
+    if not os.path.isfile(path):
+        return None
+    try:
+        with h5py.File(path, "r") as handle:
+            return json.loads(handle.attrs["config"]).get(key)
+    except (OSError, KeyError, ValueError, TypeError, AttributeError, RecursionError):
+        return None
+
+
+def same_config(stored: dict | None, config: Any) -> bool:
+    """Whether a stored configuration dict equals ``config`` (``config_json``). The stored one
+    is read back through ``config_from_dict`` first, so that a run stored before a field was
+    added (whose default keeps the former behaviour) equals a configuration with that default."""
+    if stored is None:
+        return False
+    try:
+        stored = config_to_dict(config_from_dict(stored))
+    except (ValueError, TypeError, KeyError, AttributeError, ArithmeticError, RecursionError):
+        return False
+    return json.dumps(stored, sort_keys=True) == config_json(config)
+
+
+def sample_made_with(path: str, sample: PrepareConfig) -> bool:
+    """Whether the saved sample ``path`` was prepared with the PrepareConfig ``sample``."""
+    return same_config(stored_config(path, "sample"), sample)
+

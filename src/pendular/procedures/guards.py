@@ -1,0 +1,111 @@
+"""Guards: read-only writers that stop a run whose sample has left the bounds of a packing.
+
+A guard is a writer of pendular.dem.simulation.Simulation (``apply(sim)`` after each step, as
+pendular.dem.record.HistoryRecorder): every ``period`` steps it measures the state and raises
+when a bound is crossed; it changes nothing, so a run within the bounds gives the same results
+with or without it. A shear driven past what its walls can hold (a strain no test reaches, a
+servo too slow for the strain rate) squeezes the spheres into each other: the linear contact
+law then answers with stresses of no physical meaning, and the guard stops it instead.
+"""
+
+import math
+
+import numpy as np
+
+from pendular.dem.measure import porosity
+from pendular.utils.validate import check_int, check_range
+
+#: Largest overlap of two spheres, or of a sphere and a wall, over the smaller radius [-]. The
+#: linear contact law stands for small deformations of the grains: configurations keep the
+#: overlaps at the confining stress below about 0.16 (pendular.procedures.preparation
+#: .MAX_STRESS_OVER_YOUNG), and the extremes grid's bound of a sound state is 0.25 too.
+MAX_OVERLAP_OVER_RADIUS = 0.25
+#: Porosity [-] below which equal spheres must overlap: the densest packing's, 1 - pi / sqrt(18)
+#: (Kepler's conjecture, proved by Hales 2005).
+MIN_POROSITY_EQUAL = 1.0 - math.pi / math.sqrt(18.0)
+#: Porosity [-] below which graded spheres (radius ratio at most 10, pendular.dem.grading) must
+#: overlap, with a margin: binary mixtures of size ratio 7 pack to 0.14 (McGeary 1961).
+MIN_POROSITY_GRADED = 0.1
+#: Porosity [-] above which the spheres no longer form a packing that bears a load: the
+#: loosest static packings of frictional spheres, wet ones included, stay below about 0.6
+#: (random loose packing 0.45; the box's wall layers add a few hundredths).
+MAX_POROSITY = 0.7
+#: What the error suggests by default: the settings that drive a triaxial shear.
+SHEAR_REMEDY = ("lower --max-strain, or the strain rate (--strain-rate / --inertial-number), "
+                "or raise --young")
+
+
+class SampleCrushed(ValueError):
+    """A sample's state left the bounds of a packing (overlaps or porosity, SampleGuard)."""
+
+
+class SampleGuard:
+    """Every ``period`` steps, the largest overlap over the smaller radius (sphere pairs and,
+    inside walls, sphere-wall contacts) at most ``max_overlap`` [-], and the porosity
+    (pendular.dem.measure.porosity) within ``porosity_range`` (low, high) [-] (default
+    ``default_porosity_range`` of the radii); otherwise SampleCrushed naming the bound crossed,
+    the step, ``describe(sim)`` (text, e.g. the axial strain) when given, and ``remedy``: the
+    options to change."""
+
+    def __init__(self, period, *, max_overlap=MAX_OVERLAP_OVER_RADIUS, porosity_range=None,
+                 describe=None, remedy=SHEAR_REMEDY):
+        self.period = check_int("guard period", period, low=1)
+        self.max_overlap = check_range("max_overlap", max_overlap, 0.0, 1.0,
+                                       low_inclusive=False)
+        if porosity_range is not None:
+            bounds = [check_range("porosity_range", value, 0.0, 1.0) for value in porosity_range]
+            if len(bounds) != 2 or bounds[0] >= bounds[1]:
+                raise ValueError(f"porosity_range = {porosity_range!r}: valid is (low, high) "
+                                 "with 0 <= low < high <= 1")
+            porosity_range = tuple(bounds)
+        self.porosity_range = porosity_range
+        if describe is not None and not callable(describe):
+            raise TypeError(f"describe = {describe!r} is not a function of sim")
+        self.describe = describe
+        self.remedy = remedy
+
+    def apply(self, sim):
+        if sim.step % self.period == 0:
+            self.check(sim)
+
+    def check(self, sim):
+        """Measure the state now; SampleCrushed when a bound is crossed, else (largest overlap
+        over the radius, porosity)."""
+        overlap = largest_overlap(sim)
+        measured = porosity(sim.particles, sim.walls)
+        low, high = self.porosity_range or default_porosity_range(sim.particles.radius)
+        if not overlap <= self.max_overlap:
+            self._crushed(sim, f"an overlap of {overlap:.3g} of the radius, beyond the bound "
+                               f"{self.max_overlap:g} of a packing of grains")
+        if not low <= measured <= high:
+            self._crushed(sim, f"porosity {measured:.3g}, outside the range [{low:.3g}, "
+                               f"{high:.3g}] of a packing of these spheres")
+        return overlap, measured
+
+    def _crushed(self, sim, what):
+        where = f" ({self.describe(sim)})" if self.describe is not None else ""
+        raise SampleCrushed(f"the sample is crushed at step {sim.step}{where}: {what}; "
+                            f"{self.remedy}")
+
+
+def default_porosity_range(radius):
+    """(least, largest) porosity [-] of a packing of spheres of ``radius`` [m]: equal or
+    graded (MIN_POROSITY_EQUAL or MIN_POROSITY_GRADED), and MAX_POROSITY."""
+    equal = radius.min() == radius.max()
+    return (MIN_POROSITY_EQUAL if equal else MIN_POROSITY_GRADED), MAX_POROSITY
+
+
+def largest_overlap(sim):
+    """Largest overlap over the smaller radius [-] of the pairs of ``sim`` (as at its last
+    force evaluation) and, inside walls, of the spheres with the walls; at most 0 when nothing
+    touches, NaN when a position is not finite."""
+    particles, contacts = sim.particles, sim.contacts
+    radius = particles.radius
+    overlaps = [np.zeros(1)]
+    if contacts is not None:
+        smaller = np.minimum(radius[contacts.pair_i], radius[contacts.pair_j])
+        overlaps.append(contacts.overlap / smaller)
+    if not sim.walls.periodic:
+        inside = np.minimum(particles.position - sim.walls.lo, sim.walls.hi - particles.position)
+        overlaps.append((1.0 - inside / radius[:, None]).ravel())
+    return float(np.max(np.concatenate(overlaps)))

@@ -1,0 +1,573 @@
+"""Campaigns: many runs of configurations, in parallel processes or on a Dask cluster.
+
+A campaign is a list of runs, each a folder name and a TriaxialConfig or TensionConfig (built
+with ``dataclasses.replace``)::
+
+    base = TriaxialConfig(sample=PrepareConfig(particles=300), shear=ShearConfig(0.02))
+    runs = [Run(f"s{s:g}", dataclasses.replace(base, bridges=BridgeConfig(s))) for s in (1e4, 3e4)]
+    result = Campaign(runs).run("runs/mine", jobs=2)      # result.summaries["s10000"] ...
+
+``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
+progress bars), with ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned
+processes (at most JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``. It does not
+lock ``out``: a command holds it as its pendular.io.outputs.OutputFolder around the campaign, so
+that a second campaign into it is refused. A run whose folder holds a finished result
+of an equal configuration (``pendular.procedures.config.config_json`` of the configuration stored with it:
+sample.h5 of a triaxial, tension.json of a tension test) is reused, so an interrupted campaign
+goes on where it stopped; so is a shared sample (``samples``) saved with an equal
+PrepareConfig. The campaign's progress bar shows each running run's own progress. A run that
+fails does not stop the others: ``CampaignResult.failed`` names it with its error. A run's
+summary is its summary.json (triaxial) or the scalars of its first case (tension: give each
+run one void ratio and one water content).
+
+``pendular.cli.tables.sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
+
+    command = "triaxial"            # or "tension"
+    [fixed]                         # options of the command, underscores for dashes
+    particles = 300
+    max_strain = 0.02
+    [sweep]                         # lists: every combination (cartesian product)
+    suction = [0, 30000]
+    confining = [250, 750]
+    # or explicit rows instead of [sweep] (a row's values override [fixed]):
+    # [[runs]]
+    # name = "loose"                # optional folder name
+    # prep_friction = 3
+
+Any option of the command can be fixed or swept; each run's configuration is built by the
+command's own option parser and ``config_from``, so it is validated as on the command line.
+Flags take true/false, list values are joined with commas (``table_resolution = [350, 80]``),
+relative ``sample`` and ``psd`` paths are relative to the table's folder. A table must set at
+least one option (an empty table, ``[sweep]`` or ``runs = []`` is refused: it would run the
+command's default test) and hold at most MAX_RUNS runs. Every refusal names the table and the
+key, with its section (``[fixed]``, ``[sweep]``, ``row 2 of [[runs]]``).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import contextlib
+import csv
+import itertools
+import json
+import math
+import multiprocessing
+import numbers
+import os
+import re
+import stat
+import threading
+import traceback
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Callable, Union
+
+from tqdm import tqdm
+
+from pendular.utils.atomic import replacing
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
+from pendular.dem.sample import save_sample
+from pendular.utils.threads import use_threads
+from pendular.utils.validate import check_int
+
+from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
+                                        same_config, sample_made_with, stored_config)
+from pendular.procedures.tension import TensionTest
+from pendular.procedures.triaxial import Interrupted, TriaxialTest, parameters
+
+#: Seconds between updates of the campaign's progress bar.
+PROGRESS_PERIOD = 5.0
+#: What a campaign runs.
+RunConfig = Union[TriaxialConfig, TensionConfig]
+#: Options a parameter table cannot set: the campaign decides them.
+CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep")
+#: Options of a table that are paths, relative to the table's folder.
+PATH_OPTIONS = ("sample", "psd")
+#: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra
+#: swept list), and its cartesian product would fill the memory before anything runs.
+MAX_RUNS = 10000
+#: Most local processes per CPU (--jobs): each run is compute-bound with its own interpreter,
+#: Numba runtime and sample in memory, so beyond the CPUs processes only share them; a few per
+#: CPU leave room for runs waiting on their files, more only multiply the memory.
+JOBS_PER_CPU = 4
+#: Keys of a triaxial summary.json that every finished run has (numbers); a summary without
+#: them is damaged and its run is done again.
+SUMMARY_KEYS = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak")
+
+
+@dataclass
+class Run:
+    """One run of a campaign: its folder name under ``out/runs`` and its configuration;
+    ``force``: run a triaxial refused as not quasi-static or too long (TriaxialTest)."""
+
+    name: str
+    config: RunConfig
+    force: bool = False
+
+    def __post_init__(self):
+        if (not isinstance(self.name, str) or self.name in ("", ".", "..")
+                or os.sep in self.name or (os.altsep and os.altsep in self.name)):
+            raise ValueError(f"run name {self.name!r} is not a folder name (valid: a non-empty "
+                             "name without path separators)")
+        if not isinstance(self.config, (TriaxialConfig, TensionConfig)):
+            raise TypeError(f"run {self.name}: config must be a TriaxialConfig or TensionConfig,"
+                            f" got {type(self.config).__name__}")
+
+
+class RunRefused(ValueError):
+    """A run of a campaign refused before anything runs (its message starts with the run)."""
+
+
+@dataclass
+class CampaignResult:
+    """What ``Campaign.run`` did: ``summaries`` {name: summary dict} of the finished runs (run
+    now or reused), ``reused`` the names of the reused ones, ``failed`` {name: error text} (the
+    traceback is in the run's log.txt)."""
+
+    runs: list[Run]
+    summaries: dict[str, dict] = field(default_factory=dict)
+    reused: list[str] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
+
+    def check(self) -> None:
+        """ValueError naming every failed run and its error (nothing when none failed)."""
+        if self.failed:
+            raise ValueError(f"{len(self.failed)} of {len(self.runs)} runs failed: " + "; ".join(
+                f"{name}: {error}" for name, error in self.failed.items()))
+
+
+# ---------------------------------------------------------------- workers (top level: picklable)
+
+def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False) -> dict:
+    """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads, its output
+    and progress bars in ``folder``/log.txt (with the traceback if it fails); its summary."""
+    use_threads(threads)
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "log.txt"), "w") as log, \
+            contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
+        try:
+            if isinstance(config, TriaxialConfig):
+                return TriaxialTest(config, force=force).run(folder, threads=threads)
+            return tension_summary(TensionTest(config).run(folder))
+        except BaseException:
+            traceback.print_exc()
+            raise
+
+
+def prepare_one(sample: PrepareConfig, path: str, threads: int = 1) -> str:
+    """Worker: prepare the sample of ``sample`` (a PrepareConfig) and save it at ``path`` with
+    its configuration (``{"sample": config_to_dict(sample)}``)."""
+    use_threads(threads)
+    sim, report = prepare_sample(sample, progress=False, threads=threads)
+    save_sample(path, sim, report, {"sample": config_to_dict(sample)},
+                identity={"seed": sample.seed})
+    return path
+
+
+def tension_summary(result: dict) -> dict:
+    """One summary row of a tension run: its first case's scalars (a campaign run of the
+    tension command holds one void ratio and one water content)."""
+    case = result["cases"][0]
+    return {k: v for k, v in case.items() if isinstance(v, (int, float, str, bool))}
+
+
+# ---------------------------------------------------------------- reuse
+
+def finished_summary(config: RunConfig, folder: str) -> dict | None:
+    """The summary of a run of ``folder`` that finished with an equal configuration, or None
+    (also for a damaged summary: the run is done again)."""
+    if isinstance(config, TriaxialConfig):
+        summary_path = os.path.join(folder, "summary.json")
+        stored = stored_config(os.path.join(folder, "sample.h5"), "config")
+    else:
+        summary_path = os.path.join(folder, "tension.json")
+        stored = None
+    if not os.path.isfile(summary_path):
+        return None
+    try:
+        with open(summary_path) as handle:
+            summary = json.load(handle)
+    except (OSError, ValueError, RecursionError):
+        return None
+    if not isinstance(summary, dict):
+        return None
+    if isinstance(config, TensionConfig):
+        stored = summary.get("config")
+    if not same_config(stored, config):
+        return None
+    if isinstance(config, TriaxialConfig):
+        whole = all(isinstance(summary.get(key), (int, float))
+                    and not isinstance(summary.get(key), bool) for key in SUMMARY_KEYS)
+        return summary if whole and summary.get("completed", True) is True else None
+    try:
+        return tension_summary(summary)
+    except (KeyError, IndexError, TypeError, AttributeError):
+        return None
+
+
+# ---------------------------------------------------------------- execution
+
+def max_jobs() -> int:
+    """The most local processes (--jobs) on this machine: JOBS_PER_CPU per CPU."""
+    return JOBS_PER_CPU * (os.cpu_count() or 1)
+
+
+def check_jobs(jobs: int) -> int:
+    """``jobs`` (--jobs) as an int in [1, max_jobs()]; ValueError naming --jobs and the range."""
+    high = max_jobs()
+    valid = (f"valid range [1, {high}] ({JOBS_PER_CPU} processes per CPU of this machine; "
+             "more only slow every run down)")
+    if isinstance(jobs, bool) or not isinstance(jobs, numbers.Integral):
+        raise ValueError(f"--jobs {jobs!r} is not an integer; {valid}")
+    if not 1 <= jobs <= high:
+        raise ValueError(f"--jobs {jobs} is outside the {valid}")
+    return int(jobs)
+
+
+@contextlib.contextmanager
+def executor(jobs: int, scheduler: str | None = None):
+    """Where the runs go: None (here, one after the other), a spawn process pool of ``jobs``
+    workers (check_jobs), or the concurrent.futures executor of the Dask cluster at
+    ``scheduler``. On an exception (Ctrl-C) the runs not started are cancelled."""
+    jobs = check_jobs(jobs)
+    if scheduler is not None:
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            raise ValueError("--scheduler needs dask.distributed: pip install "
+                             "'pendular[dask]'") from None
+        try:
+            client = Client(scheduler)
+        except (OSError, ValueError) as error:
+            raise ValueError(f"--scheduler {scheduler!r}: cannot connect ({error})") from None
+        with client:
+            pool = client.get_executor(pure=False)
+            try:
+                yield pool
+            finally:
+                pool.shutdown()
+    elif jobs == 1:
+        yield None
+    else:
+        # fresh interpreters (no fork of a running Numba threading layer)
+        pool = concurrent.futures.ProcessPoolExecutor(
+            jobs, mp_context=multiprocessing.get_context("spawn"))
+        try:
+            yield pool
+        except BaseException:
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
+        pool.shutdown(wait=True)
+
+
+def run_progress(folder: str) -> str:
+    """The last progress a run's log.txt shows: 'shear 42%', or for an open-ended phase its
+    steps and what it waits for ('wet 1200step unbalanced=0.02/0.01'); '' if none."""
+    try:
+        with open(os.path.join(folder, "log.txt"), "rb") as handle:
+            handle.seek(0, os.SEEK_END)
+            handle.seek(max(0, handle.tell() - 4096))
+            tail = handle.read().decode(errors="replace")
+    except OSError:
+        return ""
+    for line in reversed(re.split(r"[\r\n]+", tail)):
+        match = re.match(r"\s*(\w[\w ]*?):\s*(\d+%|\d+step)(.*)", line)
+        if match:
+            text = f"{match.group(1)} {match.group(2)}"
+            if match.group(2).endswith("step"):
+                waits = re.findall(r"(\w+=[^,\]\s]+)", match.group(3))
+                text += "".join(" " + item for item in waits[:2])
+            return text
+    return ""
+
+
+def map_tasks(pool, function: Callable, tasks: Sequence[tuple], *, description: str,
+              folders: Sequence[str] | None = None, quiet: bool = False):
+    """``function(*task)`` for every task (in ``pool`` or here) with a progress bar whose status
+    shows each running task's own progress (the log.txt of its folder in ``folders``).
+    Returns (results in the order of ``tasks``, {index: error text} of the tasks that failed)."""
+    results: list = [None] * len(tasks)
+    errors: dict[int, str] = {}
+    if not tasks:
+        return results, errors
+    names = [os.path.basename(str(f)) for f in folders] if folders else [""] * len(tasks)
+
+    def status(indices):
+        if not folders:
+            return ""
+        return ", ".join(f"{names[i]} {p}".strip() for i in indices
+                         for p in [run_progress(folders[i])])
+
+    with tqdm(total=len(tasks), desc=description, unit="run", disable=quiet) as bar:
+        if pool is None:
+            for index, task in enumerate(tasks):
+                bar.set_postfix_str(names[index])
+                with _watching(bar, lambda i=index: status([i]), quiet):
+                    try:
+                        results[index] = function(*task)
+                    except Interrupted:          # Ctrl-C in a run here stops the campaign
+                        raise KeyboardInterrupt from None
+                    except Exception as error:   # noqa: BLE001 - reported per run
+                        errors[index] = _error_text(error)
+                bar.update()
+            return results, errors
+        pending = {pool.submit(function, *task): i for i, task in enumerate(tasks)}
+        try:
+            while pending:
+                done, _ = concurrent.futures.wait(pending, timeout=PROGRESS_PERIOD,
+                                                  return_when=concurrent.futures.FIRST_COMPLETED)
+                for future in done:
+                    index = pending.pop(future)
+                    try:
+                        results[index] = future.result()
+                    except Exception as error:   # noqa: BLE001 - reported per run
+                        errors[index] = _error_text(error)
+                    bar.update()
+                bar.set_postfix_str(status(sorted(pending.values())))
+        except BaseException:
+            for future in pending:
+                future.cancel()
+            raise
+    return results, errors
+
+
+def _error_text(error: BaseException) -> str:
+    text = str(error).strip().splitlines()
+    return f"{type(error).__name__}: {text[-1] if text else ''}".rstrip(": ")
+
+
+@contextlib.contextmanager
+def _watching(bar, status: Callable[[], str], quiet: bool):
+    """While a task runs here, refresh ``bar``'s status from ``status()`` every
+    PROGRESS_PERIOD seconds (a reader thread; the run keeps the main thread and Ctrl-C)."""
+    if quiet:
+        yield
+        return
+    stop = threading.Event()
+
+    def watch():
+        while not stop.wait(PROGRESS_PERIOD):
+            bar.set_postfix_str(status())
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    watcher.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        watcher.join()
+
+
+class Campaign:
+    """Runs (``Run`` or (name, config) pairs, names unique) and the shared samples they start
+    from (``samples``: (PrepareConfig, path) pairs, prepared first unless saved with an equal
+    configuration); ``run(out)`` (module docstring)."""
+
+    def __init__(self, runs: Iterable[Run | tuple[str, RunConfig]],
+                 samples: Iterable[tuple[PrepareConfig, str]] = ()):
+        self.runs = [run if isinstance(run, Run) else Run(*run) for run in runs]
+        names = [run.name for run in self.runs]
+        repeated = sorted({name for name in names if names.count(name) > 1})
+        if repeated:
+            raise ValueError(f"run names must be unique: {', '.join(repeated)} repeated")
+        self.samples = [(sample, os.fspath(path)) for sample, path in samples]
+        for sample, _ in self.samples:
+            if not isinstance(sample, PrepareConfig):
+                raise TypeError(f"samples: a PrepareConfig expected, got "
+                                f"{type(sample).__name__}")
+
+    def folder(self, out: str, name: str) -> str:
+        """The folder of run ``name``."""
+        return os.path.join(out, "runs", name)
+
+    def run(self, out: str, *, jobs: int = 1, scheduler: str | None = None, threads: int = 1,
+            quiet: bool = False) -> CampaignResult:
+        """Run every run into ``out``/runs/<name> (reusing finished ones) with ``threads``
+        Numba threads each, in ``jobs`` local processes (check_jobs) or on the Dask cluster
+        at ``scheduler`` (its workers must see ``out`` at the same path). Every configuration
+        still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
+        tables), so a bad one is refused before anything runs. The caller holds ``out``
+        (an OutputFolder, module docstring)."""
+        jobs = check_jobs(jobs)
+        threads = check_int("threads", threads, low=1)
+        out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
+        result = CampaignResult(self.runs)
+        todo = []
+        for run in self.runs:
+            summary = finished_summary(run.config, self.folder(out, run.name))
+            if summary is None:
+                todo.append(run)
+            else:
+                result.summaries[run.name] = summary
+                result.reused.append(run.name)
+        for run in todo:
+            if isinstance(run.config, TriaxialConfig):
+                try:
+                    TriaxialTest(run.config, force=run.force)
+                except ValueError as error:
+                    raise RunRefused(f"run {run.name}: {error}") from None
+        preparations = [(sample, path) for sample, path in self.samples
+                        if not sample_made_with(path, sample)]
+        for _, path in preparations:
+            os.makedirs(os.path.dirname(path), exist_ok=True)
+        with executor(jobs, scheduler) as pool:
+            _, errors = map_tasks(pool, prepare_one,
+                                  [(sample, path, threads) for sample, path in preparations],
+                                  description="prepare", quiet=quiet)
+            unprepared = {os.path.abspath(preparations[i][1]): text
+                          for i, text in errors.items()}
+            for run in list(todo):
+                path = getattr(run.config, "sample_path", None)
+                if path is not None and os.path.abspath(path) in unprepared:
+                    todo.remove(run)
+                    result.failed[run.name] = (f"its sample {path} could not be prepared: "
+                                               f"{unprepared[os.path.abspath(path)]}")
+            folders = [self.folder(out, run.name) for run in todo]
+            results, errors = map_tasks(
+                pool, run_one, [(run.config, folder, threads, run.force)
+                                for run, folder in zip(todo, folders)],
+                description="runs", folders=folders, quiet=quiet)
+        for index, (run, summary) in enumerate(zip(todo, results)):
+            if index in errors:
+                result.failed[run.name] = (f"{errors[index]} (log: "
+                                           f"{os.path.join(folders[index], 'log.txt')})")
+            else:
+                result.summaries[run.name] = summary
+        return result
+
+
+# ---------------------------------------------------------------- parameter tables
+
+def read_table(path: str | os.PathLike) -> dict:
+    """The TOML table at ``path`` as a dict; ValueError naming the path (and the line of a
+    TOML or UTF-8 error) when it is not a readable TOML file."""
+    try:
+        import tomllib
+    except ModuleNotFoundError:        # Python 3.10
+        import tomli as tomllib
+    source = f"table = {os.fspath(path)!r}"
+    try:
+        regular = stat.S_ISREG(os.stat(path).st_mode)     # a device or a pipe may never end
+        if regular:
+            with open(path, "rb") as handle:
+                data = handle.read()
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{source} cannot be read: "
+                         f"{getattr(error, 'strerror', None) or error}") from None
+    if not regular:
+        raise ValueError(f"{source} is not a file; valid: a TOML file")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        column = error.start - data.rfind(b"\n", 0, error.start)
+        raise ValueError(f"{source} is not a TOML table: byte 0x{data[error.start]:02x} at "
+                         f"line {line}, column {column} is not UTF-8 text; valid: a UTF-8 "
+                         "TOML file") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise ValueError(f"{source} is not a valid TOML table: {error}") from None
+    except RecursionError:
+        raise ValueError(f"{source} is not a TOML table pendular can read: its values are "
+                         "nested too deep") from None
+
+
+def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str]]]:
+    """(command, [options dict per run], [the keys each run varies]) of a parameter table
+    (module docstring); ValueError starting with ``source``."""
+    valid = "valid: [fixed] options with [sweep] lists or [[runs]] rows"
+    if not table:
+        raise ValueError(f"{source} is empty; {valid}")
+    unknown = set(table) - {"command", "fixed", "sweep", "runs"}
+    if unknown:
+        raise ValueError(f"{source}: unknown table key(s) {', '.join(sorted(unknown))}; valid: "
+                         "command, fixed, sweep, runs")
+    command = table.get("command", "triaxial")
+    if command not in ("triaxial", "tension"):
+        raise ValueError(f"{source}: command = {command!r} is not one of 'triaxial', "
+                         "'tension'")
+    for key in ("fixed", "sweep"):
+        if not isinstance(table.get(key, {}), dict):
+            raise ValueError(f"{source}: {key} must be a table ([{key}])")
+    fixed = dict(table.get("fixed", {}))
+    sweep = table.get("sweep", {})
+    explicit = table.get("runs", [])
+    if not isinstance(explicit, list) or not all(isinstance(r, dict) for r in explicit):
+        raise ValueError(f"{source}: runs must be an array of tables ([[runs]])")
+    if "sweep" in table and not sweep:
+        raise ValueError(f"{source}: [sweep] is empty; valid: a non-empty list per swept "
+                         "option, e.g. suction = [0, 30000]")
+    if "runs" in table and not explicit:
+        raise ValueError(f"{source}: runs = [] holds no run; valid: one [[runs]] table per run")
+    if sweep and explicit:
+        raise ValueError(f"{source}: give [sweep] or [[runs]], not both")
+    for name, values in sweep.items():
+        if not isinstance(values, list) or not values:
+            raise ValueError(f"{source}: sweep.{name} = {values!r} is not a non-empty list")
+    both = sorted(set(fixed) & set(sweep))
+    if both:
+        raise ValueError(f"{source}: {', '.join(both)} both in [fixed] and in [sweep]")
+    count = math.prod(len(values) for values in sweep.values()) if sweep else len(explicit)
+    if count > MAX_RUNS:
+        sizes = " x ".join(f"{len(values)} {name}" for name, values in sweep.items())
+        raise ValueError(f"{source}: {count} runs ({sizes or '[[runs]] rows'}); valid: at "
+                         f"most {MAX_RUNS} runs in a table")
+    if sweep:
+        names = list(sweep)
+        own = [dict(zip(names, combination))
+               for combination in itertools.product(*(sweep[n] for n in names))]
+    else:
+        own = [dict(row) for row in explicit] or [{}]
+    rows = [{**fixed, **row} for row in own]
+    if not any(set(row) - {"name"} for row in rows):
+        raise ValueError(f"{source} sets no option, so each run would be the {command} "
+                         f"command's default test; {valid}")
+    return command, rows, [list(row) for row in own]
+
+
+def run_name(row: dict, varied: Sequence[str]) -> str:
+    """Folder name of a run: its ``name`` key, else its varied options, e.g.
+    'suction30000_confining250' ('run' when nothing varies)."""
+    if "name" in row:
+        return str(row["name"])
+    keys = [key for key in varied if key != "name"]
+    if not keys:
+        return "run"
+    return "_".join(f"{key}{_text(row[key])}" for key in keys)
+
+
+def _text(value: Any) -> str:
+    if isinstance(value, list):
+        return "-".join(_text(v) for v in value)
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return re.sub(r"[^\w.+-]", "-", str(value))
+
+
+def run_options(config: RunConfig) -> dict:
+    """A run's options, flat and named as the command's (campaign.csv columns; a tension run's
+    void ratio and water content are its summary's ``*_target`` columns)."""
+    if isinstance(config, TriaxialConfig):
+        return parameters(config)
+    return {k: v for k, v in config_to_dict(config)["fields"].items() if k != "cases"}
+
+
+def write_campaign_csv(path: str, result: CampaignResult) -> None:
+    """``path``: one row per run of ``result``: its name, status (run, reused, failed), its
+    options (flat) and its summary's scalars (the error of a failed run)."""
+    rows = []
+    for run in result.runs:
+        summary = {k: v for k, v in (result.summaries.get(run.name) or {}).items()
+                   if isinstance(v, (int, float, str, bool)) or v is None}
+        status = ("failed" if run.name in result.failed else
+                  "reused" if run.name in result.reused else "run")
+        row = {"run": run.name, "status": status, **run_options(run.config), **summary}
+        if run.name in result.failed:
+            row["error"] = result.failed[run.name]
+        rows.append(row)
+    columns = list(dict.fromkeys(key for row in rows for key in row))
+    with replacing(path) as temporary, open(temporary, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(rows)

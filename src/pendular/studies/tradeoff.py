@@ -1,0 +1,664 @@
+"""Speed against accuracy: one knob at a time, measured against a slow, fine reference run.
+
+``write_study(Study(out, particles=..., max_strain=..., quick=...))``; command
+``pendular tradeoff --out DIR [--particles N] [--max-strain X] [--quick] [--docs FOLDER]``.
+
+The reference test is a wet drained triaxial (30 kPa suction, 750 Pa lateral stress, thesis
+Table 5.2 otherwise) of ``particles`` spheres to ``max_strain`` (the peak lies near 4 %). Every
+run is a pendular.procedures.triaxial.TriaxialTest of a configuration built from the default one
+(``Study.default``: the defaults of ``pendular triaxial``, exact bridge table 350 x 80)
+with ``dataclasses.replace``; it starts from the same prepared sample (DIR/samples/, the
+sample-size knob prepares one per size), runs on one Numba thread, and is compared with the
+reference: the P-wave rule at time-step safety 0.35, inertial number 1e-4, bridge table
+700 x 160 nodes, the other knobs at their defaults. Each knob (``KNOB_FIELDS``: the field of
+the configuration it sets) is varied alone around the defaults:
+
+    timestep_safety, timestep_rule (P-wave estimate / critical step of the contacts, at the
+    default safety), inertial_number, damping, particles, table_resolution (exact bridges),
+    bridges (exact / toroidal), records (history rows), skin_factor (neighbour list)
+
+For each run: wall_time_s and cpu_time_s (sample equilibration, wetting and shear, and
+writing the run's history and summary; the sample's preparation excluded, and no figures are
+drawn), its particle-steps per second, and the relative errors of peak
+q, of Sr at the peak of q and of q'/p' at the peak of q (Eq. 3.43) against the reference;
+``error`` is the largest of the three. The noise floor: the reference settings run on
+NOISE_SEEDS other samples (seeds seed + 1, ...), whose errors against the reference are the
+scatter between samples that a knob's error is read against.
+
+Writes DIR/tradeoff.json (``arguments``, ``suction``, ``confining``, ``reference``, ``rows``:
+knob, value, settings, particles, wall_time_s, cpu_time_s, steps, wetting_steps,
+particle_steps_per_s, peak_q, saturation_at_peak, stress_ratio_at_peak, axial_strain_at_peak,
+peak_q_error, saturation_error, stress_ratio_error, error; ``noise``: the same for each other
+seed, with ``seed`` for knob and value; ``noise_floor``: their largest errors),
+DIR/tradeoff.md with a recommendation per use (quick look, paper figure) and DIR/tradeoff.png;
+``docs`` copies the three there (docs/tradeoff.*). Each run lives in DIR/runs/<name>/ with its
+timing.json (the result and the run's configuration); run again, a study reuses a finished
+run only when its stored configuration equals the wanted one (pendular.procedures.config.config_json).
+
+One sample cannot tell a knob's systematic effect from the chaos of a granular run (any change
+of the step makes another trajectory, a few per cent apart at the peak). ``SeedStudy`` (command
+``pendular tradeoff --out DIR --knob K [--seeds 6] [--jobs J]``) runs the reference and every
+setting of one knob on several samples and reads each setting against the same sample's
+reference (``seed_rows``); ``write_seed_study`` writes DIR/seeds_K.json and DIR/seeds_K.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import shutil
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from pendular.utils.atomic import write_json, write_text
+from pendular.procedures.preparation import MAX_SEED, PrepareConfig
+from pendular.dem.sample import load_sample
+from pendular.utils.threads import use_threads
+from pendular.utils.validate import check_int, check_range
+
+from pendular.procedures.config import sample_made_with
+from pendular.studies.campaign import check_jobs, executor, prepare_one
+from pendular.procedures.config import (BridgeConfig, ShearConfig, TriaxialConfig, config_json,
+    config_to_dict)
+from pendular.io.outputs import OutputFolder
+from pendular.io.plots import pyplot, save_figure
+from pendular.procedures.triaxial import TriaxialTest
+
+SUCTION = 30000.0
+CONFINING = 750.0
+#: Knob -> (part of the TriaxialConfig, field of that part) it sets.
+KNOB_FIELDS = {"timestep_safety": ("sample", "timestep_safety"),
+               "timestep_rule": ("sample", "timestep_rule"),
+               "inertial_number": ("shear", "inertial_number"),
+               "damping": ("sample", "damping"),
+               "particles": ("sample", "particles"),
+               "table_resolution": ("bridges", "table_resolution"),
+               "bridges": ("bridges", "model"),
+               "records": ("shear", "records"),
+               "skin_factor": ("sample", "skin_factor")}
+#: The exact bridge table of the default run (nodes in suction, in distance).
+DEFAULT_TABLE = (350, 80)
+#: What the slow, fine reference changes in the default run.
+REFERENCE = {"timestep_rule": "pwave", "timestep_safety": 0.35, "inertial_number": 1e-4,
+             "table_resolution": (700, 160)}
+#: Settings of each knob (particles: multiples of the study's particles).
+KNOBS = {"timestep_safety": [0.3, 0.5, 0.7, 0.9],
+         "timestep_rule": ["pwave", "stiffness"],
+         "inertial_number": [1e-4, 3e-4, 1e-3, 3e-3],
+         "damping": [0.05, 0.1, 0.2, 0.4],
+         "particles": [0.25, 0.5, 1.0, 2.0],
+         "table_resolution": [(50, 20), (100, 40), (350, 80), (700, 160)],
+         "bridges": ["exact", "toroidal"],
+         "records": [50, 500, 2000],
+         "skin_factor": [0.1, 0.3, 0.6, 1.0]}
+QUICK_KNOBS = {"timestep_safety": [0.5, 0.7, 0.9], "inertial_number": [3e-4, 1e-3, 3e-3],
+               "table_resolution": [(50, 20), (100, 40), (350, 80)]}
+#: Error bounds of the recommendations.
+PAPER_ERROR, QUICK_ERROR = 0.02, 0.10
+#: CPU times within this factor of each other count as equal in the recommendations.
+TIME_TIE = 1.05
+#: The uses recommended for, and their error bounds.
+USES = {"paper figure": PAPER_ERROR, "quick look": QUICK_ERROR}
+#: Smallest sample of the study (the particles knob included).
+MIN_PARTICLES = 50
+#: Samples beside the reference's (seeds seed + 1 ...) run at the reference settings: their
+#: scatter is the noise floor a knob's error is read against.
+NOISE_SEEDS = 2
+
+
+# ---------------------------------------------------------------- knobs on configurations
+
+def setting(config, knob):
+    """The value of ``knob`` in the TriaxialConfig ``config``."""
+    part, name = KNOB_FIELDS[knob]
+    return getattr(getattr(config, part), name)
+
+
+def with_setting(config, knob, value):
+    """``config`` with ``knob`` set to ``value`` (dataclasses.replace; validated)."""
+    part, name = KNOB_FIELDS[knob]
+    return dataclasses.replace(
+        config, **{part: dataclasses.replace(getattr(config, part), **{name: value})})
+
+
+def settings(config):
+    """The knobs' values of ``config`` (the sample size aside), as JSON values."""
+    return json.loads(json.dumps({knob: setting(config, knob) for knob in KNOB_FIELDS
+                                  if knob != "particles"}))
+
+
+def text(value):
+    """A knob's value as shown: (350, 80) -> '350,80', 0.0001 -> '0.0001'."""
+    if isinstance(value, (tuple, list)):
+        return ",".join(str(v) for v in value)
+    return str(value)
+
+
+@dataclass
+class Study:
+    """The study's inputs: output folder ``out``, ``particles`` of the reference sample
+    (>= 50), ``max_strain`` in (0, 0.5], the samples' ``seed``; ``quick``: three knobs, three
+    settings each (QUICK_KNOBS, a smoke test)."""
+
+    out: str
+    particles: int = 2000
+    max_strain: float = 0.15
+    seed: int = 0
+    quick: bool = False
+
+    def __post_init__(self):
+        self.particles = check_int("particles", self.particles, low=MIN_PARTICLES)
+        self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.5,
+                                      low_inclusive=False)
+        self.seed = check_int("seed", self.seed, high=MAX_SEED - NOISE_SEEDS)
+        self.quick = bool(self.quick)
+        if not str(self.out).strip():
+            raise ValueError(f"out = {self.out!r} is empty: give a folder name")
+
+    def knobs(self):
+        return QUICK_KNOBS if self.quick else KNOBS
+
+    def sample(self, particles, seed=None):
+        """The PrepareConfig of the prepared sample of ``particles`` spheres (every run of that
+        size starts from it; ``seed``: another sample's, for the noise floor)."""
+        return PrepareConfig(particles=particles, confining=CONFINING,
+                             seed=self.seed if seed is None else seed)
+
+    def default(self):
+        """The knobs' centre: ``pendular triaxial``'s defaults, wet at SUCTION, from the saved
+        sample of ``particles`` spheres in ``out``/samples, no ParaView output."""
+        return TriaxialConfig(sample=self.sample(self.particles),
+                              shear=ShearConfig(max_strain=self.max_strain),
+                              bridges=BridgeConfig(SUCTION, table_resolution=DEFAULT_TABLE),
+                              sample_path=sample_file(self.out, self.particles, self.seed),
+                              vtk_every=0)
+
+    def reference(self):
+        """The slow, fine reference (REFERENCE applied to the default)."""
+        config = self.default()
+        for knob, value in REFERENCE.items():
+            config = with_setting(config, knob, value)
+        return config
+
+    def reference_on(self, seed):
+        """The reference settings on the sample of another ``seed``."""
+        config = self.reference()
+        return dataclasses.replace(
+            config, sample=dataclasses.replace(config.sample, seed=seed),
+            sample_path=sample_file(self.out, self.particles, seed))
+
+    def variant(self, knob, value):
+        """(configuration, value shown) of ``knob`` at ``value`` around the default; the
+        particles knob takes a multiple of ``particles`` and its own sample."""
+        config = self.default()
+        if knob != "particles":
+            return with_setting(config, knob, value), value
+        count = max(MIN_PARTICLES, int(round(value * self.particles)))
+        config = with_setting(config, "particles", count)
+        return (dataclasses.replace(config, sample_path=sample_file(self.out, count, self.seed)),
+                count)
+
+
+def sample_file(out, particles, seed, setting=""):
+    """The saved sample of ``particles`` spheres and ``seed`` in ``out``/samples (``setting``:
+    the name of the knob setting it was prepared with, setting_name; "" for the default's)."""
+    tail = f"_{setting}" if setting else ""
+    return os.path.join(os.path.abspath(out), "samples", f"n{particles}_seed{seed}{tail}.h5")
+
+
+def setting_name(knob, value):
+    """A knob's setting as a file or folder name: 'table_resolution=350x80'."""
+    return f"{knob}={text(value)}".replace(",", "x")
+
+
+# ---------------------------------------------------------------- runs
+
+def run_variant(config, folder, sample):
+    """One wet triaxial of ``config`` in ``folder`` (TriaxialTest on one thread), its sample
+    ``sample`` (PrepareConfig, saved at config.sample_path) prepared first when missing: its
+    summary values with the measured times. A finished run whose timing.json holds an equal
+    configuration is reused."""
+    timing = os.path.join(folder, "timing.json")
+    done = _read_json(timing)
+    if done is not None and json.dumps(done.get("config"), sort_keys=True) == config_json(config):
+        return {k: v for k, v in done.items() if k != "config"}
+    if not sample_made_with(config.sample_path, sample):
+        os.makedirs(os.path.dirname(config.sample_path), exist_ok=True)
+        prepare_one(sample, config.sample_path)
+    test = TriaxialTest(config)           # checks, and builds the bridge tables untimed
+    wall, cpu = time.perf_counter(), time.process_time()
+    summary = test.run(folder, progress=False, threads=1, plots=False)   # physics only
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    result = {"settings": settings(config), "particles": config.sample.particles,
+              "wall_time_s": wall, "cpu_time_s": cpu, "steps": summary["steps"],
+              "wetting_steps": summary.get("wetting_steps", 0),
+              "particle_steps_per_s": summary["particle_steps_per_s"],
+              "peak_q": summary["peak_q"], "saturation_at_peak": summary["saturation_at_peak"],
+              "stress_ratio_at_peak": (summary["peak_q_effective"]
+                                       / summary["p_effective_at_peak"]),
+              "axial_strain_at_peak": summary["axial_strain_at_peak"]}
+    write_json(timing, {**result, "config": config_to_dict(config)})
+    return result
+
+
+def _read_json(path):
+    try:
+        with open(path) as handle:
+            return json.load(handle)
+    except (OSError, ValueError):
+        return None
+
+
+def errors(result, reference):
+    """Relative errors of one run against the reference; ``error`` is the largest."""
+    values = {f"{key}_error": abs(result[field] - reference[field]) / abs(reference[field])
+              for key, field in (("peak_q", "peak_q"), ("saturation", "saturation_at_peak"),
+                                 ("stress_ratio", "stress_ratio_at_peak"))}
+    values["error"] = max(values.values())
+    return values
+
+
+def measure(study, log=None):
+    """(reference result, rows, noise rows) of the Study ``study``: the reference on other
+    samples, every knob's runs and, per use, the run combining each knob's recommended setting
+    (module docstring). ``log(text)`` hears of each run."""
+    log = log or (lambda message: None)
+    default = study.default()
+
+    def run(name, config):
+        return run_variant(config, os.path.join(study.out, "runs", name),
+                           study.sample(config.sample.particles, config.sample.seed))
+
+    reference = run("reference", study.reference())
+    noise = []
+    for seed in range(study.seed + 1, study.seed + 1 + NOISE_SEEDS):
+        log(f"reference settings, seed {seed} (noise floor)")
+        result = run(f"reference_seed{seed}", study.reference_on(seed))
+        noise.append({"seed": seed, **result, **errors(result, reference)})
+    rows = []
+    for knob, values in study.knobs().items():
+        for value in values:
+            config, value = study.variant(knob, value)
+            name = "default" if config == default else setting_name(knob, value)
+            log(f"{knob} = {text(value)}")
+            result = run(name, config)
+            rows.append({"knob": knob, "value": value, **result, **errors(result, reference)})
+    for use, bound in USES.items():
+        config = default
+        for knob, row in recommendation(rows, bound).items():
+            if knob != "particles":
+                config = with_setting(config, knob, row["value"])
+        log(f"combined settings for a {use}: {settings(config)}")
+        result = run(f"combined_{use.replace(' ', '_')}", config)
+        rows.append({"knob": "combined", "value": use, **result, **errors(result, reference)})
+    return reference, rows, noise
+
+
+def noise_floor(noise):
+    """The largest of each relative error over the noise rows (other samples, reference
+    settings): the sample-to-sample scatter."""
+    return {key: max(r[key] for r in noise)
+            for key in ("peak_q_error", "saturation_error", "stress_ratio_error", "error")}
+
+
+def recommendation(rows, bound):
+    """Per knob (the combined rows aside), the cheapest setting whose error is within ``bound``;
+    settings within TIME_TIE of the cheapest CPU time count as equally cheap, and the one with
+    the smallest error among them is taken."""
+    chosen = {}
+    for knob in dict.fromkeys(r["knob"] for r in rows if r["knob"] != "combined"):
+        within = [r for r in rows if r["knob"] == knob and r["error"] <= bound]
+        if within:
+            cheapest = min(r["cpu_time_s"] for r in within)
+            chosen[knob] = min((r for r in within if r["cpu_time_s"] <= TIME_TIE * cheapest),
+                               key=lambda r: r["error"])
+    return chosen
+
+
+def fastest_within(rows, bound, default_time):
+    """The row with the largest speed-up over the default run whose peak-q error is within
+    ``bound``, and that speed-up."""
+    within = [r for r in rows if r["peak_q_error"] <= bound and r["knob"] != "combined"]
+    best = min(within, key=lambda r: r["cpu_time_s"])
+    return best, default_time / best["cpu_time_s"]
+
+
+# ---------------------------------------------------------------- report
+
+def write_markdown(path, study, reference, rows, noise, floor):
+    centre = settings(study.default())
+    default = next(r for r in rows if r["knob"] != "combined" and r["settings"] == centre
+                   and r["particles"] == study.particles)
+    best, speedup = fastest_within(rows, PAPER_ERROR, default["cpu_time_s"])
+    lines = [
+        "# Speed against accuracy (pendular tradeoff)", "",
+        f"`pendular tradeoff --out DIR --particles {study.particles} --max-strain "
+        f"{study.max_strain}`: a wet triaxial (suction {SUCTION:g} Pa, lateral {CONFINING:g} Pa) "
+        f"of {study.particles} spheres to {study.max_strain:g} axial strain, one knob varied at "
+        "a time around the defaults; one Numba thread per run. Errors are relative to the "
+        "reference run (P-wave time step at safety 0.35, inertial number 1e-4, table 700 x "
+        "160): "
+        f"peak q = {reference['peak_q']:.1f} Pa, Sr at peak = "
+        f"{100 * reference['saturation_at_peak']:.3f} %, q'/p' at peak = "
+        f"{reference['stress_ratio_at_peak']:.4f}; it took {reference['cpu_time_s']:.0f} s of "
+        "CPU. Times cover wetting and shear and the run's history and summary, not the "
+        "sample's preparation nor figures; CPU time (the run's "
+        "process time) is the speed measure, wall time also counts whatever else the machine "
+        "was running.", "",
+        "![time against error](tradeoff.png)", "",
+        "| knob | value | CPU [s] | wall [s] | M particle-steps/s | peak q error | "
+        "Sr error | q'/p' error | error |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        lines.append(f"| {r['knob']} | {text(r['value'])} | {r['cpu_time_s']:.1f} | "
+                     f"{r['wall_time_s']:.1f} | {r['particle_steps_per_s'] / 1e6:.2f} | "
+                     f"{100 * r['peak_q_error']:.2f} % | {100 * r['saturation_error']:.2f} % | "
+                     f"{100 * r['stress_ratio_error']:.2f} % | {100 * r['error']:.2f} % |")
+    lines += ["", "## Noise floor", "",
+              f"The reference settings on {len(noise)} other samples (seeds "
+              f"{', '.join(str(r['seed']) for r in noise)}, prepared the same way) differ from "
+              f"the reference by up to {100 * floor['peak_q_error']:.2f} % in peak q, "
+              f"{100 * floor['saturation_error']:.2f} % in Sr and "
+              f"{100 * floor['stress_ratio_error']:.2f} % in q'/p' at the peak: a knob's error "
+              "below this is within the scatter between samples, and a setting cannot be told "
+              "from the reference by it.", "",
+              "| seed | peak q [Pa] | peak q error | Sr error | q'/p' error |",
+              "|---:|---:|---:|---:|---:|"]
+    lines += [f"| {r['seed']} | {r['peak_q']:.1f} | {100 * r['peak_q_error']:.2f} % | "
+              f"{100 * r['saturation_error']:.2f} % | {100 * r['stress_ratio_error']:.2f} % |"
+              for r in noise]
+    lines += ["", "## Recommendations", "",
+              f"Fastest single-knob run within {PAPER_ERROR:.0%} of the reference on peak q: "
+              f"{best['knob']} = {text(best['value'])}, {speedup:.2f} x faster than the "
+              f"defaults ({best['cpu_time_s']:.1f} s against {default['cpu_time_s']:.1f} s of "
+              "CPU).", ""]
+    for use, bound in USES.items():
+        chosen = recommendation(rows, bound)
+        together = next(r for r in rows if r["knob"] == "combined" and r["value"] == use)
+        lines += [f"**{use.capitalize()}** (each knob's cheapest setting with all three errors "
+                  f"within {bound:.0%}); all of them together (sample size aside): peak q "
+                  f"error {100 * together['peak_q_error']:.2f} %, largest error "
+                  f"{100 * together['error']:.2f} %, {together['cpu_time_s']:.1f} s of CPU, "
+                  f"{default['cpu_time_s'] / together['cpu_time_s']:.1f} x faster than the "
+                  "defaults:", ""]
+        for knob in KNOBS:
+            if knob in chosen:
+                row = chosen[knob]
+                lines.append(f"- {knob} = {text(row['value'])} ({100 * row['error']:.1f} %, "
+                             f"{row['cpu_time_s']:.1f} s)")
+            elif any(r["knob"] == knob for r in rows):
+                lines.append(f"- {knob}: no setting within {bound:.0%} (keep the reference's)")
+        lines.append("")
+    lines += ["Reading the table: the skin leaves the dynamics unchanged (every skin gives a "
+              "bit-identical run; only its speed differs) and the record interval changes only "
+              "which steps are sampled, so where the peak is read. The sample size changes the "
+              "sample itself (smaller samples prepared by the same procedure are looser, with "
+              "proportionally more wall layers), so its errors are a size effect, not a "
+              "numerical one.", ""]
+    write_text(path, "\n".join(lines) + "\n")
+
+
+def plot(path, rows, floor):
+    """CPU time against error, one series per knob; the noise floor ``floor`` shaded."""
+    figure, axes = pyplot().subplots(figsize=(7, 5))
+    for index, knob in enumerate(dict.fromkeys(r["knob"] for r in rows)):
+        chosen = [r for r in rows if r["knob"] == knob]
+        axes.plot([r["cpu_time_s"] for r in chosen], [100 * max(r["error"], 1e-4) for r in chosen],
+                  "o-", color=f"C{index}", label=knob)
+        for r in chosen:
+            axes.annotate(text(r["value"]), (r["cpu_time_s"], 100 * max(r["error"], 1e-4)),
+                          fontsize=6)
+    axes.axhline(100 * PAPER_ERROR, color="k", ls=":", lw=1)
+    axes.axhspan(1e-2, 100 * floor, color="0.85", zorder=0, label="noise floor (other samples)")
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    axes.set_xlabel("CPU time, wetting and shear [s]")
+    axes.set_ylabel("largest relative error [%]")
+    axes.legend(fontsize=7)
+    save_figure(figure, path)
+
+
+#: Files the study owns in its output folder (its runs and samples are reused, not owned).
+OUTPUTS = ("tradeoff.json", "tradeoff.md", "tradeoff.png")
+
+
+def write_study(study, *, docs=None, log=None):
+    """Run the Study ``study`` and write tradeoff.json/.md/.png into its folder (and copies
+    in ``docs`` if given); returns the tradeoff.json content. One Numba thread; ``log(text)``
+    hears of each run."""
+    if not isinstance(study, Study):
+        raise TypeError(f"study must be a pendular.studies.tradeoff.Study, got {type(study).__name__}")
+    if docs is not None and not os.path.isdir(docs):
+        raise ValueError(f"docs = {docs!r} is not a folder")
+    use_threads(1)
+    with OutputFolder(study.out, "tradeoff") as folder:
+        paths = {name.rsplit(".", 1)[1]: folder.claim(name) for name in OUTPUTS}
+        reference, rows, noise = measure(study, log)
+        floor = noise_floor(noise)
+        data = {"arguments": {**dataclasses.asdict(study), "docs": docs},
+                "suction": SUCTION, "confining": CONFINING, "reference": reference,
+                "rows": rows, "noise": noise, "noise_floor": floor}
+        write_json(paths["json"], data)
+        write_markdown(paths["md"], study, reference, rows, noise, floor)
+        plot(paths["png"], rows, floor["error"])
+    if docs is not None:
+        for path in paths.values():
+            shutil.copy(path, docs)
+    return data
+
+
+# ---------------------------------------------------------------- one knob across samples
+
+#: Knobs that also set how a sample is prepared: the seed study runs each of their values on
+#: samples prepared with it too (the whole chain that value gives).
+PREPARATION_KNOBS = ("timestep_safety", "timestep_rule", "damping")
+#: The quantities compared, (result field, label).
+QUANTITIES = (("peak_q", "peak q"), ("saturation_at_peak", "Sr at peak"),
+              ("stress_ratio_at_peak", "q'/p' at peak"))
+
+
+@dataclass
+class SeedStudy:
+    """``knob`` across ``seeds`` samples (seeds seed ... seed + seeds - 1) of ``particles``
+    spheres, which the one-sample Study cannot tell from chaos: on each sample the reference
+    and every setting of the knob (KNOBS), each compared with the same sample's reference
+    (paired: the knob's effect without the scatter between samples); the references'
+    scatter across samples; and, for a knob of the preparation (PREPARATION_KNOBS), each
+    setting also on samples prepared with it. ``jobs`` runs at a time, one thread each."""
+
+    out: str
+    knob: str
+    seeds: int = 6
+    particles: int = 2000
+    max_strain: float = 0.15
+    seed: int = 0
+    jobs: int = 1
+
+    def __post_init__(self):
+        if self.knob not in KNOBS or self.knob == "particles":
+            raise ValueError(f"knob = {self.knob!r}: valid knobs are "
+                             f"{', '.join(k for k in KNOBS if k != 'particles')}")
+        self.seeds = check_int("seeds", self.seeds, low=2, high=100)
+        self.jobs = check_jobs(self.jobs)
+        Study(self.out, self.particles, self.max_strain, self.seed)   # checks the rest
+        self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
+
+    def study(self, seed):
+        """The one-sample Study of the sample of ``seed`` (its default, reference, variants)."""
+        return Study(self.out, self.particles, self.max_strain, seed)
+
+    def runs(self):
+        """(name, configuration, PrepareConfig of its sample) of every run: per seed the
+        reference, each setting on the default sample and, for a knob of the preparation,
+        each setting other than the default's on a sample prepared with it."""
+        runs = []
+        for seed in range(self.seed, self.seed + self.seeds):
+            study = self.study(seed)
+            default = study.default()
+            runs.append((f"seed{seed}_reference", study.reference(),
+                         study.sample(self.particles, seed)))
+            for value in KNOBS[self.knob]:
+                config, _ = study.variant(self.knob, value)
+                name = f"seed{seed}_{setting_name(self.knob, value)}"
+                runs.append((name, config, study.sample(self.particles, seed)))
+                if self.knob in PREPARATION_KNOBS and value != setting(default, self.knob):
+                    path = sample_file(self.out, self.particles, seed,
+                                       setting_name(self.knob, value))
+                    runs.append((f"{name}_prepared", dataclasses.replace(config, sample_path=path),
+                                 config.sample))
+        return runs
+
+
+def _run_named(name, config, sample, out):
+    return name, run_variant(config, os.path.join(out, "runs", name), sample)
+
+
+def _prepare_missing(path, sample):
+    if not sample_made_with(path, sample):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        prepare_one(sample, path)
+    return path
+
+
+def run_seed_study(study, log=None):
+    """Every run of the SeedStudy ``study`` (its samples prepared first, as many at a time as
+    its jobs): {name: result}, each result with its sample's porosity and coordination."""
+    log = log or (lambda message: None)
+    runs = study.runs()
+    samples = {config.sample_path: sample for _, config, sample in runs}
+    results = {}
+    with executor(study.jobs) as pool:
+        submit = (lambda f, *a: pool.submit(f, *a)) if pool else _now
+        for future in [submit(_prepare_missing, p, s) for p, s in samples.items()]:
+            log(f"sample {os.path.basename(_result(future))}")
+        for future in [submit(_run_named, name, config, sample, study.out)
+                       for name, config, sample in runs]:
+            name, result = _result(future)
+            log(f"{name}: peak q {result['peak_q']:.1f} Pa")
+            results[name] = result
+    for name, config, _ in runs:
+        report = load_sample(config.sample_path)[2]
+        results[name].update(porosity=report["porosity"], coordination=report["coordination"])
+    return results
+
+
+def _now(function, *arguments):
+    """The submit of running here, one after the other: the value itself (see _result)."""
+    return function(*arguments)
+
+
+def _result(future):
+    """The value of a pool's future, or of _now's."""
+    return future.result() if hasattr(future, "result") else future
+
+
+def _stats(values):
+    return {"mean": float(np.mean(values)), "sd": float(np.std(values, ddof=1)),
+            "largest": float(np.max(np.abs(values)))}
+
+
+def seed_rows(study, results):
+    """(rows, scatter): per setting (and setting on samples prepared with it), over the
+    samples: CPU time, steps, the samples' porosity and coordination and, per quantity,
+    ``paired`` (on the default samples): the statistics (_stats) of its relative error against
+    the same sample's reference, and ``against_references``: of its relative difference from
+    the references' mean. ``scatter``: the references' mean and relative standard deviation
+    across samples, per quantity. ``within_scatter``: every quantity's mean error (paired, or
+    against the references for a setting's own samples) within that standard deviation."""
+    seeds = range(study.seed, study.seed + study.seeds)
+    reference = [results[f"seed{s}_reference"] for s in seeds]
+    scatter = {}
+    for field, _ in QUANTITIES:
+        values = [r[field] for r in reference]
+        scatter[field] = {"mean": float(np.mean(values)),
+                          "relative_sd": float(np.std(values, ddof=1) / abs(np.mean(values)))}
+    rows = []
+    for value in KNOBS[study.knob]:
+        for prepared in (False, True):
+            suffix = setting_name(study.knob, value) + ("_prepared" * prepared)
+            own = [results.get(f"seed{s}_{suffix}") for s in seeds]
+            if None in own:
+                continue
+            row = {"value": value, "prepared_with_it": prepared,
+                   "cpu_time_s": float(np.mean([r["cpu_time_s"] for r in own])),
+                   "steps": float(np.mean([r["steps"] + r["wetting_steps"] for r in own])),
+                   "porosity": float(np.mean([r["porosity"] for r in own])),
+                   "coordination": float(np.mean([r["coordination"] for r in own]))}
+            for field, _ in QUANTITIES:
+                row[field] = {"against_references": _stats(
+                    [r[field] / scatter[field]["mean"] - 1.0 for r in own])}
+                if not prepared:
+                    row[field]["paired"] = _stats(
+                        [r[field] / ref[field] - 1.0 for r, ref in zip(own, reference)])
+            measure = "against_references" if prepared else "paired"
+            row["within_scatter"] = all(abs(row[f][measure]["mean"]) <= scatter[f]["relative_sd"]
+                                        for f, _ in QUANTITIES)
+            rows.append(row)
+    return rows, scatter
+
+
+def write_seed_study(study, log=None):
+    """Run the SeedStudy ``study``; write seeds_<knob>.json and seeds_<knob>.md in its
+    folder; returns the JSON content."""
+    if not isinstance(study, SeedStudy):
+        raise TypeError(f"study must be a pendular.studies.tradeoff.SeedStudy, got "
+                        f"{type(study).__name__}")
+    stem = f"seeds_{study.knob}"
+    with OutputFolder(study.out, "tradeoff") as folder:
+        paths = {ext: folder.claim(f"{stem}.{ext}") for ext in ("json", "md")}
+        results = run_seed_study(study, log)
+        rows, scatter = seed_rows(study, results)
+        data = {"arguments": dataclasses.asdict(study), "suction": SUCTION,
+                "confining": CONFINING, "reference_settings": REFERENCE, "rows": rows,
+                "reference_scatter": scatter, "runs": results}
+        write_json(paths["json"], data)
+        write_seed_markdown(paths["md"], study, rows, scatter)
+    return data
+
+
+def write_seed_markdown(path, study, rows, scatter):
+    def cell(stats):
+        return (f"{100 * stats['mean']:+.2f} ± {100 * stats['sd']:.2f} % "
+                f"({100 * stats['largest']:.2f})")
+
+    labels = " | ".join(label for _, label in QUANTITIES)
+    lines = [f"# {study.knob} across {study.seeds} samples (pendular tradeoff --knob)", "",
+             f"`pendular tradeoff --out DIR --knob {study.knob} --seeds {study.seeds} "
+             f"--particles {study.particles} --max-strain {study.max_strain}`: the wet "
+             f"triaxial of the trade-off study (suction {SUCTION:g} Pa, lateral {CONFINING:g} "
+             f"Pa) on {study.seeds} samples (seeds {study.seed}-{study.seed + study.seeds - 1}), "
+             "one Numba thread per run. On each sample: the reference (time-step safety "
+             "0.35 of the P-wave estimate, inertial number 1e-4, table 700 x 160) and every "
+             f"setting of {study.knob}.", "",
+             "**Same sample** (paired): each quantity's relative error against the same "
+             "sample's reference, mean ± standard deviation over the samples (largest). The "
+             "mean is the setting's systematic effect; the spread is the chaos of a granular "
+             "run, which any change of the step turns into another trajectory.", "",
+             f"| {study.knob} | CPU [s] | steps | {labels} | within the scatter |",
+             "|---|---:|---:|---:|---:|---:|---|"]
+    lines += [f"| {text(r['value'])} | {r['cpu_time_s']:.1f} | {r['steps']:.0f} | "
+              + " | ".join(cell(r[f]["paired"]) for f, _ in QUANTITIES)
+              + f" | {'yes' if r['within_scatter'] else 'no'} |"
+              for r in rows if not r["prepared_with_it"]]
+    lines += ["", "**Scatter between samples** (the references): "
+              + ", ".join(f"{label} {scatter[f]['mean']:.4g} ± "
+                          f"{100 * scatter[f]['relative_sd']:.2f} %" for f, label in QUANTITIES)
+              + ". A setting is within the scatter when the mean of its errors is within one "
+              "standard deviation of the references across samples, for all three.", ""]
+    if any(r["prepared_with_it"] for r in rows):
+        default = setting(study.study(study.seed).default(), study.knob)
+        chains = [r for r in rows if r["prepared_with_it"] or r["value"] == default]
+        lines += ["**Samples prepared with the setting** (the whole chain it gives, against "
+                  "the default's on its own samples; other samples, so not paired): each "
+                  "quantity against the references' mean, mean ± standard deviation over the "
+                  "samples (largest), and the samples' porosity and coordination.", "",
+                  f"| {study.knob} | samples | porosity | coordination | CPU [s] | {labels} |",
+                  "|---|---|---:|---:|---:|---:|---:|---:|"]
+        lines += [f"| {text(r['value'])} | "
+                  f"{'prepared with it' if r['prepared_with_it'] else f'default ({default})'} | "
+                  f"{r['porosity']:.4f} | {r['coordination']:.2f} | {r['cpu_time_s']:.1f} | "
+                  + " | ".join(cell(r[f]["against_references"]) for f, _ in QUANTITIES) + " |"
+                  for r in chains]
+    write_text(path, "\n".join(lines) + "\n")

@@ -1,0 +1,3 @@
+"""Utilities below the engine: input checks, atomic writes, file integrity, Ctrl-C handling,
+Numba's threading settings.
+"""
