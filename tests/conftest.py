@@ -1,4 +1,8 @@
-"""Shared fixtures: small scenes built with the public API."""
+"""Shared fixtures and helpers: small scenes built with the public API.
+
+The tests are split by reach: tests/unit (one function or kernel against a closed form or an
+independent computation), tests/integration (simulations through the library), tests/e2e (the
+commands as a user runs them, marked ``slow``: ``pytest -m "not slow"`` leaves them out)."""
 
 import os
 import subprocess
@@ -9,6 +13,7 @@ import numpy as np
 import pytest
 
 from pendular.dem.contact_law import ContactForces, normal_stiffness
+from pendular.dem.measure import elastic_energy
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
@@ -16,6 +21,8 @@ from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
 
+#: The repository's root folder (scenarios/, benchmarks/, src/).
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RADIUS = 1e-3
 DENSITY = 2650.0
 YOUNG = 1e6
@@ -87,3 +94,21 @@ def small_sample():
     config = PrepareConfig(particles=300, confining=750.0, seed=1, unload_steps=2000)
     sim, report = prepare_sample(config, progress=False)
     return config, sim, report
+
+
+def pytest_collection_modifyitems(items):
+    """Mark the end-to-end tests ``slow``."""
+    for item in items:
+        if f"{os.sep}e2e{os.sep}" in str(item.path):
+            item.add_marker(pytest.mark.slow)
+
+
+class SpringEnergyProbe:
+    """Test operation placed before the integrator: spring energy at x(t), v(t - dt/2)."""
+
+    def __init__(self, young):
+        self.young = young
+
+    def apply(self, sim):
+        self.energy = elastic_energy(sim.particles, sim.contacts, sim.walls, self.young, 0.3)
+        self.velocity_before = sim.particles.velocity.copy()

@@ -18,7 +18,7 @@ into a bound. On a prepared 10,000-sphere sample at 750 Pa the critical step is 
 the P-wave estimate min R / sqrt(E / rho), 1.67 times the diagonal estimate and 1.8 times the
 Gershgorin bound: both leave most of the stable range unused, hence the eigenvalue itself.
 Leapfrog on a prepared 300-sphere packing, undamped, is steady at 0.95 of it and blows up at
-1.1 (tests/test_timestep.py). A scene runs at a safety factor times it, computed when a phase
+1.1 (tests/unit/test_timestep.py). A scene runs at a safety factor times it, computed when a phase
 starts (pendular.procedures.preparation.timestep): the factor leaves room for the local damping (up to
 1 + damping times the spring force) and for contacts that form during the phase.
 """

@@ -211,7 +211,7 @@ def interface_stress(normal, nn11, nn33, surface_tension, volume):
     normal: (K, 3) unit bridge normals; nn11, nn33 (K,) [m^2]: ∫ n_x n_x dS and ∫ n_z n_z dS
     over each interface in its bridge frame (capillary.CapillaryBridges.interfaces);
     surface_tension [N/m]; volume V [m^3]. psi + this term is the Love–Weber stress of the
-    capillary forces, sign reversed (tests/test_complete_capillary_stress.py)."""
+    capillary forces, sign reversed (tests/integration/test_complete_capillary_stress.py)."""
     normal = np.asarray(normal, dtype=float).reshape(-1, 3)
     nn11 = np.broadcast_to(np.asarray(nn11, dtype=float), (len(normal),))
     nn33 = np.broadcast_to(np.asarray(nn33, dtype=float), (len(normal),))

@@ -5,7 +5,7 @@ read through capillary.BridgeState (``state`` != NO_BRIDGE marks a bridge; ``vol
 ``filling_i`` and ``filling_j`` [deg], the caps on particles pair_i and pair_j, each with its
 own radius: delta1 sits on the smaller sphere, delta2 on the larger, and A, B' of each cap use
 that sphere's radius; checked for two sizes against a hand computation of Eqs. 3.44-3.49 and
-3.53 in tests/test_unequal_bridges.py).
+3.53 in tests/integration/test_unequal_bridges.py).
 Each bridge's normal is its current branch vector x_j - x_i, unit (valid for bridges at contact
 and across a gap alike; ``contacts.normal`` is the contact law's and lags for gap pairs).
 
@@ -52,7 +52,7 @@ phase (solids, water, air and the interface as a membrane of tension gamma) over
 -(gamma/V) ∫ (delta - n n) dS to the total stress, so that psi + I is exactly, bridge by bridge,
 the Love–Weber stress of the capillary forces with its sign reversed, (1/V) d F n n (d the
 centre distance, F the attraction; Duriez et al. 2018, YADE's MeasureCapStress; checked against
-the exact solver and in a static packing in tests/test_complete_capillary_stress.py). Then
+the exact solver and in a static packing in tests/integration/test_complete_capillary_stress.py). Then
 sigma'^c = sigma_net + psi + I is the stress the contacts carry. I is taken from the exact
 tables (nn11, nn33 at each bridge's suction and gap); the toroidal model has none.
 

@@ -14,7 +14,8 @@ import pytest
 from pendular.studies import tradeoff
 from pendular.procedures.config import config_to_dict
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 SCENARIO = os.path.join(ROOT, "scenarios", "tradeoff.py")
 
 

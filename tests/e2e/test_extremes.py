@@ -9,7 +9,8 @@ import sys
 
 from pendular.studies import extremes
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 
 
 def test_quick_grid_has_no_failed_case_and_writes_the_report(tmp_path, capsys):

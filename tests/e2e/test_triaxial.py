@@ -16,7 +16,8 @@ from pendular.homogenize import contact_stress
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.triaxial import TriaxialShear, summarize
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 
 
 def test_prepared_sample_is_static_at_the_confining_stress(small_sample):

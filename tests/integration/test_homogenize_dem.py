@@ -20,7 +20,8 @@ from pendular.dem.state import Particles, Walls
 from pendular.homogenize import (bridges_in_region, contact_line_integral, homogenize_bridges,
     packing_state, regular_packing)
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 RADIUS = 2.4e-5
 GAMMA = SURFACE_TENSION
 SUCTION = 30000.0

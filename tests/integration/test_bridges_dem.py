@@ -16,14 +16,13 @@ import pytest
 from pendular import capillary
 from pendular.capillary import BridgeState, CapillaryBridges
 from pendular.capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
-from conftest import PrescribedGap, two_body_scene
+from conftest import PrescribedGap, ROOT, two_body_scene
 from pendular.dem.contact_law import ContactForces, gather_contact_forces
 from pendular.dem.neighbors import NeighborList, build_contacts
 from pendular.dem.state import Walls
 from pendular.dem.walls import WallForces
 from pendular.homogenize import capillary_force_stress, contact_stress
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 GAMMA = capillary.SURFACE_TENSION
 YOUNG = 1e6
 

@@ -10,7 +10,8 @@ import sys
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 SRC = os.path.join(ROOT, "src")
 #: The layers of the package, lowest first: a module may import from its own layer and those
 #: below it, never above. "pendular" itself (its __init__) is the public face, above all.

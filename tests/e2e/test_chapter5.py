@@ -17,7 +17,8 @@ from pendular.studies.chapter5 import Chapter5Grid, chapter5_campaign, envelopes
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.reference import FIG_5_5, TABLE_5_3
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
 KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
         "saturation_at_peak", "peak_q_effective", "p_effective_at_peak",

@@ -11,7 +11,8 @@ import meshio
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 SCENARIO = os.path.join(ROOT, "scenarios", "triaxial.py")
 PARTICLES = 150
 BASE = ["--particles", str(PARTICLES), "--max-strain", "0.01", "--inertial-number", "2e-3",

@@ -6,7 +6,7 @@ Classes: extreme settings (huge, tiny, NaN, beyond 2**63; quasi-static guards), 
 corrupt / truncated / edited / forged / foreign checkpoints, corrupt and mismatched samples,
 concurrent runs on one folder, a run into a used folder, SIGINT during a shear. Checksums,
 identities and the physical checks of samples at the library level, and tampered table caches,
-are in tests/test_integrity.py (not repeated here).
+are in tests/unit/test_integrity.py (not repeated here).
 
 Option cases run in-process through pendular.cli.run_command (they are refused before anything
 runs); runs and signals are subprocesses of 60 spheres.
@@ -26,13 +26,12 @@ import numpy as np
 import pytest
 from numba.core import event
 
-from conftest import zero_bytes
+from conftest import ROOT, zero_bytes
 from pendular.utils.integrity import stamp, verify
 from pendular.utils.interrupt import catching_interrupts
 from pendular.cli import run_command
 from pendular.io.outputs import OutputFolder
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPT = os.path.join(ROOT, "scenarios", "triaxial.py")
 TINY = ["--particles", "60", "--max-strain", "0.005", "--inertial-number", "2e-3",
         "--vtk-frames", "0", "--quiet"]

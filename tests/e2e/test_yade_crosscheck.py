@@ -29,8 +29,9 @@ from pendular.studies import crosscheck
 from pendular.procedures.config import YADE_CHOICES
 from pendular.io.history import read_history
 
+from conftest import ROOT
+
 HAVE_YADE = shutil.which("yade") is not None or shutil.which("yadedaily") is not None
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENARIO = os.path.join(ROOT, "scenarios", "yade_crosscheck.py")
 #: Tolerances of the agreement checks [-]: start of the shear (same packing), peak (same law).
 START_TOLERANCE = 1e-3

@@ -23,7 +23,8 @@ from pendular.cli import command_parser
 from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from_dict,
     config_to_dict)
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 GAMMA = 0.074
 WATER = 0.0104       # Kim's middle water content (fraction)
 TINY = ["--particles", "200", "--max-strain", "0.03", "--vtk-frames", "0", "--quiet"]

@@ -13,7 +13,8 @@ import pytest
 from pendular import read_history
 from pendular.cli import run_command
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from conftest import ROOT
+
 SMALL = ["--particles", "150", "--quiet"]
 SHEAR = ["--max-strain", "0.03", "--inertial-number", "2e-3", "--vtk-frames", "0"]
 

@@ -27,7 +27,7 @@ from pendular.dem.walls import StressServo
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.triaxial import TriaxialShear
 
-TESTS = os.path.dirname(os.path.abspath(__file__))
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 @pytest.fixture(scope="module")
@@ -227,7 +227,9 @@ def checkpoint_forever(path):
 
 def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     path = str(tmp_path / "checkpoint.h5")
-    code = (f"import sys; sys.path.insert(0, {TESTS!r}); import test_checkpoint; "
+    # this file and conftest.py (one folder up) importable in the child
+    code = (f"import sys; sys.path[:0] = [{HERE!r}, {os.path.dirname(HERE)!r}]; "
+            "import test_checkpoint; "
             f"test_checkpoint.checkpoint_forever({path!r})")
     child = subprocess.Popen([sys.executable, "-c", code])
     temporary = str(tmp_path / f".checkpoint.h5.tmp{child.pid}")   # pendular.utils.atomic.replacing

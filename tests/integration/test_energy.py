@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from pendular.dem.measure import elastic_energy, kinetic_energy
+from pendular.dem.measure import kinetic_energy
 from pendular.procedures.preparation import random_cloud
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
@@ -11,16 +11,7 @@ from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
 from pendular.dem.walls import WallForces
 
-
-class SpringEnergyProbe:
-    """Test operation placed before the integrator: spring energy at x(t), v(t - dt/2)."""
-
-    def __init__(self, young):
-        self.young = young
-
-    def apply(self, sim):
-        self.energy = elastic_energy(sim.particles, sim.contacts, sim.walls, self.young, 0.3)
-        self.velocity_before = sim.particles.velocity.copy()
+from conftest import SpringEnergyProbe
 
 
 def energy_error(timestep_factor, steps=10000):

@@ -6,6 +6,8 @@ import gzip
 import numpy as np
 import pytest
 
+from conftest import ROOT
+
 from pendular.interop.yade.formats import (read_plot_data, read_plot_headers, read_spheres,
     write_spheres)
 
@@ -155,7 +157,7 @@ def _runner():
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[1] / "benchmarks" / "yade_runner.py"
+    path = Path(ROOT) / "benchmarks" / "yade_runner.py"
     spec = importlib.util.spec_from_file_location("yade_runner", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

@@ -1,7 +1,7 @@
 """Thread counts: a dry and a wet scene give bit-identical trajectories with 1 and 2 Numba
 threads, and an undamped frictionless dense packing conserves its energy on both.
 
-(tests/test_energy.py checks the energy error's order in dt on one thread; here the
+(tests/integration/test_energy.py checks the energy error's order in dt on one thread; here the
 multi-body packing runs on both thread counts, and the wet scene adds capillary bridges.)
 """
 
@@ -17,7 +17,8 @@ from pendular.procedures.preparation import random_cloud
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
-from test_energy import SpringEnergyProbe
+
+from conftest import SpringEnergyProbe
 
 RADIUS, YOUNG, DENSITY, EDGE = 1e-3, 1e6, 2650.0, 0.016
 #: Steps run on two threads (each costs ~10-30 ms on a loaded 2-core machine).
