@@ -13,7 +13,7 @@ One namespace; its sub-packages are layers, each importing only those to its lef
   with the building blocks ``equilibrate``, ``wet``, ``TriaxialShear``, ``summarize``;
   ``TensionConfig``, ``TensionTest``; ``SwccConfig``, ``SwccTest`` (drying and wetting
   paths); campaigns of runs: ``Campaign``, ``Run``;
-- results: ``read_history``, ``read_summary``.
+- results: ``read_history``, ``read_summary``, ``read_vtk`` (a ParaView series).
 
 Units are SI, stresses compression positive.
 """
@@ -45,6 +45,7 @@ _EXPORTS = {
     "TriaxialConfig": "pendular.procedures.config",
     "read_history": "pendular.io.history",
     "read_summary": "pendular.io.history",
+    "read_vtk": "pendular.io.vtk",
     "SwccTest": "pendular.procedures.swcc",
     "TensionTest": "pendular.procedures.tension",
     "TriaxialShear": "pendular.procedures.triaxial",

@@ -386,7 +386,7 @@ def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_
         if then == "resume":
             done = script(["--resume", str(out), "--quiet"], cwd=tmp_path)
             assert done.returncode == 0, done.stderr
-            assert "earlier results there were replaced" in done.stderr
+            assert "holds the results of an earlier run" in done.stderr
             assert json.loads((out / "summary.json").read_text())["completed"] is True
             assert outputs(out)["summary.json"] != before["summary.json"]
         else:

@@ -8,6 +8,8 @@ import meshio
 import numpy as np
 import pytest
 
+import pendular
+
 from conftest import two_body_scene
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.capillary import BridgeState
@@ -62,6 +64,11 @@ def test_series_list_every_frame_with_its_time_and_hold_the_particle_arrays(prep
         assert all((folder / name).is_file() for _, name in frames)
     assert not [name for name in os.listdir(folder) if ".tmp" in name]
 
+    series = pendular.read_vtk(folder / "particles.pvd")      # the whole series, with meshio
+    assert [time for time, _ in series] == [times[s] for s in expected]
+    assert np.array_equal(series[-1][1].points, sim.particles.position)
+    with pytest.raises(ValueError, match="not a readable ParaView collection"):
+        pendular.read_vtk(folder / "particles_000001.vtu.missing")
     mesh = meshio.read(folder / f"particles_{sim.step:06d}.vtu")
     p = sim.particles
     assert np.array_equal(mesh.points, p.position)

@@ -42,7 +42,9 @@ def earlier(tmp_path):
 def test_a_run_that_succeeds_replaces_the_earlier_results_and_says_so(earlier, capsys):
     run_into(earlier, {"summary.json": "new"})
     assert contents(earlier) == {"notes.txt": "the user's", "summary.json": "new"}
-    assert "earlier results there were replaced" in capsys.readouterr().err
+    said = capsys.readouterr().err.strip().splitlines()
+    assert said == [f"{earlier}: holds the results of an earlier run; this run replaces them "
+                    "when it ends (they stay if it fails)"]
     assert json.loads((earlier / MANIFEST).read_text())["finished"] is True
 
 

@@ -127,7 +127,7 @@ def test_an_undeclared_or_misshapen_column_is_refused(tmp_path):
 def test_read_history_gives_coordinates_and_units_on_every_variable(tmp_path, names):
     columns = synthetic(names)
     write_history(tmp_path / "history.h5", columns, CONFIG)
-    history = read_history(tmp_path)                # a folder: its history.h5
+    history = read_history(tmp_path, index="record")      # a folder: its history.h5
     assert set(history.coords) >= {"axial_strain", "step", "time"}
     for name in ("axial_strain", "step", "time"):
         assert history[name].dims == ("record",)
@@ -154,8 +154,12 @@ def test_read_history_gives_coordinates_and_units_on_every_variable(tmp_path, na
         assert float(history.psi.sel(axis="z", component="x")[2]) == columns["psi"][2, 2, 0]
     if "grip_pull" in names:
         assert list(history.grip.values) == ["z-", "z+"]
-    by_strain = history.swap_dims(record="axial_strain")
+    by_strain = read_history(tmp_path)        # by default indexed by the rising strain
+    assert by_strain.sigma_wall.dims == ("axial_strain", "axis")
     np.testing.assert_array_equal(by_strain.time.sel(axial_strain=0.01), columns["time"][-1])
+    assert read_history(tmp_path, index="step").sigma_wall.dims == ("step", "axis")
+    with pytest.raises(ValueError, match="index = 'strain' is not one of"):
+        read_history(tmp_path, index="strain")
 
 
 def test_a_history_of_the_old_layout_reads_with_the_declared_attributes(tmp_path):
@@ -165,7 +169,7 @@ def test_a_history_of_the_old_layout_reads_with_the_declared_attributes(tmp_path
         group = handle.create_group("history")
         for name, values in columns.items():
             group.create_dataset(name, data=values)
-    history = read_history(tmp_path / "history.h5")
+    history = read_history(tmp_path / "history.h5", index="record")
     assert history.attrs["schema_version"] == 0 and history.attrs["confining"] == 750.0
     assert history.step.dtype == np.int64 and history.bridges.dtype == np.int64
     assert history.psi.dims == ("record", "axis", "component")

@@ -11,7 +11,9 @@ this module imports only the standard library at its top, and the rest inside ``
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
+import math
 import sys
 
 #: Command name -> (module under pendular.cli.commands, one-line description).
@@ -31,8 +33,44 @@ COMMANDS = {
 INTERRUPTED = 130
 
 
-class Formatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
-    """Help that shows every option's default after its text (units are in the text)."""
+class Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help that states an option's default once, after its text, unless the text already
+    gives it or there is none (units are in the text)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if (not action.option_strings or "default" in text.lower()
+                or action.default in (None, argparse.SUPPRESS) or isinstance(action.default, bool)):
+            return text
+        return f"{text} (default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser that takes options only as written in full (no abbreviations) and
+    answers a mistake in one line, with the closest option or command when there is one."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, allow_abbrev=False, **kwargs)
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}{self._suggestion(message)}; "
+                     f"'{self.prog} --help' lists them\n")
+
+    def _suggestion(self, message):
+        """' (did you mean X?)' for an unknown option or an invalid choice close to a valid one."""
+        if message.startswith("unrecognized arguments:"):
+            words = message.split(":", 1)[1].split()
+            known = [o for action in self._actions for o in action.option_strings]
+        elif "invalid choice:" in message:
+            words = [message.split("invalid choice:", 1)[1].split("'")[1]]
+            known = [c for action in self._actions for c in (action.choices or ())]
+        else:
+            return ""
+        for word in words:
+            close = difflib.get_close_matches(word.split("=")[0], known, n=1, cutoff=0.7)
+            if close:
+                return f" (did you mean {close[0]}?)"
+        return ""
 
 
 class UsageError(Exception):
@@ -125,8 +163,8 @@ def set_threads(threads):
 def command_parser(name, prog=None):
     """(argparse parser of command ``name``, its module)."""
     module = importlib.import_module(f"pendular.cli.commands.{COMMANDS[name][0]}")
-    parser = argparse.ArgumentParser(prog=prog or f"pendular {name}",
-                                     description=module.__doc__, formatter_class=Formatter)
+    parser = Parser(prog=prog or f"pendular {name}", description=module.__doc__,
+                    formatter_class=Formatter)
     module.add_arguments(parser)
     return parser, module
 
@@ -173,16 +211,39 @@ def _main(argv, prog):
         return run_command(argv[0], argv[1:], prog)
     from pendular.utils.version import software_version
 
-    parser = argparse.ArgumentParser(
-        prog="pendular", formatter_class=argparse.RawDescriptionHelpFormatter,
+    parser = Parser(
+        prog="pendular", usage="pendular [-h] [-V] <command> [options]",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
         description="DEM of wet granular media in the pendular regime (Khosravani 2014).",
         epilog="commands:\n" + "\n".join(f"  {name:<11} {text}"
                                          for name, (_, text) in COMMANDS.items())
         + "\n\n'pendular <command> --help' shows a command's options with their defaults.")
-    parser.add_argument("--version", action="version", version=f"pendular {software_version()}")
+    parser.add_argument("-V", "--version", action="version",
+                        version=f"pendular {software_version()}")
     parser.add_argument("command", choices=list(COMMANDS), metavar="command",
                         help="one of: " + ", ".join(COMMANDS))
-    parser.add_argument("options", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
-    args = parser.parse_args(argv)
-    return run_command(args.command, args.options)
+    if not argv:
+        parser.print_help(sys.stderr)
+        return 2
+    command, options = argv[0], argv[1:]
+    if command.startswith("-") and command not in ("-h", "--help", "-V", "--version"):
+        parser.error(f"unrecognized arguments: {command}")
+    args = parser.parse_args([command])
+    return run_command(args.command, options)
+
+
+def format_summary(summary, keys):
+    """Lines ``name  value unit`` of the ``keys`` of a run's ``summary`` that it holds, numbers
+    to 4 significant figures, units from the summary's own ``units``."""
+    units = summary.get("units", {})
+    shown = [key for key in keys if key in summary]
+    width = max((len(key) for key in shown), default=0)
+    lines = []
+    for key in shown:
+        value = summary[key]
+        if isinstance(value, float) and math.isfinite(value):
+            value = f"{value:.4g}"
+        unit = units.get(key, "")
+        lines.append(f"  {key:<{width}}  {value}{' ' + unit if unit and unit != '1' else ''}")
+    return "\n".join(lines)
 

@@ -146,13 +146,16 @@ def _variable(name, data):
     return dims, values, attrs
 
 
-def read_history(path_or_dir):
+def read_history(path_or_dir, index="auto"):
     """The history of a run (its folder or its history.h5) as an ``xarray.Dataset``.
 
     One variable per column, each with attributes ``units``, ``description`` (and
-    ``equation``); dimensions ``record``, ``axis`` and ``component`` (coordinates x, y, z),
-    ``grip`` (z-, z+); coordinates ``axial_strain``, ``step`` and ``time`` on ``record``
-    (``history.swap_dims(record="axial_strain")`` indexes by strain). Dataset attributes:
+    ``equation``); dimensions: the records, ``axis`` and ``component`` (coordinates x, y, z),
+    ``grip`` (z-, z+); coordinates ``axial_strain``, ``step`` and ``time`` on the records.
+    ``index`` names the records' dimension: "auto" (default) ``axial_strain`` when it rises or
+    falls strictly over the records (a shear: ``history.peak_q.plot()`` plots against the
+    strain, ``history.sel(axial_strain=0.01, method="nearest")`` picks a record), else
+    ``record``; or one of "record", "axial_strain", "step", "time". Dataset attributes:
     ``config`` (the run configuration as JSON text: ``json.loads(history.attrs["config"])``),
     ``pendular_version``, ``schema_version`` (0 for files written before the schema, whose
     attributes are filled from pendular.io.schema), the file's other attributes (run
@@ -161,6 +164,9 @@ def read_history(path_or_dir):
     """
     import xarray
 
+    if index not in ("auto", "record", *RECORD_COORDINATES):
+        raise ValueError(f"index = {index!r} is not one of 'auto', 'record', "
+                         + ", ".join(repr(name) for name in RECORD_COORDINATES))
     path = history_path(path_or_dir)
     if not os.path.isfile(path):
         raise ValueError(f"history = {path!r}: no such file")
@@ -190,6 +196,14 @@ def read_history(path_or_dir):
         "pendular_version": str(file_attrs.get("pendular_version", "unknown")),
         "schema_version": int(file_attrs.get("schema_version", 0)),
         "source": path})
+    if index == "auto":
+        strain = np.diff(dataset["axial_strain"].values) if "axial_strain" in dataset else []
+        rises_or_falls = len(strain) > 0 and (np.all(strain > 0) or np.all(strain < 0))
+        index = "axial_strain" if rises_or_falls else "record"
+    if index != "record":
+        if index not in dataset.coords:
+            raise ValueError(f"history = {path!r} has no {index!r} to index its records by")
+        dataset = dataset.swap_dims(record=index)
     return dataset
 
 

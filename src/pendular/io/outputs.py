@@ -13,7 +13,7 @@ A run into a used folder never leaves it with less than it had. At start, the fi
 previous manifest lists (and the manifest) are moved aside into ``DIR/.pendular-earlier/``;
 the new run writes into the folder itself. When it succeeds (or ``commit`` says its results are
 whole) the earlier files are deleted, so a dry run into an old wet run's folder leaves no stale
-plots or VTK frames, and one line on stderr says that earlier results were replaced. When it
+plots or VTK frames; one line on stderr says so when the run starts. When it
 fails or is interrupted and the earlier run had finished, the new run's files are removed and
 the earlier ones put back (``earlier_results`` tells the run so beforehand); an earlier run
 that had not finished is replaced by the new partial one. A folder left with files aside by a
@@ -224,6 +224,9 @@ class OutputFolder:
                     self._restore_earlier()
                 self.removed = self._set_aside()
                 self.files = []
+            if self.removed or (self.keep and aside):
+                print(f"{self.path}: holds the results of an earlier run; this run replaces "
+                      "them when it ends (they stay if it fails)", file=sys.stderr)
             self._write(finished=False)
         except BaseException:
             self._release()
@@ -249,7 +252,6 @@ class OutputFolder:
         aside = os.path.join(self.path, EARLIER)
         if os.path.isdir(aside):
             shutil.rmtree(aside)
-            print(f"{self.path}: the earlier results there were replaced", file=sys.stderr)
         self.earlier_results = False
         self._committed = True
 

@@ -87,6 +87,26 @@ def _insert_field_data(path, field_data):
         handle.write(text)
 
 
+def read_vtk(path):
+    """A ParaView series written here, read with meshio: [(time axis value, meshio.Mesh)] of
+    the frames the .pvd file ``path`` lists, in its order (the time axis: seconds, or what the
+    writer's ``time_axis`` gave, e.g. the axial strain of a triaxial test).
+    ValueError naming the path for a file that is not a ParaView collection."""
+    from xml.etree import ElementTree
+
+    path = os.fspath(path)
+    try:
+        root = ElementTree.parse(path).getroot()
+    except (OSError, ElementTree.ParseError) as error:
+        raise ValueError(f"series = {path!r} is not a readable ParaView collection: "
+                         f"{error}") from None
+    if root.get("type") != "Collection":
+        raise ValueError(f"series = {path!r} is not a ParaView collection (.pvd)")
+    folder = os.path.dirname(path)
+    return [(float(frame.get("timestep")), meshio.read(os.path.join(folder, frame.get("file"))))
+            for frame in root.iter("DataSet")]
+
+
 def write_pvd(path, frames):
     """Write a ParaView collection file listing ``frames`` [(time [s], file name)], atomically."""
     lines = ['<?xml version="1.0"?>',
