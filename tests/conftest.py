@@ -112,3 +112,26 @@ class SpringEnergyProbe:
     def apply(self, sim):
         self.energy = elastic_energy(sim.particles, sim.contacts, sim.walls, self.young, 0.3)
         self.velocity_before = sim.particles.velocity.copy()
+
+
+def run_in_process(name, argv, capsys, prog=None):
+    """(exit status, stderr) of command ``name`` with ``argv`` run in-process
+    (pendular.cli.run_command)."""
+    from pendular.cli import run_command
+
+    try:
+        status = run_command(name, [str(a) for a in argv], prog=prog)
+    except SystemExit as stop:
+        status = stop.code
+    return status, capsys.readouterr().err
+
+
+def refused(status, err, *words):
+    """Exit status 2, no traceback and one ``error:`` line holding every word of ``words``;
+    returns the line."""
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert status == 2 and "Traceback" not in err, err
+    assert len(lines) == 1 and ": error: " in lines[0], err
+    for word in words:
+        assert word in lines[0], (word, lines[0])
+    return lines[0]

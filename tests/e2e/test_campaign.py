@@ -13,13 +13,14 @@ import time
 import h5py
 import pytest
 
+from conftest import refused, run_in_process
+
 import pendular.studies.campaign as campaign_module
 from pendular.procedures.preparation import PrepareConfig
 from pendular.cli.tables import options_argv, sweep_from_table
 from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs,
                                        executor, finished_summary, max_jobs, run_name,
                                        run_progress, table_rows, write_campaign_csv)
-from pendular.cli import run_command
 from pendular.procedures.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict
 from pendular.io.outputs import OutputFolder
 
@@ -39,25 +40,6 @@ confining = [250, 750]
 def pendular(*arguments, check=True):
     return subprocess.run([sys.executable, "-m", "pendular.cli", *arguments],
                           capture_output=True, text=True, check=check, timeout=600)
-
-
-def command(name, argv, capsys):
-    """(exit status, stderr) of ``pendular NAME ARGV`` run in-process."""
-    try:
-        status = run_command(name, [str(a) for a in argv])
-    except SystemExit as stop:
-        status = stop.code
-    return status, capsys.readouterr().err
-
-
-def refused(status, err, *words):
-    """One ``error:`` line, exit status 2, naming ``words``; returns the line."""
-    lines = [line for line in err.splitlines() if line.strip()]
-    assert status == 2 and "Traceback" not in err, err
-    assert len(lines) == 1 and ": error: " in lines[0], err
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-    return lines[0]
 
 
 def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
@@ -147,7 +129,7 @@ def test_campaign_refuses_bad_runs_before_running(tmp_path):
 def test_a_run_of_a_table_refused_before_running_names_the_table(tmp_path, capsys):
     table = tmp_path / "fast.toml"
     table.write_text('[fixed]\nparticles = 60\n[sweep]\ninertial_number = [0.5]\n')
-    status, err = command("campaign", [table, "--out", tmp_path / "o", "--quiet"], capsys)
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o", "--quiet"], capsys)
     refused(status, err, f"table = {str(table)!r}: run inertial_number0.5: strain rate",
             "quasi-static")
     assert not (tmp_path / "o" / "runs").exists()
@@ -246,7 +228,7 @@ def test_bad_tables_are_refused_naming_what_is_wrong(tmp_path, capsys, text, mes
         sweep_from_table(table)
     assert str(error.value).startswith(f"table = {str(table)!r}")
     assert message in str(error.value)
-    status, err = command("campaign", [table, "--out", tmp_path / "o"], capsys)
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o"], capsys)
     refused(status, err, f"pendular campaign: error: table = {str(table)!r}", message)
     assert not (tmp_path / "o").exists()
 
@@ -255,7 +237,7 @@ def test_a_table_path_that_is_not_a_file_is_refused(tmp_path, capsys):
     for path, message in ((tmp_path / "none.toml", "cannot be read: No such file or directory"),
                           (tmp_path, "is not a file; valid: a TOML file"),
                           ("/dev/zero", "is not a file; valid: a TOML file")):
-        status, err = command("campaign", [path, "--out", tmp_path / "o"], capsys)
+        status, err = run_in_process("campaign", [path, "--out", tmp_path / "o"], capsys)
         refused(status, err, f"table = {str(path)!r} {message}")
 
 
@@ -285,18 +267,18 @@ def test_jobs_beyond_the_machine_are_refused_naming_jobs(tmp_path, capsys):
     table = tmp_path / "t.toml"
     table.write_text(TINY)
     big = "99999999999999999999"
-    status, err = command("campaign", [table, "--out", tmp_path / "o", "--jobs", big], capsys)
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o", "--jobs", big], capsys)
     refused(status, err, f"--jobs {big} is outside the valid range [1, {high}] "
                          f"({campaign_module.JOBS_PER_CPU} processes per CPU of this machine")
     assert not (tmp_path / "o").exists()
-    status, err = command("campaign", [table, "--out", tmp_path / "o", "--jobs", high + 1],
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o", "--jobs", high + 1],
                           capsys)
     refused(status, err, f"--jobs {high + 1} is outside the valid range [1, {high}]")
     # the other commands with --jobs reach the same check before anything runs
     for name, argv in (("chapter5", ["--particles", "60", "--suctions", "0", "--confining",
                                      "500", "--max-strain", "0.001", "--quiet"]),
                        ("tradeoff", ["--knob", "damping", "--seeds", "2", "--particles", "60"])):
-        status, err = command(name, [*argv, "--out", tmp_path / name, "--jobs", big], capsys)
+        status, err = run_in_process(name, [*argv, "--out", tmp_path / name, "--jobs", big], capsys)
         refused(status, err, f"pendular {name}: error: --jobs", f"valid range [1, {high}]")
 
 
@@ -305,7 +287,7 @@ def test_a_campaign_into_a_folder_in_use_is_refused(tmp_path, capsys, monkeypatc
     table.write_text(TINY)
     out = tmp_path / "o"
     with OutputFolder(out, "another campaign"):
-        status, err = command("campaign", [table, "--out", out, "--quiet"], capsys)
+        status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
     refused(status, err, f"out = {str(out)!r}: the folder is in use by another pendular run",
             "another campaign")
     assert not (out / "campaign.csv").exists() and not (out / "runs").exists()
@@ -318,7 +300,7 @@ def test_a_campaign_into_a_folder_in_use_is_refused(tmp_path, capsys, monkeypatc
         return CampaignResult(self.runs, summaries={r.name: {"peak_q": 1.5} for r in self.runs})
 
     monkeypatch.setattr(Campaign, "run", run)
-    assert command("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
+    assert run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
     with open(out / "campaign.csv") as handle:
         rows = list(csv.DictReader(handle))
     assert [(r["run"], r["status"], r["peak_q"]) for r in rows] == [("run", "run", "1.5")]
@@ -371,7 +353,7 @@ def test_damaged_results_of_an_earlier_campaign_are_run_again(tmp_path, capsys, 
     ran = []
     monkeypatch.setattr(campaign_module, "run_one",
                         lambda config, folder, *rest: ran.append(folder) or {"case": "new"})
-    assert command("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
+    assert run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)[0] == 0
     assert ran == [str(out / "runs" / "run")]
     with open(out / "campaign.csv") as handle:
         assert [(r["status"], r["case"]) for r in csv.DictReader(handle)] == [("run", "new")]

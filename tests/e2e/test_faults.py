@@ -26,7 +26,7 @@ import numpy as np
 import pytest
 from numba.core import event
 
-from conftest import ROOT, zero_bytes
+from conftest import ROOT, refused, run_in_process, zero_bytes
 from pendular.utils.integrity import stamp, verify
 from pendular.utils.interrupt import catching_interrupts
 from pendular.cli import run_command
@@ -40,27 +40,12 @@ BIG = "18446744073709551617"      # 2**64 + 1
 
 def command(argv, capsys):
     """(exit status, stderr) of ``triaxial.py ARGV`` run in-process."""
-    try:
-        status = run_command("triaxial", list(argv), prog="triaxial.py")
-    except SystemExit as stop:
-        status = stop.code
-    return status, capsys.readouterr().err
+    return run_in_process("triaxial", argv, capsys, prog="triaxial.py")
 
 
 def script(argv, cwd, timeout=120, **options):
     return subprocess.run([sys.executable, SCRIPT, *argv], cwd=cwd, capture_output=True,
                           text=True, timeout=timeout, **options)
-
-
-def refused(status, err, *words):
-    """One ``error:`` line (argparse may add its usage line first) naming ``words``."""
-    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("usage:")
-             and not line.startswith("  ")]
-    assert status == 2, err
-    assert "Traceback" not in err
-    assert len(lines) == 1 and ": error: " in lines[0], err
-    for word in words:
-        assert word in lines[0], (word, lines[0])
 
 
 # ---------------------------------------------------------------- extreme settings
@@ -350,7 +335,10 @@ def test_a_run_that_fails_keeps_the_earlier_results_or_says_where_it_stopped(fin
     before = outputs(out)
     failing = TINY + WET + ["--wet-steps", "1"]
     done = script(failing + ["--out", str(out)], cwd=tmp_path)
-    refused(done.returncode, done.stderr, "equilibrium after wetting", "--wet-steps")
+    said, error = done.stderr.strip().splitlines()
+    assert said.endswith("holds the results of an earlier run; this run replaces them when it "
+                         "ends (they stay if it fails)")
+    refused(done.returncode, error, "equilibrium after wetting", "--wet-steps")
     assert outputs(out) == before and not (out / ".pendular-earlier").exists()
     fresh = tmp_path / "fresh"
     done = script(failing + ["--out", str(fresh)], cwd=tmp_path)

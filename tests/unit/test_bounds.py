@@ -12,7 +12,8 @@ import copy
 import numpy as np
 import pytest
 
-from pendular.cli import run_command
+from conftest import refused, run_in_process
+
 from pendular.procedures.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES,
     MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name)
 from pendular.dem.grading import read_grading_curve
@@ -29,30 +30,12 @@ TRIAXIAL = ["--particles", "200", "--max-strain", "0.02", "--quiet"]
 TENSION = ["--particles", "200", "--void-ratio", "0.72", "--water-content", "1", "--quiet"]
 
 
-def refused(capsys, name, argv, *words):
-    """Run command ``name`` with ``argv`` in-process: exit 2, one ``error:`` line naming
-    ``words``, no traceback; returns the line."""
-    try:
-        status = run_command(name, list(argv), prog=name)
-    except SystemExit as stop:
-        status = stop.code
-    err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("usage:")
-             and not line.startswith("  ")]
-    assert status == 2, err
-    assert "Traceback" not in err
-    assert len(lines) == 1 and lines[0].startswith(f"{name}: error: "), err
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-    return lines[0]
-
-
 # ---------------------------------------------------------------- refused before running
 def test_an_axial_strain_no_test_reaches_is_refused(capsys, tmp_path):
     out = ["--out", str(tmp_path / "t")]
-    refused(capsys, "triaxial", TRIAXIAL + ["--max-strain", "0.9"] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--max-strain", "0.9"] + out,
             "--max-strain = 0.9", f"[1e-06, {MAX_AXIAL_STRAIN:g}]", "20-30 %")
-    refused(capsys, "triaxial", TRIAXIAL + ["--max-strain", "nan"] + out, "--max-strain")
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--max-strain", "nan"] + out, "--max-strain")
     with pytest.raises(ValueError, match=r"max_strain = 0.6 is outside the valid range"):
         ShearConfig(max_strain=0.6)
     assert ShearConfig(max_strain=MAX_AXIAL_STRAIN).max_strain == MAX_AXIAL_STRAIN
@@ -66,14 +49,21 @@ def test_an_axial_strain_no_test_reaches_is_refused(capsys, tmp_path):
 ])
 def test_a_sample_of_a_few_spheres_is_refused(command, extra, capsys, tmp_path):
     out = tmp_path / "out"
-    line = refused(capsys, command, extra + ["--particles", "2", "--out", str(out)],
+    line = refused_by(capsys, command, extra + ["--particles", "2", "--out", str(out)],
                    "--particles = 2", f"[{MIN_SAMPLE_PARTICLES}, ", "averages")
     assert "triaxial test" in line or "SWCC" in line
     assert not out.exists()
 
 
+def refused_by(capsys, name, argv, *words):
+    """Command ``name`` run in-process with ``argv`` refuses it in one line naming ``words``."""
+    line = refused(*run_in_process(name, argv, capsys, prog=name), *words)
+    assert line.startswith(f"{name}: error: "), line
+    return line
+
+
 def test_tension_refuses_fewer_spheres_than_its_grips_need(capsys, tmp_path):
-    refused(capsys, "tension", TENSION + ["--particles", "2", "--out", str(tmp_path / "t")],
+    refused_by(capsys, "tension", TENSION + ["--particles", "2", "--out", str(tmp_path / "t")],
             "--particles = 2", f"[{MIN_TENSION_PARTICLES}, 1000000]", "grips")
 
 
@@ -94,13 +84,13 @@ def test_counts_beyond_the_shear_steps_are_refused(capsys, tmp_path):
     steps = int(TriaxialConfig(sample=PrepareConfig(particles=200),
                                shear=ShearConfig(max_strain=0.02)).shear_steps())
     assert 4000 < steps < 10000                        # a P-wave step of 0.7 x 1.24e-6 s
-    refused(capsys, "triaxial", TRIAXIAL + ["--vtk-frames", "99999999999999999999"] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--vtk-frames", "99999999999999999999"] + out,
             "--vtk-frames = 99999999999999999999", f"[0, {steps}]", f"about {steps} steps")
-    refused(capsys, "triaxial", TRIAXIAL + ["--records", str(steps + 1)] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--records", str(steps + 1)] + out,
             f"--records = {steps + 1}", f"[2, {steps}]")
-    refused(capsys, "triaxial", TRIAXIAL + ["--records", "99999999999999999999"] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--records", "99999999999999999999"] + out,
             "--records", "[2, 10000000]")
-    refused(capsys, "triaxial", TRIAXIAL + ["--vtk-every", str(10 * steps)] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--vtk-every", str(10 * steps)] + out,
             "vtk_every")
     assert not (tmp_path / "t").exists()
 
@@ -108,10 +98,10 @@ def test_counts_beyond_the_shear_steps_are_refused(capsys, tmp_path):
 def test_tension_frames_beyond_the_pull_are_refused(capsys, tmp_path):
     out = ["--out", str(tmp_path / "t")]
     steps = int(TensionConfig(cases=[(0.72, 0.01)], particles=200).pull_steps())
-    line = refused(capsys, "tension", TENSION + ["--vtk-every", "99999999999999999999"] + out,
+    line = refused_by(capsys, "tension", TENSION + ["--vtk-every", "99999999999999999999"] + out,
                    "--vtk-every = ", f"outside the valid range [0, {steps}]", "the pull")
     assert "dtype" not in line
-    refused(capsys, "tension", TENSION + ["--max-strain", "1e-5"] + out,
+    refused_by(capsys, "tension", TENSION + ["--max-strain", "1e-5"] + out,
             "--vtk-frames = 20", "the pull to --max-strain 1e-05")
     with pytest.raises(ValueError, match="--vtk-every"):
         TensionConfig(cases=[(0.72, 0.01)], vtk_every=steps + 1)
@@ -125,7 +115,7 @@ def test_tension_frames_beyond_the_pull_are_refused(capsys, tmp_path):
 ])
 def test_repeated_list_values_are_refused(option, value, repeated, capsys, tmp_path):
     argv = ["--particles", "200", "--quiet", option, value, "--out", str(tmp_path / "t")]
-    refused(capsys, "tension", argv, option, repeated)
+    refused_by(capsys, "tension", argv, option, repeated)
     assert not (tmp_path / "t").exists()
 
 
@@ -140,15 +130,15 @@ def test_cases_sharing_a_folder_are_refused():
 def test_options_a_mode_ignores_are_refused(capsys, tmp_path):
     out = ["--out", str(tmp_path / "t")]
     for depth in ("2", "1"):                  # the default, given, is ignored all the same
-        refused(capsys, "tension", TENSION + ["--periodic", "--grip-depth", depth] + out,
+        refused_by(capsys, "tension", TENSION + ["--periodic", "--grip-depth", depth] + out,
                 f"--grip-depth = {depth}", "--periodic", "no grips")
     with pytest.raises(ValueError, match="--grip-depth = 2 does not apply to --periodic"):
         TensionConfig(cases=[(0.72, 0.01)], periodic=True, grip_depth=2.0)
     assert TensionConfig(cases=[(0.72, 0.01)], periodic=True).grip_depth == 1.0
     sample = str(tmp_path / "sample.h5")
-    refused(capsys, "triaxial", TRIAXIAL + ["--sample", sample, "--porosity", "0.45"] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--sample", sample, "--porosity", "0.45"] + out,
             "--porosity", "--sample", "already prepared")
-    refused(capsys, "triaxial", TRIAXIAL + ["--sample", sample, "--prep-friction", "5"] + out,
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--sample", sample, "--prep-friction", "5"] + out,
             "--prep-friction", "--sample")
     assert not (tmp_path / "t").exists()
 
@@ -159,7 +149,7 @@ def test_a_grading_curve_with_a_third_column_is_refused(capsys, tmp_path):
     with pytest.raises(ValueError, match=r"psd\.csv': row 5 \['4e-5', '50', '7'\] has 3 "
                                          r"values; valid: 2"):
         read_grading_curve(path)
-    refused(capsys, "triaxial", TRIAXIAL + ["--psd", str(path), "--out", str(tmp_path / "t")],
+    refused_by(capsys, "triaxial", TRIAXIAL + ["--psd", str(path), "--out", str(tmp_path / "t")],
             str(path), "row 5", "3 values")
     path.write_text("3e-5,0,\n4e-5,50, \n6e-5,100\n")           # empty trailing cells
     assert read_grading_curve(path) == ((3e-5, 0.0), (4e-5, 50.0), (6e-5, 100.0))

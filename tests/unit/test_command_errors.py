@@ -14,8 +14,9 @@ import h5py
 import numpy as np
 import pytest
 
+from conftest import refused, run_in_process
+
 from pendular.studies.chapter5 import check_history
-from pendular.cli import run_command
 from pendular.utils.integrity import stamp, verify
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.state import Particles, Walls
@@ -32,33 +33,12 @@ BASE = {
 }
 
 
-def command(name, argv, capsys):
-    """(exit status, stderr) of ``pendular NAME ARGV`` run in-process."""
-    try:
-        status = run_command(name, list(argv), prog=f"pendular {name}")
-    except SystemExit as stop:
-        status = stop.code
-    return status, capsys.readouterr().err
-
-
-def refused(status, err, *words):
-    """One ``error:`` line (argparse may add its usage lines first) holding every word."""
-    lines = [line for line in err.splitlines() if line.strip() and not line.startswith("usage:")
-             and not line.startswith(" ")]
-    assert status == 2, err
-    assert "Traceback" not in err
-    assert len(lines) == 1 and ": error: " in lines[0], err
-    for word in words:
-        assert word in lines[0], (word, lines[0])
-    return lines[0]
-
-
 # ---------------------------------------------------------------- output folders
 @pytest.mark.parametrize("name", sorted(BASE))
 def test_an_output_folder_that_is_a_file_is_refused_naming_it(name, tmp_path, capsys):
     path = tmp_path / "results.txt"
     path.write_text("the user's own file\n")
-    refused(*command(name, BASE[name] + ["--out", str(path)], capsys), str(path), "a file")
+    refused(*run_in_process(name, BASE[name] + ["--out", str(path)], capsys), str(path), "a file")
     assert path.read_text() == "the user's own file\n"
 
 
@@ -67,7 +47,7 @@ def test_an_output_folder_under_a_file_is_refused_naming_it(name, tmp_path, caps
     path = tmp_path / "results.txt"
     path.write_text("x")
     out = path / "sub"
-    line = refused(*command(name, BASE[name] + ["--out", str(out)], capsys), str(out),
+    line = refused(*run_in_process(name, BASE[name] + ["--out", str(out)], capsys), str(out),
                    "cannot create the folder")
     assert "Errno" not in line
 
@@ -93,7 +73,7 @@ CASES = {
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_values_beyond_range_are_refused_naming_the_option(case, tmp_path, capsys):
     name, argv, words = CASES[case]
-    refused(*command(name, BASE[name] + argv + ["--out", str(tmp_path / "out")], capsys),
+    refused(*run_in_process(name, BASE[name] + argv + ["--out", str(tmp_path / "out")], capsys),
             *words)
     assert not (tmp_path / "out").exists()
 
@@ -109,20 +89,20 @@ CROSSCHECK = {
 @pytest.mark.parametrize("case", sorted(CROSSCHECK))
 def test_crosscheck_checks_its_options_before_looking_for_yade(case, tmp_path, capsys):
     argv, words = CROSSCHECK[case]
-    line = refused(*command("crosscheck", ["--particles", "60", "--quiet", *argv, "--out",
+    line = refused(*run_in_process("crosscheck", ["--particles", "60", "--quiet", *argv, "--out",
                                            str(tmp_path / "out")], capsys), *words)
     assert "YADE" not in line
 
 
 def test_crosscheck_packing_that_is_a_folder_is_refused_naming_it(tmp_path, capsys):
-    refused(*command("crosscheck", ["--particles", "60", "--packing", str(tmp_path), "--out",
+    refused(*run_in_process("crosscheck", ["--particles", "60", "--packing", str(tmp_path), "--out",
                                     str(tmp_path / "out")], capsys),
             str(tmp_path), "is a folder", "packing.txt")
 
 
 # ---------------------------------------------------------------- an SWCC stage's step limit
 def test_an_swcc_stage_out_of_steps_names_stage_steps(tmp_path, capsys):
-    line = refused(*command("swcc", BASE["swcc"] + ["--stage-steps", "10", "--out",
+    line = refused(*run_in_process("swcc", BASE["swcc"] + ["--stage-steps", "10", "--out",
                                                     str(tmp_path / "out")], capsys),
                    "--stage-steps = 10", "suction 3000 Pa (drying)", "raise --stage-steps")
     assert "--wet-steps" not in line
@@ -167,7 +147,7 @@ def test_a_sample_with_a_damaged_json_attribute_is_refused_naming_it(tmp_path, n
 
 def test_triaxial_from_a_sample_with_damaged_json_ends_in_one_line(tmp_path, capsys):
     path = restamped(write_sample(tmp_path / "sample.h5"), "report", "[1,")
-    refused(*command("triaxial", ["--particles", "64", "--sample", path, "--out",
+    refused(*run_in_process("triaxial", ["--particles", "64", "--sample", path, "--out",
                                   str(tmp_path / "out")], capsys), path, "'report'")
 
 
