@@ -110,7 +110,7 @@ def test_invalid_input_is_rejected_with_name_value_and_range():
         capillary.solve_bridge(1.0, 0.0, -0.5, 10.0)
     with pytest.raises(ValueError, match=r"radius_ratio = 0.5 .*\[1, "):
         capillary.solve_bridge(0.5, 0.0, 1.0, 10.0)
-    with pytest.raises(ValueError, match=f"radius_ratio = 50.0 .*{capillary.MAX_RADIUS_RATIO}"):
+    with pytest.raises(ValueError, match=f"radius_ratio = 50.0 .*{capillary.MAX_SOLVER_RADIUS_RATIO}"):
         capillary.rupture_distance(50.0, 0.0, 1.0)
     with pytest.raises(ValueError, match="filling_angle = 70.0 deg .*90 - contact_angle"):
         capillary.solve_bridge(1.0, 30.0, 1.0, 70.0)
@@ -319,3 +319,12 @@ def test_yade_reads_the_files_and_reproduces_the_exact_bridges(tmp_path):
         exact = capillary.bridge_at_distance(2.0, 0.0, 10.0, distance)
         assert force == pytest.approx(exact.force, rel=2e-3)  # YADE interpolates linearly in u* and d*
         assert volume == pytest.approx(exact.volume, rel=1e-2)
+
+
+def test_the_samples_radius_ratio_range_is_the_tables_and_within_the_solvers():
+    """One range, declared by the engine (pendular.dem.grading) and met by the tables' last
+    radius-ratio node (YADE's M(r=10)) and the exact solver's verified range."""
+    from pendular.capillary import MAX_SOLVER_RADIUS_RATIO, YADE_RADIUS_RATIOS
+    from pendular.dem.grading import MAX_RADIUS_RATIO
+
+    assert YADE_RADIUS_RATIOS[-1] == MAX_RADIUS_RATIO <= MAX_SOLVER_RADIUS_RATIO

@@ -23,7 +23,7 @@ from pendular.capillary.suction_control import (bridge_at_distance, lowest_dista
 from pendular.capillary.table import (FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory,
     lookup_suction)
 from pendular.capillary.toroidal import ToroidalBridge, toroidal_bridge
-from pendular.capillary.validation import MAX_RADIUS_RATIO
+from pendular.capillary.validation import MAX_SOLVER_RADIUS_RATIO
 from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, bridge_with_volume,
     rupture_distance_for_volume, volume_contour)
 from pendular.capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
@@ -44,7 +44,7 @@ __all__ = [
     "BridgeTable",
     "CONTACT_SUCTION_MAX",
     "FIELDS",
-    "MAX_RADIUS_RATIO",
+    "MAX_SOLVER_RADIUS_RATIO",
     "ToroidalBridge",
     "VOLUME_FIELDS",
     "VolumeBridgeTable",

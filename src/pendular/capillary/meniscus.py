@@ -294,7 +294,7 @@ def bridge_kernel(radius_ratio, theta, suction_star, delta1):
 def solve_bridge(radius_ratio, contact_angle, suction_star, filling_angle):
     """Exact bridge from its filling angle on the smaller sphere (SPEC sections 1 and 4).
 
-    radius_ratio: r = R2/R1 in [1, MAX_RADIUS_RATIO]; contact_angle: theta in [0, 90) deg;
+    radius_ratio: r = R2/R1 in [1, MAX_SOLVER_RADIUS_RATIO]; contact_angle: theta in [0, 90) deg;
     suction_star: u* = s R2/gamma >= 0; filling_angle: delta1 on R1 in (0, 90 - theta] deg.
     Returns a Bridge (dimensionless, angles in degrees). The distance may come out negative
     (the spheres would overlap) on the large-filling-angle end of the family.

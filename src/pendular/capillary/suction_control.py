@@ -79,7 +79,7 @@ def contact_filling_angle(radius_ratio, theta, suction_star):
 def rupture_distance(radius_ratio, contact_angle, suction_star):
     """Rupture distance D/R2 at suction u* = s R2/gamma: no bridge exists farther apart (SPEC section 4).
 
-    radius_ratio in [1, MAX_RADIUS_RATIO], contact_angle in [0, 90) deg, suction_star >= 0.
+    radius_ratio in [1, MAX_SOLVER_RADIUS_RATIO], contact_angle in [0, 90) deg, suction_star >= 0.
     """
     radius_ratio = check_radius_ratio(radius_ratio)
     contact_angle = check_contact_angle(contact_angle)

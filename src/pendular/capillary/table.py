@@ -419,7 +419,7 @@ class BridgeTable:
     ):
         """Solve every node exactly (parallel over radius ratio and suction; Numba threads).
 
-        contact_angle in [0, 90) deg; radius_ratios sorted in [1, MAX_RADIUS_RATIO]; suction_max
+        contact_angle in [0, 90) deg; radius_ratios sorted in [1, MAX_SOLVER_RADIUS_RATIO]; suction_max
         and suction_scale > 0 (u* units); n_suction, n_distance >= 2.
         """
         contact_angle = check_contact_angle(contact_angle)

@@ -5,11 +5,11 @@ import math
 from pendular.dem.contact_law import normal_stiffness
 from pendular.utils.validate import check_positive, finite_number  # noqa: F401  (shared checks)
 
-MAX_RADIUS_RATIO = 20.0
+MAX_SOLVER_RADIUS_RATIO = 20.0
 """Largest R2/R1 the exact solver accepts (its accuracy is verified up to this value)."""
 
 
-def check_radius_ratio(radius_ratio, largest=MAX_RADIUS_RATIO):
+def check_radius_ratio(radius_ratio, largest=MAX_SOLVER_RADIUS_RATIO):
     """r = R2/R1 in [1, largest]."""
     radius_ratio = finite_number("radius_ratio", radius_ratio, f"[1, {largest}]")
     if not 1.0 <= radius_ratio <= largest:

@@ -239,7 +239,7 @@ def contour_point_at_distance(contour, distance_star):
 def rupture_distance_for_volume(radius_ratio, contact_angle, volume_star):
     """Volume-controlled rupture distance D/R2 of a bridge of volume V* = V/R2**3.
 
-    radius_ratio in [1, MAX_RADIUS_RATIO], contact_angle in [0, 90) deg, volume_star within the
+    radius_ratio in [1, MAX_SOLVER_RADIUS_RATIO], contact_angle in [0, 90) deg, volume_star within the
     volumes of bridges formed at contact with u* in [0, CONTACT_SUCTION_MAX]. Where the traced
     family ends before its distance peaks (VolumeContour.ends_at_peak), its last distance.
     """
