@@ -9,6 +9,9 @@ One namespace; its sub-packages are layers, each importing only those to its lef
   ``NeighborList``, ``ContactForces``, ``WallForces``, ``StressServo``, ``ConstantStrainRate``,
   ``Integrator``, ``HistoryRecorder``, ``CapillaryBridges``;
 - preparation: ``PrepareConfig``, ``prepare_sample``;
+- loading paths: ``Stage`` (per-axis stress or strain-rate control, ends at a ``Strain``, a
+  ``Stress`` or ``Static``), ``LoadingPath``; ``OedometerConfig``, ``OedometerTest``,
+  ``IsotropicConfig``, ``IsotropicTest``;
 - test procedures: ``TriaxialConfig``, ``ShearConfig``, ``BridgeConfig``, ``TriaxialTest``,
   with the building blocks ``equilibrate``, ``wet``, ``TriaxialShear``, ``summarize``;
   ``TensionConfig``, ``TensionTest``; ``SwccConfig``, ``SwccTest`` (drying and wetting
@@ -43,6 +46,15 @@ _EXPORTS = {
     "SwccConfig": "pendular.procedures.config",
     "TensionConfig": "pendular.procedures.config",
     "TriaxialConfig": "pendular.procedures.config",
+    "IsotropicConfig": "pendular.procedures.config",
+    "OedometerConfig": "pendular.procedures.config",
+    "LoadingPath": "pendular.procedures.loading",
+    "Stage": "pendular.procedures.loading",
+    "Static": "pendular.procedures.loading",
+    "Strain": "pendular.procedures.loading",
+    "Stress": "pendular.procedures.loading",
+    "IsotropicTest": "pendular.procedures.triaxial",
+    "OedometerTest": "pendular.procedures.triaxial",
     "read_history": "pendular.io.history",
     "read_summary": "pendular.io.history",
     "read_vtk": "pendular.io.vtk",

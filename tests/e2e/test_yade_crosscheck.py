@@ -162,7 +162,7 @@ def test_pendular_half_against_itself(tmp_path, monkeypatch):
                            "cost_ratio_yade_over_pendular", "axial_strain_at_peak_diff"}
     assert stored["shear_config"]["servo_stiffness_every"] == 10
     assert (out / "crosscheck.png").stat().st_size > 0 and (out / "packing.txt").exists()
-    history = read_history(out / "pendular_history.h5")
+    history = read_history(out / "pendular_history.h5", index="record")
     assert history.sizes["record"] >= 8 and "sigma_effective" in history
     # the driver is given the scene's settings
     settings = seen["settings"]

@@ -1,7 +1,7 @@
 """The ``pendular`` command: ``pendular <command> [options]`` (``pendular --help`` lists them).
 
 Each command lives in ``pendular.cli.commands.<name>`` with ``add_arguments(parser)`` and
-``run(args)``; scenarios/*.py call ``main`` with their command's name. A failure a user can
+``run(args)``; ``scenarios/*.py`` call ``main`` with their command's name. A failure a user can
 cause (bad option, bad or missing file, unusable output folder) ends in one line
 ``<prog>: error: <what is wrong>`` and exit status 2, never a traceback; an interrupted run exits
 with 130, in one line, whenever Ctrl-C comes (while Python imports the command's modules too:
@@ -19,6 +19,8 @@ import sys
 #: Command name -> (module under pendular.cli.commands, one-line description).
 COMMANDS = {
     "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
+    "oedometer": ("oedometer", "oedometric (K0) compression and unloading, dry or wet"),
+    "isotropic": ("isotropic", "isotropic loading and unloading in stages: e against log p"),
     "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
     "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),

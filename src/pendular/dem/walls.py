@@ -1,4 +1,5 @@
-"""Wall operations: sphere–wall forces, stress servo and constant strain rate (SPEC §3).
+"""Wall operations: sphere–wall forces, stress servo and constant strain rate (docs/physics.md
+'Walls, servo and preparation').
 
 A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, the high to +axis.
 """
@@ -60,7 +61,8 @@ def servo_walls(wall_position, wall_velocity, wall_force, wall_stiffness, stiffn
 
 
 class WallForces:
-    """Frictionless sphere–wall springs with kn = E R (YADE's Ig2_Box_Sphere_ScGeom, SPEC §2)."""
+    """Frictionless sphere–wall springs with kn = E R
+    (YADE's Ig2_Box_Sphere_ScGeom, docs/physics.md 'The contact law')."""
 
     def __init__(self, young):
         self.young = check_positive("young", young, "Pa")
@@ -76,19 +78,21 @@ class StressServo:
     (in a periodic cell: the cell's stress, its lengths moving by pendular.dem.cell.servo_cell, the
     same law with the cell's stiffness).
 
-    Each step every wall moves outward by
+    Each step every wall moves outward by::
+
         shift_n = gain * clip((F_wall - target A) / K_wall, +-cap) + memory * shift_n-1,
+
     K_wall being the sum of its contacts' normal stiffness and cap = max_velocity dt [m]; a
     wall without contacts moves inward by the cap. This is YADE's TriaxialStressController law,
     where gain = 1 - stressDamping (0.75) and memory = 0.8; the memory term lets a wall follow a
     dilating sample with a steady stress error (1 - memory) / gain times that of a memoryless
     servo. Two of YADE's choices are options (defaults: pendular's):
 
-    scale_max_velocity: the cap of axis a is max_velocity * 3 L_a / (L_x + L_y + L_z) (YADE's
-        max_vel1/2/3) instead of max_velocity;
-    stiffness_every: K_wall is refreshed every ``stiffness_every`` calls of the servo and at
-        each of its first 100 calls (YADE's stiffnessUpdateInterval, 10) instead of every step;
-        a periodic cell's stiffness every max(stiffness_every, CELL_STIFFNESS_EVERY) calls.
+    - scale_max_velocity: the cap of axis a is max_velocity * 3 L_a / (L_x + L_y + L_z)
+      (YADE's max_vel1/2/3) instead of max_velocity;
+    - stiffness_every: K_wall is refreshed every ``stiffness_every`` calls of the servo and at
+      each of its first 100 calls (YADE's stiffnessUpdateInterval, 10) instead of every step;
+      a periodic cell's stiffness every max(stiffness_every, CELL_STIFFNESS_EVERY) calls.
     """
 
     #: Calls during which the stiffness is refreshed every step (YADE: scene->iter < 100).
@@ -98,8 +102,11 @@ class StressServo:
     #: stiffnessUpdateInterval, it was 3 % of a 1,000-sphere step; the stiffness of a sample
     #: under shear changes little in 50 steps, and the servo's tests hold).
     CELL_STIFFNESS_EVERY = 50
+    #: Default gain and memory (YADE's 1 - stressDamping and its 0.8).
+    GAIN = 0.75
+    MEMORY = 0.8
 
-    def __init__(self, axes, target, max_velocity, gain=0.75, memory=0.8,
+    def __init__(self, axes, target, max_velocity, gain=GAIN, memory=MEMORY,
                  scale_max_velocity=False, stiffness_every=1):
         self.axes = _axes(axes)
         self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
@@ -114,6 +121,13 @@ class StressServo:
         self.previous = np.zeros(len(self.walls))
         self.stiffness = np.zeros(len(self.walls))
         self.calls = 0
+
+    @classmethod
+    def max_velocity_for(cls, strain_rate, length):
+        """The ``max_velocity`` [m/s] with which the default servo's walls of a box of edge
+        ``length`` [m] move at most at ``strain_rate`` [1/s]: the memory lets a wall travel
+        gain / (1 - memory) times its cap per step when it keeps moving one way."""
+        return strain_rate * 0.5 * length * (1.0 - cls.MEMORY) / cls.GAIN
 
     def apply(self, sim):
         walls = sim.walls
@@ -157,20 +171,23 @@ class ConstantStrainRate:
         """Engineering strain of the axis, compression positive."""
         return 1.0 - walls.lengths()[self.axis] / self.reference_length
 
-    def steps_to(self, strain, dt):
-        """Steps [-] of ``dt`` [s] to reach the engineering ``strain`` from the reference length
-        (the rate must have the strain's sign; on the current length the length shrinks by a
-        factor 1 - rate dt per step)."""
-        if self.rate == 0.0 or strain / self.rate <= 0.0:
-            raise ValueError(f"strain = {strain!r} cannot be reached at strain_rate = "
-                             f"{self.rate!r} 1/s: they must be non-zero and of the same sign")
+    def steps_to(self, strain, dt, start=0.0):
+        """Steps [-] of ``dt`` [s] to reach the engineering ``strain`` from the engineering
+        strain ``start`` (both from the reference length; the rate must have the sign of
+        strain - start; on the current length the length changes by a factor 1 - rate dt per
+        step)."""
+        change = strain - start
+        if self.rate == 0.0 or change / self.rate <= 0.0:
+            raise ValueError(f"strain = {strain!r} cannot be reached from {start!r} at "
+                             f"strain_rate = {self.rate!r} 1/s: the rate must be non-zero and "
+                             "of the sign of the change")
         if not self.on_current_length:
-            return int(np.ceil(strain / (self.rate * dt)))
+            return int(np.ceil(change / (self.rate * dt)))
         factor = 1.0 - self.rate * dt
-        if not 0.0 < factor < 1.0 or strain >= 1.0:
-            raise ValueError(f"strain_rate * dt = {self.rate * dt!r} must lie in (0, 1) and "
+        if not 0.0 < factor < 2.0 or factor == 1.0 or strain >= 1.0 or start >= 1.0:
+            raise ValueError(f"strain_rate * dt = {self.rate * dt!r} must lie in (-1, 1) and "
                              f"strain = {strain!r} below 1 on the current length")
-        return int(np.ceil(np.log1p(-strain) / np.log(factor)))
+        return int(np.ceil((np.log1p(-strain) - np.log1p(-start)) / np.log(factor)))
 
     def apply(self, sim):
         walls = sim.walls

@@ -15,6 +15,8 @@ Columns by test (pendular.procedures.triaxial.history_columns, pendular.procedur
   and, with exact bridges, psi_interface and sigma_effective_complete
   (pendular.homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
   liquid_bridges, liquid_film, liquid_lost;
+- oedometer and isotropic paths (pendular.procedures.triaxial.OedometerTest, IsotropicTest):
+  the triaxial's, and void_ratio; the oedometer k0; stage when the path has several stages;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
 """
@@ -122,6 +124,11 @@ HISTORY_COLUMNS = {
     "grip_pull": Column("N", "force of the specimen on each grip, toward the specimen",
                         ("grip",)),
     "water_content": Column("1", "gravimetric water content w = V_w / (Gs V_s)"),
+    "void_ratio": Column("1", "void ratio e = n / (1 - n) of the box inside the walls"),
+    "k0": Column("1", "coefficient of earth pressure sigma_lateral / sigma_axial of the wall "
+                      "stresses (oedometer)"),
+    "stage": Column("1", "index of the stage of the loading path running (0 first)",
+                    dtype="int64"),
 }
 
 #: Units of a triaxial summary.json (pendular.procedures.triaxial.summarize and TriaxialTest).
@@ -140,6 +147,27 @@ TRIAXIAL_SUMMARY_UNITS = {
     "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
     "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
     "stress_balance_flagged": "record", "grading": GRADING_UNITS,
+    "min_axial_stress": "Pa", "phi_peak_deg": "deg", "phi_peak_effective_deg": "deg",
+    "mean_stress_deviation": "1", "b_deviation": "1",
+}
+
+#: Units of an oedometer summary.json (pendular.procedures.loading.oedometer_summary).
+OEDOMETER_SUMMARY_UNITS = {
+    "k0": "1", "k0_effective": "1", "k0_final": "1", "axial_stress_target": "Pa",
+    "axial_stress_at_load": "Pa", "lateral_stress_at_load": "Pa", "axial_strain_at_load": "1",
+    "initial_void_ratio": "1", "void_ratio_at_load": "1", "constrained_modulus": "Pa",
+    "constrained_modulus_tangent": "Pa", "constrained_modulus_unloading": "Pa",
+    "compression_index": "1", "compression_index_effective": "1", "unload_to": "Pa",
+    "axial_stress_final": "Pa", "axial_strain_final": "1", "void_ratio_final": "1",
+    "swelling_index": "1", "swelling_index_effective": "1",
+}
+
+#: Units of an isotropic summary.json (pendular.procedures.loading.isotropic_summary); its
+#: ``stages`` rows hold target, p and p_effective [Pa], void_ratio and volumetric_strain [-].
+ISOTROPIC_SUMMARY_UNITS = {
+    "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "void_ratio": "1",
+               "volumetric_strain": "1", "stage": "1", "step": "1"},
+    "final_void_ratio": "1",
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
@@ -169,12 +197,15 @@ OPTION_UNITS = {
     "roughness": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
+    "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",
+    "record_strain": "1",
 }
 
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
-SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS}
+SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
+                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS}
 
 
 def peak_reached(axial_strain, index, fraction=0.02):

@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 
 from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
-from pendular.procedures.preparation import MAX_PARTICLES, MAX_SEED, PrepareConfig, pwave_step
+from pendular.procedures.preparation import (MAX_PARTICLES, MAX_SEED, PrepareConfig,
+    check_soft_contacts, pwave_step)
 from pendular.dem.timestep import pwave_timestep
 from pendular.utils.validate import check_int, check_positive, check_range
 from pendular.homogenize import packing_state, regular_packing
@@ -36,6 +37,10 @@ MAX_SURFACE_TENSION = 1.0
 
 #: How the bridges of a triaxial test appear (TriaxialConfig.wetting).
 WETTING_PROTOCOLS = ("isotropic", "at-shear", "constant-volume")
+
+#: Directions of a triaxial shear (ShearConfig.direction): the axial (z) walls pushed in at a
+#: constant rate, the lateral stress held (compression), or pulled apart (extension).
+SHEAR_DIRECTIONS = ("compression", "extension")
 
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
@@ -77,12 +82,20 @@ class ShearConfig:
 
     Wall-control options, pendular's choice by default; ``YADE_CHOICES`` holds YADE's
     (TriaxialStressController, docs/yade_crosscheck.md):
-    rate_on_current_length: the axial rate acts on the current height (true strain rate)
-        instead of the initial one (engineering strain rate);
-    servo_max_velocity: speed cap of the lateral walls [m/s] (None: the preparation servo's);
-    servo_scale_max_velocity: scale the cap per axis by 3 L_a / (L_x + L_y + L_z);
-    servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
-        the first 100) instead of every step.
+
+    - rate_on_current_length: the axial rate acts on the current height (true strain rate)
+      instead of the initial one (engineering strain rate);
+    - servo_max_velocity: speed cap of the lateral walls [m/s] (None: the preparation servo's);
+    - servo_scale_max_velocity: scale the cap per axis by 3 L_a / (L_x + L_y + L_z);
+    - servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
+      the first 100) instead of every step.
+
+    The path of the shear (pendular.procedures.loading.shear_stage): ``direction``
+    (SHEAR_DIRECTIONS; in extension ``max_strain`` is the magnitude of the axial extension);
+    ``b``: the intermediate principal stress ratio (sigma_2 - sigma_3) / (sigma_1 - sigma_3)
+    held through a compression, sigma_1 on z, sigma_3 on x (None: sigma_x = sigma_y, a
+    conventional triaxial); ``constant_p``: the lateral stresses follow the axial one so that
+    the mean stress stays the confining stress.
     """
 
     max_strain: float = 0.25
@@ -93,10 +106,25 @@ class ShearConfig:
     servo_max_velocity: float | None = None
     servo_scale_max_velocity: bool = False
     servo_stiffness_every: int = 1
+    direction: str = "compression"
+    b: float | None = None
+    constant_p: bool = False
 
     def __post_init__(self):
         self.max_strain = check_range("max_strain", self.max_strain, MIN_AXIAL_STRAIN,
                                       MAX_AXIAL_STRAIN)
+        if self.direction not in SHEAR_DIRECTIONS:
+            raise ValueError(f"--direction = {self.direction!r} is not one of "
+                             f"{SHEAR_DIRECTIONS}")
+        if self.b is not None:
+            self.b = check_range("--b", self.b, 0.0, 1.0)
+            if self.direction != "compression":
+                raise ValueError(f"--b = {self.b:g} needs --direction compression: b = "
+                                 "(sigma_2 - sigma_3) / (sigma_1 - sigma_3) is held with sigma_1 "
+                                 "on the axial walls")
+        if not isinstance(self.constant_p, (bool, np.bool_)):
+            raise ValueError(f"--constant-p = {self.constant_p!r}: valid values True or False")
+        self.constant_p = bool(self.constant_p)
         self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
                                            low_inclusive=False)
         if self.strain_rate is not None:
@@ -111,9 +139,14 @@ class ShearConfig:
     def rate(self, radius, density, confining):
         """Axial strain rate [1/s]: the given one, or the one of the target inertial number at
         the confining stress [Pa] for spheres of ``radius`` [m] and ``density`` [kg/m^3]."""
-        if self.strain_rate is not None:
-            return self.strain_rate
-        return self.inertial_number / inertial_number(1.0, radius, density, confining)
+        return quasi_static_rate(self.inertial_number, self.strain_rate, radius, density,
+                                 confining)
+
+    @property
+    def conventional(self):
+        """Whether this is the conventional triaxial compression of thesis Ch. 5 (lateral stress
+        held, sigma_x = sigma_y)."""
+        return self.direction == "compression" and self.b is None and not self.constant_p
 
 
 #: ShearConfig options that reproduce YADE's TriaxialStressController (stiffnessUpdateInterval 10).
@@ -126,9 +159,19 @@ def inertial_number(strain_rate, radius, density, pressure):
     return strain_rate * 2.0 * radius * np.sqrt(density / pressure)
 
 
+def quasi_static_rate(target, strain_rate, radius, density, pressure):
+    """Strain rate [1/s] of a loading stage: ``strain_rate`` when given, else the one giving the
+    inertial number ``target`` at ``pressure`` [Pa] (the lowest stress of the stage, where a
+    rate is least quasi-static) for spheres of ``radius`` [m] and ``density`` [kg/m^3]."""
+    if strain_rate is not None:
+        return strain_rate
+    return target / inertial_number(1.0, radius, density, pressure)
+
+
 @dataclass
 class BridgeConfig:
-    """Capillary bridges of a wet test (SPEC §4; capillary.CapillaryBridges).
+    """Capillary bridges of a wet test (docs/physics.md 'The bridge model';
+    capillary.CapillaryBridges).
 
     suction [Pa] > 0 (suction control: imposed; volume control: at formation), or instead
     water_content: gravimetric water content w (a fraction) that volume-controlled bridges
@@ -205,25 +248,27 @@ class BridgeConfig:
 
 
 @dataclass
-class TriaxialConfig:
-    """A drained triaxial test (thesis Ch. 5.2.3): sample, optional bridges, shear, outputs.
+class LaboratoryConfig:
+    """What every laboratory test on a prepared sample shares (TriaxialConfig, OedometerConfig,
+    IsotropicConfig; pendular.procedures.triaxial.LaboratoryTest): sample, optional bridges,
+    outputs.
 
-    sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its ``confining`` [Pa] is
-    the lateral stress of the shear; at least MIN_SAMPLE_PARTICLES spheres); bridges: None for
-    a dry test; shear: ShearConfig;
+    sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its
+    ``confining`` [Pa] is the isotropic stress the loading path starts from; at least
+    MIN_SAMPLE_PARTICLES spheres); bridges: None for a dry test;
     sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
-    vtk_frames: ParaView frames over the shear (0: none); vtk_every: steps between frames
+    vtk_frames: ParaView frames over the loading (0: none; a path whose length is not known
+    before it runs writes one every VTK_RECORDS history rows); vtk_every: steps between frames
     instead (None: from vtk_frames);
-    checkpoint_every: steps between checkpoints of the shear (0: none);
+    checkpoint_every: steps between checkpoints of the loading (0: none);
     wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.triaxial.wet_sample):
     'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
-    (switched on at the first shear step), 'constant-volume' (added with the walls fixed,
+    (switched on at the first loading step), 'constant-volume' (added with the walls fixed,
     equilibrated, then servoed to the confining stress).
     """
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
-    shear: ShearConfig = field(default_factory=ShearConfig)
     bridges: BridgeConfig | None = None
     sample_path: str | None = None
     wet_steps: int = 200000
@@ -232,20 +277,21 @@ class TriaxialConfig:
     checkpoint_every: int = 0
     wetting: str = "isotropic"
 
+    #: The test in words, for errors ("a triaxial test").
+    TEST = "a laboratory test"
+
     def __post_init__(self):
-        for name, kind in (("sample", PrepareConfig), ("shear", ShearConfig)):
-            if not isinstance(getattr(self, name), kind):
-                raise TypeError(f"{name} must be a {kind.__name__}, got "
-                                f"{type(getattr(self, name)).__name__}")
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
         if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
             raise TypeError(f"bridges must be a BridgeConfig or None, got "
                             f"{type(self.bridges).__name__}")
-        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES,
-                        "a triaxial test", AVERAGES)
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, self.TEST,
+                        AVERAGES)
         if self.sample.confining <= 0.0:
-            # the shear's lateral stress: the inertial number and the servo need it > 0
+            # the path's starting stress: the inertial number and the servo need it > 0
             raise ValueError(f"confining = {self.sample.confining:g} Pa is outside the valid "
-                             f"range (0, 1e+07] Pa for a triaxial test")
+                             f"range (0, 1e+07] Pa for {self.TEST}")
         self.wet_steps = check_int("wet_steps", self.wet_steps, low=1, high=100_000_000)
         self.vtk_frames = check_int("vtk_frames", self.vtk_frames)
         if self.vtk_every is not None:
@@ -260,22 +306,8 @@ class TriaxialConfig:
 
     @property
     def confining(self):
-        """Lateral stress of the shear [Pa] (the sample's confining stress)."""
+        """Isotropic stress the path starts from [Pa] (the sample's confining stress)."""
         return self.sample.confining
-
-    def shear_steps(self):
-        """Steps of the shear estimated before anything runs [-]: max_strain over the strain
-        rate times the P-wave step of the mean radius (pendular.procedures.preparation.pwave_step). An
-        upper bound for equal spheres: the 'stiffness' rule's step is 1.4-1.5 times longer on
-        prepared samples, so the shear takes that much fewer."""
-        sample, shear = self.sample, self.shear
-        rate = shear.rate(sample.radius, sample.density, sample.confining)
-        per_step = rate * pwave_step(sample.radius, sample)
-        if not per_step > 0.0:          # a rate or time step that underflows
-            raise ValueError(f"the strain per step, {per_step:g}, is not positive: the strain "
-                             "rate (--strain-rate / --inertial-number) or the time step "
-                             "(--timestep-safety) is too small to be represented")
-        return shear.max_strain / per_step
 
     @property
     def suction(self):
@@ -284,6 +316,166 @@ class TriaxialConfig:
         if self.bridges is None:
             return 0.0
         return math.nan if self.bridges.suction is None else self.bridges.suction
+
+    def strain_per_step(self, rate):
+        """Strain [-] of one step at ``rate`` [1/s]: the P-wave step of the mean radius
+        (pendular.procedures.preparation.pwave_step; the 'stiffness' rule's step is 1.4-1.5
+        times longer on prepared samples). ValueError when it underflows."""
+        per_step = rate * pwave_step(self.sample.radius, self.sample)
+        if not per_step > 0.0:          # a rate or time step that underflows
+            raise ValueError(f"the strain per step, {per_step:g}, is not positive: the strain "
+                             "rate (--strain-rate / --inertial-number) or the time step "
+                             "(--timestep-safety) is too small to be represented")
+        return per_step
+
+
+@dataclass
+class TriaxialConfig(LaboratoryConfig):
+    """A drained triaxial test (thesis Ch. 5.2.3): LaboratoryConfig's sample, bridges and
+    outputs, and shear: ShearConfig (the confining stress is the lateral stress of the shear).
+    """
+
+    shear: ShearConfig = field(default_factory=ShearConfig)
+
+    TEST = "a triaxial test"
+
+    def __post_init__(self):
+        if not isinstance(self.shear, ShearConfig):
+            raise TypeError(f"shear must be a ShearConfig, got {type(self.shear).__name__}")
+        super().__post_init__()
+
+    def rate(self):
+        """Axial strain rate of the shear [1/s] (ShearConfig.rate at the confining stress)."""
+        sample = self.sample
+        return self.shear.rate(sample.radius, sample.density, sample.confining)
+
+    def reference_pressure(self):
+        """Stress at which the inertial number of the rate is taken [Pa]: the confining."""
+        return self.sample.confining
+
+    def shear_steps(self):
+        """Steps of the shear estimated before anything runs [-]: max_strain over the strain
+        rate times the P-wave step of the mean radius (pendular.procedures.preparation.pwave_step). An
+        upper bound for equal spheres: the 'stiffness' rule's step is 1.4-1.5 times longer on
+        prepared samples, so the shear takes that much fewer."""
+        return self.shear.max_strain / self.strain_per_step(self.rate())
+
+    def estimated_steps(self):
+        """Steps of the loading estimated before anything runs (``shear_steps``)."""
+        return self.shear_steps()
+
+
+#: Smallest strain between two history rows of a path of unknown length [-].
+MIN_RECORD_STRAIN = 1e-7
+#: Largest strain between two history rows of a path of unknown length [-].
+MAX_RECORD_STRAIN = 0.01
+
+
+@dataclass
+class PathConfig(LaboratoryConfig):
+    """A loading path whose stages end at a stress or at equilibrium, so that its length is
+    known only as it runs (OedometerConfig, IsotropicConfig): LaboratoryConfig's fields and
+    the rate of its stages, ``strain_rate`` [1/s] or, when None, the one giving
+    ``inertial_number`` at the lowest stress of the path (``reference_pressure``);
+    ``record_strain``: strain at that rate between two history rows [-] (rows are also
+    written at the end of each stage)."""
+
+    inertial_number: float = 3e-4
+    strain_rate: float | None = None
+    record_strain: float = 1e-4
+
+    def __post_init__(self):
+        super().__post_init__()
+        self.inertial_number = check_range("--inertial-number", self.inertial_number, 0.0, 1.0,
+                                           low_inclusive=False)
+        if self.strain_rate is not None:
+            self.strain_rate = check_positive("--strain-rate", self.strain_rate, "1/s")
+        self.record_strain = check_range("--record-strain", self.record_strain,
+                                         MIN_RECORD_STRAIN, MAX_RECORD_STRAIN)
+
+    def rate(self):
+        """Strain rate of the path's stages [1/s] (quasi_static_rate)."""
+        sample = self.sample
+        return quasi_static_rate(self.inertial_number, self.strain_rate, sample.radius,
+                                 sample.density, self.reference_pressure())
+
+    def estimated_steps(self):
+        """None: the stages end at a stress or at equilibrium."""
+        return None
+
+    def record_every(self, dt):
+        """Steps of ``dt`` [s] between history rows [-]: ``record_strain`` at ``rate``."""
+        return max(1, int(round(self.record_strain / (self.rate() * dt))))
+
+
+@dataclass
+class OedometerConfig(PathConfig):
+    """Oedometric (K0) compression (pendular.procedures.loading.oedometer_stages): the lateral
+    walls fixed, the axial ones pushed in at the path's rate until the axial stress is
+    ``axial_stress`` [Pa] (above the confining stress the sample starts from), then, with
+    ``unload_to`` [Pa] (below ``axial_stress``, above 0), pulled back until it is that."""
+
+    axial_stress: float = 10000.0
+    unload_to: float | None = None
+
+    TEST = "an oedometer test"
+
+    def __post_init__(self):
+        super().__post_init__()
+        confining = self.sample.confining
+        self.axial_stress = check_range("--axial-stress", self.axial_stress, 0.0, 1e7,
+                                        unit="Pa")
+        if self.axial_stress <= confining:
+            raise ValueError(f"--axial-stress = {self.axial_stress:g} Pa is outside the valid "
+                             f"range ({confining:g}, 1e+07] Pa: the compression starts from "
+                             f"the confining stress (--confining {confining:g} Pa)")
+        check_soft_contacts("--axial-stress", self.axial_stress, self.sample.young)
+        if self.unload_to is not None:
+            self.unload_to = check_range("--unload-to", self.unload_to, 0.0, 1e7,
+                                         low_inclusive=False, unit="Pa")
+            if self.unload_to >= self.axial_stress:
+                raise ValueError(f"--unload-to = {self.unload_to:g} Pa is outside the valid "
+                                 f"range (0, {self.axial_stress:g}) Pa: an unloading ends below "
+                                 f"the load (--axial-stress {self.axial_stress:g} Pa)")
+
+    def reference_pressure(self):
+        """The lowest axial stress of the path [Pa]: the confining stress, or ``unload_to``."""
+        return min(self.sample.confining, self.unload_to or math.inf)
+
+
+#: Fewest stresses of an isotropic path: a loading (or unloading) needs two.
+MIN_ISOTROPIC_STAGES = 2
+
+
+@dataclass
+class IsotropicConfig(PathConfig):
+    """Isotropic loading and unloading in stages (pendular.procedures.loading.isotropic_stages):
+    the six walls servoed to each of ``stresses`` [Pa] (each > 0, in any order, at least
+    MIN_ISOTROPIC_STAGES) in turn, each stage run until static; the walls move at most at the
+    path's rate. ``stage_steps``: most steps of a stage."""
+
+    stresses: list[float] = field(default_factory=lambda: [500.0, 1000.0, 2000.0, 5000.0,
+                                                           2000.0, 500.0])
+    stage_steps: int = 2_000_000
+
+    TEST = "an isotropic test"
+
+    def __post_init__(self):
+        super().__post_init__()
+        self.stresses = [check_range("--stresses", value, 0.0, 1e7, low_inclusive=False,
+                                     unit="Pa") for value in self.stresses]
+        if len(self.stresses) < MIN_ISOTROPIC_STAGES:
+            raise ValueError(f"--stresses = {','.join(f'{v:g}' for v in self.stresses)}: at "
+                             f"least {MIN_ISOTROPIC_STAGES} stresses [Pa] expected (a loading "
+                             "or unloading goes from one to the next)")
+        for value in self.stresses:
+            check_soft_contacts("--stresses", value, self.sample.young)
+        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
+                                     high=100_000_000)
+
+    def reference_pressure(self):
+        """The lowest stress of the path [Pa]: the confining or the least of ``stresses``."""
+        return min(self.sample.confining, *self.stresses)
 
 
 @dataclass
@@ -497,8 +689,8 @@ def case_name(void_ratio, water_content):
 
 #: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
 CONFIG_TYPES = {kind.__name__: kind for kind in
-                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, TensionConfig,
-                 SwccConfig)}
+                (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, OedometerConfig,
+                 IsotropicConfig, TensionConfig, SwccConfig)}
 
 
 def config_to_dict(config):

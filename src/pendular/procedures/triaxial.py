@@ -1,27 +1,32 @@
 """Drained triaxial test (thesis Ch. 5.2.3): prepare, wet, shear, record, resume.
 
-Building blocks, usable alone for a custom loading path (README "Using it"):
+Building blocks, usable alone for a custom loading path (the tutorial
+docs/tutorials/plot_3_custom_loading_path.py):
 
 - ``equilibrate(sim, ...)``: run until static (unbalanced force and servoed stresses within
   tolerance);
 - ``wet(sim, bridges, ...)``: add capillary bridges to a static sample and re-equilibrate;
 - ``TriaxialShear(sim, shear, ...)``: lateral walls servoed, axial walls at a constant strain
-  rate, a history recorder; ``sim.run(shear.steps)`` shears to the final strain;
+  rate, a history recorder; ``sim.run(shear.steps)`` shears to the final strain (one stage
+  of a pendular.procedures.loading.LoadingPath, which runs any sequence of stages);
 - ``summarize(history)``: peak values.
 
 ``TriaxialTest(config).run(out)`` chains them as the thesis does and writes the outputs
 (history.h5, summary.json, triaxial.png, plots/, vtk/, sample.h5, checkpoint.h5; with
 ``vtk_prep``, vtk_prep/: ParaView frames of the preparation and wetting);
 ``TriaxialTest.resume(out)`` continues an interrupted run from its checkpoint bit-identically.
+``OedometerTest`` and ``IsotropicTest`` are the same test (``LaboratoryTest``: sample, wetting,
+outputs, resume) along the oedometric and the isotropic paths.
 
 Stresses compression positive [Pa], q and p as pendular.homogenize.invariants; strains compression
-positive, volumetric strain positive in contraction (SPEC §1).
+positive, volumetric strain positive in contraction (docs/units.md).
 """
 
 from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import sys
 import time
@@ -37,20 +42,24 @@ from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_a
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
-from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import load_sample, save_sample
 from pendular.utils.validate import check_int
 from pendular.dem.walls import ConstantStrainRate, StressServo
-from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 
-from pendular.procedures.guards import SampleCrushed, SampleGuard
-from pendular.procedures.config import (TriaxialConfig, config_from_dict, config_to_dict,
-    inertial_number)
+from pendular.procedures.guards import SampleCrushed
+from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
+    TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
+from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
+    friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
+    oedometer_summary, path_deviations, shear_stage, void_ratio)
+# the triaxial's building blocks, named here as before (pendular.procedures.swcc reads them)
+from pendular.procedures.loading import capillary_operation, history_columns  # noqa: F401
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
-from pendular.io.plots import plot_history, run_label, write_plots
+from pendular.io.plots import (plot_compression, plot_history, plot_stress_path, run_label,
+    write_plots)
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.water_content import wet_to_water_volume
 
@@ -76,10 +85,6 @@ ESTIMATE_RATE = 4e6
 #: Density of water [kg/m^3]: the specific gravity of the grains is their density over it.
 WATER_DENSITY = 1000.0
 
-
-#: Files and folders a triaxial run owns in its output folder (pendular.io.outputs).
-OUTPUTS = ("history.h5", "summary.json", "triaxial.png", "plots", "vtk", "sample.h5",
-           "checkpoint.h5", "vtk_prep")
 
 #: Phases of the vtk_prep/ series, by the code in each frame's field data ``phase``: those of
 #: pendular.procedures.preparation.prepare_sample, then "sample" (a loaded sample equilibrated at the confining
@@ -251,124 +256,99 @@ def prep_vtk_period(sample):
     return max(1, sample.unload_steps // 20)
 
 
-def capillary_operation(sim):
-    """The scene's capillary bridge operation, or None for a dry scene."""
-    found = [op for op in sim.forces if hasattr(op, "water_volume")]
-    return found[0] if found else None
-
-
-def history_columns(sim, axial, reference_volume, bridges=None):
-    """Recorded columns of a triaxial history (name -> function of sim); pendular.io.schema
-    declares their units. A wet scene adds the capillary and homogenised columns of
-    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
-
-    def contact_fabric(s):
-        return fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0)   # Eq. 4.1
-
-    columns = {
-        "step": lambda s: s.step,
-        "time": lambda s: s.time,
-        "axial_strain": lambda s: axial.strain(s.walls),
-        "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
-        "sigma_wall": lambda s: s.walls.stress(),
-        "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
-        "porosity": lambda s: porosity(s.particles, s.walls),
-        "coordination": lambda s: coordination(s.contacts, len(s.particles)),
-        "fabric": contact_fabric,
-        "anisotropy": lambda s: principal_anisotropy(contact_fabric(s)),      # Eq. 3.51
-        "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
-    }
-    if bridges is not None:
-        from pendular.homogenize.on_the_fly import CapillaryHomogenization
-
-        columns.update(CapillaryHomogenization(bridges).quantities())
-        if bridges.liquid != "reservoir":             # a closed amount of liquid
-            columns.update({"liquid_bridges": lambda s: bridges.liquid_balance(s)[0],
-                            "liquid_film": lambda s: bridges.liquid_balance(s)[1],
-                            "liquid_lost": lambda s: bridges.liquid_balance(s)[2]})
-    return columns
-
-
 class TriaxialShear:
     """The shear phase of a static sample: its wall control becomes the lateral walls servoed
     at ``confining`` [Pa] and the axial (z) walls at the strain rate of ``shear``
     (pendular.procedures.config.ShearConfig), and a HistoryRecorder of ``history_columns`` records about
-    ``shear.records`` rows (the first now, the last at the final strain).
+    ``shear.records`` rows (the first now, the last at the final strain): one stage of a
+    pendular.procedures.loading.LoadingPath (``shear_path``).
 
     radius [m], density [kg/m^3]: set the strain rate from the inertial number. ``steps``: steps
-    to the final strain; ``rate`` [1/s]; ``recorder``.
+    to the final strain; ``rate`` [1/s]; ``recorder``; ``axial``: the axial walls' control
+    (pendular.dem.walls.ConstantStrainRate); ``path``: the LoadingPath.
     """
 
     def __init__(self, sim, shear, confining, radius, density):
         self.sim = sim
-        servo = next(op for op in sim.controls if isinstance(op, StressServo))
         self.rate = shear.rate(radius, density, confining)
-        self.axial = ConstantStrainRate("z", self.rate, sim.walls.lengths()[2],
-                                        on_current_length=shear.rate_on_current_length)
-        max_velocity = (servo.max_velocity if shear.servo_max_velocity is None
-                        else shear.servo_max_velocity)
-        lateral = StressServo("xy", confining, max_velocity,
-                              scale_max_velocity=shear.servo_scale_max_velocity,
-                              stiffness_every=shear.servo_stiffness_every)
-        if sim.contacts is None:
-            sim.evaluate_forces()     # a sample just loaded: the first record sees its contacts
-        sim.controls = [lateral, self.axial]
-        self.steps = self.axial.steps_to(shear.max_strain, sim.dt)
-        self.recorder = HistoryRecorder(
-            max(1, self.steps // shear.records),
-            history_columns(sim, self.axial, sim.walls.volume(), capillary_operation(sim)),
-            origin=sim.step, end=sim.step + self.steps)
-        self.recorder.record(sim)
-        sim.writers.append(self.recorder)
-        sim.writers.append(SampleGuard(self.recorder.period, describe=lambda s: (
-            f"axial strain {self.axial.strain(s.walls):.3g}")))
+        self.path = shear_path(sim, shear, confining, self.rate)
+        self.axial = next(op for op in self.path.controls
+                          if isinstance(op, ConstantStrainRate))
+        self.steps = self.path.steps
+        self.recorder = self.path.recorder
 
     def status(self, sim):
         """Progress-bar fields: strain, axial and lateral stress, q/p."""
-        sigma = sim.walls.stress()
-        return {"strain": f"{self.recorder.last('axial_strain'):.3f}",
-                "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral_stress(sigma):.0f}Pa",
-                "q/p": f"{deviator_stress(sigma) / mean_stress(sigma):.2f}"}
+        return self.path.status(sim)
 
 
-def summarize(history):
-    """Peak values of a triaxial history (dict of arrays): axial stress, q, p, strain at the
-    peak of q (and Sr there when recorded). A wet history adds ``peak_q_effective`` and
-    ``p_effective_at_peak``: q' and p' of the effective stress (Eq. 3.43) at the peak of q,
-    and with the exact bridge model ``peak_q_effective_complete`` and
-    ``p_effective_complete_at_peak``: those of the complete effective stress (psi plus the
-    liquid-gas interface term, pendular.homogenize.on_the_fly)."""
+def shear_path(sim, shear, confining, rate, columns=None):
+    """The LoadingPath of a triaxial shear of ``shear`` (ShearConfig) at the axial strain rate
+    ``rate`` [1/s] from the isotropic ``confining`` stress [Pa] (loading.shear_stage), with
+    its servo options; ``columns``: history columns beyond ``history_columns``."""
+    return LoadingPath(sim, [shear_stage(shear, confining, rate)], records=shear.records,
+                       columns=columns, servo_max_velocity=shear.servo_max_velocity,
+                       servo_scale_max_velocity=shear.servo_scale_max_velocity,
+                       servo_stiffness_every=shear.servo_stiffness_every,
+                       rate_on_current_length=shear.rate_on_current_length)
+
+
+def summarize(history, direction="compression"):
+    """Peak values of a triaxial history (dict of arrays): in compression the axial stress, q,
+    p, strain at the peak of q (and Sr there when recorded); in extension (``direction``) the
+    least axial stress and, at the peak of q = sigma_lateral - sigma_axial, q (positive), p
+    and the strain (negative), and ``axial_contact_lost``: whether the axial stress fell to 0
+    (the walls released a cohesive sample before it failed). ``phi_peak_deg``: the mobilised friction angle there
+    (loading.friction_angle of the net wall stresses). A wet history adds
+    ``peak_q_effective``, ``p_effective_at_peak`` and ``phi_peak_effective_deg``: q', p' and
+    the friction angle of the effective stress (Eq. 3.43) at the peak of q, and with the exact
+    bridge model ``peak_q_effective_complete`` and ``p_effective_complete_at_peak``: those of
+    the complete effective stress (psi plus the liquid-gas interface term,
+    pendular.homogenize.on_the_fly)."""
     sigma = history["sigma_wall"]
-    q = deviator_stress(sigma)
+    extension = direction == "extension"
+    q = -deviator_stress(sigma) if extension else deviator_stress(sigma)
     peak = int(np.argmax(q))
-    summary = {
-        "peak_axial_stress": float(sigma[:, 2].max()),
+    summary = {"min_axial_stress": float(sigma[:, 2].min()),
+               # the axial walls cannot pull: at zero stress they have left the sample, whose
+               # strength in extension they then no longer measure (a cohesive wet sample)
+               "axial_contact_lost": bool(sigma[:, 2].min() <= 0.0)} if extension else {
+        "peak_axial_stress": float(sigma[:, 2].max())}
+    summary.update({
         "peak_q": float(q[peak]),
         "p_at_peak": float(mean_stress(sigma)[peak]),
         "axial_strain_at_peak": float(history["axial_strain"][peak]),
         "lateral_stress": float(np.mean(lateral_stress(sigma))),
         "peak_index": peak,
-    }
+        "phi_peak_deg": float(friction_angle(sigma[peak])),
+    })
     if "saturation" in history:
         summary["saturation_at_peak"] = float(history["saturation"][peak])
     if "suction" in history:                      # not in a YADE history
         summary["suction_at_peak"] = float(history["suction"][peak])
+    sign = -1.0 if extension else 1.0
     if "sigma_effective" in history:
         effective = np.diagonal(history["sigma_effective"][peak])
-        summary["peak_q_effective"] = float(deviator_stress(effective))
+        summary["peak_q_effective"] = float(sign * deviator_stress(effective))
         summary["p_effective_at_peak"] = float(effective.mean())
+        summary["phi_peak_effective_deg"] = float(friction_angle(effective))
     if "sigma_effective_complete" in history:
         complete = np.diagonal(history["sigma_effective_complete"][peak])
-        summary["peak_q_effective_complete"] = float(deviator_stress(complete))
+        summary["peak_q_effective_complete"] = float(sign * deviator_stress(complete))
         summary["p_effective_complete_at_peak"] = float(complete.mean())
-    if "sigma_contact" in history:                # not in a YADE history
-        error = stress_balance_error(history)
-        summary.update({
-            "stress_balance_error": float(np.max(error)),
-            "stress_balance_bound": STRESS_BALANCE_BOUND,
-            "stress_balance_flagged": np.flatnonzero(error > STRESS_BALANCE_BOUND).tolist(),
-        })
+    summary.update(stress_balance(history))
     return summary
+
+
+def stress_balance(history):
+    """The balance of wall and Love–Weber stresses over a history with ``sigma_contact`` (else
+    {}): the largest ``stress_balance_error``, the bound and the records beyond it."""
+    if "sigma_contact" not in history:            # not in a YADE history
+        return {}
+    error = stress_balance_error(history)
+    return {"stress_balance_error": float(np.max(error)),
+            "stress_balance_bound": STRESS_BALANCE_BOUND,
+            "stress_balance_flagged": np.flatnonzero(error > STRESS_BALANCE_BOUND).tolist()}
 
 
 def stress_balance_error(history):
@@ -387,22 +367,26 @@ def stress_balance_error(history):
 
 def check_feasible(config, force=False):
     """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
-    MAX_INERTIAL_NUMBER) or would not finish in reasonable time (more than MAX_SHEAR_STEPS shear
-    steps), with the estimate, or whose equilibrium phases cannot settle (confining below
+    MAX_INERTIAL_NUMBER at the lowest stress of its path) or would not finish in reasonable
+    time (more than MAX_SHEAR_STEPS steps of a path whose length is known), with the estimate,
+    or whose equilibrium phases cannot settle (a stress of the path below
     MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
     MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. Output periods
-    must fit the shear. ValueError naming the setting."""
-    sample, shear = config.sample, config.shear
-    rate = shear.rate(sample.radius, sample.density, sample.confining)
-    number = inertial_number(rate, sample.radius, sample.density, sample.confining)
+    must fit the loading. ValueError naming the setting."""
+    sample = config.sample
+    rate = config.rate()
+    pressure = config.reference_pressure()
+    number = inertial_number(rate, sample.radius, sample.density, pressure)
     dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
-    steps = config.shear_steps()
+    steps = config.estimated_steps()
+    where = (f"confining = {pressure:g} Pa" if pressure == sample.confining
+             else f"{pressure:g} Pa, the lowest stress of the path")
     if not force and number > MAX_INERTIAL_NUMBER:
         raise ValueError(
             f"strain rate {rate:.3g} 1/s gives the inertial number I = {number:.3g}, outside "
-            f"the quasi-static range (0, {MAX_INERTIAL_NUMBER:g}] at confining = "
-            f"{sample.confining:g} Pa: lower --strain-rate / --inertial-number (or --force)")
-    if not force and steps > MAX_SHEAR_STEPS:
+            f"the quasi-static range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower "
+            "--strain-rate / --inertial-number (or --force)")
+    if not force and steps is not None and steps > MAX_SHEAR_STEPS:
         hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
         raise ValueError(
             f"the shear would take {steps:.3g} steps (dt = {dt:.3g} s, strain rate {rate:.3g} "
@@ -416,24 +400,26 @@ def check_feasible(config, force=False):
             f"prep_stress = {sample.prep_stress:g} Pa: the radius growth cannot settle at "
             f"overlaps below {MIN_PREP_STRESS_OVER_YOUNG:g} of the radius (it would run "
             "2,000,000 steps and stop); lower young (or --force)")
-    if not force and sample.confining < MIN_CONFINING_OVER_YOUNG * sample.young:
+    if not force and pressure < MIN_CONFINING_OVER_YOUNG * sample.young:
+        name = "confining" if pressure == sample.confining else "the path's lowest stress"
         raise ValueError(
-            f"confining = {sample.confining:g} Pa is outside the valid range "
+            f"{name} = {pressure:g} Pa is outside the valid range "
             f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, 1e+07] Pa for young = "
             f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
             "never hold the confining stress (the equilibrium would run to its step limit); "
             "raise confining or lower young (or --force)")
     for name in ("vtk_every", "checkpoint_every"):
         value = getattr(config, name)
-        if value is not None and value > max(steps, 1.0) + 1:
+        if steps is not None and value is not None and value > max(steps, 1.0) + 1:
             raise ValueError(f"{name} = {value} is outside the valid range [0, {int(steps) + 1}]"
                              f": the shear has about {int(steps)} steps")
 
 
 def parameters(config):
-    """Flat name -> value of a configuration, named as the command's options (history file
-    attributes, campaign tables)."""
-    sample, shear, bridges = config.sample, config.shear, config.bridges
+    """Flat name -> value of a configuration (TriaxialConfig, OedometerConfig,
+    IsotropicConfig), named as the command's options (history file attributes, campaign
+    tables)."""
+    sample, bridges = config.sample, config.bridges
     flat = {"particles": sample.particles, "radius": sample.radius,
             "radius_spread": sample.radius_spread, "psd": sample.psd,
             "porosity": sample.porosity,
@@ -442,13 +428,26 @@ def parameters(config):
             "density": sample.density, "damping": sample.damping,
             "timestep_safety": sample.timestep_safety, "timestep_rule": sample.timestep_rule,
             "prep_stress": sample.prep_stress,
-            "confining": sample.confining, "seed": sample.seed, "skin_factor": sample.skin_factor,
-            "max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
-            "strain_rate": shear.strain_rate, "records": shear.records,
-            "suction": config.suction, "wet_steps": config.wet_steps,
-            "wetting": config.wetting,
-            "vtk_every": config.vtk_every, "checkpoint_every": config.checkpoint_every,
-            "sample": config.sample_path}
+            "confining": sample.confining, "seed": sample.seed, "skin_factor": sample.skin_factor}
+    if isinstance(config, TriaxialConfig):
+        shear = config.shear
+        flat.update({"max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
+                     "strain_rate": shear.strain_rate, "records": shear.records})
+        if not shear.conventional:          # a conventional run's rows stay as they were
+            flat.update({"direction": shear.direction, "b": shear.b,
+                         "constant_p": shear.constant_p})
+    else:
+        if isinstance(config, OedometerConfig):
+            flat.update({"axial_stress": config.axial_stress, "unload_to": config.unload_to})
+        else:
+            flat.update({"stresses": ",".join(f"{v:g}" for v in config.stresses),
+                         "stage_steps": config.stage_steps})
+        flat.update({"inertial_number": config.inertial_number,
+                     "strain_rate": config.strain_rate, "record_strain": config.record_strain})
+    flat.update({"suction": config.suction, "wet_steps": config.wet_steps,
+                 "wetting": config.wetting,
+                 "vtk_every": config.vtk_every, "checkpoint_every": config.checkpoint_every,
+                 "sample": config.sample_path})
     if bridges is not None:
         flat.update({"contact_angle": bridges.contact_angle, "bridges": bridges.model,
                      "surface_tension": bridges.surface_tension,
@@ -461,21 +460,33 @@ def parameters(config):
     return flat
 
 
-class TriaxialTest:
-    """A drained triaxial test of ``config`` (pendular.procedures.config.TriaxialConfig).
+class LaboratoryTest:
+    """A laboratory test of ``config`` (a pendular.procedures.config.LaboratoryConfig of the
+    subclass's ``CONFIG``): the sample, its wetting and its outputs, and the loading path that
+    the subclass declares (``loading``: a pendular.procedures.loading.LoadingPath;
+    ``summarize``; ``plot``).
 
     ``run(out)`` prepares the sample (or loads ``config.sample_path``), wets it at the confining
-    stress (bridges at every contact, six walls servoed until static), shears it and writes
-    into ``out``: history.h5, summary.json, triaxial.png, plots/, vtk/ (ParaView), sample.h5
-    (the sample the shear starts from, with the configuration), with checkpoint_every
-    checkpoint.h5 and, with ``vtk_prep``, vtk_prep/ (ParaView frames of the preparation and
-    wetting). Returns the summary (dict). A run stopped before its end (pendular.io.outputs)
-    names in summary.json the phase it reached: "prepare", "wet", "shear" or "write".
+    stress (bridges at every contact, six walls servoed until static), loads it along the path
+    and writes into ``out``: history.h5, summary.json, the test's figure (``FIGURE``), plots/,
+    vtk/ (ParaView), sample.h5 (the sample the loading starts from, with the configuration),
+    with checkpoint_every checkpoint.h5 and, with ``vtk_prep``, vtk_prep/ (ParaView frames of
+    the preparation and wetting). Returns the summary (dict). A run stopped before its end
+    (pendular.io.outputs) names in summary.json the phase it reached: "prepare", "wet",
+    "shear" (the loading) or "write".
     """
 
-    def __init__(self, config: TriaxialConfig, *, force=False):
-        if not isinstance(config, TriaxialConfig):
-            raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
+    #: The test's command name (output folder label), configuration type and figure.
+    NAME = "triaxial"
+    CONFIG = LaboratoryConfig
+    FIGURE = "triaxial.png"
+    #: Progress-bar label of the loading.
+    PROGRESS = "shear"
+
+    def __init__(self, config, *, force=False):
+        if not isinstance(config, self.CONFIG):
+            raise TypeError(f"config must be a {self.CONFIG.__name__}, got "
+                            f"{type(config).__name__}")
         self.config = config
         check_feasible(config, force=force)
         if config.bridges is not None and config.bridges.suction is not None:
@@ -532,8 +543,8 @@ class TriaxialTest:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         if self.config.sample_path is not None:       # checked before the folder is touched
             load_sample(self.config.sample_path, expected=self.config.sample)
-        with OutputFolder(out, "triaxial") as folder:
-            for name in OUTPUTS:
+        with OutputFolder(out, self.NAME) as folder:
+            for name in self.outputs():
                 folder.claim(name)
             return self._run(folder, progress, threads, stop_after, vtk_prep, plots)
 
@@ -575,7 +586,7 @@ class TriaxialTest:
         sample_file = os.path.join(out, "sample.h5")
         save_sample(sample_file, sim, preparation, before_shear,
                     identity={"seed": config.sample.seed})
-        run = _ShearRun(sim, config, folder, before_shear, run_identity(config, sample_file))
+        run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
         return run.finish(progress, stop_after, plots)
@@ -590,60 +601,176 @@ class TriaxialTest:
             if not os.path.exists(path):
                 raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
                                  "with checkpoint_every > 0?)")
-        with OutputFolder(out, "triaxial --resume", keep=True) as folder:
+        with OutputFolder(out, f"{cls.NAME} --resume", keep=True) as folder:
             particles, walls, _, before_shear = load_sample(sample_file)
             config = config_from_dict(before_shear.get("config"), sample_file)
+            if not isinstance(config, cls.CONFIG):
+                raise ValueError(f"resume = {out!r} holds a run of another test "
+                                 f"({type(config).__name__}), not of pendular {cls.NAME}")
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
                 sim.forces.append(config.bridges.build(
                     before_shear["wetting"].get("formation_suction_pa")))
             identity = run_identity(config, sample_file)
-            run = _ShearRun(sim, config, folder, before_shear, identity)
+            test = cls.__new__(cls)          # the stored run, checked when it started
+            test.config = config
+            run = _PathRun(sim, test, folder, before_shear, identity)
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
             if (not isinstance(state, dict) or state.get("phase") != "shear"
                     or state.get("steps") != run.steps
                     or not isinstance(state.get("start_step"), int)
                     or not isinstance(state.get("shear_time_s"), (int, float))):
-                raise ValueError(f"{checkpoint} does not belong to this run's shear")
-            start, end = state["start_step"], state["start_step"] + run.steps
+                raise ValueError(f"{checkpoint} does not belong to this run's loading")
+            start = state["start_step"]
+            end = math.inf if run.steps is None else start + run.steps
             if not start <= sim.step <= end:
-                # a checksum can be forged: the step must lie in this shear
+                # a checksum can be forged: the step must lie in this loading
                 raise ValueError(f"{checkpoint}: step = {sim.step} is outside the valid range "
-                                 f"[{start}, {end}] of this run's shear (an edited checkpoint)")
+                                 f"[{start}, {end}] of this run's loading (an edited checkpoint)")
             run.resumed(state)
             return run.finish(progress, stop_after)
+
+    # ------------------------------------------------------------ the path of the test
+    def outputs(self):
+        """Files and folders the test owns in its output folder (pendular.io.outputs)."""
+        return ("history.h5", "summary.json", self.FIGURE, "plots", "vtk", "sample.h5",
+                "checkpoint.h5", "vtk_prep")
+
+    def loading(self, sim):
+        """The LoadingPath of the test attached to the static sample ``sim`` (time step set)."""
+        raise NotImplementedError
+
+    def summarize(self, history):
+        """The test's results from its ``history`` (dict of arrays)."""
+        raise NotImplementedError
+
+    def plot(self, history, out, title):
+        """The test's figures into the folder ``out``, ``title`` the run's parameters."""
+        raise NotImplementedError
+
+
+class TriaxialTest(LaboratoryTest):
+    """A drained triaxial test of ``config`` (pendular.procedures.config.TriaxialConfig): the
+    shear of ``config.shear`` (compression, extension, at a constant b or mean stress;
+    loading.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
+    plots/ (q/p, volumetric strain, wet: saturation and capillary stresses; and, for a shear
+    other than the conventional compression, the q-p stress path stress_path.png)."""
+
+    CONFIG = TriaxialConfig
+
+    def loading(self, sim):
+        config = self.config
+        return shear_path(sim, config.shear, config.confining, config.rate())
+
+    def summarize(self, history):
+        shear = self.config.shear
+        summary = summarize(history, shear.direction)
+        summary["peak_reached"] = peak_reached(history["axial_strain"], summary["peak_index"])
+        summary.update(path_deviations(history, shear, self.config.confining))
+        return summary
+
+    def plot(self, history, out, title):
+        direction = self.config.shear.direction
+        plot_history(history, os.path.join(out, self.FIGURE), title, direction)
+        write_plots(history, os.path.join(out, "plots"), title, direction)
+        if not self.config.shear.conventional:
+            plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
+
+
+#: History columns of the oedometric and isotropic paths beyond the triaxial's.
+COMPRESSION_COLUMNS = {"void_ratio": void_ratio}
+
+
+class OedometerTest(LaboratoryTest):
+    """An oedometric (K0) test of ``config`` (pendular.procedures.config.OedometerConfig;
+    loading.oedometer_stages): history with ``void_ratio`` and ``k0`` (and ``stage`` with an
+    unloading), summary of loading.oedometer_summary; figure oedometer.png (e-log sigma_v and
+    K0), plots/ (stress path, and against axial strain as the triaxial's)."""
+
+    NAME = "oedometer"
+    CONFIG = OedometerConfig
+    FIGURE = "oedometer.png"
+    PROGRESS = "oedometer"
+
+    def loading(self, sim):
+        config = self.config
+        rate = config.rate()
+        return LoadingPath(sim, oedometer_stages(config.axial_stress, rate, config.unload_to),
+                           record_every=config.record_every(sim.dt),
+                           columns={**COMPRESSION_COLUMNS, "k0": k0})
+
+    def summarize(self, history):
+        config = self.config
+        return {**oedometer_summary(history, config.axial_stress, config.unload_to),
+                **stress_balance(history)}
+
+    def plot(self, history, out, title):
+        plot_compression(history, os.path.join(out, self.FIGURE), title, stress="axial")
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
+        write_plots(history, os.path.join(out, "plots"), title, direction=None)
+
+
+class IsotropicTest(LaboratoryTest):
+    """Isotropic loading and unloading in stages of ``config``
+    (pendular.procedures.config.IsotropicConfig; loading.isotropic_stages): history with
+    ``void_ratio`` and ``stage``, summary of loading.isotropic_summary; figure isotropic.png
+    (e-log p, net and effective, and the volumetric strain)."""
+
+    NAME = "isotropic"
+    CONFIG = IsotropicConfig
+    FIGURE = "isotropic.png"
+    PROGRESS = "stage"
+
+    def loading(self, sim):
+        config = self.config
+        sample = config.sample
+        stages = isotropic_stages(config.stresses, config.rate(), max_steps=config.stage_steps,
+                                  unbalanced=sample.equilibrium_unbalanced,
+                                  tolerance=sample.stress_tolerance)
+        return LoadingPath(sim, stages, record_every=config.record_every(sim.dt),
+                           columns=COMPRESSION_COLUMNS)
+
+    def summarize(self, history):
+        return {**isotropic_summary(history, self.config.stresses), **stress_balance(history)}
+
+    def plot(self, history, out, title):
+        plot_compression(history, os.path.join(out, self.FIGURE), title, stress="mean")
 
 
 def run_identity(config, sample_file):
     """What a checkpoint of this run must carry (pendular.utils.integrity): the configuration's hash, the
-    seed and the checksum of the sample the shear started from."""
+    seed and the checksum of the sample the loading started from."""
     return {"config_hash": config_hash(config_to_dict(config)), "seed": config.sample.seed,
             "sample_checksum": checksum(sample_file)}
 
 
-class _ShearRun:
-    """The shear of a TriaxialTest with its writers in a fixed order (recorder, ParaView,
+class _PathRun:
+    """The loading of a LaboratoryTest with its writers in a fixed order (recorder, ParaView,
     checkpoint), so that a resumed run builds the same simulation; ``finish`` runs the
-    remaining steps and writes the outputs."""
+    rest of the path and writes the outputs."""
 
-    def __init__(self, sim, config, folder, before_shear, identity):
-        self.sim, self.config, self.before_shear = sim, config, before_shear
+    def __init__(self, sim, test, folder, before_shear, identity):
+        self.sim, self.test, self.config, self.before_shear = sim, test, test.config, before_shear
         self.folder, self.out = folder, folder.path
+        config = self.config
         out = folder.path
-        sample = config.sample
-        sim.dt = timestep(sim, sample)    # from the state the shear starts from (and resumes)
-        self.shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius,
-                                   sample.density)
-        self.steps = self.shear.steps
+        sim.dt = timestep(sim, config.sample)   # from the state the loading starts from
+        self.path = test.loading(sim)
+        self.steps = self.path.steps           # None: known only as the path runs
         self.start_step = sim.step
-        self.shear_time = 0.0        # seconds spent shearing by earlier (interrupted) runs
+        self.shear_time = 0.0        # seconds spent loading by earlier (interrupted) runs
         self.vtk_period = config.vtk_every
         if self.vtk_period is None:
-            self.vtk_period = max(1, self.steps // config.vtk_frames) if config.vtk_frames else 0
+            if not config.vtk_frames:
+                self.vtk_period = 0
+            elif self.steps is not None:
+                self.vtk_period = max(1, self.steps // config.vtk_frames)
+            else:
+                self.vtk_period = self.path.recorder.period * VTK_RECORDS
         self.vtk = None
         if self.vtk_period > 0:
-            axial = self.shear.axial
+            axial = self.path.axial
             self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
                                  field_data=lambda s: {"axial_strain": axial.strain(s.walls)},
                                  time_axis=lambda s: 100.0 * axial.strain(s.walls))
@@ -660,39 +787,45 @@ class _ShearRun:
         """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
         return {"phase": "shear", "steps": self.steps, "start_step": self.start_step,
                 "shear_time_s": self.shear_time + time.perf_counter() - self._clock,
-                "config": self.before_shear["config"]}
+                "config": self.before_shear["config"], "path": self.path.state()}
 
     def resumed(self, state):
         """Take the progress of the checkpoint loaded into the simulation."""
         self.start_step = state["start_step"]
         self.shear_time = state["shear_time_s"]
+        where = state.get("path")
+        if where is None and self.steps is not None:
+            # written before paths had stages: the one stage of a shear
+            where = {"stage": 0, "stage_start": self.start_step, "stage_steps": self.steps}
+        if not isinstance(where, dict):
+            raise ValueError("the checkpoint does not say where its loading path stood")
+        self.path.resume(self.sim, where)
         self._clock = time.perf_counter()
 
     def finish(self, progress, stop_after, plots=True):
-        """Run the rest of the shear (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
+        """Run the rest of the path (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
         and write the outputs (the figures if ``plots``); returns the summary. Interrupted, it
         keeps the history so far (summary ``completed`` false), unless the folder holds the
         finished results of an earlier run, which are then kept instead."""
-        sim = self.sim
-        remaining = self.steps - (sim.step - self.start_step)
-        stop = stop_after is not None and stop_after < remaining
-        steps = stop_after if stop else remaining
+        sim, path = self.sim, self.path
+        label = self.test.PROGRESS if progress else None
+        budget = math.inf if stop_after is None else stop_after
         self._clock = time.perf_counter()
         try:
-            if pausing_at("shear"):          # tests: Ctrl-C halfway through the shear
-                sim.run(steps // 2, progress=None)
-                steps -= steps // 2
+            if pausing_at("shear"):          # tests: Ctrl-C halfway through the loading
+                half = int(min(path.steps_left(sim), budget)) // 2
+                budget -= path.run(sim, max_steps=half)
                 pause_point("shear")
-            sim.run(steps, progress="shear" if progress else None, status=self.shear.status)
+            path.run(sim, max_steps=None if budget == math.inf else budget, progress=label)
         except KeyboardInterrupt:
-            stop = True
-        except SampleCrushed as error:
+            pass
+        except (SampleCrushed, StageFailed) as error:
             self.shear_time += time.perf_counter() - self._clock
             if not self.folder.earlier_results:
                 self.write_outputs(completed=False, error=str(error))
             raise
         self.shear_time += time.perf_counter() - self._clock
-        if stop:
+        if not path.done:
             if self.folder.earlier_results:
                 raise Interrupted(f"interrupted at step {sim.step}; the earlier results in "
                                   f"{self.out} are kept")
@@ -705,32 +838,31 @@ class _ShearRun:
         return self.write_outputs(plots=plots)
 
     def write_outputs(self, completed=True, plots=True, error=None):
-        """history.h5, summary.json (``completed``: whether the shear reached its final strain;
+        """history.h5, summary.json (``completed``: whether the loading reached its end;
         ``error``: what stopped it, if not an interruption) and, for a completed run, the plots
         unless ``plots`` is False."""
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
-        history = self.shear.recorder.arrays()
-        summary = summarize(history)
-        rate = self.shear.rate
+        history = self.path.recorder.arrays()
+        summary = self.test.summarize(history)
+        rate = config.rate()
         sheared = sim.step - self.start_step
         summary.update({
             "completed": completed,
-            "peak_reached": peak_reached(history["axial_strain"], summary["peak_index"]),
             "initial_porosity": preparation["porosity"],
             "initial_coordination": preparation["coordination"],
             "wall_time_s": self.before_shear["pre_shear_time_s"] + self.shear_time,
             "preparation_time_s": self.before_shear["preparation_time_s"],
             "shear_time_s": self.shear_time,
-            "steps": self.steps,
+            "steps": self.steps if self.steps is not None else sheared,
             "preparation_steps": preparation["steps"],
             "particle_steps_per_s": (len(sim.particles) * sheared / self.shear_time
                                      if self.shear_time > 0.0 else None),
             "dt": sim.dt,
             "strain_rate": rate,
             "inertial_number": inertial_number(rate, sample.radius, sample.density,
-                                               sample.confining),
+                                               config.reference_pressure()),
             "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
             "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
             "threads": numba.get_num_threads(),
@@ -765,13 +897,16 @@ class _ShearRun:
         if flagged:
             print(f"warning: {len(flagged)} of {len(history['step'])} records have wall and "
                   f"Love-Weber stresses apart by more than {STRESS_BALANCE_BOUND:.0%} of p (up "
-                  f"to {summary['stress_balance_error']:.1%}): the shear is not quasi-static "
+                  f"to {summary['stress_balance_error']:.1%}): the loading is not quasi-static "
                   "there (summary.json stress_balance_flagged)", file=sys.stderr)
+        if summary.get("axial_contact_lost"):
+            print("warning: the axial stress fell to 0: the axial walls, which cannot pull, left "
+                  "the sample before it failed in extension, so the peak is that of the walls' "
+                  "release, not of the sample (summary.json axial_contact_lost); raise "
+                  "--confining, or read the effective stresses", file=sys.stderr)
         if not plots:
             return summary
-        title = run_label(parameters(config), preparation["porosity"])
-        plot_history(history, os.path.join(out, "triaxial.png"), title)
-        write_plots(history, os.path.join(out, "plots"), title)
+        self.test.plot(history, out, run_label(parameters(config), preparation["porosity"]))
         return summary
 
 

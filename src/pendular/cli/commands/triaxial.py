@@ -8,7 +8,14 @@ compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at
 stress, re-equilibrated, then sheared (pendular.procedures.triaxial); --wetting chooses when the bridges
 appear. Constant water content (--water-content W): volume-controlled bridges holding W % of
 the grains' mass, the liquid then conserved during the shear (--liquid) and the suction an
-output.
+output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
+extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
+axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises
+(pendular.procedures.loading.shear_stage).
+
+The sample, wetting and output options are shared with ``pendular oedometer`` and ``pendular
+isotropic`` (``add_sample_options``, ``add_wetting_options``, ``add_output_options``, built into
+configurations by ``laboratory_fields``; ``run_test`` runs any of the three).
 """
 
 from __future__ import annotations
@@ -24,8 +31,8 @@ from pendular.utils.validate import check_int, check_range
 from pendular.cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
     set_threads, sizes_from)
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MAX_RECORDS,
-    MIN_AXIAL_STRAIN, WETTING_PROTOCOLS, BridgeConfig, ShearConfig, TriaxialConfig,
-    check_steps_count)
+    MIN_AXIAL_STRAIN, SHEAR_DIRECTIONS, WETTING_PROTOCOLS, BridgeConfig, LaboratoryConfig,
+    ShearConfig, TriaxialConfig, check_steps_count)
 from pendular.procedures.triaxial import Interrupted, TriaxialTest
 
 #: Options a resumed run takes from its own command line, not from the stored run.
@@ -33,16 +40,79 @@ RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after", "force")
 #: Options of the preparation alone, which a run from a prepared --sample does not use.
 PREPARATION_OPTIONS = ("porosity", "prep_friction")
 #: Summary keys printed at the end.
-SHOWN = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak", "peak_q_effective",
-         "p_effective_at_peak", "peak_q_effective_complete", "p_effective_complete_at_peak",
-         "initial_porosity", "saturation_at_peak", "suction_at_peak", "liquid_balance_error",
-         "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
+SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
+         "phi_peak_deg", "peak_q_effective", "p_effective_at_peak", "phi_peak_effective_deg",
+         "peak_q_effective_complete", "p_effective_complete_at_peak", "mean_stress_deviation",
+         "b_deviation", "axial_contact_lost", "initial_porosity", "saturation_at_peak",
+         "suction_at_peak", "liquid_balance_error", "liquid_lost_fraction", "wall_time_s",
+         "particle_steps_per_s")
+#: Wetting options, each with its unset value: given without a wet test they are refused.
+WET_ONLY = {"contact_angle": None, "table_resolution": None, "bridges": None,
+            "surface_tension": None, "persist_bridges": False, "wetting": "isotropic"}
 
 
 def add_arguments(parser):
+    add_sample_options(parser)
+    add_wetting_options(parser)
+    parser.add_argument("--max-strain", type=float, default=0.25,
+                        help=f"final axial strain [-], at most {MAX_AXIAL_STRAIN:g} (in "
+                             "extension, the magnitude of the axial extension)")
+    parser.add_argument("--direction", choices=SHEAR_DIRECTIONS, default="compression",
+                        help="axial walls pushed in (compression) or pulled apart "
+                             "(extension), the lateral stress held")
+    parser.add_argument("--b", type=float, default=None,
+                        help="true triaxial compression: hold b = (s2 - s3) / (s1 - s3) in "
+                             "[0, 1], s1 axial, s3 = --confining on x, s2 on y (default: "
+                             "s2 = s3)")
+    parser.add_argument("--constant-p", action="store_true",
+                        help="hold the mean stress p at --confining while q rises (the "
+                             "lateral stresses follow the axial one)")
+    add_rate_options(parser)
+    parser.add_argument("--records", type=int, default=None,
+                        help=f"history rows over the test (default {ShearConfig.records}; at "
+                             "most one a step)")
+    add_output_options(parser, "runs/triaxial", frames=True)
+
+
+def add_sample_options(parser):
+    """The sample's options (preparation and material, or a prepared --sample)."""
     parser.add_argument("--particles", type=int, default=10000, help="number of spheres")
     parser.add_argument("--confining", type=float, default=750.0,
-                        help="lateral stress [Pa]")
+                        help="isotropic stress the loading starts from, the lateral stress of "
+                             "a triaxial [Pa]")
+    parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
+    parser.add_argument("--periodic", action="store_true",
+                        help="a periodic cell instead of six walls: no wall layers; the cell's "
+                             "stress (Love-Weber, contacts and bridges) servoed and its "
+                             "lengths driven at the strain rates")
+    add_size_options(parser, PrepareConfig.radius)
+    parser.add_argument("--porosity", type=float, default=0.40,
+                        help="porosity of the initial cloud box [-] (0.30-0.60; not with "
+                             "--sample)")
+    parser.add_argument("--friction", type=float, default=18.0,
+                        help="contact friction [deg]")
+    parser.add_argument("--prep-friction", type=float, default=0.5,
+                        help="contact friction during the radius growth [deg] (thesis 0.5; "
+                             "higher gives a looser sample; not with --sample)")
+    parser.add_argument("--young", type=float, default=1e6,
+                        help="YADE young E [Pa], kn = E R")
+    parser.add_argument("--damping", type=float, default=0.2,
+                        help="Cundall local damping [-]")
+    parser.add_argument("--timestep-safety", type=float, default=0.7,
+                        help="time step as a fraction of the --timestep-rule estimate [-]")
+    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="stiffness",
+                        help="time step estimate: the critical step of the contacts "
+                             "(pendular.dem.timestep; default), or YADE's P-wave estimate of the "
+                             "smallest sphere")
+    parser.add_argument("--skin-factor", type=float, default=0.1,
+                        help="Verlet skin of the neighbour list / radius (0, 2]")
+    parser.add_argument("--sample", metavar="PATH", default=None,
+                        help="start from this prepared sample (sample.h5) instead of "
+                             "preparing one")
+
+
+def add_wetting_options(parser):
+    """The options of a wet test (at a suction or a water content)."""
     parser.add_argument("--suction", type=float, default=0.0,
                         help="matric suction [Pa] (0: dry)")
     parser.add_argument("--contact-angle", type=float, default=None,
@@ -60,64 +130,44 @@ def add_arguments(parser):
                              "grains' other bridges (shared, default) or is lost")
     parser.add_argument("--wetting", choices=WETTING_PROTOCOLS, default="isotropic",
                         help="when bridges appear (--suction): added to the static sample and "
-                             "re-equilibrated (isotropic), switched on at the first shear step "
-                             "(at-shear), or added with the walls fixed, then servoed "
+                             "re-equilibrated (isotropic), switched on at the first loading "
+                             "step (at-shear), or added with the walls fixed, then servoed "
                              "(constant-volume)")
     parser.add_argument("--persist-bridges", action="store_true",
                         help="bridges live up to their rupture distance instead of breaking "
                              "when contact is lost")
     parser.add_argument("--wet-steps", type=int, default=200000,
                         help="most steps to equilibrate the wetted (or loaded) sample [-]")
-    parser.add_argument("--max-strain", type=float, default=0.25,
-                        help=f"final axial strain [-], at most {MAX_AXIAL_STRAIN:g}")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
-    parser.add_argument("--periodic", action="store_true",
-                        help="a periodic cell instead of six walls: no wall layers; the cell's "
-                             "stress (Love-Weber, contacts and bridges) servoed laterally and "
-                             "its height driven at the strain rate")
-    parser.add_argument("--out", default="runs/triaxial", help="output folder")
-    add_size_options(parser, PrepareConfig.radius)
-    parser.add_argument("--porosity", type=float, default=0.40,
-                        help="porosity of the initial cloud box [-] (0.30-0.60; not with "
-                             "--sample)")
-    parser.add_argument("--friction", type=float, default=18.0,
-                        help="contact friction [deg]")
-    parser.add_argument("--prep-friction", type=float, default=0.5,
-                        help="contact friction during the radius growth [deg] (thesis 0.5; "
-                             "higher gives a looser sample; not with --sample)")
-    parser.add_argument("--young", type=float, default=1e6,
-                        help="YADE young E [Pa], kn = E R")
-    parser.add_argument("--damping", type=float, default=0.2,
-                        help="Cundall local damping [-]")
+    parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
+                        help="bridge table nodes in suction and in distance (exact default "
+                             "350,80; toroidal 64,80)")
+
+
+def add_rate_options(parser):
+    """The loading rate: an inertial number or a strain rate."""
     parser.add_argument("--inertial-number", type=float, default=3e-4,
                         help="target inertial number setting the strain rate [-]")
     parser.add_argument("--strain-rate", type=float, default=None,
                         help="axial strain rate [1/s] (overrides --inertial-number)")
-    parser.add_argument("--timestep-safety", type=float, default=0.7,
-                        help="time step as a fraction of the --timestep-rule estimate [-]")
-    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="stiffness",
-                        help="time step estimate: the critical step of the contacts "
-                             "(pendular.dem.timestep; default), or YADE's P-wave estimate of the "
-                             "smallest sphere")
-    parser.add_argument("--skin-factor", type=float, default=0.1,
-                        help="Verlet skin of the neighbour list / radius (0, 2]")
-    parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
-                        help="bridge table nodes in suction and in distance (exact default "
-                             "350,80; toroidal 64,80)")
-    parser.add_argument("--records", type=int, default=None,
-                        help=f"history rows over the test (default {ShearConfig.records}; at "
-                             "most one a step)")
+
+
+def add_output_options(parser, out, frames=True):
+    """Output folder (default ``out``), ParaView frames (--vtk-frames only when ``frames``: a
+    path whose length is known before it runs), checkpoints, resume, run options."""
+    parser.add_argument("--out", default=out, help="output folder")
     parser.add_argument("--force", action="store_true",
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
-    frames = parser.add_mutually_exclusive_group()
-    frames.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
-                        help="steps between ParaView frames of the shear (default: about "
-                             f"{TriaxialConfig.vtk_frames} frames; 0: no ParaView output)")
-    frames.add_argument("--vtk-frames", type=positive_int("--vtk-frames"), default=None,
-                        help="ParaView frames over the shear (0: none; default "
-                             f"{TriaxialConfig.vtk_frames}; at most one a step); instead of "
-                             "--vtk-every")
+    group = parser.add_mutually_exclusive_group() if frames else parser
+    group.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
+                       help="steps between ParaView frames of the loading (default: " + (
+                           f"about {LaboratoryConfig.vtk_frames} frames" if frames else
+                           "a frame every 10 history rows") + "; 0: no ParaView output)")
+    if frames:
+        group.add_argument("--vtk-frames", type=positive_int("--vtk-frames"), default=None,
+                           help="ParaView frames over the shear (0: none; default "
+                                f"{LaboratoryConfig.vtk_frames}; at most one a step); instead "
+                                "of --vtk-every")
     parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
                         type=positive_int("--vtk-prep", low=1),
                         help="also write ParaView frames of the preparation and wetting into "
@@ -126,14 +176,11 @@ def add_arguments(parser):
                              "(default: unload_steps / 20 = 500, a few tens of frames)")
     parser.add_argument("--checkpoint-every", type=positive_int("--checkpoint-every"),
                         default=0, help="steps between checkpoints DIR/checkpoint.h5 (0: none)")
-    parser.add_argument("--sample", metavar="PATH", default=None,
-                        help="start from this prepared sample (sample.h5) instead of "
-                             "preparing one")
     parser.add_argument("--resume", metavar="DIR", default=None,
                         help="continue the interrupted run of DIR from its checkpoint, with the "
                              "configuration stored there (only --quiet and --threads may be "
                              "added)")
-    # tests: stop the shear after this many steps as an interruption would (exit status 130)
+    # tests: stop the loading after this many steps as an interruption would (exit status 130)
     parser.add_argument("--stop-after", type=positive_int("--stop-after", low=1), default=None,
                         help=argparse.SUPPRESS)
 
@@ -154,12 +201,35 @@ def table_resolution(text):
 
 def config_from(args):
     """The TriaxialConfig of parsed options (ValueError / UsageError naming the option)."""
-    check_range("--suction", args.suction, 0.0, unit="Pa")
     if not MIN_AXIAL_STRAIN <= args.max_strain <= MAX_AXIAL_STRAIN:      # NaN included
         raise UsageError(f"--max-strain = {args.max_strain:g} is outside the valid range "
                          f"[{MIN_AXIAL_STRAIN:g}, {MAX_AXIAL_STRAIN:g}]: {AXIAL_STRAIN_LIMIT}")
     if args.records is not None:
         check_int("--records", args.records, low=2, high=MAX_RECORDS)
+    fields = laboratory_fields(args, add_arguments, lambda: ShearConfig(
+        max_strain=args.max_strain, inertial_number=args.inertial_number,
+        strain_rate=args.strain_rate, direction=args.direction, b=args.b,
+        constant_p=args.constant_p,
+        **({} if args.records is None else {"records": args.records})))
+    frames = {} if args.vtk_frames is None else {"vtk_frames": args.vtk_frames}
+    config = TriaxialConfig(**fields, **frames)
+    # counts given beyond the shear's steps would silently give one a step (the defaults may)
+    steps = config.shear_steps()
+    phase = f"the shear to --max-strain {config.shear.max_strain:g}"
+    if args.vtk_frames is not None:
+        check_steps_count("--vtk-frames", args.vtk_frames, steps, phase)
+    if args.records is not None:
+        check_steps_count("--records", args.records, steps, phase, low=2)
+    return config
+
+
+def laboratory_fields(args, add_arguments, path):
+    """The fields of a LaboratoryConfig from options of ``add_sample_options``,
+    ``add_wetting_options`` and ``add_output_options`` (the command's ``add_arguments``, for
+    its defaults), with the path's own, built by ``path()`` after the sample and before the
+    bridges: {'shear': ShearConfig} or the path's fields as a dict. UsageError naming the
+    option for a wetting option without a wet test, a preparation option with --sample."""
+    check_range("--suction", args.suction, 0.0, unit="Pa")
     water = args.water_content
     if water is not None and args.suction > 0.0:
         raise UsageError("--suction and --water-content: give one (at a water content the "
@@ -169,24 +239,19 @@ def config_from(args):
                          "--bridges toroidal and --persist-bridges do not apply")
     if args.liquid is not None and water is None:
         raise UsageError("--liquid needs --water-content")
-    wet_only = {"--contact-angle": args.contact_angle is not None,
-                "--table-resolution": args.table_resolution is not None,
-                "--bridges": args.bridges is not None,
-                "--surface-tension": args.surface_tension is not None,
-                "--persist-bridges": args.persist_bridges,
-                "--wetting": args.wetting != "isotropic"}
-    if args.suction == 0.0 and water is None and any(wet_only.values()):
-        raise UsageError(f"{', '.join(k for k, v in wet_only.items() if v)} need(s) a wet "
-                         "test: give --suction > 0")
+    wet_only = [name for name, unset in WET_ONLY.items() if getattr(args, name) != unset]
+    if args.suction == 0.0 and water is None and wet_only:
+        raise UsageError(f"{', '.join('--' + n.replace('_', '-') for n in wet_only)} need(s) a "
+                         "wet test: give --suction > 0")
     if args.sample is not None:
-        defaults = _defaults()
+        defaults = _defaults(add_arguments)
         preparation = [name for name in PREPARATION_OPTIONS
                        if getattr(args, name) != getattr(defaults, name)]
         if preparation:
             raise UsageError(f"{', '.join('--' + n.replace('_', '-') for n in preparation)} "
                              f"do(es) not apply with --sample {args.sample}: the sample is "
-                             "already prepared (only its equilibrium and the shear run); leave "
-                             "out --sample to prepare one")
+                             "already prepared (only its equilibrium and the loading run); "
+                             "leave out --sample to prepare one")
     sample = PrepareConfig(particles=args.particles, porosity=args.porosity,
                            **sizes_from(args),
                            young=args.young, friction_deg=args.friction, damping=args.damping,
@@ -195,9 +260,8 @@ def config_from(args):
                            timestep_rule=args.timestep_rule, confining=args.confining,
                            seed=args.seed, skin_factor=args.skin_factor,
                            periodic=args.periodic)
-    records = {} if args.records is None else {"records": args.records}
-    shear = ShearConfig(max_strain=args.max_strain, inertial_number=args.inertial_number,
-                        strain_rate=args.strain_rate, **records)
+    own = path()
+    own = {"shear": own} if isinstance(own, ShearConfig) else own
     bridges = None
     options = {"surface_tension": args.surface_tension, "contact_angle": args.contact_angle,
                "model": args.bridges, "liquid": args.liquid}
@@ -211,52 +275,50 @@ def config_from(args):
         bridges = BridgeConfig(water_content=water / 100.0, control="volume",
                                table_resolution=table_resolution(args.table_resolution),
                                **options)
-    frames = {} if args.vtk_frames is None else {"vtk_frames": args.vtk_frames}
-    config = TriaxialConfig(sample=sample, shear=shear, bridges=bridges, sample_path=args.sample,
-                            wet_steps=args.wet_steps, vtk_every=args.vtk_every,
-                            checkpoint_every=args.checkpoint_every, wetting=args.wetting,
-                            **frames)
-    # counts given beyond the shear's steps would silently give one a step (the defaults may)
-    steps = config.shear_steps()
-    phase = f"the shear to --max-strain {config.shear.max_strain:g}"
-    if args.vtk_frames is not None:
-        check_steps_count("--vtk-frames", args.vtk_frames, steps, phase)
-    if args.records is not None:
-        check_steps_count("--records", args.records, steps, phase, low=2)
-    return config
+    return {"sample": sample, "bridges": bridges, "sample_path": args.sample,
+            "wet_steps": args.wet_steps, "vtk_every": args.vtk_every,
+            "checkpoint_every": args.checkpoint_every, "wetting": args.wetting, **own}
 
 
 def run(args):
+    return run_test(args, TriaxialTest, config_from, SHOWN, add_arguments)
+
+
+def run_test(args, test, config_from, shown, add_arguments):
+    """Run (or with --resume continue) the LaboratoryTest subclass ``test`` of the options
+    ``args`` (configuration by ``config_from``; ``add_arguments``: the command's options, for
+    their defaults); print the summary's ``shown`` keys; the exit status."""
     set_threads(args.threads)
     progress = not args.quiet
     try:
         if args.resume is not None:
-            defaults = vars(_defaults())
+            defaults = vars(_defaults(add_arguments))
             given = [name for name, value in vars(args).items()
                      if name not in RESUME_OPTIONS and value != defaults.get(name)]
             if given:
                 raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
                                  f"{', '.join('--' + n.replace('_', '-') for n in given)} "
                                  "cannot be changed (only --quiet and --threads may be added)")
-            summary = TriaxialTest.resume(args.resume, progress=progress, threads=args.threads,
-                                          stop_after=args.stop_after)
+            summary = test.resume(args.resume, progress=progress, threads=args.threads,
+                                  stop_after=args.stop_after)
             out = args.resume
         else:
             config = config_from(args)
-            summary = TriaxialTest(config, force=args.force).run(
+            summary = test(config, force=args.force).run(
                 args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
                 vtk_prep=args.vtk_prep)
             out = args.out
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED
-    print(json.dumps({k: summary[k] for k in SHOWN if k in summary}, indent=2))
+    print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
     print(f"outputs in {out}")
     return 0
 
 
-def _defaults():
-    """The options' default values (those of an empty command line)."""
+def _defaults(add_arguments):
+    """The options' default values (those of an empty command line) of the command whose
+    options ``add_arguments`` declares."""
     parser = argparse.ArgumentParser()
     add_arguments(parser)
     return parser.parse_args([])

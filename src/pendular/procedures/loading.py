@@ -1,0 +1,787 @@
+"""Loading paths: stages of per-axis stress or strain-rate control, run one after the other.
+
+A ``Stage`` says, for each axis x, y, z (z axial), either a stress target [Pa, compression
+positive], held by the stress servo (pendular.dem.walls.StressServo: the two walls of the axis,
+or the periodic cell's length), or a strain rate [1/s, compression positive; 0 holds the walls
+where they are] (pendular.dem.walls.ConstantStrainRate); optionally a mixed condition on the
+axes given neither (``MixedStress``): a constant mean stress p = (sigma_x + sigma_y +
+sigma_z) / 3 (``mean_stress``), a constant b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) with
+sigma_1 on z and sigma_3 on x (``b``), or both; and an end (``until``): ``Strain`` (the
+engineering strain of an axis, from the start of the path), ``Stress`` (the stress of a
+strain-driven axis reaching a value) or ``Static`` (equilibrium). ``LoadingPath`` runs the
+stages of a static sample in turn and records one history. Rates follow the inertial-number
+rule of the triaxial (pendular.procedures.config.quasi_static_rate); a stage that ends at
+equilibrium moves its servoed walls at most at ``max_strain_rate``.
+
+The paths of the laboratory:
+
+- ``shear_stage``: the triaxial shear of thesis Ch. 5.2.3 (lateral walls at the confining
+  stress, axial walls at the rate of ShearConfig, to the final strain), in compression or
+  extension, at a constant b or a constant mean stress;
+- ``oedometer_stages``: lateral walls fixed, axial compression to a stress, then unloading;
+- ``isotropic_stages``: the six walls servoed to each stress in turn, each stage until static.
+
+Their summaries: ``oedometer_summary`` (K0, constrained modulus, compression and swelling
+indices against the axial stress), ``isotropic_summary`` (e against log p at each stage's
+end, compression and swelling indices). Stresses compression positive [Pa]; strains
+compression positive.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pendular.dem.measure import coordination, porosity, unbalanced_force
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.walls import AXES, ConstantStrainRate, StressServo
+from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
+from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
+from pendular.procedures.config import MAX_AXIAL_STRAIN
+from pendular.procedures.guards import SampleGuard
+from pendular.procedures.preparation import servo_speed, static
+from pendular.utils.validate import check_int, check_positive, check_range
+
+#: The axes by name, in order (x, y lateral; z axial).
+AXIS_NAMES = tuple(AXES)
+#: Largest strain rate a stage may name [1/s] (ConstantStrainRate's bound).
+MAX_STRAIN_RATE = 1e6
+#: A path of unknown length writes a ParaView frame every this many history rows.
+VTK_RECORDS = 10
+#: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b
+#: (its ratio is noise over nearly zero at the start of a true triaxial shear).
+B_MEASURE_FROM = 0.1
+
+
+class StageFailed(ValueError):
+    """A stage cannot go on: a mixed condition needs walls to pull, or its end was not reached
+    within its limit."""
+
+
+# ---------------------------------------------------------------- ends of a stage
+
+@dataclass
+class Strain:
+    """End when the engineering strain of ``axis`` (1 - L / L0, L0 at the start of the path,
+    compression positive) reaches ``value`` [-]; the axis must be driven at a strain rate of
+    the sign of the change. The stage then runs a fixed number of steps."""
+
+    value: float
+    axis: str = "z"
+
+    def __post_init__(self):
+        self.axis = _axis_name("until strain axis", self.axis)
+        self.value = check_range("until strain", self.value, -MAX_AXIAL_STRAIN,
+                                 MAX_AXIAL_STRAIN)
+
+
+@dataclass
+class Stress:
+    """End when the stress of ``axis`` reaches ``value`` [Pa]: from below when the axis is
+    compressed (strain rate > 0), from above when it is unloaded. The stage fails
+    (StageFailed) if the axis's strain reaches +-``strain_limit`` [-] first."""
+
+    value: float
+    axis: str = "z"
+    strain_limit: float = MAX_AXIAL_STRAIN
+
+    def __post_init__(self):
+        self.axis = _axis_name("until stress axis", self.axis)
+        self.value = check_range("until stress", self.value, 0.0, unit="Pa")
+        self.strain_limit = check_range("until strain_limit", self.strain_limit, 0.0,
+                                        MAX_AXIAL_STRAIN, low_inclusive=False)
+
+
+@dataclass
+class Static:
+    """End at equilibrium: the unbalanced force at most ``unbalanced`` and every servoed axis
+    within ``tolerance`` (relative) of its target (pendular.procedures.preparation.static),
+    checked every ``check_every`` steps of the stage; the stage fails after ``max_steps``."""
+
+    max_steps: int = 200000
+    unbalanced: float = 0.01
+    tolerance: float = 0.01
+    check_every: int = 200
+
+    def __post_init__(self):
+        self.max_steps = check_int("until static max_steps", self.max_steps, low=1)
+        self.unbalanced = check_positive("until static unbalanced", self.unbalanced)
+        self.tolerance = check_positive("until static tolerance", self.tolerance)
+        self.check_every = check_int("until static check_every", self.check_every, low=1)
+
+
+def _axis_name(name, axis):
+    if axis not in AXIS_NAMES:
+        raise ValueError(f"{name} = {axis!r} is not one of {AXIS_NAMES}")
+    return axis
+
+
+# ---------------------------------------------------------------- a stage
+
+@dataclass
+class Stage:
+    """One stage of a loading path (module docstring).
+
+    stress: {axis: target [Pa]}; strain_rate: {axis: rate [1/s]}, compression positive, 0 for
+    walls held; every axis in one of them, except those a mixed condition sets:
+    ``mean_stress`` [Pa] (the axes given neither share 3 p less the other stresses) and/or
+    ``b`` in [0, 1] (sigma_1 on z, driven at a positive rate; with b alone, sigma_3 is x's
+    stress and y is set; with both, x and y are set). until: Strain, Stress or Static;
+    max_strain_rate: largest strain rate of the servoed walls [1/s] (None: the path's servo
+    speed), the quasi-static bound of a stage the servo drives.
+    """
+
+    stress: dict = field(default_factory=dict)
+    strain_rate: dict = field(default_factory=dict)
+    until: Strain | Stress | Static = field(default_factory=Static)
+    mean_stress: float | None = None
+    b: float | None = None
+    max_strain_rate: float | None = None
+
+    def __post_init__(self):
+        self.stress = {_axis_name("stress axis", axis): check_range(
+            f"stress[{axis!r}]", value, 0.0, unit="Pa") for axis, value in self.stress.items()}
+        self.strain_rate = {_axis_name("strain_rate axis", axis): check_range(
+            f"strain_rate[{axis!r}]", value, -MAX_STRAIN_RATE, MAX_STRAIN_RATE, unit="1/s")
+            for axis, value in self.strain_rate.items()}
+        both = sorted(set(self.stress) & set(self.strain_rate))
+        if both:
+            raise ValueError(f"axis {', '.join(both)}: give a stress or a strain rate, not both")
+        if not isinstance(self.until, (Strain, Stress, Static)):
+            raise TypeError(f"until = {self.until!r}: a Strain, Stress or Static expected")
+        if self.mean_stress is not None:
+            self.mean_stress = check_positive("mean_stress", self.mean_stress, "Pa")
+        if self.b is not None:
+            self.b = check_range("b", self.b, 0.0, 1.0)
+        if self.max_strain_rate is not None:
+            self.max_strain_rate = check_range("max_strain_rate", self.max_strain_rate, 0.0,
+                                               MAX_STRAIN_RATE, low_inclusive=False, unit="1/s")
+        self._check_mixed()
+        self._check_until()
+
+    @property
+    def free(self):
+        """The axes a mixed condition sets (neither a stress nor a strain rate given)."""
+        return tuple(a for a in AXIS_NAMES if a not in self.stress and a not in self.strain_rate)
+
+    def _check_mixed(self):
+        free = self.free
+        if self.mean_stress is None and self.b is None:
+            if free:
+                raise ValueError(f"axis {', '.join(free)} has neither a stress nor a strain "
+                                 "rate: give one (or a mean_stress or b that sets it)")
+            return
+        if self.strain_rate.get("z", 0.0) == 0.0:
+            raise ValueError("a mean_stress or b condition needs z driven at a non-zero strain "
+                             "rate (the axial walls load, the lateral ones follow)")
+        if self.b is not None:
+            if self.strain_rate["z"] < 0.0:
+                raise ValueError(f"b = {self.b:g} needs z compressed (strain rate > 0): b is "
+                                 "defined with sigma_1 on z")
+            if self.mean_stress is not None and free != ("x", "y"):
+                raise ValueError(f"b = {self.b:g} with mean_stress sets x and y: give them "
+                                 "neither a stress nor a strain rate")
+            if self.mean_stress is None and (free != ("y",) or "x" not in self.stress):
+                raise ValueError(f"b = {self.b:g} sets y from sigma_3 on x: give x a stress "
+                                 "and y neither a stress nor a strain rate")
+        elif not free or "z" in free:
+            raise ValueError("mean_stress sets the lateral axes given neither a stress nor a "
+                             "strain rate: leave x or y (or both) free")
+
+    def _check_until(self):
+        until = self.until
+        if isinstance(until, Static):
+            moving = sorted(a for a, r in self.strain_rate.items() if r != 0.0)
+            if moving or self.mean_stress is not None or self.b is not None:
+                raise ValueError("until static needs every axis servoed or held (strain rate "
+                                 f"0): axis {', '.join(moving) or 'z'} keeps moving")
+            return
+        rate = self.strain_rate.get(until.axis, 0.0)
+        if rate == 0.0:
+            kind = "strain" if isinstance(until, Strain) else "stress"
+            raise ValueError(f"until {kind} on {until.axis} needs {until.axis} driven at a "
+                             "non-zero strain rate")
+
+    def describe(self):
+        """The stage in words, e.g. 'x,y 750 Pa; z 2.6 1/s; until z strain 0.25'."""
+        parts = [f"{axis} {value:g} Pa" for axis, value in self.stress.items()]
+        parts += [f"{axis} {value:.3g} 1/s" for axis, value in self.strain_rate.items()]
+        if self.mean_stress is not None:
+            parts.append(f"p {self.mean_stress:g} Pa")
+        if self.b is not None:
+            parts.append(f"b {self.b:g}")
+        until = self.until
+        if isinstance(until, Strain):
+            parts.append(f"until {until.axis} strain {until.value:g}")
+        elif isinstance(until, Stress):
+            parts.append(f"until {until.axis} stress {until.value:g} Pa")
+        else:
+            parts.append("until static")
+        return "; ".join(parts)
+
+
+class MixedStress:
+    """A control that sets, each step before the servos run, the targets of the servos of the
+    free axes of a Stage from the stresses now (module docstring): with ``mean_stress`` alone,
+    each free axis (3 p - the other axes' stresses) / (number of free axes); with ``b`` alone,
+    sigma_y = sigma_3 + b (sigma_z - sigma_3), sigma_3 x's target; with both, sigma_3 =
+    (3 p - (1 + b) sigma_z) / (2 - b) on x and sigma_y as above. StageFailed when a target
+    falls below zero (walls cannot pull)."""
+
+    def __init__(self, stage, servos):
+        self.mean_stress = stage.mean_stress
+        self.b = stage.b
+        self.stress = {AXES[a]: value for a, value in stage.stress.items()}
+        self.free = tuple(AXES[a] for a in stage.free)
+        self.servos = servos                # {axis index: the StressServo of that axis}
+
+    def targets(self, sigma):
+        """{axis index: target [Pa]} of the free axes for the stresses ``sigma`` (3,) [Pa]."""
+        given = {a: self.stress.get(a, sigma[a]) for a in range(3)}
+        if self.b is None:
+            others = sum(given[a] for a in range(3) if a not in self.free)
+            share = (3.0 * self.mean_stress - others) / len(self.free)
+            return {a: share for a in self.free}
+        axial = sigma[2]
+        if self.mean_stress is None:
+            minor = given[0]
+            return {1: minor + self.b * (axial - minor)}
+        minor = (3.0 * self.mean_stress - (1.0 + self.b) * axial) / (2.0 - self.b)
+        return {0: minor, 1: minor + self.b * (axial - minor)}
+
+    def apply(self, sim):
+        sigma = sim.walls.stress()
+        for axis, target in self.targets(sigma).items():
+            if not target >= 0.0:
+                condition = ("the mean stress" if self.b is None else "b") + " condition"
+                raise StageFailed(
+                    f"{condition} cannot be held at step {sim.step}: it needs "
+                    f"{target:.4g} Pa on {AXIS_NAMES[axis]} with sigma_z = {sigma[2]:.4g} Pa, "
+                    "and walls cannot pull; end the shear earlier (--max-strain) or raise "
+                    "the confining stress")
+            self.servos[axis].target = target
+
+
+# ---------------------------------------------------------------- a path
+
+class AxisStrain:
+    """The engineering strain 1 - L / L0 of ``axis`` (0, 1, 2) from ``reference_length`` L0
+    [m], compression positive."""
+
+    def __init__(self, axis, reference_length):
+        self.axis = axis
+        self.reference_length = reference_length
+
+    def strain(self, walls):
+        return 1.0 - walls.lengths()[self.axis] / self.reference_length
+
+
+def capillary_operation(sim):
+    """The scene's capillary bridge operation, or None for a dry scene."""
+    found = [op for op in sim.forces if hasattr(op, "water_volume")]
+    return found[0] if found else None
+
+
+def history_columns(sim, axial, reference_volume, bridges=None):
+    """Recorded columns of a loading path's history (name -> function of sim); ``axial``
+    measures the axial strain (``strain(walls)``); pendular.io.schema declares their units. A
+    wet scene adds the capillary and homogenised columns of
+    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+
+    def contact_fabric(s):
+        return fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0)   # Eq. 4.1
+
+    columns = {
+        "step": lambda s: s.step,
+        "time": lambda s: s.time,
+        "axial_strain": lambda s: axial.strain(s.walls),
+        "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
+        "sigma_wall": lambda s: s.walls.stress(),
+        "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
+        "porosity": lambda s: porosity(s.particles, s.walls),
+        "coordination": lambda s: coordination(s.contacts, len(s.particles)),
+        "fabric": contact_fabric,
+        "anisotropy": lambda s: principal_anisotropy(contact_fabric(s)),      # Eq. 3.51
+        "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
+    }
+    if bridges is not None:
+        from pendular.homogenize.on_the_fly import CapillaryHomogenization
+
+        columns.update(CapillaryHomogenization(bridges).quantities())
+        if bridges.liquid != "reservoir":             # a closed amount of liquid
+            columns.update({"liquid_bridges": lambda s: bridges.liquid_balance(s)[0],
+                            "liquid_film": lambda s: bridges.liquid_balance(s)[1],
+                            "liquid_lost": lambda s: bridges.liquid_balance(s)[2]})
+    return columns
+
+
+def void_ratio(sim):
+    """Void ratio e = n / (1 - n) of the box [-] (n: pendular.dem.measure.porosity)."""
+    n = porosity(sim.particles, sim.walls)
+    return n / (1.0 - n)
+
+
+def k0(sim):
+    """sigma_lateral / sigma_axial of the walls [-] (the coefficient of earth pressure; NaN
+    while the axial stress is not positive)."""
+    sigma = sim.walls.stress()
+    return float(lateral_stress(sigma) / sigma[2]) if sigma[2] > 0.0 else math.nan
+
+
+class LoadingPath:
+    """Run ``stages`` (Stage) of the static sample ``sim`` one after the other, recording one
+    history: ``history_columns`` plus ``columns`` (name -> function of sim) and, for more than
+    one stage, ``stage`` (the index of the stage running).
+
+    Attaching it replaces ``sim.controls`` by the first stage's and records the first row.
+    Rows every ``records``-th of the path's steps when its length is known (one stage ending
+    at a strain: ``steps``), else every ``record_every`` steps, and at each stage's end.
+    Servo settings as pendular.procedures.config.ShearConfig (``servo_max_velocity`` None:
+    that of the scene's StressServo, or pendular.procedures.preparation.servo_speed);
+    ``rate_on_current_length``: the strain rates act on the current lengths. A SampleGuard
+    watches the sample at the rows' period (``guard`` False: none, e.g. for the densest
+    packing, whose porosity is the guard's bound).
+
+    ``run(sim)`` runs the stages to the end (or ``max_steps`` steps); ``state()`` and
+    ``resume(sim, state)`` carry the stage reached across a checkpoint. ``axial``: the
+    axial strain's measure; ``controls``: the running stage's controls.
+    """
+
+    def __init__(self, sim, stages, *, records=None, record_every=None, columns=None,
+                 servo_max_velocity=None, servo_scale_max_velocity=False,
+                 servo_stiffness_every=1, rate_on_current_length=False, guard=True):
+        self.stages = list(stages)
+        if not self.stages or not all(isinstance(s, Stage) for s in self.stages):
+            raise ValueError("stages: a non-empty list of Stage expected")
+        self.reference_length = sim.walls.lengths().copy()
+        self.axial = AxisStrain(2, self.reference_length[2])
+        servo = next((op for op in sim.controls if isinstance(op, StressServo)), None)
+        if servo_max_velocity is None:
+            servo_max_velocity = (servo.max_velocity if servo is not None
+                                  else servo_speed(sim.walls, sim.dt))
+        self.servo_max_velocity = servo_max_velocity
+        self.servo_scale_max_velocity = servo_scale_max_velocity
+        self.servo_stiffness_every = servo_stiffness_every
+        self.rate_on_current_length = rate_on_current_length
+        self.stage, self.stage_start = 0, sim.step
+        self.controls = self._controls(sim, self.stages[0], ())
+        if sim.contacts is None:
+            sim.evaluate_forces()     # a sample just loaded: the first record sees its contacts
+        sim.controls = list(self.controls)
+        self.stage_steps = self._stage_steps(sim)
+        self.steps = self.stage_steps if (len(self.stages) == 1 and isinstance(
+            self.stages[0].until, Strain)) else None
+        if self.steps is not None and records is not None:
+            period, end = max(1, self.steps // records), sim.step + self.steps
+        elif record_every is not None:
+            period, end = check_int("record_every", record_every, low=1), None
+        else:
+            raise ValueError("record_every is needed: the path's length is not known before "
+                             "it runs (records applies to one stage ending at a strain)")
+        quantities = history_columns(sim, self.axial, sim.walls.volume(),
+                                     capillary_operation(sim))
+        quantities.update(columns or {})
+        if len(self.stages) > 1:
+            quantities["stage"] = lambda s: self.stage
+        self.recorder = HistoryRecorder(period, quantities, origin=sim.step, end=end)
+        self.recorder.record(sim)
+        sim.writers.append(self.recorder)
+        if guard:
+            sim.writers.append(SampleGuard(self.recorder.period, describe=lambda s: (
+                f"axial strain {self.axial.strain(s.walls):.3g}")))
+
+    # ------------------------------------------------------------ controls of a stage
+    def _controls(self, sim, stage, previous):
+        """The controls of ``stage`` in order (MixedStress, servos, strain rates); the servos of
+        ``previous`` (the controls of the stage before) on the same axes carry on."""
+        carried = {op.axes: op for op in previous if isinstance(op, StressServo)}
+        max_velocity = self.servo_max_velocity
+        if stage.max_strain_rate is not None:
+            max_velocity = StressServo.max_velocity_for(stage.max_strain_rate,
+                                                        float(np.mean(sim.walls.lengths())))
+        groups = {}                          # axes -> target
+        for axis, target in stage.stress.items():
+            same = next((axes for axes, value in groups.items() if value == target
+                         and stage.b is None), None)
+            if same is None:
+                groups[axis] = target
+            else:
+                groups[same + axis] = groups.pop(same)
+        free = stage.free
+        if free:
+            start = stage.mean_stress if stage.mean_stress is not None else stage.stress["x"]
+            if stage.b is None:
+                groups["".join(free)] = start
+            else:
+                groups.update({axis: start for axis in free})
+        servos = []
+        for axes in sorted(groups, key=lambda a: AXIS_NAMES.index(a[0])):
+            key = tuple(AXES[a] for a in axes)
+            servo = carried.get(key)
+            if servo is None:
+                servo = StressServo(axes, groups[axes], max_velocity,
+                                    scale_max_velocity=self.servo_scale_max_velocity,
+                                    stiffness_every=self.servo_stiffness_every)
+            else:
+                servo.target, servo.max_velocity = groups[axes], max_velocity
+            servos.append(servo)
+        controls = []
+        if free:
+            by_axis = {axis: servo for servo in servos for axis in servo.axes}
+            controls.append(MixedStress(stage, by_axis))
+        controls += servos
+        for axis in AXIS_NAMES:
+            rate = stage.strain_rate.get(axis, 0.0)
+            if rate != 0.0:                 # a rate of 0: the walls stay where they are
+                controls.append(ConstantStrainRate(
+                    axis, rate, self.reference_length[AXES[axis]],
+                    on_current_length=self.rate_on_current_length))
+        return controls
+
+    def _driver(self, axis):
+        """The ConstantStrainRate of ``axis`` in the running stage's controls."""
+        return next(op for op in self.controls
+                    if isinstance(op, ConstantStrainRate) and op.axis == AXES[axis])
+
+    def strain(self, sim, axis):
+        """Engineering strain of ``axis`` from the start of the path [-]."""
+        index = AXES[axis]
+        return 1.0 - sim.walls.lengths()[index] / self.reference_length[index]
+
+    def _stage_steps(self, sim):
+        """Steps of the running stage: its length (Strain), its most (Stress: to its strain
+        limit; Static: max_steps)."""
+        until = self.stages[self.stage].until
+        if isinstance(until, Static):
+            return until.max_steps
+        driver = self._driver(until.axis)
+        start = self.strain(sim, until.axis) if self.stage else 0.0
+        if isinstance(until, Strain):
+            return driver.steps_to(until.value, sim.dt, start)
+        limit = math.copysign(until.strain_limit, driver.rate)
+        if (limit - start) * driver.rate <= 0.0:
+            raise StageFailed(f"stage {self.stage + 1}: the strain of {until.axis} is already "
+                              f"{start:.3g}, beyond its limit {limit:g}")
+        return driver.steps_to(limit, sim.dt, start)
+
+    # ------------------------------------------------------------ running
+    def state(self):
+        """What a checkpoint must carry to resume the path: the stage, its first step and its
+        steps (its length or limit)."""
+        return {"stage": self.stage, "stage_start": self.stage_start,
+                "stage_steps": self.stage_steps}
+
+    def resume(self, sim, state):
+        """Take the stage of ``state`` (``state()`` of the run a checkpoint was written by),
+        once that checkpoint is loaded into ``sim``: the path's controls are then the loaded
+        ones (a checkpoint loads into a pipeline of the same operation types, so every stage
+        of a resumable path has those of the first)."""
+        try:
+            self.stage = check_int("stage", state["stage"], high=len(self.stages) - 1)
+            self.stage_start = check_int("stage_start", state["stage_start"], high=sim.step)
+            self.stage_steps = check_int("stage_steps", state["stage_steps"])
+        except (KeyError, TypeError):
+            raise ValueError(f"a checkpoint's path state {state!r} lacks the stage, its start "
+                             "or its steps") from None
+        self.controls = list(sim.controls)
+
+    @property
+    def done(self):
+        return self.stage >= len(self.stages)
+
+    def _reached(self, sim):
+        """Whether the running stage's end is reached now."""
+        stage = self.stages[self.stage]
+        until = stage.until
+        if isinstance(until, Strain):
+            return sim.step - self.stage_start >= self.stage_steps
+        if isinstance(until, Stress):
+            sigma = sim.walls.stress()[AXES[until.axis]]
+            return (sigma - until.value) * stage.strain_rate[until.axis] >= 0.0
+        return ((sim.step - self.stage_start) % until.check_every == 0
+                and static(until.unbalanced, until.tolerance)(sim))
+
+    def run(self, sim, *, max_steps=None, progress=None, status=None):
+        """Run the stages from where the path is to its end, or ``max_steps`` steps; returns
+        the steps taken. ``progress``: a progress bar label (None: no bar); ``status``: the
+        bar's fields (default ``self.status``). StageFailed when a stage cannot reach its
+        end within its limit."""
+        budget = math.inf if max_steps is None else check_int("max_steps", max_steps)
+        status = status or self.status
+        taken = 0
+        while not self.done:
+            if self._reached(sim):
+                self._next(sim)
+                continue
+            if taken >= budget:
+                break
+            until = self.stages[self.stage].until
+            steps = int(min(self.steps_left(sim), budget - taken))
+            label = progress if progress is None or len(self.stages) == 1 else (
+                f"{progress} {self.stage + 1}/{len(self.stages)}")
+            if isinstance(until, Strain):
+                taken += sim.run(steps, progress=label, status=status)
+                continue
+            every = 1 if isinstance(until, Stress) else until.check_every
+            offset = (sim.step - self.stage_start) % every
+            if offset:              # a resumed stage: its checks fall where they fell before
+                taken += sim.run(min(every - offset, steps), progress=label, status=status)
+                continue
+            taken += sim.run(steps, until=self._reached, check_every=every, progress=label,
+                             status=status)
+            if not self._reached(sim) and sim.step >= self.stage_start + self.stage_steps:
+                raise StageFailed(self._failure(sim))
+        return taken
+
+    def steps_left(self, sim):
+        """Steps left to the running stage's end (Strain) or limit (Stress, Static) [-]."""
+        return self.stage_start + self.stage_steps - sim.step
+
+    def _failure(self, sim):
+        stage, until = self.stages[self.stage], self.stages[self.stage].until
+        where = f"stage {self.stage + 1} ({stage.describe()})"
+        if isinstance(until, Stress):
+            sigma = sim.walls.stress()[AXES[until.axis]]
+            return (f"{where}: the {until.axis} stress is {sigma:.4g} Pa after a strain of "
+                    f"{self.strain(sim, until.axis):.3g}, its limit: the target "
+                    f"{until.value:g} Pa is out of this sample's reach")
+        fields = ", ".join(f"{k} {v}" for k, v in self.status(sim).items())
+        return (f"{where}: not static after {self.stage_steps} steps ({fields}); raise the "
+                "stage's step limit (--stage-steps)")
+
+    def _next(self, sim):
+        """End the running stage: its last row (unless just recorded) and the next stage's
+        controls."""
+        if self.recorder.rows["step"][-1] != sim.step:
+            self.recorder.record(sim)
+        self.stage += 1
+        if self.done:
+            return
+        self.stage_start = sim.step
+        self.controls = self._controls(sim, self.stages[self.stage], self.controls)
+        sim.controls = list(self.controls)
+        self.stage_steps = self._stage_steps(sim)
+
+    def status(self, sim):
+        """Progress-bar fields: strain, axial and lateral stress, q/p."""
+        sigma = sim.walls.stress()
+        return {"strain": f"{self.axial.strain(sim.walls):.3f}",
+                "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral_stress(sigma):.0f}Pa",
+                "q/p": f"{deviator_stress(sigma) / mean_stress(sigma):.2f}"}
+
+
+# ---------------------------------------------------------------- the laboratory's paths
+
+def shear_stage(shear, confining, rate):
+    """The Stage of a triaxial shear of ``shear`` (pendular.procedures.config.ShearConfig)
+    from the isotropic ``confining`` stress [Pa] at the axial strain rate ``rate`` [1/s]: the
+    axial walls compressed (or, in extension, pulled apart) to ``shear.max_strain``; the lateral
+    walls at the confining stress, or with ``shear.b`` sigma_3 = confining on x and sigma_y =
+    sigma_3 + b (sigma_z - sigma_3), or with ``shear.constant_p`` at the stresses that keep
+    p = confining (and b, when given). b = 0 alone is the conventional compression."""
+    sign = 1.0 if shear.direction == "compression" else -1.0
+    until = Strain(sign * shear.max_strain)
+    axial = {"z": sign * rate}
+    if shear.constant_p:
+        return Stage(strain_rate=axial, mean_stress=confining, b=shear.b, until=until)
+    if shear.b is not None and shear.b > 0.0:
+        return Stage(stress={"x": confining}, strain_rate=axial, b=shear.b, until=until)
+    return Stage(stress={"x": confining, "y": confining}, strain_rate=axial, until=until)
+
+
+def oedometer_stages(axial_stress, rate, unload_to=None):
+    """Stages of an oedometric (K0) test: the lateral walls held, the axial walls compressed at
+    ``rate`` [1/s] until the axial stress is ``axial_stress`` [Pa], then with ``unload_to``
+    [Pa] pulled back at the same rate until it is that."""
+    held = {"x": 0.0, "y": 0.0}
+    stages = [Stage(strain_rate={**held, "z": rate}, until=Stress(axial_stress))]
+    if unload_to is not None:
+        stages.append(Stage(strain_rate={**held, "z": -rate}, until=Stress(unload_to)))
+    return stages
+
+
+def isotropic_stages(stresses, rate, *, max_steps=200000, unbalanced=0.01, tolerance=0.01):
+    """Stages of an isotropic loading and unloading: the six walls servoed to each of
+    ``stresses`` [Pa] in turn, at most at the strain rate ``rate`` [1/s], each until static
+    (``unbalanced``, ``tolerance``) within ``max_steps``."""
+    return [Stage(stress={axis: value for axis in AXIS_NAMES}, max_strain_rate=rate,
+                  until=Static(max_steps, unbalanced, tolerance)) for value in stresses]
+
+
+# ---------------------------------------------------------------- results
+
+def friction_angle(sigma):
+    """Mobilised friction angle [deg] of principal stresses ``sigma`` (..., 3) [Pa]:
+    asin((sigma_1 - sigma_3) / (sigma_1 + sigma_3)), sigma_1 and sigma_3 the largest and the
+    least (Mohr-Coulomb without cohesion); NaN where sigma_1 + sigma_3 <= 0."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    high, low = sigma.max(axis=-1), sigma.min(axis=-1)
+    total = high + low
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where(total > 0.0, (high - low) / np.where(total > 0.0, total, 1.0), np.nan)
+    return np.degrees(np.arcsin(np.clip(ratio, -1.0, 1.0)))
+
+
+def measured_b(sigma, mean):
+    """b = (sigma_y - sigma_x) / (sigma_z - sigma_x) of wall stresses ``sigma`` (n, 3) [Pa],
+    NaN where sigma_z - sigma_x is below B_MEASURE_FROM times ``mean`` [Pa]."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    span = sigma[:, 2] - sigma[:, 0]
+    measured = span > B_MEASURE_FROM * mean
+    return np.where(measured, (sigma[:, 1] - sigma[:, 0]) / np.where(measured, span, 1.0),
+                    np.nan)
+
+
+def path_deviations(history, shear, confining):
+    """How closely a shear of ``shear`` (ShearConfig) held its mixed condition: with
+    ``constant_p``, ``mean_stress_deviation`` max over the records of |p / confining - 1|;
+    with ``b``, ``b_deviation`` max of |b measured - b| over the records with sigma_z - sigma_x
+    of at least B_MEASURE_FROM confining (measured_b). Both [-]; {} for neither."""
+    sigma = history["sigma_wall"]
+    found = {}
+    if shear.constant_p:
+        found["mean_stress_deviation"] = float(np.max(np.abs(mean_stress(sigma) / confining
+                                                             - 1.0)))
+    if shear.b is not None:
+        b = measured_b(sigma, confining)
+        found["b_deviation"] = (float(np.nanmax(np.abs(b - shear.b)))
+                                if np.isfinite(b).any() else None)
+    return found
+
+
+def _stage_ends(history, count):
+    """Row of each stage's end (the last row of each stage index), for ``count`` stages."""
+    stage = history.get("stage")
+    if stage is None:
+        return [len(history["step"]) - 1]
+    return [int(np.flatnonzero(stage == k)[-1]) for k in range(count)
+            if np.any(stage == k)]
+
+
+def _index(e_high, e_low, stress_high, stress_low):
+    """Delta e per log10 of the stress over a stress change [-], None without one."""
+    span = math.log10(stress_high / stress_low) if stress_high > 0 and stress_low > 0 else 0.0
+    return (e_high - e_low) / span if span > 0.0 else None
+
+
+def _indices(void, stress):
+    """(compression index, swelling index) [-] of successive states (void ratio, stress [Pa]):
+    the total decrease of e over the total rise of log10 sigma over the steps that load, and
+    the total rise of e over the total fall of log10 sigma over those that unload (None
+    without such a step)."""
+    loading = [0.0, 0.0]
+    unloading = [0.0, 0.0]
+    for k in range(1, len(stress)):
+        if stress[k] <= 0.0 or stress[k - 1] <= 0.0:
+            continue
+        rise = math.log10(stress[k] / stress[k - 1])
+        change = void[k] - void[k - 1]
+        side = loading if rise > 0.0 else unloading
+        side[0] += -change if rise > 0.0 else change
+        side[1] += abs(rise)
+    return tuple(total / span if span > 0.0 else None for total, span in (loading, unloading))
+
+
+def _effective(history):
+    """Diagonal (n, 3) of the effective stress (Eq. 3.43) of a wet history, or None."""
+    if "sigma_effective" not in history:
+        return None
+    return np.diagonal(history["sigma_effective"], axis1=1, axis2=2)
+
+
+def oedometer_summary(history, axial_stress, unload_to=None):
+    """Results of an oedometric test's history (oedometer_stages; columns ``void_ratio`` and,
+    with unloading, ``stage``): at the end of the loading (the target ``axial_stress`` [Pa])
+    ``k0`` = sigma_lateral / sigma_axial, the axial and lateral stresses, axial strain and void
+    ratio; ``constrained_modulus`` [Pa] = (sigma_v - sigma_v0) / (eps_a - eps_a0) over the
+    loading (secant from the start) and ``constrained_modulus_tangent`` over its last fifth
+    of stress (least squares); ``compression_index`` = -Delta e / Delta log10 sigma_v over the
+    loading; with ``unload_to``: the same at the end of the unloading,
+    ``constrained_modulus_unloading`` (secant) and ``swelling_index``. A wet history adds
+    ``k0_effective`` and the indices against the effective vertical stress (Eq. 3.43)."""
+    sigma = history["sigma_wall"]
+    strain = history["axial_strain"]
+    void = history["void_ratio"]
+    ends = _stage_ends(history, 2 if unload_to is not None else 1)
+    loaded = ends[0]
+    axial, lateral = sigma[:, 2], lateral_stress(sigma)
+    summary = {
+        "k0": float(lateral[loaded] / axial[loaded]),
+        "axial_stress_target": float(axial_stress),
+        "axial_stress_at_load": float(axial[loaded]),
+        "lateral_stress_at_load": float(lateral[loaded]),
+        "axial_strain_at_load": float(strain[loaded]),
+        "initial_void_ratio": float(void[0]),
+        "void_ratio_at_load": float(void[loaded]),
+        "constrained_modulus": float((axial[loaded] - axial[0]) / (strain[loaded] - strain[0])),
+        "constrained_modulus_tangent": _tangent_modulus(strain[:loaded + 1],
+                                                        axial[:loaded + 1]),
+        "compression_index": _index(void[0], void[loaded], axial[loaded], axial[0]),
+    }
+    effective = _effective(history)
+    if effective is not None:
+        summary["k0_effective"] = float(lateral_stress(effective[loaded])
+                                        / effective[loaded, 2])
+        summary["compression_index_effective"] = _index(void[0], void[loaded],
+                                                        effective[loaded, 2], effective[0, 2])
+    if unload_to is not None and len(ends) == 2:
+        final = ends[1]
+        summary.update({
+            "unload_to": float(unload_to),
+            "k0_final": float(lateral[final] / axial[final]),
+            "axial_stress_final": float(axial[final]),
+            "axial_strain_final": float(strain[final]),
+            "void_ratio_final": float(void[final]),
+            "constrained_modulus_unloading": float((axial[loaded] - axial[final])
+                                                   / (strain[loaded] - strain[final])),
+            "swelling_index": _index(void[final], void[loaded], axial[loaded], axial[final]),
+        })
+        if effective is not None:
+            summary["swelling_index_effective"] = _index(void[final], void[loaded],
+                                                         effective[loaded, 2],
+                                                         effective[final, 2])
+    return summary
+
+
+def _tangent_modulus(strain, stress, fraction=0.2):
+    """Slope d sigma / d eps [Pa] (least squares) over the rows whose stress lies in the top
+    ``fraction`` of the range of ``stress``; None with fewer than 3 such rows."""
+    top = stress >= stress.max() - fraction * (stress.max() - stress[0])
+    if np.count_nonzero(top) < 3 or np.ptp(strain[top]) == 0.0:
+        return None
+    return float(np.polyfit(strain[top], stress[top], 1)[0])
+
+
+def isotropic_summary(history, stresses):
+    """Results of an isotropic path's history (isotropic_stages to ``stresses`` [Pa]; columns
+    ``void_ratio`` and ``stage``): ``stages``, one row per stage end (target, p [Pa], void
+    ratio, volumetric strain, and wet p' of the effective stress, Eq. 3.43), and
+    ``compression_index`` / ``swelling_index`` = Delta e per log10 p over the steps between
+    successive listed stresses that load / unload (the stage from the confining stress to the
+    first listed one is the path's start, not a step of it); wet, the same against p'
+    (``*_effective``)."""
+    void = history["void_ratio"]
+    p = mean_stress(history["sigma_wall"])
+    effective = _effective(history)
+    ends = _stage_ends(history, len(stresses))
+    rows = []
+    for k, row in enumerate(ends):
+        entry = {"stage": k, "target": float(stresses[k]), "p": float(p[row]),
+                 "void_ratio": float(void[row]),
+                 "volumetric_strain": float(history["volumetric_strain"][row]),
+                 "step": int(history["step"][row])}
+        if effective is not None:
+            entry["p_effective"] = float(effective[row].mean())
+        rows.append(entry)
+    compression, swelling = _indices([r["void_ratio"] for r in rows], [r["p"] for r in rows])
+    summary = {"stages": rows, "initial_void_ratio": float(void[0]),
+               "final_void_ratio": float(void[-1]), "compression_index": compression,
+               "swelling_index": swelling}
+    if effective is not None:
+        compression, swelling = _indices([r["void_ratio"] for r in rows],
+                                         [r["p_effective"] for r in rows])
+        summary.update({"compression_index_effective": compression,
+                        "swelling_index_effective": swelling})
+    return summary
