@@ -80,8 +80,7 @@ def wet_triaxial_run(tmp_path_factory):
     """Output folder of scenarios/triaxial.py: 200 spheres at 30 kPa to 1 % strain, with
     ParaView frames of the preparation (--vtk-prep), run once for every test that reads it."""
     out = tmp_path_factory.mktemp("wet_triaxial") / "wet"
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    subprocess.run([sys.executable, os.path.join(root, "scenarios", "triaxial.py"),
+    subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"),
                     "--particles", "200", "--max-strain", "0.01", "--inertial-number", "2e-3",
                     "--suction", "30000", "--vtk-prep", "--quiet", "--out", str(out)],
                    check=True, capture_output=True, text=True)

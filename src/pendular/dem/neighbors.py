@@ -5,10 +5,11 @@ Pairs are stored once (i < j) in CSR order: the pairs of particle i are
 for each particle, the pairs in which it is the second member, so that per-pair results
 can be gathered per particle without atomics (deterministic for any thread count).
 
-Operations may keep their own per-pair state in ``Contacts.extra`` (name -> array with one row
-per pair, any dtype and trailing shape); ``build_contacts`` carries every such array to the same
-(i, j) pair across rebuilds, as it does for the shear history. ``NeighborList`` reaches beyond
-touching as far as the scene's forces declare (``reach(sim)``, e.g. liquid bridges across gaps).
+Operations keep their own per-pair state in ``Contacts.extra`` (declared as PairFields and read
+through ``pair_arrays``, pendular.dem.protocols); ``build_contacts`` carries every such array to
+the same (i, j) pair across rebuilds, as it does for the shear history. ``NeighborList``
+reaches beyond touching as far as the scene's forces declare (``reach(sim)``, e.g. liquid
+bridges across gaps).
 """
 
 from dataclasses import dataclass, field
@@ -16,6 +17,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from pendular.dem.protocols import ReachingForce
 from pendular.utils.validate import check_positive, check_range
 from pendular.dem.virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
@@ -529,6 +531,10 @@ def build_contacts(position, radius, skin, previous=None, period=None, walls=Non
         raise FloatingPointError(
             f"position of particle {particle} = {position[particle].tolist()} is not finite: the "
             "simulation diverged (lower the time step, e.g. timestep_safety, or check the forces)")
+    if period is not None and not np.isfinite(period).all():
+        raise FloatingPointError(f"the periodic cell's period {np.asarray(period).tolist()} m is "
+                                 "not finite: the cell diverged (lower the time step or the "
+                                 "strain rate)")
     count = len(radius)
     if period is None:
         row_start, pair_j = build_pairs(position, radius, skin)
@@ -608,7 +614,7 @@ class NeighborList:
         step)."""
         reach = 0.0
         for op in sim.forces:
-            if hasattr(op, "reach"):
+            if isinstance(op, ReachingForce):
                 value = op.reach(sim)
                 if value != self.interaction_range:
                     value = check_range(f"{type(op).__name__}.reach", value, 0.0, unit="m")

@@ -25,6 +25,7 @@ import time
 import numba
 from tqdm import tqdm
 
+from pendular.dem.protocols import Operation
 from pendular.dem.state import Box, Particles
 from pendular.utils.validate import check_int, check_positive
 from pendular.utils.threads import configure as configure_threading
@@ -41,8 +42,9 @@ SERIAL_BELOW = 500
 
 
 def _check_operation(op):
-    if not callable(getattr(op, "apply", None)):
-        raise TypeError(f"operation {op!r} has no apply(sim) method")
+    """``op`` if it meets the Operation contract (pendular.dem.protocols), else TypeError."""
+    if not isinstance(op, Operation) or not callable(op.apply):
+        raise TypeError(f"operation {op!r} has no apply(sim) method (pendular.dem.protocols)")
     return op
 
 
