@@ -15,7 +15,8 @@ import pytest
 
 from pendular import capillary
 from pendular.capillary import BridgeState, CapillaryBridges
-from pendular.capillary.bridge_kernels import gather_contact_bridges, pendular_overlap_counts
+from pendular.capillary.bridge_kernels import (gather_contact_bridges, particle_pairs,
+    pendular_overlap_counts)
 from conftest import PrescribedGap, ROOT, two_body_scene
 from pendular.dem.contact_law import ContactForces, gather_contact_forces
 from pendular.dem.neighbors import NeighborList, build_contacts
@@ -182,10 +183,11 @@ def test_saturation_bridges_and_pendular_overlaps_against_hand_sums(wet_sample):
     contacts = build_contacts(position, np.full(3, 1.0), 0.1)
     state = np.ones(len(contacts), np.int8)
     wide = np.full(len(contacts), 31.0)    # caps 60 deg apart: 31 + 31 > 60
-    assert pendular_overlap_counts(position, contacts.row_start, contacts.second_start,
-                                   contacts.second_pair, contacts.pair_i, contacts.pair_j,
-                                   contacts.image, Walls.box([-3.0] * 3, [3.0] * 3).period, state,
-                                   wide, wide).sum() == 3
+    zero = np.zeros(len(contacts))
+    pairs = (position, np.full(3, 1.0), contacts.pair_i, contacts.pair_j, contacts.image,
+             Walls.box([-3.0] * 3, [3.0] * 3).period, contacts.overlap, contacts.normal)
+    assert pendular_overlap_counts(pairs, particle_pairs(contacts),
+                                   BridgeState(state, zero, zero, wide, wide, zero)).sum() == 3
 
 
 def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_sample):

@@ -1,6 +1,6 @@
 """Liquid bridges between spheres: exact Young-Laplace solutions, tables, toroidal approximation.
 
-Units (SPEC section 1): R2 >= R1, r = R2/R1, u* = s R2/gamma, d* = D/R2, V* = V/R2**3,
+Units (docs/units.md): R2 >= R1, r = R2/R1, u* = s R2/gamma, d* = D/R2, V* = V/R2**3,
 F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 
 - solve_bridge(r, theta, u*, delta1): exact bridge from its filling angle (pendular.capillary.meniscus).
@@ -9,14 +9,16 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 - BridgeTable + lookup_suction, VolumeBridgeTable + lookup_volume: tables for Numba kernels.
 - write_yade / read_yade: YADE capillary files M(r=...) (pendular.capillary.yade_files).
 - toroidal_bridge: thesis Appendix A (pendular.capillary.toroidal).
-- CapillaryBridges: the bridge operation of wet DEM scenes (pendular.capillary.bridges), its per-pair
-  BridgeState (pendular.capillary.bridge_state) and kernels (pendular.capillary.bridge_kernels).
+- CapillaryBridges: the bridge operations of wet DEM scenes (pendular.capillary.bridges), one per
+  control, SuctionBridges and VolumeBridges (``CapillaryBridges(..., control=...)`` builds
+  either), their per-pair BridgeState (pendular.capillary.bridge_state) and kernels
+  (pendular.capillary.bridge_kernels).
 - formation_suction, gravimetric_water_content: wetting at a water content (pendular.capillary.wetting).
 """
 
 from pendular.capillary.bridge_state import BridgeState
-from pendular.capillary.bridges import (BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION,
-    CapillaryBridges, sample_radius_ratios, table_radius_ratios)
+from pendular.capillary.bridges import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION,
+    CapillaryBridges, SuctionBridges, VolumeBridges, sample_radius_ratios, table_radius_ratios)
 from pendular.capillary.meniscus import Bridge, solve_bridge
 from pendular.capillary.suction_control import (bridge_at_distance, lowest_distance,
     rupture_distance)
@@ -35,8 +37,11 @@ __all__ = [
     "Bridge",
     "BridgeState",
     "CapillaryBridges",
+    "CONTROLS",
     "LIQUID_MODELS",
     "SURFACE_TENSION",
+    "SuctionBridges",
+    "VolumeBridges",
     "formation_suction",
     "gravimetric_water_content",
     "sample_radius_ratios",

@@ -1,4 +1,5 @@
-"""Numba kernels of the liquid bridges in the DEM (thesis Ch. 5, SPEC section 4).
+"""Numba kernels of the liquid bridges in the DEM (thesis Ch. 5, docs/physics.md
+'The bridge model').
 
 Per pair (parallel over pairs) a bridge forms when the spheres touch (overlap > 0, from the
 contact law of the same step) and breaks when contact is lost or, across gaps, where no bridge
@@ -6,13 +7,30 @@ exists at that gap; its force F [N] acts along the branch vector, attractive (fo
 i: -F n, n unit i -> j). Gathers add the forces per particle, each particle summing its own
 pairs in a fixed order (deterministic for any thread count, no atomics).
 
-Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
+Lookups (the units of docs/units.md): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
 d* = max(gap, 0) / R2, F = F* 2 pi gamma R2, V = V* R2^3, filling angles delta1 on the smaller
-sphere and delta2 on the larger one. Arguments named state, volume, force, filling_i,
-filling_j, bridge_suction are the arrays of pendular.capillary.bridge_state.BridgeState.
+sphere and delta2 on the larger one.
+
+The kernels take their arrays in tuples, one per kind, each unpacked at the kernel's top:
+``pairs`` (pair_geometry: what they read of the particles and the neighbour list), ``rows``
+(particle_pairs: each particle's pairs, for per-particle loops), ``table`` / ``volume_table``
+(a BridgeTable's / VolumeBridgeTable's arrays()), which they only read, are plain tuples;
+``bridges`` (a pendular.capillary.bridge_state.BridgeState) and ``liquid`` (a LiquidExchange),
+which they write, are named tuples. The scalars and the per-pair force vectors ``pair_force``
+(K, 3) [N] (force on j from i) are loose.
+
+Why two kinds. A parallel kernel names every array its ``prange`` loop writes before the loop,
+by attribute (``force = bridges.force``), and writes through that name: Numba's parallel loops
+silently drop the writes to an array taken from a tuple inside the loop, or unpacked from one
+anywhere (numba issues 5872 and 7135: their alias analysis does not see that it is the
+argument's array; tests/unit/test_bridge_operations.py checks every parallel kernel's writes).
+Its loop body reads loose arrays only, unpacked before the loop: a tuple read inside the loop
+costs a reload per access. Numba's dispatch types a plain tuple of arrays in C, as it does
+loose arrays, and a named tuple in Python, so only the bundles written carry names.
 """
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -25,8 +43,39 @@ from pendular.capillary.table import lookup_interface, lookup_suction
 from pendular.capillary.volume_table import lookup_volume, lookup_volume_interface
 
 
+def pair_geometry(sim):
+    """``pairs`` of the kernels: (position (N, 3) [m], radius (N,) [m], pair_i, pair_j (K,)
+    int64, image (K, 3) int8, period (3,) [m], overlap (K,) [m], normal (K, 3)) of ``sim`` now:
+    the particles, the pairs with their periodic images and the box period
+    (pendular.dem.neighbors.branch_vector), and the contact law's overlap (negative: a gap) and
+    unit normal i -> j of this step."""
+    p, c = sim.particles, sim.contacts
+    return (p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period, c.overlap,
+            c.normal)
+
+
+def particle_pairs(contacts):
+    """``rows`` of the kernels: (row_start, second_start, second_pair) of ``contacts``
+    (pendular.dem.neighbors.Contacts): p is the first member of pairs
+    row_start[p]:row_start[p + 1] and the second of
+    second_pair[second_start[p]:second_start[p + 1]]."""
+    return contacts.row_start, contacts.second_start, contacts.second_pair
+
+
+class LiquidExchange(NamedTuple):
+    """The liquid a closed amount moves between bridges and grains: ``film`` (N,) [m^3] held on
+    each grain; per pair, ``released`` (K,) [m^3] the volume of a bridge that ruptured and
+    ``events`` (K,) int8 what exchange_liquid has to do (NO_EVENT, RUPTURED,
+    FORMS_FROM_FILMS)."""
+
+    film: np.ndarray
+    released: np.ndarray
+    events: np.ndarray
+
+
 @numba.njit(cache=True, inline="always")
 def _clear(k, state, volume, force, filling_i, filling_j, pair_force):
+    """Pair k holds no bridge and no force."""
     state[k] = NO_BRIDGE
     volume[k] = 0.0
     force[k] = 0.0
@@ -60,6 +109,7 @@ def _apply_along(k, magnitude, n0, n1, n2, pair_force):
 
 @numba.njit(cache=True, inline="always")
 def _apply_across_gap(k, position, i, j, image, period, magnitude, pair_force):
+    """_apply_along the branch vector of pair k (i, j)."""
     d0, d1, d2 = branch_vector(position, i, j, image, k, period)
     inverse = 1.0 / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     _apply_along(k, magnitude, d0 * inverse, d1 * inverse, d2 * inverse, pair_force)
@@ -81,15 +131,20 @@ def _form_at_contact(k, radius_i, radius_j, state, volume, force, filling_i, fil
 
 
 @numba.njit(cache=True, parallel=True)
-def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filling_i, filling_j,
-                    suction, surface_tension, radius_ratios, suction_axis, distance_low,
-                    log_distance_rupture, log_values):
+def contact_bridges(pairs, bridges, suction, surface_tension, table):
     """Suction-controlled bridges that exist exactly while the spheres touch (thesis Ch. 5.2.2).
 
     A pair that starts touching gets its bridge from the table at d* = 0 (force, volume and
     filling angles depend only on the radii then); a pair that stops touching loses it. In
-    steady state this pass only reads overlap and state. overlap: the contact law's, this step.
+    steady state this pass only reads overlap and state. suction [Pa], surface_tension [N/m].
     """
+    _, radius, pair_i, pair_j, _, _, overlap, _ = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    state = bridges.state           # written in the loop: named by attribute (module docstring)
+    volume = bridges.volume
+    force = bridges.force
+    filling_i = bridges.filling_i
+    filling_j = bridges.filling_j
     for k in numba.prange(len(pair_i)):
         _follow_contact(k, radius, pair_i, pair_j, overlap, state, volume, force, filling_i,
                         filling_j, suction, surface_tension, radius_ratios, suction_axis,
@@ -97,14 +152,15 @@ def contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filli
 
 
 @numba.njit(cache=True, _nrt=False)
-def serial_contact_bridges(radius, pair_i, pair_j, overlap, state, volume, force, filling_i,
-                           filling_j, suction, surface_tension, radius_ratios, suction_axis,
-                           distance_low, log_distance_rupture, log_values):
+def serial_contact_bridges(pairs, bridges, suction, surface_tension, table):
     """contact_bridges on one thread, without the parallel launch (2-3 us a call)."""
+    _, radius, pair_i, pair_j, _, _, overlap, _ = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
     for k in range(len(pair_i)):
-        _follow_contact(k, radius, pair_i, pair_j, overlap, state, volume, force, filling_i,
-                        filling_j, suction, surface_tension, radius_ratios, suction_axis,
-                        distance_low, log_distance_rupture, log_values)
+        _follow_contact(k, radius, pair_i, pair_j, overlap, bridges.state, bridges.volume,
+                        bridges.force, bridges.filling_i, bridges.filling_j, suction,
+                        surface_tension, radius_ratios, suction_axis, distance_low,
+                        log_distance_rupture, log_values)
 
 
 @numba.njit(cache=True, inline="always")
@@ -129,11 +185,16 @@ def _follow_contact(k, radius, pair_i, pair_j, overlap, state, volume, force, fi
 
 
 @numba.njit(cache=True, parallel=True)
-def refresh_contact_bridges(radius, pair_i, pair_j, state, volume, force, filling_i, filling_j,
-                            suction, surface_tension, radius_ratios, suction_axis, distance_low,
-                            log_distance_rupture, log_values):
+def refresh_contact_bridges(pairs, bridges, suction, surface_tension, table):
     """Look every bridge at contact (AT_CONTACT, values cached) up again at a new ``suction``
     [Pa] (a suction path); bridges across gaps are looked up each step anyway."""
+    _, radius, pair_i, pair_j, _, _, _, _ = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    state = bridges.state           # written in the loop: named by attribute (module docstring)
+    volume = bridges.volume
+    force = bridges.force
+    filling_i = bridges.filling_i
+    filling_j = bridges.filling_j
     for k in numba.prange(len(pair_i)):
         if state[k] == AT_CONTACT:
             _form_at_contact(k, radius[pair_i[k]], radius[pair_j[k]], state, volume, force,
@@ -168,8 +229,8 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
     (unit i -> j, current for touching pairs): +F n on i, -F n on j (attraction).
 
     Branch-free (a pair without bridge adds 0 x its normal); each particle sums its own pairs
-    in a fixed order, as pendular.dem.neighbors.gather_pair_forces: deterministic without atomics. In a
-    periodic cell use gather_contact_bridges_virial.
+    in a fixed order, as pendular.dem.neighbors.gather_pair_forces: deterministic without
+    atomics. In a periodic cell use gather_contact_bridges_virial.
     """
     for p in numba.prange(len(row_start) - 1):
         _add_contact_bridges(p, force, normal, row_start, second_start, second_pair, out)
@@ -179,8 +240,8 @@ def gather_contact_bridges(force, normal, row_start, second_start, second_pair, 
 def gather_contact_bridges_virial(force, normal, row_start, second_start, second_pair, out,
                                   image, through_face, face_start, period, virial):
     """gather_contact_bridges in a periodic cell, which also adds the face terms of the
-    bridges' Love–Weber sum to ``virial`` (as pendular.dem.virial.add_face_block, the force on j from
-    i being -F n)."""
+    bridges' Love–Weber sum to ``virial`` (as pendular.dem.virial.add_face_block, the force on
+    j from i being -F n)."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)
@@ -196,20 +257,22 @@ def gather_contact_bridges_virial(force, normal, row_start, second_start, second
 
 
 @numba.njit(cache=True, parallel=True)
-def suction_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
-                    volume, force, filling_i, filling_j, pair_force, suction, surface_tension,
-                    radius_ratios, suction_axis, distance_low, log_distance_rupture,
-                    log_values):
+def suction_bridges(pairs, bridges, pair_force, suction, surface_tension, table):
     """Suction-controlled bridges that persist across gaps (thesis Table 5.1, ``persist``).
 
     A bridge forms when the spheres touch and lives while the table has a bridge at the gap
     (d* = gap / R2 up to the rupture distance at u* = s R2 / gamma). At contact its values are
     cached (looked up once per contact); across a gap it is looked up each step and pulls along
-    the current branch vector. overlap and normal: the contact law's values of this step;
-    image, period: the pairs' periodic images and the box period (pendular.dem.neighbors.branch_vector).
-    suction [Pa], surface_tension [N/m]; the last five arguments are a BridgeTable's arrays().
-    Fills the per-pair state and pair_force (force on j from i) [N].
+    the current branch vector. suction [Pa], surface_tension [N/m]. Fills ``bridges`` and
+    ``pair_force`` (force on j from i) [N].
     """
+    position, radius, pair_i, pair_j, image, period, overlap, normal = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    state = bridges.state           # written in the loop: named by attribute (module docstring)
+    volume = bridges.volume
+    force = bridges.force
+    filling_i = bridges.filling_i
+    filling_j = bridges.filling_j
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
         j = pair_j[k]
@@ -239,34 +302,42 @@ def suction_bridges(position, radius, pair_i, pair_j, image, period, overlap, no
             pair_force[k, 2] = 0.0
 
 
-#: Values of the per-pair ``events`` of volume_bridges (what exchange_liquid handles).
+#: Values of LiquidExchange.events (what exchange_liquid handles).
 NO_EVENT = 0
 RUPTURED = 1
 FORMS_FROM_FILMS = 2
 
 
 @numba.njit(cache=True, parallel=True)
-def volume_bridges(position, radius, pair_i, pair_j, image, period, overlap, normal, state,
-                   volume, force, filling_i, filling_j, bridge_suction, pair_force,
-                   formation_suction, surface_tension, roughness, suction_table, volume_table,
-                   closed, film, released, events):
+def volume_bridges(pairs, bridges, pair_force, formation_suction, surface_tension, roughness,
+                   table, volume_table, liquid, closed):
     """Volume-controlled bridges: formed at contact, then of constant volume; force and suction
     from (V*, d*) (pendular.capillary.lookup_volume), rupture where no bridge of that volume exists.
 
     Formation: open liquid (``closed`` False, a reservoir), with the volume of the
     suction-controlled bridge at ``formation_suction`` [Pa]; closed liquid (a fixed water
-    content), only where the two grains hold liquid as film (``film`` (N,) [m^3], read here):
-    the pair is marked FORMS_FROM_FILMS in ``events`` for exchange_liquid. A bridge that
-    ruptures is marked RUPTURED with its volume [m^3] in ``released`` (closed liquid).
+    content), only where the two grains hold liquid as film (``liquid.film``, read here):
+    the pair is marked FORMS_FROM_FILMS in ``liquid.events`` for exchange_liquid. A bridge that
+    ruptures is marked RUPTURED with its volume [m^3] in ``liquid.released`` (closed liquid).
     Returns the number of events marked.
 
     roughness: the meniscus separation of touching spheres / R2 (asperities hold the wetted
     surfaces H = roughness R2 apart, thesis Ch. 4's H): d* = roughness at contact and
     gap / R2 + roughness across a gap; 0 for smooth spheres. A pair whose bridge at formation
     would not span H gets none.
-    suction_table, volume_table: the arrays() of a BridgeTable and a VolumeBridgeTable;
-    image, period as suction_bridges.
     """
+    position, radius, pair_i, pair_j, image, period, overlap, normal = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid = volume_table
+    film = liquid.film
+    state = bridges.state           # written in the loop: named by attribute (module docstring)
+    volume = bridges.volume
+    force = bridges.force
+    filling_i = bridges.filling_i
+    filling_j = bridges.filling_j
+    bridge_suction = bridges.suction
+    released = liquid.released
+    events = liquid.events
     marked = 0
     for k in numba.prange(len(pair_i)):
         i = pair_i[k]
@@ -290,8 +361,8 @@ def volume_bridges(position, radius, pair_i, pair_j, image, period, overlap, nor
                     marked += 1
                 continue
             forms, _, volume_star, _, _ = lookup_suction(
-                suction_table[0], suction_table[1], suction_table[2], suction_table[3],
-                suction_table[4], ratio, formation_suction * larger / surface_tension, roughness)
+                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                ratio, formation_suction * larger / surface_tension, roughness)
             if not forms:
                 continue
             volume[k] = volume_star * cube
@@ -301,8 +372,8 @@ def volume_bridges(position, radius, pair_i, pair_j, image, period, overlap, nor
             continue
         gap_star = roughness if touching else roughness - overlap[k] / larger
         exists, force_star, suction_star, delta1, delta2 = lookup_volume(
-            volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
-            ratio, volume[k] / cube, gap_star)
+            volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid, ratio,
+            volume[k] / cube, gap_star)
         if not exists:
             if closed:
                 released[k] = volume[k]
@@ -324,12 +395,14 @@ def volume_bridges(position, radius, pair_i, pair_j, image, period, overlap, nor
 
 
 @numba.njit(cache=True)
-def _give_to_bridges(p, share, row_start, second_start, second_pair, radius, pair_i, pair_j,
-                     state, volume, film, largest_star):
+def _give_to_bridges(p, share, rows, pairs, bridges, film, largest_star):
     """Share ``share`` [m^3] of grain p's liquid equally among its bridges (each capped at
     ``largest_star`` R2^3, the volume table's range; the rest stays on the grain as film); a
     grain without bridge keeps it all as film. Bridges that receive liquid are marked
     ACROSS_GAP, so volume_bridges looks them up again."""
+    row_start, second_start, second_pair = rows
+    _, radius, pair_i, pair_j, _, _, _, _ = pairs
+    state, volume = bridges.state, bridges.volume
     count = 0
     for k in range(row_start[p], row_start[p + 1]):
         count += state[k] != NO_BRIDGE
@@ -357,8 +430,7 @@ def _give_to_bridges(p, share, row_start, second_start, second_pair, radius, pai
 
 
 @numba.njit(cache=True)
-def exchange_liquid(events, released, row_start, second_start, second_pair, radius, pair_i,
-                    pair_j, state, volume, film, share, smallest_star, largest_star):
+def exchange_liquid(liquid, rows, pairs, bridges, share, smallest_star, largest_star):
     """The liquid exchanges of the events volume_bridges marked, in pair order (deterministic);
     returns the liquid lost [m^3].
 
@@ -369,14 +441,16 @@ def exchange_liquid(events, released, row_start, second_start, second_pair, radi
     both grains as its bridge (marked ACROSS_GAP, evaluated at the next step) when that volume
     lies in the volume table's range [smallest_star, largest_star] R2^3; otherwise the films
     stay. Events are cleared."""
+    events, released, film = liquid.events, liquid.released, liquid.film
+    _, radius, pair_i, pair_j, _, _, _, _ = pairs
     lost = 0.0
     for k in range(len(events)):
         if events[k] != RUPTURED:
             continue
         if share:
             for p in (pair_i[k], pair_j[k]):
-                _give_to_bridges(p, 0.5 * released[k], row_start, second_start, second_pair,
-                                 radius, pair_i, pair_j, state, volume, film, largest_star)
+                _give_to_bridges(p, 0.5 * released[k], rows, pairs, bridges, film,
+                                 largest_star)
         else:
             lost += released[k]
         released[k] = 0.0
@@ -390,35 +464,38 @@ def exchange_liquid(events, released, row_start, second_start, second_pair, radi
         larger = max(radius[i], radius[j])
         cube = larger * larger * larger
         held = film[i] + film[j]
-        if state[k] != NO_BRIDGE or not smallest_star * cube <= held <= largest_star * cube:
+        if (bridges.state[k] != NO_BRIDGE
+                or not smallest_star * cube <= held <= largest_star * cube):
             continue
-        volume[k] = held
-        state[k] = ACROSS_GAP
+        bridges.volume[k] = held
+        bridges.state[k] = ACROSS_GAP
         film[i] = 0.0
         film[j] = 0.0
     return lost
 
 
 @numba.njit(cache=True)
-def bridges_across_gaps(radius, pair_i, pair_j, overlap, state, volume, formation_suction,
-                        surface_tension, roughness, max_gap, suction_table):
+def bridges_across_gaps(pairs, bridges, formation_suction, surface_tension, roughness, max_gap,
+                        table):
     """Wetting across gaps: every pair without a bridge whose spheres are apart by a gap in
     (0, max_gap] [m] gets, marked ACROSS_GAP, the volume [m^3] of the suction-controlled bridge
     at ``formation_suction`` [Pa] at its gap (d* = roughness + gap / R2), if one exists there;
-    volume_bridges then carries it. Returns the number of bridges formed."""
+    volume_bridges or suction_bridges then carries it. Returns the number of bridges formed."""
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    _, radius, pair_i, pair_j, _, _, overlap, _ = pairs
     formed = 0
     for k in range(len(pair_i)):
         gap = -overlap[k]
-        if state[k] != NO_BRIDGE or gap <= 0.0 or gap > max_gap:
+        if bridges.state[k] != NO_BRIDGE or gap <= 0.0 or gap > max_gap:
             continue
         larger = max(radius[pair_i[k]], radius[pair_j[k]])
         exists, _, volume_star, _, _ = lookup_suction(
-            suction_table[0], suction_table[1], suction_table[2], suction_table[3],
-            suction_table[4], larger / min(radius[pair_i[k]], radius[pair_j[k]]),
+            radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+            larger / min(radius[pair_i[k]], radius[pair_j[k]]),
             formation_suction * larger / surface_tension, roughness + gap / larger)
         if exists:
-            volume[k] = volume_star * larger * larger * larger
-            state[k] = ACROSS_GAP
+            bridges.volume[k] = volume_star * larger * larger * larger
+            bridges.state[k] = ACROSS_GAP
             formed += 1
     return formed
 
@@ -440,32 +517,37 @@ def _bridge_gap_star(position, radius, pair_i, pair_j, image, period, k, at_cont
 
 
 @numba.njit(cache=True, parallel=True)
-def suction_interfaces(position, radius, pair_i, pair_j, image, period, state, index, suction,
-                       surface_tension, suction_table):
+def suction_interfaces(pairs, bridges, index, suction, surface_tension, table):
     """Liquid-gas interfaces of the suction-controlled bridges ``index`` (pair numbers) at the
     suction [Pa]: (B, 2) [m^2], per bridge nn11 = ∫ n_x n_x dS and nn33 = ∫ n_z n_z dS over
     its interface in the bridge frame (z along the branch vector; the area is 2 nn11 + nn33),
     from the suction table at its gap."""
+    position, radius, pair_i, pair_j, image, period, _, _ = pairs
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    state = bridges.state
     out = np.empty((len(index), 2))
     for b in numba.prange(len(index)):
         k = index[b]
         larger, ratio, distance_star = _bridge_gap_star(position, radius, pair_i, pair_j, image,
                                                         period, k, state[k] == AT_CONTACT, 0.0)
         _, nn11, nn33 = lookup_interface(
-            suction_table[0], suction_table[1], suction_table[2], suction_table[3],
-            suction_table[4], ratio, suction * larger / surface_tension, distance_star)
+            radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values, ratio,
+            suction * larger / surface_tension, distance_star)
         out[b, 0] = nn11 * larger * larger
         out[b, 1] = nn33 * larger * larger
     return out
 
 
 @numba.njit(cache=True, parallel=True)
-def volume_interfaces(position, radius, pair_i, pair_j, image, period, state, index, volume,
-                      roughness, volume_table):
+def volume_interfaces(pairs, bridges, index, roughness, volume_table):
     """As suction_interfaces for volume-controlled bridges, from the volume table at each
     bridge's volume [m^3] and gap (d* with the roughness): a bridge near its volume-controlled
     rupture is off the stable branch of the suction-controlled family, so its suction alone does
     not name it."""
+    position, radius, pair_i, pair_j, image, period, _, _ = pairs
+    volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid = volume_table
+    state = bridges.state
+    volume = bridges.volume
     out = np.empty((len(index), 2))
     for b in numba.prange(len(index)):
         k = index[b]
@@ -473,8 +555,8 @@ def volume_interfaces(position, radius, pair_i, pair_j, image, period, state, in
                                                         period, k, state[k] == AT_CONTACT,
                                                         roughness)
         _, nn11, nn33 = lookup_volume_interface(
-            volume_table[0], volume_table[1], volume_table[2], volume_table[3], volume_table[4],
-            ratio, volume[k] / (larger * larger * larger), distance_star)
+            volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid, ratio,
+            volume[k] / (larger * larger * larger), distance_star)
         out[b, 0] = nn11 * larger * larger
         out[b, 1] = nn33 * larger * larger
     return out
@@ -510,13 +592,16 @@ def _meniscus_caps(p, position, row_start, second_start, second_pair, pair_i, pa
 
 
 @numba.njit(cache=True, parallel=True)
-def pendular_overlap_counts(position, row_start, second_start, second_pair, pair_i, pair_j,
-                            image, period, state, filling_i, filling_j):
-    """Per particle, the number of pairs of its menisci that overlap (SPEC section 4 pendular
-    limit): two wetted caps whose normals are separated by less than the sum of their filling
-    angles a + b (YADE's Law2_ScGeom_CapillaryPhys_Capillarity fusion test), i.e. whose
-    normals' dot product exceeds cos(a + b) (filling angles at most 90 deg: a + b <= 180 deg,
-    where the arc cosine falls). Each block of particles has its own scratch rows."""
+def pendular_overlap_counts(pairs, rows, bridges):
+    """Per particle, the number of pairs of its menisci that overlap (the pendular limit,
+    docs/physics.md 'The bridge model'): two wetted caps whose normals are separated by less
+    than the sum of their filling angles a + b (YADE's Law2_ScGeom_CapillaryPhys_Capillarity
+    fusion test), i.e. whose normals' dot product exceeds cos(a + b) (filling angles at most 90
+    deg: a + b <= 180 deg, where the arc cosine falls). Each block of particles has its own
+    scratch rows."""
+    position, _, pair_i, pair_j, image, period, _, _ = pairs
+    row_start, second_start, second_pair = rows
+    state, filling_i, filling_j = bridges.state, bridges.filling_i, bridges.filling_j
     count = len(row_start) - 1
     overlaps = np.zeros(count, np.int64)
     widest = 0

@@ -1,36 +1,47 @@
 """Per-pair liquid-bridge state, declared once and read by attribute.
 
-The arrays live in the neighbour list's ``Contacts.extra`` (so that dem carries them across
-rebuilds and checkpoints them without knowing what they hold) under the keys
-``"bridge." + field``; ``BridgeState.of(contacts)`` is the view every reader uses (the bridge
-operation, homogenisation, ParaView writer, tests).
+``FIELDS`` declares each per-pair quantity of a bridge (name, dtype, unit; pendular.dem.protocols
+.PairField); the bridge operations declare them as their ``pair_state``. The arrays live in the
+neighbour list's ``Contacts.extra`` under ``pair_key(OWNER, field)`` = ``"bridge.<field>"`` (so
+that dem carries them across rebuilds and checkpoints them without knowing what they hold);
+``BridgeState.of(contacts)`` is the view every reader uses (the bridge operations and kernels,
+homogenisation, the ParaView writer, tests). A BridgeState is a named tuple of those arrays, so
+that the Numba kernels take it as one argument (pendular.capillary.bridge_kernels).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from typing import NamedTuple
 
 import numpy as np
+
+from pendular.dem.protocols import PairField, pair_arrays, pair_key
 
 #: Values of ``BridgeState.state``.
 NO_BRIDGE = 0
 AT_CONTACT = 1
 ACROSS_GAP = 2
 
-#: Key prefix of the bridge arrays in ``Contacts.extra``.
-PREFIX = "bridge."
+#: Owner name of the bridge arrays in ``Contacts.extra`` (keys ``"bridge.<field>"``).
+OWNER = "bridge"
+
+#: The per-pair quantities of a liquid bridge, in BridgeState's order.
+FIELDS = (
+    PairField("state", np.int8, "1", "NO_BRIDGE (0), AT_CONTACT (1: values cached at contact) "
+              "or ACROSS_GAP (2)"),
+    PairField("volume", np.float64, "m^3", "liquid volume of the bridge"),
+    PairField("force", np.float64, "N", "magnitude of the attractive capillary force (> 0)"),
+    PairField("filling_i", np.float64, "deg", "filling angle on particle pair_i (delta1 on the "
+              "smaller sphere)"),
+    PairField("filling_j", np.float64, "deg", "filling angle on particle pair_j"),
+    PairField("suction", np.float64, "Pa", "the bridge's own suction (volume control; 0 under "
+              "suction control, where the imposed suction holds)"),
+)
 
 
-@dataclass
-class BridgeState:
-    """Liquid bridges of the K candidate pairs (one row per pair of ``sim.contacts``).
-
-    state: int8, NO_BRIDGE, AT_CONTACT (values cached at contact) or ACROSS_GAP;
-    volume [m^3]; force [N] magnitude of the attractive capillary force (> 0);
-    filling_i, filling_j [deg] filling angles on particles pair_i and pair_j (delta1 on the
-    smaller sphere); suction [Pa] the bridge's own suction (volume control; 0 under suction
-    control, where the imposed suction holds).
-    """
+class BridgeState(NamedTuple):
+    """Liquid bridges of the K candidate pairs (one row per pair of ``sim.contacts``): the
+    arrays of ``FIELDS``, by name."""
 
     state: np.ndarray
     volume: np.ndarray
@@ -41,21 +52,14 @@ class BridgeState:
 
     @classmethod
     def of(cls, contacts):
-        """The bridge arrays of ``contacts`` (created as zeros, no bridge, when absent)."""
-        extra = contacts.extra
-        arrays = {}
-        for field in fields(cls):
-            key = PREFIX + field.name
-            if key not in extra:
-                extra[key] = np.zeros(len(contacts), np.int8 if field.name == "state"
-                                      else np.float64)
-            arrays[field.name] = extra[key]
-        return cls(**arrays)
+        """The bridge arrays of ``contacts`` (created as zeros, no bridge, when absent;
+        ValueError when one held there does not match its declaration)."""
+        return cls(**pair_arrays(contacts, OWNER, FIELDS))
 
     @staticmethod
     def present(contacts):
         """Whether ``contacts`` holds bridge arrays (a wet scene ran)."""
-        return PREFIX + "state" in contacts.extra
+        return pair_key(OWNER, FIELDS[0]) in contacts.extra
 
     def mask(self):
         """(K,) bool: the pairs holding a bridge."""

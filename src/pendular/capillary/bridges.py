@@ -1,10 +1,20 @@
-"""Liquid bridges in the DEM: the capillary operation of wet scenes (thesis Ch. 5, SPEC section 4).
+"""Liquid bridges in the DEM: the capillary operations of wet scenes (thesis Ch. 5, docs/physics.md
+'The bridge model').
 
-A wet scene lists ``CapillaryBridges`` among its forces after the contact law and the wall
-springs (``sim.forces.append(bridges)``; YADE's order: InteractionLoop,
+Two operations, one per control, share their tables, kernels and measures (``CapillaryBridges``,
+their base): ``SuctionBridges`` at an imposed suction (the thesis's Ch. 5), ``VolumeBridges`` of
+constant volume. ``CapillaryBridges(suction, ..., control=...)`` builds the one of that control
+(``control`` "suction", the default, or "volume"; each refuses the other's options), so that a
+scene, a configuration or a test names the bridges one way and finds them with
+``sim.operation(CapillaryBridges)``. What depends on the control, on ``persist`` and on the
+liquid model is chosen once, when the operation is built or the liquid closed: the kernel each
+step calls, how its forces are gathered, which tables it reads.
+
+A wet scene lists the bridges among its forces after the contact law and the wall springs
+(``sim.forces.append(bridges)``; YADE's order: InteractionLoop,
 Law2_ScGeom_CapillaryPhys_Capillarity, TriaxialStressController, NewtonIntegrator); a dry scene
-never builds it. Bridges that persist across gaps declare how far the neighbour list must reach
-(``reach(sim)``, their largest rupture distance). Each step:
+never builds them. Bridges that persist across gaps declare how far the neighbour list must
+reach (``reach(sim)``, their largest rupture distance). Each step:
 
 1. per pair (parallel over pairs): a bridge forms when the spheres touch (overlap > 0, from
    the contact law of the same step) and breaks when contact is lost (the thesis's choice) or,
@@ -14,15 +24,14 @@ never builds it. Bridges that persist across gaps declare how far the neighbour 
 2. the forces are gathered per particle, -f to i and +f to j, each particle summing its own
    pairs in a fixed order (deterministic for any thread count, no atomics).
 
-The kernels are pendular.capillary.bridge_kernels. Default (suction control, bridges only at contact):
-``contact_bridges`` only reads overlap and
-the bridge state and looks a bridge up when it forms; the contact law's gather then adds the
-cached magnitudes along its normals with the contact forces, in the same pass over the pairs
-(``joins_contact_gather``, pendular.dem.contact_law.ContactForces.gather; ``gather_contact_bridges``
-when the scene has no contact law). A wet step at 10,000 spheres costs 1.0-1.1 times a dry
-one (1.1-1.2 with a gather of its own). Bridges across gaps (``persist``, volume
-control): ``suction_bridges`` / ``volume_bridges`` write per-pair force vectors ``pair_force``,
-gathered by ``pendular.dem.neighbors.gather_pair_forces``.
+The kernels are pendular.capillary.bridge_kernels. Suction control, bridges only at contact
+(the default): ``contact_bridges`` only reads overlap and the bridge state and looks a bridge up
+when it forms; the contact law's gather then adds the cached magnitudes along its normals with
+the contact forces, in the same pass over the pairs (``joins_contact_gather``,
+pendular.dem.contact_law.ContactForces.gather; ``gather_contact_bridges`` when the scene has no
+contact law). Bridges across gaps (``persist``, volume control): ``suction_bridges`` /
+``volume_bridges`` write per-pair force vectors ``pair_force``, gathered by
+``pendular.dem.neighbors.gather_pair_forces``.
 
 The capillary force is added on top of the mechanical contact force and does not enter the
 Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack caps the shear
@@ -33,7 +42,7 @@ pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bri
 capillary law skips pairs of different shapes), and ``contacts.force`` stays the mechanical
 force, so that pendular.homogenize.contact_stress is Eq. 3.41's contact stress.
 
-Lookups (SPEC section 1 units): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
+Lookups (the units of docs/units.md): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
 d* = max(gap, 0) / R2 (overlaps read the table's contact values, as YADE does), F = F* 2 pi gamma
 R2, V = V* R2^3, filling angles delta1 on the smaller sphere and delta2 on the larger one. At
 d* = 0 a bridge's force, volume and filling angles depend only on the radii (suction control)
@@ -42,8 +51,9 @@ or on the radii and its volume (volume control): they are looked up once when th
 no lookup per step; only bridges across a gap (``persist``, volume control) are looked up
 each step.
 
-Per-pair state: pendular.capillary.bridge_state.BridgeState (state, volume, force, filling_i,
-filling_j, suction), kept in ``sim.contacts.extra`` and carried across neighbour-list rebuilds.
+Per-pair state: pendular.capillary.bridge_state.BridgeState, the arrays of its declared
+``FIELDS`` (state, volume, force, filling_i, filling_j, suction; the operations'
+``pair_state``), kept in ``sim.contacts.extra`` and carried across neighbour-list rebuilds.
 
 Volume control: a bridge forms at contact with the volume of the suction-controlled bridge at
 contact at ``suction`` (the formation suction, the same for bridges that form later), then keeps
@@ -55,7 +65,7 @@ The liquid of volume-controlled bridges (``liquid``; docs/hydro_mechanical.md):
 bridge's goes back there (a sample in contact with a water supply, the wetting phase);
 "shared" and "lost": the amount is closed (a fixed water content). On rupture, "shared" gives
 half of the bridge's liquid to each of its two grains, split equally among that grain's
-remaining bridges, or held on the grain as a film when it has none (Mani, Kadau & Herrmann
+remaining bridges, or held on the grain as film when it has none (Mani, Kadau & Herrmann
 2012; MercuryDPM's liquid migration); "lost" removes it, counted in ``liquid_lost``. A new
 contact forms a bridge only from the films of its two grains. ``close_liquid`` switches a
 reservoir-wetted sample to a closed model; then bridges + films + lost = the liquid at closing
@@ -68,11 +78,12 @@ import math
 import numba
 import numpy as np
 
-from pendular.capillary.bridge_kernels import (bridges_across_gaps, contact_bridges,
-    exchange_liquid, gather_contact_bridges, gather_contact_bridges_virial,
-    pendular_overlap_counts, refresh_contact_bridges, serial_contact_bridges, suction_bridges,
-    suction_interfaces, volume_bridges, volume_interfaces)
-from pendular.capillary.bridge_state import BridgeState
+from pendular.capillary.bridge_kernels import (LiquidExchange, bridges_across_gaps,
+    contact_bridges, exchange_liquid, gather_contact_bridges, gather_contact_bridges_virial,
+    pair_geometry, particle_pairs, pendular_overlap_counts, refresh_contact_bridges,
+    serial_contact_bridges, suction_bridges, suction_interfaces, volume_bridges,
+    volume_interfaces)
+from pendular.capillary.bridge_state import FIELDS, BridgeState
 from pendular.capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from pendular.capillary.validation import (check_bridge_stiffness, check_contact_angle,
     check_pendular_suction)
@@ -85,7 +96,8 @@ from pendular.utils.validate import check_positive, check_range
 SURFACE_TENSION = 0.073
 #: Bridge models: exact Young–Laplace tables, or the toroidal approximation (Appendix A).
 BRIDGE_MODELS = ("exact", "toroidal")
-#: How bridges are controlled: imposed suction, or constant volume.
+#: How bridges are controlled: imposed suction (SuctionBridges), or constant volume
+#: (VolumeBridges).
 CONTROLS = ("suction", "volume")
 #: Where the liquid of volume-controlled bridges comes from and goes (``liquid``): an outside
 #: reservoir, or a closed amount shared among the grains' bridges on rupture, or lost on rupture.
@@ -148,21 +160,30 @@ def sample_radius_ratios(radii):
     return (1.0, *(largest ** (k / n) for k in range(1, n)), largest)
 
 
-class CapillaryBridges:
-    """Capillary bridges between touching spheres (SPEC section 4); an operation ``apply(sim)``.
+class _ByControl(type):
+    """Calling ``CapillaryBridges`` itself builds the operation of the ``control`` asked for
+    (``bridges_by_control``); calling a subclass builds that subclass."""
+
+    def __call__(cls, *args, **kwargs):
+        if cls is CapillaryBridges:
+            return bridges_by_control(*args, **kwargs)
+        return super().__call__(*args, **kwargs)
+
+
+class CapillaryBridges(metaclass=_ByControl):
+    """What the bridge operations of both controls share (docs/physics.md 'The bridge model'):
+    parameters, tables, the per-pair state and its neighbour-list reach, formation across gaps
+    at wetting, and the measures read at record time. An operation ``apply(sim)``.
+
+    ``CapillaryBridges(suction, surface_tension=0.073, contact_angle=0.0, model="exact",
+    control="suction", persist=False, table_options=None, roughness=0.0, liquid="reservoir")``
+    builds a SuctionBridges or a VolumeBridges (``bridges_by_control``).
 
     suction [Pa] >= 0: imposed matric suction (suction control), or the suction at which bridges
         form (volume control);
     surface_tension [N/m] > 0 (thesis Ch. 5: 0.073); contact_angle [deg] in [0, 90);
     model: "exact" (Young–Laplace tables, capillary.BridgeTable) or "toroidal" (thesis
         Appendix A, equal spheres only);
-    control: "suction" (default, thesis Ch. 5) or "volume" (each bridge keeps its volume);
-    persist: suction control only: bridges live up to the rupture distance instead of breaking
-        when contact is lost (volume-controlled bridges always persist up to rupture);
-    roughness: volume control only: meniscus separation of touching spheres H / R2 in [0, 0.5]
-        (rough grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
-    liquid: volume control only: "reservoir", "shared" or "lost" (LIQUID_MODELS, module
-        docstring);
     table_options: keyword arguments of BridgeTable.cached (model 'exact') or
         pendular.capillary.toroidal_table.toroidal_table (model 'toroidal'): resolution, range.
 
@@ -171,46 +192,39 @@ class CapillaryBridges:
     exist.
     """
 
-    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0, model="exact",
-                 control="suction", persist=False, table_options=None, roughness=0.0,
-                 liquid="reservoir"):
+    #: The per-pair quantities the bridges keep (pendular.dem.protocols.PairField), in
+    #: ``sim.contacts.extra["bridge.<name>"]``.
+    pair_state = FIELDS
+    #: "suction" or "volume" (CONTROLS), set by each operation.
+    control = None
+    #: Whether bridges live across gaps up to their rupture distance.
+    persist = False
+    #: Meniscus separation of touching spheres / R2 (rough grains; volume control only).
+    roughness = 0.0
+    #: Where a bridge's liquid comes from and goes (LIQUID_MODELS; volume control only).
+    liquid = "reservoir"
+    #: The bridges' pair forces are central along the contact normals and join the contact
+    #: law's gather (pendular.dem.contact_law.ContactForces.joined_by).
+    joins_contact_gather = False
+
+    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
+                 model="exact", table_options=None):
         self.suction = check_range("suction", suction, 0.0, unit="Pa")
         self.surface_tension = check_positive("surface_tension", surface_tension, "N/m")
         self.contact_angle = check_contact_angle(contact_angle)
         if model not in BRIDGE_MODELS:
             raise ValueError(f"model = {model!r} is not one of {BRIDGE_MODELS}")
-        if control not in CONTROLS:
-            raise ValueError(f"control = {control!r} is not one of {CONTROLS}")
-        if control == "volume" and model != "exact":
-            raise ValueError("volume-controlled bridges need model='exact'")
         self.model = model
-        self.control = control
-        self.persist = bool(persist) or control == "volume"
-        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
-        if self.roughness > 0.0 and control != "volume":
-            raise ValueError(f"roughness = {self.roughness:g} needs control='volume' (suction-"
-                             "controlled bridges are between smooth spheres: roughness 0)")
-        if liquid not in LIQUID_MODELS:
-            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
-        if liquid != "reservoir" and control != "volume":
-            raise ValueError(f"liquid = {liquid!r} needs control='volume' (suction-controlled "
-                             "bridges exchange liquid with a reservoir at the imposed suction)")
-        self.liquid = liquid
-        self.liquid_initial = None       # [m^3] at closing (None: open liquid)
-        self.liquid_lost = 0.0           # [m^3] since closing
-        self.film = None                 # (N,) [m^3] liquid held on each grain
         self.table_options = dict(table_options or {})
         self.suction_table = None
-        self.volume_table = None
         self.required_range = 0.0
         self.pair_force = np.zeros((0, 3))
-        self._table_arrays = None
+        self._lookup = None              # suction_table.arrays()
         self._contacts = None
         self._bridges = 0
         self._radius_bounds = None
         self._checked_stiffness = False
         self._state = None
-        self._applied_suction = None
 
     # ---------------------------------------------------------------- set-up, once per sample
     def reach(self, sim):
@@ -231,9 +245,8 @@ class CapillaryBridges:
         radius = sim.particles.radius
         low, high = float(radius.min()), float(radius.max())
         if self._radius_bounds is not None and self._radius_bounds[:2] == (low, high):
-            return                            # same spheres: the tables of the last rebuild
-        nodes = sample_radius_ratios(radius) if self.model == "exact" else None
-        self.load_tables(low, high, radius_ratios=nodes)
+            return
+        self.load_tables(low, high, radius_ratios=sample_radius_ratios(radius))
 
     def load_tables(self, low, high, radius_ratios=None):
         """Check the input against spheres of radii in [low, high] [m] and load (or build and
@@ -264,12 +277,13 @@ class CapillaryBridges:
             options.setdefault("radius_ratios", radius_ratios)
             self.suction_table = BridgeTable.cached(self.contact_angle, **options)
         self._check_suction(self.suction, low, high)
-        if self.control == "volume":
-            self.volume_table = VolumeBridgeTable.cached(
-                self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
-        self._table_arrays = self.suction_table.arrays()
+        self._load_control_tables()
+        self._lookup = self.suction_table.arrays()
         self._radius_bounds = (low, high, radius_ratios)
         self.required_range = self._rupture_range(low, high)
+
+    def _load_control_tables(self):
+        """Load what this control reads besides the suction table (nothing)."""
 
     def _check_suction(self, suction, low, high):
         """ValueError naming ``suction`` [Pa] unless the loaded table covers it for spheres of
@@ -285,48 +299,14 @@ class CapillaryBridges:
         check_pendular_suction(self.suction_table, suction, low, self.surface_tension)
 
     def set_suction(self, suction):
-        """Impose a new suction [Pa] from the next step on (suction control; a path of drying
-        and wetting): bridges at contact are looked up again at it, bridges across a gap
-        (``persist``) follow it and rupture where the new rupture distance is shorter than their
-        gap, new bridges form at contact only, so drying and wetting differ (hysteresis). The
-        neighbour list's reach follows the lowest suction imposed so far, so no persisting
-        bridge leaves it. ValueError naming ``suction`` outside the table or the pendular
-        regime."""
-        if self.control != "suction":
-            raise ValueError(f"control = {self.control!r}: set_suction needs control = "
-                             "'suction' (volume-controlled bridges have their own suctions)")
-        suction = check_range("suction", suction, 0.0, unit="Pa")
-        if self._radius_bounds is not None:
-            low, high = self._radius_bounds[:2]
-            self._check_suction(suction, low, high)
-        self.suction = suction
-        if self._radius_bounds is not None:
-            self.required_range = max(self.required_range, self._rupture_range(low, high))
+        """Impose a new suction [Pa] (suction control only: SuctionBridges.set_suction)."""
+        raise ValueError(f"control = {self.control!r}: set_suction needs control = "
+                         "'suction' (volume-controlled bridges have their own suctions)")
 
-    def _rupture_range(self, low, high):
-        """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).
-
-        The rupture distance d*_rupture(u*) decreases with u*, and u* = s R2/gamma >= s Rmin/gamma,
-        so Rmax * max_r d*_rupture(r, s Rmin/gamma) bounds D (5 % margin). Volume control: the
-        largest volume forms at the smallest suction; d*_rupture grows with the volume.
-        """
-        if not self.persist:
-            return 0.0
-        table = self.suction_table
-        xi = math.log1p(self.suction * low / self.surface_tension / table.suction_scale)
-        nodes = np.log1p(table.suction / table.suction_scale)
-        ruptures = [np.interp(xi, nodes, row) for row in table.distance_rupture]
-        if self.control == "suction":
-            return 1.05 * high * max(ruptures)
-        volumes = [table.lookup(r, self.suction * low / self.surface_tension, 0.0)[2]
-                   for r in table.radius_ratios]
-        largest = []
-        vtable = self.volume_table
-        for index, axis in enumerate(vtable.volume_axes):
-            volume_nodes = np.linspace(axis[0], axis[1], vtable.n_volume)
-            largest.append(np.interp(math.log(max(volumes)), volume_nodes,
-                                     vtable.distance_rupture[index]))
-        return 1.05 * high * max(largest)
+    def close_liquid(self, sim, liquid="shared"):
+        """Close the liquid (volume control only: VolumeBridges.close_liquid)."""
+        raise ValueError(f"control = {self.control!r}: a closed amount of liquid needs "
+                         "control = 'volume'")
 
     # ---------------------------------------------------------------- every step
     def _attach(self, sim):
@@ -340,11 +320,6 @@ class CapillaryBridges:
                 f"rebuild: its reach ({sim.neighbors.interaction_range:g} m plus skin) is "
                 f"shorter than the rupture distance ({self.required_range:g} m)")
         self.pair_force = np.zeros((len(contacts) if self.persist else 0, 3))
-        if self.control == "volume":
-            self._released = np.zeros(len(contacts))
-            self._events = np.zeros(len(contacts), np.int8)
-            if self.film is None or len(self.film) != len(sim.particles):
-                self.film = np.zeros(len(sim.particles))
         self._contacts = contacts
         self._state = state
 
@@ -356,76 +331,18 @@ class CapillaryBridges:
         self._prepare(sim)
         self._attach(sim)
 
-    def apply(self, sim):
-        self._sync(sim)
-        p = sim.particles
-        c = sim.contacts
-        b = self._state
-        if self.control == "suction" and self._applied_suction != self.suction:
-            if self._applied_suction is not None:          # set_suction: bridges at contact
-                refresh_contact_bridges(p.radius, c.pair_i, c.pair_j, b.state, b.volume,
-                                        b.force, b.filling_i, b.filling_j, self.suction,
-                                        self.surface_tension, *self._table_arrays)
-            self._applied_suction = self.suction
-        if self.control == "suction" and not self.persist:
-            follow = contact_bridges if numba.get_num_threads() > 1 else serial_contact_bridges
-            follow(p.radius, c.pair_i, c.pair_j, c.overlap, b.state, b.volume, b.force,
-                   b.filling_i, b.filling_j, self.suction, self.surface_tension,
-                   *self._table_arrays)
-            contact_law = self._joined_contact_law(sim)
-            if contact_law is not None:
-                contact_law.gather(sim, b.force)
-            elif sim.walls.periodic:
-                gather_contact_bridges_virial(b.force, c.normal, c.row_start, c.second_start,
-                                              c.second_pair, p.force, c.image, c.through_face,
-                                              c.face_start, sim.walls.period,
-                                              sim.walls.virial_blocks)
-            else:
-                gather_contact_bridges(b.force, c.normal, c.row_start, c.second_start,
-                                       c.second_pair, p.force)
-            return
-        if self.control == "suction":
-            suction_bridges(p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period,
-                            c.overlap, c.normal, b.state, b.volume, b.force, b.filling_i,
-                            b.filling_j, self.pair_force, self.suction, self.surface_tension,
-                            *self._table_arrays)
-        else:
-            closed = self.liquid != "reservoir"
-            events = volume_bridges(
-                p.position, p.radius, c.pair_i, c.pair_j, c.image, sim.walls.period, c.overlap,
-                c.normal, b.state, b.volume, b.force, b.filling_i, b.filling_j, b.suction,
-                self.pair_force, self.suction, self.surface_tension, self.roughness, self._table_arrays,
-                self.volume_table.arrays(), closed, self.film, self._released, self._events)
-            if events:
-                self.liquid_lost += exchange_liquid(
-                    self._events, self._released, c.row_start, c.second_start, c.second_pair,
-                    p.radius, c.pair_i, c.pair_j, b.state, b.volume, self.film,
-                    self.liquid == "shared", *self.volume_table.volume_star_bounds())
-        if sim.walls.periodic:
+    def _gather_pair_forces(self, sim):
+        """Add ``pair_force`` to the particles (with the face terms of the cell's stress in a
+        periodic cell) and count the bridges the next neighbour list must carry."""
+        p, c, box = sim.particles, sim.contacts, sim.walls
+        if box.periodic:
             gather_pair_forces_virial(self.pair_force, c.row_start, c.second_start,
                                       c.second_pair, p.force, c.image, c.through_face,
-                                      c.face_start, sim.walls.period, sim.walls.virial_blocks)
+                                      c.face_start, box.period, box.virial_blocks)
         else:
             gather_pair_forces(self.pair_force, c.row_start, c.second_start, c.second_pair,
                                p.force)
-        if self.persist:
-            self._bridges = b.count()
-
-    @property
-    def joins_contact_gather(self):
-        """Whether the contact law's gather adds these bridges' forces
-        (pendular.dem.contact_law.ContactForces.joined_by): bridges at contact only (suction control,
-        not ``persist``) pull along the contact normals, so one pass over the pairs gathers
-        both."""
-        return self.control == "suction" and not self.persist
-
-    def _joined_contact_law(self, sim):
-        """The ContactForces of ``sim.forces`` whose gather waits for this operation, or None
-        (the bridges gather themselves)."""
-        for op in sim.forces:
-            if isinstance(op, ContactForces) and op.joined_by(sim) is self:
-                return op
-        return None
+        self._bridges = self._state.count()
 
     def form_across_gaps(self, sim, max_gap):
         """Wetting where the liquid would be (volume control, or suction control with
@@ -439,35 +356,9 @@ class CapillaryBridges:
                              "form at wetting with control = 'volume' or persist = True only")
         max_gap = check_positive("max_gap", max_gap, "m")
         self._sync(sim)
-        b, c = self._state, sim.contacts
-        return int(bridges_across_gaps(sim.particles.radius, c.pair_i, c.pair_j, c.overlap,
-                                       b.state, b.volume, self.suction, self.surface_tension,
-                                       self.roughness, max_gap, self._table_arrays))
-
-    def close_liquid(self, sim, liquid="shared"):
-        """From now on the liquid is a closed amount (volume control; ``liquid`` "shared" or
-        "lost", module docstring): the bridges' liquid now is ``liquid_initial`` [m^3], and
-        every later exchange is accounted for (``liquid_balance``)."""
-        if self.control != "volume":
-            raise ValueError(f"control = {self.control!r}: a closed amount of liquid needs "
-                             "control = 'volume'")
-        if liquid not in LIQUID_MODELS[1:]:
-            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS[1:]}")
-        self._sync(sim)
-        self.liquid = liquid
-        self.liquid_lost = 0.0
-        self.liquid_initial = self.water_volume(sim.contacts) + float(np.sum(self.film))
-
-    def liquid_balance(self, sim):
-        """(liquid in bridges, on grains as film, lost) [m^3] and the relative error of
-        bridges + film + lost against ``liquid_initial`` (NaN while the liquid is open)."""
-        self._sync(sim)
-        bridges = self.water_volume(sim.contacts)
-        film = 0.0 if self.film is None else float(np.sum(self.film))
-        if self.liquid_initial is None:
-            return bridges, film, self.liquid_lost, math.nan
-        error = abs(bridges + film + self.liquid_lost - self.liquid_initial) / self.liquid_initial
-        return bridges, film, self.liquid_lost, error
+        return int(bridges_across_gaps(pair_geometry(sim), self._state, self.suction,
+                                       self.surface_tension, self.roughness, max_gap,
+                                       self._lookup))
 
     # ---------------------------------------------------------------- measures (record time)
     def state(self, sim):
@@ -490,21 +381,10 @@ class CapillaryBridges:
         voids = sim.walls.volume() - sim.particles.solid_volume()
         return self.water_volume(sim.contacts) / voids
 
-    def mean_suction(self, sim):
-        """The imposed suction [Pa] (suction control) or the bridges' mean suction (volume
-        control; NaN without bridges)."""
-        state = self.state(sim)
-        if self.control == "suction":
-            return self.suction
-        mask = state.mask()
-        if not mask.any():
-            return math.nan
-        return float(np.mean(state.suction[mask]))
-
     def pair_forces(self, sim):
         """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
-        state = self.state(sim)
-        return self.pair_force if self.persist else -state.force[:, None] * sim.contacts.normal
+        self._sync(sim)
+        return self.pair_force
 
     def interfaces(self, sim, index):
         """(B, 2) [m^2]: nn11 and nn33, ∫ n_i n_i dS over the liquid-gas interface of each
@@ -514,20 +394,259 @@ class CapillaryBridges:
             raise ValueError(f"model = {self.model!r}: the liquid-gas interface is tabulated for "
                              "model = 'exact' only")
         state = self.state(sim)
-        index = np.ascontiguousarray(index, dtype=np.int64)
-        p, c = sim.particles, sim.contacts
-        if self.control == "volume":
-            return volume_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
-                                     sim.walls.period, state.state, index, state.volume,
-                                     self.roughness, self.volume_table.arrays())
-        return suction_interfaces(p.position, p.radius, c.pair_i, c.pair_j, c.image,
-                                  sim.walls.period, state.state, index, self.suction,
-                                  self.surface_tension, self._table_arrays)
+        return self._interfaces(pair_geometry(sim), state,
+                                np.ascontiguousarray(index, dtype=np.int64))
 
     def pendular_overlaps(self, sim):
         """Number of pairs of overlapping menisci on a same particle, summed over particles."""
-        b = self.state(sim)
-        c = sim.contacts
-        return int(np.sum(pendular_overlap_counts(
-            sim.particles.position, c.row_start, c.second_start, c.second_pair, c.pair_i,
-            c.pair_j, c.image, sim.walls.period, b.state, b.filling_i, b.filling_j)))
+        state = self.state(sim)
+        return int(np.sum(pendular_overlap_counts(pair_geometry(sim),
+                                                  particle_pairs(sim.contacts), state)))
+
+
+class SuctionBridges(CapillaryBridges):
+    """Suction-controlled bridges: every bridge is the one in equilibrium with the imposed
+    ``suction`` [Pa] at its gap (thesis Ch. 5); the liquid comes from and goes to a reservoir.
+
+    persist: False (the thesis's choice, the default): a bridge exists exactly while its
+        spheres touch, and the contact law's gather adds its force (``joins_contact_gather``);
+        True: bridges live up to the rupture distance instead of breaking when contact is
+        lost (thesis Table 5.1), gathered apart.
+    The other parameters are CapillaryBridges'.
+    """
+
+    control = "suction"
+
+    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
+                 model="exact", persist=False, table_options=None):
+        super().__init__(suction, surface_tension, contact_angle, model, table_options)
+        self.persist = bool(persist)
+        self._applied_suction = None
+
+    @property
+    def joins_contact_gather(self):
+        """Whether the contact law's gather adds these bridges' forces
+        (pendular.dem.contact_law.ContactForces.joined_by): bridges at contact only (not
+        ``persist``) pull along the contact normals, so one pass over the pairs gathers
+        both."""
+        return not self.persist
+
+    def set_suction(self, suction):
+        """Impose a new suction [Pa] from the next step on (a path of drying and wetting):
+        bridges at contact are looked up again at it, bridges across a gap (``persist``)
+        follow it and rupture where the new rupture distance is shorter than their gap, new
+        bridges form at contact only, so drying and wetting differ (hysteresis). The
+        neighbour list's reach follows the lowest suction imposed so far, so no persisting
+        bridge leaves it. ValueError naming ``suction`` outside the table or the pendular
+        regime."""
+        suction = check_range("suction", suction, 0.0, unit="Pa")
+        if self._radius_bounds is not None:
+            low, high = self._radius_bounds[:2]
+            self._check_suction(suction, low, high)
+        self.suction = suction
+        if self._radius_bounds is not None:
+            self.required_range = max(self.required_range, self._rupture_range(low, high))
+
+    def _rupture_range(self, low, high):
+        """Upper bound of the gap [m] at which a bridge can still exist (0 if none persists).
+
+        The rupture distance d*_rupture(u*) decreases with u*, and u* = s R2/gamma >= s Rmin/gamma,
+        so Rmax * max_r d*_rupture(r, s Rmin/gamma) bounds D (5 % margin).
+        """
+        if not self.persist:
+            return 0.0
+        table = self.suction_table
+        xi = math.log1p(self.suction * low / self.surface_tension / table.suction_scale)
+        nodes = np.log1p(table.suction / table.suction_scale)
+        return 1.05 * high * max(np.interp(xi, nodes, row) for row in table.distance_rupture)
+
+    def apply(self, sim):
+        self._sync(sim)
+        pairs = pair_geometry(sim)
+        state = self._state
+        if self._applied_suction != self.suction:
+            if self._applied_suction is not None:          # set_suction: bridges at contact
+                refresh_contact_bridges(pairs, state, self.suction, self.surface_tension,
+                                        self._lookup)
+            self._applied_suction = self.suction
+        if self.persist:
+            suction_bridges(pairs, state, self.pair_force, self.suction, self.surface_tension,
+                            self._lookup)
+            self._gather_pair_forces(sim)
+            return
+        follow = contact_bridges if numba.get_num_threads() > 1 else serial_contact_bridges
+        follow(pairs, state, self.suction, self.surface_tension, self._lookup)
+        contact_law = self._joined_contact_law(sim)
+        if contact_law is not None:
+            contact_law.gather(sim, state.force)
+            return
+        p, c, box = sim.particles, sim.contacts, sim.walls
+        if box.periodic:
+            gather_contact_bridges_virial(state.force, c.normal, c.row_start, c.second_start,
+                                          c.second_pair, p.force, c.image, c.through_face,
+                                          c.face_start, box.period, box.virial_blocks)
+        else:
+            gather_contact_bridges(state.force, c.normal, c.row_start, c.second_start,
+                                   c.second_pair, p.force)
+
+    def _joined_contact_law(self, sim):
+        """The ContactForces of ``sim.forces`` whose gather waits for this operation, or None
+        (the bridges gather themselves)."""
+        for op in sim.forces:
+            if isinstance(op, ContactForces) and op.joined_by(sim) is self:
+                return op
+        return None
+
+    def mean_suction(self, sim):
+        """The imposed suction [Pa]."""
+        return self.suction
+
+    def pair_forces(self, sim):
+        """Capillary force on j from i per pair (K, 3) [N] as applied at the last step."""
+        if self.persist:
+            return super().pair_forces(sim)
+        return -self.state(sim).force[:, None] * sim.contacts.normal
+
+    def _interfaces(self, pairs, state, index):
+        return suction_interfaces(pairs, state, index, self.suction, self.surface_tension,
+                                  self._lookup)
+
+
+class VolumeBridges(CapillaryBridges):
+    """Volume-controlled bridges: each keeps the volume it formed with (at contact, from the
+    suction-controlled bridge at the formation ``suction`` [Pa]); its force and suction follow
+    from its volume and gap, and it persists across gaps up to its volume-controlled rupture
+    distance (capillary.VolumeBridgeTable). Exact tables only.
+
+    roughness: meniscus separation of touching spheres H / R2 in [0, 0.5] (rough grains,
+        thesis Ch. 4's H/R; 0: smooth spheres, the default);
+    liquid: "reservoir" (default), "shared" or "lost" (LIQUID_MODELS, module docstring);
+        ``close_liquid`` closes a reservoir-wetted sample's liquid later.
+    The other parameters are CapillaryBridges'.
+    """
+
+    control = "volume"
+    persist = True
+
+    def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
+                 roughness=0.0, liquid="reservoir", table_options=None):
+        super().__init__(suction, surface_tension, contact_angle, "exact", table_options)
+        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
+        self.volume_table = None
+        self.liquid_initial = None       # [m^3] at closing (None: open liquid)
+        self.liquid_lost = 0.0           # [m^3] since closing
+        self.film = None                 # (N,) [m^3] liquid held on each grain
+        self._volume_lookup = None       # volume_table.arrays()
+        self._released = None
+        self._events = None
+        self._set_liquid(liquid)
+
+    def _set_liquid(self, liquid):
+        """The liquid model (LIQUID_MODELS) and what it decides each step: whether the amount
+        is closed and whether a ruptured bridge's liquid goes to its grains."""
+        if liquid not in LIQUID_MODELS:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
+        self.liquid = liquid
+        self._closed = liquid != "reservoir"
+        self._shares = liquid == "shared"
+
+    def _load_control_tables(self):
+        self.volume_table = VolumeBridgeTable.cached(
+            self.contact_angle, radius_ratios=self.suction_table.radius_ratios)
+        self._volume_lookup = self.volume_table.arrays()
+
+    def _rupture_range(self, low, high):
+        """Upper bound of the gap [m] at which a bridge can still exist: the largest volume
+        forms at the smallest suction, and d*_rupture grows with the volume (5 % margin)."""
+        table = self.suction_table
+        volumes = [table.lookup(r, self.suction * low / self.surface_tension, 0.0)[2]
+                   for r in table.radius_ratios]
+        largest = []
+        vtable = self.volume_table
+        for index, axis in enumerate(vtable.volume_axes):
+            volume_nodes = np.linspace(axis[0], axis[1], vtable.n_volume)
+            largest.append(np.interp(math.log(max(volumes)), volume_nodes,
+                                     vtable.distance_rupture[index]))
+        return 1.05 * high * max(largest)
+
+    def _attach(self, sim):
+        super()._attach(sim)
+        self._released = np.zeros(len(sim.contacts))
+        self._events = np.zeros(len(sim.contacts), np.int8)
+        if self.film is None or len(self.film) != len(sim.particles):
+            self.film = np.zeros(len(sim.particles))
+
+    def apply(self, sim):
+        self._sync(sim)
+        pairs = pair_geometry(sim)
+        state = self._state
+        liquid = LiquidExchange(self.film, self._released, self._events)
+        events = volume_bridges(pairs, state, self.pair_force, self.suction,
+                                self.surface_tension, self.roughness, self._lookup,
+                                self._volume_lookup, liquid, self._closed)
+        if events:
+            self.liquid_lost += exchange_liquid(
+                liquid, particle_pairs(sim.contacts), pairs, state, self._shares,
+                *self.volume_table.volume_star_bounds())
+        self._gather_pair_forces(sim)
+
+    def close_liquid(self, sim, liquid="shared"):
+        """From now on the liquid is a closed amount (``liquid`` "shared" or "lost", module
+        docstring): the bridges' liquid now is ``liquid_initial`` [m^3], and every later
+        exchange is accounted for (``liquid_balance``)."""
+        if liquid not in LIQUID_MODELS[1:]:
+            raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS[1:]}")
+        self._sync(sim)
+        self._set_liquid(liquid)
+        self.liquid_lost = 0.0
+        self.liquid_initial = self.water_volume(sim.contacts) + float(np.sum(self.film))
+
+    def liquid_balance(self, sim):
+        """(liquid in bridges, on grains as film, lost) [m^3] and the relative error of
+        bridges + film + lost against ``liquid_initial`` (NaN while the liquid is open)."""
+        self._sync(sim)
+        bridges = self.water_volume(sim.contacts)
+        film = 0.0 if self.film is None else float(np.sum(self.film))
+        if self.liquid_initial is None:
+            return bridges, film, self.liquid_lost, math.nan
+        error = abs(bridges + film + self.liquid_lost - self.liquid_initial) / self.liquid_initial
+        return bridges, film, self.liquid_lost, error
+
+    def mean_suction(self, sim):
+        """The bridges' mean suction [Pa] (NaN without bridges)."""
+        state = self.state(sim)
+        mask = state.mask()
+        if not mask.any():
+            return math.nan
+        return float(np.mean(state.suction[mask]))
+
+    def _interfaces(self, pairs, state, index):
+        return volume_interfaces(pairs, state, index, self.roughness, self._volume_lookup)
+
+
+def bridges_by_control(suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
+                       model="exact", control="suction", persist=False, table_options=None,
+                       roughness=0.0, liquid="reservoir"):
+    """The bridge operation of ``control`` ("suction": SuctionBridges, "volume":
+    VolumeBridges, which always persist) with these parameters (CapillaryBridges and the two
+    classes); ValueError naming a parameter the control does not take: ``roughness`` > 0 and
+    ``liquid`` other than "reservoir" need volume control, volume control needs the exact
+    model."""
+    if control not in CONTROLS:
+        raise ValueError(f"control = {control!r} is not one of {CONTROLS}")
+    if control == "volume":
+        if model != "exact":
+            raise ValueError("volume-controlled bridges need model='exact'")
+        return VolumeBridges(suction, surface_tension, contact_angle, roughness=roughness,
+                             liquid=liquid, table_options=table_options)
+    roughness = check_range("roughness", roughness, 0.0, 0.5)
+    if roughness > 0.0:
+        raise ValueError(f"roughness = {roughness:g} needs control='volume' (suction-"
+                         "controlled bridges are between smooth spheres: roughness 0)")
+    if liquid not in LIQUID_MODELS:
+        raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
+    if liquid != "reservoir":
+        raise ValueError(f"liquid = {liquid!r} needs control='volume' (suction-controlled "
+                         "bridges exchange liquid with a reservoir at the imposed suction)")
+    return SuctionBridges(suction, surface_tension, contact_angle, model, persist=persist,
+                          table_options=table_options)
