@@ -1,13 +1,13 @@
 """Exact axisymmetric liquid bridge between two spheres (Young–Laplace).
 
-Geometry (thesis section 3.4.1, SPEC section 4): spheres of radii R1 <= R2, r = R2/R1,
-contact angle theta on both, filling angle delta1 on the smaller sphere. The meridian
+Geometry (thesis section 3.4.1, docs/physics.md 'The bridge model'): spheres of radii R1 <= R2, r =
+R2/R1, contact angle theta on both, filling angle delta1 on the smaller sphere. The meridian
 of the liquid–gas surface has constant mean curvature fixed by the suction s:
 with tangent angle phi to the bridge axis and arc length l,
 
     dphi/dl = cos(phi)/y + s/gamma                                (Young–Laplace)
 
-and the axial force through any cross-section is invariant (SPEC section 4),
+and the axial force through any cross-section is invariant (docs/physics.md 'The bridge model'),
 
     F / (2 pi gamma) = y cos(phi) + (s / 2 gamma) y**2
                      = R1 sin(delta1) sin(delta1 + theta) + (s R1**2 / 2 gamma) sin(delta1)**2.
@@ -22,7 +22,7 @@ meniscus starts on sphere 1 at phi0 = delta1 + theta - 90 deg and ends at the fi
 the neck where it meets sphere 2 at the contact angle: phi_end = 90 deg - theta - delta2, height
 R2 sin(delta2). That fixes delta2; the length of the profile fixes the gap.
 
-All results are in YADE's dimensionless units (SPEC section 1): distance D/R2,
+All results are in YADE's dimensionless units (docs/units.md): distance D/R2,
 volume V/R2**3, force F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS over the
 liquid–gas surface (axis 3 along the bridge axis), suction s R2/gamma.
 """
@@ -45,7 +45,7 @@ _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(GAUSS_ORDER)
 
 @dataclass(frozen=True)
 class Bridge:
-    """One liquid bridge in YADE's dimensionless units (SPEC section 1); angles in degrees.
+    """One liquid bridge in YADE's dimensionless units (docs/units.md); angles in degrees.
 
     radius_ratio: R2/R1 >= 1. contact_angle: theta. suction: s R2/gamma.
     distance: surface gap D/R2. volume: V/R2**3. force: F/(2 pi gamma R2), attractive.
@@ -261,9 +261,9 @@ def bridge_kernel(radius_ratio, theta, suction_star, delta1):
 
     Returns (distance D/R2, volume V/R2**3, force F/(2 pi gamma R2), delta2 (rad), nn11, nn33),
     all NaN where no such meniscus exists (negative suction strong enough to make the force
-    repulsive or the profile miss sphere 2). Force: SPEC section 4; volume: ∫ pi y**2 dx minus
-    the two wetted caps. Negative suction (liquid pressure above the gas pressure) is only
-    reached by volume-controlled bridges.
+    repulsive or the profile miss sphere 2). Force: docs/physics.md 'The bridge model';
+    volume: ∫ pi y**2 dx minus the two wetted caps. Negative suction (liquid pressure above the
+    gas pressure) is only reached by volume-controlled bridges.
     """
     nan = np.nan
     suction1 = suction_star / radius_ratio  # s R1 / gamma
@@ -292,7 +292,8 @@ def bridge_kernel(radius_ratio, theta, suction_star, delta1):
 
 
 def solve_bridge(radius_ratio, contact_angle, suction_star, filling_angle):
-    """Exact bridge from its filling angle on the smaller sphere (SPEC sections 1 and 4).
+    """Exact bridge from its filling angle on the smaller sphere (docs/units.md; docs/physics.md
+    'The bridge model').
 
     radius_ratio: r = R2/R1 in [1, MAX_SOLVER_RADIUS_RATIO]; contact_angle: theta in [0, 90) deg;
     suction_star: u* = s R2/gamma >= 0; filling_angle: delta1 on R1 in (0, 90 - theta] deg.

@@ -77,7 +77,8 @@ def contact_filling_angle(radius_ratio, theta, suction_star):
 
 
 def rupture_distance(radius_ratio, contact_angle, suction_star):
-    """Rupture distance D/R2 at suction u* = s R2/gamma: no bridge exists farther apart (SPEC section 4).
+    """Rupture distance D/R2 at suction u* = s R2/gamma: no bridge exists farther apart
+    (docs/physics.md 'The bridge model').
 
     radius_ratio in [1, MAX_SOLVER_RADIUS_RATIO], contact_angle in [0, 90) deg, suction_star >= 0.
     """

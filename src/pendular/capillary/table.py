@@ -1,6 +1,7 @@
 """Tabulated suction-controlled bridges over (u*, d*) for fast lookups inside Numba kernels.
 
-Grid, per radius ratio r (SPEC section 1 units):
+Grid, per radius ratio r (the units of docs/units.md):
+
 - suction: xi = ln(1 + u*/suction_scale) uniform on [0, ln(1 + suction_max/suction_scale)], so
   u* = 0 is the first node, small suctions are linear and large ones logarithmic;
 - distance: z = arccos(2 f - 1)/pi uniform on [0, 1], with the fraction
@@ -9,6 +10,7 @@ Grid, per radius ratio r (SPEC section 1 units):
   z is proportional to sqrt(d*_rupture - d*), which makes every quantity smooth there (they
   behave like sqrt(d*_rupture - d*)); the nodes also cluster near contact, where small
   volume-controlled bridges change fast.
+
 Each node holds the exact stable bridge (pendular.capillary.suction_control). Lookups interpolate the
 logarithms of the quantities linearly in (r, xi, z), z relative to the interpolated rupture
 distance (YADE's capillary law interpolates the quantities themselves linearly in (r, u*, d*)).

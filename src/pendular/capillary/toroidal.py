@@ -2,10 +2,10 @@
 
 The meridian is a circle arc of radius R1 (Eq. A.1) and the neck radius is R2 (Eq. A.2),
 both in units of the sphere radius R; the suction follows from Young–Laplace with these two
-radii (Eq. 3.47, SPEC section 7: s = gamma (1/R1 - 1/R2)) and the volume from Eq. A.7 with the
-erratum of SPEC section 7 (its last term is the wetted-cap volume (N - H/2)**2 (3 - N + H/2)/3).
-The force is evaluated at the contact line (SPEC section 4) with that suction. Valid while
-alpha + theta < 90 deg and R2 > 0.
+radii (Eq. 3.47, docs/physics.md 'Errata': s = gamma (1/R1 - 1/R2)) and the volume from Eq. A.7
+with the erratum in docs/physics.md 'Errata' (its last term is the wetted-cap volume (N - H/2)**2
+(3 - N + H/2)/3). The force is evaluated at the contact line (docs/physics.md 'The bridge model')
+with that suction. Valid while alpha + theta < 90 deg and R2 > 0.
 """
 
 from dataclasses import dataclass
@@ -16,7 +16,7 @@ from pendular.capillary.validation import check_contact_angle, check_distance, f
 
 @dataclass(frozen=True)
 class ToroidalBridge:
-    """Toroidal bridge in SPEC section 1 units (R = sphere radius): suction_star = s R/gamma,
+    """Toroidal bridge in the units of docs/units.md (R = sphere radius): suction_star = s R/gamma,
     volume = V/R**3, force = F/(2 pi gamma R), meridian_radius = R1/R, neck_radius = R2/R."""
 
     suction_star: float

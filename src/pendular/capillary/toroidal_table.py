@@ -12,8 +12,9 @@ whose root with R2 > 0 is R1 = 2 S / (b + sqrt(b^2 - 4 u* c S)), b = u* S + c + 
 Eqs. A.1 and A.3 give the gap H/R = 2 (R1 cos(alpha + theta) - 1 + cos(alpha)). As for the exact
 bridge, H rises from 0 (alpha -> 0) to the rupture distance and falls through contact; the
 stable branch is the one of larger alpha. Volume and force at each node come from
-pendular.capillary.toroidal_bridge (Eq. A.7 with SPEC section 7's erratum, force at the contact line).
-Units as SPEC section 1 with R2 = R the sphere radius; nn11, nn33 are not defined (NaN).
+pendular.capillary.toroidal_bridge (Eq. A.7 with the erratum in docs/physics.md 'Errata', force at
+the contact line). Units as docs/units.md with R2 = R the sphere radius; nn11, nn33 are not defined
+(NaN).
 """
 
 import math

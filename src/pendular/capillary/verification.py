@@ -1,4 +1,5 @@
-"""Accuracy measurements published in docs/capillary.md; run `python -m pendular.capillary.verification`.
+"""Accuracy measurements published in docs/capillary.md; run `python -m
+pendular.capillary.verification`.
 
 - reference_bridge: an independent integration of the meridian (scipy solve_ivp in arc length,
   no use of the force invariant), the reference for the exact solver;
@@ -28,8 +29,9 @@ def reference_bridge(radius_ratio, contact_angle, suction_star, filling_angle, r
 
     Integrates (R1 units) from the contact line on sphere 1 to the neck (phi = 0), then on to
     the first point where y = r cos(phi + theta) (contact angle theta on sphere 2), with the
-    volume and interface integrals as extra unknowns. Returns a dict in SPEC units with the
-    force evaluated on sphere 1 (`force`), at the neck (`force_neck`) and on sphere 2 (`force_2`).
+    volume and interface integrals as extra unknowns. Returns a dict in the units of
+    docs/units.md with the force evaluated on sphere 1 (`force`), at the neck (`force_neck`)
+    and on sphere 2 (`force_2`).
     """
     theta, delta1, r = math.radians(contact_angle), math.radians(filling_angle), radius_ratio
     suction1 = suction_star / r

@@ -1,16 +1,17 @@
 """Volume-controlled bridges: the bridge of given volume at a given distance, and its rupture distance.
 
-A bridge of fixed volume V* (it keeps the water it formed with: SPEC section 4) is followed from
-contact as the spheres separate. Its states form the contour V(u*, delta1) = V* of the exact
-solution (pendular.capillary.meniscus); along it the distance first grows, reaches a maximum, the
-volume-controlled rupture distance (Lian et al. 1993 estimate it as (1 + theta/2) V*^(1/3)),
-then falls again on the unstable part. The stable part is the one connected to contact. It goes
-well past the suction-controlled rupture point, and for larger volumes or contact angles the
-suction turns negative (liquid pressure above the gas pressure, convex menisci) before rupture,
-so `suction` may come out negative here. The contour is traced by pseudo-arclength continuation
-in (asinh(u*/r), delta1). Its contact end is the stable suction-controlled bridge at contact
-(or at delta1 = 90 deg - theta where that comes first, large radius ratios), so the volumes
-covered are those of bridges formed at contact with a suction in [0, CONTACT_SUCTION_MAX].
+A bridge of fixed volume V* (it keeps the water it formed with: docs/physics.md 'The bridge
+model') is followed from contact as the spheres separate. Its states form the contour V(u*,
+delta1) = V* of the exact solution (pendular.capillary.meniscus); along it the distance first
+grows, reaches a maximum, the volume-controlled rupture distance (Lian et al. 1993 estimate it
+as (1 + theta/2) V*^(1/3)), then falls again on the unstable part. The stable part is the one
+connected to contact. It goes well past the suction-controlled rupture point, and for larger
+volumes or contact angles the suction turns negative (liquid pressure above the gas pressure,
+convex menisci) before rupture, so `suction` may come out negative here. The contour is traced
+by pseudo-arclength continuation in (asinh(u*/r), delta1). Its contact end is the stable
+suction-controlled bridge at contact (or at delta1 = 90 deg - theta where that comes first,
+large radius ratios), so the volumes covered are those of bridges formed at contact with a
+suction in [0, CONTACT_SUCTION_MAX].
 """
 
 from dataclasses import dataclass

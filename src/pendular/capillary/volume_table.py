@@ -161,7 +161,8 @@ class VolumeBridgeTable:
     """Exact volume-controlled bridges tabulated over (r, V*, d*) for one contact angle.
 
     Build with VolumeBridgeTable.build(...) or, cached on disk, VolumeBridgeTable.cached(...).
-    Inside Numba code call lookup_volume(*table.arrays(), radius_ratio, volume_star, distance_star).
+    Inside Numba code call ``lookup_volume(*table.arrays(), radius_ratio, volume_star,
+    distance_star)``.
     Covered range per radius ratio: volume_range(i); distances from contact to rupture.
     """
 

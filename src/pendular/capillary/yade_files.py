@@ -1,6 +1,7 @@
 """YADE capillary files M(r=...): the data read by Law2_ScGeom_CapillaryPhys_Capillarity.
 
 Layout (YADE's Tableau/TableauD readers, files written by its writesCapFile.m):
+
 - line 1: the radius ratio r = R2/R1; line 2: the number n_D of distance blocks;
 - then n_D blocks, in increasing distance. Each block starts with a line whose first number is
   its row count n (the rest of that line is ignored; writesCapFile writes "n 0 0 0 0 0 0 0"),
@@ -10,6 +11,7 @@ Layout (YADE's Tableau/TableauD readers, files written by its writesCapFile.m):
   All rows of a block share one distance (YADE reads it from the block's last row).
 - distances are uniform from 0 to the rupture distance at zero suction; a block lists the
   suctions (from the given list) at which a stable bridge exists at its distance.
+
 YADE loads M(r=1), M(r=1.1), M(r=1.25), M(r=1.5), M(r=1.75), M(r=2), M(r=3), M(r=4), M(r=5),
 M(r=10) from its working directory and interpolates linearly in r, d* and u*.
 """

@@ -1,6 +1,6 @@
 """Checkpoints: everything a simulation needs to continue bit-identically, written atomically.
 
-A checkpoint is one HDF5 file:
+A checkpoint is one HDF5 file::
 
     attrs        format, version, step, time [s], dt [s], pipeline (the types of the neighbour
                  list, forces, controls, integrator and writers, JSON), skipped (per operation,

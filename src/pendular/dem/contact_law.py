@@ -1,4 +1,5 @@
-"""Linear elastic–frictional contact law (YADE's FrictMat / CundallStrack conventions, SPEC §2).
+"""Linear elastic–frictional contact law
+(YADE's FrictMat / CundallStrack conventions, docs/physics.md 'The contact law').
 
 Sphere–sphere: kn = 2 E R1 R2 / (R1 + R2), ks = shear_ratio * kn, Fn = kn * overlap (no tension),
 incremental shear spring rotated into the current contact plane, Coulomb cap |Fs| <= Fn tan(phi).
@@ -29,7 +30,7 @@ from pendular.dem.virial import (SUM_BLOCKS, add_face_block, block_bounds,
 @numba.njit(cache=True, inline="always")
 def normal_stiffness(young, radius_i, radius_j):
     """Normal stiffness of a sphere pair kn = 2 E R1 R2 / (R1 + R2) [N/m] (YADE FrictMat,
-    SPEC §2; E R for equal spheres); scalars or arrays."""
+    docs/physics.md 'The contact law'; E R for equal spheres); scalars or arrays."""
     return 2.0 * young * radius_i * radius_j / (radius_i + radius_j)
 
 

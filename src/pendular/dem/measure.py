@@ -52,7 +52,7 @@ def elastic_energy(particles, contacts, walls, young, shear_ratio):
     """Energy stored in the linear springs [J]: pairs (normal and shear) and walls.
 
     Uses the overlaps and shear forces of the last force evaluation; kn = 2 E R1 R2 / (R1 + R2),
-    ks = shear_ratio kn, wall kn = E R (SPEC §2).
+    ks = shear_ratio kn, wall kn = E R (docs/physics.md 'The contact law').
     """
     touching = contacts.overlap > 0.0
     ri = particles.radius[contacts.pair_i[touching]]

@@ -2,23 +2,23 @@
 
 A liquid bridge wets a spherical cap of half-angle alpha (its filling angle) on each of its two
 particles. In the bridge frame of one particle (origin at its centre, z along the branch vector
-toward the other particle, outward unit normal n on the sphere, SPEC section 5):
+toward the other particle, outward unit normal n on the sphere, docs/physics.md 'Effective stress'):
 
 - wetted-cap integral  A_ij  = ∫_{cap} R n_i n_j dΓ                       [m^3]   (Eq. 3.48)
 - contact-line integral B'_ij = ∫_{contact line} R gamma n_i e_j dl          [N m]   (Eq. 3.49)
 
 where e is the unit direction of the surface-tension force on the particle: along the liquid-gas
-interface where it leaves the solid, at the contact angle theta from the wetted surface,
-e = cos(theta) t + sin(theta) n with t the surface tangent pointing into the wetted cap. Its
-axial part integrates to the surface-tension force of SPEC section 4, 2 pi gamma R sin(alpha)
-sin(alpha + theta). Both tensors are diag(a, a, c) (axisymmetric about z), so their rotation
-onto a bridge normal, Rot(X) = M X M^T with M e_z = normal, does not depend on how M turns
-about the normal and is the same for the normal and its opposite: each cap can be rotated with
-the bridge's normal, whichever particle it sits on (SPEC section 7: rotate onto the actual
-normal, not with Eq. 3.26, which sends e_z to azimuth phi + pi).
+interface where it leaves the solid, at the contact angle theta from the wetted surface, e =
+cos(theta) t + sin(theta) n with t the surface tangent pointing into the wetted cap. Its axial
+part integrates to the surface-tension force of docs/physics.md 'The bridge model', 2 pi gamma R
+sin(alpha) sin(alpha + theta). Both tensors are diag(a, a, c) (axisymmetric about z), so their
+rotation onto a bridge normal, Rot(X) = M X M^T with M e_z = normal, does not depend on how M
+turns about the normal and is the same for the normal and its opposite: each cap can be rotated
+with the bridge's normal, whichever particle it sits on (docs/physics.md 'Errata': rotate onto
+the actual normal, not with Eq. 3.26, which sends e_z to azimuth phi + pi).
 
-Discrete sums over the bridges in a volume V (SPEC section 5), one cap on each particle of a
-bridge (alpha = delta1 on R1, delta2 on R2):
+Discrete sums over the bridges in a volume V (docs/physics.md 'Effective stress'), one cap on each
+particle of a bridge (alpha = delta1 on R1, delta2 on R2):
 
     chi_ij  = (V_w / V) delta_ij + (1/V) sum_bridges [Rot A(R1, delta1) + Rot A(R2, delta2)]   (Eq. 3.44)
     B_ij    = (1/V) sum_bridges [Rot B'(R1, delta1) + Rot B'(R2, delta2)]                       (Eq. 3.45)

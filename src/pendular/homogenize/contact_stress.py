@@ -1,9 +1,10 @@
 """Love–Weber stress of contact forces (thesis Eq. 3.41).
 
-Sign convention (SPEC §1, §5): compression positive. For a pair, l = x_j - x_i and f = force
-exerted by i on j, so a repulsive contact contributes l_i f_j > 0. For a wall contact, l runs
-from the particle centre to the contact point on the wall plane and f is the force the particle
-exerts on the wall; then, in static equilibrium, the contact stress equals the wall stresses.
+Sign convention (docs/units.md; docs/physics.md 'Effective stress'): compression positive. For a
+pair, l = x_j - x_i and f = force exerted by i on j, so a repulsive contact contributes l_i f_j
+> 0. For a wall contact, l runs from the particle centre to the contact point on the wall plane
+and f is the force the particle exerts on the wall; then, in static equilibrium, the contact
+stress equals the wall stresses.
 """
 
 import numba

@@ -3,13 +3,14 @@
 The bridges of a volume V are described by a density of normals instead of a list:
 
     p(n) = (1 / 4 pi) [1 + a (3 cos^2 beta - 1)]                                    (Eq. 3.50)
-    p'(n) = 2 N_LB p(n) / V, N_LB the number of bridges in V (SPEC section 7)       (Eq. 3.57)
+    p'(n) = 2 N_LB p(n) / V, N_LB the number of bridges in V (Errata)              (Eq. 3.57)
     chi_ij = (V_w / V) delta_ij + ∫∫ M A M^T p'(n) sin beta dbeta dphi             (Eq. 3.55)
     B_ij   = ∫∫ M B' M^T p'(n) sin beta dbeta dphi                                  (Eq. 3.56)
 
 with A, B' of one cap (Eqs. 3.48-3.49; all bridges alike) and M(beta, phi) of Eq. 3.26. As
-printed, Eq. 3.26 sends the local z axis to azimuth phi + pi (SPEC section 7); p(n) does not
-depend on phi, so the integrals are unchanged and M is used here as printed.
+printed, Eq. 3.26 sends the local z axis to azimuth phi + pi; p(n) does not depend on phi, so the
+integrals are unchanged and M is used here as printed. "Errata": the errata of the thesis text
+in docs/physics.md.
 
 Relation to the discrete sums (pendular.homogenize.bridge_tensors): A and B' are diag(a, a, c), so a sum
 of rotated caps depends on the normals only through their fabric F (sum = N (a I + (c - a) F)),
@@ -42,7 +43,7 @@ def fabric_density(anisotropy, polar_angle):
 def thesis_rotation(polar_angle, azimuth):
     """M(beta, phi) of Eq. 3.26 as printed (angles in degrees); shape (..., 3, 3).
 
-    M e_z points to polar angle beta and azimuth phi + pi (SPEC section 7).
+    M e_z points to polar angle beta and azimuth phi + pi (docs/physics.md 'Errata').
     """
     beta, phi = np.broadcast_arrays(np.radians(polar_angle), np.radians(azimuth))
     cb, sb, cp, sp = np.cos(beta), np.sin(beta), np.cos(phi), np.sin(phi)

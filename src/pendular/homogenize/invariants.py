@@ -1,4 +1,4 @@
-"""Stress invariants of axisymmetric (triaxial) tests: q and p, defined once (SPEC §1).
+"""Stress invariants of axisymmetric (triaxial) tests: q and p, defined once (docs/units.md).
 
 Compression positive [Pa]; the lateral stress is the mean of the x and y stresses:
 q = sigma_z - (sigma_x + sigma_y) / 2, p = (sigma_x + sigma_y + sigma_z) / 3.

@@ -23,13 +23,14 @@ homogenised over (the box inside the walls for a recorder). In the triaxial the 
 sigma_ij is the wall stress diag(sigma_x, sigma_y, sigma_z) and u_a = 0. SI units, angles in
 degrees, stresses compression positive.
 
-Sign of B (Eq. 3.45 with SPEC section 5's Eq. 3.49). In Love-Weber form, compression positive,
-forces f acting on a particle at points x of its surface (x from its centre) contribute
--(1/V) sum x_i f_j to the stress: a force pushing the particle inward is compressive. A bridge
-acts on each of its particles through the water pressure u_w = -s on the wetted cap (the force
-s n dGamma pulls the surface outward: contribution -(s/V) A_ij) and through the surface tension
-gamma e dl along the contact line, e pointing along the liquid-gas interface, i.e. toward the
-other particle (attraction: contribution -(1/V) B'_ij); the water itself adds u_w n Sr delta_ij.
+Sign of B (Eq. 3.45 with Eq. 3.49 as restated in docs/physics.md 'Effective stress'). In
+Love-Weber form, compression positive, forces f acting on a particle at points x of its surface
+(x from its centre) contribute -(1/V) sum x_i f_j to the stress: a force pushing the particle
+inward is compressive. A bridge acts on each of its particles through the water pressure u_w =
+-s on the wetted cap (the force s n dGamma pulls the surface outward: contribution -(s/V) A_ij)
+and through the surface tension gamma e dl along the contact line, e pointing along the
+liquid-gas interface, i.e. toward the other particle (attraction: contribution -(1/V) B'_ij);
+the water itself adds u_w n Sr delta_ij.
 The total stress is then sigma = sigma' - chi s - B, i.e. Eq. 3.43 with a plus sign for
 both terms, provided B'_ij = ∫ R gamma n_i e_j dl with e the direction of the surface-tension
 force ON the particle. That is how Eq. 3.49 reads: in the bridge frame n_z = cos(alpha) and

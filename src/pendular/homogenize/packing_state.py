@@ -1,15 +1,17 @@
 """Wet state of a regular packing: SWCC, chi_ij, B_ij and psi_ij (thesis Tables 4.2-4.4).
 
 One bridge per contact, all alike (the contacts of these packings are equivalent); the water
-volume V_w = V n Sr of the unit cell is shared equally by its N_LB bridges (SPEC section 6).
-The bridge follows from one state input (pendular.homogenize.cell_bridge, method "exact" or
-"toroidal"); chi, B and psi are the discrete sums of Eqs. 3.44-3.46 over the bridges of the
-cell (pendular.homogenize.bridge_tensors), a_psi is Eq. 4.5. Water content is gravimetric,
-w = Sr e / Gs (SPEC section 7). SI units (m, N/m, Pa), stresses compression positive, angles
-in degrees; saturation and water content as fractions (not per cent).
+volume V_w = V n Sr of the unit cell is shared equally by its N_LB bridges (docs/physics.md
+'Regular packings'). The bridge follows from one state input (pendular.homogenize.cell_bridge,
+method "exact" or "toroidal"); chi, B and psi are the discrete sums of Eqs. 3.44-3.46 over the
+bridges of the cell (pendular.homogenize.bridge_tensors), a_psi is Eq. 4.5. Water content is
+gravimetric, w = Sr e / Gs (docs/physics.md 'Errata'). SI units (m, N/m, Pa), stresses
+compression positive, angles in degrees; saturation and water content as fractions (not per
+cent).
 
 A state whose filling angle exceeds the packing's pendular limit (max_filling_angle: wetted
-caps of neighbouring bridges on a particle would overlap, SPEC section 4) raises ValueError.
+caps of neighbouring bridges on a particle would overlap, docs/physics.md 'The bridge
+model') raises ValueError.
 """
 
 from dataclasses import dataclass
@@ -32,7 +34,8 @@ class PackingState:
 
     suction: s = u_a - u_w [Pa]; suction_star = s R / gamma. saturation: Sr (fraction).
     water_content: w = Sr e / Gs (gravimetric, fraction). filling_angle: alpha [deg].
-    bridge_volume [m^3] and bridge_force [N] (attractive, SPEC section 4) of each bridge.
+    bridge_volume [m^3] and bridge_force [N] (attractive, docs/physics.md 'The bridge model')
+    of each bridge.
     chi: chi_ij (3, 3), dimensionless (Eq. 3.44). B: B_ij (3, 3) [Pa] (Eq. 3.45).
     psi: psi_ij = chi_ij s + B_ij (3, 3) [Pa] (Eq. 3.46). a_psi: Eq. 4.5.
     """

@@ -6,11 +6,11 @@ Lengths are in units of the particle radius R. Neighbours whose centres lie 2 (1
 
 - SCP: cube of side 2 (1 + H/2), one particle; 6 contacts.
 - BCC: box L x L x L' (z along L'), particles at the corners and the centre (two per cell);
-  the centre touches the 8 corners: l'^2 + 2 l^2 = 16 (1 + H/2)^2 (Eq. 4.2). Geometric limits
-  (Eq. 4.3 with SPEC section 7's erratum, scaled with 1 + H/2): 1 <= l'/2 and l/2 <= sqrt(3/2),
-  i.e. l' in [2, 2 sqrt 2] (1 + H/2). At l' = 2 (1 + H/2) the neighbours along z touch too
-  (10 contacts); at l = 4/sqrt 3 (1 + H/2) = l' the packing is isotropic; at the upper end,
-  l' = 2 sqrt 2 (1 + H/2), the neighbours along x and y touch (12 contacts): the FCP.
+  the centre touches the 8 corners: l'^2 + 2 l^2 = 16 (1 + H/2)^2 (Eq. 4.2). Geometric limits (Eq.
+  4.3 with the erratum in docs/physics.md 'Errata', scaled with 1 + H/2): 1 <= l'/2 and l/2 <=
+  sqrt(3/2), i.e. l' in [2, 2 sqrt 2] (1 + H/2). At l' = 2 (1 + H/2) the neighbours along z
+  touch too (10 contacts); at l = 4/sqrt 3 (1 + H/2) = l' the packing is isotropic; at the upper
+  end, l' = 2 sqrt 2 (1 + H/2), the neighbours along x and y touch (12 contacts): the FCP.
 - FCP: the BCC cell with l' = 2 sqrt 2 (1 + H/2), l = 2 (1 + H/2) (section 4.2.3); 12 contacts.
 
 Every particle of these packings has the same set of contact normals, so the fabric of one
@@ -44,7 +44,7 @@ class RegularPacking:
     (particles_per_cell * coordination / 2 bridges). fabric: (3, 3) F_ij (Eq. 4.1).
     anisotropy: a = 5/2 (F_z - F_x) / tr F (Eq. 3.51). max_filling_angle: the pendular limit
     [deg], half the smallest angle between two contact normals of a particle, where the wetted
-    caps of neighbouring bridges on one particle touch (SPEC section 4).
+    caps of neighbouring bridges on one particle touch (docs/physics.md 'The bridge model').
     """
 
     kind: str
@@ -68,12 +68,13 @@ class RegularPacking:
 
     @property
     def bridges_per_cell(self):
-        """Number of bridges (contacts) in the cell, N_LB (SPEC section 7, Eq. 3.57)."""
+        """Number of bridges (contacts) in the cell, N_LB (docs/physics.md 'Errata', Eq. 3.57)."""
         return len(self.bridge_normals)
 
 
 def bcc_l_prime_range(separation=0.0):
-    """(smallest, largest) l' = L'/R of a BCC packing with gap H/R = separation (Eq. 4.3, SPEC section 7)."""
+    """(smallest, largest) l' = L'/R of a BCC packing with gap H/R = separation (Eq. 4.3,
+    docs/physics.md 'Errata')."""
     scale = 1.0 + 0.5 * separation
     return 2.0 * scale, 2.0 * math.sqrt(2.0) * scale
 
@@ -111,8 +112,8 @@ def _smallest_angle(normals):
 def regular_packing(kind, l_prime=None, separation=0.0):
     """The regular packing `kind` ("scp", "bcc", "fcp") with surface gap H/R = separation >= 0.
 
-    l_prime = L'/R applies to "bcc" only: in [2, 2 sqrt 2] (1 + H/2) (Eq. 4.3, SPEC section 7);
-    None gives the isotropic BCC, l' = 4/sqrt(3) (1 + H/2). Returns a RegularPacking.
+    l_prime = L'/R applies to "bcc" only: in [2, 2 sqrt 2] (1 + H/2) (Eq. 4.3, docs/physics.md
+    'Errata'); None gives the isotropic BCC, l' = 4/sqrt(3) (1 + H/2). Returns a RegularPacking.
     """
     if kind not in KINDS:
         raise ValueError(f"kind = {kind!r} is not a regular packing; valid kinds {KINDS}")

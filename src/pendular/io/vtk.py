@@ -6,7 +6,8 @@ file), four series indexed by ParaView collection files whose ``timestep`` is th
 time [s] or the writer's ``time_axis`` (the triaxial test: axial strain in %):
 
 ``particles.pvd`` / ``particles_NNNNNN.vtu`` (NNNNNN: the step), one VTK vertex per sphere,
-point data (SI units):
+point data (SI units)::
+
     id                 particle index
     radius             [m] (ParaView: Glyph, sphere, Scale Array = radius, scale factor 1)
     velocity           (3) [m/s]
@@ -17,23 +18,27 @@ point data (SI units):
     coordination       number of touching sphere–sphere pairs (overlap > 0)
     bridges            number of liquid bridges (capillary.BridgeState; 0 in a dry scene)
 
-``walls.pvd`` / ``walls_NNNNNN.vtu``: the six walls as quads spanning the box, cell data
+``walls.pvd`` / ``walls_NNNNNN.vtu``: the six walls as quads spanning the box, cell data::
+
     wall               index 0..5 (x-, x+, y-, y+, z-, z+; ``pendular.dem.state.WALL_NAMES``)
     normal_stress      [Pa] force / area, compression positive
     force              [N] normal force of the particles on the wall, compression positive
     velocity           [m/s] outward wall speed of the last step
 
 ``bridges.pvd`` / ``bridges_NNNNNN.vtu``: one line per liquid bridge between the two centres,
-cell data from capillary.BridgeState:
+cell data from capillary.BridgeState::
+
     force              [N] magnitude of the attractive capillary force
     volume             [m^3]
     delta1, delta2     [deg] filling angles on the smaller / larger sphere
 
 ``contacts.pvd`` / ``contacts_NNNNNN.vtu``: the contact network, one line per touching sphere
-pair between the two centres (YADE's interaction network), cell data
+pair between the two centres (YADE's interaction network), cell data::
+
     normal_force       [N] spring normal force (compressive, >= 0)
     shear_force        [N] magnitude of the elastic shear force
     bridge             1 when the pair also holds a liquid bridge
+
 In a periodic cell (pendular.dem.cell) the particles are drawn wrapped into the cell, a pair's line
 runs from particle i to the image of j it interacts with (so lines through a face stick out
 of the cell), and ``walls`` are the cell's faces: normal_stress is the cell's stress on that

@@ -1,4 +1,4 @@
-"""Sample preparation (thesis Ch. 5.2.2, SPEC §3).
+"""Sample preparation (thesis Ch. 5.2.2, docs/physics.md 'Walls, servo and preparation').
 
 1. A random non-overlapping cloud in a fixed frictionless box, friction ``prep_friction`` (0.5°).
 2. Radii grown homogeneously until the mean wall stress reaches ``prep_stress`` (5 kPa) and the

@@ -1,14 +1,15 @@
 """Reference numbers the tests and studies compare with, in one place (SI units).
 
 Sources: Khosravani (2014), thesis Tables 4.1, 4.5, 5.3 and Fig. 5.5; Kim, T.-H. (2001),
-Moisture-induced tensile strength and cohesion of sand, PhD thesis, University of Colorado at
-Boulder, through the thesis's Table 4.5 (direct tension of F-75 sand); SPEC §7 for the Chapter 4
-surface tension. ``comparison_packing`` names the regular packing of thesis Ch. 4 a sample of a
-given void ratio is compared with (pendular.procedures.tension, pendular.studies.chapter4).
+Moisture-induced tensile strength and cohesion in sand, PhD thesis, University of Colorado at
+Boulder, through the thesis's Table 4.5 (direct tension of F-75 sand); docs/physics.md 'Errata'
+for the Chapter 4 surface tension. ``comparison_packing`` names the regular packing of thesis
+Ch. 4 a sample of a given void ratio is compared with (pendular.procedures.tension,
+pendular.studies.chapter4).
 """
 
-#: Surface tension of Chapter 4 [N/m] (the printed "74 µN/m" is 0.074 N/m, SPEC §7); Chapter 5
-#: uses capillary.SURFACE_TENSION = 0.073.
+#: Surface tension of Chapter 4 [N/m] (the printed "74 µN/m" is 0.074 N/m, docs/physics.md
+#: 'Errata'); Chapter 5 uses capillary.SURFACE_TENSION = 0.073.
 CHAPTER4_SURFACE_TENSION = 0.074
 #: Specific gravity of the grains (quartz sand), Gs.
 SPECIFIC_GRAVITY = 2.65

@@ -38,7 +38,7 @@ strength against w beside Kim and the prediction), and per case cases/<case>/his
 (group ``history``: step, time, axial_strain (compression positive, so negative here),
 tensile_stress [Pa], grip_pull (2) [N] (z-, z+ grips), sigma_wall (3) [Pa], coordination,
 bridges, water_content, saturation, unbalanced_force) and the ParaView series
-cases/<case>/vtk/*.pvd (every --vtk-every steps, or --vtk-frames frames per pull).
+``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull).
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ from pendular.io.schema import TENSION_SUMMARY_UNITS
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.water_content import wet_to_water_volume
 
-#: Surface tension [N/m] of the Chapter 4 comparison (SPEC section 7).
+#: Surface tension [N/m] of the Chapter 4 comparison (docs/physics.md 'Errata').
 SURFACE_TENSION = CHAPTER4_SURFACE_TENSION
 #: Preparation friction range searched for the void ratio [deg].
 PREP_FRICTION_RANGE = (0.0, 30.0)

@@ -5,7 +5,8 @@
 Writes the counterparts of Figs. 4.6-4.10, 4.12-4.15, 4.17 and 4.19 as DIR/fig4_*.png and the
 printed tables as DIR/chapter4_tables.txt; prints Table 4.1 (computed next to printed), the key
 numbers and the Kim (2001) comparison of Table 4.5. One bridge per contact (Tables 4.2-4.4),
-surface tension 0.074 N/m (SPEC section 7), specific gravity 2.65, water content gravimetric.
+surface tension 0.074 N/m (docs/physics.md 'Errata'), specific gravity 2.65, water content
+gravimetric.
 Solid lines: exact Young-Laplace bridges; dashed: toroidal approximation (Appendix A).
 """
 

@@ -170,7 +170,7 @@ def plot_anisotropy(path, history, suction, confining):
 
 
 def _line(phi_deg, cohesion, p_max):
-    """p and q of the Mohr–Coulomb line q = M p + q0 (pendular.dem.envelope) over [0, p_max]."""
+    """p and q of the Mohr–Coulomb line q = M p + q0 (pendular.studies.envelope) over [0, p_max]."""
     sin_phi = math.sin(math.radians(phi_deg))
     slope = 6 * sin_phi / (3 - sin_phi)
     q0 = cohesion * 6 * math.cos(math.radians(phi_deg)) / (3 - sin_phi)

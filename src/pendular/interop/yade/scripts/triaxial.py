@@ -161,7 +161,8 @@ def build_scene(config):
         young=E, poisson=float(config["poisson"]), density=float(config["density"]),
         frictionAngle=math.radians(float(config["friction_deg"])), label="spheres"))
     # Same E as the spheres: Ig2_Box_Sphere_ScGeom gives the wall the sphere's radius, so
-    # kn_wall = E R (SPEC 2); friction angle 0 makes the walls frictionless (Ip2 takes the min).
+    # kn_wall = E R (docs/physics.md 'The contact law'); friction angle 0 makes the walls
+    # frictionless (Ip2 takes the min).
     wall_mat = O.materials.append(FrictMat(
         young=E, poisson=float(config["poisson"]), density=float(config["density"]),
         frictionAngle=0.0, label="walls"))

@@ -1,0 +1,168 @@
+"""Pages generated from the code when the docs build, so that nothing is written twice.
+
+On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
+
+- ``outputs_tables.md``: every history column (pendular.io.schema.HISTORY_COLUMNS), summary key
+  (SUMMARY_UNITS), sample and checkpoint dataset (pendular.dem.sample.DATASETS,
+  pendular.dem.checkpoint.DATASETS) with its units, and the ParaView fields as declared in
+  pendular.io.vtk's docstring;
+- ``commands.md``: ``pendular --help`` and every command's ``--help``, as the command prints them;
+- ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
+  sub-package, its docstring and every module in it.
+
+A file is rewritten only when its text changes, so that an incremental build stays incremental.
+"""
+
+import argparse
+import importlib
+import io
+import os
+import pkgutil
+import textwrap
+from contextlib import redirect_stdout
+
+#: Sub-packages with an API page, in the order of the layers (lowest first).
+API_PACKAGES = ("pendular.utils", "pendular.dem", "pendular.capillary", "pendular.homogenize",
+                "pendular.io", "pendular.procedures", "pendular.studies",
+                "pendular.interop.yade", "pendular.cli")
+
+#: Modules that are not imported as a library: ``python -m`` entry points, and the driver
+#: script run by YADE's own Python (it imports yade).
+SKIPPED = ("__main__", ".scripts")
+
+
+def _write(path, text):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    if os.path.exists(path):
+        with open(path, encoding="utf-8") as handle:
+            if handle.read() == text:
+                return
+    with open(path, "w", encoding="utf-8") as handle:
+        handle.write(text)
+
+
+def _cell(text):
+    """Text safe inside a Markdown table cell."""
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _units(units):
+    return "–" if units == "1" else f"`{units}`"
+
+
+def outputs_tables():
+    """The Markdown of the outputs reference's tables."""
+    from pendular.dem import checkpoint, sample
+    from pendular.dem.grading import GRADING_UNITS
+    from pendular.io import schema, vtk
+
+    lines = ["## History datasets (`history.h5`, group `history`)", "",
+             "One row per record; the dimensions after `record` are `axis` and `component` "
+             "(x, y, z) or `grip` (z−, z+). `–`: dimensionless.", "",
+             "| dataset | units | dimensions | dtype | equation | description |",
+             "|---|---|---|---|---|---|"]
+    for name, column in schema.HISTORY_COLUMNS.items():
+        dims = ", ".join(("record", *column.dims))
+        lines.append(f"| `{name}` | {_units(column.units)} | {dims} | {column.dtype} | "
+                     f"{_cell(column.equation)} | {_cell(column.description)} |")
+    lines += ["", "## Summary keys (`summary.json`, `tension.json` cases, campaign rows)", "",
+              "Keys not listed are text, flags or nested records (`units`, `grading`, "
+              "`stress_balance_flagged` lists record indices). Grading keys "
+              "(`grading` block of a summary and of `sample.h5`): "
+              + ", ".join(f"`{key}` [{_units(unit)}]" for key, unit in GRADING_UNITS.items())
+              + ".", "",
+              "| key | units | triaxial | tension | run option |", "|---|---|---|---|---|"]
+    for key in sorted(k for k in schema.SUMMARY_UNITS if k != "grading"):
+        unit = schema.SUMMARY_UNITS[key]
+        marks = ["✓" if key in table else "" for table in (
+            schema.TRIAXIAL_SUMMARY_UNITS, schema.TENSION_SUMMARY_UNITS, schema.OPTION_UNITS)]
+        lines.append(f"| `{key}` | {_units(unit)} | " + " | ".join(marks) + " |")
+    lines += ["", "## Sample datasets (`sample.h5`)", "",
+              "| dataset | units | description |", "|---|---|---|"]
+    lines += [f"| `{name}` | {_units(units)} | {_cell(text)} |"
+              for name, (units, text) in sample.DATASETS.items()]
+    lines += ["", "## Checkpoint datasets (`checkpoint.h5`)", "",
+              "| group / dataset | units | description |", "|---|---|---|"]
+    lines += [f"| `{group}/{name}` | {_units(units)} | {_cell(text)} |"
+              for group, datasets in checkpoint.DATASETS.items()
+              for name, (units, text) in datasets.items()]
+    lines += ["", "## ParaView series (`vtk/*.pvd`)", "",
+              "As declared in `pendular.io.vtk` (series: "
+              + ", ".join(f"`{name}`" for name in vtk.SERIES) + "):", "", "```text",
+              textwrap.dedent(vtk.__doc__).strip(), "```", ""]
+    return "\n".join(lines)
+
+
+def commands_page():
+    """The Markdown of every command's help, as ``pendular ... --help`` prints it."""
+    from pendular import cli
+
+    main = io.StringIO()
+    with redirect_stdout(main):
+        try:
+            cli.main(["--help"])
+        except SystemExit:
+            pass
+    lines = ["## `pendular --help`", "", "```text", main.getvalue().rstrip(), "```", ""]
+    for name in cli.COMMANDS:
+        parser, _ = cli.command_parser(name)
+        lines += [f"## `pendular {name}`", "", "```text", parser.format_help().rstrip(), "```",
+                  ""]
+    return "\n".join(lines)
+
+
+def _modules(package):
+    module = importlib.import_module(package)
+    names = [info.name for info in pkgutil.walk_packages(module.__path__, package + ".")]
+    return [name for name in sorted(names) if not any(skip in name for skip in SKIPPED)]
+
+
+def api_page(package):
+    """The Markdown of a sub-package's API page: its docstring, then each module's members."""
+    lines = [f"# `{package}`", "", "```{eval-rst}",
+             f".. automodule:: {package}", "   :no-members:", "```", ""]
+    for name in _modules(package):
+        importlib.import_module(name)
+        lines += [f"## `{name}`", "", "```{eval-rst}", f".. automodule:: {name}",
+                  "   :members:", "   :show-inheritance:", "```", ""]
+    return "\n".join(lines)
+
+
+def public_page():
+    """The Markdown of the public names of ``pendular`` (``from pendular import ...``)."""
+    import inspect
+
+    import pendular
+
+    lines = ["# `pendular`: the public names", "", "```{eval-rst}", ".. automodule:: pendular",
+             "   :no-members:", "```", ""]
+    for name in pendular.__all__:
+        if name == "__version__":
+            continue
+        kind = "autoclass" if inspect.isclass(getattr(pendular, name)) else "autofunction"
+        options = ["   :members:", "   :show-inheritance:"] if kind == "autoclass" else []
+        lines += [f"## `{name}`", "", "```{eval-rst}", f".. {kind}:: pendular.{name}",
+                  *options, "```", ""]
+    return "\n".join(lines)
+
+
+def generate(app):
+    folder = os.path.join(app.srcdir, "_generated")
+    _write(os.path.join(folder, "outputs_tables.md"), outputs_tables())
+    _write(os.path.join(folder, "commands.md"), commands_page())
+    _write(os.path.join(folder, "api", "pendular.md"), public_page())
+    for package in API_PACKAGES:
+        _write(os.path.join(folder, "api", package + ".md"), api_page(package))
+
+
+def setup(app):
+    app.connect("builder-inited", generate)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}
+
+
+if __name__ == "__main__":      # print one generated page: python docs/_ext/pendular_docs.py
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("page", choices=["outputs", "commands", "pendular", *API_PACKAGES])
+    page = parser.parse_args().page
+    print({"outputs": outputs_tables, "commands": commands_page, "pendular": public_page}.get(
+        page, lambda: api_page(page))())
