@@ -17,7 +17,6 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from pendular.dem.protocols import ReachingForce
 from pendular.utils.validate import check_positive, check_range
 from pendular.dem.virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
@@ -614,8 +613,11 @@ class NeighborList:
         step)."""
         reach = 0.0
         for op in sim.forces:
-            if isinstance(op, ReachingForce):
-                value = op.reach(sim)
+            # the ReachingForce contract, tested by attribute: isinstance against a runtime
+            # protocol costs microseconds a force, every step
+            reach_of = getattr(op, "reach", None)
+            if reach_of is not None:
+                value = reach_of(sim)
                 if value != self.interaction_range:
                     value = check_range(f"{type(op).__name__}.reach", value, 0.0, unit="m")
                 reach = max(reach, value)
