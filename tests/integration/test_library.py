@@ -111,7 +111,8 @@ def test_scenarios_are_thin_wrappers():
 
 
 def test_custom_loading_path_in_a_few_lines():
-    """The README's example: isotropic compression to 2 kPa, unload to 500 Pa, then shear."""
+    """The custom loading path of docs/tutorials/plot_3_custom_loading_path.py: isotropic
+    compression to 2 kPa, unload to 500 Pa, then shear."""
     from pendular import (PrepareConfig, ShearConfig, StressServo, TriaxialShear, equilibrate,
         prepare_sample, summarize)
 

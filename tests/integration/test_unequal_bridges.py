@@ -153,7 +153,7 @@ def frame(normal):
 
 
 def cap_tensors(radius, alpha_deg, theta_deg):
-    """Eq. 3.48 A and Eq. 3.49 B' (per gamma) of a cap, bridge frame, as printed in SPEC section 5."""
+    """Eq. 3.48 A and Eq. 3.49 B' (per gamma) of a cap, bridge frame, as restated in docs/physics.md 'Effective stress'."""
     a, t = math.radians(alpha_deg), math.radians(theta_deg)
     c = math.cos(a)
     A = math.pi * radius ** 3 / 3 * np.diag([(1 - c) ** 2 * (2 + c), (1 - c) ** 2 * (2 + c),

@@ -65,7 +65,7 @@ def test_contact_line_integral_is_the_line_integral_of_the_surface_tension(radiu
             value, _ = quad(lambda phi: radius * gamma * sphere_normal(alpha, phi)[i] * direction(phi)[j]
                             * radius * math.sin(alpha), 0.0, 2.0 * math.pi, epsabs=1e-13 * scale, limit=200)
             assert tensor[i, j] == pytest.approx(value, rel=1e-9, abs=1e-12 * scale)
-    # the same e gives the surface-tension part of the bridge force of SPEC section 4
+    # the same e gives the surface-tension part of the bridge force of docs/physics.md 'The bridge model'
     axial_force, _ = quad(lambda phi: gamma * direction(phi)[2] * radius * math.sin(alpha), 0.0, 2.0 * math.pi)
     assert axial_force == pytest.approx(2.0 * math.pi * gamma * radius * math.sin(alpha) * math.sin(alpha + theta))
 
@@ -97,7 +97,7 @@ def test_rotating_an_axisymmetric_tensor_depends_only_on_the_normal():
 
 
 def test_thesis_rotation_sends_z_to_the_opposite_azimuth():
-    """Eq. 3.26 as printed is a rotation with M e_z at azimuth phi + pi (SPEC section 7)."""
+    """Eq. 3.26 as printed is a rotation with M e_z at azimuth phi + pi (docs/physics.md 'Errata')."""
     for beta, phi in ((30.0, 0.0), (70.0, 125.0), (140.0, 290.0)):
         rotation = thesis_rotation(beta, phi)
         assert rotation @ rotation.T == pytest.approx(np.eye(3), abs=1e-14)

@@ -137,7 +137,7 @@ def test_a_psi_tends_to_the_fabric_anisotropy_as_the_packing_dries(l_prime, meth
 @pytest.mark.parametrize("contact_angle", [0.0, 30.0])
 @pytest.mark.parametrize("kind, l_prime", [("scp", None), ("fcp", None), ("bcc", 2.6)])
 def test_psi_at_high_suction_is_the_love_weber_stress_of_the_pendular_forces(kind, l_prime, contact_angle):
-    """alpha -> 0: psi -> (1/V) sum_bridges l F n n with l = 2R and F = 2 pi gamma R cos(theta) (SPEC section 4)."""
+    """alpha -> 0: psi -> (1/V) sum_bridges l F n n with l = 2R and F = 2 pi gamma R cos(theta) (docs/physics.md 'The bridge model')."""
     packing = regular_packing(kind, l_prime)
     s = state(packing, contact_angle=contact_angle, suction=1e4 * GAMMA / RADIUS)
     force = 2.0 * math.pi * GAMMA * RADIUS * math.cos(math.radians(contact_angle))
