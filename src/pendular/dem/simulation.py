@@ -30,14 +30,8 @@ from pendular.dem.state import Box, Particles
 from pendular.utils.validate import check_int, check_positive
 from pendular.utils.threads import configure as configure_threading
 
-#: Below this many particles a step is too short to pay for waking a second thread (quiet
-#: 2-core machine, 2026-11-25, dry and wet shear, 2 threads against 1 in one run: 0.72x at
-#: 300 spheres, 1.5x at 600, 1.5-1.6x at 1,000; 2,000 until then, measured before the
-#: Z-order numbering and GOMP_SPINCOUNT). Since one thread scatters the pair forces without
-#: a gather pass (2026-11-26): dry / wet 1.00 / 1.12x at 300 spheres, 1.02 / 1.37x at 500,
-#: 1.33 / 1.47x at 700, 1.35 / 1.28x at 1,000. Since the one-thread kernels run row by row
-#: (2026-11-26, afternoon, another VM): 1.00 / 1.07x at 500, 1.01 / 1.06x at 1,000, 1.29 /
-#: 1.31x at 2,000 (never slower, so the threshold stays).
+#: Below this many particles a step is too short to pay for waking a second thread
+#: (docs/performance.md, "Threads by sample size").
 SERIAL_BELOW = 500
 
 

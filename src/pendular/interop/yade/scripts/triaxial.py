@@ -20,7 +20,7 @@
 #   strain_rate   axial (z) compression rate [1/s], > 0 compresses
 #   steps, warmup_steps, record_every, output, history (optional, plot.saveDataTxt file)
 # Optional, with defaults: skin (Verlet skin [m], 0.3 R_min; YADE verletDist = skin / 2: YADE's
-#   faster of 0.1 and 0.3 R, by 15 % at 10,000 spheres, 2026-11-25; pendular's own is 0.1 R),
+#   faster of 0.1 and 0.3 R, docs/performance.md; pendular's own is 0.1 R),
 #   stress_damping 0.25 (TriaxialStressController.stressDamping, YADE's default),
 #   strain_damping 0.0 (TriaxialStressController.strainDamping; YADE's default 0.99 ramps the
 #   axial rate up geometrically, 0 imposes it at once as pendular does),
