@@ -1,0 +1,203 @@
+"""Verlet neighbour list built on the device from a cell list, with per-pair state carried
+across rebuilds by pair identity (pendular.dem.neighbors on the CPU).
+
+Layout: rows of at most ``width`` pairs stored slot by slot (ELLPACK, so that the threads of
+a warp, one per particle, read neighbouring words): pair k = s * N + p (N particles) is
+particle p's s-th neighbour j > p within r_p + r_j + skin (``pair_j``, the row sorted by j;
+``pair_count[p]`` of them); ``second_pair[s * N + p]``, s < ``second_count[p]``, are the pairs
+in which p is the second member, sorted by their first member, the transposed index of the
+CPU list, so that each particle sums its pairs in the CPU's order. Fixed widths need no
+prefix sum on the host: the whole rebuild runs on the device, and its kernels do nothing
+unless ``flags[0]`` asks for a rebuild (set by the integrator when a particle moved more than
+skin / 2 since the last rebuild, by the walls' controls when a wall did; cleared by the next
+pair-force pass).
+
+The cells tile the walls' box, at least ``cell_size`` = 2 max(radius) + skin a side (as many
+as the grid allocated holds), particles outside it counted in the nearest cell (as the CPU's
+grid). A cell's members are appended by integer atomics in any order; the rows are sorted by
+index as they are filled, so the list does not depend on that order. Overflow of a cell or a
+row sets a bit of ``flags[1]`` (CELL_OVERFLOW, ROW_OVERFLOW), which the host reads at its
+checks (pendular.gpu.simulation).
+"""
+
+import math
+
+from pendular.gpu.cuda import cuda, device
+
+#: Bits of flags[1].
+CELL_OVERFLOW = 1
+ROW_OVERFLOW = 2
+
+
+@device
+def grid_dims(wall_position, cell_size, max_dims, axis):
+    """Cells along ``axis``: as many of at least ``cell_size`` [m] as the box holds, within
+    [1, max_dims[axis]] (1 for a box that is not finite or not open: a diverged run)."""
+    cells = (wall_position[2 * axis + 1] - wall_position[2 * axis]) / cell_size
+    if not cells >= 1.0:
+        return 1
+    if cells >= max_dims[axis]:
+        return max_dims[axis]
+    return int(cells)
+
+
+@device
+def cell_coordinate(x, wall_position, dims, axis):
+    """Cell index along ``axis`` of coordinate x [m], clamped into [0, dims) (0 for a
+    coordinate or box that is not finite)."""
+    cells = (x - wall_position[2 * axis]) / (wall_position[2 * axis + 1]
+                                             - wall_position[2 * axis]) * dims
+    if not cells > 0.0:
+        return 0
+    if cells >= dims:
+        return dims - 1
+    return int(cells)
+
+
+@cuda.jit
+def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell_members,
+                  cell_width, cell_of, flags):
+    """Append each particle to its cell (x-major numbering, as the CPU's grid)."""
+    p = cuda.grid(1)
+    if flags[0] == 0 or p >= position.shape[0]:
+        return
+    d0 = grid_dims(wall_position, cell_size, max_dims, 0)
+    d1 = grid_dims(wall_position, cell_size, max_dims, 1)
+    d2 = grid_dims(wall_position, cell_size, max_dims, 2)
+    c = ((cell_coordinate(position[p, 0], wall_position, d0, 0) * d1
+          + cell_coordinate(position[p, 1], wall_position, d1, 1)) * d2
+         + cell_coordinate(position[p, 2], wall_position, d2, 2))
+    cell_of[p] = c
+    slot = cuda.atomic.add(cell_count, c, 1)
+    if slot < cell_width:
+        cell_members[c * cell_width + slot] = p
+    else:
+        cuda.atomic.or_(flags, 1, CELL_OVERFLOW)
+
+
+@device
+def insert_sorted(row, p, n, found, width, q, flags):
+    """Put q into particle p's row (slots s * n + p, s < ``found``) kept sorted, if there is
+    room (else flag the overflow); returns the new count."""
+    if found >= width:
+        cuda.atomic.or_(flags, 1, ROW_OVERFLOW)
+        return found + 1
+    s = found
+    while s > 0 and row[(s - 1) * n + p] > q:
+        row[s * n + p] = row[(s - 1) * n + p]
+        s -= 1
+    row[s * n + p] = q
+    return found + 1
+
+
+@device
+def carry(old, new, source, k, fill):
+    """Row k of the (K, C) ``new`` from row ``source`` of ``old``, or ``fill`` (source -1)."""
+    for c in range(new.shape[1]):
+        new[k, c] = old[source, c] if source >= 0 else fill
+
+
+@cuda.jit
+def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_count,
+               cell_members, cell_width, cell_of, width, pair_count, pair_j, new_count,
+               new_pair_j, lower_count, lower, shear_force, normal, overlap, bridges,
+               new_shear_force, new_normal, new_overlap, new_bridges, flags):
+    """Particle p's neighbours within r_p + r_q + skin from the 27 cells around its own:
+    those above p into its new row, those below into ``lower`` (both sorted); then the per-pair
+    state of the new row from the same (p, j) pairs of the old one (the CPU's
+    previous_pair_index and carry_pair_array): shear force, normal, overlap (-inf: never
+    touched) and the bridges' (K, C) values (state, volume, force, filling angles; zeros)."""
+    p = cuda.grid(1)
+    if flags[0] == 0 or p >= position.shape[0]:
+        return
+    d0 = grid_dims(wall_position, cell_size, max_dims, 0)
+    d1 = grid_dims(wall_position, cell_size, max_dims, 1)
+    d2 = grid_dims(wall_position, cell_size, max_dims, 2)
+    cell = cell_of[p]
+    cz = cell % d2
+    cy = (cell // d2) % d1
+    cx = cell // (d1 * d2)
+    n = position.shape[0]
+    above = 0
+    below = 0
+    for x in range(max(cx - 1, 0), min(cx + 2, d0)):
+        for y in range(max(cy - 1, 0), min(cy + 2, d1)):
+            for z in range(max(cz - 1, 0), min(cz + 2, d2)):
+                c = (x * d1 + y) * d2 + z
+                for slot in range(c * cell_width,
+                                  c * cell_width + min(cell_count[c], cell_width)):
+                    q = cell_members[slot]
+                    if q == p:
+                        continue
+                    reach = radius[p] + radius[q] + skin
+                    e0 = position[q, 0] - position[p, 0]
+                    e1 = position[q, 1] - position[p, 1]
+                    e2 = position[q, 2] - position[p, 2]
+                    if e0 * e0 + e1 * e1 + e2 * e2 < reach * reach:
+                        if q > p:
+                            above = insert_sorted(new_pair_j, p, n, above, width, q, flags)
+                        else:
+                            below = insert_sorted(lower, p, n, below, width, q, flags)
+    new_count[p] = min(above, width)
+    lower_count[p] = min(below, width)
+    old = 0
+    for s in range(new_count[p]):
+        k = s * n + p
+        j = new_pair_j[k]
+        while old < pair_count[p] and pair_j[old * n + p] < j:
+            old += 1
+        source = old * n + p if old < pair_count[p] and pair_j[old * n + p] == j else -1
+        carry(shear_force, new_shear_force, source, k, 0.0)
+        carry(normal, new_normal, source, k, 0.0)
+        new_overlap[k] = overlap[source] if source >= 0 else -math.inf
+        if bridges.shape[0] == overlap.shape[0]:        # a wet scene
+            carry(bridges, new_bridges, source, k, 0.0)
+
+
+@device
+def copy_row(new, current, k):
+    """Row k of the (K, C) ``new`` into ``current``."""
+    for c in range(new.shape[1]):
+        current[k, c] = new[k, c]
+
+
+@cuda.jit
+def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shear_force,
+                   new_normal, new_overlap, new_bridges, pair_count, pair_j, second_count,
+                   second_pair, shear_force, normal, overlap, bridges, normal_force, force,
+                   reference_position, wall_position, reference_walls, cell_count, cell_of,
+                   flags, rebuilds):
+    """Make the new rows the list: counts, neighbours and carried state (force and normal
+    force zero, as a new CPU list's), the transposed index (for each q below p, the slot of p
+    in q's row), the reference positions and walls of the displacement test; empty the cells
+    used."""
+    p = cuda.grid(1)
+    if flags[0] == 0 or p >= position.shape[0]:
+        return
+    n = position.shape[0]
+    pair_count[p] = new_count[p]
+    for s in range(new_count[p]):
+        k = s * n + p
+        pair_j[k] = new_pair_j[k]
+        overlap[k] = new_overlap[k]
+        normal_force[k] = 0.0
+        for c in range(3):
+            force[k, c] = 0.0
+        copy_row(new_shear_force, shear_force, k)
+        copy_row(new_normal, normal, k)
+        if bridges.shape[0] == overlap.shape[0]:
+            copy_row(new_bridges, bridges, k)
+    second_count[p] = lower_count[p]
+    for s in range(lower_count[p]):
+        q = lower[s * n + p]
+        slot = 0
+        while slot < new_count[q] - 1 and new_pair_j[slot * n + q] != p:
+            slot += 1
+        second_pair[s * n + p] = slot * n + q
+    for c in range(3):
+        reference_position[p, c] = position[p, c]
+    cell_count[cell_of[p]] = 0
+    if p == 0:
+        for w in range(6):
+            reference_walls[w] = wall_position[w]
+        rebuilds[0] += 1

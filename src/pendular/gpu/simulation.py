@@ -1,0 +1,324 @@
+"""A CPU Simulation's scene run on the GPU: ``GpuSimulation(sim).run(steps)``.
+
+The state is copied to the device once; each step is a fixed sequence of kernel launches, the
+CPU pipeline (pendular.dem.simulation) on the device::
+
+    bin_particles, find_pairs, finish_rebuild   neighbour list (only when a rebuild is due)
+    pair_forces                                 contact law (+ bridges at contact, wet)
+    gather                                      forces and torques per particle (+ walls)
+    wall_partials, wall_sums, wall_controls     walls' force, stiffness, moment; controls
+    leapfrog                                    integrator (+ the rebuild test)
+
+The host reads nothing per step. It reads the device's flags at its checks (every
+``check_every`` steps, as Simulation.run checks ``until``) and copies the state back into the
+Simulation (``to_host``) when a writer, ``until`` or the caller asks: a HistoryRecorder is run
+at its recording steps only (its ``period``, ``origin``, ``end``), any other writer every step.
+
+What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
+wet, SuctionBridges at contact (``persist`` False); controls StressServo and
+ConstantStrainRate; the Integrator. Anything else is refused by name (ValueError), so that a
+scene never runs with part of its physics missing.
+"""
+
+import math
+
+import numpy as np
+from tqdm import tqdm
+
+from pendular.capillary.bridges import SuctionBridges
+from pendular.dem.contact_law import ContactForces
+from pendular.dem.integrate import Integrator
+from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.state import Walls
+from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
+from pendular.gpu import forces, integrate, neighbors, walls as device_walls
+from pendular.gpu.cuda import configured, cuda, simulated
+from pendular.gpu.state import DeviceState
+from pendular.utils.validate import check_int
+
+
+#: The first launches of a step, the neighbour list's: in the simulator, where the host reads
+#: the device's memory for free, they are skipped when no rebuild is due (the kernels would
+#: return at once), which saves a third of a simulated step.
+REBUILD_LAUNCHES = 3
+
+
+def _one(sim, kind, required=True):
+    """The one operation of class ``kind`` among sim's forces (None if absent and not
+    ``required``)."""
+    found = [op for op in sim.forces if type(op) is kind]
+    if len(found) > 1 or (required and not found):
+        raise ValueError(f"device='gpu' needs {'one' if required else 'at most one'} "
+                         f"{kind.__name__} among the forces; found {len(found)}")
+    return found[0] if found else None
+
+
+def check_scene(sim):
+    """ValueError naming what of ``sim`` the GPU path does not run yet (module docstring)."""
+    if not isinstance(sim.walls, Walls):
+        raise ValueError(f"device='gpu' runs walled scenes only so far; the box is a "
+                         f"{type(sim.walls).__name__}")
+    if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
+        raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
+    for op in sim.forces:
+        if type(op) not in (ContactForces, WallForces, SuctionBridges):
+            raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
+                             "(valid: ContactForces, WallForces, SuctionBridges)")
+    bridges = _one(sim, SuctionBridges, required=False)
+    if bridges is not None and bridges.persist:
+        raise ValueError("device='gpu' runs suction-controlled bridges at contact only so far "
+                         "(persist = False)")
+    for op in sim.controls:
+        if type(op) not in (StressServo, ConstantStrainRate):
+            raise ValueError(f"device='gpu' does not run the control {type(op).__name__} yet "
+                             "(valid: StressServo, ConstantStrainRate)")
+
+
+def _next_write(writer, step):
+    """First step after ``step`` at which ``writer`` may write: a HistoryRecorder's next
+    recording step, any other writer's next step."""
+    if type(writer) is not HistoryRecorder:
+        return step + 1
+    after = step + 1
+    due = after + (writer.origin - after) % writer.period
+    if writer.end is not None and after <= writer.end < due:
+        return writer.end
+    return due
+
+
+class GpuSimulation:
+    """Runs ``sim`` (a pendular.dem.simulation.Simulation whose scene the GPU path supports,
+    ``check_scene``) on the GPU: ``run(steps)`` as Simulation.run, ``to_host()`` to bring the
+    state back into ``sim`` (done before its writers and ``until`` read it). ``sim.step`` and
+    ``sim.time`` advance with the device. Parameters of the operations (friction, servo
+    target, dt, ...) are read at every ``run``; a scene whose operations change (a new
+    control list) needs ``to_host()`` and a new GpuSimulation.
+    """
+
+    def __init__(self, sim):
+        check_scene(sim)
+        self.sim = sim
+        bridges = _one(sim, SuctionBridges, required=False)
+        self._bridges = bridges
+        self._table = None
+        if bridges is not None:
+            bridges.reach(sim)                  # loads the tables, checks the suction
+            self._table = tuple(cuda.to_device(np.ascontiguousarray(a))
+                                for a in bridges.suction_table.arrays())
+            self._suction = bridges.suction
+        else:
+            self._table = tuple(cuda.to_device(np.zeros(shape)) for shape in
+                                ((1,), (3,), (1, 1), (1, 1), (1, 1, 1, 1)))
+            self._suction = 0.0
+        self.state = DeviceState(sim, sim.neighbors.skin, bridges is not None)
+        self._controls = tuple(sim.controls)
+        self._upload_controls()
+        self._steps = []
+        self._launches = []
+
+    # ---------------------------------------------------------------- set-up
+    def _upload_controls(self):
+        """The controls' program and memory (pendular.gpu.walls) from the host's operations."""
+        count = max(1, len(self._controls))
+        kinds = np.zeros(len(self._controls), np.int64)
+        control_walls = np.zeros((count, 6), np.int64)
+        wall_counts = np.zeros(count, np.int64)
+        previous = np.zeros((count, 6))
+        stiffness = np.zeros((count, 6))
+        calls = np.zeros(count, np.int64)
+        for c, op in enumerate(self._controls):
+            if type(op) is StressServo:
+                kinds[c] = device_walls.STRESS_SERVO
+                walls = op.walls
+                previous[c, :len(walls)] = op.previous
+                stiffness[c, :len(walls)] = op.stiffness
+                calls[c] = op.calls
+            else:
+                kinds[c] = device_walls.STRAIN_RATE
+                walls = (2 * op.axis, 2 * op.axis + 1)
+            control_walls[c, :len(walls)] = walls
+            wall_counts[c] = len(walls)
+        s = self.state
+        s.kinds = cuda.to_device(kinds)
+        s.control_walls = cuda.to_device(control_walls)
+        s.wall_counts = cuda.to_device(wall_counts)
+        s.previous = cuda.to_device(previous)
+        s.stiffness = cuda.to_device(stiffness)
+        s.calls = cuda.to_device(calls)
+        s.parameters = cuda.to_device(self._control_parameters())
+
+    def _control_parameters(self):
+        """(controls, 6) parameters of the controls now (pendular.gpu.walls's fields)."""
+        parameters = np.zeros((max(1, len(self._controls)), 6))
+        for c, op in enumerate(self._controls):
+            if type(op) is StressServo:
+                parameters[c] = (op.target, op.gain, op.memory, op.max_velocity,
+                                 float(op.scale_max_velocity), float(op.stiffness_every))
+            else:
+                parameters[c, :3] = (op.rate, op.reference_length, float(op.on_current_length))
+        return parameters
+
+    def _configure(self):
+        """The step's launches (``_launches``: configured kernel, arguments) with the
+        operations' parameters now."""
+        sim = self.sim
+        if tuple(sim.controls) != self._controls:
+            raise ValueError("the scene's controls changed since the GPU copy was made: call "
+                             "to_host() and build a new GpuSimulation")
+        check_scene(sim)
+        if self._bridges is not None and self._bridges.suction != self._suction:
+            raise ValueError(f"suction = {self._bridges.suction:g} Pa changed since the GPU "
+                             f"copy was made at {self._suction:g} Pa: a suction path does not "
+                             "run on the GPU yet")
+        self.state.parameters.copy_to_device(self._control_parameters())
+        contact = _one(sim, ContactForces)
+        wall_law = _one(sim, WallForces)
+        tan_friction = float(np.tan(np.radians(contact.friction_deg)))
+        s = self.state
+        n = s.count
+        order = [type(op) for op in sim.forces]
+        gathered_by = SuctionBridges if s.wet else ContactForces
+        walls_first = order.index(WallForces) < order.index(gathered_by)
+        limit = 0.5 * s.skin
+        bridges = s.bridges
+        # the bridges' columns (pendular.gpu.state.BRIDGE_COLUMNS) as the law's arrays
+        columns = tuple(bridges[:, c] for c in range(bridges.shape[1]))
+        young = contact.young
+        self._steps = [
+            (neighbors.bin_particles, n, (s.position, s.wall_position, s.cell_size, s.max_dims,
+                                          s.cell_count, s.cell_members, s.cell_width,
+                                          s.cell_of, s.flags)),
+            (neighbors.find_pairs, n, (s.position, s.radius, s.skin, s.wall_position,
+                                       s.cell_size, s.max_dims, s.cell_count, s.cell_members,
+                                       s.cell_width, s.cell_of, s.width, s.pair_count,
+                                       s.pair_j, s.new_count, s.new_pair_j, s.lower_count,
+                                       s.lower, s.shear_force, s.normal, s.overlap, bridges,
+                                       s.new_shear_force, s.new_normal, s.new_overlap,
+                                       s.new_bridges, s.flags)),
+            (neighbors.finish_rebuild, n, (s.position, s.new_count, s.new_pair_j,
+                                           s.lower_count, s.lower, s.new_shear_force,
+                                           s.new_normal, s.new_overlap, s.new_bridges,
+                                           s.pair_count, s.pair_j, s.second_count,
+                                           s.second_pair, s.shear_force, s.normal, s.overlap,
+                                           bridges, s.normal_force, s.pair_force,
+                                           s.reference_position, s.wall_position,
+                                           s.reference_walls, s.cell_count, s.cell_of,
+                                           s.flags, s.rebuilds)),
+            (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
+                                     s.pair_count, s.pair_j, s.shear_force, s.normal,
+                                     s.overlap, s.normal_force, s.pair_force, young,
+                                     contact.shear_ratio, tan_friction, sim.dt, s.flags,
+                                     s.wet, *columns, self._suction,
+                                     self._bridges.surface_tension if s.wet else 1.0,
+                                     *self._table)),
+            (forces.gather, n, (s.position, s.radius, s.pair_count, s.second_count,
+                                s.second_pair, s.pair_force, s.normal, s.overlap, s.wet,
+                                columns[2], walls_first, s.wall_position, wall_law.young,
+                                s.force, s.torque)),
+            (device_walls.wall_partials, s.partial.shape[0],
+             (s.position, s.radius, s.wall_position, wall_law.young, s.partial)),
+            (device_walls.wall_sums, 6 * device_walls.WALL_SUMS,
+             (s.partial, s.wall_force, s.wall_stiffness, s.wall_moment)),
+            (device_walls.wall_controls, 1,
+             (s.wall_force, s.wall_stiffness, s.kinds, s.control_walls, s.wall_counts,
+              s.parameters, s.previous, s.stiffness, s.calls, s.wall_position,
+              s.wall_velocity, s.reference_walls, limit, sim.dt, s.flags)),
+            (integrate.leapfrog, n, (s.position, s.velocity, s.angular_velocity, s.force,
+                                     s.torque, s.mass, s.inertia, sim.integrator.damping,
+                                     sim.dt, s.reference_position, limit, s.flags)),
+        ]
+        self._launches = [(configured(kernel, items), args)
+                          for kernel, items, args in self._steps]
+
+    # ---------------------------------------------------------------- running
+    def advance(self):
+        """One step on the device (launches only); sim.step and sim.time advance."""
+        idle = simulated() and self.state.flags[0] == 0
+        for kernel, args in self._launches[REBUILD_LAUNCHES if idle else 0:]:
+            kernel(*args)
+        self.sim.step += 1
+        self.sim.time += self.sim.dt
+
+    def check(self):
+        """Read the device's flags: RuntimeError when a cell or a row overflowed (the list
+        would miss pairs), FloatingPointError when a position is not finite."""
+        _, overflow, not_finite = self.state.flags_now()
+        if not_finite:
+            raise FloatingPointError("a particle's position is not finite on the GPU: the "
+                                     "simulation diverged (lower the time step, e.g. "
+                                     "timestep_safety, or check the forces)")
+        if overflow & neighbors.CELL_OVERFLOW:
+            raise RuntimeError(f"a cell of the GPU's neighbour grid holds more than "
+                               f"{self.state.cell_width} particles (the box grew past the grid "
+                               "allocated, or spheres overlap deeply): results after it are "
+                               "not valid")
+        if overflow & neighbors.ROW_OVERFLOW:
+            raise RuntimeError(f"a particle has more than {self.state.width} neighbours on "
+                               "one side in the GPU's neighbour list: results after it are "
+                               "not valid")
+
+    def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
+        """Advance ``steps`` steps on the device, or fewer if ``until(sim)`` becomes true
+        (checked every ``check_every`` steps on the state brought back); the writers run at
+        their steps on the state brought back. Arguments and result as Simulation.run."""
+        steps = check_int("steps", steps)
+        check_every = check_int("check_every", check_every, low=1)
+        self._configure()
+        sim = self.sim
+        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
+                   mininterval=1.0, disable=progress is None)
+        taken = 0
+        try:
+            while taken < steps:
+                writes = min((_next_write(w, sim.step) for w in sim.writers),
+                             default=math.inf)
+                chunk = int(min(check_every - taken % check_every, steps - taken,
+                                writes - sim.step))
+                for _ in range(chunk):
+                    self.advance()
+                taken += chunk
+                bar.update(chunk)
+                self.check()
+                checking = until is not None and (taken % check_every == 0 or taken == steps)
+                if sim.step == writes or checking:
+                    self.to_host()
+                    for writer in sim.writers:
+                        writer.apply(sim)
+                if status is not None and checking:
+                    bar.set_postfix(status(sim), refresh=False)
+                if checking and until(sim):
+                    break
+        finally:
+            bar.close()
+        return taken
+
+    def to_host(self):
+        """Bring the device's state into ``sim``: particles, walls, the neighbour list with its
+        per-pair state (rebuilt by the CPU's NeighborList from it, so that the CPU can go on
+        from here) and the servos' memory."""
+        sim = self.sim
+        self.state.to_host(sim)
+        s = self.state
+        previous = s.previous.copy_to_host()
+        stiffness = s.stiffness.copy_to_host()
+        calls = s.calls.copy_to_host()
+        for c, op in enumerate(self._controls):
+            if type(op) is StressServo:
+                op.previous[:] = previous[c, :len(op.walls)]
+                op.stiffness[:] = stiffness[c, :len(op.walls)]
+                op.calls = int(calls[c])
+        # the CPU's own list from the device's, so that its rebuild test holds if the CPU goes
+        # on; a rebuilt list holds no pair forces (pendular.dem.neighbors.build_contacts): the
+        # device's are carried to the same pairs (every touching pair is in both lists)
+        listed = sim.contacts
+        sim.neighbors.rebuild(sim)
+        index = previous_pair_index(listed.row_start, listed.pair_j, sim.contacts.row_start,
+                                    sim.contacts.pair_j)
+        sim.contacts.force = carry_pair_array(listed.force, index)
+        sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
+
+    @property
+    def rebuilds(self):
+        """Neighbour-list rebuilds on the device so far."""
+        return int(self.state.rebuilds.copy_to_host()[0])

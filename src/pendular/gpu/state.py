@@ -1,0 +1,178 @@
+"""The device's copy of a walled scene: particles, the neighbour list with its per-pair state,
+the cell grid, the walls and their controls' memory, copied in from a CPU Simulation once and
+out when the host asks (pendular.gpu.simulation).
+
+Per-pair arrays follow the device list's layout (pendular.gpu.neighbors: pair k = s * N + p);
+the bridges' per-pair state is one (K, BRIDGE_COLUMNS) float64 array whose columns are
+BridgeState's ``state``, ``volume``, ``force``, ``filling_i``, ``filling_j`` (the ``suction``
+field is 0 under suction control and is not kept on the device).
+"""
+
+import math
+
+import numpy as np
+
+from pendular.capillary.bridge_state import FIELDS, OWNER
+from pendular.dem.neighbors import Contacts, build_pairs, second_index
+from pendular.dem.protocols import pair_key
+from pendular.gpu.cuda import cuda
+from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS
+
+#: BridgeState fields kept on the device, in the columns of ``bridges``.
+BRIDGE_COLUMNS = ("state", "volume", "force", "filling_i", "filling_j")
+#: Room left in each row beyond the longest row of the first list (neighbours come and go).
+ROW_ROOM = 1.5
+#: Fewest slots of a row.
+MIN_WIDTH = 16
+#: Cells per axis allocated for each cell the box holds now (room for the box to grow).
+GRID_ROOM = 2
+#: Densest packing of spheres (fcc) bounding how many fit a cell.
+DENSEST = 0.7405
+
+
+def row_width(position, radius, skin, contacts=None):
+    """Slots per row [-]: ROW_ROOM times the most neighbours one particle has above or below it
+    in the CPU's list (``contacts``, or one built here with ``skin`` [m]), at least MIN_WIDTH."""
+    if contacts is None:
+        row_start, pair_j = build_pairs(position, radius, skin)
+    else:
+        row_start, pair_j = contacts.row_start, contacts.pair_j
+    above = np.diff(row_start)
+    below = np.bincount(pair_j, minlength=len(radius))
+    longest = int(max(above.max(initial=0), below.max(initial=0)))
+    return max(MIN_WIDTH, math.ceil(ROW_ROOM * longest))
+
+
+def cell_capacity(radius, cell_size):
+    """Most spheres of these radii [m] that fit a cell of edge below 2 ``cell_size`` [m] (the
+    largest a grid of at least ``cell_size`` has), at the densest packing, plus a few."""
+    smallest = 4.0 / 3.0 * math.pi * float(radius.min()) ** 3
+    return math.ceil(DENSEST * (2.0 * cell_size) ** 3 / smallest) + 8
+
+
+def _to_ell(values, slots, count, width, fill):
+    """Per-pair ``values`` in CSR order (K, ...) laid out as device rows (width * count, ...)."""
+    out = np.full((width * count,) + values.shape[1:], fill, dtype=values.dtype)
+    out[slots] = values
+    return out
+
+
+class DeviceState:
+    """Device arrays of a walled scene (attributes named as on the host). Build with
+    ``from_host``; ``to_host`` writes them back into the Simulation."""
+
+    def __init__(self, sim, skin, wet):
+        p = sim.particles
+        walls = sim.walls
+        count = len(p)
+        self.count = count
+        self.skin = skin
+        self.wet = wet
+        self.cell_size = 2.0 * float(p.radius.max()) + skin
+        self.width = row_width(p.position, p.radius, skin, sim.contacts)
+        self.cell_width = cell_capacity(p.radius, self.cell_size)
+        lengths = walls.lengths()
+        max_dims = np.array([max(1, int(GRID_ROOM * length / self.cell_size))
+                             for length in lengths], dtype=np.int64)
+        cells = int(np.prod(max_dims))
+        pairs = self.width * count
+        to = cuda.to_device
+        for name in ("position", "velocity", "angular_velocity", "radius", "mass", "inertia"):
+            setattr(self, name, to(np.ascontiguousarray(getattr(p, name))))
+        self.force = to(np.zeros((count, 3)))
+        self.torque = to(np.zeros((count, 3)))
+        self.reference_position = to(np.ascontiguousarray(p.position))
+        for name in ("position", "velocity", "force", "stiffness", "moment"):
+            setattr(self, f"wall_{name}", to(np.ascontiguousarray(getattr(walls, name))))
+        self.reference_walls = to(np.ascontiguousarray(walls.position))
+        self.partial = to(np.zeros((max(1, -(-count // REDUCE_CHUNK)), 6, WALL_SUMS)))
+        self.max_dims = to(max_dims)
+        self.cell_count = to(np.zeros(cells, np.int32))
+        self.cell_members = to(np.zeros(cells * self.cell_width, np.int32))
+        self.cell_of = to(np.zeros(count, np.int32))
+        # the list in use, filled from the host's if it has one; flags[0] = 1: rebuild first
+        rows = self._host_rows(sim.contacts, count)
+        self.pair_count = to(rows["pair_count"])
+        self.pair_j = to(rows["pair_j"])
+        self.shear_force = to(rows["shear_force"])
+        self.normal = to(rows["normal"])
+        self.overlap = to(rows["overlap"])
+        self.bridges = to(rows["bridges"])
+        self.normal_force = to(np.zeros(pairs))
+        self.pair_force = to(np.zeros((pairs, 3)))
+        self.second_count = to(np.zeros(count, np.int32))
+        self.second_pair = to(np.zeros(pairs, np.int32))
+        # the list being built at a rebuild
+        self.new_count = to(np.zeros(count, np.int32))
+        self.new_pair_j = to(np.zeros(pairs, np.int32))
+        self.lower_count = to(np.zeros(count, np.int32))
+        self.lower = to(np.zeros(pairs, np.int32))
+        self.new_shear_force = to(np.zeros((pairs, 3)))
+        self.new_normal = to(np.zeros((pairs, 3)))
+        self.new_overlap = to(np.zeros(pairs))
+        self.new_bridges = to(np.zeros(rows["bridges"].shape))
+        self.flags = to(np.array([1, 0, 0], np.int32))
+        self.rebuilds = to(np.zeros(1, np.int64))
+
+    def _host_rows(self, contacts, count):
+        """The host's list (or none) as device rows: counts, neighbours and per-pair state."""
+        width = self.width
+        bridge_rows = width * count if self.wet else 1
+        if contacts is None or len(contacts) == 0:
+            return {"pair_count": np.zeros(count, np.int32),
+                    "pair_j": np.zeros(width * count, np.int32),
+                    "shear_force": np.zeros((width * count, 3)),
+                    "normal": np.zeros((width * count, 3)),
+                    "overlap": np.full(width * count, -np.inf),
+                    "bridges": np.zeros((bridge_rows, len(BRIDGE_COLUMNS)))}
+        counts = np.diff(contacts.row_start)
+        slots = (np.arange(len(contacts)) - contacts.row_start[contacts.pair_i]) * count \
+            + contacts.pair_i
+        bridges = np.zeros((bridge_rows, len(BRIDGE_COLUMNS)))
+        if self.wet and pair_key(OWNER, FIELDS[0]) in contacts.extra:
+            columns = np.stack([contacts.extra[pair_key(OWNER, field)].astype(np.float64)
+                                for field in FIELDS if field.name in BRIDGE_COLUMNS], axis=1)
+            bridges = _to_ell(columns, slots, count, width, 0.0)
+        return {"pair_count": counts.astype(np.int32),
+                "pair_j": _to_ell(contacts.pair_j.astype(np.int32), slots, count, width, 0),
+                "shear_force": _to_ell(contacts.shear_force, slots, count, width, 0.0),
+                "normal": _to_ell(contacts.normal, slots, count, width, 0.0),
+                "overlap": _to_ell(contacts.overlap, slots, count, width, -np.inf),
+                "bridges": bridges}
+
+    def flags_now(self):
+        """(rebuild asked, overflow bits, not-finite flag) read from the device (a sync)."""
+        return tuple(int(value) for value in self.flags.copy_to_host())
+
+    def contacts(self):
+        """The device's neighbour list and per-pair state as a host Contacts (CSR order)."""
+        count = self.count
+        pair_count = self.pair_count.copy_to_host().astype(np.int64)
+        row_start = np.concatenate([[0], np.cumsum(pair_count)]).astype(np.int64)
+        pair_i = np.repeat(np.arange(count, dtype=np.int64), pair_count)
+        slots = (np.arange(row_start[-1]) - row_start[pair_i]) * count + pair_i
+        pair_j = self.pair_j.copy_to_host()[slots].astype(np.int64)
+        second_start, second_pair = second_index(row_start, pair_j, count)
+        extra = {}
+        if self.wet:
+            bridges = self.bridges.copy_to_host()[slots]
+            for field in FIELDS:
+                values = (bridges[:, BRIDGE_COLUMNS.index(field.name)]
+                          if field.name in BRIDGE_COLUMNS else np.zeros(len(slots)))
+                extra[pair_key(OWNER, field)] = values.astype(field.dtype)
+        return Contacts(pair_i=pair_i, pair_j=pair_j, row_start=row_start,
+                        second_start=second_start, second_pair=second_pair,
+                        shear_force=self.shear_force.copy_to_host()[slots],
+                        normal=self.normal.copy_to_host()[slots],
+                        overlap=self.overlap.copy_to_host()[slots],
+                        normal_force=self.normal_force.copy_to_host()[slots],
+                        force=self.pair_force.copy_to_host()[slots], extra=extra)
+
+    def to_host(self, sim):
+        """Write the particles, the walls and the neighbour list into ``sim`` (a copy each)."""
+        p = sim.particles
+        for name in ("position", "velocity", "angular_velocity", "force", "torque"):
+            getattr(self, name).copy_to_host(getattr(p, name))
+        for name in ("position", "velocity", "force", "stiffness", "moment"):
+            getattr(self, f"wall_{name}").copy_to_host(getattr(sim.walls, name))
+        sim.contacts = self.contacts()

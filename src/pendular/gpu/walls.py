@@ -1,0 +1,154 @@
+"""The six walls on the device: the particles' forces on them reduced in a fixed order, then
+the walls' controls (stress servo, constant strain rate) in the scene's order, with no host
+round trip (pendular.dem.walls on the CPU).
+
+The reduction: each block of REDUCE_CHUNK particles sums its contacts with each wall in
+particle order (``wall_partials``), then one thread per wall quantity adds the blocks in order
+(``wall_sums``): for up to REDUCE_CHUNK particles the CPU's sum (pendular.dem.contact_law.
+wall_forces) in the CPU's order.
+
+The controls are a small program: row c of ``kinds`` is STRESS_SERVO or STRAIN_RATE, its walls
+in ``control_walls[c, :wall_counts[c]]``, its parameters in ``parameters[c]`` (SERVO_FIELDS or
+STRAIN_RATE_FIELDS) and a servo's memory in ``previous[c]``, ``stiffness[c]`` and
+``calls[c]`` (pendular.dem.walls.StressServo's ``previous``, ``stiffness``, ``calls``).
+"""
+
+from pendular.dem.walls import StressServo
+from pendular.gpu.cuda import cuda, device
+from pendular.gpu.forces import wall_push
+
+#: Servo calls during which the stiffness is refreshed every call (StressServo's).
+STIFFNESS_WARMUP = StressServo.STIFFNESS_WARMUP
+#: Particles summed by one thread of wall_partials.
+REDUCE_CHUNK = 1024
+#: Wall quantities summed: force [N], stiffness [N/m], moment [N m] (pendular.dem.state.Walls).
+WALL_SUMS = 3
+
+STRESS_SERVO = 0
+STRAIN_RATE = 1
+#: parameters[c] of a servo and of a constant strain rate.
+SERVO_FIELDS = ("target", "gain", "memory", "max_velocity", "scale_max_velocity",
+                "stiffness_every")
+STRAIN_RATE_FIELDS = ("rate", "reference_length", "on_current_length")
+
+
+@cuda.jit
+def wall_partials(position, radius, wall_position, young, partial):
+    """partial[b, w, q]: block b's sum over its particles, in order, of wall w's force,
+    stiffness and moment (q: WALL_SUMS) from their contacts."""
+    b = cuda.grid(1)
+    if b >= partial.shape[0]:
+        return
+    for w in range(6):
+        for q in range(WALL_SUMS):
+            partial[b, w, q] = 0.0
+    for p in range(b * REDUCE_CHUNK, min((b + 1) * REDUCE_CHUNK, position.shape[0])):
+        for axis in range(3):
+            for side in range(2):
+                push, kn, gap_overlap = wall_push(p, axis, side == 1, position, radius,
+                                                  wall_position, young)
+                if gap_overlap > 0.0:
+                    w = 2 * axis + side
+                    partial[b, w, 0] += push
+                    partial[b, w, 1] += kn
+                    partial[b, w, 2] += (radius[p] - gap_overlap) * push
+
+
+@device
+def move_walls(wall_position, wall_velocity, c, control_walls, count, outward, dt):
+    """Shift control c's walls outward by ``outward[c, slot]`` [m] each and record their
+    velocity (pendular.dem.walls.move_walls)."""
+    for slot in range(count):
+        w = control_walls[c, slot]
+        sign = 1.0 if w % 2 else -1.0
+        wall_position[w] += sign * outward[c, slot]
+        wall_velocity[w] = outward[c, slot] / dt
+
+
+@device
+def servo(c, control_walls, count, parameters, previous, stiffness, calls, wall_position,
+          wall_velocity, wall_force, wall_stiffness, dt):
+    """One call of StressServo c (pendular.dem.walls.StressServo.apply and servo_walls)."""
+    target = parameters[c, 0]
+    gain = parameters[c, 1]
+    memory = parameters[c, 2]
+    max_velocity = parameters[c, 3]
+    scale_max_velocity = parameters[c, 4] != 0.0
+    every = int(parameters[c, 5])
+    refresh = calls[c] < STIFFNESS_WARMUP or calls[c] % every == 0
+    calls[c] += 1
+    lx = wall_position[1] - wall_position[0]
+    ly = wall_position[3] - wall_position[2]
+    lz = wall_position[5] - wall_position[4]
+    for slot in range(count):
+        w = control_walls[c, slot]
+        axis = w // 2
+        if refresh:
+            stiffness[c, slot] = wall_stiffness[w]
+        cap = max_velocity * dt
+        if scale_max_velocity:
+            length = lx if axis == 0 else (ly if axis == 1 else lz)
+            cap = cap * (3.0 * length / (lx + ly + lz))
+        if stiffness[c, slot] > 0.0:
+            area = ly * lz if axis == 0 else (lx * lz if axis == 1 else lx * ly)
+            shift = (wall_force[w] - target * area) / stiffness[c, slot]
+            shift = min(max(shift, -cap), cap)
+        else:
+            shift = -cap
+        previous[c, slot] = gain * shift + memory * previous[c, slot]
+    move_walls(wall_position, wall_velocity, c, control_walls, count, previous, dt)
+
+
+@device
+def strain_rate(c, control_walls, parameters, previous, wall_position, wall_velocity, dt):
+    """One call of ConstantStrainRate c (pendular.dem.walls.ConstantStrainRate.apply): both
+    walls of its axis move inward at rate * L / 2, L the reference or current length."""
+    rate = parameters[c, 0]
+    axis = control_walls[c, 0] // 2
+    length = parameters[c, 1]
+    if parameters[c, 2] != 0.0:
+        length = wall_position[2 * axis + 1] - wall_position[2 * axis]
+    shift = -0.5 * rate * length * dt
+    previous[c, 0] = shift
+    previous[c, 1] = shift
+    move_walls(wall_position, wall_velocity, c, control_walls, 2, previous, dt)
+
+
+@cuda.jit
+def wall_sums(partial, wall_force, wall_stiffness, wall_moment):
+    """One thread per wall and quantity: the blocks' partial sums added in order into the
+    walls' force, stiffness and moment."""
+    t = cuda.grid(1)
+    if t >= 6 * WALL_SUMS:
+        return
+    w = t // WALL_SUMS
+    q = t % WALL_SUMS
+    total = 0.0
+    for b in range(partial.shape[0]):
+        total += partial[b, w, q]
+    if q == 0:
+        wall_force[w] = total
+    elif q == 1:
+        wall_stiffness[w] = total
+    else:
+        wall_moment[w] = total
+
+
+@cuda.jit
+def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts, parameters,
+                  previous, stiffness, calls, wall_position, wall_velocity, reference_walls,
+                  limit, dt, flags):
+    """One thread: the controls in order, then a neighbour-list rebuild asked when a wall has
+    moved more than ``limit`` [m] since the last one."""
+    if cuda.grid(1) != 0:
+        return
+    for c in range(kinds.shape[0]):
+        if kinds[c] == STRESS_SERVO:
+            servo(c, control_walls, wall_counts[c], parameters, previous, stiffness, calls,
+                  wall_position, wall_velocity, wall_force, wall_stiffness, dt)
+        else:
+            strain_rate(c, control_walls, parameters, previous, wall_position,
+                        wall_velocity, dt)
+    for w in range(6):
+        if abs(wall_position[w] - reference_walls[w]) > limit:
+            flags[0] = 1
