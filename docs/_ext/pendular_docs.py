@@ -4,8 +4,9 @@ On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
 
 - ``outputs_tables.md``: every history column (pendular.io.schema.HISTORY_COLUMNS), summary key
   (SUMMARY_UNITS), sample and checkpoint dataset (pendular.dem.sample.DATASETS,
-  pendular.dem.checkpoint.DATASETS) with its units, and the ParaView fields as declared in
-  pendular.io.vtk's docstring;
+  pendular.dem.checkpoint.DATASETS) with its units, the ParaView frames' field data
+  (pendular.io.schema.VTK_FIELDS) and the ParaView fields as declared in pendular.io.vtk's
+  docstring;
 - ``commands.md``: ``pendular --help`` and every command's ``--help``, as the command prints them;
 - ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
   sub-package, its docstring and every module in it.
@@ -87,7 +88,12 @@ def outputs_tables():
               for group, datasets in checkpoint.DATASETS.items()
               for name, (units, text) in datasets.items()]
     lines += ["", "## ParaView series (`vtk/*.pvd`)", "",
-              "As declared in `pendular.io.vtk` (series: "
+              "Field data of every frame (`pendular.io.schema.VTK_FIELDS`; a series' time axis, "
+              "the `.pvd` timestep, is one of them, named in a comment of the `.pvd` file):", "",
+              "| field | units | description |", "|---|---|---|"]
+    lines += [f"| `{name}` | {_units(column.units)} | {_cell(column.description)} |"
+              for name, column in schema.VTK_FIELDS.items()]
+    lines += ["", "As declared in `pendular.io.vtk` (series: "
               + ", ".join(f"`{name}`" for name in vtk.SERIES) + "):", "", "```text",
               textwrap.dedent(vtk.__doc__).strip(), "```", ""]
     return "\n".join(lines)

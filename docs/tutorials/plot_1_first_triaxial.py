@@ -21,7 +21,8 @@ two cores).
 #     pendular triaxial --particles 200 --suction 30000 --max-strain 0.05 --out runs/first
 #
 # (``python scenarios/triaxial.py`` takes the same options). Here we run it from Python, as a
-# shell would, and print what it prints. ``--quiet`` leaves out the progress bars.
+# shell would, and print what it prints on its standard output (the progress bars go to the
+# standard error; ``--quiet`` leaves them out and prints the summary as JSON, for scripts).
 
 # sphinx_gallery_start_ignore
 import shutil
@@ -32,16 +33,18 @@ import subprocess
 import sys
 
 command = ("pendular triaxial --particles 200 --suction 30000 --max-strain 0.05 "
-           "--out runs/first --quiet")
+           "--out runs/first")
 done = subprocess.run([sys.executable, "-m", *command.split()], capture_output=True,
                       text=True, check=True)
 print(done.stdout)
 
 # %%
-# The terminal summary gives the peak of the deviator stress q = σ₁ − σ₃, the mean stress
-# p = (σ₁ + 2σ₃)/3 there, the same for the effective stress of thesis Eq. 3.43 (q′, p′), the
-# degree of saturation Sr and the timings. Stresses are in Pa, compression positive; strains are
-# fractions, compression positive (:doc:`/units`).
+# The terminal summary gives, one a line with its unit and to 4 significant figures, the peak of
+# the deviator stress q = σ₁ − σ₃, the mean stress p = (σ₁ + 2σ₃)/3 there, the same for the
+# effective stress of thesis Eq. 3.43 (q′, p′), the degree of saturation Sr and the timings.
+# Stresses are in Pa, compression positive; strains are fractions, compression positive
+# (:doc:`/units`). A note follows when q still rises at the end of the test (``peak_reached``
+# false in ``summary.json``): the "peak" is then the highest record, not a peak.
 #
 # What the run left
 # -----------------
@@ -79,12 +82,19 @@ show("runs/first/triaxial.png")
 
 # %%
 # ``plots/`` holds the stress ratio of the net stress, q/p, beside that of the effective stress
-# of Eq. 3.43, q′/p′ (thesis Fig. 5.7), the degree of saturation against the strain, and the
-# capillary stress ψ (Eq. 3.46).
+# of Eq. 3.43, q′/p′ (thesis Fig. 5.7), the degree of saturation against the strain, the
+# capillary stress ψ (Eq. 3.46) with the interface term and σ_cap, and the stress paths.
 
 for name in sorted(os.listdir("runs/first/plots")):
     print(name)
 show("runs/first/plots/q_p.png")
+
+# %%
+# ``stress_path.png`` draws the path of the net stress, q against p, and beside it that of the
+# effective stress, q′ against p′: the capillary stress ψ shifts the wet sample's path to
+# higher mean stress.
+
+show("runs/first/plots/stress_path.png")
 
 # %%
 # Next: :doc:`plot_2_results_in_python` reads the same folder in Python, and

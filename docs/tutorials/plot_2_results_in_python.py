@@ -99,8 +99,9 @@ for key in ("peak_q", "p_at_peak", "axial_strain_at_peak", "peak_q_effective",
 # ParaView collections of ``.vtu`` frames. In ParaView: *File → Open* ``particles.pvd``, then a
 # *Glyph* filter (sphere, *Scale Array* = ``radius``, scale factor 1); ``bridges.pvd`` and
 # ``contacts.pvd`` draw as lines, coloured by their ``force`` or ``normal_force``. Each frame's
-# time value is the axial strain of the triaxial test; its field data hold the step, the
-# simulated time and the axial strain.
+# time value (ParaView's time axis) is the axial strain of the triaxial test in %; its field data
+# hold the step, the simulated time and the axial strain both as a fraction (``axial_strain``)
+# and in % (``axial_strain_percent``, the time value).
 #
 # In Python, :func:`pendular.read_vtk` reads a series with ``meshio`` (a dependency of
 # pendular): a list of (time value, mesh) pairs.

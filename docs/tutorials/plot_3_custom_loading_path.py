@@ -91,3 +91,69 @@ figure.tight_layout()
 # ``TriaxialTest(TriaxialConfig(sample=..., shear=..., bridges=...)).run("runs/mine")``
 # (:class:`pendular.TriaxialTest`); the configurations are typed dataclasses, validated once,
 # and ``dataclasses.replace(config, ...)`` makes variants.
+
+# %%
+# Any path from a table
+# ---------------------
+#
+# The same stages run from the command line: ``pendular path PATH.toml`` reads a TOML list of
+# ``[[stage]]`` tables whose keys are those of :class:`pendular.Stage` — ``stress``
+# (servoed walls, {axis: Pa}), ``strain_rate`` (driven walls, {axis: 1/s}; 0 holds them),
+# ``mean_stress``, ``b``, ``max_strain_rate`` — and its end ``until``: ``{strain = 0.05,
+# axis = "z"}``, ``{stress = 5000, axis = "z"}`` or ``"static"``. A stress may be written
+# ``"confining"`` (the ``--confining`` the path starts from), a strain rate ``"quasi-static"``
+# or ``"-quasi-static"`` (the inertial-number rule, ``--inertial-number``). An entry with
+# ``repeat = N`` and ``stages = [...]`` runs its stages N times: cycles. The sample and its
+# wetting are the command's options, as for ``pendular triaxial``; a mistyped key is refused
+# with the file, the stage and the valid keys, before anything runs.
+#
+# Here a K0 loading to 5 kPa and two unload–reload cycles, on a wet sample of 150 spheres:
+
+table = """\
+[[stage]]                                   # K0 loading: x and y held, z pushed in
+strain_rate = {x = 0, y = 0, z = "quasi-static"}
+until = {stress = 5000, axis = "z"}
+
+[[stage]]                                   # two unload-reload cycles
+repeat = 2
+stages = [
+  {strain_rate = {x = 0, y = 0, z = "-quasi-static"}, until = {stress = 1500, axis = "z"}},
+  {strain_rate = {x = 0, y = 0, z = "quasi-static"}, until = {stress = 5000, axis = "z"}},
+]
+"""
+with open("k0_cycles.toml", "w") as handle:
+    handle.write(table)
+
+# sphinx_gallery_start_ignore
+import shutil
+
+shutil.rmtree("runs/k0_cycles", ignore_errors=True)     # a fresh folder at every build
+# sphinx_gallery_end_ignore
+import subprocess
+import sys
+
+command = ("pendular path k0_cycles.toml --particles 150 --confining 750 --suction 30000 "
+           "--inertial-number 1e-3 --vtk-every 0 --out runs/k0_cycles")
+done = subprocess.run([sys.executable, "-m", *command.split()], capture_output=True,
+                      text=True, check=True)
+print(done.stdout)
+
+# %%
+# ``summary.json`` lists the end of each stage (stresses, p and q, strains, void ratio and,
+# wet, p′ and q′ of the effective stress, Eq. 3.43); ``path.png`` draws the stress paths and
+# the stresses and strains against the history row:
+
+figure, axes = plt.subplots(figsize=(9, 5.5))
+axes.imshow(plt.imread("runs/k0_cycles/path.png"))
+axes.set_axis_off()
+figure.tight_layout()
+
+# %%
+# ``examples/paths/`` holds three tables: ``triaxial.toml``, the triaxial of thesis Ch. 5
+# (with ``--records 500`` its history is, row for row and bit for bit, that of ``pendular
+# triaxial`` with the same options), ``oedometer_unload.toml`` and ``cyclic.toml``.
+#
+# A change of suction is not a table's stage yet; in Python it is one call,
+# ``pendular.procedures.path_table.change_suction``, between stages run by ``run_path``:
+# the example :doc:`/auto_examples/loading_path_api` wets a sample at 30 kPa, loads it
+# oedometrically to 10 kPa, dries it to 300 kPa at constant σv and unloads it, in six lines.

@@ -71,7 +71,7 @@ def test_paraview_series_read_back_with_meshio(finished):
 
 def test_plots_are_written(finished):
     kind, out = finished
-    names = {"q_p.png", "volumetric_strain.png"} | (
+    names = {"q_p.png", "volumetric_strain.png", "stress_path.png"} | (
         {"capillary_stress.png", "saturation.png"} if kind == "wet" else set())
     assert set(os.listdir(out / "plots")) == names
     for name in names:

@@ -239,7 +239,8 @@ def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder)
     """Each series of the shear (vtk/) and of the preparation and wetting (vtk_prep/) opens
     with the vtk package: 200 spheres, six wall quads, two points per bridge or contact line,
     the declared arrays, and field data step, time and axial_strain (shear: the .pvd time axis
-    is the axial strain in %) or phase (preparation: every phase of a wet run, in order)."""
+    is the axial strain in %, field data axial_strain_percent) or phase (preparation: every
+    phase of a wet run, in order)."""
     pytest.importorskip("vtk")
     from pendular.procedures.triaxial import PREP_PHASES
 
@@ -268,7 +269,8 @@ def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder)
                 assert set(data) == names, (series, sorted(data))
                 assert all(len(values) == cells for values in data.values())
             if folder == "vtk":
-                assert set(field) == {"step", "time", "axial_strain"}
+                assert set(field) == {"step", "time", "axial_strain", "axial_strain_percent"}
+                assert timestep == field["axial_strain_percent"][0]      # the same unit, %
                 assert timestep == pytest.approx(100.0 * field["axial_strain"][0], abs=1e-12)
             else:
                 assert set(field) == {"step", "time", "phase", "mean_wall_stress"}

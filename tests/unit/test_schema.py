@@ -22,7 +22,7 @@ TENSION = ["step", "time", "axial_strain", "tensile_stress", "grip_pull", "sigma
            "coordination", "unbalanced_force", "bridges", "water_content", "saturation"]
 #: Columns of a triaxial at constant water content (closed liquid), besides WET.
 LIQUID = ["liquid_bridges", "liquid_film", "liquid_lost"]
-PATHS = ["void_ratio", "k0", "stage"]
+PATHS = ["void_ratio", "k0", "stage", "cycle"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}
 ROWS = 7
 
@@ -195,14 +195,18 @@ def test_unreadable_histories_are_reported_with_their_path(tmp_path):
 
 def test_peak_reached():
     strain = np.linspace(0.0, 0.1, 101)
-    assert peak_reached(strain, 40)
-    assert peak_reached(strain, 97)               # 3 % of the range before the end
-    assert not peak_reached(strain, 100)          # the maximum is the last row
-    assert not peak_reached(strain, -1)
-    assert not peak_reached(strain, 99)           # within the last 2 % of the range
-    assert not peak_reached(strain, 97, fraction=0.05)
-    assert peak_reached(-strain, 40) and not peak_reached(-strain, 99)    # tension
-    assert not peak_reached(np.zeros(3), 0)       # no strain range
+
+    def peaked(row):                               # the maximum at ``row``, falling after it
+        return -np.abs(np.arange(101.0) - row)
+
+    assert peak_reached(strain, peaked(40))
+    assert peak_reached(strain, peaked(97), window=0.02)   # 3 % of the range before the end
+    assert not peak_reached(strain, peaked(97))    # the last 20 %: 17 records up, three down
+    assert not peak_reached(strain, peaked(100))   # the maximum is the last row
+    assert not peak_reached(strain, peaked(99))    # within the last 2 % of the range
+    assert not peak_reached(strain, peaked(97), fraction=0.05)
+    assert peak_reached(-strain, peaked(40)) and not peak_reached(-strain, peaked(99))  # tension
+    assert not peak_reached(np.zeros(3), np.arange(3.0))    # no strain range
 
 
 def test_read_summary_of_a_run(tmp_path):

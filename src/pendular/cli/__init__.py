@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 import difflib
 import importlib
-import math
+import json
 import sys
 
 #: Command name -> (module under pendular.cli.commands, one-line description).
@@ -21,6 +21,8 @@ COMMANDS = {
     "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
     "oedometer": ("oedometer", "oedometric (K0) compression and unloading, dry or wet"),
     "isotropic": ("isotropic", "isotropic loading and unloading in stages: e against log p"),
+    "cyclic": ("cyclic", "cyclic triaxial loading, stress- or strain-controlled"),
+    "path": ("path", "any loading path from a TOML table of stages, dry or wet"),
     "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
     "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
@@ -100,7 +102,11 @@ def add_run_options(parser, threads_default=None):
                         help="Numba threads of a run" + (
                             " (None: all from 500 spheres on, else 1)"
                             if threads_default is None else ""))
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--quiet", action="store_true",
+                        help="no progress bars, and the results in the form scripts read: a "
+                             "loading test's summary as JSON, tension's and swcc's tables in "
+                             "fixed columns (without --quiet: one line or table row per result, "
+                             "to 4 significant figures, with units)")
 
 
 def add_executor_options(parser):
@@ -234,18 +240,95 @@ def _main(argv, prog):
     return run_command(args.command, options)
 
 
-def format_summary(summary, keys):
+def format_value(value):
+    """A summary value as the terminal shows it: a float to 4 significant figures (without an
+    exponent below a million: 30000, not 3e+04), a flag as true/false (as in summary.json),
+    None as '-', anything else as it is."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        text = f"{value:.4g}"
+        return f"{float(text):.0f}" if "e+" in text and abs(value) < 1e6 else text
+    return "-" if value is None else str(value)
+
+
+def _shown(unit):
+    """Whether a unit is printed: not for a dimensionless value, record indices or no unit."""
+    return isinstance(unit, str) and unit not in ("1", "record")
+
+
+def _with_unit(name, unit):
+    """``name [unit]``, or the name alone for a unit not shown or one the name ends with
+    (``tensile_strength_pa``)."""
+    return f"{name} [{unit}]" if _shown(unit) and not name.endswith(f"_{unit.lower()}") else name
+
+
+def _is_table(value):
+    """Whether a summary value is a list of records (an isotropic path's ``stages``)."""
+    return isinstance(value, list) and bool(value) and all(isinstance(r, dict) for r in value)
+
+
+def format_table(rows, units, columns=None, width=100):
+    """Lines of a table of ``rows`` (dicts): a header ``name [unit]`` (``units``: column ->
+    unit), then one line per row, numbers to 4 significant figures, right-aligned. ``columns``:
+    those shown (default: every column holding a number, flag or text). A table wider than
+    ``width`` characters is cut into blocks of columns, one under the other (a blank line
+    between), each led by the first column (the row's name: stage, cycle)."""
+    if columns is None:
+        columns = [name for name in dict.fromkeys(k for row in rows for k in row)
+                   if all(not isinstance(row.get(name), (list, dict)) for row in rows)]
+    header = [_with_unit(name, units.get(name)) for name in columns]
+    cells = [[format_value(row.get(name)) for name in columns] for row in rows]
+    widths = [max(len(text) for text in column) for column in zip(header, *cells)]
+    blocks = [[0]]
+    for index in range(1, len(columns)):
+        if len(blocks[-1]) > 1 and sum(widths[k] + 2 for k in blocks[-1]) + widths[index] > width:
+            blocks.append([0])
+        blocks[-1].append(index)
+    lines = []
+    for block in blocks:
+        lines += [""] if lines else []
+        lines += ["  ".join(line[k].rjust(widths[k]) for k in block) for line in (header, *cells)]
+    return lines
+
+
+def format_summary(summary, keys, columns=None):
     """Lines ``name  value unit`` of the ``keys`` of a run's ``summary`` that it holds, numbers
-    to 4 significant figures, units from the summary's own ``units``."""
-    units = summary.get("units", {})
+    to 4 significant figures (format_value), units from the summary's own ``units`` block, else
+    from pendular.io.schema.SUMMARY_UNITS; a list of records (an isotropic path's ``stages``)
+    as a table under its name (format_table, with ``columns``), the units of its columns from
+    the key's own units (a dict), else from those of the summary."""
+    from pendular.io.schema import SUMMARY_UNITS
+
+    units = {**SUMMARY_UNITS, **summary.get("units", {})}
     shown = [key for key in keys if key in summary]
-    width = max((len(key) for key in shown), default=0)
+    width = max((len(key) for key in shown if not _is_table(summary[key])), default=0)
     lines = []
     for key in shown:
         value = summary[key]
-        if isinstance(value, float) and math.isfinite(value):
-            value = f"{value:.4g}"
-        unit = units.get(key, "")
-        lines.append(f"  {key:<{width}}  {value}{' ' + unit if unit and unit != '1' else ''}")
+        if _is_table(value):
+            table_units = units.get(key) if isinstance(units.get(key), dict) else units
+            lines.append(f"  {key}:")
+            lines += [f"    {line}" if line else "" for line in
+                      format_table(value, table_units, columns)]
+            continue
+        unit = units.get(key)
+        if isinstance(value, dict):        # e.g. steps by phase: one line, each with its unit
+            inner = unit if isinstance(unit, dict) else {}
+            value = ", ".join(f"{name} {format_value(item)}"
+                              + (f" {inner[name]}" if _shown(inner.get(name)) else "")
+                              for name, item in value.items())
+        elif isinstance(value, list):      # e.g. record indices
+            value = ", ".join(format_value(item) for item in value) or "none"
+        lines.append(f"  {key:<{width}}  {format_value(value)}"
+                     + (f" {unit}" if _shown(unit) else ""))
     return "\n".join(lines)
 
+
+def print_summary(summary, keys, quiet=False, columns=None):
+    """Print the ``keys`` of a run's ``summary``: format_summary's lines, or with ``quiet``
+    (--quiet, for scripts) the same keys as JSON, values unrounded."""
+    if quiet:
+        print(json.dumps({key: summary[key] for key in keys if key in summary}, indent=2))
+    else:
+        print(format_summary(summary, keys, columns))

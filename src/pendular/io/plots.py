@@ -46,7 +46,7 @@ def _diagonals(values):
 
 def run_label(parameters, initial_porosity=None):
     """One line of a run's parameters for figure titles: N, sigma_3 (an oedometer's start and
-    end stress, an isotropic path's stresses), s, theta, porosity."""
+    end stress, an isotropic path's stresses), s, the contact angle, porosity."""
     parts = [f"N = {parameters['particles']}"]
     if parameters.get("psd") is not None:
         parts[0] += " (graded)"
@@ -65,7 +65,7 @@ def run_label(parameters, initial_porosity=None):
         parts.append(f"s = {parameters.get('suction', 0.0) / 1e3:g} kPa")
     if (parameters.get("water_content_percent") is not None
             or parameters.get("suction", 0.0) > 0.0):
-        parts.append(f"θ = {parameters.get('contact_angle', 0.0):g}°")
+        parts.append(f"contact angle θ = {parameters.get('contact_angle', 0.0):g}°")
     if initial_porosity is not None:
         parts.append(f"n0 = {initial_porosity:.3f}")
     return ", ".join(parts)
@@ -86,39 +86,45 @@ def _strain_axes(axes, label):
     axes.grid(alpha=0.3)
 
 
-def plot_history(history, path, title="", direction="compression"):
-    """q [kPa] and volumetric strain [%] against axial strain [%] (thesis Fig. 5.3), the peak
-    of q marked (in extension the least q); ``title``: the run's parameters (run_label)."""
+def history_figure(history, title="", direction="compression"):
+    """The figure of plot_history: q [kPa] above the volumetric strain [%], both against the
+    axial strain [%], tick labels on both panels."""
     strain = 100.0 * history["axial_strain"]
     q = deviator_stress(history["sigma_wall"]) / 1e3
     peak = _peak(history, direction)
     figure, (top, bottom) = pyplot().subplots(2, 1, figsize=(6, 7), sharex=True)
-    top.plot(strain, q, color="C0")
+    top.plot(strain, q, color="C0", label="net stress")
     top.plot(strain[peak], q[peak], "o", color="C3",
              label=f"{'peak' if direction == 'compression' else 'least'} q = {q[peak]:.3g} kPa "
                    f"at εa = {strain[peak]:.2f} %")
-    top.legend()
-    _strain_axes(top, "deviator stress q [kPa] (net stress)")
+    top.legend(fontsize=8)
+    _strain_axes(top, "deviator stress q [kPa]")
+    top.tick_params(labelbottom=True)          # sharex hides them on the upper panel
     bottom.plot(strain, 100.0 * history["volumetric_strain"], color="C2")
     bottom.axvline(strain[peak], color="C3", lw=0.8, ls=":")
-    _strain_axes(bottom, "volumetric strain εv [%] (contraction +)")
-    top.set_title(title, fontsize=9)
-    save_figure(figure, path)
+    _strain_axes(bottom, "volumetric strain εv [%]\n(contraction +)")
+    top.set_title(f"Drained triaxial {direction}\n{title}", fontsize=9)
+    return figure
+
+
+def plot_history(history, path, title="", direction="compression"):
+    """q [kPa] and volumetric strain [%] against axial strain [%] (thesis Fig. 5.3), the peak
+    of q marked (in extension the least q); ``title``: the run's parameters (run_label)."""
+    return save_figure(history_figure(history, title, direction), path)
 
 
 def write_plots(history, folder, title="", direction="compression"):
     """The plots of a triaxial run into ``folder``, each against axial strain [%] with the run's
-    parameters as title: q_p.png (q/p of the net stress and, wet, q'/p' of the effective
+    parameters in the title: q_p.png (q/p of the net stress and, wet, q'/p' of the effective
     stress of Eq. 3.43), volumetric_strain.png and, wet, saturation.png (Sr [%]) and
-    capillary_stress.png (diagonal components of psi, Eq. 3.46, and of the Love–Weber stress
-    of the capillary forces, [kPa]); the peak of q (``direction`` 'extension': of -q) marked,
-    none for ``direction`` None (a path without a failure). Returns the paths."""
+    capillary_stress.png (capillary_figure); the peak of q (``direction`` 'extension': of -q)
+    marked, none for ``direction`` None (a path without a failure). Returns the paths."""
     plt = pyplot()
     strain = 100.0 * history["axial_strain"]
     peak = None if direction is None else _peak(history, direction)
     paths = []
 
-    def single(name, label, series):
+    def single(name, heading, label, series):
         figure, axes = plt.subplots(figsize=(6, 4))
         for legend, values in series:
             axes.plot(strain, values, label=legend)
@@ -126,41 +132,61 @@ def write_plots(history, folder, title="", direction="compression"):
             axes.axvline(strain[peak], color="C3", lw=0.8, ls=":", label="peak of q")
         _strain_axes(axes, label)
         axes.legend(fontsize=8)
-        axes.set_title(title, fontsize=9)
+        axes.set_title(f"{heading}\n{title}", fontsize=9)
         paths.append(save_figure(figure, os.path.join(folder, name)))
 
     ratios = [("q/p, net stress", stress_ratio(history["sigma_wall"]))]
     if "sigma_effective" in history:
-        ratios.append(("q'/p', effective stress (Eq. 3.43)",
+        ratios.append(("q′/p′, effective stress (Eq. 3.43)",
                        stress_ratio(_diagonals(history["sigma_effective"]))))
     if "sigma_effective_complete" in history:
-        ratios.append(("q'/p', complete effective stress (ψ + interface)",
+        ratios.append(("q′/p′, complete effective stress (ψ + interface term)",
                        stress_ratio(_diagonals(history["sigma_effective_complete"]))))
-    single("q_p.png", "stress ratio [-]", ratios)
-    single("volumetric_strain.png", "volumetric strain εv [%] (contraction +)",
+    single("q_p.png", "Stress ratio", "stress ratio q/p [-]", ratios)
+    single("volumetric_strain.png", "Volumetric strain",
+           "volumetric strain εv [%]\n(contraction +)",
            [("εv", 100.0 * history["volumetric_strain"])])
     if "saturation" in history:
-        single("saturation.png", "degree of saturation Sr [%]",
+        single("saturation.png", "Degree of saturation", "degree of saturation Sr [%]",
                [("Sr", 100.0 * history["saturation"])])
-    capillary = [(key, title_) for key, title_ in
-                 (("psi", "capillary stress ψ = χ s + B [kPa] (Eq. 3.46)"),
-                  ("psi_interface", "liquid–gas interface stress [kPa]"),
-                  ("sigma_capillary", "Love–Weber stress of the capillary forces [kPa] "
-                                      "(tension negative)"))
-                 if key in history]
-    if capillary:
-        figure, panels = plt.subplots(len(capillary), 1, figsize=(6.5, 3.5 * len(capillary)),
-                                      sharex=True, squeeze=False)
-        for axes, (key, label) in zip(panels[:, 0], capillary):
-            for words, values in zip(AXIS_WORDS, _diagonals(history[key]).T):
-                axes.plot(strain, values / 1e3, label=f"{key} {words}")
-            axes.set_ylabel(label, fontsize=8)
-            axes.grid(alpha=0.3)
-            axes.legend(fontsize=8)
-        panels[-1, 0].set_xlabel("axial strain εa [%]")
-        panels[0, 0].set_title(title, fontsize=9)
+    figure = capillary_figure(history, title)
+    if figure is not None:
         paths.append(save_figure(figure, os.path.join(folder, "capillary_stress.png")))
     return paths
+
+
+#: Panels of the capillary stress figure: history column, symbol (y label and legends), what
+#: the panel shows (its title).
+CAPILLARY_PANELS = (
+    ("psi", "ψ", "capillary stress ψ = χ s + B (Eq. 3.46)"),
+    ("psi_interface", "interface term", "liquid–gas interface term of the complete "
+                                        "capillary stress"),
+    ("sigma_capillary", "σ$_\\mathrm{cap}$", "σ$_\\mathrm{cap}$: Love–Weber stress of the "
+                                               "capillary forces (tension negative)"),
+)
+
+
+def capillary_figure(history, title=""):
+    """The diagonal components (lateral x, y; axial z) [kPa] against axial strain [%] of the
+    capillary stress ψ (Eq. 3.46), the liquid–gas interface term and the Love–Weber stress of
+    the capillary forces, one panel each that the history holds; None for a dry history."""
+    panels = [panel for panel in CAPILLARY_PANELS if panel[0] in history]
+    if not panels:
+        return None
+    strain = 100.0 * history["axial_strain"]
+    figure, axes_list = pyplot().subplots(len(panels), 1, figsize=(6.5, 3.2 * len(panels) + 0.6),
+                                          sharex=True, squeeze=False)
+    for axes, (key, symbol, what) in zip(axes_list[:, 0], panels):
+        for words, values in zip(AXIS_WORDS, _diagonals(history[key]).T):
+            axes.plot(strain, values / 1e3, label=f"{symbol}, {words}")
+        axes.set_ylabel(f"{symbol} [kPa]")
+        axes.set_title(what, fontsize=9)
+        axes.grid(alpha=0.3)
+        axes.legend(fontsize=8)
+        axes.tick_params(labelbottom=True)
+    axes_list[-1, 0].set_xlabel("axial strain εa [%]")
+    figure.suptitle(f"Capillary stresses\n{title}", fontsize=9)
+    return figure
 
 
 def _effective_diagonals(history):
@@ -176,23 +202,42 @@ def _stage_ends(history):
     return np.flatnonzero(np.append(stage[1:] != stage[:-1], True))
 
 
-def plot_stress_path(history, path, title=""):
-    """The stress path q [kPa] against p [kPa] of the net wall stress and, wet, q' against p'
-    of the effective stress (Eq. 3.43); q = sigma_z - (sigma_x + sigma_y) / 2, negative in
-    extension."""
-    figure, axes = pyplot().subplots(figsize=(6, 5))
-    sigma = np.asarray(history["sigma_wall"])
-    axes.plot(mean_stress(sigma) / 1e3, deviator_stress(sigma) / 1e3, label="q–p, net stress")
+def stress_path_figure(history, title="", direction=None):
+    """The figure of plot_stress_path: q against p [kPa] of the net wall stress and, wet, q′
+    against p′ of the effective stress (Eq. 3.43) and of the complete one (ψ + interface
+    term) on the same axes, each path's start and (``direction`` of a shear) its peak of q
+    marked."""
+    figure, axes = pyplot().subplots(figsize=(6, 5.5))
+    peak = None if direction is None else _peak(history, direction)
+    paths = [("net stress: q–p", np.asarray(history["sigma_wall"]), "C0")]
     effective = _effective_diagonals(history)
     if effective is not None:
-        axes.plot(mean_stress(effective) / 1e3, deviator_stress(effective) / 1e3,
-                  label="q'–p', effective stress (Eq. 3.43)")
-    axes.set_xlabel("mean stress p [kPa]")
-    axes.set_ylabel("deviator stress q [kPa]")
+        paths.append(("effective stress (Eq. 3.43): q′–p′", effective, "C1"))
+    if "sigma_effective_complete" in history:
+        paths.append(("complete effective stress (ψ + interface term): q′–p′",
+                      _diagonals(history["sigma_effective_complete"]), "C2"))
+    for label, sigma, color in paths:
+        p, q = mean_stress(sigma) / 1e3, deviator_stress(sigma) / 1e3
+        axes.plot(p, q, color=color, label=label)
+        axes.plot(p[0], q[0], "s", color=color, ms=4)
+        if peak is not None:
+            axes.plot(p[peak], q[peak], "o", color=color, mfc="none")
+    wet = len(paths) > 1
+    axes.set_xlabel(f"mean stress {'p, p′' if wet else 'p'} [kPa]")
+    axes.set_ylabel(f"deviator stress {'q, q′' if wet else 'q'} [kPa]")
     axes.grid(alpha=0.3)
-    axes.legend(fontsize=8)
-    axes.set_title(title, fontsize=9)
-    return save_figure(figure, path)
+    axes.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12),
+                title=("square: start, circle: peak of q" if peak is not None
+                       else "square: start"), title_fontsize=8)
+    axes.set_title(f"Stress path{'s, net and effective' if wet else ''}\n{title}", fontsize=9)
+    return figure
+
+
+def plot_stress_path(history, path, title="", direction=None):
+    """The stress path q [kPa] against p [kPa] of the net wall stress and, wet, q′ against p′
+    of the effective stress (Eq. 3.43) beside it (stress_path_figure); q = sigma_z -
+    (sigma_x + sigma_y) / 2, negative in extension; ``direction`` of a shear marks its peak."""
+    return save_figure(stress_path_figure(history, title, direction), path)
 
 
 def plot_compression(history, path, title="", stress="axial"):
@@ -242,4 +287,101 @@ def plot_compression(history, path, title="", stress="axial"):
                       "(log scale)")
     bottom.grid(alpha=0.3, which="both")
     bottom.legend(fontsize=8)
+    return save_figure(figure, path)
+
+
+def plot_cyclic(history, cycles, path, title=""):
+    """The loops of a cyclic triaxial path (pendular.procedures.cyclic): left, q [kPa] against
+    the axial strain [%], the first loading in grey and each cycle (history column ``cycle``)
+    in its own colour; right, the secant modulus [kPa] and the damping ratio [-] of each
+    cycle (``cycles``: the summary's rows) against its number, wet the effective ones
+    (Eq. 3.43) dashed. ``title``: the run's parameters."""
+    plt = pyplot()
+    strain = 100.0 * np.asarray(history["axial_strain"])
+    q = deviator_stress(history["sigma_wall"]) / 1e3
+    cycle = np.asarray(history["cycle"])
+    count = int(cycle.max()) if len(cycle) else 0
+    colours = plt.get_cmap("viridis")(np.linspace(0.0, 0.9, max(count, 1)))
+    figure, (loops, measures) = plt.subplots(1, 2, figsize=(11, 4.8))
+    first = np.flatnonzero(cycle == 0)
+    loops.plot(strain[first], q[first], color="0.6", lw=1.0, label="first loading")
+    for k in range(1, count + 1):
+        rows = np.flatnonzero(cycle == k)
+        if len(rows) and rows[0] > 0:
+            rows = np.concatenate([rows[:1] - 1, rows])         # from the top of the loop
+        loops.plot(strain[rows], q[rows], color=colours[k - 1], lw=1.0,
+                   label=f"cycle {k}" if count <= 10 or k in (1, count) else None)
+    loops.axhline(0.0, color="0.8", lw=0.6)
+    _strain_axes(loops, "deviator stress q [kPa] (net stress)")
+    loops.legend(fontsize=8)
+    numbers = [row["cycle"] for row in cycles]
+    modulus = [np.nan if row["secant_modulus"] is None else row["secant_modulus"] / 1e3
+               for row in cycles]
+    damping = [np.nan if row["damping_ratio"] is None else row["damping_ratio"]
+               for row in cycles]
+    measures.plot(numbers, modulus, "o-", color="C0",
+                  label="secant modulus (q_max - q_min) / (εmax - εmin)")
+    ratio = measures.twinx()
+    ratio.plot(numbers, damping, "s-", color="C3", label="damping ratio W_D / (4π W_S)")
+    if cycles and "secant_modulus_effective" in cycles[0]:
+        measures.plot(numbers, [np.nan if row["secant_modulus_effective"] is None
+                                else row["secant_modulus_effective"] / 1e3 for row in cycles],
+                      "o--", color="C0", mfc="none", label="secant modulus, effective")
+        ratio.plot(numbers, [np.nan if row["damping_ratio_effective"] is None
+                             else row["damping_ratio_effective"] for row in cycles],
+                   "s--", color="C3", mfc="none", label="damping ratio, effective")
+    measures.set_xlabel("cycle [-]")
+    measures.set_ylabel("secant modulus E_sec [kPa]", color="C0")
+    ratio.set_ylabel("damping ratio D [-]", color="C3")
+    measures.grid(alpha=0.3)
+    if numbers:
+        measures.set_xticks(numbers if len(numbers) <= 12 else numbers[::len(numbers) // 10])
+    handles = [h for axes in (measures, ratio) for h in axes.get_legend_handles_labels()[0]]
+    measures.legend(handles, [h.get_label() for h in handles], fontsize=8)
+    figure.suptitle(title, fontsize=9)
+    return save_figure(figure, path)
+
+
+def plot_path(history, path, title=""):
+    """A loading path of any stages (pendular.procedures.path_table): left, the stress path q
+    against p [kPa] of the net wall stress and, wet, q' against p' of the effective stress
+    (Eq. 3.43), each stage's end marked; right, the wall stresses sigma_x, sigma_y, sigma_z
+    [kPa] (wet, the effective ones dashed) and the axial and volumetric strains [%] against
+    the history row, the stages' ends dotted. ``title``: the run's parameters."""
+    sigma = np.asarray(history["sigma_wall"])
+    effective = _effective_diagonals(history)
+    row = np.arange(len(sigma))
+    ends = _stage_ends(history)
+    figure, axes = pyplot().subplot_mosaic([["path", "stress"], ["path", "strain"]],
+                                           figsize=(11, 6.5))
+    curves = [("q–p, net stress", sigma, "C0")]
+    if effective is not None:
+        curves.append(("q'–p', effective stress (Eq. 3.43)", effective, "C1"))
+    for label, values, color in curves:
+        p, q = mean_stress(values) / 1e3, deviator_stress(values) / 1e3
+        axes["path"].plot(p, q, color=color, label=label)
+        axes["path"].plot(p[ends], q[ends], "o", color=color, ms=4)
+    axes["path"].plot([], [], "o", color="0.4", ms=4, label="end of a stage")
+    axes["path"].set_xlabel("mean stress p [kPa]")
+    axes["path"].set_ylabel("deviator stress q = σz − (σx + σy)/2 [kPa]")
+    for axis, words in enumerate(AXIS_WORDS):
+        axes["stress"].plot(row, sigma[:, axis] / 1e3, color=f"C{axis}", label=f"σ {words}")
+        if effective is not None:
+            axes["stress"].plot(row, effective[:, axis] / 1e3, color=f"C{axis}", ls="--",
+                                label=f"σ' {words}")
+    axes["stress"].set_ylabel("wall stress [kPa]\n(compression +)")
+    axes["strain"].plot(row, 100.0 * np.asarray(history["axial_strain"]), color="C0",
+                        label="axial strain εa")
+    axes["strain"].plot(row, 100.0 * np.asarray(history["volumetric_strain"]), color="C2",
+                        label="volumetric strain εv")
+    axes["strain"].set_ylabel("strain [%] (compression +)")
+    axes["strain"].set_xlabel("history row [-]")
+    for name in ("stress", "strain"):
+        if len(ends) <= 50:                    # more would grey the panel
+            for end in ends[:-1]:
+                axes[name].axvline(end, color="0.6", lw=0.6, ls=":")
+    for name, panel in axes.items():
+        panel.grid(alpha=0.3)
+        panel.legend(fontsize=7, ncol=2 if name == "stress" else 1)
+    figure.suptitle(title, fontsize=9)
     return save_figure(figure, path)

@@ -17,6 +17,7 @@ Columns by test (pendular.procedures.triaxial.history_columns, pendular.procedur
   liquid_bridges, liquid_film, liquid_lost;
 - oedometer and isotropic paths (pendular.procedures.triaxial.OedometerTest, IsotropicTest):
   the triaxial's, and void_ratio; the oedometer k0; stage when the path has several stages;
+- cyclic triaxial (pendular.procedures.cyclic.CyclicTest): the oedometer's less k0, and cycle;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
 """
@@ -129,6 +130,26 @@ HISTORY_COLUMNS = {
                       "stresses (oedometer)"),
     "stage": Column("1", "index of the stage of the loading path running (0 first)",
                     dtype="int64"),
+    "cycle": Column("1", "cycle of a cyclic triaxial path running (1 first; 0 the first "
+                         "loading)", dtype="int64"),
+}
+
+#: Field data of the ParaView frames (pendular.io.vtk.VtkWriter: one number a .vtu file, the
+#: same in the four series). A series' time axis (the .pvd ``timestep``, ParaView's time
+#: slider) is one of these, named in a comment of its .pvd file.
+VTK_FIELDS = {
+    "step": Column("1", "time step number of the frame"),
+    "time": Column("s", "simulated time; the time axis of the direct tension's vtk/ and of "
+                        "vtk_prep/"),
+    "axial_strain": Column("1", "axial (z) strain 1 - L/L0 of a loading path's vtk/ "
+                                "(triaxial, oedometer, isotropic), compression positive, as "
+                                "the history's axial_strain"),
+    "axial_strain_percent": Column("%", "the same axial strain in %: the time axis of a loading "
+                                        "path's vtk/"),
+    "phase": Column("1", "vtk_prep/: index of the phase (0 growth, 1 friction, 2 unload, "
+                         "3 equilibrate, 4 sample, 5 wetting)"),
+    "mean_wall_stress": Column("Pa", "vtk_prep/: mean normal stress on the walls, compression "
+                                     "positive"),
 }
 
 #: Units of a triaxial summary.json (pendular.procedures.triaxial.summarize and TriaxialTest).
@@ -162,12 +183,14 @@ OEDOMETER_SUMMARY_UNITS = {
     "swelling_index": "1", "swelling_index_effective": "1",
 }
 
-#: Units of an isotropic summary.json (pendular.procedures.loading.isotropic_summary); its
-#: ``stages`` rows hold target, p and p_effective [Pa], void_ratio and volumetric_strain [-].
+#: Units of an isotropic summary.json (pendular.procedures.loading.isotropic_summary) and of
+#: a path table's (pendular.procedures.path_table.path_summary): their ``stages`` rows hold
+#: the end state of each stage.
 ISOTROPIC_SUMMARY_UNITS = {
-    "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "void_ratio": "1",
-               "volumetric_strain": "1", "stage": "1", "step": "1"},
-    "final_void_ratio": "1",
+    "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa", "q_effective": "Pa",
+               "sigma_wall": "Pa", "void_ratio": "1", "axial_strain": "1",
+               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1"},
+    "final_void_ratio": "1", "peak_stage": "1",
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
@@ -198,24 +221,85 @@ OPTION_UNITS = {
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
     "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",
-    "record_strain": "1",
+    "record_strain": "1", "amplitude_q": "Pa", "amplitude_strain": "1",
+}
+
+#: Units of a cyclic triaxial summary.json (pendular.procedures.cyclic.cyclic_summary); its
+#: ``cycles`` rows hold the measures of each cycle's loop.
+CYCLIC_SUMMARY_UNITS = {
+    "cycles": {"cycle": "1", "secant_modulus": "Pa", "damping_ratio": "1",
+               "secant_modulus_effective": "Pa", "damping_ratio_effective": "1",
+               "dissipated_energy": "Pa", "strain_energy": "Pa", "q_max": "Pa", "q_min": "Pa",
+               "axial_strain_max": "1", "axial_strain_min": "1",
+               "axial_strain_increment": "1", "axial_strain_accumulated": "1",
+               "volumetric_strain": "1", "volumetric_strain_increment": "1", "records": "1"},
+    "cycles_completed": "1", "secant_modulus_first": "Pa", "secant_modulus_last": "Pa",
+    "damping_ratio_first": "1", "damping_ratio_last": "1",
+    "secant_modulus_first_effective": "Pa", "secant_modulus_last_effective": "Pa",
+    "damping_ratio_first_effective": "1", "damping_ratio_last_effective": "1",
+    "axial_strain_accumulated": "1", "volumetric_strain_accumulated": "1",
+    "axial_strain_at_load": "1", "q_at_load": "Pa",
 }
 
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
-                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS}
+                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS}
 
 
-def peak_reached(axial_strain, index, fraction=0.02):
-    """Whether the maximum at row ``index`` of a history is a peak: False when its strain lies
-    within the last ``fraction`` of the strain range (the test ended before the stress fell),
-    or when the strain did not move. Works for either sign of the strain (tension)."""
-    strain = np.asarray(axial_strain, dtype=float)
-    if strain.ndim != 1 or len(strain) == 0:
-        raise ValueError(f"axial_strain has shape {strain.shape}; expected one value per record")
+def still_rising(axial_strain, stress, window=0.2, min_records=5):
+    """Whether ``stress`` still rises at the end of a history: the least-squares slope of the
+    stress against the strain travelled over the last ``window`` of the strain range (at least
+    the last ``min_records`` records) is positive by more than twice its standard error, so
+    that the records' scatter alone does not make a rise (the last fifth of a test sees the
+    rise of a flattening curve that the scatter hides over a shorter span). Either sign of the
+    strain (tension)."""
+    strain, stress = _strain_and_stress(axial_strain, stress)
+    travelled = np.abs(strain - strain[0])
+    before = np.flatnonzero(travelled < (1.0 - window) * travelled[-1])
+    start = before[-1] + 1 if len(before) else 0
+    rows = slice(min(start, max(len(strain) - min_records, 0)), None)
+    x, y = travelled[rows], stress[rows]
+    if len(x) < 3:                 # no scatter to judge by: the last step decides
+        return bool(y[-1] > y[0])
+    dx = x - x.mean()
+    spread = np.sum(dx * dx)
+    if spread == 0.0:
+        return False
+    slope = np.sum(dx * (y - y.mean())) / spread
+    residual = y - y.mean() - slope * dx
+    error = np.sqrt(np.sum(residual * residual) / (len(x) - 2) / spread)
+    return bool(slope > 2.0 * error)
+
+
+def peak_reached(axial_strain, stress, fraction=0.02, window=0.2, min_records=5):
+    """Whether the maximum of ``stress`` (q, or -q in extension, or a tensile stress) over a
+    history is a peak the test went past: False when it lies within the last ``fraction`` of
+    the strain range, when it lies within the last ``window`` and the stress still rises there
+    (still_rising, at least ``min_records`` records: the test ended on its way up), or when
+    the strain did not move. A maximum before the last ``window`` is a peak even when q rises
+    again at the end below it (a stick-slip tooth, a late hardening). On a plateau with
+    scatter (a loose sample at critical state) the maximum is taken as the peak: True, unless
+    the scatter puts it in the last ``fraction``, or in the last ``window`` with an upward
+    trend there beyond twice the slope's standard error."""
+    strain, stress = _strain_and_stress(axial_strain, stress)
     span = strain[-1] - strain[0]
     if not np.isfinite(span) or span == 0.0:
         return False
-    return bool((strain[index] - strain[0]) / span < 1.0 - fraction)
+    travelled = (strain[int(np.argmax(stress))] - strain[0]) / span
+    if travelled >= 1.0 - fraction:
+        return False
+    return not (travelled >= 1.0 - window and still_rising(strain, stress, window, min_records))
+
+
+def _strain_and_stress(axial_strain, stress):
+    """The two series of a history as float arrays of one value per record (ValueError)."""
+    strain = np.asarray(axial_strain, dtype=float)
+    stress = np.asarray(stress, dtype=float)
+    if strain.ndim != 1 or len(strain) == 0:
+        raise ValueError(f"axial_strain has shape {strain.shape}; expected one value per record")
+    if stress.shape != strain.shape:
+        raise ValueError(f"stress has shape {stress.shape}; expected one value per record, "
+                         f"{strain.shape}")
+    return strain, stress

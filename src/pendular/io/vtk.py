@@ -2,8 +2,13 @@
 
 ``VtkWriter(folder, period)`` is a writer: on its first call and then every ``period`` steps it
 writes, each file under a temporary name then renamed (a killed run never leaves a truncated
-file), four series indexed by ParaView collection files whose ``timestep`` is the simulation
-time [s] or the writer's ``time_axis`` (the triaxial test: axial strain in %):
+file), four series indexed by ParaView collection files whose ``timestep`` (ParaView's time
+axis) is one of the frames' field data, named in a comment of the .pvd file: the simulated time
+[s], or the writer's ``time_axis`` (a loading path's vtk/: ``axial_strain_percent``, the axial
+strain in %, which the field data also hold as the fraction ``axial_strain``). Every file's
+field data, declared with their units in pendular.io.schema.VTK_FIELDS: ``step``, ``time``
+[s]; a loading path's ``axial_strain`` [-] and ``axial_strain_percent`` [%]; vtk_prep/'s
+``phase`` and ``mean_wall_stress`` [Pa].
 
 ``particles.pvd`` / ``particles_NNNNNN.vtu`` (NNNNNN: the step), one VTK vertex per sphere,
 point data (SI units)::
@@ -59,6 +64,7 @@ import meshio
 import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
+from pendular.io.schema import VTK_FIELDS
 from pendular.utils.atomic import replacing
 from pendular.utils.validate import check_int
 
@@ -94,8 +100,9 @@ def _insert_field_data(path, field_data):
 
 def read_vtk(path):
     """A ParaView series written here, read with meshio: [(time axis value, meshio.Mesh)] of
-    the frames the .pvd file ``path`` lists, in its order (the time axis: seconds, or what the
-    writer's ``time_axis`` gave, e.g. the axial strain of a triaxial test).
+    the frames the .pvd file ``path`` lists, in its order (the time axis: the field data the
+    writer's ``time_axis`` names, e.g. ``axial_strain_percent`` of a triaxial test's vtk/, the
+    time [s] otherwise; each mesh's ``field_data`` holds it).
     ValueError naming the path for a file that is not a ParaView collection."""
     from xml.etree import ElementTree
 
@@ -112,10 +119,20 @@ def read_vtk(path):
             for frame in root.iter("DataSet")]
 
 
-def write_pvd(path, frames):
-    """Write a ParaView collection file listing ``frames`` [(time [s], file name)], atomically."""
+def axial_strain_fields(strain):
+    """Field data of a loading path's frame at axial ``strain`` [-]: the fraction and, as the
+    series' time axis, the same in %."""
+    return {"axial_strain": float(strain), "axial_strain_percent": 100.0 * float(strain)}
+
+
+def write_pvd(path, frames, time_axis="time"):
+    """Write a ParaView collection file listing ``frames`` [(time axis value, file name)],
+    atomically; a comment names the time axis, ``time_axis`` (a VTK_FIELDS name), and its
+    unit."""
     lines = ['<?xml version="1.0"?>',
              '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             f"  <!-- timestep (ParaView's time axis): each file's field data {time_axis}, in "
+             f"{VTK_FIELDS[time_axis].units} (pendular.io.schema.VTK_FIELDS) -->",
              "  <Collection>"]
     lines += [f'    <DataSet timestep="{float(time)!r}" group="" part="0" file={quoteattr(name)}/>'
               for time, name in frames]
@@ -251,9 +268,11 @@ class VtkWriter:
     are rewritten with every frame (so that a killed run leaves a usable series) and by
     ``close()``. ``frames`` lists (step, time axis value) of the frames written. ``compression``:
     "zlib" (default) or None (larger files, about 10x faster to write). Every file's field data
-    holds ``step``, ``time`` [s] and what ``field_data(sim)`` returns (name -> number, e.g. the
-    axial strain of a triaxial test); ``time_axis(sim)``, if given, is the .pvd ``timestep``
-    instead of the time (e.g. the axial strain in %, ParaView's time slider then in strain).
+    holds ``step``, ``time`` [s] and what ``field_data(sim)`` returns (name -> number, names of
+    pendular.io.schema.VTK_FIELDS, e.g. the axial strain of a triaxial test); ``time_axis``,
+    the name of one of them, is the .pvd ``timestep`` (default the time; e.g.
+    ``axial_strain_percent``: ParaView's time slider then in % of axial strain, the unit the
+    frame's field data give it).
     ``phases``: names of the phases of a multi-phase run; the writer then has an attribute
     ``phase`` (one of them, set by the driver of the run), writes a frame at the first step of
     each new phase and stores the phase's index as field data ``phase``.
@@ -262,8 +281,11 @@ class VtkWriter:
     #: Not restored from a checkpoint: a resumed run writes into its own folder.
     checkpoint_exclude = ("folder",)
 
-    def __init__(self, folder, period, compression="zlib", field_data=None, time_axis=None,
+    def __init__(self, folder, period, compression="zlib", field_data=None, time_axis="time",
                  phases=None):
+        if time_axis not in VTK_FIELDS:
+            raise ValueError(f"vtk time_axis = {time_axis!r} is not one of the field data "
+                             f"{', '.join(VTK_FIELDS)}")
         self.folder = os.fspath(folder)
         self.field_data = field_data
         self.time_axis = time_axis
@@ -296,11 +318,13 @@ class VtkWriter:
             self._frame_phase = self.phase
         if self.field_data is not None:
             fields.update(self.field_data(sim))
+        if self.time_axis not in fields:
+            raise ValueError(f"vtk time_axis = {self.time_axis!r} is not in the frame's field "
+                             f"data {', '.join(fields)}")
         for series, mesh in meshes.items():
             write_vtu(os.path.join(self.folder, self.file_name(series, sim.step)), mesh,
                       self.compression, fields)
-        self.frames.append((int(sim.step),
-                            float(sim.time if self.time_axis is None else self.time_axis(sim))))
+        self.frames.append((int(sim.step), float(fields[self.time_axis])))
         self.close()
 
     def file_name(self, series, step):
@@ -315,6 +339,7 @@ class VtkWriter:
             return
         for series in SERIES:
             write_pvd(os.path.join(self.folder, f"{series}.pvd"),
-                      [(time, self.file_name(series, step)) for step, time in self.frames])
+                      [(time, self.file_name(series, step)) for step, time in self.frames],
+                      self.time_axis)
 
     finish = close

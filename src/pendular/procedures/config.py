@@ -685,12 +685,147 @@ def case_name(void_ratio, water_content):
     return f"e{void_ratio:.2f}_w{100 * water_content:.2f}"
 
 
+# ---------------------------------------------------------------- cyclic triaxial
+
+#: Most cycles of a cyclic triaxial test: liquefaction tests run tens to hundreds of cycles,
+#: resilient-modulus tests about 2,000 (AASHTO T 307: up to 1,000 to condition, then 15
+#: sequences of 100).
+MAX_CYCLES = 10_000
+#: Largest axial strain amplitude of a strain-controlled cyclic test [-]: cyclic triaxial tests
+#: measure modulus and damping from about 1e-5 to a few % (Kramer 1996, Ch. 6); beyond, the
+#: extension half of a cycle pulls the sample apart rather than cycling it.
+MAX_CYCLIC_STRAIN = 0.05
+
+
+@dataclass
+class CyclicConfig(PathConfig):
+    """Cyclic triaxial loading (pendular.procedures.cyclic.cyclic_stages) from the isotropic
+    confining stress sigma_c, the lateral walls servoed at sigma_c, the axial walls driven at
+    the path's rate: a first loading to the amplitude, then ``cycles`` cycles (at most
+    MAX_CYCLES), each an unloading to minus the amplitude and a reloading back. Exactly one
+    amplitude: ``amplitude_q`` [Pa] (stress control: q = sigma_axial - sigma_lateral between
+    +A and -A, in (0, sigma_c): at -A the axial stress is sigma_c - A, and walls cannot pull)
+    or ``amplitude_strain`` [-] (strain control: the axial strain between +X and -X from the
+    start, in [MIN_AXIAL_STRAIN, MAX_CYCLIC_STRAIN]; a run whose axial stress falls to 0
+    stops with pendular.procedures.loading.StageFailed)."""
+
+    amplitude_q: float | None = None
+    amplitude_strain: float | None = None
+    cycles: int = 10
+
+    TEST = "a cyclic triaxial test"
+
+    def __post_init__(self):
+        super().__post_init__()
+        if (self.amplitude_q is None) == (self.amplitude_strain is None):
+            raise ValueError("--amplitude-q / --amplitude-strain: give exactly one (stress "
+                             "control: q between +-A [Pa]; strain control: the axial strain "
+                             "between +-X)")
+        confining = self.sample.confining
+        if self.amplitude_q is not None:
+            try:
+                self.amplitude_q = check_range("--amplitude-q", self.amplitude_q, 0.0,
+                                               confining, low_inclusive=False,
+                                               high_inclusive=False, unit="Pa")
+            except ValueError as error:
+                raise ValueError(f"{error}: at q = -A the axial stress is --confining "
+                                 f"({confining:g} Pa) - A, and walls cannot pull") from None
+            check_soft_contacts("the largest axial stress (--confining + --amplitude-q)",
+                                confining + self.amplitude_q, self.sample.young)
+        else:
+            self.amplitude_strain = check_range("--amplitude-strain", self.amplitude_strain,
+                                                MIN_AXIAL_STRAIN, MAX_CYCLIC_STRAIN)
+        self.cycles = check_int("--cycles", self.cycles, low=1, high=MAX_CYCLES)
+
+    @property
+    def stress_controlled(self):
+        """Whether q (not the axial strain) cycles between the amplitudes."""
+        return self.amplitude_q is not None
+
+    def reference_pressure(self):
+        """The least mean stress of the path [Pa], where the inertial number is taken: sigma_c
+        - A / 3 at q = -A (stress control); 2 sigma_c / 3, its bound while the axial walls
+        touch, under strain control."""
+        confining = self.sample.confining
+        if self.stress_controlled:
+            return confining - self.amplitude_q / 3.0
+        return 2.0 * confining / 3.0
+
+    def estimated_steps(self):
+        """Steps of a strain-controlled path, (1 + 4 cycles) X over the strain of a step;
+        None under stress control (its stages end at a stress)."""
+        if self.stress_controlled:
+            return None
+        travel = (1 + 4 * self.cycles) * self.amplitude_strain
+        return travel / self.strain_per_step(self.rate())
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"amplitude_q": self.amplitude_q, "amplitude_strain": self.amplitude_strain,
+                "cycles": self.cycles}
+
+
+# ---------------------------------------------------------------- a path from a table
+
+@dataclass
+class TablePathConfig(PathConfig):
+    """A loading path read from a table (pendular.procedures.path_table): PathConfig's sample,
+    bridges, outputs, rate (``inertial_number`` at the lowest stress of the path, or
+    ``strain_rate``: the value of the name 'quasi-static') and row spacing, and ``stages``:
+    the table's [[stage]] entries as plain data (numbers, the names 'confining' and
+    'quasi-static', groups repeated), built into pendular.procedures.loading.Stage objects by
+    ``loading_stages``; ``source``: the table's file, named in errors; ``records``: history
+    rows over a path of one stage ending at a strain, as ShearConfig.records (None: a row
+    every ``record_strain``)."""
+
+    stages: list = field(default_factory=list)
+    source: str = "path table"
+    records: int | None = None
+
+    TEST = "a loading path"
+
+    def __post_init__(self):
+        super().__post_init__()
+        stages = self.loading_stages()       # every entry checked, named by file and stage
+        if self.records is not None:
+            self.records = check_int("--records", self.records, low=2, high=MAX_RECORDS)
+            from pendular.procedures.loading import Strain
+
+            if len(stages) != 1 or not isinstance(stages[0].until, Strain):
+                raise ValueError(f"--records = {self.records} applies to a path of one stage "
+                                 f"ending at a strain (a triaxial's); {self.source} has "
+                                 f"{len(stages)} stage(s): leave it out (a row every "
+                                 "--record-strain)")
+
+    def loading_stages(self):
+        """The pendular.procedures.loading.Stage list of the table (ValueError naming the
+        source, the entry and the key)."""
+        from pendular.procedures.path_table import build_stages
+
+        return build_stages(self.stages, self.source, confining=self.sample.confining,
+                            rate=self.rate(), young=self.sample.young)
+
+    def reference_pressure(self):
+        """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining
+        stress or a lower target of a stage."""
+        from pendular.procedures.path_table import lowest_stress
+
+        return lowest_stress(self.stages, self.source, self.sample.confining)
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"path": self.source, "records": self.records}
+
+
 # ---------------------------------------------------------------- JSON form
 
 #: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
 CONFIG_TYPES = {kind.__name__: kind for kind in
                 (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, OedometerConfig,
-                 IsotropicConfig, TensionConfig, SwccConfig)}
+                 IsotropicConfig, TensionConfig, SwccConfig, CyclicConfig,
+                 TablePathConfig)}
 
 
 def config_to_dict(config):

@@ -416,23 +416,46 @@ def _fields(config):
     return {key: value for key, value in asdict(config).items() if key != "cases"}
 
 
-def plot_curves(histories: dict, folder: str) -> None:
-    """Tensile stress against axial extension, one figure per case and one with all."""
+def plot_label(config: TensionConfig) -> str:
+    """One line of the run's parameters for the figures' titles."""
+    return (f"N = {config.particles}, R = {config.radius * 1e3:g} mm, contact angle "
+            f"θ = {config.contact_angle:g}°, γ = {config.surface_tension:g} N/m")
+
+
+def case_label(summary: dict) -> str:
+    """A case in words: its target void ratio and water content."""
+    return (f"e = {summary['void_ratio_target']:g}, "
+            f"w = {100 * summary['water_content_target']:g} %")
+
+
+def plot_curves(summaries: list[dict], histories: dict, folder: str,
+                config: TensionConfig) -> None:
+    """Tensile stress against axial extension, one figure per case (tension_<case>.png) and
+    one with all (tension_all.png)."""
     plt = pyplot()
     every, all_axes = plt.subplots(figsize=(6, 4))
-    for name, history in histories.items():
+    for summary in summaries:
+        history = histories[summary["case"]]
         figure, axes = plt.subplots(figsize=(6, 4))
         for target in (axes, all_axes):
-            target.plot(-100.0 * history["axial_strain"], history["tensile_stress"], label=name)
-        axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]", title=name)
-        save_figure(figure, os.path.join(folder, f"tension_{name}.png"))
-    all_axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]")
+            target.plot(-100.0 * history["axial_strain"], history["tensile_stress"],
+                        label=case_label(summary))
+        axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
+                 title=f"Direct tension, {case_label(summary)}\n{plot_label(config)}")
+        axes.title.set_fontsize(9)
+        axes.grid(alpha=0.3)
+        save_figure(figure, os.path.join(folder, f"tension_{summary['case']}.png"))
+    all_axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
+                 title=f"Direct tension, every case\n{plot_label(config)}")
+    all_axes.title.set_fontsize(9)
+    all_axes.grid(alpha=0.3)
     all_axes.legend(fontsize=7)
     save_figure(every, os.path.join(folder, "tension_all.png"))
 
 
 def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> None:
-    """Tensile strength against water content: DEM, Kim (2001) and packing_state's curve."""
+    """Tensile strength against water content: DEM, Kim (2001) and the prediction of the
+    regular packing of the same void ratio (pendular.homogenize.packing_state, thesis Ch. 4)."""
     figure, axes = pyplot().subplots(figsize=(6, 4.5))
     void_ratios = sorted({s["void_ratio_target"] for s in summaries}, reverse=True)
     for colour, e in zip(("C0", "C3", "C2", "C1"), void_ratios):
@@ -446,9 +469,12 @@ def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> No
         grid = np.linspace(0.002, max(s["water_content_target"] for s in mine) * 1.15, 25)
         curve = [prediction(config, e, w)[0] for w in grid]
         axes.plot(100 * grid, curve, "--", color=colour,
-                  label=f"packing_state, {comparison_packing(e)[1]}")
+                  label=f"regular packing prediction (Ch. 4), {comparison_packing(e)[1]}")
     axes.set(xlabel="gravimetric water content w [%]", ylabel="tensile strength [Pa]",
-             xlim=(0, None), ylim=(0, None))
+             xlim=(0, None), ylim=(0, None),
+             title=f"Tensile strength against water content\n{plot_label(config)}")
+    axes.title.set_fontsize(9)
+    axes.grid(alpha=0.3)
     axes.legend(fontsize=7)
     save_figure(figure, path)
 
@@ -543,7 +569,7 @@ class TensionTest:
                               for e, r in samples.items()},
                   "cases": summaries, "wall_time_s": time.perf_counter() - started}
         write_json(os.path.join(out, "tension.json"), output, default=float)
-        plot_curves(histories, os.path.join(out, "plots"))
+        plot_curves(summaries, histories, os.path.join(out, "plots"), config)
         plot_strength(summaries, config, os.path.join(out, "plots", "strength_vs_water.png"))
         write_report(summaries, config, os.path.join(out, "report.md"))
         return output

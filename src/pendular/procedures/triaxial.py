@@ -60,7 +60,7 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
 from pendular.io.plots import (plot_compression, plot_history, plot_stress_path, run_label,
     write_plots)
-from pendular.io.vtk import VtkWriter
+from pendular.io.vtk import VtkWriter, axial_strain_fields
 from pendular.procedures.water_content import wet_to_water_volume
 
 #: Largest inertial number of a quasi-static shear (GDR MiDi 2004: I < 1e-3 quasi-static,
@@ -439,9 +439,11 @@ def parameters(config):
     else:
         if isinstance(config, OedometerConfig):
             flat.update({"axial_stress": config.axial_stress, "unload_to": config.unload_to})
-        else:
+        elif isinstance(config, IsotropicConfig):
             flat.update({"stresses": ",".join(f"{v:g}" for v in config.stresses),
                          "stage_steps": config.stage_steps})
+        else:                       # a path that names its own options (CyclicConfig)
+            flat.update(config.path_parameters())
         flat.update({"inertial_number": config.inertial_number,
                      "strain_rate": config.strain_rate, "record_strain": config.record_strain})
     flat.update({"suction": config.suction, "wet_steps": config.wet_steps,
@@ -654,8 +656,8 @@ class TriaxialTest(LaboratoryTest):
     """A drained triaxial test of ``config`` (pendular.procedures.config.TriaxialConfig): the
     shear of ``config.shear`` (compression, extension, at a constant b or mean stress;
     loading.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
-    plots/ (q/p, volumetric strain, wet: saturation and capillary stresses; and, for a shear
-    other than the conventional compression, the q-p stress path stress_path.png)."""
+    plots/ (q/p, volumetric strain, wet: saturation and capillary stresses; the stress path
+    stress_path.png: q-p and, wet, q'-p' of the effective stress)."""
 
     CONFIG = TriaxialConfig
 
@@ -666,7 +668,9 @@ class TriaxialTest(LaboratoryTest):
     def summarize(self, history):
         shear = self.config.shear
         summary = summarize(history, shear.direction)
-        summary["peak_reached"] = peak_reached(history["axial_strain"], summary["peak_index"])
+        sign = -1.0 if shear.direction == "extension" else 1.0     # summarize's q at failure
+        summary["peak_reached"] = peak_reached(history["axial_strain"],
+                                               sign * deviator_stress(history["sigma_wall"]))
         summary.update(path_deviations(history, shear, self.config.confining))
         return summary
 
@@ -674,8 +678,8 @@ class TriaxialTest(LaboratoryTest):
         direction = self.config.shear.direction
         plot_history(history, os.path.join(out, self.FIGURE), title, direction)
         write_plots(history, os.path.join(out, "plots"), title, direction)
-        if not self.config.shear.conventional:
-            plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title,
+                         direction)
 
 
 #: History columns of the oedometric and isotropic paths beyond the triaxial's.
@@ -772,8 +776,8 @@ class _PathRun:
         if self.vtk_period > 0:
             axial = self.path.axial
             self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
-                                 field_data=lambda s: {"axial_strain": axial.strain(s.walls)},
-                                 time_axis=lambda s: 100.0 * axial.strain(s.walls))
+                                 field_data=lambda s: axial_strain_fields(axial.strain(s.walls)),
+                                 time_axis="axial_strain_percent")
             sim.writers.append(self.vtk)
         self.checkpoint = None
         if config.checkpoint_every > 0:

@@ -55,7 +55,6 @@ import multiprocessing
 import numbers
 import os
 import re
-import stat
 import threading
 import traceback
 from collections.abc import Iterable, Sequence
@@ -68,6 +67,7 @@ from pendular.utils.atomic import replacing
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.sample import save_sample
 from pendular.utils.threads import use_threads
+from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
 
 from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
@@ -441,36 +441,7 @@ class Campaign:
 def read_table(path: str | os.PathLike) -> dict:
     """The TOML table at ``path`` as a dict; ValueError naming the path (and the line of a
     TOML or UTF-8 error) when it is not a readable TOML file."""
-    try:
-        import tomllib
-    except ModuleNotFoundError:        # Python 3.10
-        import tomli as tomllib
-    source = f"table = {os.fspath(path)!r}"
-    try:
-        regular = stat.S_ISREG(os.stat(path).st_mode)     # a device or a pipe may never end
-        if regular:
-            with open(path, "rb") as handle:
-                data = handle.read()
-    except (OSError, ValueError) as error:
-        raise ValueError(f"{source} cannot be read: "
-                         f"{getattr(error, 'strerror', None) or error}") from None
-    if not regular:
-        raise ValueError(f"{source} is not a file; valid: a TOML file")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        column = error.start - data.rfind(b"\n", 0, error.start)
-        raise ValueError(f"{source} is not a TOML table: byte 0x{data[error.start]:02x} at "
-                         f"line {line}, column {column} is not UTF-8 text; valid: a UTF-8 "
-                         "TOML file") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise ValueError(f"{source} is not a valid TOML table: {error}") from None
-    except RecursionError:
-        raise ValueError(f"{source} is not a TOML table pendular can read: its values are "
-                         "nested too deep") from None
+    return read_toml(path, f"table = {os.fspath(path)!r}")
 
 
 def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str]]]:

@@ -12,14 +12,14 @@ positive [Pa]. Needs ``yade`` on PATH; docs/yade_crosscheck.md lists the differe
 
 from __future__ import annotations
 
-import json
 import math
 
 import numba
 
 from pendular.procedures.preparation import PrepareConfig
 
-from pendular.cli import UsageError, add_size_options, positive_int, set_threads, sizes_from
+from pendular.cli import (UsageError, add_size_options, positive_int, print_summary, set_threads,
+    sizes_from)
 from pendular.procedures.config import (AVERAGES, AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN,
     MIN_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES)
 from pendular.studies.crosscheck import (SHOWN, check_mirrored, check_packing, crosscheck_config,
@@ -53,7 +53,8 @@ def add_arguments(parser):
     parser.add_argument("--concurrent", action="store_true",
                         help="run YADE while pendular shears (halves the wall time; each code's "
                              "timing then shares the machine with the other)")
-    parser.add_argument("--quiet", action="store_true", help="no progress bars")
+    parser.add_argument("--quiet", action="store_true",
+                        help="no progress bars, and the differences printed as JSON")
 
 
 def check(args):
@@ -105,6 +106,6 @@ def run(args):
     result = run_crosscheck(config, args.out, settle=args.settle_steps > 0,
                             packing=args.packing, concurrent=args.concurrent,
                             threads=args.threads, progress=not args.quiet)
-    print(json.dumps({k: result[k] for k in SHOWN}, indent=2))
+    print_summary(result, SHOWN, args.quiet)
     print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)")
     return 0

@@ -16,9 +16,13 @@ import sys
 
 from pendular.procedures.preparation import PrepareConfig
 
-from pendular.cli import UsageError, add_run_options, add_size_options, set_threads, sizes_from
+from pendular.cli import (UsageError, add_run_options, add_size_options, print_summary,
+    set_threads, sizes_from)
 from pendular.procedures.config import SwccConfig
 from pendular.procedures.swcc import SwccTest
+
+#: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
+SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
 
 
 def add_arguments(parser):
@@ -72,13 +76,16 @@ def run(args):
     set_threads(args.threads)
     result = SwccTest(config_from(args)).run(args.out, progress=not args.quiet,
                                             threads=args.threads)
-    print(f"{'branch':<8} {'suction [Pa]':>12} {'Sr [%]':>8} {'bridges':>8} {'porosity':>9} "
-          f"{'eps_v':>9} {'chi':>8}")
-    for branch in ("drying", "wetting"):
-        for row in result[branch]:
-            print(f"{branch:<8} {row['suction']:>12g} {100 * row['saturation']:>8.3f} "
-                  f"{row['bridges']:>8d} {row['porosity']:>9.4f} "
-                  f"{row['volumetric_strain']:>9.2e} {row['chi']:>8.4f}")
+    if args.quiet:
+        print(f"{'branch':<8} {'suction [Pa]':>12} {'Sr [%]':>8} {'bridges':>8} "
+              f"{'porosity':>9} {'eps_v':>9} {'chi':>8}")
+        for branch in ("drying", "wetting"):
+            for row in result[branch]:
+                print(f"{branch:<8} {row['suction']:>12g} {100 * row['saturation']:>8.3f} "
+                      f"{row['bridges']:>8d} {row['porosity']:>9.4f} "
+                      f"{row['volumetric_strain']:>9.2e} {row['chi']:>8.4f}")
+    else:
+        print_summary(result, ("drying", "wetting"), columns=SHOWN_COLUMNS)
     merged = sorted({row["suction"] for branch in ("drying", "wetting") for row in result[branch]
                      if row["pendular_overlaps"] > 0})
     if merged:

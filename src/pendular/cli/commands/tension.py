@@ -11,12 +11,16 @@ from __future__ import annotations
 
 import argparse
 
-from pendular.cli import (UsageError, add_run_options, add_size_options, positive_int, set_threads,
-    sizes_from)
+from pendular.cli import (UsageError, add_run_options, add_size_options, positive_int,
+    print_summary, set_threads, sizes_from)
 from pendular.procedures.config import TensionConfig
 from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
 from pendular.procedures.reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
 from pendular.procedures.tension import TensionTest, cases_of, report_lines
+
+#: Columns of the cases' table printed at the end (--quiet: report.md's table).
+SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
+                 "tensile_strength_pa", "kim_measured_pa", "packing_state_pa")
 
 
 def _numbers(name, text):
@@ -109,6 +113,9 @@ def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
     config = config_from(args)
     output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args))
-    print("\n".join(report_lines(output["cases"], config)))
+    if args.quiet:
+        print("\n".join(report_lines(output["cases"], config)))
+    else:
+        print_summary(output, ("cases",), columns=SHOWN_COLUMNS)
     print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}")
     return 0

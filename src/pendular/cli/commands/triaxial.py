@@ -21,7 +21,6 @@ configurations by ``laboratory_fields``; ``run_test`` runs any of the three).
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 
 from pendular.procedures.preparation import PrepareConfig
@@ -29,7 +28,7 @@ from pendular.dem.timestep import TIMESTEP_RULES
 from pendular.utils.validate import check_int, check_range
 
 from pendular.cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
-    set_threads, sizes_from)
+    print_summary, set_threads, sizes_from)
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MAX_RECORDS,
     MIN_AXIAL_STRAIN, SHEAR_DIRECTIONS, WETTING_PROTOCOLS, BridgeConfig, LaboratoryConfig,
     ShearConfig, TriaxialConfig, check_steps_count)
@@ -287,7 +286,8 @@ def run(args):
 def run_test(args, test, config_from, shown, add_arguments):
     """Run (or with --resume continue) the LaboratoryTest subclass ``test`` of the options
     ``args`` (configuration by ``config_from``; ``add_arguments``: the command's options, for
-    their defaults); print the summary's ``shown`` keys; the exit status."""
+    their defaults); print the summary's ``shown`` keys (print_summary: JSON with --quiet);
+    the exit status."""
     set_threads(args.threads)
     progress = not args.quiet
     try:
@@ -311,7 +311,11 @@ def run_test(args, test, config_from, shown, add_arguments):
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED
-    print(json.dumps({k: summary[k] for k in shown if k in summary}, indent=2))
+    print_summary(summary, shown, args.quiet)
+    if not args.quiet and summary.get("peak_reached") is False:
+        print("note: q still rises at the end of the test (peak_reached false in "
+              "summary.json): the values 'at peak' are those of the highest record; a larger "
+              "--max-strain reaches the peak")
     print(f"outputs in {out}")
     return 0
 

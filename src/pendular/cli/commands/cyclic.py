@@ -1,0 +1,71 @@
+"""Cyclic triaxial loading, dry or wet, stress- or strain-controlled: prepare (or load) a sample
+at --confining, wet it, servo the lateral walls at --confining and drive the axial ones at the
+quasi-static rate: a first loading to the amplitude, then --cycles cycles of unloading to minus
+the amplitude and reloading (pendular.procedures.cyclic.cyclic_stages). Give one amplitude:
+--amplitude-q A (stress control: q = sigma_axial - sigma_lateral between +A and -A, A below
+--confining since the walls cannot pull) or --amplitude-strain X (strain control: the axial
+strain between +X and -X; a run whose axial stress falls to 0 stops with an error).
+
+Writes into --out: history.h5 (with void_ratio, stage and cycle at every row), summary.json
+(per cycle the secant modulus (q_max - q_min) / (eps_max - eps_min), the damping ratio
+W_D / (4 pi W_S) of its loop (Kramer 1996), its strain range and the accumulated axial and
+volumetric strains; net and, wet, effective), cyclic.png (the q-eps_a loops, the modulus and
+damping ratio against the cycle), vtk/, sample.h5, with --checkpoint-every checkpoint.h5;
+--resume DIR continues an interrupted run. The history has a row every --record-strain and,
+under strain control, at least pendular.procedures.cyclic.MIN_BRANCH_RECORDS a half-cycle;
+under stress control choose --record-strain well below the strain a half-cycle travels (a
+loop's area needs its shape). The sample, wetting
+and output options are those of ``pendular triaxial``. Stresses compression positive [Pa].
+"""
+
+from __future__ import annotations
+
+from pendular.procedures.config import (MAX_CYCLES, MAX_CYCLIC_STRAIN, MIN_AXIAL_STRAIN,
+    CyclicConfig)
+from pendular.procedures.cyclic import CyclicTest
+
+from pendular.cli import UsageError
+from pendular.cli.commands.oedometer import add_record_option
+from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
+    add_sample_options, add_wetting_options, laboratory_fields, run_test)
+
+#: Summary keys printed at the end.
+SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
+         "damping_ratio_last", "secant_modulus_first_effective",
+         "secant_modulus_last_effective", "damping_ratio_first_effective",
+         "damping_ratio_last_effective", "axial_strain_accumulated",
+         "volumetric_strain_accumulated", "phi_peak_deg", "initial_porosity", "wall_time_s",
+         "particle_steps_per_s")
+
+
+def add_arguments(parser):
+    add_sample_options(parser)
+    add_wetting_options(parser)
+    amplitude = parser.add_mutually_exclusive_group()
+    amplitude.add_argument("--amplitude-q", metavar="PA", type=float, default=None,
+                           help="stress control: q cycles between +PA and -PA [Pa], in (0, "
+                                "--confining) (one of --amplitude-q and --amplitude-strain is "
+                                "required)")
+    amplitude.add_argument("--amplitude-strain", metavar="X", type=float, default=None,
+                           help="strain control: the axial strain cycles between +X and -X "
+                                f"[-], in [{MIN_AXIAL_STRAIN:g}, {MAX_CYCLIC_STRAIN:g}]")
+    parser.add_argument("--cycles", type=int, default=CyclicConfig.cycles,
+                        help=f"cycles after the first loading, in [1, {MAX_CYCLES}]")
+    add_rate_options(parser)
+    add_record_option(parser)
+    add_output_options(parser, "runs/cyclic", frames=False)
+
+
+def config_from(args):
+    """The CyclicConfig of parsed options (ValueError / UsageError naming the option)."""
+    if args.amplitude_q is None and args.amplitude_strain is None:
+        raise UsageError("give --amplitude-q PA (stress control) or --amplitude-strain X "
+                         "(strain control)")
+    return CyclicConfig(**laboratory_fields(args, add_arguments, lambda: {
+        "amplitude_q": args.amplitude_q, "amplitude_strain": args.amplitude_strain,
+        "cycles": args.cycles, "inertial_number": args.inertial_number,
+        "strain_rate": args.strain_rate, "record_strain": args.record_strain}))
+
+
+def run(args):
+    return run_test(args, CyclicTest, config_from, SHOWN, add_arguments)

@@ -1,0 +1,77 @@
+"""Any loading path from a table, dry or wet: prepare (or load) a sample at --confining, wet
+it, then run the stages of PATH.toml in turn (pendular.procedures.path_table).
+
+PATH.toml holds the path, a list of [[stage]] tables with the keys of the Python API's Stage:
+
+    [[stage]]                                 # K0 loading to 10 kPa
+    strain_rate = {x = 0, y = 0, z = "quasi-static"}
+    until = {stress = 10000, axis = "z"}
+
+    [[stage]]                                 # three unload-reload cycles
+    repeat = 3
+    stages = [
+      {strain_rate = {x = 0, y = 0, z = "-quasi-static"}, until = {stress = 2000}},
+      {strain_rate = {x = 0, y = 0, z = "quasi-static"}, until = {stress = 10000}},
+    ]
+
+Keys of a stage: stress = {axis = Pa} (servoed walls), strain_rate = {axis = 1/s} (driven
+walls, 0 holds them), mean_stress [Pa], b, max_strain_rate [1/s], until = {strain = X, axis =
+"z"} | {stress = Pa, axis = "z", strain_limit = X} | "static" (the default) | {static = true,
+max_steps = N}; a stress may be "confining" (--confining), a strain rate "quasi-static" or
+"-quasi-static" (--inertial-number at the lowest stress of the path, or --strain-rate). A
+group {repeat = N, stages = [...]} runs its stages N times (they may follow instead as
+[[stage.stages]] tables). examples/paths/ holds the triaxial of thesis Ch. 5 (with --records
+500, row for row the history of ``pendular triaxial``), an oedometric loading, unloading and
+reloading, and a cyclic loading. The sample, wetting and output options are those of
+``pendular triaxial``.
+
+Writes into --out: history.h5 (with void_ratio, k0 and stage at every row), summary.json (the
+end of each stage: stresses, p, q, strains, void ratio, and wet p', q'; the peak of q where the
+path has one), path.png (q-p and q'-p' stress paths, stresses and strains against the row),
+vtk/, sample.h5, with --checkpoint-every checkpoint.h5; --resume DIR continues an interrupted
+run without its table. Stresses compression positive [Pa].
+"""
+
+from __future__ import annotations
+
+from pendular.procedures.config import MAX_RECORDS, TablePathConfig
+from pendular.procedures.path_table import PathTest, read_table
+
+from pendular.cli import UsageError
+from pendular.cli.commands.oedometer import add_record_option
+from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
+    add_sample_options, add_wetting_options, laboratory_fields, run_test)
+
+#: Summary keys printed at the end.
+SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
+         "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
+         "phi_peak_effective_deg", "initial_porosity", "wall_time_s", "particle_steps_per_s")
+
+
+def add_arguments(parser):
+    parser.add_argument("table", metavar="PATH.toml", nargs="?", default=None,
+                        help="the path table (not with --resume: the run keeps its own)")
+    add_sample_options(parser)
+    add_wetting_options(parser)
+    add_rate_options(parser)
+    add_record_option(parser)
+    parser.add_argument("--records", type=int, default=None,
+                        help="history rows over a path of one stage ending at a strain, as "
+                             f"pendular triaxial's --records (2-{MAX_RECORDS:g}; default: a "
+                             "row every --record-strain)")
+    add_output_options(parser, "runs/path", frames=False)
+
+
+def config_from(args):
+    """The TablePathConfig of parsed options and the table (ValueError / UsageError naming the
+    option, or the table's file, entry and key)."""
+    if args.table is None:
+        raise UsageError("PATH.toml is missing: give the path table (or --resume DIR)")
+    return TablePathConfig(**laboratory_fields(args, add_arguments, lambda: {
+        **read_table(args.table), "inertial_number": args.inertial_number,
+        "strain_rate": args.strain_rate, "record_strain": args.record_strain,
+        "records": args.records}))
+
+
+def run(args):
+    return run_test(args, PathTest, config_from, SHOWN, add_arguments)

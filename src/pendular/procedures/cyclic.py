@@ -1,0 +1,256 @@
+"""Cyclic triaxial loading, stress- or strain-controlled: its stages, its loops' measures and
+the test (``pendular cyclic``).
+
+The path (``cyclic_stages``) starts from the isotropic confining stress sigma_c with the
+lateral walls servoed at sigma_c and the axial (z) walls driven at the path's strain rate: a
+first loading to the amplitude, then per cycle an unloading to minus the amplitude and a
+reloading back. Stress control: q = sigma_z - (sigma_x + sigma_y) / 2 between +A and -A
+(``Stress`` ends on z at sigma_c +- A); strain control: the axial strain between +X and -X
+from the start (``Strain`` ends). Stage 0 is the first loading, stages 2k - 1 and 2k the
+unloading and reloading of cycle k (1-based): the history's ``cycle`` is 0 on the first
+loading and k on cycle k. The axial walls cannot pull: a run whose axial stress falls to 0
+stops (``AxialStressGuard``, StageFailed).
+
+The measures of a loop (``loop_measures``; Kramer 1996, "Geotechnical Earthquake
+Engineering", Ch. 6, the equivalent linear model, with q for tau and the axial strain for
+gamma): the secant modulus E_sec = (q_max - q_min) / (eps_max - eps_min) and the damping ratio
+D = W_D / (4 pi W_S), W_D the loop's area (the oint of q d eps_a, the work of q per unit
+volume dissipated in a cycle) and W_S = 1/2 (Delta q / 2)(Delta eps / 2) the strain energy
+at the amplitudes. Stresses compression positive [Pa], strains compression positive.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from pendular.homogenize.invariants import deviator_stress
+from pendular.io.plots import plot_cyclic
+from pendular.io.schema import peak_reached
+from pendular.procedures.config import CyclicConfig
+from pendular.procedures.loading import (LoadingPath, Stage, StageFailed, Strain, Stress,
+    friction_angle)
+from pendular.procedures.triaxial import COMPRESSION_COLUMNS, LaboratoryTest, stress_balance
+
+#: Least history rows of a half-cycle under strain control: a loop's area needs its shape.
+MIN_BRANCH_RECORDS = 20
+#: Least fall of q after its peak in a half-cycle, over the peak, that makes it a failure
+#: peak [-]: a plateau's records scatter by 1-3 % at a few hundred spheres.
+FAILURE_DROP = 0.05
+
+
+def cyclic_stages(confining, rate, cycles, *, amplitude_q=None, amplitude_strain=None):
+    """Stages of a cyclic triaxial path (module docstring) from the isotropic ``confining``
+    stress [Pa] at the axial strain rate ``rate`` [1/s] > 0: a first loading, then ``cycles``
+    times an unloading and a reloading; the lateral walls servoed at ``confining``. One of
+    ``amplitude_q`` [Pa] (ends at the axial stress confining +- A) and ``amplitude_strain``
+    [-] (ends at the axial strain +- X)."""
+    if (amplitude_q is None) == (amplitude_strain is None):
+        raise ValueError("give one of amplitude_q (Pa) and amplitude_strain")
+    if amplitude_q is not None:
+        ends = {1.0: Stress(confining + amplitude_q), -1.0: Stress(confining - amplitude_q)}
+    else:
+        ends = {1.0: Strain(amplitude_strain), -1.0: Strain(-amplitude_strain)}
+
+    def stage(sign):
+        return Stage(stress={"x": confining, "y": confining}, strain_rate={"z": sign * rate},
+                     until=ends[sign])
+
+    return [stage(1.0)] + [stage(sign) for _ in range(cycles) for sign in (-1.0, 1.0)]
+
+
+def cycle_of(stage):
+    """The cycle (1-based; 0: the first loading) of the stage of index ``stage``."""
+    return (stage + 1) // 2
+
+
+class AxialStressGuard:
+    """A writer: StageFailed when the axial (z) stress is 0 or below after a step. The axial
+    walls cannot pull: at zero stress they have left the sample (in a periodic cell, the
+    sample is in tension), which a cyclic test does not measure. ``describe(sim)``: where the
+    path stands (text); ``remedy``: what to change (text)."""
+
+    def __init__(self, describe, remedy):
+        self.describe = describe
+        self.remedy = remedy
+
+    def apply(self, sim):
+        sigma = sim.walls.stress()[2]
+        if not sigma > 0.0:
+            raise StageFailed(f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa "
+                              f"at step {sim.step} and the axial walls cannot pull; "
+                              f"{self.remedy}")
+
+
+class CyclicPath(LoadingPath):
+    """The LoadingPath of ``cyclic_stages`` (same options): its history adds ``cycle``
+    (cycle_of the running stage) and an AxialStressGuard stops it when the axial stress falls
+    to 0."""
+
+    def __init__(self, sim, stages, *, columns=None, **options):
+        columns = {**(columns or {}), "cycle": lambda s: cycle_of(self.stage)}
+        super().__init__(sim, stages, columns=columns, **options)
+        sim.writers.append(AxialStressGuard(
+            lambda s: (f"stage {self.stage + 1} ({self.stages[self.stage].describe()}), "
+                       f"cycle {cycle_of(self.stage)}, axial strain "
+                       f"{self.axial.strain(s.walls):.3g}"),
+            "lower --amplitude-strain or raise --confining"))
+
+
+# ---------------------------------------------------------------- results
+
+def loop_measures(strain, q):
+    """(secant modulus [Pa], damping ratio [-], W_D [Pa], W_S [Pa]) of one loop of axial
+    strains ``strain`` [-] and deviator stresses ``q`` [Pa] in the order travelled (Kramer
+    1996, Ch. 6): E_sec = (q_max - q_min) / (eps_max - eps_min); W_D = the oint of
+    q d eps (trapezoids, closed by the chord from the last point to the first: a loop that
+    ratchets does not close), positive for a loop travelled clockwise in the (eps, q) plane
+    (loading above unloading); W_S = 1/2 (Delta q / 2)(Delta eps / 2); D = W_D / (4 pi W_S).
+    The modulus and the damping ratio are None where Delta eps (or Delta q) is 0."""
+    strain = np.asarray(strain, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    span_q, span_strain = float(np.ptp(q)), float(np.ptp(strain))
+    closed_strain, closed_q = np.append(strain, strain[0]), np.append(q, q[0])
+    dissipated = float(np.sum(0.5 * (closed_q[1:] + closed_q[:-1]) * np.diff(closed_strain)))
+    stored = 0.5 * (span_q / 2.0) * (span_strain / 2.0)
+    modulus = span_q / span_strain if span_strain > 0.0 else None
+    damping = dissipated / (4.0 * math.pi * stored) if stored > 0.0 else None
+    return modulus, damping, dissipated, stored
+
+
+def _stage_end(stage, k):
+    """Last row of stage ``k`` (stage index per row), None if it has none."""
+    rows = np.flatnonzero(stage == k)
+    return int(rows[-1]) if len(rows) else None
+
+
+def _failure_peak(strain, q, stage):
+    """Row of the largest |q| at a failure peak of a half-cycle, None without one: q (or -q
+    on an unloading) peaks before the half-cycle's end (schema.peak_reached) and falls after
+    it by at least FAILURE_DROP of the peak."""
+    found = None
+    for k in np.unique(stage):
+        rows = np.flatnonzero(stage == k)
+        sign = 1.0 if k % 2 == 0 else -1.0           # even stages load, odd ones unload
+        branch = sign * q[rows]
+        peak = int(np.argmax(branch))
+        if (len(rows) < 2 or not peak_reached(strain[rows], branch)
+                or branch[-1] > branch[peak] - FAILURE_DROP * abs(branch[peak])):
+            continue
+        if found is None or abs(q[rows[peak]]) > abs(q[found]):
+            found = int(rows[peak])
+    return found
+
+
+def cyclic_summary(history, cycles, complete=True):
+    """Results of a cyclic path's history (cyclic_stages with ``cycles`` cycles; columns
+    ``sigma_wall``, ``axial_strain``, ``volumetric_strain``, ``stage``); ``complete``: whether
+    the path reached its end (else the last cycle recorded, cut short, is left out).
+
+    ``cycles``: one row per complete cycle: ``cycle`` (1-based), ``secant_modulus`` [Pa] and
+    ``damping_ratio`` [-] of its loop (loop_measures over the rows from the end of the cycle
+    before, at +A, to its own end), ``dissipated_energy`` W_D and ``strain_energy`` W_S [Pa],
+    ``q_max``, ``q_min`` [Pa], ``axial_strain_max``, ``axial_strain_min``,
+    ``axial_strain_increment`` over the cycle and ``axial_strain_accumulated`` since the end
+    of the first loading (ratcheting), ``volumetric_strain`` at its end (from the start of
+    the path) and ``volumetric_strain_increment`` over it, ``records`` (rows of the loop).
+    Top level: ``secant_modulus_first`` / ``_last``, ``damping_ratio_first`` / ``_last``,
+    ``axial_strain_accumulated``, ``volumetric_strain_accumulated`` after the last cycle,
+    ``axial_strain_at_load`` and ``q_at_load`` at the end of the first loading,
+    ``cycles_completed``; ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
+    where a half-cycle has a failure peak (q falls after it by FAILURE_DROP or more). A wet
+    history adds, per cycle and at the top, the modulus and damping ratio of the effective
+    stress (Eq. 3.43; ``*_effective``)."""
+    sigma = np.asarray(history["sigma_wall"], dtype=np.float64)
+    strain = np.asarray(history["axial_strain"], dtype=np.float64)
+    volumetric = np.asarray(history["volumetric_strain"], dtype=np.float64)
+    stage = np.asarray(history["stage"])
+    q = deviator_stress(sigma)
+    effective = None
+    if "sigma_effective" in history:
+        effective = deviator_stress(np.diagonal(history["sigma_effective"], axis1=1, axis2=2))
+    loaded = _stage_end(stage, 0)
+    rows = []
+    start = loaded
+    last_stage = int(stage.max())
+    for k in range(1, cycles + 1):
+        end = _stage_end(stage, 2 * k)
+        if end is None or (2 * k == last_stage and not complete):
+            break
+        loop = slice(start, end + 1)
+        modulus, damping, dissipated, stored = loop_measures(strain[loop], q[loop])
+        row = {"cycle": k, "secant_modulus": modulus, "damping_ratio": damping,
+               "dissipated_energy": dissipated, "strain_energy": stored,
+               "q_max": float(q[loop].max()), "q_min": float(q[loop].min()),
+               "axial_strain_max": float(strain[loop].max()),
+               "axial_strain_min": float(strain[loop].min()),
+               "axial_strain_increment": float(strain[end] - strain[start]),
+               "axial_strain_accumulated": float(strain[end] - strain[loaded]),
+               "volumetric_strain": float(volumetric[end]),
+               "volumetric_strain_increment": float(volumetric[end] - volumetric[start]),
+               "records": end + 1 - start}
+        if effective is not None:
+            modulus, damping, _, _ = loop_measures(strain[loop], effective[loop])
+            row.update({"secant_modulus_effective": modulus,
+                        "damping_ratio_effective": damping})
+        rows.append(row)
+        start = end
+    summary = {"cycles": rows, "cycles_completed": len(rows),
+               "axial_strain_at_load": float(strain[loaded]), "q_at_load": float(q[loaded])}
+    suffixes = ("", "_effective") if effective is not None else ("",)
+    for suffix in suffixes:
+        for name in ("secant_modulus", "damping_ratio"):
+            summary[f"{name}_first{suffix}"] = rows[0][name + suffix] if rows else None
+            summary[f"{name}_last{suffix}"] = rows[-1][name + suffix] if rows else None
+    summary["axial_strain_accumulated"] = rows[-1]["axial_strain_accumulated"] if rows else None
+    summary["volumetric_strain_accumulated"] = (float(volumetric[start] - volumetric[loaded])
+                                                if rows else None)
+    peak = _failure_peak(strain, q, stage)
+    if peak is not None:
+        summary["phi_peak_deg"] = float(friction_angle(sigma[peak]))
+    return summary
+
+
+# ---------------------------------------------------------------- the test
+
+class CyclicTest(LaboratoryTest):
+    """A cyclic triaxial test of ``config`` (pendular.procedures.config.CyclicConfig;
+    cyclic_stages): history with ``void_ratio``, ``stage`` and ``cycle``, summary of
+    cyclic_summary; figure cyclic.png (the q-eps_a loops, and the secant modulus and damping
+    ratio against the cycle). Rows every ``record_strain`` of the path's rate and, under
+    strain control, at least MIN_BRANCH_RECORDS a half-cycle."""
+
+    NAME = "cyclic"
+    CONFIG = CyclicConfig
+    FIGURE = "cyclic.png"
+    PROGRESS = "cyclic"
+
+    def loading(self, sim):
+        config = self.config
+        rate = config.rate()
+        stages = cyclic_stages(config.confining, rate, config.cycles,
+                               amplitude_q=config.amplitude_q,
+                               amplitude_strain=config.amplitude_strain)
+        every = config.record_every(sim.dt)
+        if not config.stress_controlled:
+            branch = 2.0 * config.amplitude_strain / (rate * sim.dt)       # steps
+            every = max(1, min(every, int(branch // MIN_BRANCH_RECORDS)))
+        self.path = CyclicPath(sim, stages, record_every=every, columns=COMPRESSION_COLUMNS)
+        return self.path
+
+    def summarize(self, history):
+        path = getattr(self, "path", None)
+        complete = path is None or path.done
+        return {**cyclic_summary(history, self.config.cycles, complete),
+                **stress_balance(history)}
+
+    def plot(self, history, out, title):
+        config = self.config
+        amplitude = (f"q = ±{config.amplitude_q:g} Pa" if config.stress_controlled
+                     else f"εa = ±{100.0 * config.amplitude_strain:g} %")
+        plot_cyclic(history, cyclic_summary(history, config.cycles)["cycles"],
+                    os.path.join(out, self.FIGURE),
+                    f"{title}, {amplitude}, {config.cycles} cycle"
+                    + ("s" if config.cycles > 1 else ""))

@@ -1,0 +1,416 @@
+"""Loading paths from a table, and the few functions that compose a hydro-mechanical path in
+Python.
+
+A path table is a TOML file of ``[[stage]]`` entries, run in their order by
+``pendular path PATH.toml`` (``PathTest``). An entry is one of:
+
+- a stage: the keys of pendular.procedures.loading.Stage, read from its fields, so that a
+  field added to Stage is a key here: ``stress = {x = 500, y = 500}`` [Pa],
+  ``strain_rate = {z = 0.5}`` [1/s, compression positive; 0 holds the walls], ``mean_stress``
+  [Pa], ``b``, ``max_strain_rate`` [1/s], and ``until``, its end (``UNTIL_KINDS``):
+  ``{strain = 0.05, axis = "z"}``, ``{stress = 5000, axis = "z", strain_limit = 0.2}``,
+  ``"static"`` or ``{static = true, max_steps = 100000, unbalanced = 0.01, tolerance = 0.01,
+  check_every = 200}`` (no ``until``: static);
+- a group repeated: ``repeat = N`` and ``stages``, its entries (stages or groups) run N
+  times in turn, e.g. the cycles of a cyclic loading; they follow as ``[[stage.stages]]``
+  tables or inline, ``stages = [{...}, {...}]``. A group is an entry of the same
+  ``[[stage]]`` list because TOML keeps the order of one list, not that between two.
+
+Values may be named instead of written (``NAMES``): a stress or mean stress ``"confining"``,
+the confining stress the path starts from (--confining); a strain rate ``"quasi-static"`` or
+``"-quasi-static"`` (unloading), the rate of the inertial-number rule
+(pendular.procedures.config.quasi_static_rate, --inertial-number at the lowest stress of the
+path, or --strain-rate). The sample, its wetting and the outputs are the command line's
+options (those of ``pendular triaxial``), so one table runs on any sample, dry or wet.
+
+Every unknown key is refused with the file, the entry ("stage 2", "stage 3.1": the first
+entry of the group at entry 3) and the valid keys; a value Stage refuses, with its field,
+prefixed by the same. The parsed entries are stored as plain data in the configuration
+(pendular.procedures.config.TablePathConfig), so a run resumes without its table.
+
+In Python, ``run_path`` runs stages on a scene and returns their history, ``change_suction``
+brings suction-controlled bridges to a new suction at a held stress; with
+pendular.procedures.triaxial's ``equilibrate`` and ``wet`` they compose any path of stress
+and suction (examples/loading_path_api.py). Stresses compression positive [Pa].
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import NamedTuple
+
+import numpy as np
+
+from pendular.dem.record import HistoryRecorder
+from pendular.dem.walls import StressServo
+from pendular.homogenize.invariants import deviator_stress, mean_stress
+from pendular.io.plots import plot_path
+from pendular.io.schema import peak_reached
+from pendular.procedures.config import TablePathConfig
+from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
+    Strain, Stress, capillary_operation, friction_angle, history_columns, k0, void_ratio)
+from pendular.procedures.preparation import check_soft_contacts, servo_speed
+from pendular.procedures.triaxial import LaboratoryTest, equilibrate, stress_balance
+from pendular.utils.toml_file import read_toml
+from pendular.utils.validate import check_int, check_positive
+
+#: Most stages of a path once its groups are repeated.
+MAX_STAGES = 100_000
+#: Names a value may take instead of a number, by kind: stresses [Pa], strain rates [1/s].
+STRESS_NAMES = ("confining",)
+RATE_NAMES = ("quasi-static", "-quasi-static")
+#: The fields of Stage (or of an end) that take named values, and which.
+NAMES = {"stress": STRESS_NAMES, "mean_stress": STRESS_NAMES, "strain_rate": RATE_NAMES,
+         "max_strain_rate": RATE_NAMES, "shear_rate": RATE_NAMES}
+#: The fields of Stage that hold a value per axis ({axis: value}).
+AXIS_FIELDS = tuple(f.name for f in dataclasses.fields(Stage) if f.default_factory is dict)
+#: Keys of an entry that repeats a group of entries.
+GROUP_KEYS = ("repeat", "stages")
+#: History columns of a path beyond loading.history_columns.
+PATH_COLUMNS = {"void_ratio": void_ratio, "k0": k0}
+
+
+class Until(NamedTuple):
+    """An end of a stage as a table writes it: the class, the field its key sets (None: the
+    key is ``true``), the names that value may take."""
+
+    kind: type
+    value: str | None = None
+    names: tuple = ()
+
+
+#: The ends of a stage by their table key: ``until = {strain = 0.05}`` is Strain(value=0.05).
+UNTIL_KINDS = {"strain": Until(Strain, "value"),
+               "stress": Until(Stress, "value", STRESS_NAMES),
+               "static": Until(Static)}
+
+
+# ---------------------------------------------------------------- reading a table
+
+def read_table(path):
+    """The fields of a TablePathConfig from the TOML file ``path``: {'stages': the entries as
+    plain data, 'source': the path as given}. ValueError naming the file (unreadable, not
+    TOML, unknown keys, no stage)."""
+    source = os.fspath(path)
+    table = read_toml(path, source)
+    unknown = sorted(set(table) - {"stage"})
+    if unknown:
+        raise ValueError(f"{source}: unknown key {unknown[0]!r}; valid: stage (the sample, "
+                         "wetting and output options are given on the command line)")
+    entries = table.get("stage", [])
+    parse_entries(entries, source)
+    return {"stages": entries, "source": source}
+
+
+def stage_keys():
+    """The keys of a stage in a table: the fields of loading.Stage."""
+    return tuple(f.name for f in dataclasses.fields(Stage))
+
+
+def parse_entries(entries, source):
+    """[(label, stage entry)] of the table's ``entries`` with their groups repeated; each
+    entry's keys checked (ValueError naming ``source``, the entry and the key, with the
+    valid keys)."""
+    if not isinstance(entries, list) or not entries:
+        raise ValueError(f"{source}: no stage; valid: at least one [[stage]] table "
+                         "(pendular.procedures.path_table)")
+    stages = []
+    _expand(entries, source, "stage ", stages)
+    return stages
+
+
+def _expand(entries, source, prefix, stages):
+    keys = stage_keys()
+    for number, entry in enumerate(entries, 1):
+        label = f"{prefix}{number}"
+        if not isinstance(entry, dict):
+            raise ValueError(f"{source}: {label} = {entry!r}; valid: a table of "
+                             f"{', '.join(keys)}")
+        if "repeat" in entry or "stages" in entry:
+            _expand_group(entry, source, label, stages)
+            continue
+        unknown = [key for key in entry if key not in keys]
+        if unknown:
+            raise ValueError(f"{source}: {label}: unknown key {unknown[0]!r}; valid: "
+                             f"{', '.join(keys)} (a stage), or {', '.join(GROUP_KEYS)} (a "
+                             "group repeated)")
+        stages.append((label, entry))
+        if len(stages) > MAX_STAGES:
+            raise ValueError(f"{source}: {label}: the path has more than {MAX_STAGES} stages "
+                             "once its groups are repeated; valid: at most that many")
+
+
+def _expand_group(entry, source, label, stages):
+    other = [key for key in entry if key not in GROUP_KEYS]
+    if other:
+        raise ValueError(f"{source}: {label}: key {other[0]!r} beside repeat and stages; "
+                         f"valid: {', '.join(GROUP_KEYS)} (a group: give {other[0]!r} to the "
+                         "stages in it)")
+    try:
+        times = check_int("repeat", entry.get("repeat"), low=1, high=MAX_STAGES)
+    except ValueError as error:
+        raise ValueError(f"{source}: {label}: {error}") from None
+    inner = entry.get("stages")
+    if not isinstance(inner, list) or not inner:
+        raise ValueError(f"{source}: {label}: stages = {inner!r}; valid: a non-empty list of "
+                         "stages repeated")
+    for _ in range(times):
+        _expand(inner, source, f"{label}.", stages)
+
+
+# ---------------------------------------------------------------- building the stages
+
+def _value(name, value, values):
+    """``value`` of key ``name`` as a number, its name resolved through ``values`` (name ->
+    number) when the key takes names (NAMES); other values as they are, for the dataclass to
+    check, except a boolean where a number is expected."""
+    names = NAMES.get(name.split("[")[0], ())
+    if isinstance(value, str) and value in names:
+        return values[value]
+    if isinstance(value, str) and names:
+        raise ValueError(f"{name} = {value!r}; valid: a number or "
+                         f"{' or '.join(repr(n) for n in names)}")
+    if isinstance(value, bool):
+        raise ValueError(f"{name} = {value!r} is not a number")
+    return value
+
+
+def _until(value, values):
+    """The end of a stage (UNTIL_KINDS) of its table value."""
+    valid = (f"valid: one of {', '.join(repr(k) for k in UNTIL_KINDS)}, e.g. "
+             "{strain = 0.05, axis = 'z'}, {stress = 5000, axis = 'z'} or 'static'")
+    if isinstance(value, str):
+        kind = UNTIL_KINDS.get(value)
+        if kind is None or kind.value is not None:
+            raise ValueError(f"until = {value!r}; {valid}" + (
+                "" if kind is None else f" ({value!r} needs its value: {{{value} = ...}})"))
+        return kind.kind()
+    if not isinstance(value, dict):
+        raise ValueError(f"until = {value!r}; {valid}")
+    named = [key for key in value if key in UNTIL_KINDS]
+    if len(named) != 1:
+        raise ValueError(f"until = {value!r} names {len(named)} ends; {valid}")
+    kind = UNTIL_KINDS[named[0]]
+    given = dict(value)
+    marker = given.pop(named[0])
+    fields = [f.name for f in dataclasses.fields(kind.kind) if f.name != kind.value]
+    unknown = [key for key in given if key not in fields]
+    if unknown:
+        raise ValueError(f"until: unknown key {unknown[0]!r}; valid: "
+                         f"{', '.join([named[0], *fields])}")
+    options = {key: _value(f"until {key}", item, values) for key, item in given.items()}
+    if kind.value is None:
+        if marker is not True:
+            raise ValueError(f"until {named[0]} = {marker!r}; valid: true")
+    else:
+        if isinstance(marker, str) and marker in kind.names:
+            marker = values[marker]
+        elif isinstance(marker, (str, bool)):
+            raise ValueError(f"until {named[0]} = {marker!r}; valid: a number"
+                             + "".join(f" or {n!r}" for n in kind.names))
+        options[kind.value] = marker
+    return kind.kind(**options)
+
+
+def _stage(entry, values):
+    """The Stage of one table entry (keys checked), its named values resolved."""
+    fields = {}
+    for key, value in entry.items():
+        if key == "until":
+            fields[key] = _until(value, values)
+        elif key in AXIS_FIELDS and not isinstance(value, dict):
+            raise ValueError(f"{key} = {value!r}; valid: a value per axis, e.g. "
+                             f"{key} = {{x = 500, y = 500}}")
+        elif isinstance(value, dict):
+            fields[key] = {axis: _value(f"{key}[{axis!r}]", item, values)
+                           for axis, item in value.items()}
+        else:
+            fields[key] = _value(key, value, values)
+    return Stage(**fields)
+
+
+def build_stages(entries, source, *, confining, rate, young=None):
+    """The loading.Stage list of a table's ``entries`` (read_table), groups repeated;
+    ``confining`` [Pa] and ``rate`` [1/s] are the values of the names 'confining' and
+    'quasi-static'; with ``young`` [Pa], every stress is checked against it
+    (preparation.check_soft_contacts). ValueError naming ``source`` and the entry."""
+    values = {"confining": confining, "quasi-static": rate, "-quasi-static": -rate}
+    stages = []
+    for label, entry in parse_entries(entries, source):
+        try:
+            stage = _stage(entry, values)
+            for name, value in stage_stresses(stage) if young is not None else ():
+                check_soft_contacts(name, value, young)
+        except (ValueError, TypeError) as error:
+            raise ValueError(f"{source}: {label}: {error}") from None
+        stages.append(stage)
+    return stages
+
+
+def stage_stresses(stage):
+    """[(name, stress [Pa])] of the stress targets of ``stage``: its servoed stresses, mean
+    stress and stress end."""
+    found = [(f"stress[{axis!r}]", value) for axis, value in stage.stress.items()]
+    if stage.mean_stress is not None:
+        found.append(("mean_stress", stage.mean_stress))
+    if isinstance(stage.until, Stress):
+        found.append(("until stress", stage.until.value))
+    return found
+
+
+def lowest_stress(entries, source, confining):
+    """The lowest stress of a table's path [Pa], where its quasi-static rate is taken: of
+    ``confining`` and every positive stress target of its stages (stage_stresses; they do
+    not depend on the rate, so the stages are built at 1 1/s here)."""
+    stages = build_stages(entries, source, confining=confining, rate=1.0)
+    return min([confining] + [value for stage in stages for _, value in stage_stresses(stage)
+                              if value > 0.0])
+
+
+# ---------------------------------------------------------------- the test
+
+class PathTest(LaboratoryTest):
+    """The loading path of a table (``config``: pendular.procedures.config.TablePathConfig),
+    on the sample and wetting of LaboratoryTest: history with ``void_ratio``, ``k0`` and
+    ``stage`` (rows every ``record_strain``, or ``records`` rows over one stage ending at a
+    strain as a triaxial's), summary of ``path_summary``; figure path.png (plot_path: the q-p
+    and q'-p' stress paths, the stresses and strains against the history row)."""
+
+    NAME = "path"
+    CONFIG = TablePathConfig
+    FIGURE = "path.png"
+    PROGRESS = "stage"
+
+    def loading(self, sim):
+        config = self.config
+        stages = config.loading_stages()
+        columns = dict(PATH_COLUMNS)
+        if len(stages) == 1:                  # LoadingPath names the stages of a longer path
+            columns["stage"] = lambda s: 0
+        return LoadingPath(sim, stages, records=config.records,
+                           record_every=config.record_every(sim.dt), columns=columns)
+
+    def summarize(self, history):
+        count = len(self.config.loading_stages())
+        return {**path_summary(history, count), **stress_balance(history)}
+
+    def plot(self, history, out, title):
+        stages = len(self.config.loading_stages())
+        label = (f"{os.path.basename(self.config.source)}, {stages} "
+                 f"stage{'s' if stages > 1 else ''}")
+        plot_path(history, os.path.join(out, self.FIGURE), f"{title}\n{label}")
+
+
+def _diagonal(history, name):
+    """(rows, 3) diagonal of a tensor column of ``history``, or None without it."""
+    if name not in history:
+        return None
+    return np.diagonal(history[name], axis1=1, axis2=2)
+
+
+def path_summary(history, count=None):
+    """Results of a loading path's history (columns sigma_wall, axial_strain,
+    volumetric_strain, void_ratio and, for several stages, stage) of ``count`` stages (None:
+    those recorded): ``stages``, the end state of each (its row, step, axial and volumetric
+    strain, void ratio, wall stresses sigma_wall [Pa], p and q [Pa]; wet, p' and q' of the
+    effective stress, Eq. 3.43; a stage that ended at once, static already, ends where the
+    one before did); ``initial_void_ratio`` and ``final_void_ratio``; ``has_peak``: whether
+    the largest q of the path is a peak within a stage, past its first row and one that the
+    stage went past (pendular.io.schema.peak_reached over its rows), and then ``peak_q``,
+    ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (loading.friction_angle),
+    ``peak_index``, ``peak_stage`` and, wet, ``peak_q_effective``, ``p_effective_at_peak``,
+    ``phi_peak_effective_deg``."""
+    sigma = history["sigma_wall"]
+    stage = np.asarray(history.get("stage", np.zeros(len(sigma), dtype=np.int64)))
+    count = int(stage[-1]) + 1 if count is None else count
+    effective = _diagonal(history, "sigma_effective")
+    p, q = mean_stress(sigma), deviator_stress(sigma)
+    rows = []
+    for number in range(count):
+        row = int(np.flatnonzero(stage <= number)[-1])
+        entry = {"stage": number, "row": row, "step": int(history["step"][row]),
+                 "axial_strain": float(history["axial_strain"][row]),
+                 "volumetric_strain": float(history["volumetric_strain"][row]),
+                 "void_ratio": float(history["void_ratio"][row]),
+                 "sigma_wall": sigma[row].tolist(), "p": float(p[row]), "q": float(q[row])}
+        if effective is not None:
+            entry.update({"p_effective": float(mean_stress(effective[row])),
+                          "q_effective": float(deviator_stress(effective[row]))})
+        rows.append(entry)
+    void = history["void_ratio"]
+    summary = {"stages": rows, "initial_void_ratio": float(void[0]),
+               "final_void_ratio": float(void[-1])}
+    peak = int(np.argmax(q))
+    within = np.flatnonzero(stage == stage[peak])
+    summary["has_peak"] = bool(q[peak] > 0.0 and peak > within[0]
+                               and peak_reached(history["axial_strain"][within], q[within]))
+    if not summary["has_peak"]:
+        return summary
+    summary.update({"peak_q": float(q[peak]), "p_at_peak": float(p[peak]),
+                    "axial_strain_at_peak": float(history["axial_strain"][peak]),
+                    "phi_peak_deg": float(friction_angle(sigma[peak])),
+                    "peak_index": peak, "peak_stage": int(stage[peak])})
+    if effective is not None:
+        summary.update({"peak_q_effective": float(deviator_stress(effective[peak])),
+                        "p_effective_at_peak": float(mean_stress(effective[peak])),
+                        "phi_peak_effective_deg": float(friction_angle(effective[peak]))})
+    return summary
+
+
+# ---------------------------------------------------------------- composing in Python
+
+def run_path(sim, stages, *, records=None, record_every=None, columns=None, progress=None,
+             **options):
+    """Run ``stages`` (loading.Stage) on the static scene ``sim`` as one loading.LoadingPath
+    (``records``, ``record_every`` and the servo ``options`` are its own) recording also
+    PATH_COLUMNS and ``columns``; returns its history (dict of arrays). The path's recorder
+    and guard leave ``sim.writers`` at its end, so that paths, equilibria and suction changes
+    (``change_suction``) follow one another on one scene."""
+    writers = list(sim.writers)
+    path = LoadingPath(sim, stages, records=records, record_every=record_every,
+                       columns={**PATH_COLUMNS, **(columns or {})}, **options)
+    try:
+        path.run(sim, progress=progress)
+    finally:
+        sim.writers = writers
+    return path.recorder.arrays()
+
+
+def change_suction(sim, bridges, suction, *, stress, increments=4, max_velocity=None,
+                   unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None):
+    """Bring the suction of the suction-controlled ``bridges`` (capillary.CapillaryBridges in
+    the forces of ``sim``) to ``suction`` [Pa] at a held stress: the walls of each axis of
+    ``stress`` ({axis: Pa}) servoed at it (at most at ``max_velocity`` [m/s]; None: the
+    scene's servo speed), those of the other axes fixed (e.g. {'z': sigma_v}: drying at a
+    constant vertical stress, no lateral strain). The suction changes in ``increments`` steps
+    of equal ratio, each run until static (triaxial.equilibrate with ``unbalanced``,
+    ``tolerance``, ``max_steps``). Returns the history of the state before and after each
+    increment (loading.history_columns, strains from the start, with PATH_COLUMNS)."""
+    if bridges.control != "suction":
+        raise ValueError(f"control = {bridges.control!r}: change_suction needs "
+                         "suction-controlled bridges (volume-controlled ones hold their liquid)")
+    suction = check_positive("suction", suction, "Pa")
+    held = Stage(stress=stress, strain_rate={a: 0.0 for a in AXIS_NAMES if a not in stress})
+    increments = check_int("increments", increments, low=1)
+    if max_velocity is None:
+        servo = next((op for op in sim.controls if isinstance(op, StressServo)), None)
+        max_velocity = servo.max_velocity if servo is not None else servo_speed(sim.walls,
+                                                                                 sim.dt)
+    if sim.contacts is None:
+        sim.evaluate_forces()
+    axial = AxisStrain(2, sim.walls.lengths()[2])
+    recorder = HistoryRecorder(1, {**history_columns(sim, axial, sim.walls.volume(),
+                                                     capillary_operation(sim)),
+                                   **PATH_COLUMNS})
+    recorder.record(sim)
+    sim.controls = [StressServo(axis, target, max_velocity)
+                    for axis, target in held.stress.items()]
+    steps = np.geomspace(bridges.suction, suction, increments + 1)[1:]
+    steps[-1] = suction
+    for value in steps:
+        bridges.set_suction(float(value))
+        equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
+                    progress=progress, phase=f"equilibrium at suction {value:.4g} Pa")
+        recorder.record(sim)
+    return recorder.arrays()

@@ -1,0 +1,161 @@
+"""``pendular path PATH.toml`` as a user runs it: the Chapter 5 triaxial as a table gives, bit
+for bit, the history of ``pendular triaxial``; each shipped table of examples/paths/ runs at a
+small size; a multi-stage path resumes without its table; bad input is refused in one line;
+and the Python API example of a hydro-mechanical path (examples/loading_path_api.py) runs."""
+
+import json
+import os
+import runpy
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import ROOT, refused, run_in_process
+
+PATHS = os.path.join(ROOT, "examples", "paths")
+SMALL = ["--particles", "150", "--confining", "750", "--seed", "2", "--quiet"]
+
+
+def summary_of(out):
+    return json.loads((out / "summary.json").read_text())
+
+
+def history_of(out):
+    with h5py.File(out / "history.h5") as handle:
+        return {name: handle["history"][name][()] for name in handle["history"]
+                if name not in ("record", "axis", "component")}
+
+
+@pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])
+def test_the_triaxial_as_a_table_is_the_triaxial_bit_for_bit(wet, tmp_path, capsys):
+    """The shipped triaxial.toml (to 25 % strain) with --records as the triaxial's: the same
+    rows, every column of the triaxial's history equal to the last bit."""
+    options = [*SMALL, *wet, "--inertial-number", "2e-3", "--records", "60",
+               "--vtk-every", "0"]
+    status, err = run_in_process("triaxial", [*options, "--max-strain", "0.25",
+                                              "--out", tmp_path / "triaxial"], capsys)
+    assert status == 0, err
+    status, err = run_in_process("path", [os.path.join(PATHS, "triaxial.toml"), *options,
+                                          "--out", tmp_path / "path"], capsys)
+    assert status == 0, err
+    expected, got = history_of(tmp_path / "triaxial"), history_of(tmp_path / "path")
+    assert 61 <= len(expected["step"]) <= 63          # a row every steps // records, and the end
+    assert expected["axial_strain"][-1] == pytest.approx(0.25, rel=1e-3)
+    for name in ("sigma_wall", "axial_strain"):
+        assert np.array_equal(got[name], expected[name]), name
+    for name in expected:                                  # and every other column
+        assert np.array_equal(got[name], expected[name], equal_nan=True), name
+    assert np.all(got["stage"] == 0)
+    triaxial, path = summary_of(tmp_path / "triaxial"), summary_of(tmp_path / "path")
+    assert path["strain_rate"] == triaxial["strain_rate"]
+    end = path["stages"][0]
+    assert end["q"] == pytest.approx(expected["sigma_wall"][-1, 2]
+                                     - expected["sigma_wall"][-1, :2].mean())
+    if wet:
+        assert "q_effective" in end and "sigma_effective" in got
+
+
+def test_the_oedometer_table_loads_unloads_and_reloads(tmp_path, capsys):
+    out = tmp_path / "oedometer"
+    status, err = run_in_process("path", [os.path.join(PATHS, "oedometer_unload.toml"),
+                                          *SMALL, "--out", out], capsys)
+    assert status == 0, err
+    history, summary = history_of(out), summary_of(out)
+    sigma, stage = history["sigma_wall"], history["stage"]
+    assert sorted(set(stage)) == [0, 1, 2]
+    ends = [row["row"] for row in summary["stages"]]
+    targets = (10000.0, 2000.0, 20000.0)
+    for row, target, sign in zip(ends, targets, (1, -1, 1)):
+        # each stage stops at the first record past its target, within a step's change
+        assert sign * (sigma[row, 2] - target) >= 0.0
+        assert abs(sigma[row, 2] - target) < 0.01 * target
+    # lateral walls held: the volumetric strain is the axial strain
+    assert np.allclose(history["volumetric_strain"], history["axial_strain"], atol=1e-12)
+    void = [row["void_ratio"] for row in summary["stages"]]
+    assert void[1] > void[0] > void[2]          # swells on unloading, compacts past 10 kPa
+    assert summary["has_peak"] is False and "peak_q" not in summary
+    assert summary["stages"][0]["p"] == pytest.approx(sigma[ends[0]].mean())
+    for name in ("path.png", "sample.h5", "vtk"):
+        assert (out / name).exists()
+    assert (out / "path.png").stat().st_size > 20000
+
+
+def test_the_cyclic_table_cycles_between_its_axial_stresses(tmp_path, capsys):
+    out = tmp_path / "cyclic"
+    status, err = run_in_process("path", [os.path.join(PATHS, "cyclic.toml"), *SMALL,
+                                          "--vtk-every", "0", "--out", out], capsys)
+    assert status == 0, err
+    history, summary = history_of(out), summary_of(out)
+    assert len(summary["stages"]) == 11 and sorted(set(history["stage"])) == list(range(11))
+    axial = [row["sigma_wall"][2] for row in summary["stages"]]
+    assert all(1600.0 <= value < 1616.0 for value in axial[0::2])
+    assert all(990.0 < value <= 1000.0 for value in axial[1::2])
+    lateral = history["sigma_wall"][:, :2]
+    assert np.abs(lateral / 750.0 - 1.0).max() < 0.05        # servoed at the confining stress
+    # the strain accumulates over the cycles (ratcheting), never back to where it started
+    strain = [row["axial_strain"] for row in summary["stages"]]
+    assert strain[-1] > strain[0] > 0.0
+
+
+def test_an_interrupted_path_resumes_to_the_same_history_without_its_table(tmp_path, capsys):
+    table = tmp_path / "cycles.toml"
+    with open(os.path.join(PATHS, "cyclic.toml")) as shipped:
+        table.write_text(shipped.read().replace("repeat = 5", "repeat = 2"))
+    options = [*SMALL, "--vtk-every", "0", "--checkpoint-every", "2000"]
+    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
+    status, err = run_in_process("path", [table, *options, "--out", whole], capsys)
+    assert status == 0, err
+    steps = summary_of(whole)["steps"]
+    status, _ = run_in_process("path", [table, *options, "--out", stopped,
+                                        "--stop-after", str(int(0.6 * steps))], capsys)
+    assert status == 130 and summary_of(stopped)["completed"] is False
+    table.unlink()                                  # the run keeps its stages
+    status, err = run_in_process("path", ["--resume", stopped, "--quiet"], capsys)
+    assert status == 0, err
+    expected, got = history_of(whole), history_of(stopped)
+    for name in expected:
+        assert np.array_equal(got[name], expected[name], equal_nan=True), name
+
+
+@pytest.mark.parametrize("table, arguments, words", [
+    ("[[stage]]\nstress = {x = 750, y = 750, z = 750}\n[[stage]]\nstres = {x = 5}\n", [],
+     ("path.toml: stage 2: unknown key 'stres'; valid: stress, strain_rate",)),
+    ("[[stage]]\nstress = {x = 750, y = 750}\nstrain_rate = {z = 'quasi-static'}\n", [],
+     ("path.toml: stage 1: until static needs",)),
+    ("", [], ("path.toml: no stage",)),
+    ("[sample]\nparticles = 100\n", [], ("unknown key 'sample'", "command line")),
+    ("[[stage]]\nstress = {x = 750, y = 750, z = 1000}\n", ["--records", "50"],
+     ("--records = 50 applies to a path of one stage",)),
+    ("[[stage]]\nstress = {x = 750, y = 750, z = 1000}\n", ["--particles", "10"],
+     ("--particles = 10",)),
+    ("[[stage]]\nstress = {x = 750, y = 750, z = 1000}\n", ["--resume", "somewhere"],
+     ("--resume", "cannot be changed")),
+    (None, [], ("PATH.toml is missing",)),
+])
+def test_bad_input_is_refused_in_one_line(table, arguments, words, tmp_path, capsys):
+    argv = []
+    if table is not None:
+        (tmp_path / "path.toml").write_text(table)
+        argv = [tmp_path / "path.toml"]
+    out = tmp_path / "out"
+    status, err = run_in_process("path", [*argv, "--particles", "100", *arguments,
+                                          "--out", out], capsys)
+    refused(status, err, *words)
+    assert not out.exists()
+
+
+def test_the_python_api_example_composes_wetting_loading_drying_and_unloading(
+        tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    found = runpy.run_path(os.path.join(ROOT, "examples", "loading_path_api.py"))
+    loading, drying, unloading = found["loading"], found["drying"], found["unloading"]
+    assert 10000.0 <= loading["sigma_wall"][-1, 2] < 10100.0
+    # the drying: the suction in equal ratios from 30 to 300 kPa, sigma_v held, x and y fixed
+    assert np.allclose(drying["suction"], np.geomspace(30e3, 300e3, 5), rtol=1e-12)
+    assert np.abs(drying["sigma_wall"][1:, 2] / 10e3 - 1.0).max() < 0.01
+    assert np.all(drying["saturation"][1:] < drying["saturation"][:-1])
+    assert drying["volumetric_strain"] == pytest.approx(drying["axial_strain"], abs=1e-12)
+    assert 1000.0 >= unloading["sigma_wall"][-1, 2] > 990.0
+    assert unloading["void_ratio"][-1] > drying["void_ratio"][-1]    # it swells back
