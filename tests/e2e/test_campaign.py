@@ -21,7 +21,8 @@ from pendular.cli.tables import options_argv, sweep_from_table
 from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs,
                                        executor, finished_summary, max_jobs, run_name,
                                        run_progress, table_rows, write_campaign_csv)
-from pendular.procedures.config import ShearConfig, TensionConfig, TriaxialConfig, config_to_dict
+from pendular.procedures.config import (ShearConfig, TensionConfig, TriaxialConfig, config_to_dict,
+    tension_sample)
 from pendular.io.outputs import OutputFolder
 
 TABLE = """
@@ -102,7 +103,8 @@ def test_library_campaign_of_replaced_configs_keeps_going_past_a_failed_run(tmp_
 
 
 def test_a_tension_run_in_a_campaign_is_summarised_and_reused(tmp_path):
-    config = TensionConfig(cases=[(0.72, 0.01)], particles=100, max_strain=0.02, vtk_frames=0)
+    config = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100),
+                           max_strain=0.02, vtk_frames=0)
     result = Campaign([("w1", config)]).run(tmp_path / "t", quiet=True)
     assert not result.failed
     summary = result.summaries["w1"]
@@ -329,7 +331,7 @@ def test_damaged_results_of_an_earlier_campaign_are_run_again(tmp_path, capsys, 
         handle.attrs["config"] = 5                  # not JSON text
     assert finished_summary(triaxial, str(folder)) is None
 
-    tension = TensionConfig(cases=[(0.72, 0.01)], particles=100)
+    tension = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100))
     stored = config_to_dict(tension)
     folder = tmp_path / "tension"
     folder.mkdir()

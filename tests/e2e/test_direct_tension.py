@@ -21,7 +21,8 @@ from pendular.procedures import tension as direct_tension
 from pendular.procedures.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
 from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from_dict,
-    config_to_dict)
+    config_to_dict, tension_sample)
+from pendular.procedures.preparation import PrepareConfig
 
 from conftest import ROOT
 
@@ -37,7 +38,7 @@ def table():
 
 @pytest.fixture(scope="module")
 def args():
-    return TensionConfig(particles=200, max_strain=0.03, vtk_frames=0)
+    return TensionConfig(sample=tension_sample(particles=200), max_strain=0.03, vtk_frames=0)
 
 
 @pytest.fixture(scope="module")
@@ -71,9 +72,10 @@ def test_formation_suction_holds_the_target_volume(table):
 
 
 def test_wetting_reaches_the_water_content(wetted, dry, args):
+    """w = water mass / grain mass, the grains' mass from the simulated spheres' density."""
     sim, bridges, report = wetted
-    water = bridges.water_volume(sim.contacts) / (args.specific_gravity
-                                                  * sim.particles.solid_volume())
+    water = (1000.0 * bridges.water_volume(sim.contacts)
+             / (sim.particles.density * sim.particles.solid_volume()))
     assert water == pytest.approx(WATER, rel=WATER_TOLERANCE)
     assert report["water_content"] == pytest.approx(water)
     # the bridges outnumber the dry contacts: the settling under the bridges made new ones
@@ -143,6 +145,8 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     (["--contact-angle", "95"], "--contact-angle = 95.0 deg is outside"),
     (["--particles", "10"], "--particles = 10 is outside"),
     (["--residual", "1.5"], "--residual = 1.5 is outside"),
+    (["--specific-gravity", "11"], "--specific-gravity = 11.0 is outside the valid range [1, 10]"),
+    (["--friction", "95"], "--friction = 95.0 deg is outside"),
     (["--void-ratio", "0.7,x"], "--void-ratio = '0.7,x' is not a comma-separated list"),
 ])
 def test_bad_inputs_are_refused_by_name(arguments, message):
@@ -155,13 +159,23 @@ def test_bad_inputs_are_refused_by_name(arguments, message):
 
 
 def test_config_is_validated_and_saved_as_json(args):
-    """Variants by dataclasses.replace are validated again; the JSON form reads back equal."""
+    """Variants by dataclasses.replace are validated again; the JSON form (the sample nested
+    as a PrepareConfig) reads back equal."""
     assert CONFIG_TYPES["TensionConfig"] is TensionConfig
-    variant = dataclasses.replace(args, cases=[(0.65, 0.01), (0.65, 0.02)], vtk_every=50)
-    assert config_from_dict(json.loads(json.dumps(config_to_dict(variant)))) == variant
+    variant = dataclasses.replace(args, cases=[(0.65, 0.01), (0.65, 0.02)], vtk_every=50,
+                                  sample=dataclasses.replace(args.sample, radius_spread=0.1))
+    data = json.loads(json.dumps(config_to_dict(variant)))
+    assert data["fields"]["sample"]["type"] == "PrepareConfig"
+    assert "specific_gravity" not in data["fields"] and "particles" not in data["fields"]
+    assert config_from_dict(data) == variant
     assert TensionConfig().cases == [(e, w) for e, w, _ in direct_tension.KIM_2001]
     with pytest.raises(ValueError, match="--friction = 95.0 deg is outside"):
-        dataclasses.replace(args, friction=95.0)
+        tension_sample(friction_deg=95.0)
+    # the tension's own ranges, narrower than PrepareConfig's, name the command's options
+    with pytest.raises(ValueError, match=r"--young = 2000000000000.0 Pa is outside"):
+        dataclasses.replace(args, sample=dataclasses.replace(args.sample, young=2e12))
+    with pytest.raises(ValueError, match=r"--specific-gravity = 0.5 is outside"):
+        dataclasses.replace(args, sample=PrepareConfig(particles=200, density=500.0))
     with pytest.raises(ValueError, match="--void-ratio = 1.5 is outside"):
         dataclasses.replace(args, cases=[(1.5, 0.01)])
     with pytest.raises(ValueError, match="empty"):
@@ -174,12 +188,19 @@ def test_command_options_build_the_config():
         ["--void-ratio", "0.65,0.6", "--water-content", "1", "--vtk-every", "100"]))
     assert config.cases == [(0.65, 0.01), (0.6, 0.01)] and config.vtk_every == 100
     assert module.config_from(parser.parse_args([])) == TensionConfig()
+    # one grain density: --specific-gravity sets the spheres' density, Gs = rho_s / rho_w
+    assert TensionConfig().sample.density == 2650.0 and TensionConfig().specific_gravity == 2.65
+    heavy = module.config_from(parser.parse_args(["--specific-gravity", "2.7",
+                                                  "--friction", "25", "--confining", "200"]))
+    assert heavy.sample.density == 2700.0 and heavy.specific_gravity == 2.7
+    assert heavy.sample.friction_deg == 25.0 and heavy.sample.confining == 200.0
+    assert heavy.options()["specific_gravity"] == 2.7 and heavy.options()["friction"] == 25.0
     with pytest.raises(SystemExit):           # one of --vtk-every, --vtk-frames
         parser.parse_args(["--vtk-every", "100", "--vtk-frames", "5"])
 
 
 def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
-    dense = dataclasses.replace(args, particles=100)
+    dense = dataclasses.replace(args, sample=dataclasses.replace(args.sample, particles=100))
     with pytest.raises(ValueError, match=r"--void-ratio = 0.52 is outside the valid range"):
         direct_tension.prepare_void_ratio(dense, 0.52, progress=False)
 
@@ -199,7 +220,8 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     assert list((folder / "vtk").glob("*.pvd"))
     # the command line as given, and the configuration it built
     assert result["arguments"]["void_ratio"] == "0.65" and result["arguments"]["quiet"] is True
-    assert config_from_dict(result["config"]).vtk_every == 2000
+    config = config_from_dict(result["config"])
+    assert config.vtk_every == 2000 and config.sample.particles == 200
 
 
 def test_prediction_is_chapter4s_kim_comparison(args):

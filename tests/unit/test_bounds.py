@@ -15,7 +15,8 @@ import pytest
 from conftest import refused, run_in_process
 
 from pendular.procedures.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES,
-    MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name)
+    MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name,
+    tension_sample)
 from pendular.dem.grading import read_grading_curve
 from pendular.dem.measure import porosity
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
@@ -76,7 +77,11 @@ def test_the_smallest_samples_are_the_tests_own():
     enough = PrepareConfig(particles=MIN_SAMPLE_PARTICLES)
     assert TriaxialConfig(sample=enough).sample.particles == SwccConfig(
         sample=enough).sample.particles == MIN_SAMPLE_PARTICLES
-    assert TensionConfig(particles=MIN_TENSION_PARTICLES).particles == MIN_TENSION_PARTICLES
+    few = tension_sample(particles=MIN_TENSION_PARTICLES)
+    assert TensionConfig(sample=few).sample.particles == MIN_TENSION_PARTICLES
+    with pytest.raises(ValueError, match=r"--particles = 99 is outside the valid range "
+                                         r"\[100, 1000000\] for direct tension"):
+        TensionConfig(sample=PrepareConfig(particles=MIN_TENSION_PARTICLES - 1))
 
 
 def test_counts_beyond_the_shear_steps_are_refused(capsys, tmp_path):
@@ -97,7 +102,8 @@ def test_counts_beyond_the_shear_steps_are_refused(capsys, tmp_path):
 
 def test_tension_frames_beyond_the_pull_are_refused(capsys, tmp_path):
     out = ["--out", str(tmp_path / "t")]
-    steps = int(TensionConfig(cases=[(0.72, 0.01)], particles=200).pull_steps())
+    steps = int(TensionConfig(cases=[(0.72, 0.01)],
+                              sample=tension_sample(particles=200)).pull_steps())
     line = refused_by(capsys, "tension", TENSION + ["--vtk-every", "99999999999999999999"] + out,
                    "--vtk-every = ", f"outside the valid range [0, {steps}]", "the pull")
     assert "dtype" not in line
@@ -133,8 +139,10 @@ def test_options_a_mode_ignores_are_refused(capsys, tmp_path):
         refused_by(capsys, "tension", TENSION + ["--periodic", "--grip-depth", depth] + out,
                 f"--grip-depth = {depth}", "--periodic", "no grips")
     with pytest.raises(ValueError, match="--grip-depth = 2 does not apply to --periodic"):
-        TensionConfig(cases=[(0.72, 0.01)], periodic=True, grip_depth=2.0)
-    assert TensionConfig(cases=[(0.72, 0.01)], periodic=True).grip_depth == 1.0
+        TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(periodic=True),
+                      grip_depth=2.0)
+    assert TensionConfig(cases=[(0.72, 0.01)],
+                         sample=tension_sample(periodic=True)).grip_depth == 1.0
     sample = str(tmp_path / "sample.h5")
     refused_by(capsys, "triaxial", TRIAXIAL + ["--sample", sample, "--porosity", "0.45"] + out,
             "--porosity", "--sample", "already prepared")
@@ -168,7 +176,7 @@ def test_a_case_without_kim_measurement_says_so():
 
 def test_tension_surface_tension_is_chapter4s():
     """The tension default stays thesis Chapter 4's 0.074 N/m (the value its comparison with
-    Kim and packing_state uses), a constant apart from Chapter 5's 0.073."""
+    Kim and the regular packing prediction use), a constant apart from Chapter 5's 0.073."""
     from pendular.capillary import SURFACE_TENSION
     from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION
 

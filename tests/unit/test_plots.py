@@ -9,7 +9,7 @@ import pytest
 
 from pendular.io import plots
 from pendular.procedures import tension
-from pendular.procedures.config import TensionConfig
+from pendular.procedures.config import TensionConfig, tension_sample
 
 #: Code names that must not reach a legend or a label.
 CODE_NAMES = ("psi_interface", "sigma_capillary", "sigma_effective", "packing_state", "psi ",
@@ -159,7 +159,7 @@ def test_a_triaxial_run_writes_every_plot_titled_in_words(saved, tmp_path):
 
 
 def test_the_tension_plots_are_titled_and_name_the_cases_in_words(saved, tmp_path):
-    config = TensionConfig(cases=((0.72, 0.01),), particles=200)
+    config = TensionConfig(cases=((0.72, 0.01),), sample=tension_sample(particles=200))
     summary = {"case": "e0.72_w1.00", "void_ratio_target": 0.72, "water_content_target": 0.01,
                "water_content": 0.0101, "void_ratio": 0.721, "tensile_strength_pa": 600.0}
     extension = np.linspace(0.0, 0.05, 50)

@@ -137,7 +137,7 @@ def write_pvd(path, frames, time_axis="time"):
     lines += [f'    <DataSet timestep="{float(time)!r}" group="" part="0" file={quoteattr(name)}/>'
               for time, name in frames]
     lines += ["  </Collection>", "</VTKFile>", ""]
-    with replacing(path) as temporary, open(temporary, "w") as handle:
+    with replacing(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write("\n".join(lines))
 
 

@@ -21,7 +21,6 @@ import numpy as np
 from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
 from pendular.procedures.preparation import (MAX_PARTICLES, MAX_SEED, PrepareConfig,
     check_soft_contacts, pwave_step)
-from pendular.dem.timestep import pwave_timestep
 from pendular.utils.validate import check_int, check_positive, check_range
 from pendular.homogenize import packing_state, regular_packing
 
@@ -478,44 +477,87 @@ class IsotropicConfig(PathConfig):
         return min(self.sample.confining, *self.stresses)
 
 
+#: Density of water [kg/m^3]: the specific gravity of the grains is their density over it
+#: (Gs = rho_s / rho_w), which turns a water content by mass into a water volume.
+WATER_DENSITY = 1000.0
+#: Valid specific gravities Gs of a direct tension's grains [-] (--specific-gravity).
+SPECIFIC_GRAVITY_RANGE = (1.0, 10.0)
+#: The direct tension's sample where it differs from PrepareConfig's defaults: Kim's (2001)
+#: F-75 sand (R = 0.11 mm, Gs = 2.65), 2,000 spheres held at 100 Pa.
+TENSION_SAMPLE = {"particles": 2000, "radius": KIM_RADIUS,
+                  "density": SPECIFIC_GRAVITY * WATER_DENSITY, "confining": 100.0}
+
+
+def check_tension_sample(fields):
+    """ValueError naming the command's option for a field of ``fields`` (PrepareConfig's names;
+    those absent are not checked) outside the direct tension's range, narrower than
+    PrepareConfig's: particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES], radius [m],
+    density [kg/m^3] as --specific-gravity Gs = density / WATER_DENSITY, confining [Pa],
+    friction_deg (--friction) [deg], young [Pa], seed."""
+    checks = {
+        "particles": lambda value: check_particles(
+            value, MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES, "direct tension",
+            "the grips hold a layer at each z wall and the void ratio is the core's"),
+        "radius": lambda value: check_range("--radius", value, 1e-6, 1e-2, unit="m"),
+        "density": lambda value: check_range("--specific-gravity", value / WATER_DENSITY,
+                                             *SPECIFIC_GRAVITY_RANGE),
+        "confining": lambda value: check_range("--confining", value, 1.0, 1e5, unit="Pa"),
+        "friction_deg": lambda value: check_range("--friction", value, 0.0, 90.0,
+                                                  high_inclusive=False, unit="deg"),
+        "young": lambda value: check_range("--young", value, 0.0, 1e12, low_inclusive=False,
+                                           unit="Pa"),
+        "seed": lambda value: check_int("--seed", value, high=MAX_SEED),
+    }
+    for name, check in checks.items():
+        if name in fields:
+            check(fields[name])
+
+
+def tension_sample(**fields):
+    """The PrepareConfig of a direct tension's sample: TENSION_SAMPLE with ``fields``
+    (PrepareConfig's names) over it, e.g. ``tension_sample(particles=200)``; ValueError naming
+    the command's option (check_tension_sample) before PrepareConfig's own checks."""
+    check_tension_sample(fields)
+    return PrepareConfig(**{**TENSION_SAMPLE, **fields})
+
+
 @dataclass
 class TensionConfig:
-    """Direct tension of wet sand at fixed water content (pendular.procedures.tension; Kim 2001, thesis
-    §4.4.1.2 and Table 4.5). Validated on creation (ValueError naming the command's option).
+    """Direct tension of wet sand at fixed water content (pendular.procedures.tension; Kim 2001,
+    thesis §4.4.1.2 and Table 4.5). Validated on creation (ValueError naming the command's
+    option).
+
+    sample: the grains and their preparation (pendular.procedures.preparation.PrepareConfig,
+    default ``tension_sample()``): particles, sizes (radius [m], the mean radius;
+    radius_spread; psd), density [kg/m^3], the one grain density (its specific gravity Gs =
+    density / WATER_DENSITY turns water contents by mass into water volumes; the command's
+    --specific-gravity sets it), confining: isotropic stress of preparation and wetting [Pa],
+    friction_deg: contact friction of wetting and pull [deg], young: YADE young E [Pa], seed,
+    periodic: a periodic cell pulled along z at zero lateral stress (no walls, no grips: a
+    grip_depth other than the default is refused; the void ratio is the whole cell's). Its
+    prep_friction_deg is not used: the growth friction is tuned to each void ratio. Ranges
+    narrower than PrepareConfig's: check_tension_sample.
 
     cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
-    void ratio (default Kim's six); roughness: meniscus separation of touching grains H/R [-];
-    form_gap: at wetting, bridges also form across gaps up to form_gap x radius [-] (0: at
-    contacts only; the default 1 reaches past the rupture distance of Kim's bridges, so they
-    form wherever they can; pendular.capillary.wetting); particles, radius [m] (the mean radius),
-    radius_spread [-] and psd (grading curve) as in pendular.procedures.preparation.PrepareConfig,
-    contact_angle [deg], surface_tension [N/m], specific_gravity Gs [-];
-    confining: isotropic stress of preparation and wetting [Pa]; friction: contact friction of
-    wetting and pull [deg]; young: YADE young E [Pa]; inertial_number: I of the pull [-];
-    max_strain: largest axial extension [-]; residual: fraction of the peak below which the
-    pull has ruptured [-]; grip_depth: grip thickness [diameters] (walls only);
-    void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull (0: none); vtk_every: steps
-    between frames instead (None: from vtk_frames; 0: none), both at most the pull's steps
-    (``pull_steps``); seed: random seed of the samples; periodic: samples in a periodic cell
-    pulled along z at zero lateral stress (no walls, no grips: a grip_depth other than the
-    default is refused; the void ratio is the whole cell's). Cases are distinct by their
-    folder names (``case_name``); particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES].
+    void ratio (default Kim's six), distinct by their folder names (``case_name``);
+    roughness: meniscus separation of touching grains H/R [-]; form_gap: at wetting, bridges
+    also form across gaps up to form_gap x radius [-] (0: at contacts only; the default 1
+    reaches past the rupture distance of Kim's bridges, so they form wherever they can;
+    pendular.capillary.wetting); contact_angle [deg], surface_tension [N/m];
+    inertial_number: I of the pull [-]; max_strain: largest axial extension [-]; residual:
+    fraction of the peak below which the pull has ruptured [-]; grip_depth: grip thickness
+    [diameters] (walls only); void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull
+    (0: none); vtk_every: steps between frames instead (None: from vtk_frames; 0: none), both
+    at most the pull's steps (``pull_steps``).
     """
 
+    sample: PrepareConfig = field(default_factory=tension_sample)
     cases: list[tuple[float, float]] = field(
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
     roughness: float = KIM_SEPARATION
     form_gap: float = 1.0
-    particles: int = 2000
-    radius: float = KIM_RADIUS
-    radius_spread: float = 0.0
-    psd: tuple | None = None
     contact_angle: float = 0.0
     surface_tension: float = CHAPTER4_SURFACE_TENSION
-    specific_gravity: float = SPECIFIC_GRAVITY
-    confining: float = 100.0
-    friction: float = 18.0
-    young: float = 1e6
     inertial_number: float = 1e-3
     max_strain: float = 0.1
     residual: float = 0.2
@@ -523,14 +565,12 @@ class TensionConfig:
     void_ratio_tolerance: float = 0.01
     vtk_frames: int = 20
     vtk_every: int | None = None
-    seed: int = 0
-    periodic: bool = False
 
     def __post_init__(self):
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        check_tension_sample(vars(self.sample))
         self.cases = [(float(e), float(w)) for e, w in self.cases]
-        if not isinstance(self.periodic, (bool, np.bool_)):
-            raise ValueError(f"--periodic = {self.periodic!r}: valid values True or False")
-        self.periodic = bool(self.periodic)
         if not self.cases:
             raise ValueError("cases = [] is empty: give at least one (void ratio, water "
                              "content)")
@@ -545,31 +585,18 @@ class TensionConfig:
                     f"--void-ratio / --water-content: the cases (e {e0:g}, w {100 * w0:g} %) "
                     f"and (e {e1:g}, w {100 * w1:g} %) share the folder {name}: give each "
                     "case once, void ratios 0.01 or water contents 0.01 % apart")
-        self.particles = check_particles(
-            self.particles, MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES, "direct tension",
-            "the grips hold a layer at each z wall and the void ratio is the core's")
         check_range("--form-gap", self.form_gap, 0.0, 1.0)
-        if self.psd is not None or self.radius_spread:
-            sizes = PrepareConfig(particles=int(self.particles), radius=self.radius,
-                                  radius_spread=self.radius_spread, psd=self.psd,
-                                  seed=self.seed)
-            self.radius, self.psd = sizes.radius, sizes.psd
-        check_range("--radius", self.radius, 1e-6, 1e-2, unit="m")
         check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
                     unit="deg")
         check_range("--surface-tension", self.surface_tension, 0.0, MAX_SURFACE_TENSION,
                     low_inclusive=False, unit="N/m")
-        check_range("--specific-gravity", self.specific_gravity, 1.0, 10.0)
         check_range("--roughness", self.roughness, 0.0, 0.5)
-        check_range("--confining", self.confining, 1.0, 1e5, unit="Pa")
-        check_range("--friction", self.friction, 0.0, 90.0, high_inclusive=False, unit="deg")
-        check_range("--young", self.young, 0.0, 1e12, low_inclusive=False, unit="Pa")
         check_range("--inertial-number", self.inertial_number, 0.0, 0.01, low_inclusive=False)
         check_range("--max-strain", self.max_strain, 0.0, 0.5, low_inclusive=False)
         check_range("--residual", self.residual, 0.0, 1.0, low_inclusive=False,
                     high_inclusive=False)
         check_range("--grip-depth", self.grip_depth, 0.0, 3.0)
-        if self.periodic and self.grip_depth != TensionConfig.grip_depth:
+        if self.sample.periodic and self.grip_depth != TensionConfig.grip_depth:
             raise ValueError(f"--grip-depth = {self.grip_depth:g} does not apply to --periodic: "
                              "a periodic cell has no walls, so no grips")
         check_range("--void-ratio-tolerance", self.void_ratio_tolerance, 0.001, 0.1)
@@ -581,7 +608,6 @@ class TensionConfig:
             self.vtk_every = check_int("--vtk-every", self.vtk_every)
             check_steps_count("--vtk-every", self.vtk_every, steps,
                               f"the pull to --max-strain {self.max_strain:g}")
-        check_int("--seed", self.seed, high=MAX_SEED)
         for e, w in self.cases:
             limit = self.pendular_limit(e)
             if not 0.0 < w <= limit:
@@ -590,23 +616,44 @@ class TensionConfig:
                                  "at the pendular limit of the "
                                  f"{comparison_packing(e)[1]} packing")
 
+    @property
+    def specific_gravity(self):
+        """Specific gravity Gs of the grains [-]: the sample's density over WATER_DENSITY."""
+        return self.sample.density / WATER_DENSITY
+
+    def options(self):
+        """The run's options, flat and named as the command's (tension.json 'arguments' of a
+        library run, campaign rows): the sample's as --particles, --radius, ..., its density
+        as specific_gravity."""
+        sample = self.sample
+        return {"roughness": self.roughness, "form_gap": self.form_gap,
+                "particles": sample.particles, "radius": sample.radius,
+                "radius_spread": sample.radius_spread, "psd": sample.psd,
+                "contact_angle": self.contact_angle, "surface_tension": self.surface_tension,
+                "specific_gravity": self.specific_gravity, "confining": sample.confining,
+                "friction": sample.friction_deg, "young": sample.young,
+                "inertial_number": self.inertial_number, "max_strain": self.max_strain,
+                "residual": self.residual, "grip_depth": self.grip_depth,
+                "void_ratio_tolerance": self.void_ratio_tolerance,
+                "vtk_frames": self.vtk_frames, "vtk_every": self.vtk_every,
+                "seed": sample.seed, "periodic": sample.periodic}
+
     def pull_steps(self):
         """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
         the strain rate times the P-wave step of the mean radius (pendular.procedures.preparation
         .pwave_step; the pull runs at the 'stiffness' rule's step, 1.4-1.5 times longer on
         prepared samples); a pull that ruptures stops sooner."""
-        sample = PrepareConfig          # the tension samples' density and time-step safety
-        rate = self.inertial_number / inertial_number(1.0, self.radius, sample.density,
-                                                      self.confining)
-        dt = sample.timestep_safety * pwave_timestep(self.radius, self.young, sample.density)
-        return self.max_strain / (rate * dt)
+        sample = self.sample
+        rate = self.inertial_number / inertial_number(1.0, sample.radius, sample.density,
+                                                      sample.confining)
+        return self.max_strain / (rate * pwave_step(sample.radius, sample))
 
     def pendular_limit(self, void_ratio):
         """Gravimetric water content [-] at the pendular limit of the regular packing compared
         with a sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION)."""
         kind, _ = comparison_packing(void_ratio)
         return packing_state(regular_packing(kind, separation=KIM_SEPARATION),
-                             radius=self.radius, contact_angle=self.contact_angle,
+                             radius=self.sample.radius, contact_angle=self.contact_angle,
                              surface_tension=self.surface_tension,
                              filling_angle=regular_packing(kind).max_filling_angle,
                              specific_gravity=self.specific_gravity).water_content
@@ -819,13 +866,83 @@ class TablePathConfig(PathConfig):
         return {"path": self.source, "records": self.records}
 
 
+# ---------------------------------------------------------------- simple shear
+
+#: Largest final shear strain of a simple shear [-]: laboratory simple shear stops by 20-30 %
+#: (ASTM D6528: 20 %), a ring shear measures the residual strength over several; the
+#: Lees–Edwards cell (pendular.dem.cell) has no end, but beyond 10 a run only repeats the
+#: residual state.
+MAX_SHEAR_STRAIN = 10.0
+
+
+@dataclass
+class SimpleShearConfig(PathConfig):
+    """Simple shear, x with z, of a sample in a periodic cell (pendular.procedures.simple_shear;
+    Lees–Edwards, pendular.dem.cell): from the isotropic confining stress, z brought to
+    ``normal_stress`` [Pa] (None: the confining stress) with x and y held, then sheared to the
+    shear strain ``max_strain`` [-] (in [MIN_AXIAL_STRAIN, MAX_SHEAR_STRAIN]) at that normal
+    stress (drained), or with ``constant_volume`` with the cell's lengths held. The shear rate
+    gamma_dot [1/s] is ``strain_rate`` or the one giving ``inertial_number`` at the lower of
+    the confining and normal stresses (quasi_static_rate); ``record_strain``: shear strain
+    between two history rows; ``stage_steps``: most steps of the consolidation to the normal
+    stress. The sample must be periodic (walls cannot shear it)."""
+
+    normal_stress: float | None = None
+    constant_volume: bool = False
+    max_strain: float = 0.2
+    stage_steps: int = 2_000_000
+    record_strain: float = 4e-4
+
+    TEST = "a simple shear test"
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not self.sample.periodic:
+            raise ValueError("periodic = False: a simple shear needs a periodic cell (--periodic;"
+                             " Lees–Edwards images), walls cannot shear a sample")
+        if self.normal_stress is None:
+            self.normal_stress = self.sample.confining
+        self.normal_stress = check_range("--normal-stress", self.normal_stress, 0.0, 1e7,
+                                         low_inclusive=False, unit="Pa")
+        check_soft_contacts("--normal-stress", self.normal_stress, self.sample.young)
+        if not isinstance(self.constant_volume, (bool, np.bool_)):
+            raise ValueError(f"--constant-volume = {self.constant_volume!r}: valid values True "
+                             "or False")
+        self.constant_volume = bool(self.constant_volume)
+        self.max_strain = check_range("--max-strain", self.max_strain, MIN_AXIAL_STRAIN,
+                                      MAX_SHEAR_STRAIN)
+        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
+                                     high=100_000_000)
+
+    @property
+    def consolidates(self):
+        """Whether z is first brought from the confining to the normal stress."""
+        return self.normal_stress != self.sample.confining
+
+    def reference_pressure(self):
+        """The lower of the confining and normal stresses [Pa], where the inertial number of
+        the shear rate is taken."""
+        return min(self.sample.confining, self.normal_stress)
+
+    def estimated_steps(self):
+        """Steps of the shear, max_strain over the shear strain of a step (the consolidation,
+        which ends at equilibrium, not counted)."""
+        return self.max_strain / self.strain_per_step(self.rate())
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"normal_stress": self.normal_stress, "constant_volume": self.constant_volume,
+                "max_strain": self.max_strain, "stage_steps": self.stage_steps}
+
+
 # ---------------------------------------------------------------- JSON form
 
 #: Dataclasses a configuration may nest, by name (JSON ``type`` tags).
 CONFIG_TYPES = {kind.__name__: kind for kind in
                 (PrepareConfig, ShearConfig, BridgeConfig, TriaxialConfig, OedometerConfig,
                  IsotropicConfig, TensionConfig, SwccConfig, CyclicConfig,
-                 TablePathConfig)}
+                 TablePathConfig, SimpleShearConfig)}
 
 
 def config_to_dict(config):

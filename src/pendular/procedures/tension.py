@@ -1,10 +1,12 @@
 """Direct tension of wet sand at fixed water content (Kim 2001; thesis §4.4.1.2, Table 4.5).
 
 ``TensionTest(TensionConfig(...)).run(out)`` returns the content of tension.json; command
-``pendular tension`` (pendular.cli.commands.tension; options named as the TensionConfig fields,
-dashes for underscores). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``. By
-default Kim's six cases: F-75 sand, R = 0.11 mm, e = 0.72 at w = 0.47, 1.04, 2.11 % and
-e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric, Gs = 2.65). Each case:
+``pendular tension`` (pendular.cli.commands.tension; options named as the TensionConfig fields
+and those of its sample, a PrepareConfig, dashes for underscores; --specific-gravity sets the
+grains' density). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``, a sample
+by ``tension_sample(particles=200)``. By default Kim's six cases: F-75 sand, R = 0.11 mm,
+e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
+Gs = 2.65, the grains' density over the water's). Each case:
 
 1. Sample (one per void ratio, shared by its water contents): equal spheres prepared as thesis
    Ch. 5.2.2 (pendular.procedures.preparation, radius growth to 5 kPa, friction set, walls servoed at
@@ -46,7 +48,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import asdict
+from dataclasses import replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -112,11 +114,7 @@ def cases_of(void_ratios: list[float] | None = None,
 
 def prepare_config(config: TensionConfig, prep_friction: float) -> PrepareConfig:
     """The sample's preparation (thesis Ch. 5.2.2) with growth friction ``prep_friction`` [deg]."""
-    return PrepareConfig(particles=config.particles, radius=config.radius,
-                         radius_spread=config.radius_spread, psd=config.psd,
-                         young=config.young, friction_deg=config.friction,
-                         prep_friction_deg=prep_friction, confining=config.confining,
-                         seed=config.seed, periodic=config.periodic)
+    return replace(config.sample, prep_friction_deg=prep_friction)
 
 
 def sample_void_ratio(sim: Simulation, radius: float) -> float:
@@ -138,7 +136,7 @@ def prepare_void_ratio(config: TensionConfig, target: float,
 
     def prepared(friction):
         sim, report = prepare_sample(prepare_config(config, friction), progress=False)
-        report["void_ratio"] = sample_void_ratio(sim, config.radius)
+        report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
         report["box_void_ratio"] = report["porosity"] / (1.0 - report["porosity"])
         report["prep_friction_deg"] = friction
         tried[friction] = (sim, report)
@@ -212,18 +210,17 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
     pendular.capillary.formation_suction)."""
     particles = dry.particles
     target = water_content * config.specific_gravity * particles.solid_volume()
-    max_gap = config.form_gap * config.radius
+    max_gap = config.form_gap * config.sample.radius
     pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
     table = BridgeTable.cached(config.contact_angle,
                                radius_ratios=sample_radius_ratios(particles.radius))
-    thresholds = prepare_config(config, 0.0)      # for the equilibrium thresholds only
 
     def build(suction):
         return CapillaryBridges(suction, config.surface_tension, config.contact_angle,
                                 control="volume", roughness=config.roughness)
 
     def settle(sim):
-        return sim.run(WET_STEPS, until=equilibrated(thresholds), check_every=CHECK_EVERY,
+        return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
                        progress="wet" if progress else None)
 
     sim, bridges, tries = wet_to_water_volume(
@@ -239,7 +236,7 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
               "water_content": attempts[-1]["water_content"],
               "saturation": bridges.saturation(sim), "bridges": bridges.count(sim),
               "coordination_wet": coordination(sim.contacts, len(sim.particles)),
-              "void_ratio_wet": sample_void_ratio(sim, config.radius),
+              "void_ratio_wet": sample_void_ratio(sim, config.sample.radius),
               "unbalanced_force_wet": unbalanced_force(sim.particles, sim.contacts)}
     return sim, bridges, report
 
@@ -255,15 +252,16 @@ class Pull:
     def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
                  config: TensionConfig, folder: str, progress: bool):
         self.sim, self.bridges, self.config, self.progress = sim, bridges, config, progress
-        self.rate = config.inertial_number / inertial_number(1.0, config.radius,
-                                                           sim.particles.density, config.confining)
+        sample = config.sample
+        self.rate = config.inertial_number / inertial_number(1.0, sample.radius,
+                                                           sim.particles.density, sample.confining)
         self.extension = ConstantStrainRate("z", -self.rate, sim.walls.lengths()[2])
         if sim.walls.periodic:
             self.grips = []
             lateral = StressServo("xy", 0.0, servo_speed(sim.walls, sim.dt))
             sim.controls = [self.extension, lateral]
         else:
-            depth = config.radius * (1.0 + 2.0 * config.grip_depth)
+            depth = sample.radius * (1.0 + 2.0 * config.grip_depth)
             self.grips = [Grip(wall, grip_members(sim.particles.position, sim.particles.radius,
                                                   sim.walls, wall, depth)) for wall in (4, 5)]
             sim.controls = [self.extension, *self.grips]   # the x, y walls held where they are
@@ -335,7 +333,8 @@ def prediction(config: TensionConfig, void_ratio: float,
     comparison packing at this water content (exact bridges, H/R = 0.09)."""
     kind, label = comparison_packing(void_ratio)
     packing = regular_packing(kind, separation=KIM_SEPARATION)
-    state = packing_state(packing, radius=config.radius, contact_angle=config.contact_angle,
+    state = packing_state(packing, radius=config.sample.radius,
+                          contact_angle=config.contact_angle,
                           surface_tension=config.surface_tension, water_content=water_content,
                           specific_gravity=config.specific_gravity)
     return float(state.psi[0, 0]), label, packing.void_ratio
@@ -354,7 +353,7 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
              arguments: dict | None = None) -> tuple[dict, dict]:
     """Wet, pull and summarise one case into ``out``/cases/<case>: history.h5 (and vtk/);
     returns (summary, history). ``arguments``: history file attributes (default the
-    configuration's fields but cases)."""
+    configuration's options, TensionConfig.options)."""
     name = case_name(void_ratio, water_content)
     folder = os.path.join(out, "cases", name)
     os.makedirs(folder, exist_ok=True)
@@ -401,7 +400,7 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
         "wetting_time_s": wetted - started,
         "pull_time_s": time.perf_counter() - wetted,
     }
-    attributes = dict(arguments if arguments is not None else _fields(config))
+    attributes = dict(arguments if arguments is not None else config.options())
     attributes.update({key: value for key, value in summary.items()
                        if isinstance(value, (int, float, str))})
     write_history(os.path.join(folder, "history.h5"), history, config_to_dict(config),
@@ -411,14 +410,10 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
     return summary, history
 
 
-def _fields(config):
-    """The configuration's fields but cases (tension.json 'arguments' of a library run)."""
-    return {key: value for key, value in asdict(config).items() if key != "cases"}
-
-
 def plot_label(config: TensionConfig) -> str:
     """One line of the run's parameters for the figures' titles."""
-    return (f"N = {config.particles}, R = {config.radius * 1e3:g} mm, contact angle "
+    sample = config.sample
+    return (f"N = {sample.particles}, R = {sample.radius * 1e3:g} mm, contact angle "
             f"θ = {config.contact_angle:g}°, γ = {config.surface_tension:g} N/m")
 
 
@@ -481,11 +476,11 @@ def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> No
 
 def case_line(summary: dict) -> str:
     """The progress line of a finished case (``run_case``'s summary): its strength beside
-    Kim's measurement, when he made one, and packing_state's prediction."""
+    Kim's measurement, when he made one, and the regular packing's prediction."""
     kim = summary["kim_measured_pa"]
     measured = "no Kim measurement" if kim is None else f"Kim {kim:.1f} Pa"
     return (f"  {summary['case']}: tensile strength {summary['tensile_strength_pa']:.1f} Pa "
-            f"({measured}, packing_state {summary['packing_state_pa']:.1f} Pa)")
+            f"({measured}, regular packing prediction {summary['packing_state_pa']:.1f} Pa)")
 
 
 def _percent(value):
@@ -494,16 +489,19 @@ def _percent(value):
 
 def report_lines(summaries: list[dict], config: TensionConfig) -> list[str]:
     """The lines of report.md: one table row per case."""
-    lines = [f"# Direct tension, {config.particles} spheres, R = {config.radius * 1e3:g} mm, "
-             f"theta = {config.contact_angle:g} deg, gamma = {config.surface_tension:g} N/m, "
-             f"bridge roughness H/R = {config.roughness:g}",
+    sample = config.sample
+    lines = [f"# Direct tension, {sample.particles} spheres, R = {sample.radius * 1e3:g} mm, "
+             f"contact angle θ = {config.contact_angle:g}°, surface tension "
+             f"γ = {config.surface_tension:g} N/m, bridge roughness H/R = {config.roughness:g}",
              "",
              "Tensile strength [Pa] positive in tension. e: core void ratio (box less one "
-             "diameter along each wall); packing_state: psi_xx of the comparison packing at the "
-             "target w (exact bridges, H/R = 0.09).",
+             "diameter along each wall); w: gravimetric water content (water mass over grain "
+             f"mass, Gs = {config.specific_gravity:g}); Sr: degree of saturation; prediction: "
+             "tensile strength psi_xx of the regular packing compared with this void ratio at "
+             f"the target w (thesis Ch. 4, exact bridges, H/R = {KIM_SEPARATION:g}).",
              "",
              "| e target | e reached (box) | w target [%] | w [%] | Sr | bridges | s_form [Pa] "
-             "| DEM | Kim | packing_state | DEM/Kim | DEM/prediction |",
+             "| DEM | Kim | prediction | DEM/Kim | DEM/prediction |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for s in summaries:
         kim = "" if s["kim_measured_pa"] is None else f"{s['kim_measured_pa']:.1f}"
@@ -537,11 +535,11 @@ class TensionTest:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
         the tension.json content. ``arguments``: what tension.json records under 'arguments'
         and the histories as attributes (the command: its options; default: the
-        configuration's fields but cases); the configuration itself is under 'config'."""
+        configuration's, TensionConfig.options); the configuration itself is under 'config'."""
         with OutputFolder(out, "tension") as folder:
             for name in ("tension.json", "report.md", "plots", "cases"):
                 folder.claim(name)
-            return self._run(out, progress, _fields(self.config) if arguments is None
+            return self._run(out, progress, self.config.options() if arguments is None
                              else dict(arguments))
 
     def _run(self, out, progress, arguments):

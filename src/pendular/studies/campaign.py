@@ -143,7 +143,7 @@ def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = Fals
     and progress bars in ``folder``/log.txt (with the traceback if it fails); its summary."""
     use_threads(threads)
     os.makedirs(folder, exist_ok=True)
-    with open(os.path.join(folder, "log.txt"), "w") as log, \
+    with open(os.path.join(folder, "log.txt"), "w", encoding="utf-8") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
         try:
             if isinstance(config, TriaxialConfig):
@@ -521,7 +521,7 @@ def run_options(config: RunConfig) -> dict:
     void ratio and water content are its summary's ``*_target`` columns)."""
     if isinstance(config, TriaxialConfig):
         return parameters(config)
-    return {k: v for k, v in config_to_dict(config)["fields"].items() if k != "cases"}
+    return {k: v for k, v in config.options().items() if k != "cases"}
 
 
 def write_campaign_csv(path: str, result: CampaignResult) -> None:
@@ -538,7 +538,7 @@ def write_campaign_csv(path: str, result: CampaignResult) -> None:
             row["error"] = result.failed[run.name]
         rows.append(row)
     columns = list(dict.fromkeys(key for row in rows for key in row))
-    with replacing(path) as temporary, open(temporary, "w", newline="") as handle:
+    with replacing(path) as temporary, open(temporary, "w", newline="", encoding="utf-8") as handle:
         writer = csv.DictWriter(handle, fieldnames=columns)
         writer.writeheader()
         writer.writerows(rows)

@@ -106,7 +106,7 @@ def table_4_1():
 
 
 def pendular_limits():
-    lines = ["Pendular limit (H = 0, theta = 0, R = 0.1 mm): largest filling angle and the state there",
+    lines = ["Pendular limit (H = 0, contact angle θ = 0, R = 0.1 mm): largest filling angle and the state there",
              " packing  method     alpha_max  Sr       w        s [kPa]  s R/gamma  chi_ii"]
     for kind in ("scp", "fcp"):
         packing = regular_packing(kind)
@@ -121,8 +121,8 @@ def pendular_limits():
 def high_suction_limits():
     """psi at s = 1e4 kPa against 4 pi gamma R^2 cos(theta) N_LB F / V (Love-Weber of F = 2 pi gamma R cos theta)."""
     lines = ["High-suction limit of psi_ii (R = 0.1 mm, H = 0): computed at s = 1e4 kPa and the limit "
-             "4 pi gamma R^2 cos(theta) N_LB F_ii / V",
-             " packing  theta  method     psi_ii(1e4 kPa) [kPa]  limit [kPa]"]
+             "4 pi gamma R^2 cos θ N_LB F_ii / V (θ: contact angle)",
+             " packing  θ [°]  method     psi_ii(1e4 kPa) [kPa]  limit [kPa]"]
     radius = 1e-4
     for kind in ("scp", "fcp"):
         packing = regular_packing(kind)
@@ -153,7 +153,7 @@ def crossover_suction(kind, method, contact_angle=30.0, radius=1e-4):
 
 
 def crossovers():
-    lines = ["Fig. 4.14 crossover (theta = 30 deg, R = 0.1 mm, H = 0): suction where chi s = B",
+    lines = ["Fig. 4.14 crossover (contact angle θ = 30°, R = 0.1 mm, H = 0): suction where chi s = B",
              " packing  method     crossover [kPa]   wettest pendular state: s [kPa], alpha [deg], Sr"]
     for kind in ("scp", "fcp"):
         for method in METHODS:
@@ -165,7 +165,7 @@ def crossovers():
 
 
 def anisotropy_at_limits():
-    lines = ["Fig. 4.19 end points (BCC, H = theta = 0): fabric anisotropy a and a_psi at the pendular limit",
+    lines = ["Fig. 4.19 end points (BCC, H = 0, contact angle θ = 0): fabric anisotropy a and a_psi at the pendular limit",
              " l'      a       alpha_max  | exact: Sr      a_psi   | toroidal: Sr   a_psi"]
     for l_prime in (2.1, 4.0 / math.sqrt(3.0), 2.4, 2.5, 2.6, 2.7):
         packing = regular_packing("bcc", l_prime)
@@ -177,8 +177,9 @@ def anisotropy_at_limits():
 
 def kim_comparison():
     lines = [f"Table 4.5 - Kim (2001) direct tension, F-75 sand, against psi (R = {KIM_RADIUS * 1e3} mm, "
-             f"H/R = {KIM_SEPARATION}, Gs = {SPECIFIC_GRAVITY}); predicted tensile strength psi_ii [Pa]",
-             " e     w [%]  measured | packing (e)          exact th=0  exact th=20  toroidal th=0  toroidal th=20"]
+             f"H/R = {KIM_SEPARATION}, Gs = {SPECIFIC_GRAVITY}); predicted tensile strength psi_ii [Pa] "
+             "at contact angle θ = 0° and 20°",
+             " e     w [%]  measured | packing (e)          exact θ=0°  exact θ=20°  toroidal θ=0°  toroidal θ=20°"]
     for void_ratio, water, measured in KIM_2001:
         kind, label = KIM_PACKINGS[void_ratio]
         packing = regular_packing(kind, separation=KIM_SEPARATION)
@@ -219,7 +220,7 @@ def fig_4_7(plt, folder, points):
                             alpha=1.0 if radius == 1e-4 else 0.55,
                             label=f"{kind.upper()}, R = {radius * 1e3:g} mm" if method == "exact" else None)
     ax.set(xlim=(0, 25), ylim=(0.1, 1e6), xlabel="degree of saturation (Sr %)", ylabel="matric suction (kPa)",
-           title="Fig. 4.7: H = theta = 0 (solid exact, dashed toroidal)")
+           title="Fig. 4.7: H = 0, contact angle θ = 0 (solid exact, dashed toroidal)")
     ax.legend(fontsize=8)
     save(fig, folder, "fig4_07_swcc_particle_size.png")
 
@@ -231,14 +232,14 @@ def two_panels(plt, title):
 
 
 def fig_4_8(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.8: wetting angle (drying theta = 0, wetting theta = 30 deg), H = 0")
+    fig, axes = two_panels(plt, "Fig. 4.8: contact angle θ (drying θ = 0°, wetting θ = 30°), H = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (30, 40)):
         packing = regular_packing(kind)
         for theta, color in ((0.0, "C0"), (30.0, "C3")):
             for method, style in METHODS.items():
                 curve = saturation_curve(packing, points, contact_angle=theta, method=method)
                 ax.semilogy(percent(curve), column(curve, "suction_star"), style, color=color,
-                            label=f"theta = {theta:g} deg" if method == "exact" else None)
+                            label=f"contact angle θ = {theta:g}°" if method == "exact" else None)
         ax.set(xlim=(0, xmax), ylim=(0.01, 100), xlabel="degree of saturation (%)",
                ylabel="dimensionless matric suction s R / gamma", title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
         ax.legend()
@@ -246,7 +247,7 @@ def fig_4_8(plt, folder, points):
 
 
 def fig_4_9(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.9: separation distance, theta = 0")
+    fig, axes = two_panels(plt, "Fig. 4.9: separation distance, contact angle θ = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
         for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2")):
             packing = regular_packing(kind, separation=separation)
@@ -261,7 +262,7 @@ def fig_4_9(plt, folder, points):
 
 
 def fig_4_10(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.10: isotropic chi_ij, theta = 0")
+    fig, axes = two_panels(plt, "Fig. 4.10: isotropic chi_ij, contact angle θ = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
         for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2"), (0.2, "C3")):
             packing = regular_packing(kind, separation=separation)
@@ -282,7 +283,7 @@ def fig_stress_components(plt, folder, points, kind, number, xmin):
         for method, style in METHODS.items():
             curve = suction_curve(packing, points, contact_angle=theta, method=method, smallest=xmin * 1e3)
             s = column(curve, "suction")
-            label = f"theta = {theta:g} deg" if method == "exact" else None
+            label = f"contact angle θ = {theta:g}°" if method == "exact" else None
             axes[0].semilogx(s / 1e3, diagonal(curve, "chi") * s / 1e3, style, color=color, label=label)
             axes[1].semilogx(s / 1e3, diagonal(curve, "B") / 1e3, style, color=color, label=label)
     for ax, name, panel in zip(axes, ("chi_ij (ua - uw) (kPa)", "B_ij (kPa)"), "ab"):
@@ -293,7 +294,7 @@ def fig_stress_components(plt, folder, points, kind, number, xmin):
 
 
 def fig_4_14(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.14: total capillary stress, R = 0.1 mm, theta = 30 deg, H = 0")
+    fig, axes = two_panels(plt, "Fig. 4.14: total capillary stress, R = 0.1 mm, contact angle θ = 30°, H = 0")
     for ax, kind, xmin in zip(axes, ("scp", "fcp"), (0.01, 1.0)):
         packing = regular_packing(kind)
         for method, style in METHODS.items():
@@ -318,7 +319,7 @@ def fig_4_15(plt, folder, points):
             for method, style in METHODS.items():
                 curve = saturation_curve(packing, points, radius=KIM_RADIUS, contact_angle=theta, method=method)
                 ax.plot(percent(curve, "water_content"), diagonal(curve, "psi"), style, color=color, lw=width,
-                        label=f"predicted, {name} (e = {packing.void_ratio:.2f}), theta = {theta:g} deg"
+                        label=f"predicted, {name} (e = {packing.void_ratio:.2f}), contact angle θ = {theta:g}°"
                         if method == "exact" else None)
     for void_ratio, marker in ((0.72, "o"), (0.58, "s")):
         rows = [(w, t) for e, w, t in KIM_2001 if e == void_ratio]
@@ -331,7 +332,7 @@ def fig_4_15(plt, folder, points):
 
 
 def fig_4_17(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.17: BCC l' = 2.7, R = 0.1 mm, H = theta = 0: principal capillary stresses")
+    fig, axes = two_panels(plt, "Fig. 4.17: BCC l' = 2.7, R = 0.1 mm, H = 0, contact angle θ = 0: principal capillary stresses")
     packing = regular_packing("bcc", 2.7)
     for method, style in METHODS.items():
         curve = suction_curve(packing, points, method=method, smallest=1e3)
@@ -357,7 +358,7 @@ def fig_4_19(plt, folder, points):
             ax.plot(percent(curve), column(curve, "a_psi"), style, color=color,
                     label=f"l' = {l_prime:.4g} (a = {packing.anisotropy:.3f})" if method == "exact" else None)
     ax.set(xlim=(0, 20), ylim=(-0.4, 0.8), xlabel="degree of saturation (%)", ylabel="anisotropy factor a_psi",
-           title="Fig. 4.19: BCC, theta = H = 0")
+           title="Fig. 4.19: BCC, contact angle θ = 0, H = 0")
     ax.legend(fontsize=8)
     save(fig, folder, "fig4_19_anisotropy.png")
 

@@ -269,7 +269,7 @@ def write_report(path, results, quick, wall_time):
     report = {"quick": quick, "base": BASE, "bounds": BOUNDS, "stress_floor": STRESS_FLOOR,
               "wet_steps": WET_STEPS, "lattice_steps": LATTICE_STEPS, "counts": counts,
               "wall_time_s": wall_time, "cases": results}
-    with replacing(path) as temporary, open(temporary, "w") as handle:
+    with replacing(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         json.dump(_plain(report), handle, indent=1)
     return counts
 

@@ -36,7 +36,7 @@ def replacing(path, durable=False):
 
 def write_text(path, text):
     """Write ``text`` to ``path`` atomically."""
-    with replacing(path) as temporary, open(temporary, "w") as handle:
+    with replacing(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         handle.write(text)
 
 
@@ -44,5 +44,5 @@ def write_json(path, data, **options):
     """Write ``data`` as JSON (json.dump ``options``, indent 2 by default) to ``path``
     atomically."""
     options.setdefault("indent", 2)
-    with replacing(path) as temporary, open(temporary, "w") as handle:
+    with replacing(path) as temporary, open(temporary, "w", encoding="utf-8") as handle:
         json.dump(data, handle, **options)

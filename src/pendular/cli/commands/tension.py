@@ -13,7 +13,8 @@ import argparse
 
 from pendular.cli import (UsageError, add_run_options, add_size_options, positive_int,
     print_summary, set_threads, sizes_from)
-from pendular.procedures.config import TensionConfig
+from pendular.procedures.config import (SPECIFIC_GRAVITY_RANGE, TENSION_SAMPLE, WATER_DENSITY,
+    TensionConfig, tension_sample)
 from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
 from pendular.procedures.reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
 from pendular.procedures.tension import TensionTest, cases_of, report_lines
@@ -44,11 +45,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "0.58)")
     parser.add_argument("--roughness", type=float, default=KIM_SEPARATION,
                         help="meniscus separation of touching grains H/R [-] (default Kim's sand, "
-                             "as in the packing_state prediction; 0: smooth spheres)")
+                             "as in the regular packing prediction; 0: smooth spheres)")
     parser.add_argument("--water-content", default=None,
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
-    parser.add_argument("--particles", type=int, default=2000, help="number of spheres [-]")
+    parser.add_argument("--particles", type=int, default=TENSION_SAMPLE["particles"],
+                        help="number of spheres [-]")
     parser.add_argument("--form-gap", type=float, default=TensionConfig.form_gap,
                         help="at wetting, bridges also form across gaps up to this many "
                              "radii [-] (0: at contacts only; 1: wherever a bridge of the "
@@ -57,11 +59,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
     parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
                         help="surface tension [N/m] (thesis Chapter 4's, which the comparison "
-                             "with Kim and packing_state uses; triaxial and swcc default to "
-                             "Chapter 5's 0.073)")
+                             "with Kim and the regular packing prediction uses; triaxial and "
+                             "swcc default to Chapter 5's 0.073)")
     parser.add_argument("--specific-gravity", type=float, default=SPECIFIC_GRAVITY,
-                        help="specific gravity Gs of the grains [-]")
-    parser.add_argument("--confining", type=float, default=100.0,
+                        help="specific gravity Gs of the grains [-], in "
+                             f"[{SPECIFIC_GRAVITY_RANGE[0]:g}, {SPECIFIC_GRAVITY_RANGE[1]:g}]: "
+                             f"sets their density, Gs x {WATER_DENSITY:g} kg/m^3, which gives "
+                             "their mass (time step, strain rate) and the water volume of a "
+                             "water content by mass")
+    parser.add_argument("--confining", type=float, default=TENSION_SAMPLE["confining"],
                         help="isotropic stress of preparation and wetting [Pa]")
     parser.add_argument("--friction", type=float, default=18.0,
                         help="contact friction during wetting and pull [deg]")
@@ -100,13 +106,16 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
     if args.periodic and args.grip_depth is not None:
         raise UsageError(f"--grip-depth = {args.grip_depth:g} does not apply to --periodic: a "
                          "periodic cell has no walls, so no grips")
+    sample = tension_sample(particles=args.particles, **sizes_from(args),
+                            density=args.specific_gravity * WATER_DENSITY,
+                            confining=args.confining, friction_deg=args.friction,
+                            young=args.young, seed=args.seed, periodic=args.periodic)
     options = {name: getattr(args, name) for name in (
-        "roughness", "form_gap", "particles", "contact_angle", "surface_tension",
-        "specific_gravity", "confining", "friction", "young", "inertial_number", "max_strain",
-        "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames", "vtk_every", "seed",
-        "periodic")}
+        "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
+        "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
+        "vtk_every")}
     options = {name: value for name, value in options.items() if value is not None}
-    return TensionConfig(cases=cases, **sizes_from(args), **options)
+    return TensionConfig(sample=sample, cases=cases, **options)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -97,7 +97,7 @@ def write_spheres(path, positions, radii, box_lo=None, box_hi=None):
     lines.extend("\t".join(map(_number, (*x, r))) + "\n" for x, r in zip(position, radius))
 
     path = os.fspath(path)
-    with replacing(path) as temporary, open(temporary, "w") as out:
+    with replacing(path) as temporary, open(temporary, "w", encoding="utf-8") as out:
         out.writelines(lines)
     return position.shape[0]
 

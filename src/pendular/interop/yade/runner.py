@@ -91,7 +91,7 @@ def run_yade_triaxial(config, threads=1, timeout=None, yade=None, env=None):
             config["capillary"]["files"] = os.path.abspath(config["capillary"]["files"])
         output = config.setdefault("output", os.path.join(folder, "result.json"))
         config_path = os.path.join(folder, "config.json")
-        with open(config_path, "w") as out:
+        with open(config_path, "w", encoding="utf-8") as out:
             json.dump(config, out, indent=1)
         command = [executable, "-n", "-x", "-j", str(int(threads)), DRIVER, config_path]
         try:

@@ -366,7 +366,7 @@ def main(config_path):
         plot.saveDataTxt(history, vars=columns)
     output = config["output"]
     temporary = output + ".tmp"
-    with open(temporary, "w") as out:
+    with open(temporary, "w", encoding="utf-8") as out:
         json.dump(result, out, indent=1)
     os.replace(temporary, output)
 
