@@ -22,7 +22,7 @@ TENSION = ["step", "time", "axial_strain", "tensile_stress", "grip_pull", "sigma
            "coordination", "unbalanced_force", "bridges", "water_content", "saturation"]
 #: Columns of a triaxial at constant water content (closed liquid), besides WET.
 LIQUID = ["liquid_bridges", "liquid_film", "liquid_lost"]
-PATHS = ["void_ratio", "k0", "stage", "cycle"]
+PATHS = ["void_ratio", "k0", "stage", "cycle", "shear_strain", "shear_stress", "normal_stress"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}
 ROWS = 7
 

@@ -21,6 +21,7 @@ COMMANDS = {
     "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
     "oedometer": ("oedometer", "oedometric (K0) compression and unloading, dry or wet"),
     "isotropic": ("isotropic", "isotropic loading and unloading in stages: e against log p"),
+    "simple-shear": ("simple_shear", "simple shear (periodic cell), drained or constant volume"),
     "cyclic": ("cyclic", "cyclic triaxial loading, stress- or strain-controlled"),
     "path": ("path", "any loading path from a TOML table of stages, dry or wet"),
     "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),

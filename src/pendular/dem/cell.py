@@ -10,6 +10,19 @@ position + wraps * L). A pair interacts through the image of j nearest to i
 homogeneous velocity rate * x on top of its own (fluctuating) velocity, so the contact law adds
 rate * l to the relative velocity of a pair of branch vector l (YADE's periodic scheme).
 
+The cell also shears in the x-z plane (Lees–Edwards boundaries, as LAMMPS's ``fix deform`` of
+a tilt or YADE's Cell under a velocity gradient with an xz term): at ``shear_rate`` gamma_dot
+[1/s] the homogeneous velocity gains gamma_dot * z along x, the image of the cell above in z
+is displaced by ``shear_offset`` delta along x, and the branch vector through image (ix, iy,
+iz) is x_j - x_i + (ix Lx + iz delta, iy Ly, iz Lz). The offset follows the velocity gradient,
+delta' = (L'_x / L_x) delta + gamma_dot Lz (``follow``), and is brought back into
+[-Lx/2, Lx/2) at each neighbour-list rebuild (the lattice of images is periodic in delta
+modulo Lx); a particle wrapped through a z face shifts x by -+delta. ``shear_strain`` gamma
+is the shear imposed, the integral of gamma_dot dt (delta = gamma Lz at a constant height). A
+sheared cell's ``period`` and ``affine_rate`` hold a fourth entry, delta and gamma_dot, which
+the kernels read behind a test of the arrays' shapes: a cell never sheared (and walls) runs
+the code of before, bit for bit.
+
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
 each step from the particles' forces and the face terms that the forces' gathers add to
@@ -19,6 +32,7 @@ unit strain] as a wall servo reads the stiffness of the wall's contacts; the ser
 (``update_stiffness``) when it refreshes its own.
 """
 
+import math
 from dataclasses import dataclass, field
 
 import numba
@@ -26,7 +40,7 @@ import numpy as np
 
 from pendular.dem.neighbors import branch_vector
 from pendular.dem.state import Box, _box_position, _check_box
-from pendular.utils.validate import check_array
+from pendular.utils.validate import check_array, check_range
 from pendular.dem.virial import (SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds,
     sum_blocks)
 
@@ -148,7 +162,10 @@ class PeriodicCell(Box):
     compression positive [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
     wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face);
     virial_blocks: (SUM_BLOCKS, 9) the face terms of the pair forces' sum of l (x) f [N m]
-    gathered since the step began (pendular.dem.virial; zeroed with the forces).
+    gathered since the step began (pendular.dem.virial; zeroed with the forces);
+    shear_offset: delta [m], the offset along x of the image above in z; shear_rate:
+    gamma_dot [1/s] of the current step (x with z, set by a control: ConstantShearRate);
+    shear_strain: gamma [-], the integral of gamma_dot dt (module docstring).
     """
 
     position: np.ndarray
@@ -156,6 +173,9 @@ class PeriodicCell(Box):
     stress_tensor: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
     stiffness: np.ndarray = field(default_factory=lambda: np.zeros(3))
     wraps: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
+    shear_offset: float = 0.0
+    shear_rate: float = 0.0
+    shear_strain: float = 0.0
 
     periodic = True
 
@@ -170,6 +190,9 @@ class PeriodicCell(Box):
         self.stiffness = check_array("cell stiffness", self.stiffness, length=3)
         self.wraps = np.asarray(self.wraps, dtype=np.int64).reshape(-1, 3)
         self.virial_blocks = np.zeros((SUM_BLOCKS, 9))
+        self.shear_offset = check_range("cell shear_offset", self.shear_offset, unit="m")
+        self.shear_rate = check_range("cell shear_rate", self.shear_rate, unit="1/s")
+        self.shear_strain = check_range("cell shear_strain", self.shear_strain)
 
     @classmethod
     def box(cls, lo, hi):
@@ -177,10 +200,21 @@ class PeriodicCell(Box):
         return cls(position=_box_position(lo, hi))
 
     @property
+    def sheared(self):
+        """Whether the cell is sheared now: an offset or a shear rate (module docstring)."""
+        return self.shear_offset != 0.0 or self.shear_rate != 0.0
+
+    @property
     def period(self):
         """Shift of one periodic image (3,) [m]: the edge lengths (a view of ``position``,
-        the low faces being at 0)."""
-        return self.position[1::2]
+        the low faces being at 0); sheared, (4,): (Lx, Ly, Lz, delta), laid out as the view
+        (one compiled version of each kernel)."""
+        if not self.sheared:
+            return self.position[1::2]
+        lattice = np.zeros(8)
+        lattice[1:6:2] = self.position[1::2]
+        lattice[7] = self.shear_offset
+        return lattice[1::2]
 
     def volume(self):
         """Volume of the cell [m^3]."""
@@ -188,19 +222,32 @@ class PeriodicCell(Box):
 
     @property
     def affine_rate(self):
-        """Homogeneous stretching rate carrying the particles (3,) [1/s]."""
-        return self.rate
+        """Homogeneous stretching rate carrying the particles (3,) [1/s]; sheared, (4,) with
+        the shear rate gamma_dot last (the velocity gamma_dot * z along x)."""
+        if not self.sheared:
+            return self.rate
+        return np.array([self.rate[0], self.rate[1], self.rate[2], self.shear_rate])
 
     def stress(self):
         """Normal stress on each axis (3,) [Pa], compression positive: the diagonal of the
         Love–Weber stress of the last evaluation."""
         return np.diagonal(self.stress_tensor).copy()
 
+    def shear_stress(self):
+        """Shear stress tau [Pa] of the x-z plane: -(sigma_xz + sigma_zx) / 2 of the
+        Love–Weber stress (compression positive), the stress whose power tau gamma_dot per
+        unit volume the shear puts in, positive where it resists a positive shear rate."""
+        return float(-0.5 * (self.stress_tensor[0, 2] + self.stress_tensor[2, 0]))
+
     def wrap(self, particles):
-        """Bring every position into [0, L) and count the periods crossed in ``wraps``."""
+        """Bring every position into [0, L) and count the periods crossed in ``wraps``; a
+        sheared cell first brings its offset into [-Lx/2, Lx/2) and its particles through the
+        z faces, shifting x by -+ delta (module docstring)."""
         if len(self.wraps) != len(particles):
             self.wraps = np.zeros((len(particles), 3), np.int64)
         lengths = self.lengths()
+        if self.sheared:
+            self._wrap_sheared(particles.position, lengths)
         crossed = np.floor(particles.position / lengths)
         if crossed.any():
             particles.position -= crossed * lengths
@@ -208,17 +255,47 @@ class PeriodicCell(Box):
             np.maximum(particles.position, 0.0, out=particles.position)
             self.wraps += crossed.astype(np.int64)
 
+    def _wrap_sheared(self, position, lengths):
+        """The offset into [-Lx/2, Lx/2) (whole Lx taken out of it counted in the x wraps of
+        the particles wrapped in z, so that ``unwrapped`` is unchanged), then the particles
+        through the z faces, x shifted by -+ delta and z clamped into [0, Lz)."""
+        turns = math.floor(self.shear_offset / lengths[0] + 0.5)
+        if turns:
+            self.shear_offset -= turns * lengths[0]
+            self.wraps[:, 0] += turns * self.wraps[:, 2]
+        crossed = np.floor(position[:, 2] / lengths[2])
+        if crossed.any():
+            position[:, 0] -= crossed * self.shear_offset
+            position[:, 2] -= crossed * lengths[2]
+            np.clip(position[:, 2], 0.0, np.nextafter(lengths[2], 0.0), out=position[:, 2])
+            self.wraps[:, 2] += crossed.astype(np.int64)
+
     def unwrapped(self, particles):
-        """Positions with the periods crossed added back (N, 3) [m], in the current cell."""
+        """Positions with the periods crossed added back (N, 3) [m], in the current cell (a
+        sheared one's images above in z at +delta along x)."""
         if len(self.wraps) != len(particles):
             return particles.position.copy()
-        return particles.position + self.wraps * self.lengths()
+        unwrapped = particles.position + self.wraps * self.lengths()
+        if self.shear_offset != 0.0:
+            unwrapped[:, 0] += self.wraps[:, 2] * self.shear_offset
+        return unwrapped
+
+    def follow(self, dt):
+        """Advance the offset over the step ``dt`` [s] with the step's velocity gradient (the
+        integrator's affine motion): delta += (rate_x delta + gamma_dot Lz0) dt, Lz0 the
+        height at the step's start (the controls have set this step's lengths and rates);
+        gamma += gamma_dot dt."""
+        if self.sheared:
+            height = self.position[5] / (1.0 + self.rate[2] * dt)
+            self.shear_offset += (self.rate[0] * self.shear_offset
+                                  + self.shear_rate * height) * dt
+            self.shear_strain += self.shear_rate * dt
 
     def after_forces(self, sim):
         """The stress of this step's pair forces: from the particles' forces and the face terms
         the gathers left in ``virial_blocks`` (store_cell_stress) when every force operation
         is a pair force (has ``pair_forces(sim)``); otherwise pair by pair over the operations
-        that are. The stretching rate returns to zero until a control sets it."""
+        that are. The stretching and shear rates return to zero until a control sets them."""
         contacts = sim.contacts
         if all(hasattr(op, "pair_forces") for op in sim.forces):
             store_cell_stress(self.virial_blocks, sim.particles.position, sim.particles.force,
@@ -232,6 +309,7 @@ class PeriodicCell(Box):
                                          op.pair_forces(sim))
             self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
         self.rate.fill(0.0)
+        self.shear_rate = 0.0
 
     def update_stiffness(self, sim):
         """``stiffness`` (3,) [Pa] of the current contacts, S_a = (1/V) sum kn (l_a n_a)^2
@@ -251,3 +329,33 @@ class PeriodicCell(Box):
         length = self.position[2 * axis + 1]
         self.position[2 * axis + 1] += shift
         self.rate[axis] = shift / (length * dt)
+
+
+class ConstantShearRate:
+    """Shear the periodic cell at ``rate`` gamma_dot [1/s], x with z (the velocity
+    gamma_dot * z along x on top of the particles' own; module docstring): a control, set each
+    step (the cell's rate returns to zero after the forces). Walls cannot shear a sample:
+    ValueError on a walled scene."""
+
+    #: Largest shear rate [1/s] (ConstantStrainRate's bound on a strain rate).
+    MAX_RATE = 1e6
+
+    def __init__(self, rate):
+        self.rate = check_range("shear_rate", rate, -self.MAX_RATE, self.MAX_RATE, unit="1/s")
+
+    def steps_to(self, strain, dt, start=0.0):
+        """Steps [-] of ``dt`` [s] to bring the shear strain from ``start`` to ``strain`` [-];
+        ValueError unless the rate is non-zero and of the sign of the change."""
+        change = strain - start
+        if self.rate == 0.0 or change / self.rate <= 0.0:
+            raise ValueError(f"shear strain = {strain!r} cannot be reached from {start!r} at "
+                             f"shear_rate = {self.rate!r} 1/s: the rate must be non-zero and of "
+                             "the sign of the change")
+        return int(np.ceil(change / (self.rate * dt)))
+
+    def apply(self, sim):
+        box = sim.walls
+        if not box.periodic:
+            raise ValueError(f"shear_rate = {self.rate:g} 1/s needs a periodic cell "
+                             "(--periodic): walls cannot shear a sample")
+        box.shear_rate = self.rate

@@ -51,13 +51,22 @@ def _first_member(i, position, velocity, angular_velocity, radius):
 
 
 @numba.njit(cache=True, inline="always")
+def _stretched(affine_rate):
+    """Whether ``affine_rate`` carries the particles: a stretching, or a sheared cell's (4,)."""
+    return (len(affine_rate) > 3 or affine_rate[0] != 0.0 or affine_rate[1] != 0.0
+            or affine_rate[2] != 0.0)
+
+
+@numba.njit(cache=True, inline="always")
 def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, image, period,
                    periodic, affine_rate, stretched, shear_force, normal, overlap, normal_force,
                    force, young, shear_ratio, tan_friction, dt):
     """Evaluate pair k of first member ``first`` (_first_member) and second member j
     (pair_forces), fill its per-pair arrays; (touching, the force on j from i [N], the normal,
     the overlap [m]), force and normal (0, 0, 0) for a pair apart. ``periodic``,
-    ``stretched``: whether the scene has images, stretching (pair_forces)."""
+    ``stretched``: whether the scene has images, stretching (pair_forces); a sheared cell's
+    ``period`` and ``affine_rate`` hold a fourth entry (the tests of their lengths are on
+    the arrays' shapes, hoisted out of the loops)."""
     xi0, xi1, xi2, ui0, ui1, ui2, wi0, wi1, wi2, ri = first
     d0 = position[j, 0] - xi0
     d1 = position[j, 1] - xi1
@@ -70,6 +79,8 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
             d0 += m0 * period[0]
             d1 += m1 * period[1]
             d2 += m2 * period[2]
+            if len(period) > 3:     # Lees–Edwards: the images above in z offset along x
+                d0 += m2 * period[3]
     distance = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     rj = radius[j]
     gap_overlap = ri + rj - distance
@@ -116,6 +127,8 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
         v0 += affine_rate[0] * d0
         v1 += affine_rate[1] * d1
         v2 += affine_rate[2] * d2
+        if len(affine_rate) > 3:    # simple shear: the velocity gamma_dot * z along x
+            v0 += affine_rate[3] * d2
     vn = v0 * n0 + v1 * n1 + v2 * n2
     fs0 -= ks * (v0 - vn * n0) * dt
     fs1 -= ks * (v1 - vn * n1) * dt
@@ -158,10 +171,12 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     with both kernels loaded from Numba's cache). image, period: each pair's
     periodic image and the box period (pendular.dem.neighbors.branch_vector; zeros inside walls);
     affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell, whose velocity
-    affine_rate * l adds to the relative velocity of a pair of branch l. A scene without
-    images or stretching (walls) skips both terms (a branch taken the same way by every pair:
-    no cost). prefetch_ahead: how many pairs ahead particle j's rows and radius are asked of
-    the cache (0: none; pendular.dem.prefetch.prefetch_distance; no effect on results).
+    affine_rate * l adds to the relative velocity of a pair of branch l; a sheared cell's
+    (4,) adds its shear rate gamma_dot = affine_rate[3], the velocity gamma_dot * l_z along x
+    (pendular.dem.cell). A scene without images or stretching (walls) skips these terms (a
+    branch taken the same way by every pair: no cost). prefetch_ahead: how many pairs ahead
+    particle j's rows and radius are asked of the cache (0: none;
+    pendular.dem.prefetch.prefetch_distance; no effect on results).
 
     The shear spring follows YADE's Law2_ScGeom_FrictPhys_CundallStrack: the stored shear force
     is first rotated with the contact (tilt of the normal, then twist by the mean spin about it),
@@ -170,7 +185,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     at Fn tan(phi), the elastic part being kept on the cap when sliding.
     """
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
-    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
+    stretched = _stretched(affine_rate)
     for k in numba.prange(len(pair_i)):
         _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity),
                          radius)
@@ -187,7 +202,7 @@ def serial_pair_forces(position, velocity, angular_velocity, radius, row_start, 
     """pair_forces on one thread, row by row (particle i's state read once for its row,
     _first_member): no parallel launch (2-3 us a call) and a plain loop (the same results)."""
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
-    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
+    stretched = _stretched(affine_rate)
     for i in range(len(row_start) - 1):
         first = _first_member(i, position, velocity, angular_velocity, radius)
         for k in range(row_start[i], row_start[i + 1]):
@@ -372,7 +387,7 @@ def scattered_pair_forces(position, velocity, angular_velocity, radius, row_star
     ``particle_force`` and ``particle_torque`` when its row starts. A pair apart adds nothing,
     where the gather adds its zeros (the same sums but for a zero's sign)."""
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
-    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
+    stretched = _stretched(affine_rate)
     for i in range(len(row_start) - 1):
         start = row_start[i]
         stop = row_start[i + 1]

@@ -25,7 +25,9 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
     """Advance velocities to t + dt/2 and positions to t + dt (spheres: no orientation needed).
 
     affine_rate (3,) [1/s]: a periodic cell's homogeneous stretching (pendular.dem.cell), the velocity
-    affine_rate * x carrying every particle on top of its own; zeros inside walls."""
+    affine_rate * x carrying every particle on top of its own; zeros inside walls. A sheared
+    cell's (4,) adds its shear rate gamma_dot: the velocity gamma_dot * z along x, z at the
+    step's start (as the cell's offset follows, PeriodicCell.follow)."""
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
     for p in numba.prange(position.shape[0]):
         _advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
@@ -48,6 +50,7 @@ def _advance(p, position, velocity, angular_velocity, force, torque, mass, inert
     """Particle p's leapfrog step (leapfrog)."""
     dt_mass = dt / mass[p]          # [s/kg], once: 17 % off the integration (measured)
     dt_inertia = dt / inertia[p]
+    height = position[p, 2]
     for c in range(3):
         f = _damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
         velocity[p, c] += f * dt_mass
@@ -57,6 +60,8 @@ def _advance(p, position, velocity, angular_velocity, force, torque, mass, inert
             position[p, c] += velocity[p, c] * dt
         t = _damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
         angular_velocity[p, c] += t * dt_inertia
+    if len(affine_rate) > 3:        # simple shear (a test on the array's shape: hoisted)
+        position[p, 0] += affine_rate[3] * height * dt
 
 
 class Integrator:
@@ -70,3 +75,4 @@ class Integrator:
         step = leapfrog if numba.get_num_threads() > 1 else serial_leapfrog
         step(p.position, p.velocity, p.angular_velocity, p.force, p.torque, p.mass, p.inertia,
              self.damping, sim.walls.affine_rate, sim.dt)
+        sim.walls.follow(sim.dt)

@@ -81,9 +81,13 @@ class Contacts:
 @numba.njit(cache=True, inline="always")
 def branch_vector(position, i, j, image, k, period):
     """Branch vector of pair k from i to j [m]: x_j - x_i + image_k * period (the periodic
-    image of j nearest to i; period zeros inside walls)."""
-    return (position[j, 0] - position[i, 0] + image[k, 0] * period[0],
-            position[j, 1] - position[i, 1] + image[k, 1] * period[1],
+    image of j nearest to i; period zeros inside walls); a sheared cell's ``period`` (4,)
+    adds its offset delta = period[3] along x per image in z (Lees–Edwards,
+    pendular.dem.cell). The length test is on the array's shape: hoisted out of any loop."""
+    d0 = position[j, 0] - position[i, 0] + image[k, 0] * period[0]
+    if len(period) > 3:
+        d0 += image[k, 2] * period[3]
+    return (d0, position[j, 1] - position[i, 1] + image[k, 1] * period[1],
             position[j, 2] - position[i, 2] + image[k, 2] * period[2])
 
 
@@ -250,31 +254,47 @@ def _wrap_cell(c, dim):
     return c, 0
 
 
+@numba.njit(cache=True, inline="always")
+def _sheared_cell(c, dim):
+    """(cell index, image) of cell coordinate ``c`` (any integer) in a periodic row of ``dim``
+    cells: c modulo dim and the periods it lies beyond the row."""
+    index = c % dim
+    return index, (c - index) // dim
+
+
 @numba.njit(cache=True)
-def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
+def _periodic_neighbors_of(p, position, radius, skin, period, shear, dims, cell_of, cell_start,
                            cell_particles, out, out_image):
     """As _neighbors_of in a periodic box: the j > p within r_p + r_j + skin of p through
     the nearest image, written sorted with that image into ``out`` and ``out_image`` while
-    they have room; returns how many."""
+    they have room; returns how many. In a sheared cell (``shear`` = delta [m], the offset
+    along x of the images above in z, pendular.dem.cell) the rows of cells through a z face
+    are searched around p's x less their offset sz * delta."""
     room = len(out)
     found = 0
     cell = cell_of[p]
     cz = cell % dims[2]
     cy = (cell // dims[2]) % dims[1]
     cx = cell // (dims[1] * dims[2])
+    width = period[0] / dims[0]
     for dx in range(-1, 2):
-        x, sx = _wrap_cell(cx + dx, dims[0])
         for dy in range(-1, 2):
             y, sy = _wrap_cell(cy + dy, dims[1])
             for dz in range(-1, 2):
                 z, sz = _wrap_cell(cz + dz, dims[2])
+                offset = sz * shear
+                if offset != 0.0:   # the images of that row sit offset along x
+                    x, sx = _sheared_cell(
+                        int(np.floor((position[p, 0] - offset) / width)) + dx, dims[0])
+                else:
+                    x, sx = _wrap_cell(cx + dx, dims[0])
                 c = (x * dims[1] + y) * dims[2] + z
                 for slot in range(cell_start[c], cell_start[c + 1]):
                     q = cell_particles[slot]
                     if q <= p:
                         continue
                     reach = radius[p] + radius[q] + skin
-                    d0 = position[q, 0] + sx * period[0] - position[p, 0]
+                    d0 = position[q, 0] + sx * period[0] + offset - position[p, 0]
                     d1 = position[q, 1] + sy * period[1] - position[p, 1]
                     d2 = position[q, 2] + sz * period[2] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
@@ -295,17 +315,19 @@ def _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cel
 @numba.njit(cache=True, parallel=True)
 def build_periodic_pairs(position, radius, skin, period):
     """Half Verlet list of a periodic box (positions wrapped into [0, period)): CSR arrays
-    (row_start, pair_j) and each pair's image (K, 3) int8 (branch_vector). The box must be at
-    least 3 cells of 2 max(radius) + skin a side, so that a pair has one image in reach."""
+    (row_start, pair_j) and each pair's image (K, 3) int8 (branch_vector; ``period`` (4,) of a
+    sheared cell: its images above in z offset along x). The box must be at least 3 cells of
+    2 max(radius) + skin a side, so that a pair has one image in reach."""
     count = position.shape[0]
     cell_size = 2.0 * radius.max() + skin
+    shear = period[3] if len(period) > 3 else 0.0
     dims, cell_of, cell_start, cell_particles = _periodic_grid(position, cell_size, period)
     kept = np.empty((count, ROW_CAPACITY), np.int64)
     kept_image = np.empty((count, ROW_CAPACITY, 3), np.int8)
     row_count = np.empty(count, np.int64)
     for p in numba.prange(count):
-        row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of,
-                                              cell_start, cell_particles, kept[p],
+        row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, shear, dims,
+                                              cell_of, cell_start, cell_particles, kept[p],
                                               kept_image[p])
     row_start = _row_starts(row_count)
     pair_j = np.empty(row_start[count], np.int64)
@@ -316,8 +338,9 @@ def build_periodic_pairs(position, radius, skin, period):
             pair_j[start:stop] = kept[p, :stop - start]
             image[start:stop] = kept_image[p, :stop - start]
         else:
-            _periodic_neighbors_of(p, position, radius, skin, period, dims, cell_of, cell_start,
-                                   cell_particles, pair_j[start:stop], image[start:stop])
+            _periodic_neighbors_of(p, position, radius, skin, period, shear, dims, cell_of,
+                                   cell_start, cell_particles, pair_j[start:stop],
+                                   image[start:stop])
     return row_start, pair_j, image
 
 
@@ -379,17 +402,28 @@ def moved_beyond(position, reference_position, radius, reference_radius, limit, 
     rebuild (walls: ones for both), the particles ride the cell's stretching s = L / L_ref,
     which changes a branch vector l by (s - 1) l: displacements are measured from s x_ref, and
     the limit shrinks by max|s - 1| / 2 times ``shortest_unlisted`` [m], the shortest branch of
-    a pair left out of the list."""
+    a pair left out of the list. A sheared cell's (4,) adds its offset delta (pendular.dem.cell):
+    the particles also ride the shear g = (delta - s_x delta_ref) / L_z,ref of x with z (the
+    map that takes the reference cell's images to the current ones), measured from
+    s_x x_ref + g z_ref, and the limit shrinks by |g| / 2 times more."""
     s0 = lengths[0] / reference_lengths[0]
     s1 = lengths[1] / reference_lengths[1]
     s2 = lengths[2] / reference_lengths[2]
-    limit -= 0.5 * max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) * shortest_unlisted
+    shear = 0.0
+    if len(lengths) > 3 or len(reference_lengths) > 3:
+        offset = lengths[3] if len(lengths) > 3 else 0.0
+        reference_offset = reference_lengths[3] if len(reference_lengths) > 3 else 0.0
+        shear = (offset - s0 * reference_offset) / reference_lengths[2]
+    stretch = max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) + abs(shear)
+    limit -= 0.5 * stretch * shortest_unlisted
     if limit <= 0.0:
         return True
     limit_squared = limit * limit
     for p in range(position.shape[0]):
         growth = max(radius[p] - reference_radius[p], 0.0)
         d0 = position[p, 0] - s0 * reference_position[p, 0]
+        if shear != 0.0:
+            d0 -= shear * reference_position[p, 2]
         d1 = position[p, 1] - s1 * reference_position[p, 1]
         d2 = position[p, 2] - s2 * reference_position[p, 2]
         if growth == 0.0:
@@ -475,11 +509,16 @@ def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, 
 
 def branch_vectors(position, contacts, period, index=None):
     """Branch vectors i -> j [m] (B, 3) of the pairs ``index`` (all if None) of ``contacts``:
-    x_j - x_i + image * period (branch_vector; ``period`` (3,) [m], zeros inside walls)."""
+    x_j - x_i + image * period (branch_vector; ``period`` (3,) [m], zeros inside walls, or a
+    sheared cell's (4,))."""
     index = np.arange(len(contacts)) if index is None else index
     branch = position[contacts.pair_j[index]] - position[contacts.pair_i[index]]
+    period = np.asarray(period)
     if np.any(period):
-        branch += contacts.image[index] * np.asarray(period)
+        image = contacts.image[index]
+        branch += image * period[:3]
+        if len(period) > 3:
+            branch[:, 0] += image[:, 2] * period[3]
     return branch
 
 
@@ -521,7 +560,8 @@ def build_contacts(position, radius, skin, previous=None, period=None, walls=Non
     overlaps (new pairs: -inf, never touched) and every ``extra`` per-pair array from
     ``previous`` if given. ``period`` (3,) [m]: a periodic box [0, period) holding the
     positions, pairs through the nearest image (ValueError if the box is narrower than 3
-    times 2 max(radius) + skin on an axis). ``walls`` (6,) [m]: wall planes, whose particles
+    times 2 max(radius) + skin on an axis); (4,): a sheared cell's, its offset last
+    (branch_vector). ``walls`` (6,) [m]: wall planes, whose particles
     within ``wall_margin`` [m] make Contacts.near_wall (None: every particle).
     FloatingPointError if a position is not finite (a diverged simulation would otherwise get
     a meaningless list)."""
@@ -540,9 +580,9 @@ def build_contacts(position, radius, skin, previous=None, period=None, walls=Non
         image = None
     else:
         narrowest = 3.0 * (2.0 * float(radius.max()) + skin)
-        if np.min(period) < narrowest:
+        if np.min(period[:3]) < narrowest:
             raise ValueError(
-                f"periodic cell edges {np.asarray(period).tolist()} m: valid range at least "
+                f"periodic cell edges {np.asarray(period[:3]).tolist()} m: valid range at least "
                 f"{narrowest:g} m (3 times the largest diameter plus the neighbour reach "
                 f"{skin:g} m); use more particles")
         row_start, pair_j, image = build_periodic_pairs(position, radius, skin,
@@ -582,8 +622,8 @@ _UNSTRETCHED_REFERENCE = np.ones(3)
 
 class NeighborList:
     """Keep ``sim.contacts`` current: rebuild when a particle moved (or grew) more than skin / 2
-    (in a periodic cell: moved relative to the cell's stretching, against a skin reduced by
-    what the stretching does to the pairs, ``apply``) or a wall more than skin / 2; the
+    (in a periodic cell: moved relative to the cell's stretching and shear, against a skin
+    reduced by what they do to the pairs, ``moved_beyond``) or a wall more than skin / 2; the
     particles within the skin of a wall at a rebuild are the wall forces' (Contacts.near_wall).
 
     skin [m]: extra reach of the list beyond touching; larger means fewer rebuilds, more pairs;
@@ -636,7 +676,7 @@ class NeighborList:
                                       wall_margin=self.skin)
         self._reference_position = p.position.copy()
         self._reference_radius = p.radius.copy()
-        self._reference_lengths = box.lengths()
+        self._reference_lengths = np.array(box.period) if box.periodic else box.lengths()
         self._reference_walls = box.position.copy()
         self._reference_skin = self.skin
         self._shortest_unlisted = 2.0 * float(p.radius.max()) + self.interaction_range + self.skin

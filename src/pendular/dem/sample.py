@@ -59,6 +59,9 @@ def save_sample(path, sim, report=None, config=None, identity=None):
     ``pendular_version`` and ``schema_version``, stamped last with a checksum and an identity:
     kind, format version, software version, hash of ``config``, and the entries of
     ``identity`` (e.g. the seed)."""
+    if getattr(sim.walls, "shear_offset", 0.0) != 0.0:
+        raise ValueError("a sheared periodic cell cannot be saved as a sample (a sample's "
+                         "cell is a box, its images unshifted): save it before the shear")
     with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
         p = sim.particles
         position = p.position

@@ -71,8 +71,11 @@ class Box:
     ``virial_blocks`` (SUM_BLOCKS, 9) [N m]: where the pair forces' gathers add the face
     terms of their Love–Weber sums when ``period`` is not zero (pendular.dem.virial; walls: empty,
     never written),
-    ``wrap(particles)`` (positions brought back into the box at a neighbour-list rebuild) and
-    ``after_forces(sim)`` (what the box measures once the step's forces are known).
+    ``wrap(particles)`` (positions brought back into the box at a neighbour-list rebuild),
+    ``after_forces(sim)`` (what the box measures once the step's forces are known) and
+    ``follow(dt)`` (what the box does as the integrator moves the particles). A sheared
+    periodic cell's ``period`` and ``affine_rate`` hold a fourth entry, its offset and shear
+    rate (pendular.dem.cell).
     """
 
     periodic = False
@@ -169,6 +172,9 @@ class Walls(Box):
 
     def wrap(self, particles):
         """Nothing to wrap inside walls."""
+
+    def follow(self, dt):
+        """Walls move by their own controls, not with the particles."""
 
     def after_forces(self, sim):
         """The wall forces come from pendular.dem.walls.WallForces among the scene's forces."""

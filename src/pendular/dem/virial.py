@@ -54,9 +54,13 @@ def face_block_starts(through_face, row_start):
 @numba.njit(cache=True, inline="always")
 def add_face_term(total, image, k, period, f0, f1, f2):
     """``total`` plus (image_k L) (x) f for pair k through a face, f [N] its force on j from i
-    (what its branch vector holds beyond x_j - x_i)."""
-    return add_outer(total, image[k, 0] * period[0], image[k, 1] * period[1],
-                     image[k, 2] * period[2], f0, f1, f2)
+    (what its branch vector holds beyond x_j - x_i; a sheared cell's ``period`` (4,) adds its
+    offset along x per image in z, pendular.dem.neighbors.branch_vector)."""
+    shift0 = image[k, 0] * period[0]
+    if len(period) > 3:
+        shift0 += image[k, 2] * period[3]
+    return add_outer(total, shift0, image[k, 1] * period[1], image[k, 2] * period[2], f0, f1,
+                     f2)
 
 
 @numba.njit(cache=True, inline="always")

@@ -385,3 +385,35 @@ def plot_path(history, path, title=""):
         panel.legend(fontsize=7, ncol=2 if name == "stress" else 1)
     figure.suptitle(title, fontsize=9)
     return save_figure(figure, path)
+
+
+def plot_simple_shear(history, path, title=""):
+    """A simple shear's records (pendular.procedures.simple_shear) against the shear strain
+    gamma [%]: the shear stress tau [kPa] with the peak of tau / sigma_n marked and its
+    friction angle, the normal stress sigma_n = sigma_zz [kPa] and the volumetric strain [%]
+    from the shear's start; ``title``: the run's parameters."""
+    gamma = 100.0 * np.asarray(history["shear_strain"])
+    tau = np.asarray(history["shear_stress"]) / 1e3
+    normal = np.asarray(history["normal_stress"]) / 1e3
+    volume = 1.0 - np.asarray(history["volumetric_strain"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(normal > 0.0, tau / normal, np.nan)
+    figure, (top, middle, bottom) = pyplot().subplots(3, 1, figsize=(6, 9), sharex=True)
+    top.plot(gamma, tau, color="C0")
+    if np.isfinite(ratio).any():
+        peak = int(np.nanargmax(ratio))
+        top.plot(gamma[peak], tau[peak], "o", color="C3",
+                 label=f"peak τ/σn = {ratio[peak]:.3g} (φ = "
+                       f"{np.degrees(np.arctan(ratio[peak])):.1f}°) at γ = {gamma[peak]:.2f} %")
+        top.legend(fontsize=8)
+    top.set_ylabel("shear stress τ [kPa]")
+    middle.plot(gamma, normal, color="C1")
+    middle.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
+    bottom.plot(gamma, 100.0 * (1.0 - volume / volume[0]), color="C2")
+    bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
+    bottom.set_xlabel("shear strain γ [%]")
+    for axes in (top, middle, bottom):
+        axes.grid(alpha=0.3)
+        axes.tick_params(labelbottom=True)
+    top.set_title(f"Simple shear (x with z, periodic cell)\n{title}", fontsize=9)
+    return save_figure(figure, path)

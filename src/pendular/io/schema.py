@@ -18,6 +18,8 @@ Columns by test (pendular.procedures.triaxial.history_columns, pendular.procedur
 - oedometer and isotropic paths (pendular.procedures.triaxial.OedometerTest, IsotropicTest):
   the triaxial's, and void_ratio; the oedometer k0; stage when the path has several stages;
 - cyclic triaxial (pendular.procedures.cyclic.CyclicTest): the oedometer's less k0, and cycle;
+- simple shear (pendular.procedures.simple_shear.SimpleShearTest): the loading path's,
+  shear_strain, shear_stress and normal_stress;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
 """
@@ -132,6 +134,14 @@ HISTORY_COLUMNS = {
                     dtype="int64"),
     "cycle": Column("1", "cycle of a cyclic triaxial path running (1 first; 0 the first "
                          "loading)", dtype="int64"),
+    "shear_strain": Column("1", "simple shear: shear strain gamma of x with z, the integral of "
+                                "the shear rate (a periodic cell's images above in z displaced "
+                                "by gamma Lz along x at a constant height)"),
+    "shear_stress": Column("Pa", "simple shear: shear stress tau = -(sigma_xz + sigma_zx) / 2 "
+                                 "of the cell's Love-Weber stress (compression positive), "
+                                 "positive resisting a positive shear", equation="Eq. 3.41"),
+    "normal_stress": Column("Pa", "simple shear: normal stress sigma_zz of the cell, "
+                                  "compression positive"),
 }
 
 #: Field data of the ParaView frames (pendular.io.vtk.VtkWriter: one number a .vtu file, the
@@ -146,6 +156,10 @@ VTK_FIELDS = {
                                 "the history's axial_strain"),
     "axial_strain_percent": Column("%", "the same axial strain in %: the time axis of a loading "
                                         "path's vtk/"),
+    "shear_strain": Column("1", "shear strain gamma of a simple shear's vtk/, as the "
+                                "history's shear_strain"),
+    "shear_strain_percent": Column("%", "the same shear strain in %: the time axis of a simple "
+                                        "shear's vtk/"),
     "phase": Column("1", "vtk_prep/: index of the phase (0 growth, 1 friction, 2 unload, "
                          "3 equilibrate, 4 sample, 5 wetting)"),
     "mean_wall_stress": Column("Pa", "vtk_prep/: mean normal stress on the walls, compression "
@@ -241,11 +255,22 @@ CYCLIC_SUMMARY_UNITS = {
     "axial_strain_at_load": "1", "q_at_load": "Pa",
 }
 
+#: Units of a simple shear summary.json (pendular.procedures.simple_shear.simple_shear_summary)
+#: and of its options.
+SIMPLE_SHEAR_SUMMARY_UNITS = {
+    "peak_shear_stress": "Pa", "shear_strain_at_peak_stress": "1", "peak_stress_ratio": "1",
+    "shear_strain_at_peak": "1", "normal_stress_at_peak": "Pa", "residual_stress_ratio": "1",
+    "phi_residual_deg": "deg", "normal_stress_final": "Pa", "max_dilatancy": "1",
+    "dilatancy_angle_deg": "deg", "volumetric_strain_of_shear": "1", "max_volume_change": "1",
+    "normal_stress": "Pa",
+}
+
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
-                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS}
+                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
+                 **SIMPLE_SHEAR_SUMMARY_UNITS}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

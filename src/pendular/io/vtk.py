@@ -64,6 +64,7 @@ import meshio
 import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
+from pendular.dem.neighbors import branch_vectors
 from pendular.io.schema import VTK_FIELDS
 from pendular.utils.atomic import replacing
 from pendular.utils.validate import check_int
@@ -123,6 +124,12 @@ def axial_strain_fields(strain):
     """Field data of a loading path's frame at axial ``strain`` [-]: the fraction and, as the
     series' time axis, the same in %."""
     return {"axial_strain": float(strain), "axial_strain_percent": 100.0 * float(strain)}
+
+
+def shear_strain_fields(strain):
+    """Field data of a simple shear's frame at shear ``strain`` gamma [-]: the fraction and, as
+    the series' time axis, the same in %."""
+    return {"shear_strain": float(strain), "shear_strain_percent": 100.0 * float(strain)}
 
 
 def write_pvd(path, frames, time_axis="time"):
@@ -217,9 +224,9 @@ def _lines(sim, mask):
     start = position[contacts.pair_i[index]]
     end = position[contacts.pair_j[index]]
     if sim.walls.periodic:         # from i in the cell to the image of j it interacts with
-        lengths = sim.walls.lengths()
-        shift = np.mod(start, lengths) - start
-        start, end = start + shift, end + contacts.image[index] * lengths + shift
+        shift = np.mod(start, sim.walls.lengths()) - start
+        start = start + shift
+        end = start + branch_vectors(position, contacts, sim.walls.period, index)
     points = np.concatenate([start, end]) if count else np.zeros((0, 3))
     lines = np.stack([np.arange(count), np.arange(count, 2 * count)], axis=1).astype(np.int64)
     return points, lines

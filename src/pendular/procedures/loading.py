@@ -8,10 +8,13 @@ axes given neither (``MixedStress``): a constant mean stress p = (sigma_x + sigm
 sigma_z) / 3 (``mean_stress``), a constant b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) with
 sigma_1 on z and sigma_3 on x (``b``), or both; and an end (``until``): ``Strain`` (the
 engineering strain of an axis, from the start of the path), ``Stress`` (the stress of a
-strain-driven axis reaching a value) or ``Static`` (equilibrium). ``LoadingPath`` runs the
-stages of a static sample in turn and records one history. Rates follow the inertial-number
-rule of the triaxial (pendular.procedures.config.quasi_static_rate); a stage that ends at
-equilibrium moves its servoed walls at most at ``max_strain_rate``.
+strain-driven axis reaching a value) or ``Static`` (equilibrium). In a periodic cell a stage
+may also shear x with z at ``shear_rate`` gamma_dot (simple shear, Lees–Edwards:
+pendular.dem.cell), to an end ``ShearStrain`` (the shear strain gamma imposed since the start of
+the path). ``LoadingPath`` runs the stages of a static sample in turn and records one
+history. Rates follow the inertial-number rule of the triaxial
+(pendular.procedures.config.quasi_static_rate); a stage that ends at equilibrium moves its
+servoed walls at most at ``max_strain_rate``.
 
 The paths of the laboratory:
 
@@ -19,7 +22,10 @@ The paths of the laboratory:
   stress, axial walls at the rate of ShearConfig, to the final strain), in compression or
   extension, at a constant b or a constant mean stress;
 - ``oedometer_stages``: lateral walls fixed, axial compression to a stress, then unloading;
-- ``isotropic_stages``: the six walls servoed to each stress in turn, each stage until static.
+- ``isotropic_stages``: the six walls servoed to each stress in turn, each stage until static;
+- ``simple_shear_stages`` (pendular.procedures.simple_shear): a periodic cell brought to a
+  normal stress on z (x and y held), then sheared, x with z, at that stress (drained) or at
+  constant volume.
 
 Their summaries: ``oedometer_summary`` (K0, constrained modulus, compression and swelling
 indices against the axial stress), ``isotropic_summary`` (e against log p at each stage's
@@ -34,12 +40,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pendular.dem.cell import ConstantShearRate
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
-from pendular.procedures.config import MAX_AXIAL_STRAIN
+from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.preparation import servo_speed, static
 from pendular.utils.validate import check_int, check_positive, check_range
@@ -95,6 +102,19 @@ class Stress:
 
 
 @dataclass
+class ShearStrain:
+    """End when the shear strain gamma of x with z (pendular.dem.cell, the integral of the
+    shear rate from the start of the path) reaches ``value`` [-]; the stage must shear at a
+    ``shear_rate`` of the sign of the change, and then runs a fixed number of steps."""
+
+    value: float
+
+    def __post_init__(self):
+        self.value = check_range("until shear strain", self.value, -MAX_SHEAR_STRAIN,
+                                 MAX_SHEAR_STRAIN)
+
+
+@dataclass
 class Static:
     """End at equilibrium: the unbalanced force at most ``unbalanced`` and every servoed axis
     within ``tolerance`` (relative) of its target (pendular.procedures.preparation.static),
@@ -128,17 +148,21 @@ class Stage:
     walls held; every axis in one of them, except those a mixed condition sets:
     ``mean_stress`` [Pa] (the axes given neither share 3 p less the other stresses) and/or
     ``b`` in [0, 1] (sigma_1 on z, driven at a positive rate; with b alone, sigma_3 is x's
-    stress and y is set; with both, x and y are set). until: Strain, Stress or Static;
-    max_strain_rate: largest strain rate of the servoed walls [1/s] (None: the path's servo
-    speed), the quasi-static bound of a stage the servo drives.
+    stress and y is set; with both, x and y are set). until: Strain, Stress, Static or
+    ShearStrain; max_strain_rate: largest strain rate of the servoed walls [1/s] (None: the
+    path's servo speed), the quasi-static bound of a stage the servo drives; shear_rate:
+    gamma_dot [1/s] of x with z, a simple shear of a periodic cell (pendular.dem.cell; walls
+    refuse it when the path starts), ending with ``until`` ShearStrain, or any end but
+    Static.
     """
 
     stress: dict = field(default_factory=dict)
     strain_rate: dict = field(default_factory=dict)
-    until: Strain | Stress | Static = field(default_factory=Static)
+    until: Strain | Stress | Static | ShearStrain = field(default_factory=Static)
     mean_stress: float | None = None
     b: float | None = None
     max_strain_rate: float | None = None
+    shear_rate: float = 0.0
 
     def __post_init__(self):
         self.stress = {_axis_name("stress axis", axis): check_range(
@@ -149,8 +173,11 @@ class Stage:
         both = sorted(set(self.stress) & set(self.strain_rate))
         if both:
             raise ValueError(f"axis {', '.join(both)}: give a stress or a strain rate, not both")
-        if not isinstance(self.until, (Strain, Stress, Static)):
-            raise TypeError(f"until = {self.until!r}: a Strain, Stress or Static expected")
+        if not isinstance(self.until, (Strain, Stress, Static, ShearStrain)):
+            raise TypeError(f"until = {self.until!r}: a Strain, Stress, Static or ShearStrain "
+                            "expected")
+        self.shear_rate = check_range("shear_rate", self.shear_rate, -MAX_STRAIN_RATE,
+                                      MAX_STRAIN_RATE, unit="1/s")
         if self.mean_stress is not None:
             self.mean_stress = check_positive("mean_stress", self.mean_stress, "Pa")
         if self.b is not None:
@@ -194,9 +221,16 @@ class Stage:
         until = self.until
         if isinstance(until, Static):
             moving = sorted(a for a, r in self.strain_rate.items() if r != 0.0)
+            if self.shear_rate != 0.0:
+                moving.append("x-z (shear_rate)")
             if moving or self.mean_stress is not None or self.b is not None:
                 raise ValueError("until static needs every axis servoed or held (strain rate "
                                  f"0): axis {', '.join(moving) or 'z'} keeps moving")
+            return
+        if isinstance(until, ShearStrain):
+            if until.value * self.shear_rate <= 0.0:
+                raise ValueError(f"until shear strain {until.value:g} needs a shear_rate of its "
+                                 f"sign, not {self.shear_rate:g} 1/s")
             return
         rate = self.strain_rate.get(until.axis, 0.0)
         if rate == 0.0:
@@ -212,11 +246,15 @@ class Stage:
             parts.append(f"p {self.mean_stress:g} Pa")
         if self.b is not None:
             parts.append(f"b {self.b:g}")
+        if self.shear_rate != 0.0:
+            parts.append(f"shear xz {self.shear_rate:.3g} 1/s")
         until = self.until
         if isinstance(until, Strain):
             parts.append(f"until {until.axis} strain {until.value:g}")
         elif isinstance(until, Stress):
             parts.append(f"until {until.axis} stress {until.value:g} Pa")
+        elif isinstance(until, ShearStrain):
+            parts.append(f"until shear strain {until.value:g}")
         else:
             parts.append("until static")
         return "; ".join(parts)
@@ -357,6 +395,14 @@ class LoadingPath:
             raise ValueError("stages: a non-empty list of Stage expected")
         self.reference_length = sim.walls.lengths().copy()
         self.axial = AxisStrain(2, self.reference_length[2])
+        shearing = [s for s in self.stages if s.shear_rate != 0.0]
+        if shearing and not sim.walls.periodic:
+            raise ValueError(f"shear_rate = {shearing[0].shear_rate:g} 1/s needs a periodic "
+                             "cell (--periodic): walls cannot shear a sample")
+        self.reference_shear = getattr(sim.walls, "shear_strain", 0.0)
+        # every stage of a path that shears holds a shear control (rate 0 where it does not
+        # shear): a checkpoint loads into a pipeline of the same operation types
+        self._shears = bool(shearing)
         servo = next((op for op in sim.controls if isinstance(op, StressServo)), None)
         if servo_max_velocity is None:
             servo_max_velocity = (servo.max_velocity if servo is not None
@@ -372,7 +418,7 @@ class LoadingPath:
         sim.controls = list(self.controls)
         self.stage_steps = self._stage_steps(sim)
         self.steps = self.stage_steps if (len(self.stages) == 1 and isinstance(
-            self.stages[0].until, Strain)) else None
+            self.stages[0].until, (Strain, ShearStrain))) else None
         if self.steps is not None and records is not None:
             period, end = max(1, self.steps // records), sim.step + self.steps
         elif record_every is not None:
@@ -394,8 +440,9 @@ class LoadingPath:
 
     # ------------------------------------------------------------ controls of a stage
     def _controls(self, sim, stage, previous):
-        """The controls of ``stage`` in order (MixedStress, servos, strain rates); the servos of
-        ``previous`` (the controls of the stage before) on the same axes carry on."""
+        """The controls of ``stage`` in order (MixedStress, servos, strain rates, and in a path
+        that shears the shear rate); the servos of ``previous`` (the controls of the stage
+        before) on the same axes carry on."""
         carried = {op.axes: op for op in previous if isinstance(op, StressServo)}
         max_velocity = self.servo_max_velocity
         if stage.max_strain_rate is not None:
@@ -438,6 +485,8 @@ class LoadingPath:
                 controls.append(ConstantStrainRate(
                     axis, rate, self.reference_length[AXES[axis]],
                     on_current_length=self.rate_on_current_length))
+        if self._shears:
+            controls.append(ConstantShearRate(stage.shear_rate))
         return controls
 
     def _driver(self, axis):
@@ -450,12 +499,20 @@ class LoadingPath:
         index = AXES[axis]
         return 1.0 - sim.walls.lengths()[index] / self.reference_length[index]
 
+    def shear_strain(self, sim):
+        """Shear strain gamma of x with z imposed since the start of the path [-] (0 inside
+        walls)."""
+        return getattr(sim.walls, "shear_strain", 0.0) - self.reference_shear
+
     def _stage_steps(self, sim):
-        """Steps of the running stage: its length (Strain), its most (Stress: to its strain
-        limit; Static: max_steps)."""
+        """Steps of the running stage: its length (Strain, ShearStrain), its most (Stress: to
+        its strain limit; Static: max_steps)."""
         until = self.stages[self.stage].until
         if isinstance(until, Static):
             return until.max_steps
+        if isinstance(until, ShearStrain):
+            shear = next(op for op in self.controls if isinstance(op, ConstantShearRate))
+            return shear.steps_to(until.value, sim.dt, self.shear_strain(sim))
         driver = self._driver(until.axis)
         start = self.strain(sim, until.axis) if self.stage else 0.0
         if isinstance(until, Strain):
@@ -495,7 +552,7 @@ class LoadingPath:
         """Whether the running stage's end is reached now."""
         stage = self.stages[self.stage]
         until = stage.until
-        if isinstance(until, Strain):
+        if isinstance(until, (Strain, ShearStrain)):
             return sim.step - self.stage_start >= self.stage_steps
         if isinstance(until, Stress):
             sigma = sim.walls.stress()[AXES[until.axis]]
@@ -521,7 +578,7 @@ class LoadingPath:
             steps = int(min(self.steps_left(sim), budget - taken))
             label = progress if progress is None or len(self.stages) == 1 else (
                 f"{progress} {self.stage + 1}/{len(self.stages)}")
-            if isinstance(until, Strain):
+            if isinstance(until, (Strain, ShearStrain)):
                 taken += sim.run(steps, progress=label, status=status)
                 continue
             every = 1 if isinstance(until, Stress) else until.check_every
@@ -536,7 +593,8 @@ class LoadingPath:
         return taken
 
     def steps_left(self, sim):
-        """Steps left to the running stage's end (Strain) or limit (Stress, Static) [-]."""
+        """Steps left to the running stage's end (Strain, ShearStrain) or limit (Stress,
+        Static) [-]."""
         return self.stage_start + self.stage_steps - sim.step
 
     def _failure(self, sim):
@@ -565,11 +623,18 @@ class LoadingPath:
         self.stage_steps = self._stage_steps(sim)
 
     def status(self, sim):
-        """Progress-bar fields: strain, axial and lateral stress, q/p."""
+        """Progress-bar fields: strain, axial and lateral stress, q/p; in a sheared cell the
+        shear strain, tau and tau / sigma_z instead of the last two."""
         sigma = sim.walls.stress()
-        return {"strain": f"{self.axial.strain(sim.walls):.3f}",
-                "sz": f"{sigma[2]:.0f}Pa", "sr": f"{lateral_stress(sigma):.0f}Pa",
-                "q/p": f"{deviator_stress(sigma) / mean_stress(sigma):.2f}"}
+        fields = {"strain": f"{self.axial.strain(sim.walls):.3f}", "sz": f"{sigma[2]:.0f}Pa"}
+        if getattr(sim.walls, "sheared", False):
+            tau = sim.walls.shear_stress()
+            fields.update({"gamma": f"{self.shear_strain(sim):.3f}", "tau": f"{tau:.0f}Pa",
+                           "tau/sz": f"{tau / sigma[2]:.2f}" if sigma[2] else "-"})
+            return fields
+        fields.update({"sr": f"{lateral_stress(sigma):.0f}Pa",
+                       "q/p": f"{deviator_stress(sigma) / mean_stress(sigma):.2f}"})
+        return fields
 
 
 # ---------------------------------------------------------------- the laboratory's paths

@@ -1,0 +1,180 @@
+"""Simple shear of a sample in a periodic cell (Lees–Edwards images, pendular.dem.cell): x
+sheared with z, z the normal (height) direction.
+
+``simple_shear_stages(config, rate)``: from the isotropic confining stress, z brought to the
+normal stress with x and y held (a K0 consolidation, skipped when the normal stress is the
+confining one), then the shear at the rate gamma_dot to the final shear strain, the normal
+stress held by the cell's servo (drained) or the cell's lengths held (constant volume: the
+volume is conserved exactly). ``SimpleShearTest(config).run(out)`` runs it as every
+laboratory test (pendular.procedures.triaxial.LaboratoryTest: sample, wetting, checkpoints,
+resume) and writes history.h5 (the loading path's columns and ``shear_strain`` gamma,
+``shear_stress`` tau, ``normal_stress`` sigma_zz), summary.json (``simple_shear_summary``),
+simple_shear.png (tau, sigma_n and the volumetric strain against gamma), vtk/.
+
+tau = -(sigma_xz + sigma_zx) / 2 of the cell's Love–Weber stress (compression positive), the
+stress whose power tau gamma_dot per unit volume the shear puts in: positive where the sample
+resists a positive shear (PeriodicCell.shear_stress). Friction angles atan(tau / sigma_n).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from pendular.io.plots import plot_simple_shear
+from pendular.io.schema import peak_reached
+from pendular.io.vtk import shear_strain_fields
+from pendular.procedures.config import SimpleShearConfig
+from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static
+from pendular.procedures.triaxial import LaboratoryTest, stress_balance
+
+#: Records whose normal stress is below this fraction of the shear's initial one do not
+#: measure tau / sigma_n (a ratio of noise over nearly zero, e.g. a loose sample whose normal
+#: stress collapses at constant volume).
+MIN_NORMAL_FRACTION = 0.01
+#: Final fraction of the shear strain over which the residual state is averaged.
+RESIDUAL_FRACTION = 0.1
+#: Span of shear strain, as a fraction of the shear's, of the differences that measure the
+#: dilatancy -d(eps_v)/d(gamma) (narrower windows measure the records' scatter).
+DILATANCY_WINDOW = 0.05
+
+#: History columns of a simple shear beyond the loading path's (pendular.io.schema).
+SHEAR_COLUMNS = {
+    "shear_strain": lambda s: s.walls.shear_strain,
+    "shear_stress": lambda s: s.walls.shear_stress(),
+    "normal_stress": lambda s: s.walls.stress()[2],
+}
+
+
+def simple_shear_stages(config, rate):
+    """The Stages of ``config`` (SimpleShearConfig) at the shear rate ``rate`` [1/s]: the
+    consolidation of z to the normal stress (x, y held; until static, at most
+    ``config.stage_steps``, the servo at most at ``rate``) when it differs from the confining
+    stress, then the shear to ``config.max_strain``, drained (z at the normal stress) or at
+    constant volume."""
+    sample = config.sample
+    held = {"x": 0.0, "y": 0.0}
+    stages = []
+    if config.consolidates:
+        stages.append(Stage(stress={"z": config.normal_stress}, strain_rate=held,
+                            max_strain_rate=rate,
+                            until=Static(config.stage_steps, sample.equilibrium_unbalanced,
+                                         sample.stress_tolerance)))
+    if config.constant_volume:
+        stages.append(Stage(strain_rate={**held, "z": 0.0}, shear_rate=rate,
+                            until=ShearStrain(config.max_strain)))
+    else:
+        stages.append(Stage(stress={"z": config.normal_stress}, strain_rate=held,
+                            shear_rate=rate, until=ShearStrain(config.max_strain)))
+    return stages
+
+
+def shear_rows(history):
+    """Indices of the records of the shear stage (the last stage of the path), with the
+    record it starts from."""
+    stage = history.get("stage")
+    if stage is None:
+        return np.arange(len(history["step"]))
+    rows = np.flatnonzero(stage == stage.max())
+    return np.concatenate([rows[:1] - 1, rows]) if rows[0] > 0 else rows
+
+
+def _friction_angle(ratio):
+    """atan(tau / sigma_n) [deg], None for a ratio that is not finite."""
+    return float(math.degrees(math.atan(ratio))) if np.isfinite(ratio) else None
+
+
+def simple_shear_summary(history, constant_volume):
+    """Results of a simple shear's history (``shear_rows``): ``peak_shear_stress`` [Pa] and
+    the shear strain there; at the peak of tau / sigma_n (records with sigma_n above
+    MIN_NORMAL_FRACTION of its initial value) ``peak_stress_ratio``, ``phi_peak_deg`` =
+    atan(tau / sigma_n), ``shear_strain_at_peak``, ``normal_stress_at_peak``, ``peak_reached``
+    (pendular.io.schema.peak_reached); over the last RESIDUAL_FRACTION of the shear strain
+    ``residual_stress_ratio`` (mean tau / sigma_n) and ``phi_residual_deg``;
+    ``normal_stress_final``. Drained: ``max_dilatancy`` = max -d(eps_v)/d(gamma) over windows
+    of DILATANCY_WINDOW of the shear strain (eps_v contraction positive, so dilation is
+    positive), ``dilatancy_angle_deg`` = atan of it, ``volumetric_strain_of_shear``; at
+    constant volume ``max_volume_change``, max |V / V_start - 1| over the shear (round-off
+    at most)."""
+    rows = shear_rows(history)
+    gamma = np.asarray(history["shear_strain"], dtype=float)[rows]
+    tau = np.asarray(history["shear_stress"], dtype=float)[rows]
+    normal = np.asarray(history["normal_stress"], dtype=float)[rows]
+    measured = normal > MIN_NORMAL_FRACTION * normal[0]
+    ratio = np.where(measured, tau / np.where(measured, normal, 1.0), np.nan)
+    top = int(np.argmax(tau))
+    summary = {"peak_shear_stress": float(tau[top]),
+               "shear_strain_at_peak_stress": float(gamma[top])}
+    if np.isfinite(ratio).any():
+        peak = int(np.nanargmax(ratio))
+        span = gamma[-1] - gamma[0]
+        residual = ratio[(gamma >= gamma[-1] - RESIDUAL_FRACTION * span) & measured]
+        residual_ratio = float(np.mean(residual)) if len(residual) else math.nan
+        summary.update({
+            "peak_stress_ratio": float(ratio[peak]),
+            "phi_peak_deg": _friction_angle(ratio[peak]),
+            "shear_strain_at_peak": float(gamma[peak]),
+            "normal_stress_at_peak": float(normal[peak]),
+            "peak_reached": peak_reached(gamma[measured], ratio[measured]),
+            "residual_stress_ratio": residual_ratio if np.isfinite(residual_ratio) else None,
+            "phi_residual_deg": _friction_angle(residual_ratio)})
+    summary["normal_stress_final"] = float(normal[-1])
+    volume = 1.0 - np.asarray(history["volumetric_strain"], dtype=float)[rows]   # V / V0
+    if constant_volume:
+        summary["max_volume_change"] = float(np.max(np.abs(volume / volume[0] - 1.0)))
+    else:
+        summary.update(dilatancy(gamma, 1.0 - volume / volume[0]))
+    summary.update(stress_balance(history))
+    return summary
+
+
+def dilatancy(gamma, volumetric):
+    """``max_dilatancy`` = max over the shear of -d(eps_v)/d(gamma) [-], differences over
+    windows of DILATANCY_WINDOW of the shear strain range (eps_v ``volumetric``, contraction
+    positive, against ``gamma``, rising), ``dilatancy_angle_deg`` = atan of it and
+    ``volumetric_strain_of_shear`` (the last eps_v); None without a range of shear strain."""
+    span = gamma[-1] - gamma[0]
+    found = {"volumetric_strain_of_shear": float(volumetric[-1])}
+    if not span > 0.0 or len(gamma) < 3:
+        return {**found, "max_dilatancy": None, "dilatancy_angle_deg": None}
+    window = DILATANCY_WINDOW * span
+    start = np.linspace(gamma[0], gamma[-1] - window, 200)
+    slope = -(np.interp(start + window, gamma, volumetric)
+              - np.interp(start, gamma, volumetric)) / window
+    most = float(np.max(slope))
+    return {**found, "max_dilatancy": most, "dilatancy_angle_deg": _friction_angle(most)}
+
+
+class SimpleShearTest(LaboratoryTest):
+    """A simple shear test of ``config`` (pendular.procedures.config.SimpleShearConfig; module
+    docstring): history with ``shear_strain``, ``shear_stress``, ``normal_stress`` (and
+    ``stage`` with a consolidation), summary of ``simple_shear_summary``, figure
+    simple_shear.png."""
+
+    NAME = "simple-shear"
+    CONFIG = SimpleShearConfig
+    FIGURE = "simple_shear.png"
+    PROGRESS = "simple shear"
+
+    def loading(self, sim):
+        config = self.config
+        return LoadingPath(sim, simple_shear_stages(config, config.rate()),
+                           record_every=config.record_every(sim.dt), columns=SHEAR_COLUMNS)
+
+    def summarize(self, history):
+        return simple_shear_summary(history, self.config.constant_volume)
+
+    def frame_fields(self, path):
+        """The shear strain gamma, in % on the ParaView time axis."""
+        return (lambda s: shear_strain_fields(s.walls.shear_strain)), "shear_strain_percent"
+
+    def plot(self, history, out, title):
+        config = self.config
+        rows = shear_rows(history)
+        shear = {name: np.asarray(values)[rows] for name, values in history.items()
+                 if np.ndim(values) and len(values) == len(history["step"])}
+        kind = "constant volume" if config.constant_volume else "drained"
+        plot_simple_shear(shear, os.path.join(out, self.FIGURE),
+                          f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}")

@@ -1,0 +1,143 @@
+"""`pendular simple-shear` as a user runs it: drained (with a consolidation to the normal
+stress) and wet at constant volume, their outputs and keys, a resumed run bit for bit, and bad
+input refused in one line."""
+
+import json
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import refused, run_in_process
+
+SMALL = ["--particles", "200", "--seed", "4", "--max-strain", "0.02", "--quiet"]
+
+
+def summary_of(out):
+    return json.loads((out / "summary.json").read_text())
+
+
+def history_of(out):
+    with h5py.File(out / "history.h5") as handle:
+        history = {name: handle["history"][name][()] for name in handle["history"]
+                   if name not in ("record", "axis", "component")}
+        units = {name: handle["history"][name].attrs.get("units") for name in handle["history"]}
+    return history, units
+
+
+@pytest.fixture(scope="module")
+def drained_run(tmp_path_factory):
+    """A dry drained shear at 600 Pa from a sample at 750 Pa, with checkpoints."""
+    out = tmp_path_factory.mktemp("simple_shear") / "drained"
+    subprocess.run([sys.executable, "-m", "pendular", "simple-shear", *SMALL, "--normal-stress",
+                    "600", "--checkpoint-every", "1000", "--out", str(out)],
+                   check=True, capture_output=True, text=True, timeout=600)
+    return out
+
+
+def test_a_drained_shear_writes_its_history_summary_and_figures(drained_run):
+    summary, (history, units) = summary_of(drained_run), history_of(drained_run)
+    rows = len(history["step"])
+    assert history["sigma_wall"].shape == (rows, 3) and history["axial_strain"].shape == (rows,)
+    for name in ("shear_strain", "shear_stress", "normal_stress", "stage"):
+        assert history[name].shape == (rows,), name
+    assert units["shear_stress"] == units["normal_stress"] == "Pa"
+    assert units["shear_strain"] == "1"
+    shear = history["stage"] == 1
+    assert np.all(history["shear_strain"][~shear] == 0.0)
+    assert 0.02 <= history["shear_strain"][-1] < 0.02 * 1.001     # to the step past it
+    assert np.all(np.diff(history["shear_strain"][shear]) > 0.0)
+    np.testing.assert_array_equal(history["normal_stress"], history["sigma_wall"][:, 2])
+    # consolidated to the normal stress, held there through the shear
+    assert np.mean(history["normal_stress"][shear]) == pytest.approx(600.0, rel=0.02)
+    contact = history["sigma_contact"]
+    np.testing.assert_allclose(history["shear_stress"][shear],
+                               -0.5 * (contact[shear, 0, 2] + contact[shear, 2, 0]),
+                               rtol=0.05, atol=0.02 * 600.0)
+    for key, unit in (("peak_shear_stress", "Pa"), ("phi_peak_deg", "deg"),
+                      ("shear_strain_at_peak", "1"), ("residual_stress_ratio", "1"),
+                      ("phi_residual_deg", "deg"), ("max_dilatancy", "1"),
+                      ("dilatancy_angle_deg", "deg")):
+        assert summary[key] is not None and summary["units"][key] == unit, key
+    ratio = history["shear_stress"][shear] / history["normal_stress"][shear]
+    assert summary["peak_stress_ratio"] == pytest.approx(np.max(ratio))
+    assert summary["phi_peak_deg"] == pytest.approx(np.degrees(np.arctan(np.max(ratio))))
+    assert 0.1 < summary["peak_stress_ratio"] < 1.0 and summary["completed"]
+    assert "max_volume_change" not in summary
+    for name in ("simple_shear.png", "sample.h5", "checkpoint.h5", "vtk/particles.pvd"):
+        assert (drained_run / name).stat().st_size > 0, name
+
+
+def test_the_paraview_frames_follow_the_shear_strain_and_draw_pairs_through_the_shear(
+        drained_run):
+    """The series' time axis is gamma in %, and each contact line, through a z face of the
+    sheared cell included, is as long as its pair's branch vector: at most the sum of the
+    radii (a line missing the shift delta would span the cell)."""
+    import meshio
+
+    pvd = (drained_run / "vtk" / "particles.pvd").read_text()
+    assert "shear_strain_percent" in pvd
+    times = [float(part.split('"')[0]) for part in pvd.split('timestep="')[1:]]
+    history, _ = history_of(drained_run)
+    assert times[-1] == pytest.approx(100.0 * history["shear_strain"][-1], rel=0.05)
+    last = sorted((drained_run / "vtk").glob("contacts_*.vtu"))[-1]
+    lines = meshio.read(last)
+    particles = meshio.read(str(last).replace("contacts_", "particles_"))
+    ends = lines.points[lines.cells_dict["line"]]
+    length = np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1)
+    assert len(length) > 0
+    assert length.max() <= 2.0 * particles.point_data["radius"].max()
+
+
+def test_a_resumed_shear_has_the_history_of_an_uninterrupted_one(drained_run, tmp_path,
+                                                                   capsys):
+    out = tmp_path / "stopped"
+    steps = summary_of(drained_run)["steps"]
+    argv = [*SMALL, "--normal-stress", "600", "--checkpoint-every", "1000", "--out", out]
+    status, _ = run_in_process("simple-shear", [*argv, "--stop-after", str(int(0.7 * steps))],
+                               capsys)
+    assert status == 130 and summary_of(out)["completed"] is False
+    status, err = run_in_process("simple-shear", ["--resume", out, "--quiet"], capsys)
+    assert status == 0, err
+    (expected, _), (got, _) = history_of(drained_run), history_of(out)
+    for name in expected:
+        assert np.array_equal(got[name], expected[name], equal_nan=True), name
+
+
+def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
+    out = tmp_path / "wet"
+    status, err = run_in_process("simple-shear", [*SMALL, "--suction", "30000",
+                                                  "--constant-volume", "--out", out], capsys)
+    assert status == 0, err
+    summary, (history, _) = summary_of(out), history_of(out)
+    assert "stage" not in history                 # at the confining stress: no consolidation
+    assert summary["max_volume_change"] == 0.0
+    assert np.all(history["volumetric_strain"] == 0.0)
+    assert history["saturation"][-1] > 0.0 and history["bridges"][-1] > 0
+    assert summary["peak_shear_stress"] > 0.0 and summary["phi_peak_deg"] > 0.0
+    assert "max_dilatancy" not in summary
+    assert (out / "simple_shear.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("arguments, words", [
+    (["--max-strain", "-0.1"], ("--max-strain = -0.1", "[1e-06, 10]")),
+    (["--max-strain", "20"], ("--max-strain = 20", "[1e-06, 10]")),
+    (["--normal-stress", "-5"], ("--normal-stress = -5", "(0, 1e+07]")),
+    (["--shear-rate", "0"], ("--shear-rate = 0", "(0, inf]")),
+    (["--record-strain", "0.5"], ("--record-strain = 0.5",)),
+    (["--inertial-number", "0.5"], ("inertial number", "(0, 0.01]")),
+])
+def test_bad_input_is_refused_in_one_line(arguments, words, tmp_path, capsys):
+    status, err = run_in_process("simple-shear", ["--particles", "200", *arguments,
+                                                  "--out", tmp_path / "bad"], capsys)
+    refused(status, err, *words)
+    assert not (tmp_path / "bad").exists()
+
+
+def test_a_sample_in_walls_is_refused_in_one_line(wet_triaxial_run, tmp_path, capsys):
+    status, err = run_in_process("simple-shear", ["--particles", "200", "--sample",
+                                                  wet_triaxial_run / "sample.h5",
+                                                  "--out", tmp_path / "walls"], capsys)
+    refused(status, err, "six walls", "periodic")
