@@ -152,7 +152,35 @@ def dry():
             "deterministic": identical(half, snapshot(again.sim)),
             "forced_equals_plain": identical(snapshot(plain.sim), snapshot(forced.sim)),
             "step": [cpu.step, plain.sim.step], "time": [cpu.time, plain.sim.time],
-            "refusals": refusals(), "diverged": diverged()}
+            "refusals": refusals(), "diverged": diverged(), "device": device_run()}
+
+
+def device_run():
+    """``Simulation(device="gpu").run`` with ``until`` against the CPU: the steps taken, the
+    state and the history, and the device's copies back (GpuSimulation.copy_back) by part: an
+    ``until`` that reads the walls brings back the walls alone, the recorder everything."""
+    copies = []
+    copy_back = GpuSimulation.copy_back
+
+    def counted(self, part=None):
+        copies.append(part or "all")
+        return copy_back(self, part)
+
+    GpuSimulation.copy_back = counted
+    cpu, gpu = scene(), scene()
+    gpu.device = "gpu"
+    length = cpu.walls.lengths()[2]
+
+    def until(sim):                 # the axial walls closer by 110 steps of the strain rate
+        return sim.walls.lengths()[2] < length * (1.0 - 110 * sim.dt * 1.0)
+
+    taken = [sim.run(STEPS, until=until, check_every=25) for sim in (cpu, gpu)]
+    GpuSimulation.copy_back = copy_back
+    return {"taken": taken, "step": [cpu.step, gpu.step], "copies": copies,
+            "agreement": compare(snapshot(cpu), snapshot(gpu)),
+            "history": history_difference(cpu, gpu),
+            "released": sorted(set(gpu.__dict__) & {"particles", "walls", "contacts",
+                                                    "controls", "_held", "_holder"})}
 
 
 def refusals():

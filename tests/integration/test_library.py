@@ -14,10 +14,13 @@ from conftest import ROOT
 
 SRC = os.path.join(ROOT, "src")
 #: The layers of the package, lowest first: a module may import from its own layer and those
-#: below it, never above. "pendular" itself (its __init__) is the public face, above all.
-LAYER_ORDER = ("pendular.utils", "pendular.dem", "pendular.capillary", "pendular.homogenize",
-               "pendular.io", "pendular.procedures", "pendular.interop", "pendular.studies",
-               "pendular.cli", "pendular")
+#: below it, never above. "pendular" itself (its __init__) is the public face, above all. The
+#: one way up is declared: pendular.dem.simulation imports a device's module (DEVICE_MODULES,
+#: e.g. pendular.gpu) by name when a Simulation first asks for that device
+#: (test_the_device_registry_is_the_one_plug_in_point).
+LAYER_ORDER = ("pendular.utils", "pendular.dem", "pendular.capillary", "pendular.gpu",
+               "pendular.homogenize", "pendular.io", "pendular.procedures", "pendular.interop",
+               "pendular.studies", "pendular.cli", "pendular")
 LAYERS = {layer: set(LAYER_ORDER[:rank + 1]) for rank, layer in enumerate(LAYER_ORDER)}
 
 
@@ -86,6 +89,25 @@ def test_no_module_imports_a_layer_above_it():
         if "sys.path" in open(path).read():
             wrong.append(f"{path}: edits sys.path")
     assert not wrong, "\n".join(wrong)
+
+
+def test_the_device_registry_is_the_one_plug_in_point():
+    """Below the command line, only pendular.dem.simulation imports a module by name: a
+    device's (DEVICE_MODULES), from a layer above pendular.dem, which registers its run
+    (register_device) when imported (docs/architecture.md)."""
+    from pendular.dem.simulation import DEVICE_MODULES
+
+    by_name = sorted(_module_name(path) for path in _python_files(os.path.join(SRC, "pendular"))
+                     if _layer(_module_name(path)) not in ("pendular.cli", "pendular")
+                     and any(word in open(path).read()
+                             for word in ("import_module(", "__import__(")))
+    assert by_name == ["pendular.dem.simulation"]
+    devices = {name: module for name, module in DEVICE_MODULES.items() if module is not None}
+    assert devices == {"gpu": "pendular.gpu"}
+    for name, module in devices.items():
+        assert LAYER_ORDER.index(_layer(module)) > LAYER_ORDER.index("pendular.dem")
+        source = open(os.path.join(SRC, *module.split("."), "__init__.py")).read()
+        assert f'register_device("{name}"' in source
 
 
 def test_only_pendular_is_installed_and_importing_it_changes_no_setting():

@@ -18,8 +18,16 @@ among the forces) or a ``pendular.dem.cell.PeriodicCell``.
 ``forces``, ``controls`` and ``writers`` are plain lists: a phase change replaces
 ``sim.controls``, wetting appends a force. An operation has ``apply(sim)``; a force that
 needs pairs beyond contact says so with ``reach(sim)`` [m] (pendular.dem.neighbors.NeighborList asks).
+
+``device`` chooses where ``run`` advances: "cpu" (here) or another device, whose module
+(DEVICE_MODULES) is imported by name when first asked for and registers its run
+(``register_device``): the one plug-in point of the layers (docs/architecture.md). During a
+device run the state (DEVICE_HELD) is the device's: reading one of these attributes of the
+Simulation (a writer, ``until``, ``status``) brings it back first, so nothing reads a stale
+host copy; after ``run`` the host holds the state.
 """
 
+import importlib
 import time
 
 import numba
@@ -33,6 +41,50 @@ from pendular.utils.threads import configure as configure_threading
 #: Below this many particles a step is too short to pay for waking a second thread
 #: (docs/performance.md, "Threads by sample size").
 SERIAL_BELOW = 500
+#: The devices a Simulation runs on, with the module that provides each one's run (None: this
+#: module's); pendular.dem never imports them statically (module docstring).
+DEVICE_MODULES = {"cpu": None, "gpu": "pendular.gpu"}
+DEVICES = tuple(DEVICE_MODULES)
+#: What a device run holds between its syncs (module docstring).
+DEVICE_HELD = ("particles", "walls", "contacts", "controls")
+#: Registered devices: name -> (start(sim), unavailable()) (``register_device``).
+_DEVICES = {}
+
+
+def register_device(name, start, unavailable):
+    """Declare how device ``name`` (a key of DEVICE_MODULES; its module calls this when
+    imported) runs a Simulation: ``start(sim)`` returns a run with ``run(steps, until=,
+    check_every=, progress=, status=)`` as Simulation.run, which holds the state (``hold``)
+    after each of its steps, and ``copy_back(part)``, which writes the device's state into sim
+    (``part`` "walls": those alone); ``unavailable()`` says why the device cannot run here
+    (text), or None."""
+    if name not in DEVICE_MODULES or DEVICE_MODULES[name] is None:
+        raise ValueError(f"device = {name!r} is not one of the plug-in devices "
+                         f"{', '.join(repr(n) for n, m in DEVICE_MODULES.items() if m)}")
+    _DEVICES[name] = (start, unavailable)
+
+
+def device_start(device, label=None):
+    """The ``start`` of ``device`` (None for "cpu"), its module imported on first use;
+    ValueError naming ``label`` (default "device = '<device>'") when the device is unknown or
+    cannot run here (its extra not installed, no GPU), with how to install it."""
+    label = label or f"device = {device!r}"
+    if device not in DEVICE_MODULES:
+        raise ValueError(f"{label} is not one of {', '.join(map(repr, DEVICE_MODULES))}")
+    module = DEVICE_MODULES[device]
+    if module is None:
+        return None
+    install = f"pip install -e '.[{device}]'"
+    try:
+        importlib.import_module(module)
+    except ImportError as error:
+        raise ValueError(f"{label} cannot run here: {module} does not import ({error}); "
+                         f"install its extra: {install}") from None
+    start, unavailable = _DEVICES[device]
+    reason = unavailable()
+    if reason is not None:
+        raise ValueError(f"{label} cannot run here: {reason}")
+    return start
 
 
 def _check_operation(op):
@@ -49,10 +101,11 @@ class Simulation:
     dt [s]; ``step`` and ``time`` [s] count from the start; ``contacts`` is filled by the
     neighbour list. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
     SERIAL_BELOW particles or more, else 1). Results do not depend on the thread count.
+    ``device``: where ``run`` advances, "cpu" or "gpu" (module docstring; docs/gpu.md).
     """
 
     def __init__(self, particles, walls, dt, *, neighbors, forces=(), controls=(),
-                 integrator, writers=(), threads=None):
+                 integrator, writers=(), threads=None, device="cpu"):
         for name, value, kind in (("particles", particles, Particles), ("walls", walls, Box)):
             if not isinstance(value, kind):
                 raise TypeError(f"{name} must be a pendular.dem.state.{kind.__name__}, got "
@@ -72,6 +125,50 @@ class Simulation:
         if threads is None:
             threads = numba.get_num_threads() if len(particles) >= SERIAL_BELOW else 1
         self.threads = check_int("threads", threads, low=1, high=numba.config.NUMBA_NUM_THREADS)
+        self.device = device
+
+    @property
+    def device(self):
+        """Where ``run`` advances: "cpu" or "gpu" (set it to move the next runs there)."""
+        return self._device
+
+    @device.setter
+    def device(self, device):
+        self._device_start = device_start(device)
+        self._device = device
+
+    def __getattr__(self, name):
+        # reached only for an attribute that is not there: the state a device run holds
+        if name in DEVICE_HELD and "_holder" in self.__dict__:
+            self.release(name)
+            return self.__dict__[name]
+        raise AttributeError(f"'Simulation' object has no attribute {name!r}")
+
+    def hold(self, run):
+        """The device run ``run`` changed the state (DEVICE_HELD): until released, reading it
+        brings it back from there (``run.copy_back``). Called by a device run after a step."""
+        state = self.__dict__
+        held = state.setdefault("_held", {})
+        for name in DEVICE_HELD:
+            if name in state:
+                held[name] = state.pop(name)
+        state["_holder"] = run
+
+    def release(self, name=None):
+        """The held state back from the device run holding it: the walls alone for ``name``
+        "walls" (a wall stress read every step stays cheap), else all of it, which ends the
+        hold (nothing is held: nothing to do)."""
+        state = self.__dict__
+        run = state.get("_holder")
+        if run is None:
+            return
+        if name == "walls":
+            state["walls"] = state["_held"].pop("walls")
+            run.copy_back("walls")
+            return
+        state.update(state.pop("_held"))
+        del state["_holder"]
+        run.copy_back(None)
 
     @property
     def operations(self):
@@ -112,15 +209,30 @@ class Simulation:
         """Advance ``steps`` steps, or fewer if ``until(sim)`` becomes true (checked every
         ``check_every`` steps). ``progress`` is a label for a progress bar; ``status(sim)``
         returns a dict shown beside it (an open-ended run, with ``until``, shows the steps
-        taken and its status, not a fraction of the step limit). Returns the steps taken."""
+        taken and its status, not a fraction of the step limit). Returns the steps taken.
+        On another ``device`` the steps run there, the writers, ``until`` and ``status``
+        reading the state brought back (module docstring)."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
+        caller_threads = numba.get_num_threads()
+        numba.set_num_threads(self.threads)
+        try:
+            if self._device_start is None:
+                return self._run_here(steps, until, check_every, progress, status)
+            try:
+                return self._device_start(self).run(steps, until=until, check_every=check_every,
+                                                    progress=progress, status=status)
+            finally:
+                self.release()              # after a run, the host holds the state
+        finally:
+            numba.set_num_threads(caller_threads)
+
+    def _run_here(self, steps, until, check_every, progress, status):
+        """``run`` on the CPU."""
         bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
                    mininterval=1.0, smoothing=0.05, disable=progress is None)
         taken = 0
         started = time.perf_counter()
-        caller_threads = numba.get_num_threads()
-        numba.set_num_threads(self.threads)
         try:
             while taken < steps:
                 chunk = min(check_every, steps - taken)
@@ -133,6 +245,5 @@ class Simulation:
                 if until is not None and until(self):
                     break
         finally:
-            numba.set_num_threads(caller_threads)
             bar.close()
         return taken

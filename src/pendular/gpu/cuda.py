@@ -32,3 +32,14 @@ def configured(kernel, items):
 def simulated():
     """Whether Numba's CUDA simulator stands in for a GPU (NUMBA_ENABLE_CUDASIM=1)."""
     return os.environ.get("NUMBA_ENABLE_CUDASIM", "0") == "1"
+
+
+def unavailable():
+    """Why the GPU path cannot run here (text), or None: numba-cuda missing (Numba's own,
+    deprecated CUDA target in its place), or no GPU visible and not the simulator."""
+    if getattr(cuda, "implementation", None) == "Built-in":
+        return "numba-cuda is not installed; install it with pip install -e '.[gpu]'"
+    if not cuda.is_available():
+        return ("no CUDA GPU is visible (numba.cuda.is_available() is False); use the CPU "
+                "(device 'cpu'), or Numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1) for tests")
+    return None

@@ -10,9 +10,13 @@ CPU pipeline (pendular.dem.simulation) on the device::
     leapfrog                                    integrator (+ the rebuild test)
 
 The host reads nothing per step. It reads the device's flags at its checks (every
-``check_every`` steps, as Simulation.run checks ``until``) and copies the state back into the
-Simulation (``to_host``) when a writer, ``until`` or the caller asks: a HistoryRecorder is run
-at its recording steps only (its ``period``, ``origin``, ``end``), any other writer every step.
+``check_every`` steps, as Simulation.run checks ``until``). After each step the Simulation's
+state is held by the device (Simulation.hold) and the writers are called as on the CPU: one
+that reads the state (a HistoryRecorder at its recording steps, a checkpoint at its period)
+brings it back first (``copy_back``; the walls alone when only they are read, as a stress
+``until`` does every step), one that is not due reads nothing and costs no copy.
+Simulation.run brings the state back as it returns; a GpuSimulation driven directly leaves it
+held until read (or ``to_host``), so that runs in a row copy nothing between them.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
 wet, SuctionBridges at contact (``persist`` False); controls StressServo and
@@ -20,7 +24,7 @@ ConstantStrainRate; the Integrator. Anything else is refused by name (ValueError
 scene never runs with part of its physics missing.
 """
 
-import math
+import time
 
 import numpy as np
 from tqdm import tqdm
@@ -29,7 +33,6 @@ from pendular.capillary.bridges import SuctionBridges
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
-from pendular.dem.record import HistoryRecorder
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import forces, integrate, neighbors, walls as device_walls
@@ -75,22 +78,11 @@ def check_scene(sim):
                              "(valid: StressServo, ConstantStrainRate)")
 
 
-def _next_write(writer, step):
-    """First step after ``step`` at which ``writer`` may write: a HistoryRecorder's next
-    recording step, any other writer's next step."""
-    if type(writer) is not HistoryRecorder:
-        return step + 1
-    after = step + 1
-    due = after + (writer.origin - after) % writer.period
-    if writer.end is not None and after <= writer.end < due:
-        return writer.end
-    return due
-
-
 class GpuSimulation:
     """Runs ``sim`` (a pendular.dem.simulation.Simulation whose scene the GPU path supports,
     ``check_scene``) on the GPU: ``run(steps)`` as Simulation.run, ``to_host()`` to bring the
-    state back into ``sim`` (done before its writers and ``until`` read it). ``sim.step`` and
+    state back into ``sim`` (done whenever anything reads it from sim: module docstring).
+    ``sim.step`` and
     ``sim.time`` advance with the device. Parameters of the operations (friction, servo
     target, dt, ...) are read at every ``run``; a scene whose operations change (a new
     control list) needs ``to_host()`` and a new GpuSimulation.
@@ -233,12 +225,14 @@ class GpuSimulation:
 
     # ---------------------------------------------------------------- running
     def advance(self):
-        """One step on the device (launches only); sim.step and sim.time advance."""
+        """One step on the device (launches only); sim.step and sim.time advance, the rest of
+        sim's state is held by the device (Simulation.hold) until read."""
         idle = simulated() and self.state.flags[0] == 0
         for kernel, args in self._launches[REBUILD_LAUNCHES if idle else 0:]:
             kernel(*args)
         self.sim.step += 1
         self.sim.time += self.sim.dt
+        self.sim.hold(self)
 
     def check(self):
         """Read the device's flags: RuntimeError when a cell or a row overflowed (the list
@@ -260,44 +254,49 @@ class GpuSimulation:
 
     def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
         """Advance ``steps`` steps on the device, or fewer if ``until(sim)`` becomes true
-        (checked every ``check_every`` steps on the state brought back); the writers run at
-        their steps on the state brought back. Arguments and result as Simulation.run."""
+        (checked every ``check_every`` steps); the writers after every step, as on the CPU
+        (module docstring). Arguments and result as Simulation.run; the state stays held by
+        the device until read (``to_host``; Simulation.run brings it back as it returns)."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
         self._configure()
         sim = self.sim
         bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
-                   mininterval=1.0, disable=progress is None)
+                   mininterval=1.0, smoothing=0.05, disable=progress is None)
         taken = 0
+        started = time.perf_counter()
         try:
             while taken < steps:
-                writes = min((_next_write(w, sim.step) for w in sim.writers),
-                             default=math.inf)
-                chunk = int(min(check_every - taken % check_every, steps - taken,
-                                writes - sim.step))
+                chunk = min(check_every, steps - taken)
                 for _ in range(chunk):
                     self.advance()
+                    for writer in sim.writers:
+                        writer.apply(sim)
                 taken += chunk
                 bar.update(chunk)
                 self.check()
-                checking = until is not None and (taken % check_every == 0 or taken == steps)
-                if sim.step == writes or checking:
-                    self.to_host()
-                    for writer in sim.writers:
-                        writer.apply(sim)
-                if status is not None and checking:
+                if status is not None and time.perf_counter() - started > 1.0:
                     bar.set_postfix(status(sim), refresh=False)
-                if checking and until(sim):
+                if until is not None and until(sim):
                     break
         finally:
             bar.close()
         return taken
 
     def to_host(self):
-        """Bring the device's state into ``sim``: particles, walls, the neighbour list with its
-        per-pair state (rebuilt by the CPU's NeighborList from it, so that the CPU can go on
-        from here) and the servos' memory."""
+        """Bring the device's state into ``sim`` now (Simulation.release; nothing to do when
+        sim holds it already)."""
+        self.sim.release()
+
+    def copy_back(self, part=None):
+        """Copy the device's state into ``sim`` (called by Simulation.release): particles,
+        walls, the neighbour list with its per-pair state (rebuilt by the CPU's NeighborList
+        from it, so that the CPU can go on from here) and the servos' memory; with ``part``
+        "walls", the walls alone."""
         sim = self.sim
+        if part == "walls":
+            self.state.walls_to_host(sim.walls)
+            return
         self.state.to_host(sim)
         s = self.state
         previous = s.previous.copy_to_host()

@@ -168,11 +168,15 @@ class DeviceState:
                         normal_force=self.normal_force.copy_to_host()[slots],
                         force=self.pair_force.copy_to_host()[slots], extra=extra)
 
+    def walls_to_host(self, walls):
+        """Write the walls' position, velocity, force, stiffness and moment into ``walls``."""
+        for name in ("position", "velocity", "force", "stiffness", "moment"):
+            getattr(self, f"wall_{name}").copy_to_host(getattr(walls, name))
+
     def to_host(self, sim):
         """Write the particles, the walls and the neighbour list into ``sim`` (a copy each)."""
         p = sim.particles
         for name in ("position", "velocity", "angular_velocity", "force", "torque"):
             getattr(self, name).copy_to_host(getattr(p, name))
-        for name in ("position", "velocity", "force", "stiffness", "moment"):
-            getattr(self, f"wall_{name}").copy_to_host(getattr(sim.walls, name))
+        self.walls_to_host(sim.walls)
         sim.contacts = self.contacts()

@@ -43,13 +43,14 @@ from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
 from pendular.dem.sample import load_sample, save_sample
+from pendular.dem.simulation import device_start
 from pendular.utils.validate import check_int
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 
 from pendular.procedures.guards import SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
-    TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
+    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
     friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
     oedometer_summary, path_deviations, shear_stage, void_ratio)
@@ -82,8 +83,6 @@ MIN_CONFINING_OVER_YOUNG = 5e-6
 STRESS_BALANCE_BOUND = 0.05
 #: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
 ESTIMATE_RATE = 4e6
-#: Density of water [kg/m^3]: the specific gravity of the grains is their density over it.
-WATER_DENSITY = 1000.0
 
 
 #: Phases of the vtk_prep/ series, by the code in each frame's field data ``phase``: those of
@@ -415,6 +414,29 @@ def check_feasible(config, force=False):
                              f": the shear has about {int(steps)} steps")
 
 
+def check_device(config, device):
+    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the loading
+    of ``config`` (what the GPU path does not run yet, docs/gpu.md) or cannot run here (no
+    numba-cuda, no GPU): ValueError naming --device and what is missing."""
+    label = f"--device {device}"
+    if device == "gpu":
+        bridges = config.bridges
+        stages = ([shear_stage(config.shear, config.confining, config.rate())]
+                  if isinstance(config, TriaxialConfig) else
+                  config.loading_stages() if hasattr(config, "loading_stages") else ())
+        missing = [what for what, used in (
+            ("the periodic cell (--periodic)", config.sample.periodic),
+            ("volume-controlled bridges (--water-content)",
+             bridges is not None and bridges.control == "volume"),
+            ("bridges across gaps (--persist-bridges)", bridges is not None and bridges.persist),
+            ("mixed stress conditions (--b, --constant-p, a stage holding p or b)",
+             any(stage.free for stage in stages))) if used]
+        if missing:
+            raise ValueError(f"{label} does not run {' nor '.join(missing)} yet: run this test "
+                             "on the CPU (--device cpu)")
+    device_start(device, label)
+
+
 def parameters(config):
     """Flat name -> value of a configuration (TriaxialConfig, OedometerConfig,
     IsotropicConfig), named as the command's options (history file attributes, campaign
@@ -533,14 +555,17 @@ class LaboratoryTest:
         return sim, report
 
     def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False,
-            plots=True):
+            plots=True, device="cpu"):
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
         shear after this many steps as an interruption would (raises Interrupted); ``plots``:
         False leaves out triaxial.png and plots/ (a run timed for its physics, as the
         trade-off study's: the figures cost about 2 s a run).
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
-        many steps, False (default) or 0 none. Output only: the results are the same."""
+        many steps, False (default) or 0 none. Output only: the results are the same.
+        ``device``: where the loading runs, "cpu" or "gpu" (``check_device``; the preparation
+        and wetting run on the CPU); a run option, not part of the configuration."""
+        check_device(self.config, device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         if self.config.sample_path is not None:       # checked before the folder is touched
@@ -548,7 +573,7 @@ class LaboratoryTest:
         with OutputFolder(out, self.NAME) as folder:
             for name in self.outputs():
                 folder.claim(name)
-            return self._run(folder, progress, threads, stop_after, vtk_prep, plots)
+            return self._run(folder, progress, threads, stop_after, vtk_prep, plots, device)
 
     def prep_writer(self, out, vtk_prep):
         """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
@@ -563,7 +588,7 @@ class LaboratoryTest:
                          field_data=lambda s: {"mean_wall_stress":
                                                float(np.mean(s.walls.stress()))})
 
-    def _run(self, folder, progress, threads, stop_after, vtk_prep, plots):
+    def _run(self, folder, progress, threads, stop_after, vtk_prep, plots, device):
         config, out = self.config, folder.path
         started = time.perf_counter()
         frames = self.prep_writer(out, vtk_prep)
@@ -588,15 +613,17 @@ class LaboratoryTest:
         sample_file = os.path.join(out, "sample.h5")
         save_sample(sample_file, sim, preparation, before_shear,
                     identity={"seed": config.sample.seed})
+        sim.device = device
         run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
         return run.finish(progress, stop_after, plots)
 
     @classmethod
-    def resume(cls, out, *, progress=True, threads=None, stop_after=None):
+    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration stored in its sample.h5; returns the summary."""
+        configuration stored in its sample.h5, its loading on ``device`` (whichever device
+        wrote the checkpoint); returns the summary."""
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
         for path in (sample_file, checkpoint):
@@ -609,6 +636,7 @@ class LaboratoryTest:
             if not isinstance(config, cls.CONFIG):
                 raise ValueError(f"resume = {out!r} holds a run of another test "
                                  f"({type(config).__name__}), not of pendular {cls.NAME}")
+            check_device(config, device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
@@ -631,6 +659,7 @@ class LaboratoryTest:
                 raise ValueError(f"{checkpoint}: step = {sim.step} is outside the valid range "
                                  f"[{start}, {end}] of this run's loading (an edited checkpoint)")
             run.resumed(state)
+            sim.device = device
             return run.finish(progress, stop_after)
 
     # ------------------------------------------------------------ the path of the test
@@ -646,6 +675,12 @@ class LaboratoryTest:
     def summarize(self, history):
         """The test's results from its ``history`` (dict of arrays)."""
         raise NotImplementedError
+
+    def frame_fields(self, path):
+        """(field data function of sim, time axis name) of the ParaView frames of the loading
+        ``path`` (pendular.io.vtk.VtkWriter): the axial strain, in % on the time axis."""
+        axial = path.axial
+        return (lambda s: axial_strain_fields(axial.strain(s.walls))), "axial_strain_percent"
 
     def plot(self, history, out, title):
         """The test's figures into the folder ``out``, ``title`` the run's parameters."""
@@ -774,10 +809,9 @@ class _PathRun:
                 self.vtk_period = self.path.recorder.period * VTK_RECORDS
         self.vtk = None
         if self.vtk_period > 0:
-            axial = self.path.axial
+            field_data, time_axis = test.frame_fields(self.path)
             self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
-                                 field_data=lambda s: axial_strain_fields(axial.strain(s.walls)),
-                                 time_axis="axial_strain_percent")
+                                 field_data=field_data, time_axis=time_axis)
             sim.writers.append(self.vtk)
         self.checkpoint = None
         if config.checkpoint_every > 0:
@@ -870,6 +904,7 @@ class _PathRun:
             "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
             "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
             "threads": numba.get_num_threads(),
+            "device": sim.device,
             "grading": grading(sim.particles.radius),
             **self.before_shear["wetting"],
         })

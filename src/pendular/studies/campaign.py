@@ -80,7 +80,7 @@ PROGRESS_PERIOD = 5.0
 #: What a campaign runs.
 RunConfig = Union[TriaxialConfig, TensionConfig]
 #: Options a parameter table cannot set: the campaign decides them.
-CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep")
+CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep", "device")
 #: Options of a table that are paths, relative to the table's folder.
 PATH_OPTIONS = ("sample", "psd")
 #: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra

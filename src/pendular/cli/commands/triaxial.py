@@ -24,6 +24,7 @@ import argparse
 import sys
 
 from pendular.procedures.preparation import PrepareConfig
+from pendular.dem.simulation import DEVICES
 from pendular.dem.timestep import TIMESTEP_RULES
 from pendular.utils.validate import check_int, check_range
 
@@ -32,10 +33,10 @@ from pendular.cli import (INTERRUPTED, UsageError, add_run_options, add_size_opt
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MAX_RECORDS,
     MIN_AXIAL_STRAIN, SHEAR_DIRECTIONS, WETTING_PROTOCOLS, BridgeConfig, LaboratoryConfig,
     ShearConfig, TriaxialConfig, check_steps_count)
-from pendular.procedures.triaxial import Interrupted, TriaxialTest
+from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device
 
 #: Options a resumed run takes from its own command line, not from the stored run.
-RESUME_OPTIONS = ("resume", "quiet", "threads", "stop_after", "force")
+RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
 #: Options of the preparation alone, which a run from a prepared --sample does not use.
 PREPARATION_OPTIONS = ("porosity", "prep_friction")
 #: Summary keys printed at the end.
@@ -157,6 +158,10 @@ def add_output_options(parser, out, frames=True):
     parser.add_argument("--force", action="store_true",
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
+    parser.add_argument("--device", choices=DEVICES, default="cpu",
+                        help="where the loading runs: cpu, or gpu (numba-cuda, pip install -e "
+                             "'.[gpu]'; the preparation and wetting stay on the CPU; "
+                             "docs/gpu.md); a run option: a checkpoint resumes on either")
     group = parser.add_mutually_exclusive_group() if frames else parser
     group.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
                        help="steps between ParaView frames of the loading (default: " + (
@@ -177,8 +182,8 @@ def add_output_options(parser, out, frames=True):
                         default=0, help="steps between checkpoints DIR/checkpoint.h5 (0: none)")
     parser.add_argument("--resume", metavar="DIR", default=None,
                         help="continue the interrupted run of DIR from its checkpoint, with the "
-                             "configuration stored there (only --quiet and --threads may be "
-                             "added)")
+                             "configuration stored there (only --quiet, --threads and --device "
+                             "may be added)")
     # tests: stop the loading after this many steps as an interruption would (exit status 130)
     parser.add_argument("--stop-after", type=positive_int("--stop-after", low=1), default=None,
                         help=argparse.SUPPRESS)
@@ -298,15 +303,17 @@ def run_test(args, test, config_from, shown, add_arguments):
             if given:
                 raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
                                  f"{', '.join('--' + n.replace('_', '-') for n in given)} "
-                                 "cannot be changed (only --quiet and --threads may be added)")
+                                 "cannot be changed (only --quiet, --threads and --device may be "
+                                 "added)")
             summary = test.resume(args.resume, progress=progress, threads=args.threads,
-                                  stop_after=args.stop_after)
+                                  stop_after=args.stop_after, device=args.device)
             out = args.resume
         else:
             config = config_from(args)
+            check_device(config, args.device)       # before the test loads its tables
             summary = test(config, force=args.force).run(
                 args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
-                vtk_prep=args.vtk_prep)
+                vtk_prep=args.vtk_prep, device=args.device)
             out = args.out
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
