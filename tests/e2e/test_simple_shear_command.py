@@ -118,6 +118,14 @@ def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
     assert history["saturation"][-1] > 0.0 and history["bridges"][-1] > 0
     assert summary["peak_shear_stress"] > 0.0 and summary["phi_peak_deg"] > 0.0
     assert "max_dilatancy" not in summary
+    # the effective stress of Eq. 3.43 adds the capillary stress psi to the net one
+    psi = history["psi"]
+    tau = history["shear_stress"] - 0.5 * (psi[:, 0, 2] + psi[:, 2, 0])
+    ratio = tau / (history["normal_stress"] + psi[:, 2, 2])
+    assert summary["peak_stress_ratio_effective"] == pytest.approx(ratio.max())
+    assert summary["phi_peak_effective_deg"] == pytest.approx(
+        np.degrees(np.arctan(ratio.max())))
+    assert summary["phi_peak_effective_deg"] < summary["phi_peak_deg"]   # psi_zz > 0
     assert (out / "simple_shear.png").stat().st_size > 0
 
 

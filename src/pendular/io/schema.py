@@ -261,6 +261,8 @@ SIMPLE_SHEAR_SUMMARY_UNITS = {
     "peak_shear_stress": "Pa", "shear_strain_at_peak_stress": "1", "peak_stress_ratio": "1",
     "shear_strain_at_peak": "1", "normal_stress_at_peak": "Pa", "residual_stress_ratio": "1",
     "phi_residual_deg": "deg", "normal_stress_final": "Pa", "max_dilatancy": "1",
+    "peak_stress_ratio_effective": "1", "shear_strain_at_peak_effective": "1",
+    "phi_residual_effective_deg": "deg",
     "dilatancy_angle_deg": "deg", "volumetric_strain_of_shear": "1", "max_volume_change": "1",
     "normal_stress": "Pa",
 }

@@ -97,7 +97,8 @@ def simple_shear_summary(history, constant_volume):
     of DILATANCY_WINDOW of the shear strain (eps_v contraction positive, so dilation is
     positive), ``dilatancy_angle_deg`` = atan of it, ``volumetric_strain_of_shear``; at
     constant volume ``max_volume_change``, max |V / V_start - 1| over the shear (round-off
-    at most)."""
+    at most). Wet, the same peak and residual of the effective stress
+    (``effective_friction``)."""
     rows = shear_rows(history)
     gamma = np.asarray(history["shear_strain"], dtype=float)[rows]
     tau = np.asarray(history["shear_stress"], dtype=float)[rows]
@@ -121,6 +122,8 @@ def simple_shear_summary(history, constant_volume):
             "residual_stress_ratio": residual_ratio if np.isfinite(residual_ratio) else None,
             "phi_residual_deg": _friction_angle(residual_ratio)})
     summary["normal_stress_final"] = float(normal[-1])
+    if "psi" in history:
+        summary.update(effective_friction(history, rows))
     volume = 1.0 - np.asarray(history["volumetric_strain"], dtype=float)[rows]   # V / V0
     if constant_volume:
         summary["max_volume_change"] = float(np.max(np.abs(volume / volume[0] - 1.0)))
@@ -128,6 +131,31 @@ def simple_shear_summary(history, constant_volume):
         summary.update(dilatancy(gamma, 1.0 - volume / volume[0]))
     summary.update(stress_balance(history))
     return summary
+
+
+def effective_friction(history, rows):
+    """Of a wet history (the capillary stress psi, Eq. 3.43): the effective shear and normal
+    stresses tau' = tau - (psi_xz + psi_zx) / 2 and sigma_n' = sigma_n + psi_zz [Pa] of the
+    shear ``rows``, and at the peak of tau' / sigma_n' ``peak_stress_ratio_effective``,
+    ``phi_peak_effective_deg`` = atan of it and ``shear_strain_at_peak_effective``; over the
+    last RESIDUAL_FRACTION of the shear strain ``phi_residual_effective_deg``."""
+    psi = np.asarray(history["psi"], dtype=float)[rows]
+    gamma = np.asarray(history["shear_strain"], dtype=float)[rows]
+    tau = np.asarray(history["shear_stress"], dtype=float)[rows] - 0.5 * (psi[:, 0, 2]
+                                                                         + psi[:, 2, 0])
+    normal = np.asarray(history["normal_stress"], dtype=float)[rows] + psi[:, 2, 2]
+    measured = normal > MIN_NORMAL_FRACTION * normal[0]
+    if not measured.any():
+        return {}
+    ratio = np.where(measured, tau / np.where(measured, normal, 1.0), np.nan)
+    peak = int(np.nanargmax(ratio))
+    span = gamma[-1] - gamma[0]
+    residual = ratio[(gamma >= gamma[-1] - RESIDUAL_FRACTION * span) & measured]
+    return {"peak_stress_ratio_effective": float(ratio[peak]),
+            "phi_peak_effective_deg": _friction_angle(ratio[peak]),
+            "shear_strain_at_peak_effective": float(gamma[peak]),
+            "phi_residual_effective_deg": (_friction_angle(float(np.mean(residual)))
+                                           if len(residual) else None)}
 
 
 def dilatancy(gamma, volumetric):
