@@ -361,7 +361,7 @@ def test_wet_triaxial_scenario_writes_the_capillary_history(wet_triaxial_run):
 
 @pytest.mark.parametrize("arguments, message", [
     (["--suction", "-5"], "--suction"),
-    (["--suction", "30000", "--contact-angle", "95"], "contact_angle"),
+    (["--suction", "30000", "--contact-angle", "95"], "--contact-angle = 95.0 deg"),
     (["--suction", "1e9"], "suction = 1e+09 Pa is outside the valid range"),
     (["--contact-angle", "10"], "--suction > 0"),
     (["--suction", "30000", "--bridges", "cylinder"], "invalid choice"),

@@ -129,7 +129,7 @@ def test_bad_grading_options_end_in_one_error_line(tmp_path, capsys):
     refused_triaxial(capsys, out + ["--psd", str(tmp_path / "down.csv")], "down.csv", "increasing")
     refused_triaxial(capsys, out + ["--psd", str(tmp_path / "down.csv"), "--radius", "1e-5"],
             "--radius", "--psd")
-    refused_triaxial(capsys, out + ["--radius-spread", "0.9"], "radius_spread")
+    refused_triaxial(capsys, out + ["--radius-spread", "0.9"], "--radius-spread = 0.9")
 
 
 def test_a_graded_wet_triaxial_reports_its_grading(tmp_path):

@@ -71,7 +71,7 @@ def test_tension_refuses_fewer_spheres_than_its_grips_need(capsys, tmp_path):
 def test_the_smallest_samples_are_the_tests_own():
     few = PrepareConfig(particles=MIN_SAMPLE_PARTICLES - 1)
     for build in (lambda: TriaxialConfig(sample=few), lambda: SwccConfig(sample=few)):
-        with pytest.raises(ValueError, match=r"--particles = 49 is outside the valid range "
+        with pytest.raises(ValueError, match=r"^particles = 49 is outside the valid range "
                                              r"\[50, 10000000\]"):
             build()
     enough = PrepareConfig(particles=MIN_SAMPLE_PARTICLES)
@@ -79,7 +79,7 @@ def test_the_smallest_samples_are_the_tests_own():
         sample=enough).sample.particles == MIN_SAMPLE_PARTICLES
     few = tension_sample(particles=MIN_TENSION_PARTICLES)
     assert TensionConfig(sample=few).sample.particles == MIN_TENSION_PARTICLES
-    with pytest.raises(ValueError, match=r"--particles = 99 is outside the valid range "
+    with pytest.raises(ValueError, match=r"^particles = 99 is outside the valid range "
                                          r"\[100, 1000000\] for direct tension"):
         TensionConfig(sample=PrepareConfig(particles=MIN_TENSION_PARTICLES - 1))
 

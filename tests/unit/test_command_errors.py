@@ -65,7 +65,7 @@ CASES = {
                                                                      "[0, 90) deg"]),
     "chapter5 particles 2**64": ("chapter5", ["--particles", BIG], ["particles", "10000000"]),
     "chapter5 suctions nan": ("chapter5", ["--suctions", "nan"], ["--suctions", "[0, inf)"]),
-    "chapter5 max strain nan": ("chapter5", ["--max-strain", "nan"], ["max_strain",
+    "chapter5 max strain nan": ("chapter5", ["--max-strain", "nan"], ["--max-strain",
                                                                        "not finite"]),
 }
 

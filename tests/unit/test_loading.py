@@ -168,9 +168,9 @@ def test_oedometer_summary_reads_k0_and_the_constrained_modulus():
 
 
 @pytest.mark.parametrize("build, words", [
-    (lambda: ShearConfig(b=-0.1), "--b = -0.1 is outside the valid range [0, 1]"),
+    (lambda: ShearConfig(b=-0.1), "b = -0.1 is outside the valid range [0, 1]"),
     (lambda: ShearConfig(b=0.5, direction="extension"), "needs --direction compression"),
-    (lambda: ShearConfig(direction="sideways"), "--direction = 'sideways'"),
+    (lambda: ShearConfig(direction="sideways"), "direction = 'sideways'"),
     (lambda: OedometerConfig(sample=PrepareConfig(particles=100, confining=500.0),
                              axial_stress=400.0), "--axial-stress = 400 Pa"),
     (lambda: OedometerConfig(sample=PrepareConfig(particles=100), axial_stress=5000.0,

@@ -192,7 +192,9 @@ def run_command(name, argv, prog=None):
             return module.run(args) or 0
     except (UsageError, ValueError, FileNotFoundError, IsADirectoryError,
             NotADirectoryError, PermissionError) as error:
-        parser.exit(2, f"{parser.prog}: error: {error}\n")
+        # a configuration names its field; the command line names the option the user typed
+        text = error.on_command_line() if hasattr(error, "on_command_line") else error
+        parser.exit(2, f"{parser.prog}: error: {text}\n")
     except (ArithmeticError, MemoryError, numba.core.errors.NumbaError) as error:
         # a value the configurations' ranges let through but this run cannot hold (the ranges
         # refuse such values where they enter; this is the last line of defence)

@@ -9,6 +9,7 @@ import os
 import re
 
 from pendular.cli import UsageError, command_parser
+from pendular.utils.parameters import ParameterError
 from pendular.studies.campaign import (CAMPAIGN_OPTIONS, PATH_OPTIONS, Run, read_table,
                                        run_name, table_rows)
 
@@ -103,6 +104,8 @@ def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
             args = parser.parse_args(options_argv(options))
             config = module.config_from(args)
         except (_Refused, ValueError, UsageError, ArithmeticError) as error:
+            if isinstance(error, ParameterError) and error.flag:   # a field: name its table key
+                error = error.named(error.key)
             # the command's own checks name its options: point at the table keys that set them
             named = [key for key in options if _mentions(str(error), key)] or list(options)
             raise ValueError(f"{source}: run {name}: "

@@ -18,9 +18,10 @@ from typing import Any
 
 import numpy as np
 
-from pendular.capillary import BRIDGE_MODELS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
 from pendular.procedures.preparation import (MAX_PARTICLES, MAX_SEED, PrepareConfig,
     check_soft_contacts, pwave_step)
+from pendular.utils.parameters import fail, parameter, spec_of, validate
 from pendular.utils.validate import check_int, check_positive, check_range
 from pendular.homogenize import packing_state, regular_packing
 
@@ -72,6 +73,18 @@ MIN_TENSION_PARTICLES = 100
 MAX_TENSION_PARTICLES = 1_000_000
 
 
+def inertial_number_parameter():
+    """The field of a loading's target inertial number [-] (ShearConfig, PathConfig)."""
+    return parameter(3e-4, low=0.0, high=1.0, low_inclusive=False, flag="--inertial-number",
+                     help="target inertial number setting the strain rate")
+
+
+def strain_rate_parameter():
+    """The field of a loading's strain rate [1/s], None for the inertial number's."""
+    return parameter(None, unit="1/s", low=0.0, low_inclusive=False, flag="--strain-rate",
+                     help="axial strain rate (overrides --inertial-number)")
+
+
 @dataclass
 class ShearConfig:
     """Shear phase of a triaxial test to the axial strain ``max_strain`` [-] (at most
@@ -97,43 +110,41 @@ class ShearConfig:
     the mean stress stays the confining stress.
     """
 
-    max_strain: float = 0.25
-    inertial_number: float = 3e-4
-    strain_rate: float | None = None
-    records: int = 500
-    rate_on_current_length: bool = False
-    servo_max_velocity: float | None = None
-    servo_scale_max_velocity: bool = False
-    servo_stiffness_every: int = 1
-    direction: str = "compression"
-    b: float | None = None
-    constant_p: bool = False
+    max_strain: float = parameter(0.25, low=MIN_AXIAL_STRAIN, high=MAX_AXIAL_STRAIN,
+                                  flag="--max-strain",
+                                  help="final axial strain (in extension, the magnitude of the "
+                                       "axial extension)")
+    inertial_number: float = inertial_number_parameter()
+    strain_rate: float | None = strain_rate_parameter()
+    records: int = parameter(500, kind=int, low=2, high=MAX_RECORDS, flag="--records", unset=True,
+                             help="history rows over the test (at most one a step)")
+    rate_on_current_length: bool = parameter(False, kind=bool, recorded=False,
+                                             help="axial rate on the current height")
+    servo_max_velocity: float | None = parameter(None, unit="m/s", low=0.0, low_inclusive=False,
+                                                 recorded=False,
+                                                 help="speed cap of the lateral walls")
+    servo_scale_max_velocity: bool = parameter(False, kind=bool, recorded=False,
+                                               help="speed cap scaled per axis")
+    servo_stiffness_every: int = parameter(1, kind=int, low=1, recorded=False,
+                                           help="steps between wall stiffness updates")
+    direction: str = parameter("compression", kind=str, choices=SHEAR_DIRECTIONS,
+                               flag="--direction",
+                               help="axial walls pushed in (compression) or pulled apart "
+                                    "(extension), the lateral stress held")
+    b: float | None = parameter(None, low=0.0, high=1.0, flag="--b",
+                                help="true triaxial compression: hold b = (s2 - s3) / (s1 - s3), "
+                                     "s1 axial, s3 = --confining on x, s2 on y (default: "
+                                     "s2 = s3)")
+    constant_p: bool = parameter(False, kind=bool, flag="--constant-p",
+                                 help="hold the mean stress p at --confining while q rises (the "
+                                      "lateral stresses follow the axial one)")
 
     def __post_init__(self):
-        self.max_strain = check_range("max_strain", self.max_strain, MIN_AXIAL_STRAIN,
-                                      MAX_AXIAL_STRAIN)
-        if self.direction not in SHEAR_DIRECTIONS:
-            raise ValueError(f"--direction = {self.direction!r} is not one of "
-                             f"{SHEAR_DIRECTIONS}")
-        if self.b is not None:
-            self.b = check_range("--b", self.b, 0.0, 1.0)
-            if self.direction != "compression":
-                raise ValueError(f"--b = {self.b:g} needs --direction compression: b = "
-                                 "(sigma_2 - sigma_3) / (sigma_1 - sigma_3) is held with sigma_1 "
-                                 "on the axial walls")
-        if not isinstance(self.constant_p, (bool, np.bool_)):
-            raise ValueError(f"--constant-p = {self.constant_p!r}: valid values True or False")
-        self.constant_p = bool(self.constant_p)
-        self.inertial_number = check_range("inertial_number", self.inertial_number, 0.0, 1.0,
-                                           low_inclusive=False)
-        if self.strain_rate is not None:
-            self.strain_rate = check_positive("strain_rate", self.strain_rate, "1/s")
-        self.records = check_int("records", self.records, low=2, high=MAX_RECORDS)
-        if self.servo_max_velocity is not None:
-            self.servo_max_velocity = check_positive("servo_max_velocity",
-                                                     self.servo_max_velocity, "m/s")
-        self.servo_stiffness_every = check_int("servo_stiffness_every",
-                                               self.servo_stiffness_every, low=1)
+        validate(self)
+        if self.b is not None and self.direction != "compression":
+            raise fail(self, "b", f"b = {self.b:g} needs --direction compression: b = "
+                       "(sigma_2 - sigma_3) / (sigma_1 - sigma_3) is held with sigma_1 on the "
+                       "axial walls")
 
     def rate(self, radius, density, confining):
         """Axial strain rate [1/s]: the given one, or the one of the target inertial number at
@@ -184,49 +195,58 @@ class BridgeConfig:
     default.
     """
 
-    suction: float | None = None
-    surface_tension: float = SURFACE_TENSION
-    contact_angle: float = 0.0
-    model: str = "exact"
-    control: str = "suction"
-    persist: bool = False
-    roughness: float = 0.0
-    table_resolution: tuple[int, int] | None = None
-    water_content: float | None = None
-    liquid: str = "shared"
+    suction: float | None = parameter(None, unit="Pa", low=0.0, low_inclusive=False,
+                                      flag="--suction", help="matric suction")
+    surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
+                                       high=MAX_SURFACE_TENSION, low_inclusive=False,
+                                       flag="--surface-tension", unset=True,
+                                       help="liquid surface tension (wet test)")
+    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                     flag="--contact-angle", unset=True,
+                                     help="wetting angle (wet test)")
+    model: str = parameter("exact", kind=str, choices=BRIDGE_MODELS, flag="--bridges",
+                           unset=True,
+                           help="bridge model of the wet test: exact Young-Laplace tables "
+                                "(default) or the toroidal approximation (equal spheres)")
+    control: str = parameter("suction", kind=str, choices=CONTROLS,
+                             help="what the bridges hold: their suction or their volume")
+    persist: bool = parameter(False, kind=bool, flag="--persist-bridges",
+                              help="bridges live up to their rupture distance instead of "
+                                   "breaking when contact is lost")
+    roughness: float = parameter(0.0, low=0.0, high=0.5,
+                                 help="meniscus separation of touching spheres H / R2")
+    table_resolution: tuple[int, int] | None = parameter(
+        None, kind=None, flag="--table-resolution",
+        help="bridge table nodes in suction and in distance")
+    water_content: float | None = parameter(None, low=0.0, high=1.0, low_inclusive=False,
+                                            help="gravimetric water content (a fraction)")
+    liquid: str = parameter("shared", kind=str, choices=LIQUID_MODELS[1:], flag="--liquid",
+                            unset=True,
+                            help="with --water-content: the liquid of a ruptured bridge goes "
+                                 "to its grains' other bridges (shared, default) or is lost")
 
     def __post_init__(self):
         if (self.suction is None) == (self.water_content is None):
             raise ValueError("bridges: give one of suction (Pa) and water_content (a fraction)")
-        if self.suction is not None:
-            self.suction = check_positive("suction", self.suction, "Pa")
-        else:
-            self.water_content = check_range("--water-content", self.water_content, 0.0, 1.0,
-                                             low_inclusive=False)
-            if self.control != "volume" or self.model != "exact":
-                raise ValueError("--water-content needs volume-controlled exact bridges "
-                                 "(control='volume', model='exact')")
-        if self.liquid not in LIQUID_MODELS[1:]:
-            raise ValueError(f"--liquid = {self.liquid!r} is not one of {LIQUID_MODELS[1:]}")
-        self.surface_tension = check_range("surface_tension", self.surface_tension, 0.0,
-                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
-        self.contact_angle = check_range("contact_angle", self.contact_angle, 0.0, 90.0,
-                                         high_inclusive=False, unit="deg")
-        if self.model not in BRIDGE_MODELS:
-            raise ValueError(f"bridges = {self.model!r} is not one of {BRIDGE_MODELS}")
+        validate(self)
+        if self.water_content is not None and (self.control != "volume"
+                                               or self.model != "exact"):
+            raise fail(self, "water_content", "water_content needs volume-controlled exact "
+                       "bridges (control='volume', model='exact')")
         if self.table_resolution is not None:
             if len(self.table_resolution) != 2:
-                raise ValueError(f"table_resolution = {self.table_resolution!r}: two integers "
-                                 "(nodes in suction, nodes in distance) expected")
+                raise fail(self, "table_resolution", f"table_resolution = "
+                           f"{self.table_resolution!r}: two integers (nodes in suction, nodes in "
+                           "distance) expected")
             self.table_resolution = tuple(check_int(name, value, low=4, high=MAX_TABLE_NODES // 4)
                                           for name, value in
                                           zip(("table_resolution[0]", "table_resolution[1]"),
                                               self.table_resolution))
             nodes = self.table_resolution[0] * self.table_resolution[1]
             if nodes > MAX_TABLE_NODES:
-                raise ValueError(f"table_resolution = {self.table_resolution!r} has {nodes} nodes, "
-                                 f"outside the valid range [16, {MAX_TABLE_NODES}] (suction "
-                                 "nodes x distance nodes)")
+                raise fail(self, "table_resolution", f"table_resolution = "
+                           f"{self.table_resolution!r} has {nodes} nodes, outside the valid range "
+                           f"[16, {MAX_TABLE_NODES}] (suction nodes x distance nodes)")
 
     def build(self, suction=None):
         """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
@@ -269,12 +289,22 @@ class LaboratoryConfig:
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
     bridges: BridgeConfig | None = None
-    sample_path: str | None = None
-    wet_steps: int = 200000
-    vtk_frames: int = 50
-    vtk_every: int | None = None
-    checkpoint_every: int = 0
-    wetting: str = "isotropic"
+    sample_path: str | None = parameter(None, kind=str, flag="--sample", metavar="PATH",
+                                        help="start from this prepared sample (sample.h5) "
+                                             "instead of preparing one")
+    wet_steps: int = parameter(200000, kind=int, low=1, high=100_000_000, flag="--wet-steps",
+                               help="most steps to equilibrate the wetted (or loaded) sample")
+    vtk_frames: int = parameter(50, kind=int, low=0, flag="--vtk-frames",
+                                help="ParaView frames over the loading")
+    vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
+                                      help="steps between ParaView frames of the loading")
+    checkpoint_every: int = parameter(0, kind=int, low=0, flag="--checkpoint-every",
+                                      help="steps between checkpoints")
+    wetting: str = parameter("isotropic", kind=str, choices=WETTING_PROTOCOLS, flag="--wetting",
+                             help="when bridges appear (--suction): added to the static sample "
+                                  "and re-equilibrated (isotropic), switched on at the first "
+                                  "loading step (at-shear), or added with the walls fixed, then "
+                                  "servoed (constant-volume)")
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
@@ -289,19 +319,13 @@ class LaboratoryConfig:
                         AVERAGES)
         if self.sample.confining <= 0.0:
             # the path's starting stress: the inertial number and the servo need it > 0
-            raise ValueError(f"confining = {self.sample.confining:g} Pa is outside the valid "
-                             f"range (0, 1e+07] Pa for {self.TEST}")
-        self.wet_steps = check_int("wet_steps", self.wet_steps, low=1, high=100_000_000)
-        self.vtk_frames = check_int("vtk_frames", self.vtk_frames)
-        if self.vtk_every is not None:
-            self.vtk_every = check_int("vtk_every", self.vtk_every)
-        self.checkpoint_every = check_int("checkpoint_every", self.checkpoint_every)
-        if self.wetting not in WETTING_PROTOCOLS:
-            raise ValueError(f"--wetting = {self.wetting!r} is not one of {WETTING_PROTOCOLS}")
+            raise fail(self.sample, "confining", f"confining = {self.sample.confining:g} Pa is "
+                       f"outside the valid range (0, 1e+07] Pa for {self.TEST}")
+        validate(self)
         if self.wetting != "isotropic" and (self.bridges is None
                                             or self.bridges.water_content is not None):
-            raise ValueError(f"--wetting = {self.wetting!r} needs a wet test at a suction "
-                             "(--suction > 0)")
+            raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
+                       "suction (--suction > 0)")
 
     @property
     def confining(self):
@@ -379,18 +403,11 @@ class PathConfig(LaboratoryConfig):
     ``record_strain``: strain at that rate between two history rows [-] (rows are also
     written at the end of each stage)."""
 
-    inertial_number: float = 3e-4
-    strain_rate: float | None = None
-    record_strain: float = 1e-4
-
-    def __post_init__(self):
-        super().__post_init__()
-        self.inertial_number = check_range("--inertial-number", self.inertial_number, 0.0, 1.0,
-                                           low_inclusive=False)
-        if self.strain_rate is not None:
-            self.strain_rate = check_positive("--strain-rate", self.strain_rate, "1/s")
-        self.record_strain = check_range("--record-strain", self.record_strain,
-                                         MIN_RECORD_STRAIN, MAX_RECORD_STRAIN)
+    inertial_number: float = inertial_number_parameter()
+    strain_rate: float | None = strain_rate_parameter()
+    record_strain: float = parameter(1e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
+                                     flag="--record-strain",
+                                     help="strain between two history rows")
 
     def rate(self):
         """Strain rate of the path's stages [1/s] (quasi_static_rate)."""
@@ -706,12 +723,13 @@ class SwccConfig:
 
 
 def check_particles(particles, low, high, test, why):
-    """``particles`` as an int; ValueError naming --particles outside [low, high], the sample
-    sizes of ``test`` (e.g. 'a triaxial test'), saying ``why`` (the reason for ``low``)."""
-    count = check_int("--particles", particles)
+    """``particles`` as an int; ParameterError naming particles outside [low, high], the
+    sample sizes of ``test`` (e.g. 'a triaxial test'), saying ``why`` (the reason for
+    ``low``)."""
+    count = spec_of(PrepareConfig, "particles").check("particles", particles)
     if not low <= count <= high:
-        raise ValueError(f"--particles = {count} is outside the valid range [{low}, {high}] "
-                         f"for {test}: {why}")
+        raise fail(PrepareConfig, "particles", f"particles = {count} is outside the valid range "
+                   f"[{low}, {high}] for {test}: {why}")
     return count
 
 

@@ -24,14 +24,15 @@ import numpy as np
 
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
-from pendular.dem.grading import check_grading_curve, check_spread, grading, sample_radii
+from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.neighbors import NeighborList, spatial_order
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import TIMESTEP_RULES, critical_timestep, pwave_timestep
-from pendular.utils.validate import check_int, check_positive, check_range
+from pendular.utils.parameters import fail, parameter, spec_of, validate
+from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
 
 
@@ -273,66 +274,77 @@ class PrepareConfig:
     faster than 0.3 at 1,000 and 10,000 spheres (fewer pairs, still rare rebuilds).
     """
 
-    particles: int = 10000
-    radius: float = 0.024e-3
-    radius_spread: float = 0.0
-    psd: tuple | None = None
-    porosity: float = 0.40
-    young: float = 1e6
-    shear_ratio: float = 0.3
-    friction_deg: float = 18.0
-    prep_friction_deg: float = 0.5
-    density: float = 2650.0
-    damping: float = 0.2
-    timestep_safety: float = 0.7
-    timestep_rule: str = "stiffness"
-    prep_stress: float = 5000.0
-    confining: float = 750.0
-    seed: int = 0
-    skin_factor: float = 0.1
-    equilibrium_unbalanced: float = 0.01
-    stress_tolerance: float = 0.01
-    unload_steps: int = 10000
-    periodic: bool = False
+    particles: int = parameter(10000, kind=int, low=2, high=MAX_PARTICLES, flag="--particles",
+                               help="number of spheres")
+    radius: float = parameter(0.024e-3, unit="m", low=RADIUS_RANGE[0], high=RADIUS_RANGE[1],
+                              flag="--radius", help="sphere radius, the mean radius of a graded "
+                              "sample")
+    radius_spread: float = parameter(0.0, low=0.0, high=MAX_RADIUS_SPREAD, flag="--radius-spread",
+                                     help="radii uniform in R(1 ± S), R = --radius")
+    psd: tuple | None = parameter(None, kind=None, help="grading curve ((diameter [m], percent "
+                                  "passing by mass), ...)")
+    porosity: float = parameter(0.40, low=0.30, high=0.60, flag="--porosity",
+                                help="porosity of the initial cloud box (not with --sample)")
+    young: float = parameter(1e6, unit="Pa", low=0.0, low_inclusive=False, flag="--young",
+                             help="YADE young E, kn = E R")
+    shear_ratio: float = parameter(0.3, low=0.0, high=10.0, help="contact stiffness ratio "
+                                   "ks / kn")
+    friction_deg: float = parameter(18.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                    flag="--friction", help="contact friction")
+    prep_friction_deg: float = parameter(
+        0.5, unit="deg", low=0.0, high=90.0, high_inclusive=False, flag="--prep-friction",
+        help="contact friction during the radius growth (thesis 0.5; higher gives a looser "
+             "sample; not with --sample)")
+    density: float = parameter(2650.0, unit="kg/m^3", low=0.0, low_inclusive=False,
+                               help="grain density")
+    damping: float = parameter(0.2, low=0.0, high=1.0, high_inclusive=False, flag="--damping",
+                               help="Cundall local damping")
+    timestep_safety: float = parameter(0.7, low=0.0, high=1.0, low_inclusive=False,
+                                       flag="--timestep-safety",
+                                       help="time step as a fraction of the --timestep-rule "
+                                            "estimate")
+    timestep_rule: str = parameter("stiffness", kind=str, choices=TIMESTEP_RULES,
+                                   flag="--timestep-rule",
+                                   help="time step estimate: the critical step of the contacts "
+                                        "(pendular.dem.timestep; default), or YADE's P-wave "
+                                        "estimate of the smallest sphere")
+    prep_stress: float = parameter(5000.0, unit="Pa", low=0.0, low_inclusive=False,
+                                   help="mean wall stress that ends the radius growth")
+    confining: float = parameter(750.0, unit="Pa", low=0.0, high=1e7, flag="--confining",
+                                 help="isotropic stress the loading starts from, the lateral "
+                                      "stress of a triaxial")
+    seed: int = parameter(0, kind=int, low=0, high=MAX_SEED, flag="--seed",
+                          help="random seed of the sample")
+    skin_factor: float = parameter(0.1, low=0.0, high=2.0, low_inclusive=False,
+                                   flag="--skin-factor",
+                                   help="Verlet skin of the neighbour list / radius")
+    equilibrium_unbalanced: float = parameter(0.01, low=0.0, low_inclusive=False,
+                                              recorded=False,
+                                              help="unbalanced force of a static sample")
+    stress_tolerance: float = parameter(0.01, low=0.0, low_inclusive=False, recorded=False,
+                                        help="relative error of a servoed wall stress at "
+                                             "equilibrium")
+    unload_steps: int = parameter(10000, kind=int, low=20, recorded=False,
+                                  help="steps lowering the stress to the confining stress")
+    periodic: bool = parameter(False, kind=bool, flag="--periodic", recorded=False,
+                               help="a periodic cell instead of six walls: no wall layers; the "
+                                    "cell's stress (Love-Weber, contacts and bridges) servoed "
+                                    "and its lengths driven at the strain rates")
 
     def __post_init__(self):
-        self.particles = check_int("particles", self.particles, low=2, high=MAX_PARTICLES)
-        self.seed = check_int("seed", self.seed, high=MAX_SEED)
-        self.radius_spread = check_spread(self.radius_spread)
+        validate(self)
         if self.psd is not None:
             if self.radius_spread > 0.0:
-                raise ValueError(f"radius_spread = {self.radius_spread:g} and a psd given: "
-                                 "valid is one of them (the grading curve sets the sizes)")
+                raise fail(self, "radius_spread",
+                           f"radius_spread = {self.radius_spread:g} and a psd given: valid is "
+                           "one of them (the grading curve sets the sizes)")
             self.psd = check_grading_curve(self.psd)
-            self.radius = float(np.mean(self.radii()))
-        self.radius = check_range("radius", self.radius, *RADIUS_RANGE, unit="m")
-        self.porosity = check_range("porosity", self.porosity, 0.30, 0.60)
-        self.young = check_positive("young", self.young, "Pa")
-        self.shear_ratio = check_range("shear_ratio", self.shear_ratio, 0.0, 10.0)
-        self.friction_deg = check_range("friction", self.friction_deg, 0.0, 90.0,
-                                        high_inclusive=False, unit="deg")
-        self.prep_friction_deg = check_range("prep_friction", self.prep_friction_deg, 0.0, 90.0,
-                                             high_inclusive=False, unit="deg")
-        self.density = check_positive("density", self.density, "kg/m^3")
-        self.damping = check_range("damping", self.damping, 0.0, 1.0, high_inclusive=False)
-        self.timestep_safety = check_range("timestep_safety", self.timestep_safety, 0.0, 1.0,
-                                           low_inclusive=False)
-        if self.timestep_rule not in TIMESTEP_RULES:
-            raise ValueError(f"timestep_rule = {self.timestep_rule!r}: valid values "
-                             f"{', '.join(TIMESTEP_RULES)}")
-        self.prep_stress = check_positive("prep_stress", self.prep_stress, "Pa")
-        self.confining = check_range("confining", self.confining, 0.0, 1e7, unit="Pa")
-        self.unload_steps = check_int("unload_steps", self.unload_steps, low=20)
-        self.skin_factor = check_range("skin_factor", self.skin_factor, 0.0, 2.0,
-                                       low_inclusive=False)
+            self.radius = spec_of(self, "radius").check("radius", float(np.mean(self.radii())))
         for name in ("prep_stress", "confining"):
-            check_soft_contacts(name, getattr(self, name), self.young)
-        self.equilibrium_unbalanced = check_positive("equilibrium_unbalanced",
-                                                     self.equilibrium_unbalanced)
-        self.stress_tolerance = check_positive("stress_tolerance", self.stress_tolerance)
-        if not isinstance(self.periodic, (bool, np.bool_)):
-            raise ValueError(f"periodic = {self.periodic!r}: valid values True or False")
-        self.periodic = bool(self.periodic)
+            try:
+                check_soft_contacts(name, getattr(self, name), self.young)
+            except ValueError as error:
+                raise fail(self, name, str(error)) from None
 
     @property
     def graded(self):

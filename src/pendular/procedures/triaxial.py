@@ -39,6 +39,7 @@ from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
+from pendular.utils.parameters import flat_options
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
@@ -440,24 +441,15 @@ def check_device(config, device):
 def parameters(config):
     """Flat name -> value of a configuration (TriaxialConfig, OedometerConfig,
     IsotropicConfig), named as the command's options (history file attributes, campaign
-    tables)."""
-    sample, bridges = config.sample, config.bridges
-    flat = {"particles": sample.particles, "radius": sample.radius,
-            "radius_spread": sample.radius_spread, "psd": sample.psd,
-            "porosity": sample.porosity,
-            "young": sample.young, "shear_ratio": sample.shear_ratio,
-            "friction": sample.friction_deg, "prep_friction": sample.prep_friction_deg,
-            "density": sample.density, "damping": sample.damping,
-            "timestep_safety": sample.timestep_safety, "timestep_rule": sample.timestep_rule,
-            "prep_stress": sample.prep_stress,
-            "confining": sample.confining, "seed": sample.seed, "skin_factor": sample.skin_factor}
+    tables): the sample's and the shear's from their fields' Parameters; the rest, values
+    derived from the fields (the suction, the water content in %), in the columns' order of
+    earlier campaign tables."""
+    bridges = config.bridges
+    flat = flat_options(config.sample)          # the recorded fields, keyed by their options
     if isinstance(config, TriaxialConfig):
-        shear = config.shear
-        flat.update({"max_strain": shear.max_strain, "inertial_number": shear.inertial_number,
-                     "strain_rate": shear.strain_rate, "records": shear.records})
-        if not shear.conventional:          # a conventional run's rows stay as they were
-            flat.update({"direction": shear.direction, "b": shear.b,
-                         "constant_p": shear.constant_p})
+        # a conventional run's rows stay as they were, without the path's options
+        flat.update(flat_options(config.shear, () if not config.shear.conventional else
+                                 ("direction", "b", "constant_p")))
     else:
         if isinstance(config, OedometerConfig):
             flat.update({"axial_stress": config.axial_stress, "unload_to": config.unload_to})

@@ -29,7 +29,9 @@ import numpy as np
 
 from pendular.capillary import CapillaryBridges
 from pendular.utils.atomic import replacing
+from pendular.utils.parameters import default_of
 from pendular.dem.measure import kinetic_energy
+from pendular.procedures.config import BridgeConfig
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from pendular.dem.state import Particles, Walls
 from pendular.homogenize import capillary_force_stress, contact_stress
@@ -38,8 +40,10 @@ from pendular.io.outputs import OutputFolder
 
 #: The base case; every case changes one of these (``water`` is the formation suction [Pa] of
 #: volume-controlled bridges, None for suction control).
-BASE = {"suction": 30000.0, "contact_angle": 0.0, "radius": 0.024e-3, "young": 1e6,
-        "timestep_safety": 0.7, "particles": 60, "confining": 750.0, "water": None}
+BASE = {"suction": 30000.0, "contact_angle": default_of(BridgeConfig, "contact_angle"),
+        **{name: default_of(PrepareConfig, name) for name in ("radius", "young",
+                                                              "timestep_safety")},
+        "particles": 60, "confining": default_of(PrepareConfig, "confining"), "water": None}
 
 #: Values per parameter: (valid values, out-of-range values that must be refused).
 GRID = {

@@ -57,6 +57,7 @@ from pendular.utils.atomic import write_json, write_text
 from pendular.procedures.preparation import MAX_SEED, PrepareConfig
 from pendular.dem.sample import load_sample
 from pendular.utils.threads import use_threads
+from pendular.utils.parameters import option_field
 from pendular.utils.validate import check_int, check_range
 
 from pendular.procedures.config import sample_made_with
@@ -69,16 +70,6 @@ from pendular.procedures.triaxial import TriaxialTest
 
 SUCTION = 30000.0
 CONFINING = 750.0
-#: Knob -> (part of the TriaxialConfig, field of that part) it sets.
-KNOB_FIELDS = {"timestep_safety": ("sample", "timestep_safety"),
-               "timestep_rule": ("sample", "timestep_rule"),
-               "inertial_number": ("shear", "inertial_number"),
-               "damping": ("sample", "damping"),
-               "particles": ("sample", "particles"),
-               "table_resolution": ("bridges", "table_resolution"),
-               "bridges": ("bridges", "model"),
-               "records": ("shear", "records"),
-               "skin_factor": ("sample", "skin_factor")}
 #: The exact bridge table of the default run (nodes in suction, in distance).
 DEFAULT_TABLE = (350, 80)
 #: What the slow, fine reference changes in the default run.
@@ -94,6 +85,10 @@ KNOBS = {"timestep_safety": [0.3, 0.5, 0.7, 0.9],
          "bridges": ["exact", "toroidal"],
          "records": [50, 500, 2000],
          "skin_factor": [0.1, 0.3, 0.6, 1.0]}
+#: Knob -> (part of the TriaxialConfig, field of that part) it sets, found by the option that
+#: names the field (e.g. 'bridges' -> ('bridges', 'model')).
+KNOB_FIELDS = {knob: option_field(knob, {"sample": PrepareConfig, "shear": ShearConfig,
+                                         "bridges": BridgeConfig}) for knob in KNOBS}
 QUICK_KNOBS = {"timestep_safety": [0.5, 0.7, 0.9], "inertial_number": [3e-4, 1e-3, 3e-3],
                "table_resolution": [(50, 20), (100, 40), (350, 80)]}
 #: Error bounds of the recommendations.

@@ -25,13 +25,13 @@ import sys
 
 from pendular.procedures.preparation import PrepareConfig
 from pendular.dem.simulation import DEVICES
-from pendular.dem.timestep import TIMESTEP_RULES
+from pendular.utils.parameters import add_options
 from pendular.utils.validate import check_int, check_range
 
 from pendular.cli import (INTERRUPTED, UsageError, add_run_options, add_size_options, positive_int,
     print_summary, set_threads, sizes_from)
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN, MAX_RECORDS,
-    MIN_AXIAL_STRAIN, SHEAR_DIRECTIONS, WETTING_PROTOCOLS, BridgeConfig, LaboratoryConfig,
+    MIN_AXIAL_STRAIN, BridgeConfig, LaboratoryConfig,
     ShearConfig, TriaxialConfig, check_steps_count)
 from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device
 
@@ -54,90 +54,34 @@ WET_ONLY = {"contact_angle": None, "table_resolution": None, "bridges": None,
 def add_arguments(parser):
     add_sample_options(parser)
     add_wetting_options(parser)
-    parser.add_argument("--max-strain", type=float, default=0.25,
-                        help=f"final axial strain [-], at most {MAX_AXIAL_STRAIN:g} (in "
-                             "extension, the magnitude of the axial extension)")
-    parser.add_argument("--direction", choices=SHEAR_DIRECTIONS, default="compression",
-                        help="axial walls pushed in (compression) or pulled apart "
-                             "(extension), the lateral stress held")
-    parser.add_argument("--b", type=float, default=None,
-                        help="true triaxial compression: hold b = (s2 - s3) / (s1 - s3) in "
-                             "[0, 1], s1 axial, s3 = --confining on x, s2 on y (default: "
-                             "s2 = s3)")
-    parser.add_argument("--constant-p", action="store_true",
-                        help="hold the mean stress p at --confining while q rises (the "
-                             "lateral stresses follow the axial one)")
+    add_options(parser, ShearConfig, ("max_strain", "direction", "b", "constant_p"))
     add_rate_options(parser)
-    parser.add_argument("--records", type=int, default=None,
-                        help=f"history rows over the test (default {ShearConfig.records}; at "
-                             "most one a step)")
+    add_options(parser, ShearConfig, ("records",))
     add_output_options(parser, "runs/triaxial", frames=True)
 
 
 def add_sample_options(parser):
     """The sample's options (preparation and material, or a prepared --sample)."""
-    parser.add_argument("--particles", type=int, default=10000, help="number of spheres")
-    parser.add_argument("--confining", type=float, default=750.0,
-                        help="isotropic stress the loading starts from, the lateral stress of "
-                             "a triaxial [Pa]")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
-    parser.add_argument("--periodic", action="store_true",
-                        help="a periodic cell instead of six walls: no wall layers; the cell's "
-                             "stress (Love-Weber, contacts and bridges) servoed and its "
-                             "lengths driven at the strain rates")
+    add_options(parser, PrepareConfig, ("particles", "confining", "seed", "periodic"))
     add_size_options(parser, PrepareConfig.radius)
-    parser.add_argument("--porosity", type=float, default=0.40,
-                        help="porosity of the initial cloud box [-] (0.30-0.60; not with "
-                             "--sample)")
-    parser.add_argument("--friction", type=float, default=18.0,
-                        help="contact friction [deg]")
-    parser.add_argument("--prep-friction", type=float, default=0.5,
-                        help="contact friction during the radius growth [deg] (thesis 0.5; "
-                             "higher gives a looser sample; not with --sample)")
-    parser.add_argument("--young", type=float, default=1e6,
-                        help="YADE young E [Pa], kn = E R")
-    parser.add_argument("--damping", type=float, default=0.2,
-                        help="Cundall local damping [-]")
-    parser.add_argument("--timestep-safety", type=float, default=0.7,
-                        help="time step as a fraction of the --timestep-rule estimate [-]")
-    parser.add_argument("--timestep-rule", choices=TIMESTEP_RULES, default="stiffness",
-                        help="time step estimate: the critical step of the contacts "
-                             "(pendular.dem.timestep; default), or YADE's P-wave estimate of the "
-                             "smallest sphere")
-    parser.add_argument("--skin-factor", type=float, default=0.1,
-                        help="Verlet skin of the neighbour list / radius (0, 2]")
-    parser.add_argument("--sample", metavar="PATH", default=None,
-                        help="start from this prepared sample (sample.h5) instead of "
-                             "preparing one")
+    add_options(parser, PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg", "young",
+                                        "damping", "timestep_safety", "timestep_rule",
+                                        "skin_factor"))
+    add_options(parser, LaboratoryConfig, ("sample_path",))
 
 
 def add_wetting_options(parser):
     """The options of a wet test (at a suction or a water content)."""
     parser.add_argument("--suction", type=float, default=0.0,
                         help="matric suction [Pa] (0: dry)")
-    parser.add_argument("--contact-angle", type=float, default=None,
-                        help="wetting angle [deg] (wet test; default 0)")
-    parser.add_argument("--bridges", choices=("exact", "toroidal"), default=None,
-                        help="bridge model of the wet test: exact Young-Laplace tables "
-                             "(default) or the toroidal approximation (equal spheres)")
-    parser.add_argument("--surface-tension", type=float, default=None,
-                        help="liquid surface tension [N/m] (wet test; default 0.073)")
+    add_options(parser, BridgeConfig, ("contact_angle", "model", "surface_tension"))
     parser.add_argument("--water-content", type=float, default=None,
                         help="gravimetric water content [%%] held by volume-controlled bridges "
                              "at constant liquid volume, instead of --suction")
-    parser.add_argument("--liquid", choices=("shared", "lost"), default=None,
-                        help="with --water-content: the liquid of a ruptured bridge goes to its "
-                             "grains' other bridges (shared, default) or is lost")
-    parser.add_argument("--wetting", choices=WETTING_PROTOCOLS, default="isotropic",
-                        help="when bridges appear (--suction): added to the static sample and "
-                             "re-equilibrated (isotropic), switched on at the first loading "
-                             "step (at-shear), or added with the walls fixed, then servoed "
-                             "(constant-volume)")
-    parser.add_argument("--persist-bridges", action="store_true",
-                        help="bridges live up to their rupture distance instead of breaking "
-                             "when contact is lost")
-    parser.add_argument("--wet-steps", type=int, default=200000,
-                        help="most steps to equilibrate the wetted (or loaded) sample [-]")
+    add_options(parser, BridgeConfig, ("liquid",))
+    add_options(parser, LaboratoryConfig, ("wetting",))
+    add_options(parser, BridgeConfig, ("persist",))
+    add_options(parser, LaboratoryConfig, ("wet_steps",))
     parser.add_argument("--table-resolution", metavar="NS,ND", default=None,
                         help="bridge table nodes in suction and in distance (exact default "
                              "350,80; toroidal 64,80)")
@@ -145,10 +89,7 @@ def add_wetting_options(parser):
 
 def add_rate_options(parser):
     """The loading rate: an inertial number or a strain rate."""
-    parser.add_argument("--inertial-number", type=float, default=3e-4,
-                        help="target inertial number setting the strain rate [-]")
-    parser.add_argument("--strain-rate", type=float, default=None,
-                        help="axial strain rate [1/s] (overrides --inertial-number)")
+    add_options(parser, ShearConfig, ("inertial_number", "strain_rate"))
 
 
 def add_output_options(parser, out, frames=True):

@@ -1,0 +1,217 @@
+"""Parameters declared once: a configuration field carries its unit, valid range, help text and
+command-line flag as metadata (``parameter``); from it ``validate`` checks a configuration,
+``add_options`` makes the command-line options and ``flat_options`` the flat rows of a run.
+
+Errors name the field in Python and tables (``particles = 1 is outside the valid range [2,
+...]``); ``ParameterError`` carries the field's name and flag, so that the command line names
+the option the user typed instead (``ParameterError.on_command_line``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from pendular.utils.validate import check_int, check_range
+
+#: Key of a field's Parameter in its dataclasses metadata.
+METADATA_KEY = "pendular.parameter"
+
+
+class ParameterError(ValueError):
+    """A configuration value outside its valid set; the message starts with the field's
+    ``name``, ``flag`` is the command-line option that sets it (None without one)."""
+
+    def __init__(self, name, message, flag=None):
+        super().__init__(message)
+        self.name = name
+        self.flag = flag
+
+    def named(self, label):
+        """The message with its leading field name replaced by ``label`` (a flag, a table key)."""
+        text = str(self)
+        return label + text[len(self.name):] if text.startswith(self.name) else text
+
+    @property
+    def key(self):
+        """The name of a table key or flat row: the flag's (``--prep-friction`` ->
+        prep_friction), else the field's."""
+        return self.flag[2:].replace("-", "_") if self.flag else self.name
+
+    def on_command_line(self):
+        """The message as the command line says it: naming the flag."""
+        return self.named(self.flag) if self.flag else str(self)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """What a configuration field declares (``parameter`` makes one): ``unit`` ('1' for
+    dimensionless), valid range [low, high] (bounds open with ``*_inclusive`` False, None for
+    none), ``choices`` of a text field, ``kind`` (float, int, str, bool; None: checked by hand
+    in the configuration), command-line ``flag``, ``help`` (without unit or range: added from
+    these), ``unset``: the option's default is None, meaning the configuration's default
+    (stated in the help), ``metavar`` of the option, ``recorded``: one of a run's flat options
+    (``flat_options``)."""
+
+    unit: str
+    help: str
+    low: float | None = None
+    high: float | None = None
+    low_inclusive: bool = True
+    high_inclusive: bool = True
+    flag: str | None = None
+    choices: tuple | None = None
+    kind: type | None = float
+    unset: bool = False
+    metavar: str | None = None
+    recorded: bool = True
+
+    def valid_range(self):
+        """The range as errors and help state it, e.g. '(0, 1]'."""
+        text = (lambda bound: str(int(bound))) if self.kind is int else "{:g}".format
+        low = "-inf" if self.low is None else text(self.low)
+        high = "inf" if self.high is None else text(self.high)
+        return (f"{'[' if self.low_inclusive else '('}{low}, {high}"
+                f"{']' if self.high_inclusive else ')'}")
+
+    def key(self, name):
+        """The field's name in flat rows and tables: its option's (``--prep-friction`` ->
+        prep_friction), else the field's ``name``."""
+        return self.flag[2:].replace("-", "_") if self.flag else name
+
+    def check(self, name, value, optional=False):
+        """``value`` of field ``name`` converted to its kind (ParameterError outside the
+        parameter's valid set); None passes where ``optional``."""
+        if (value is None and optional) or self.kind is None:
+            return value
+        if self.kind is bool:
+            if not isinstance(value, (bool, np.bool_)):
+                raise ParameterError(name, f"{name} = {value!r}: valid values True or False",
+                                     self.flag)
+            return bool(value)
+        if self.choices is not None:
+            if value not in self.choices:
+                raise ParameterError(name, f"{name} = {value!r} is not one of {self.choices}",
+                                     self.flag)
+            return value
+        try:
+            if self.kind is int:
+                return check_int(name, value, low=0 if self.low is None else int(self.low),
+                                 high=None if self.high is None else int(self.high))
+            if self.kind is float:
+                return check_range(name, value, -math.inf if self.low is None else self.low,
+                                   math.inf if self.high is None else self.high,
+                                   low_inclusive=self.low_inclusive,
+                                   high_inclusive=self.high_inclusive,
+                                   unit="" if self.unit == "1" else self.unit)
+        except ValueError as error:
+            raise ParameterError(name, str(error), self.flag) from None
+        return value
+
+    def option_help(self, default):
+        """The option's help: text, unit, range, and the configuration's ``default`` where
+        the option's own is None (``unset``)."""
+        text = self.help
+        if self.kind in (int, float):
+            text += f" [{'-' if self.unit == '1' else self.unit}]"
+            if self.low is not None or self.high is not None:
+                text += f", valid range {self.valid_range()}"
+        if self.unset and "default" not in text:
+            text += f" (default {default:g})" if isinstance(default, float) else \
+                f" (default {default})"
+        return text.replace("%", "%%")
+
+
+def parameter(default=dataclasses.MISSING, *, unit="1", help, low=None, high=None,
+              low_inclusive=True, high_inclusive=True, flag=None, choices=None, kind=float,
+              unset=False, metavar=None, recorded=True):
+    """A dataclass field of ``default`` declaring its Parameter (see there) in its metadata."""
+    if kind is int and not (low_inclusive and high_inclusive):
+        raise ValueError(f"{help}: integer ranges are closed")
+    spec = Parameter(unit, help, low, high, low_inclusive, high_inclusive, flag,
+                     None if choices is None else tuple(choices), kind, unset, metavar, recorded)
+    return dataclasses.field(default=default, metadata={METADATA_KEY: spec})
+
+
+def spec_of(config, name):
+    """The Parameter of field ``name`` of the dataclass (or instance) ``config``; KeyError
+    for a field that declares none."""
+    for item in dataclasses.fields(config):
+        if item.name == name:
+            return item.metadata[METADATA_KEY]
+    raise KeyError(f"{type(config).__name__ if not isinstance(config, type) else config.__name__}"
+                   f" has no field {name!r}")
+
+
+def parameters_of(config):
+    """(field, Parameter) of the fields of ``config`` that declare one, in field order."""
+    return [(item, item.metadata[METADATA_KEY]) for item in dataclasses.fields(config)
+            if METADATA_KEY in item.metadata]
+
+
+def validate(config):
+    """Check and convert every declared field of the dataclass instance ``config`` in place
+    (ParameterError naming the first field outside its valid set); a field whose default is
+    None may be None. Cross-field checks stay in the configuration's ``__post_init__``."""
+    for item, spec in parameters_of(config):
+        setattr(config, item.name, spec.check(item.name, getattr(config, item.name),
+                                              optional=item.default is None))
+
+
+def fail(config, name, message):
+    """ParameterError of field ``name`` of ``config`` (``message`` starts with the name)."""
+    return ParameterError(name, message, spec_of(config, name).flag)
+
+
+def default_of(config, name):
+    """The default of field ``name`` of the dataclass ``config``."""
+    item = next(item for item in dataclasses.fields(config) if item.name == name)
+    if item.default_factory is not dataclasses.MISSING:
+        return item.default_factory()
+    return item.default
+
+
+def add_options(parser, config, names):
+    """Add to ``parser`` the options of fields ``names`` of the dataclass ``config`` from their
+    Parameters: flag, type, choices, default (the field's, or None where ``unset``) and help
+    with unit and range. Each action records its field as ``action.parameter`` = (config,
+    name)."""
+    for name in names:
+        spec = spec_of(config, name)
+        default = default_of(config, name)
+        options = {"help": spec.option_help(default)}
+        if spec.kind is bool:
+            if default is not False:
+                raise ValueError(f"{config.__name__}.{name}: a flag's default is False")
+            options["action"] = "store_true"
+        else:
+            options["default"] = None if spec.unset else default
+            if spec.choices is not None:
+                options["choices"] = spec.choices
+            elif spec.kind in (int, float):
+                options["type"] = spec.kind
+            if spec.metavar is not None:
+                options["metavar"] = spec.metavar
+        action = parser.add_argument(spec.flag, **options)
+        action.parameter = (config, name)
+
+
+def flat_options(config, exclude=()):
+    """Flat key -> value of the recorded fields of the dataclass instance ``config`` (keys as
+    its options are named, Parameter.key), in field order, but ``exclude`` (keys)."""
+    return {spec.key(item.name): getattr(config, item.name)
+            for item, spec in parameters_of(config)
+            if spec.recorded and spec.key(item.name) not in exclude}
+
+
+def option_field(key, parts):
+    """(part, field) of the flat option ``key`` in a configuration whose nested parts are
+    ``parts`` (part name -> dataclass), e.g. 'friction' -> ('sample', 'friction_deg')."""
+    for part, kind in parts.items():
+        for item, spec in parameters_of(kind):
+            if spec.key(item.name) == key:
+                return part, item.name
+    raise KeyError(f"{key!r} is not an option of {', '.join(parts)}")

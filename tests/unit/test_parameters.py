@@ -1,0 +1,155 @@
+"""Parameters declared once (pendular.utils.parameters): a field's metadata drives its
+validation, its command-line option, its flat key and its unit; errors name the field in Python
+and tables and the flag on the command line."""
+
+import dataclasses
+import math
+
+import pytest
+
+from pendular.cli import command_parser, main
+from pendular.cli.tables import sweep_from_table
+from pendular.io.schema import OPTION_UNITS
+from pendular.procedures.config import (BridgeConfig, LaboratoryConfig, PathConfig, ShearConfig,
+    TriaxialConfig)
+from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
+from pendular.utils.parameters import (ParameterError, default_of, parameters_of, spec_of,
+    validate)
+
+#: (config, field, low, high, low inclusive, high inclusive)
+BOUNDS = [
+    (PrepareConfig, "porosity", 0.30, 0.60, True, True),
+    (PrepareConfig, "damping", 0.0, 1.0, True, False),
+    (PrepareConfig, "timestep_safety", 0.0, 1.0, False, True),
+    (PrepareConfig, "friction_deg", 0.0, 90.0, True, False),
+    (PrepareConfig, "particles", 2, MAX_PARTICLES, True, True),
+    (ShearConfig, "inertial_number", 0.0, 1.0, False, True),
+    (BridgeConfig, "contact_angle", 0.0, 90.0, True, False),
+]
+#: The options of ``pendular triaxial`` made from their fields' metadata.
+GENERATED = {"particles", "confining", "seed", "periodic", "porosity", "friction",
+             "prep_friction", "young", "damping", "timestep_safety", "timestep_rule",
+             "skin_factor", "sample", "contact_angle", "bridges", "surface_tension", "liquid",
+             "wetting", "persist_bridges", "wet_steps", "max_strain", "direction", "b",
+             "constant_p", "inertial_number", "strain_rate", "records"}
+LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
+
+
+def build(config, name, value):
+    """``config`` with field ``name`` = ``value`` (the bridges at a suction)."""
+    return config(**({"suction": 1e4} if config is BridgeConfig else {}), **{name: value})
+
+
+def nudge(value, up):
+    """The next float (integer) above or below ``value``."""
+    if isinstance(value, int):
+        return value + (1 if up else -1)
+    return math.nextafter(value, math.inf if up else -math.inf)
+
+
+@pytest.mark.parametrize("config, name, low, high, low_inclusive, high_inclusive", BOUNDS)
+def test_the_metadata_bounds_are_the_validation_bounds(config, name, low, high, low_inclusive,
+                                                       high_inclusive):
+    spec = spec_of(config, name)
+    assert (spec.low, spec.high, spec.low_inclusive, spec.high_inclusive) == (
+        low, high, low_inclusive, high_inclusive)
+    for bound, inclusive, outward in ((low, low_inclusive, False), (high, high_inclusive, True)):
+        if inclusive:
+            assert getattr(build(config, name, bound), name) == bound
+        else:
+            with pytest.raises(ParameterError, match=rf"^{name} = .* is outside the valid range"):
+                build(config, name, bound)
+        inside = nudge(bound, not outward)
+        assert getattr(build(config, name, inside), name) == inside
+        with pytest.raises(ParameterError) as refused:
+            build(config, name, nudge(bound, outward))
+        assert refused.value.name == name and str(refused.value).startswith(f"{name} = ")
+
+
+def test_validate_converts_and_refuses_by_kind():
+    sample = PrepareConfig(particles=300.0, seed=3)
+    assert type(sample.particles) is int and sample.particles == 300
+    with pytest.raises(ParameterError, match=r"^timestep_rule = 'fast' is not one of"):
+        PrepareConfig(timestep_rule="fast")
+    with pytest.raises(ParameterError, match=r"^periodic = 'yes': valid values True or False"):
+        PrepareConfig(periodic="yes")
+    sample.damping = math.nan                   # validate checks an existing instance too
+    with pytest.raises(ParameterError, match=r"^damping = nan is not finite"):
+        validate(sample)
+
+
+def test_python_names_the_field_and_the_command_line_the_flag(capsys):
+    with pytest.raises(ParameterError, match=r"^friction_deg = 95.0 deg is outside the valid "
+                                             r"range \[0, 90\) deg$"):
+        PrepareConfig(friction_deg=95.0)
+    with pytest.raises(ParameterError, match=r"^particles = 20 is outside the valid range "
+                                             r"\[50, "):
+        TriaxialConfig(sample=PrepareConfig(particles=20))
+    for argv, expected in (("--friction=95", "--friction = 95.0 deg is outside"),
+                           ("--particles=20", "--particles = 20 is outside the valid range [50, "),
+                           ("--inertial-number=2", "--inertial-number = 2.0 is outside the valid "
+                                                   "range (0, 1]")):
+        with pytest.raises(SystemExit) as stop:
+            main(["triaxial", argv])
+        assert stop.value.code == 2
+        line = capsys.readouterr().err.strip()
+        assert line.startswith("pendular triaxial: error: " + expected), line
+        assert "\n" not in line
+
+
+def test_a_table_names_its_key(tmp_path):
+    table = tmp_path / "t.toml"
+    table.write_text('command = "triaxial"\n[fixed]\nparticles = 60\n[sweep]\n'
+                     'prep_friction = [0.5, 95]\n')
+    with pytest.raises(ValueError, match=r"prep_friction = 95 \(\[sweep\]\): prep_friction = "
+                                         r"95.0 deg is outside the valid range \[0, 90\) deg"):
+        sweep_from_table(table)
+
+
+@pytest.mark.parametrize("command", LOADING_COMMANDS)
+def test_generated_options_hold_the_dataclass_defaults(command):
+    parser, _ = command_parser(command)
+    generated = [action for action in parser._actions if hasattr(action, "parameter")]
+    if command == "triaxial":       # an option written by hand instead would be missing here
+        assert {action.dest for action in generated} == GENERATED
+    for action in generated:
+        if action.dest in parser._defaults:     # a command's own set_defaults (simple shear)
+            continue
+        config, name = action.parameter
+        spec = spec_of(config, name)
+        assert action.option_strings == [spec.flag]
+        assert action.default == (None if spec.unset else default_of(config, name)), spec.flag
+        if spec.choices is not None:
+            assert tuple(action.choices) == spec.choices
+        elif spec.kind in (int, float):
+            assert action.type is spec.kind
+
+
+def test_help_states_units_and_ranges():
+    parser, _ = command_parser("triaxial")
+    text = parser.format_help()
+    for action in parser._actions:
+        if not hasattr(action, "parameter"):
+            continue
+        spec = spec_of(*action.parameter)
+        if spec.kind is float:
+            unit = "-" if spec.unit == "1" else spec.unit
+            assert f"[{unit}], valid range {spec.valid_range()}" in " ".join(
+                parser._get_formatter()._expand_help(action).split()), spec.flag
+    assert "[Pa], valid range [0, 1e+07]" in " ".join(text.split())     # --confining
+
+
+def test_option_units_follow_the_metadata():
+    for config in (PrepareConfig, ShearConfig, BridgeConfig, LaboratoryConfig, PathConfig):
+        for item, spec in parameters_of(config):
+            if spec.recorded and spec.kind in (int, float) and spec.key(item.name) in OPTION_UNITS:
+                assert OPTION_UNITS[spec.key(item.name)] == spec.unit, item.name
+    for item, spec in parameters_of(PrepareConfig) + parameters_of(ShearConfig):
+        if spec.recorded and spec.kind in (int, float):
+            assert spec.key(item.name) in OPTION_UNITS, item.name
+
+
+def test_every_field_of_the_configurations_declares_a_parameter():
+    for config in (PrepareConfig, ShearConfig, BridgeConfig):
+        assert [item.name for item in dataclasses.fields(config)] == [
+            item.name for item, _ in parameters_of(config)]
