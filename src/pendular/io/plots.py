@@ -409,6 +409,8 @@ def plot_simple_shear(history, path, title=""):
     top.set_ylabel("shear stress τ [kPa]")
     middle.plot(gamma, normal, color="C1")
     middle.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
+    middle.ticklabel_format(axis="y", useOffset=False)
+    middle.set_ylim(0.0, 1.1 * max(float(np.max(normal)), 0.0) or 1.0)   # held: a flat line
     bottom.plot(gamma, 100.0 * (1.0 - volume / volume[0]), color="C2")
     bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
     bottom.set_xlabel("shear strain γ [%]")
