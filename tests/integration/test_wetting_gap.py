@@ -100,5 +100,5 @@ def test_wetting_without_a_gap_wets_the_contacts_only(tmp_path):
 def test_a_formation_gap_out_of_range_is_refused_naming_it():
     from pendular.procedures.config import TensionConfig
 
-    with pytest.raises(ValueError, match="--form-gap"):
+    with pytest.raises(ValueError, match="^form_gap = 1.5 is outside"):
         TensionConfig(form_gap=1.5)

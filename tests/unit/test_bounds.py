@@ -109,7 +109,7 @@ def test_tension_frames_beyond_the_pull_are_refused(capsys, tmp_path):
     assert "dtype" not in line
     refused_by(capsys, "tension", TENSION + ["--max-strain", "1e-5"] + out,
             "--vtk-frames = 20", "the pull to --max-strain 1e-05")
-    with pytest.raises(ValueError, match="--vtk-every"):
+    with pytest.raises(ValueError, match="^vtk_every = "):
         TensionConfig(cases=[(0.72, 0.01)], vtk_every=steps + 1)
     assert TensionConfig(cases=[(0.72, 0.01)], vtk_every=steps).vtk_every == steps
     assert not (tmp_path / "t").exists()
@@ -127,7 +127,7 @@ def test_repeated_list_values_are_refused(option, value, repeated, capsys, tmp_p
 
 def test_cases_sharing_a_folder_are_refused():
     assert case_name(0.721, 0.01) == case_name(0.722, 0.01) == "e0.72_w1.00"
-    with pytest.raises(ValueError, match=r"--void-ratio / --water-content: .*\(e 0\.721, w 1 %\) "
+    with pytest.raises(ValueError, match=r"^cases: .*\(e 0\.721, w 1 %\) "
                                          r".*share the folder e0\.72_w1\.00"):
         TensionConfig(cases=[(0.721, 0.01), (0.722, 0.01)])
     assert len(TensionConfig(cases=[(0.72, 0.01), (0.58, 0.01)]).cases) == 2
@@ -138,7 +138,7 @@ def test_options_a_mode_ignores_are_refused(capsys, tmp_path):
     for depth in ("2", "1"):                  # the default, given, is ignored all the same
         refused_by(capsys, "tension", TENSION + ["--periodic", "--grip-depth", depth] + out,
                 f"--grip-depth = {depth}", "--periodic", "no grips")
-    with pytest.raises(ValueError, match="--grip-depth = 2 does not apply to --periodic"):
+    with pytest.raises(ValueError, match="^grip_depth = 2 does not apply to --periodic"):
         TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(periodic=True),
                       grip_depth=2.0)
     assert TensionConfig(cases=[(0.72, 0.01)],

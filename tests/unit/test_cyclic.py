@@ -47,8 +47,8 @@ def test_the_configuration_takes_one_amplitude_and_round_trips_through_json():
     for fields, words in (({}, "give exactly one"),
                           ({"amplitude_q": 1.0, "amplitude_strain": 1e-3}, "give exactly one"),
                           ({"amplitude_q": 500.0}, "(0, 500) Pa"),
-                          ({"amplitude_strain": 0.0}, "--amplitude-strain = 0.0"),
-                          ({"amplitude_q": 100.0, "cycles": 0}, "--cycles = 0")):
+                          ({"amplitude_strain": 0.0}, "amplitude_strain = 0.0"),
+                          ({"amplitude_q": 100.0, "cycles": 0}, "cycles = 0")):
         with pytest.raises(ValueError, match=words.replace("(", r"\(").replace(")", r"\)")):
             CyclicConfig(sample=sample, **fields)
 

@@ -10,8 +10,9 @@ import pytest
 from pendular.cli import command_parser, main
 from pendular.cli.tables import sweep_from_table
 from pendular.io.schema import OPTION_UNITS
-from pendular.procedures.config import (BridgeConfig, LaboratoryConfig, PathConfig, ShearConfig,
-    TriaxialConfig)
+from pendular.procedures.config import (BridgeConfig, CyclicConfig, IsotropicConfig,
+    LaboratoryConfig, OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig,
+    TablePathConfig, TensionConfig, TriaxialConfig, tension_sample)
 from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
 from pendular.utils.parameters import (ParameterError, default_of, parameters_of, spec_of,
     validate)
@@ -33,6 +34,29 @@ GENERATED = {"particles", "confining", "seed", "periodic", "porosity", "friction
              "wetting", "persist_bridges", "wet_steps", "max_strain", "direction", "b",
              "constant_p", "inertial_number", "strain_rate", "records"}
 LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
+#: The sample and wetting options every laboratory command shares (generated on the triaxial).
+LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "records",
+                          "inertial_number", "strain_rate"}
+RATE = {"inertial_number", "strain_rate"}
+#: Each command's own options made from their fields' metadata: an option written by hand
+#: instead would be missing.
+OWN_GENERATED = {
+    "oedometer": {"axial_stress", "unload_to", "record_strain"} | RATE,
+    "isotropic": {"stage_steps", "record_strain"} | RATE,
+    "cyclic": {"amplitude_q", "amplitude_strain", "cycles", "record_strain"} | RATE,
+    "path": {"record_strain", "records"} | RATE,
+    "simple-shear": {"normal_stress", "constant_volume", "max_strain", "inertial_number",
+                     "shear_rate", "record_strain", "stage_steps"},
+    "tension": {"roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
+                "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames"},
+    "swcc": {"confining", "contact_angle", "surface_tension", "form_gap", "stage_steps",
+             "record_every", "friction", "prep_friction", "seed"},
+}
+#: Configurations whose every field declares a Parameter, but their nested configurations.
+DECLARED = (PrepareConfig, ShearConfig, BridgeConfig, LaboratoryConfig, PathConfig,
+            OedometerConfig, IsotropicConfig, CyclicConfig, TablePathConfig, SimpleShearConfig,
+            TensionConfig, SwccConfig)
+NESTED = {"sample", "bridges", "shear"}
 
 
 def build(config, name, value):
@@ -106,12 +130,15 @@ def test_a_table_names_its_key(tmp_path):
         sweep_from_table(table)
 
 
-@pytest.mark.parametrize("command", LOADING_COMMANDS)
+@pytest.mark.parametrize("command", LOADING_COMMANDS + ("tension", "swcc"))
 def test_generated_options_hold_the_dataclass_defaults(command):
     parser, _ = command_parser(command)
     generated = [action for action in parser._actions if hasattr(action, "parameter")]
     if command == "triaxial":       # an option written by hand instead would be missing here
         assert {action.dest for action in generated} == GENERATED
+    else:
+        shared = LABORATORY if command in LOADING_COMMANDS else set()
+        assert {action.dest for action in generated} == shared | OWN_GENERATED[command]
     for action in generated:
         if action.dest in parser._defaults:     # a command's own set_defaults (simple shear)
             continue
@@ -140,7 +167,7 @@ def test_help_states_units_and_ranges():
 
 
 def test_option_units_follow_the_metadata():
-    for config in (PrepareConfig, ShearConfig, BridgeConfig, LaboratoryConfig, PathConfig):
+    for config in DECLARED:
         for item, spec in parameters_of(config):
             if spec.recorded and spec.kind in (int, float) and spec.key(item.name) in OPTION_UNITS:
                 assert OPTION_UNITS[spec.key(item.name)] == spec.unit, item.name
@@ -150,6 +177,72 @@ def test_option_units_follow_the_metadata():
 
 
 def test_every_field_of_the_configurations_declares_a_parameter():
-    for config in (PrepareConfig, ShearConfig, BridgeConfig):
-        assert [item.name for item in dataclasses.fields(config)] == [
-            item.name for item, _ in parameters_of(config)]
+    for config in DECLARED:
+        assert [item.name for item in dataclasses.fields(config) if item.name not in NESTED] == [
+            item.name for item, _ in parameters_of(config)], config.__name__
+
+
+SMALL = PrepareConfig(particles=100)
+
+
+@pytest.mark.parametrize("command, argv, expected", [
+    ("oedometer", [], OedometerConfig()),
+    ("isotropic", [], IsotropicConfig()),
+    ("simple-shear", [], SimpleShearConfig(sample=PrepareConfig(periodic=True))),
+    ("cyclic", ["--amplitude-q=300"], CyclicConfig(amplitude_q=300.0)),
+    ("tension", [], TensionConfig()),
+    ("swcc", [], SwccConfig(sample=PrepareConfig(particles=1000))),
+])
+def test_the_default_command_line_builds_the_dataclass_defaults(command, argv, expected):
+    parser, module = command_parser(command)
+    assert module.config_from(parser.parse_args(argv)) == expected
+
+
+#: (command, option, value, the configuration refusing the field's value, field, its message)
+REFUSED = [
+    ("oedometer", "--axial-stress", "500", lambda: OedometerConfig(sample=SMALL,
+                                                                   axial_stress=500.0),
+     "axial_stress", "= 500 Pa is outside the valid range (750, 1e+07] Pa"),
+    ("oedometer", "--unload-to", "0", lambda: OedometerConfig(sample=SMALL, unload_to=0.0),
+     "unload_to", "= 0.0 Pa is outside the valid range (0, 1e+07] Pa"),
+    ("isotropic", "--stage-steps", "0", lambda: IsotropicConfig(sample=SMALL, stage_steps=0),
+     "stage_steps", "= 0 is outside the valid range [1, 100000000]"),
+    ("cyclic", "--cycles", "0", lambda: CyclicConfig(sample=SMALL, amplitude_q=100.0,
+                                                     cycles=0),
+     "cycles", "= 0 is outside the valid range [1, 10000]"),
+    ("simple-shear", "--shear-rate", "-1", lambda: SimpleShearConfig(
+        sample=PrepareConfig(particles=100, periodic=True), strain_rate=-1.0),
+     "strain_rate", "= -1.0 1/s is outside the valid range (0, inf] 1/s"),
+    ("tension", "--residual", "1", lambda: TensionConfig(residual=1.0),
+     "residual", "= 1.0 is outside the valid range (0, 1)"),
+    ("tension", "--specific-gravity", "0.5", lambda: TensionConfig(
+        sample=tension_sample(density=500.0)),
+     "specific_gravity", "= 0.5 is outside the valid range [1, 10]"),
+    ("swcc", "--record-every", "0", lambda: SwccConfig(sample=SMALL, record_every=0),
+     "record_every", "= 0 is outside the valid range [1, inf]"),
+]
+
+
+@pytest.mark.parametrize("command, option, value, build, name, message", REFUSED)
+def test_errors_name_the_field_in_python_and_the_flag_on_the_command_line(
+        command, option, value, build, name, message, capsys):
+    with pytest.raises(ParameterError) as refused:
+        build()
+    assert str(refused.value).startswith(f"{name} {message}"), str(refused.value)
+    amplitude = ["--amplitude-q=100"] if command == "cyclic" and option != "--amplitude-q" else []
+    argv = [command, "--particles=100", *amplitude, f"{option}={value}", "--out=/nonexistent/x"]
+    if option == "--unload-to":
+        argv.insert(2, "--axial-stress=5000")
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    line = capsys.readouterr().err.strip()
+    assert f"error: {option} = " in line and "\n" not in line, line
+
+
+def test_a_list_field_checks_each_value():
+    assert IsotropicConfig(sample=SMALL, stresses=[500, 1000]).stresses == [500.0, 1000.0]
+    with pytest.raises(ParameterError, match=r"^stresses = 0 Pa is outside the valid range"):
+        IsotropicConfig(sample=SMALL, stresses=[500.0, 0])
+    with pytest.raises(ParameterError, match=r"^suctions = 3000.0: a list of numbers expected"):
+        SwccConfig(sample=SMALL, suctions=3000.0)

@@ -266,10 +266,10 @@ stages = [{strain_rate = {x = 0, y = 0, z = -0.5}, until = {stress = 500}},
 
 
 def test_records_apply_to_one_stage_ending_at_a_strain(tmp_path):
-    with pytest.raises(ValueError, match=r"--records = 50 applies to a path of one stage "
+    with pytest.raises(ValueError, match=r"^records = 50 applies to a path of one stage "
                                          r"ending at a strain.*has 2 stage"):
         triaxial_config(tmp_path, TRIAXIAL + TRIAXIAL, records=50)
-    with pytest.raises(ValueError, match=r"--records = 1 is outside the valid range \[2, "):
+    with pytest.raises(ValueError, match=r"^records = 1 is outside the valid range \[2, "):
         triaxial_config(tmp_path, TRIAXIAL, records=1)
 
 

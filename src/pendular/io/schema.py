@@ -235,7 +235,7 @@ OPTION_UNITS = {
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
     "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",
-    "record_strain": "1", "amplitude_q": "Pa", "amplitude_strain": "1",
+    "record_strain": "1", "amplitude_q": "Pa", "amplitude_strain": "1", "unload_to": "Pa",
 }
 
 #: Units of a cyclic triaxial summary.json (pendular.procedures.cyclic.cyclic_summary); its

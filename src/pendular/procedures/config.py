@@ -19,10 +19,11 @@ from typing import Any
 import numpy as np
 
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
-from pendular.procedures.preparation import (MAX_PARTICLES, MAX_SEED, PrepareConfig,
-    check_soft_contacts, pwave_step)
-from pendular.utils.parameters import fail, parameter, spec_of, validate
-from pendular.utils.validate import check_int, check_positive, check_range
+from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
+    pwave_step)
+from pendular.utils.parameters import (Parameter, ParameterError, default_of, fail, parameter,
+    spec_of, validate)
+from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
@@ -407,7 +408,8 @@ class PathConfig(LaboratoryConfig):
     strain_rate: float | None = strain_rate_parameter()
     record_strain: float = parameter(1e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
                                      flag="--record-strain",
-                                     help="strain between two history rows")
+                                     help="strain at the loading rate between history rows "
+                                          "(rows also at each stage's end)")
 
     def rate(self):
         """Strain rate of the path's stages [1/s] (quasi_static_rate)."""
@@ -431,28 +433,29 @@ class OedometerConfig(PathConfig):
     ``axial_stress`` [Pa] (above the confining stress the sample starts from), then, with
     ``unload_to`` [Pa] (below ``axial_stress``, above 0), pulled back until it is that."""
 
-    axial_stress: float = 10000.0
-    unload_to: float | None = None
+    axial_stress: float = parameter(10000.0, unit="Pa", low=0.0, high=1e7,
+                                    flag="--axial-stress",
+                                    help="axial stress the compression ends at, above "
+                                         "--confining")
+    unload_to: float | None = parameter(None, unit="Pa", low=0.0, high=1e7, low_inclusive=False,
+                                        flag="--unload-to",
+                                        help="then unload to this axial stress, below "
+                                             "--axial-stress")
 
     TEST = "an oedometer test"
 
     def __post_init__(self):
         super().__post_init__()
         confining = self.sample.confining
-        self.axial_stress = check_range("--axial-stress", self.axial_stress, 0.0, 1e7,
-                                        unit="Pa")
         if self.axial_stress <= confining:
-            raise ValueError(f"--axial-stress = {self.axial_stress:g} Pa is outside the valid "
-                             f"range ({confining:g}, 1e+07] Pa: the compression starts from "
-                             f"the confining stress (--confining {confining:g} Pa)")
-        check_soft_contacts("--axial-stress", self.axial_stress, self.sample.young)
-        if self.unload_to is not None:
-            self.unload_to = check_range("--unload-to", self.unload_to, 0.0, 1e7,
-                                         low_inclusive=False, unit="Pa")
-            if self.unload_to >= self.axial_stress:
-                raise ValueError(f"--unload-to = {self.unload_to:g} Pa is outside the valid "
-                                 f"range (0, {self.axial_stress:g}) Pa: an unloading ends below "
-                                 f"the load (--axial-stress {self.axial_stress:g} Pa)")
+            raise fail(self, "axial_stress", f"axial_stress = {self.axial_stress:g} Pa is "
+                       f"outside the valid range ({confining:g}, 1e+07] Pa: the compression "
+                       f"starts from the confining stress (--confining {confining:g} Pa)")
+        check_soft(self, "axial_stress", self.axial_stress)
+        if self.unload_to is not None and self.unload_to >= self.axial_stress:
+            raise fail(self, "unload_to", f"unload_to = {self.unload_to:g} Pa is outside the "
+                       f"valid range (0, {self.axial_stress:g}) Pa: an unloading ends below "
+                       f"the load (--axial-stress {self.axial_stress:g} Pa)")
 
     def reference_pressure(self):
         """The lowest axial stress of the path [Pa]: the confining stress, or ``unload_to``."""
@@ -470,24 +473,25 @@ class IsotropicConfig(PathConfig):
     MIN_ISOTROPIC_STAGES) in turn, each stage run until static; the walls move at most at the
     path's rate. ``stage_steps``: most steps of a stage."""
 
-    stresses: list[float] = field(default_factory=lambda: [500.0, 1000.0, 2000.0, 5000.0,
-                                                           2000.0, 500.0])
-    stage_steps: int = 2_000_000
+    stresses: list[float] = parameter(
+        default_factory=lambda: [500.0, 1000.0, 2000.0, 5000.0, 2000.0, 500.0], many=True,
+        unit="Pa", low=0.0, high=1e7, low_inclusive=False, flag="--stresses",
+        metavar="P1,P2,...", help="isotropic stresses of the stages, each > 0, in any order")
+    stage_steps: int = parameter(2_000_000, kind=int, low=1, high=100_000_000,
+                                 flag="--stage-steps",
+                                 help="most steps of a stage to reach equilibrium")
 
     TEST = "an isotropic test"
 
     def __post_init__(self):
         super().__post_init__()
-        self.stresses = [check_range("--stresses", value, 0.0, 1e7, low_inclusive=False,
-                                     unit="Pa") for value in self.stresses]
         if len(self.stresses) < MIN_ISOTROPIC_STAGES:
-            raise ValueError(f"--stresses = {','.join(f'{v:g}' for v in self.stresses)}: at "
-                             f"least {MIN_ISOTROPIC_STAGES} stresses [Pa] expected (a loading "
-                             "or unloading goes from one to the next)")
+            raise fail(self, "stresses", f"stresses = "
+                       f"{','.join(f'{v:g}' for v in self.stresses)}: at least "
+                       f"{MIN_ISOTROPIC_STAGES} stresses [Pa] expected (a loading or unloading "
+                       "goes from one to the next)")
         for value in self.stresses:
-            check_soft_contacts("--stresses", value, self.sample.young)
-        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
-                                     high=100_000_000)
+            check_soft(self, "stresses", value)
 
     def reference_pressure(self):
         """The lowest stress of the path [Pa]: the confining or the least of ``stresses``."""
@@ -505,35 +509,41 @@ TENSION_SAMPLE = {"particles": 2000, "radius": KIM_RADIUS,
                   "density": SPECIFIC_GRAVITY * WATER_DENSITY, "confining": 100.0}
 
 
+#: The direct tension's ranges of its sample's fields, narrower than PrepareConfig's:
+#: field -> (low, high), the bounds' openness PrepareConfig's.
+TENSION_RANGES = {"radius": (1e-6, 1e-2), "confining": (1.0, 1e5), "young": (0.0, 1e12)}
+#: The specific gravity Gs = density / WATER_DENSITY of a direct tension's grains, as its
+#: command sets it.
+SPECIFIC_GRAVITY_PARAMETER = Parameter(
+    "1", "specific gravity Gs of the grains", *SPECIFIC_GRAVITY_RANGE, flag="--specific-gravity")
+#: The core void ratio of a direct tension's case: denser than random close packing or looser
+#: than the loosest growth is unreachable.
+VOID_RATIO_PARAMETER = Parameter("1", "core void ratio", 0.5, 1.2, flag="--void-ratio")
+
+
 def check_tension_sample(fields):
-    """ValueError naming the command's option for a field of ``fields`` (PrepareConfig's names;
+    """ParameterError naming the field (and its option) of ``fields`` (PrepareConfig's names;
     those absent are not checked) outside the direct tension's range, narrower than
-    PrepareConfig's: particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES], radius [m],
-    density [kg/m^3] as --specific-gravity Gs = density / WATER_DENSITY, confining [Pa],
-    friction_deg (--friction) [deg], young [Pa], seed."""
-    checks = {
-        "particles": lambda value: check_particles(
-            value, MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES, "direct tension",
-            "the grips hold a layer at each z wall and the void ratio is the core's"),
-        "radius": lambda value: check_range("--radius", value, 1e-6, 1e-2, unit="m"),
-        "density": lambda value: check_range("--specific-gravity", value / WATER_DENSITY,
-                                             *SPECIFIC_GRAVITY_RANGE),
-        "confining": lambda value: check_range("--confining", value, 1.0, 1e5, unit="Pa"),
-        "friction_deg": lambda value: check_range("--friction", value, 0.0, 90.0,
-                                                  high_inclusive=False, unit="deg"),
-        "young": lambda value: check_range("--young", value, 0.0, 1e12, low_inclusive=False,
-                                           unit="Pa"),
-        "seed": lambda value: check_int("--seed", value, high=MAX_SEED),
-    }
-    for name, check in checks.items():
+    PrepareConfig's: particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES],
+    TENSION_RANGES, density [kg/m^3] as the specific gravity Gs = density / WATER_DENSITY
+    (--specific-gravity), friction_deg and seed in PrepareConfig's ranges."""
+    if "particles" in fields:
+        check_particles(fields["particles"], MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES,
+                        "direct tension", "the grips hold a layer at each z wall and the void "
+                        "ratio is the core's")
+    if "density" in fields:
+        SPECIFIC_GRAVITY_PARAMETER.check("specific_gravity", fields["density"] / WATER_DENSITY)
+    for name in ("radius", "confining", "friction_deg", "young", "seed"):
         if name in fields:
-            check(fields[name])
+            spec = spec_of(PrepareConfig, name)
+            low, high = TENSION_RANGES.get(name, (spec.low, spec.high))
+            dataclasses.replace(spec, low=low, high=high).check(name, fields[name])
 
 
 def tension_sample(**fields):
     """The PrepareConfig of a direct tension's sample: TENSION_SAMPLE with ``fields``
-    (PrepareConfig's names) over it, e.g. ``tension_sample(particles=200)``; ValueError naming
-    the command's option (check_tension_sample) before PrepareConfig's own checks."""
+    (PrepareConfig's names) over it, e.g. ``tension_sample(particles=200)``; the tension's ranges
+    (check_tension_sample) checked before PrepareConfig's own."""
     check_tension_sample(fields)
     return PrepareConfig(**{**TENSION_SAMPLE, **fields})
 
@@ -541,8 +551,8 @@ def tension_sample(**fields):
 @dataclass
 class TensionConfig:
     """Direct tension of wet sand at fixed water content (pendular.procedures.tension; Kim 2001,
-    thesis §4.4.1.2 and Table 4.5). Validated on creation (ValueError naming the command's
-    option).
+    thesis §4.4.1.2 and Table 4.5). Validated on creation (ParameterError naming the field; its
+    Parameter's flag on the command line).
 
     sample: the grains and their preparation (pendular.procedures.preparation.PrepareConfig,
     default ``tension_sample()``): particles, sizes (radius [m], the mean radius;
@@ -569,69 +579,87 @@ class TensionConfig:
     """
 
     sample: PrepareConfig = field(default_factory=tension_sample)
-    cases: list[tuple[float, float]] = field(
-        default_factory=lambda: [(e, w) for e, w, _ in KIM_2001])
-    roughness: float = KIM_SEPARATION
-    form_gap: float = 1.0
-    contact_angle: float = 0.0
-    surface_tension: float = CHAPTER4_SURFACE_TENSION
-    inertial_number: float = 1e-3
-    max_strain: float = 0.1
-    residual: float = 0.2
-    grip_depth: float = 1.0
-    void_ratio_tolerance: float = 0.01
-    vtk_frames: int = 20
-    vtk_every: int | None = None
+    cases: list[tuple[float, float]] = parameter(
+        default_factory=lambda: [(e, w) for e, w, _ in KIM_2001], kind=None, recorded=False,
+        help="(core void ratio, gravimetric water content as a fraction) of each case")
+    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=0.5, flag="--roughness",
+                                 help="meniscus separation of touching grains H/R (default "
+                                      "Kim's sand, as in the regular packing prediction; 0: "
+                                      "smooth spheres)")
+    form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
+                                help="at wetting, bridges also form across gaps up to this many "
+                                     "radii (0: at contacts only; 1: wherever a bridge of the "
+                                     "formation suction can exist, docs/direct_tension.md)")
+    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                     flag="--contact-angle", help="wetting angle")
+    surface_tension: float = parameter(CHAPTER4_SURFACE_TENSION, unit="N/m", low=0.0,
+                                       high=MAX_SURFACE_TENSION, low_inclusive=False,
+                                       flag="--surface-tension",
+                                       help="surface tension (thesis Chapter 4's, which the "
+                                            "comparison with Kim and the regular packing "
+                                            "prediction uses; triaxial and swcc default to "
+                                            "Chapter 5's 0.073)")
+    inertial_number: float = parameter(1e-3, low=0.0, high=0.01, low_inclusive=False,
+                                       flag="--inertial-number",
+                                       help="I = strain rate x d x sqrt(rho / confining) of "
+                                            "the pull")
+    max_strain: float = parameter(0.1, low=0.0, high=0.5, low_inclusive=False,
+                                  flag="--max-strain", help="largest axial extension of the pull")
+    residual: float = parameter(0.2, low=0.0, high=1.0, low_inclusive=False,
+                                high_inclusive=False, flag="--residual",
+                                help="fraction of the peak below which the pull has ruptured")
+    grip_depth: float = parameter(1.0, low=0.0, high=3.0, flag="--grip-depth", unset=True,
+                                  help="grip thickness: particles whose surface is within this "
+                                       "many diameters of a z wall, in diameters (not with "
+                                       "--periodic, which has no grips)")
+    void_ratio_tolerance: float = parameter(0.01, low=0.001, high=0.1,
+                                            flag="--void-ratio-tolerance",
+                                            help="largest |e - target| accepted from the "
+                                                 "preparation")
+    vtk_frames: int = parameter(20, kind=int, low=0, high=1000, flag="--vtk-frames",
+                                help="ParaView frames per pull (0: none)")
+    vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
+                                      help="steps between ParaView frames of the pull, instead "
+                                           "of --vtk-frames (0: none)")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
             raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
         check_tension_sample(vars(self.sample))
+        validate(self)
         self.cases = [(float(e), float(w)) for e, w in self.cases]
         if not self.cases:
             raise ValueError("cases = [] is empty: give at least one (void ratio, water "
                              "content)")
         for e, _ in self.cases:
             # denser than random close packing or looser than the loosest growth: unreachable
-            check_range("--void-ratio", e, 0.5, 1.2)
+            VOID_RATIO_PARAMETER.check("void_ratio", e)
         names = [case_name(e, w) for e, w in self.cases]
         for k, name in enumerate(names):
             if name in names[:k]:        # one folder, one sample per void ratio: run once
                 (e0, w0), (e1, w1) = self.cases[names.index(name)], self.cases[k]
                 raise ValueError(
-                    f"--void-ratio / --water-content: the cases (e {e0:g}, w {100 * w0:g} %) "
-                    f"and (e {e1:g}, w {100 * w1:g} %) share the folder {name}: give each "
-                    "case once, void ratios 0.01 or water contents 0.01 % apart")
-        check_range("--form-gap", self.form_gap, 0.0, 1.0)
-        check_range("--contact-angle", self.contact_angle, 0.0, 90.0, high_inclusive=False,
-                    unit="deg")
-        check_range("--surface-tension", self.surface_tension, 0.0, MAX_SURFACE_TENSION,
-                    low_inclusive=False, unit="N/m")
-        check_range("--roughness", self.roughness, 0.0, 0.5)
-        check_range("--inertial-number", self.inertial_number, 0.0, 0.01, low_inclusive=False)
-        check_range("--max-strain", self.max_strain, 0.0, 0.5, low_inclusive=False)
-        check_range("--residual", self.residual, 0.0, 1.0, low_inclusive=False,
-                    high_inclusive=False)
-        check_range("--grip-depth", self.grip_depth, 0.0, 3.0)
-        if self.sample.periodic and self.grip_depth != TensionConfig.grip_depth:
-            raise ValueError(f"--grip-depth = {self.grip_depth:g} does not apply to --periodic: "
-                             "a periodic cell has no walls, so no grips")
-        check_range("--void-ratio-tolerance", self.void_ratio_tolerance, 0.001, 0.1)
-        check_range("--vtk-frames", self.vtk_frames, 0, 1000)
+                    f"cases: (e {e0:g}, w {100 * w0:g} %) and (e {e1:g}, w {100 * w1:g} %) "
+                    f"share the folder {name}: give each case once, void ratios 0.01 or water "
+                    "contents 0.01 % apart")
+        if self.sample.periodic and self.grip_depth != default_of(TensionConfig, "grip_depth"):
+            raise fail(self, "grip_depth", f"grip_depth = {self.grip_depth:g} does not apply "
+                       "to --periodic: a periodic cell has no walls, so no grips")
         steps = self.pull_steps()
-        check_steps_count("--vtk-frames", self.vtk_frames, steps,
-                          f"the pull to --max-strain {self.max_strain:g}")
-        if self.vtk_every is not None:
-            self.vtk_every = check_int("--vtk-every", self.vtk_every)
-            check_steps_count("--vtk-every", self.vtk_every, steps,
-                              f"the pull to --max-strain {self.max_strain:g}")
+        for name in ("vtk_frames", "vtk_every"):
+            if getattr(self, name) is not None:
+                try:
+                    check_steps_count(name, getattr(self, name), steps,
+                                      f"the pull to --max-strain {self.max_strain:g}")
+                except ValueError as error:
+                    raise fail(self, name, str(error)) from None
         for e, w in self.cases:
             limit = self.pendular_limit(e)
             if not 0.0 < w <= limit:
-                raise ValueError(f"--water-content = {100.0 * w:g} % is outside the valid "
-                                 f"range (0, {100.0 * limit:.3g}] %: the pendular regime ends "
-                                 "at the pendular limit of the "
-                                 f"{comparison_packing(e)[1]} packing")
+                raise ParameterError("water_content", f"water_content = {100.0 * w:g} % is "
+                                     f"outside the valid range (0, {100.0 * limit:.3g}] %: the "
+                                     "pendular regime ends at the pendular limit of the "
+                                     f"{comparison_packing(e)[1]} packing", "--water-content")
 
     @property
     def specific_gravity(self):
@@ -690,36 +718,39 @@ class SwccConfig:
     """
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
-    suctions: list[float] = field(default_factory=lambda: [3000.0, 10000.0, 30000.0,
-                                                           100000.0, 300000.0])
-    surface_tension: float = SURFACE_TENSION
-    contact_angle: float = 0.0
-    form_gap: float = 1.0
-    stage_steps: int = 200000
-    record_every: int = 1000
+    suctions: list[float] = parameter(
+        default_factory=lambda: [3000.0, 10000.0, 30000.0, 100000.0, 300000.0], many=True,
+        unit="Pa", low=0.0, low_inclusive=False, flag="--suctions",
+        help="suctions of the drying path, ascending; wetting goes back along them")
+    surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
+                                       high=MAX_SURFACE_TENSION, low_inclusive=False,
+                                       flag="--surface-tension", help="liquid surface tension")
+    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                     flag="--contact-angle", help="wetting angle")
+    form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
+                                help="at wetting, bridges also form across gaps up to this many "
+                                     "mean radii (0: at contacts only; 1: wherever a bridge of "
+                                     "the lowest suction can exist)")
+    stage_steps: int = parameter(200000, kind=int, low=1, high=100_000_000, flag="--stage-steps",
+                                 help="most steps per stage to reach equilibrium")
+    record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
+                                  help="steps between history records")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
             raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
         check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, "an SWCC",
                         AVERAGES)
-        self.suctions = [check_positive("--suctions", value, "Pa") for value in self.suctions]
+        validate(self)
         if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
                                                                    self.suctions[1:])):
-            raise ValueError(f"--suctions = {','.join(f'{s:g}' for s in self.suctions)}: at "
-                             "least two suctions [Pa], ascending and distinct, expected (the "
-                             "drying path; wetting goes back along it)")
+            raise fail(self, "suctions", f"suctions = "
+                       f"{','.join(f'{s:g}' for s in self.suctions)}: at least two suctions "
+                       "[Pa], ascending and distinct, expected (the drying path; wetting goes "
+                       "back along it)")
         if self.sample.confining <= 0.0:
-            raise ValueError(f"--confining = {self.sample.confining:g} Pa is outside the valid "
-                             "range (0, 1e+07] Pa for an SWCC at constant stress")
-        self.surface_tension = check_range("--surface-tension", self.surface_tension, 0.0,
-                                           MAX_SURFACE_TENSION, low_inclusive=False, unit="N/m")
-        self.contact_angle = check_range("--contact-angle", self.contact_angle, 0.0, 90.0,
-                                         high_inclusive=False, unit="deg")
-        self.form_gap = check_range("--form-gap", self.form_gap, 0.0, 1.0)
-        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
-                                     high=100_000_000)
-        self.record_every = check_int("--record-every", self.record_every, low=1)
+            raise fail(self.sample, "confining", f"confining = {self.sample.confining:g} Pa is "
+                       "outside the valid range (0, 1e+07] Pa for an SWCC at constant stress")
 
 
 def check_particles(particles, low, high, test, why):
@@ -731,6 +762,18 @@ def check_particles(particles, low, high, test, why):
         raise fail(PrepareConfig, "particles", f"particles = {count} is outside the valid range "
                    f"[{low}, {high}] for {test}: {why}")
     return count
+
+
+def check_soft(config, name, stress, label=None):
+    """ParameterError of field ``name`` of the LaboratoryConfig ``config`` when ``stress`` [Pa]
+    (the field's value, or the stress called ``label`` made from it) is too large for its
+    sample's contacts (pendular.procedures.preparation.check_soft_contacts)."""
+    try:
+        check_soft_contacts(label or name, stress, config.sample.young)
+    except ValueError as error:
+        message = str(error) if label is None else \
+            f"{name} = {getattr(config, name):g} Pa: {error}"
+        raise fail(config, name, message) from None
 
 
 def check_steps_count(name, value, steps, phase, low=0):
@@ -774,33 +817,36 @@ class CyclicConfig(PathConfig):
     start, in [MIN_AXIAL_STRAIN, MAX_CYCLIC_STRAIN]; a run whose axial stress falls to 0
     stops with pendular.procedures.loading.StageFailed)."""
 
-    amplitude_q: float | None = None
-    amplitude_strain: float | None = None
-    cycles: int = 10
+    amplitude_q: float | None = parameter(None, unit="Pa", low=0.0, low_inclusive=False,
+                                          flag="--amplitude-q", metavar="PA",
+                                          help="stress control: q cycles between +PA and -PA, "
+                                               "below --confining (one of --amplitude-q and "
+                                               "--amplitude-strain is required)")
+    amplitude_strain: float | None = parameter(None, low=MIN_AXIAL_STRAIN,
+                                               high=MAX_CYCLIC_STRAIN,
+                                               flag="--amplitude-strain", metavar="X",
+                                               help="strain control: the axial strain cycles "
+                                                    "between +X and -X")
+    cycles: int = parameter(10, kind=int, low=1, high=MAX_CYCLES, flag="--cycles",
+                            help="cycles after the first loading")
 
     TEST = "a cyclic triaxial test"
 
     def __post_init__(self):
         super().__post_init__()
         if (self.amplitude_q is None) == (self.amplitude_strain is None):
-            raise ValueError("--amplitude-q / --amplitude-strain: give exactly one (stress "
-                             "control: q between +-A [Pa]; strain control: the axial strain "
-                             "between +-X)")
+            raise ValueError("amplitude_q, amplitude_strain: give exactly one (stress control: "
+                             "q between +-A [Pa]; strain control: the axial strain between "
+                             "+-X)")
         confining = self.sample.confining
         if self.amplitude_q is not None:
-            try:
-                self.amplitude_q = check_range("--amplitude-q", self.amplitude_q, 0.0,
-                                               confining, low_inclusive=False,
-                                               high_inclusive=False, unit="Pa")
-            except ValueError as error:
-                raise ValueError(f"{error}: at q = -A the axial stress is --confining "
-                                 f"({confining:g} Pa) - A, and walls cannot pull") from None
-            check_soft_contacts("the largest axial stress (--confining + --amplitude-q)",
-                                confining + self.amplitude_q, self.sample.young)
-        else:
-            self.amplitude_strain = check_range("--amplitude-strain", self.amplitude_strain,
-                                                MIN_AXIAL_STRAIN, MAX_CYCLIC_STRAIN)
-        self.cycles = check_int("--cycles", self.cycles, low=1, high=MAX_CYCLES)
+            if self.amplitude_q >= confining:
+                raise fail(self, "amplitude_q", f"amplitude_q = {self.amplitude_q!r} Pa is "
+                           f"outside the valid range (0, {confining:g}) Pa: at q = -A the axial "
+                           f"stress is --confining ({confining:g} Pa) - A, and walls cannot "
+                           "pull")
+            check_soft(self, "amplitude_q", confining + self.amplitude_q,
+                       "the largest axial stress (--confining + --amplitude-q)")
 
     @property
     def stress_controlled(self):
@@ -844,9 +890,13 @@ class TablePathConfig(PathConfig):
     rows over a path of one stage ending at a strain, as ShearConfig.records (None: a row
     every ``record_strain``)."""
 
-    stages: list = field(default_factory=list)
-    source: str = "path table"
-    records: int | None = None
+    stages: list = parameter(default_factory=list, kind=None, recorded=False,
+                             help="the table's [[stage]] entries, as plain data")
+    source: str = parameter("path table", kind=str, help="the table's file, named in errors")
+    records: int | None = parameter(None, kind=int, low=2, high=MAX_RECORDS, flag="--records",
+                                    help="history rows over a path of one stage ending at a "
+                                         "strain, as pendular triaxial's --records (default: a "
+                                         "row every --record-strain)")
 
     TEST = "a loading path"
 
@@ -854,14 +904,13 @@ class TablePathConfig(PathConfig):
         super().__post_init__()
         stages = self.loading_stages()       # every entry checked, named by file and stage
         if self.records is not None:
-            self.records = check_int("--records", self.records, low=2, high=MAX_RECORDS)
             from pendular.procedures.loading import Strain
 
             if len(stages) != 1 or not isinstance(stages[0].until, Strain):
-                raise ValueError(f"--records = {self.records} applies to a path of one stage "
-                                 f"ending at a strain (a triaxial's); {self.source} has "
-                                 f"{len(stages)} stage(s): leave it out (a row every "
-                                 "--record-strain)")
+                raise fail(self, "records", f"records = {self.records} applies to a path of "
+                           f"one stage ending at a strain (a triaxial's); {self.source} has "
+                           f"{len(stages)} stage(s): leave it out (a row every "
+                           "--record-strain)")
 
     def loading_stages(self):
         """The pendular.procedures.loading.Stage list of the table (ValueError naming the
@@ -905,32 +954,39 @@ class SimpleShearConfig(PathConfig):
     between two history rows; ``stage_steps``: most steps of the consolidation to the normal
     stress. The sample must be periodic (walls cannot shear it)."""
 
-    normal_stress: float | None = None
-    constant_volume: bool = False
-    max_strain: float = 0.2
-    stage_steps: int = 2_000_000
-    record_strain: float = 4e-4
+    # the shear rate gamma_dot [1/s]: PathConfig's strain rate, under the command's name
+    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, low_inclusive=False,
+                                          flag="--shear-rate",
+                                          help="shear rate gamma_dot (overrides "
+                                               "--inertial-number)")
+    record_strain: float = parameter(4e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
+                                     flag="--record-strain",
+                                     help="shear strain between history rows")
+    normal_stress: float | None = parameter(None, unit="Pa", low=0.0, high=1e7,
+                                            low_inclusive=False, flag="--normal-stress",
+                                            help="normal stress sigma_zz of the shear "
+                                                 "(default: --confining)")
+    constant_volume: bool = parameter(False, kind=bool, flag="--constant-volume",
+                                      help="shear at constant volume (the cell's lengths held; "
+                                           "the normal stress an output) instead of at "
+                                           "--normal-stress")
+    max_strain: float = parameter(0.2, low=MIN_AXIAL_STRAIN, high=MAX_SHEAR_STRAIN,
+                                  flag="--max-strain", help="final shear strain gamma")
+    stage_steps: int = parameter(2_000_000, kind=int, low=1, high=100_000_000,
+                                 flag="--stage-steps",
+                                 help="most steps of the consolidation to --normal-stress")
 
     TEST = "a simple shear test"
 
     def __post_init__(self):
         super().__post_init__()
         if not self.sample.periodic:
-            raise ValueError("periodic = False: a simple shear needs a periodic cell (--periodic;"
-                             " Lees–Edwards images), walls cannot shear a sample")
+            raise fail(self.sample, "periodic", "periodic = False: a simple shear needs a "
+                       "periodic cell (--periodic; Lees–Edwards images), walls cannot shear a "
+                       "sample")
         if self.normal_stress is None:
             self.normal_stress = self.sample.confining
-        self.normal_stress = check_range("--normal-stress", self.normal_stress, 0.0, 1e7,
-                                         low_inclusive=False, unit="Pa")
-        check_soft_contacts("--normal-stress", self.normal_stress, self.sample.young)
-        if not isinstance(self.constant_volume, (bool, np.bool_)):
-            raise ValueError(f"--constant-volume = {self.constant_volume!r}: valid values True "
-                             "or False")
-        self.constant_volume = bool(self.constant_volume)
-        self.max_strain = check_range("--max-strain", self.max_strain, MIN_AXIAL_STRAIN,
-                                      MAX_SHEAR_STRAIN)
-        self.stage_steps = check_int("--stage-steps", self.stage_steps, low=1,
-                                     high=100_000_000)
+        check_soft(self, "normal_stress", self.normal_stress)
 
     @property
     def consolidates(self):

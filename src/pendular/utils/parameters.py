@@ -1,6 +1,7 @@
 """Parameters declared once: a configuration field carries its unit, valid range, help text and
 command-line flag as metadata (``parameter``); from it ``validate`` checks a configuration,
-``add_options`` makes the command-line options and ``flat_options`` the flat rows of a run.
+``add_options`` makes the command-line options, ``fields_from`` reads the fields back from the
+parsed options and ``flat_options`` makes the flat rows of a run.
 
 Errors name the field in Python and tables (``particles = 1 is outside the valid range [2,
 ...]``); ``ParameterError`` carries the field's name and flag, so that the command line names
@@ -54,7 +55,8 @@ class Parameter:
     in the configuration), command-line ``flag``, ``help`` (without unit or range: added from
     these), ``unset``: the option's default is None, meaning the configuration's default
     (stated in the help), ``metavar`` of the option, ``recorded``: one of a run's flat options
-    (``flat_options``)."""
+    (``flat_options``), ``many``: the field is a list, each value of ``kind`` in the range (its
+    option, a comma list, is written by hand)."""
 
     unit: str
     help: str
@@ -68,6 +70,7 @@ class Parameter:
     unset: bool = False
     metavar: str | None = None
     recorded: bool = True
+    many: bool = False
 
     def valid_range(self):
         """The range as errors and help state it, e.g. '(0, 1]'."""
@@ -87,6 +90,11 @@ class Parameter:
         parameter's valid set); None passes where ``optional``."""
         if (value is None and optional) or self.kind is None:
             return value
+        if self.many:
+            if isinstance(value, (str, bytes)) or not np.iterable(value):
+                raise ParameterError(name, f"{name} = {value!r}: a list of numbers expected",
+                                     self.flag)
+            return [dataclasses.replace(self, many=False).check(name, item) for item in value]
         if self.kind is bool:
             if not isinstance(value, (bool, np.bool_)):
                 raise ParameterError(name, f"{name} = {value!r}: valid values True or False",
@@ -127,13 +135,17 @@ class Parameter:
 
 def parameter(default=dataclasses.MISSING, *, unit="1", help, low=None, high=None,
               low_inclusive=True, high_inclusive=True, flag=None, choices=None, kind=float,
-              unset=False, metavar=None, recorded=True):
-    """A dataclass field of ``default`` declaring its Parameter (see there) in its metadata."""
+              unset=False, metavar=None, recorded=True, many=False,
+              default_factory=dataclasses.MISSING):
+    """A dataclass field of ``default`` (or ``default_factory``, for a list) declaring its
+    Parameter (see there) in its metadata."""
     if kind is int and not (low_inclusive and high_inclusive):
         raise ValueError(f"{help}: integer ranges are closed")
     spec = Parameter(unit, help, low, high, low_inclusive, high_inclusive, flag,
-                     None if choices is None else tuple(choices), kind, unset, metavar, recorded)
-    return dataclasses.field(default=default, metadata={METADATA_KEY: spec})
+                     None if choices is None else tuple(choices), kind, unset, metavar, recorded,
+                     many)
+    return dataclasses.field(default=default, default_factory=default_factory,
+                             metadata={METADATA_KEY: spec})
 
 
 def spec_of(config, name):
@@ -181,6 +193,9 @@ def add_options(parser, config, names):
     name)."""
     for name in names:
         spec = spec_of(config, name)
+        if spec.many or spec.flag is None:
+            raise ValueError(f"{config.__name__}.{name}: no option of its own value (a list, "
+                             "or no flag)")
         default = default_of(config, name)
         options = {"help": spec.option_help(default)}
         if spec.kind is bool:
@@ -197,6 +212,18 @@ def add_options(parser, config, names):
                 options["metavar"] = spec.metavar
         action = parser.add_argument(spec.flag, **options)
         action.parameter = (config, name)
+
+
+def fields_from(args, config, names):
+    """{field: value} of fields ``names`` of the dataclass ``config`` from the parsed options
+    ``args`` of ``add_options`` (an option left at None where ``unset``: the field's default)."""
+    fields = {}
+    for name in names:
+        spec = spec_of(config, name)
+        value = getattr(args, spec.key(name))
+        if not (spec.unset and value is None):
+            fields[name] = value
+    return fields
 
 
 def flat_options(config, exclude=()):

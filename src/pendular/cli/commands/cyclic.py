@@ -20,15 +20,17 @@ and output options are those of ``pendular triaxial``. Stresses compression posi
 
 from __future__ import annotations
 
-from pendular.procedures.config import (MAX_CYCLES, MAX_CYCLIC_STRAIN, MIN_AXIAL_STRAIN,
-    CyclicConfig)
+from pendular.procedures.config import CyclicConfig, PathConfig
 from pendular.procedures.cyclic import CyclicTest
+from pendular.utils.parameters import add_options, fields_from
 
 from pendular.cli import UsageError
-from pendular.cli.commands.oedometer import add_record_option
 from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
     add_sample_options, add_wetting_options, laboratory_fields, run_test)
 
+#: The path's own fields, each set by its option.
+OWN = ("amplitude_q", "amplitude_strain", "cycles", "inertial_number", "strain_rate",
+       "record_strain")
 #: Summary keys printed at the end.
 SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
          "damping_ratio_last", "secant_modulus_first_effective",
@@ -41,18 +43,11 @@ SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio
 def add_arguments(parser):
     add_sample_options(parser)
     add_wetting_options(parser)
-    amplitude = parser.add_mutually_exclusive_group()
-    amplitude.add_argument("--amplitude-q", metavar="PA", type=float, default=None,
-                           help="stress control: q cycles between +PA and -PA [Pa], in (0, "
-                                "--confining) (one of --amplitude-q and --amplitude-strain is "
-                                "required)")
-    amplitude.add_argument("--amplitude-strain", metavar="X", type=float, default=None,
-                           help="strain control: the axial strain cycles between +X and -X "
-                                f"[-], in [{MIN_AXIAL_STRAIN:g}, {MAX_CYCLIC_STRAIN:g}]")
-    parser.add_argument("--cycles", type=int, default=CyclicConfig.cycles,
-                        help=f"cycles after the first loading, in [1, {MAX_CYCLES}]")
+    add_options(parser.add_mutually_exclusive_group(), CyclicConfig,
+                ("amplitude_q", "amplitude_strain"))
+    add_options(parser, CyclicConfig, ("cycles",))
     add_rate_options(parser)
-    add_record_option(parser)
+    add_options(parser, PathConfig, ("record_strain",))
     add_output_options(parser, "runs/cyclic", frames=False)
 
 
@@ -61,10 +56,8 @@ def config_from(args):
     if args.amplitude_q is None and args.amplitude_strain is None:
         raise UsageError("give --amplitude-q PA (stress control) or --amplitude-strain X "
                          "(strain control)")
-    return CyclicConfig(**laboratory_fields(args, add_arguments, lambda: {
-        "amplitude_q": args.amplitude_q, "amplitude_strain": args.amplitude_strain,
-        "cycles": args.cycles, "inertial_number": args.inertial_number,
-        "strain_rate": args.strain_rate, "record_strain": args.record_strain}))
+    return CyclicConfig(**laboratory_fields(args, add_arguments, lambda: fields_from(
+        args, CyclicConfig, OWN)))
 
 
 def run(args):

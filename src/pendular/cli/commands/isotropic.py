@@ -13,14 +13,16 @@ triaxial``. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.config import IsotropicConfig
+from pendular.procedures.config import IsotropicConfig, PathConfig
 from pendular.procedures.triaxial import IsotropicTest
+from pendular.utils.parameters import add_options, fields_from, spec_of
 
 from pendular.cli import UsageError
-from pendular.cli.commands.oedometer import add_record_option
 from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
     add_sample_options, add_wetting_options, laboratory_fields, run_test)
 
+#: The path's own fields set by their options as they are (--stresses, a comma list, by hand).
+OWN = ("stage_steps", "inertial_number", "strain_rate", "record_strain")
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "compression_index",
          "swelling_index", "compression_index_effective", "swelling_index_effective",
@@ -30,13 +32,13 @@ SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "compression_index"
 def add_arguments(parser):
     add_sample_options(parser)
     add_wetting_options(parser)
-    parser.add_argument("--stresses", metavar="P1,P2,...",
+    stresses = spec_of(IsotropicConfig, "stresses")       # a comma list: by hand
+    parser.add_argument(stresses.flag, metavar=stresses.metavar,
                         default=",".join(f"{v:g}" for v in IsotropicConfig().stresses),
-                        help="isotropic stresses of the stages [Pa], each > 0, in any order")
-    parser.add_argument("--stage-steps", type=int, default=IsotropicConfig.stage_steps,
-                        help="most steps of a stage to reach equilibrium [-]")
+                        help=f"{stresses.help} [{stresses.unit}]")
+    add_options(parser, IsotropicConfig, ("stage_steps",))
     add_rate_options(parser)
-    add_record_option(parser)
+    add_options(parser, PathConfig, ("record_strain",))
     add_output_options(parser, "runs/isotropic", frames=False)
 
 
@@ -52,9 +54,7 @@ def stresses(text):
 def config_from(args):
     """The IsotropicConfig of parsed options (ValueError / UsageError naming the option)."""
     return IsotropicConfig(**laboratory_fields(args, add_arguments, lambda: {
-        "stresses": stresses(args.stresses), "stage_steps": args.stage_steps,
-        "inertial_number": args.inertial_number, "strain_rate": args.strain_rate,
-        "record_strain": args.record_strain}))
+        "stresses": stresses(args.stresses), **fields_from(args, IsotropicConfig, OWN)}))
 
 
 def run(args):

@@ -13,12 +13,15 @@ compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.config import MAX_RECORD_STRAIN, MIN_RECORD_STRAIN, OedometerConfig
+from pendular.procedures.config import OedometerConfig, PathConfig
 from pendular.procedures.triaxial import OedometerTest
+from pendular.utils.parameters import add_options, fields_from
 
 from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
     add_sample_options, add_wetting_options, laboratory_fields, run_test)
 
+#: The path's own fields, each set by its option.
+OWN = ("axial_stress", "unload_to", "inertial_number", "strain_rate", "record_strain")
 #: Summary keys printed at the end.
 SHOWN = ("k0", "k0_effective", "axial_stress_at_load", "lateral_stress_at_load",
          "axial_strain_at_load", "initial_void_ratio", "void_ratio_at_load",
@@ -31,29 +34,16 @@ SHOWN = ("k0", "k0_effective", "axial_stress_at_load", "lateral_stress_at_load",
 def add_arguments(parser):
     add_sample_options(parser)
     add_wetting_options(parser)
-    parser.add_argument("--axial-stress", type=float, default=10000.0,
-                        help="axial stress the compression ends at [Pa], above --confining")
-    parser.add_argument("--unload-to", type=float, default=None,
-                        help="then unload to this axial stress [Pa], in (0, --axial-stress)")
+    add_options(parser, OedometerConfig, ("axial_stress", "unload_to"))
     add_rate_options(parser)
-    add_record_option(parser)
+    add_options(parser, PathConfig, ("record_strain",))
     add_output_options(parser, "runs/oedometer", frames=False)
-
-
-def add_record_option(parser):
-    """--record-strain, the history's spacing on a path of unknown length."""
-    parser.add_argument("--record-strain", type=float, default=OedometerConfig.record_strain,
-                        help="strain at the loading rate between history rows [-] "
-                             f"({MIN_RECORD_STRAIN:g}-{MAX_RECORD_STRAIN:g}; rows also at each "
-                             "stage's end)")
 
 
 def config_from(args):
     """The OedometerConfig of parsed options (ValueError / UsageError naming the option)."""
-    return OedometerConfig(**laboratory_fields(args, add_arguments, lambda: {
-        "axial_stress": args.axial_stress, "unload_to": args.unload_to,
-        "inertial_number": args.inertial_number, "strain_rate": args.strain_rate,
-        "record_strain": args.record_strain}))
+    return OedometerConfig(**laboratory_fields(args, add_arguments, lambda: fields_from(
+        args, OedometerConfig, OWN)))
 
 
 def run(args):

@@ -34,14 +34,16 @@ run without its table. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.config import MAX_RECORDS, TablePathConfig
+from pendular.procedures.config import PathConfig, TablePathConfig
 from pendular.procedures.path_table import PathTest, read_table
+from pendular.utils.parameters import add_options, fields_from
 
 from pendular.cli import UsageError
-from pendular.cli.commands.oedometer import add_record_option
 from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
     add_sample_options, add_wetting_options, laboratory_fields, run_test)
 
+#: The path's own fields set by their options (the stages and source: the table's).
+OWN = ("inertial_number", "strain_rate", "record_strain", "records")
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
          "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
@@ -54,11 +56,8 @@ def add_arguments(parser):
     add_sample_options(parser)
     add_wetting_options(parser)
     add_rate_options(parser)
-    add_record_option(parser)
-    parser.add_argument("--records", type=int, default=None,
-                        help="history rows over a path of one stage ending at a strain, as "
-                             f"pendular triaxial's --records (2-{MAX_RECORDS:g}; default: a "
-                             "row every --record-strain)")
+    add_options(parser, PathConfig, ("record_strain",))
+    add_options(parser, TablePathConfig, ("records",))
     add_output_options(parser, "runs/path", frames=False)
 
 
@@ -68,9 +67,7 @@ def config_from(args):
     if args.table is None:
         raise UsageError("PATH.toml is missing: give the path table (or --resume DIR)")
     return TablePathConfig(**laboratory_fields(args, add_arguments, lambda: {
-        **read_table(args.table), "inertial_number": args.inertial_number,
-        "strain_rate": args.strain_rate, "record_strain": args.record_strain,
-        "records": args.records}))
+        **read_table(args.table), **fields_from(args, TablePathConfig, OWN)}))
 
 
 def run(args):

@@ -20,6 +20,12 @@ from pendular.cli import (UsageError, add_run_options, add_size_options, print_s
     set_threads, sizes_from)
 from pendular.procedures.config import SwccConfig
 from pendular.procedures.swcc import SwccTest
+from pendular.utils.parameters import add_options, fields_from, spec_of
+
+#: The fields set by their options as they are (--suctions, a comma list, by hand).
+OWN = ("contact_angle", "surface_tension", "form_gap", "stage_steps", "record_every")
+#: The sample's options whose defaults are PrepareConfig's (--particles, 1000 here, by hand).
+SAMPLE = ("friction_deg", "prep_friction_deg", "seed")
 
 #: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
 SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
@@ -27,27 +33,14 @@ SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_str
 
 def add_arguments(parser):
     parser.add_argument("--particles", type=int, default=1000, help="number of spheres")
-    parser.add_argument("--confining", type=float, default=750.0,
-                        help="isotropic stress held during the path [Pa]")
-    parser.add_argument("--suctions", default="3000,10000,30000,100000,300000",
-                        help="suctions of the drying path [Pa], comma separated, ascending; "
-                             "wetting goes back along them")
-    parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
-    parser.add_argument("--surface-tension", type=float, default=SwccConfig.surface_tension,
-                        help="liquid surface tension [N/m]")
-    parser.add_argument("--form-gap", type=float, default=SwccConfig.form_gap,
-                        help="at wetting, bridges also form across gaps up to this many mean "
-                             "radii [-] (0: at contacts only; 1: wherever a bridge of the "
-                             "lowest suction can exist)")
-    parser.add_argument("--stage-steps", type=int, default=SwccConfig.stage_steps,
-                        help="most steps per stage to reach equilibrium [-]")
-    parser.add_argument("--record-every", type=int, default=SwccConfig.record_every,
-                        help="steps between history records [-]")
+    add_options(parser, PrepareConfig, ("confining",))
+    suctions = spec_of(SwccConfig, "suctions")         # a comma list: by hand
+    parser.add_argument(suctions.flag, default=",".join(
+        f"{v:g}" for v in SwccConfig().suctions), help=f"{suctions.help} [{suctions.unit}], "
+        "comma separated")
+    add_options(parser, SwccConfig, OWN)
     add_size_options(parser, PrepareConfig.radius)
-    parser.add_argument("--friction", type=float, default=18.0, help="contact friction [deg]")
-    parser.add_argument("--prep-friction", type=float, default=0.5,
-                        help="contact friction during the radius growth [deg]")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
+    add_options(parser, PrepareConfig, SAMPLE)
     parser.add_argument("--out", default="runs/swcc", help="output folder")
     add_run_options(parser)
 
@@ -63,13 +56,10 @@ def suctions_of(text):
 
 def config_from(args):
     """The SwccConfig of parsed options (ValueError / UsageError naming the option)."""
-    sample = PrepareConfig(particles=args.particles, confining=args.confining,
-                           friction_deg=args.friction, prep_friction_deg=args.prep_friction,
-                           seed=args.seed, **sizes_from(args))
+    sample = PrepareConfig(particles=args.particles, **sizes_from(args),
+                           **fields_from(args, PrepareConfig, ("confining", *SAMPLE)))
     return SwccConfig(sample=sample, suctions=suctions_of(args.suctions),
-                      surface_tension=args.surface_tension, contact_angle=args.contact_angle,
-                      form_gap=args.form_gap, stage_steps=args.stage_steps,
-                      record_every=args.record_every)
+                      **fields_from(args, SwccConfig, OWN))
 
 
 def run(args):

@@ -15,9 +15,16 @@ from pendular.cli import (UsageError, add_run_options, add_size_options, positiv
     print_summary, set_threads, sizes_from)
 from pendular.procedures.config import (SPECIFIC_GRAVITY_RANGE, TENSION_SAMPLE, WATER_DENSITY,
     TensionConfig, tension_sample)
-from pendular.procedures.reference import CHAPTER4_SURFACE_TENSION as SURFACE_TENSION
-from pendular.procedures.reference import KIM_RADIUS, KIM_SEPARATION, SPECIFIC_GRAVITY
+from pendular.procedures.reference import KIM_RADIUS, SPECIFIC_GRAVITY
 from pendular.procedures.tension import TensionTest, cases_of, report_lines
+from pendular.utils.parameters import add_options, fields_from
+
+#: The fields set by their options as they are. By hand: --void-ratio and --water-content
+#: (comma lists, the water content in %, making ``cases``), the sample's options (the tension's
+#: own defaults, TENSION_SAMPLE, and narrower ranges, check_tension_sample; the density as
+#: --specific-gravity), --vtk-every (parsed by positive_int, as the laboratory commands').
+OWN = ("roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
+       "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames")
 
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
@@ -43,24 +50,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--void-ratio", default=None,
                         help="void ratio(s) of the core [-], comma separated (default: Kim's 0.72, "
                              "0.58)")
-    parser.add_argument("--roughness", type=float, default=KIM_SEPARATION,
-                        help="meniscus separation of touching grains H/R [-] (default Kim's sand, "
-                             "as in the regular packing prediction; 0: smooth spheres)")
+    add_options(parser, TensionConfig, ("roughness",))
     parser.add_argument("--water-content", default=None,
                         help="gravimetric water content(s) [%%], comma separated (default: Kim's "
                              "for his void ratios, else 0.5,1,2)")
     parser.add_argument("--particles", type=int, default=TENSION_SAMPLE["particles"],
                         help="number of spheres [-]")
-    parser.add_argument("--form-gap", type=float, default=TensionConfig.form_gap,
-                        help="at wetting, bridges also form across gaps up to this many "
-                             "radii [-] (0: at contacts only; 1: wherever a bridge of the "
-                             "formation suction can exist, docs/direct_tension.md)")
+    add_options(parser, TensionConfig, ("form_gap",))
     add_size_options(parser, KIM_RADIUS)
-    parser.add_argument("--contact-angle", type=float, default=0.0, help="wetting angle [deg]")
-    parser.add_argument("--surface-tension", type=float, default=SURFACE_TENSION,
-                        help="surface tension [N/m] (thesis Chapter 4's, which the comparison "
-                             "with Kim and the regular packing prediction uses; triaxial and "
-                             "swcc default to Chapter 5's 0.073)")
+    add_options(parser, TensionConfig, ("contact_angle", "surface_tension"))
     parser.add_argument("--specific-gravity", type=float, default=SPECIFIC_GRAVITY,
                         help="specific gravity Gs of the grains [-], in "
                              f"[{SPECIFIC_GRAVITY_RANGE[0]:g}, {SPECIFIC_GRAVITY_RANGE[1]:g}]: "
@@ -72,22 +70,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--friction", type=float, default=18.0,
                         help="contact friction during wetting and pull [deg]")
     parser.add_argument("--young", type=float, default=1e6, help="YADE young E [Pa], kn = E R")
-    parser.add_argument("--inertial-number", type=float, default=1e-3,
-                        help="I = strain rate x d x sqrt(rho / confining) of the pull [-]")
-    parser.add_argument("--max-strain", type=float, default=0.1,
-                        help="largest axial extension of the pull [-]")
-    parser.add_argument("--residual", type=float, default=0.2,
-                        help="fraction of the peak below which the pull has ruptured [-]")
-    parser.add_argument("--grip-depth", type=float, default=None,
-                        help="grip thickness: particles whose surface is within this many "
-                             "diameters of a z wall [diameters] (default "
-                             f"{TensionConfig.grip_depth:g}; not with --periodic, which has no "
-                             "grips)")
-    parser.add_argument("--void-ratio-tolerance", type=float, default=0.01,
-                        help="largest |e - target| accepted from the preparation [-]")
+    add_options(parser, TensionConfig, ("inertial_number", "max_strain", "residual",
+                                        "grip_depth", "void_ratio_tolerance"))
     frames = parser.add_mutually_exclusive_group()
-    frames.add_argument("--vtk-frames", type=int, default=TensionConfig.vtk_frames,
-                        help="ParaView frames per pull (0: none)")
+    add_options(frames, TensionConfig, ("vtk_frames",))
     frames.add_argument("--vtk-every", type=positive_int("--vtk-every"), default=None,
                         help="steps between ParaView frames of the pull, instead of "
                              "--vtk-frames (0: none)")
@@ -110,12 +96,8 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
                             density=args.specific_gravity * WATER_DENSITY,
                             confining=args.confining, friction_deg=args.friction,
                             young=args.young, seed=args.seed, periodic=args.periodic)
-    options = {name: getattr(args, name) for name in (
-        "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
-        "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
-        "vtk_every")}
-    options = {name: value for name, value in options.items() if value is not None}
-    return TensionConfig(sample=sample, cases=cases, **options)
+    return TensionConfig(sample=sample, cases=cases, vtk_every=args.vtk_every,
+                         **fields_from(args, TensionConfig, OWN))
 
 
 def run(args: argparse.Namespace) -> int:
