@@ -109,3 +109,21 @@ def test_resume_refuses_new_arguments_and_runs_without_checkpoint(tmp_path):
     assert changed.returncode != 0 and "--suction" in changed.stderr
     missing = triaxial("--resume", str(tmp_path), check=False)
     assert missing.returncode != 0 and "sample.h5" in missing.stderr
+
+
+def test_a_run_at_a_water_content_resumes_with_its_liquid_account(tmp_path):
+    """The closed liquid (--water-content, shared at rupture) comes back from the checkpoint:
+    the resumed history has the uninterrupted one's liquid columns, to the bit."""
+    argv = [*BASE, "--water-content", "1", "--liquid", "shared"]
+    whole, run = tmp_path / "whole", tmp_path / "interrupted"
+    triaxial(*argv, "--out", str(whole))
+    stopped = triaxial(*argv, "--out", str(run), "--stop-after", "237", check=False)
+    assert stopped.returncode == 130, stopped.stderr
+    triaxial("--resume", str(run), "--quiet")
+    with h5py.File(whole / "history.h5") as full, h5py.File(run / "history.h5") as resumed:
+        expected, got = full["history"], resumed["history"]
+        assert {"liquid_bridges", "liquid_film", "liquid_lost"} <= set(got) == set(expected)
+        for name in expected:
+            assert np.array_equal(got[name][()], expected[name][()]), name
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["completed"] and summary["liquid_balance_error"] < 1e-9

@@ -83,14 +83,15 @@ from pendular.capillary.bridge_kernels import (LiquidExchange, bridges_across_ga
     pair_geometry, particle_pairs, pendular_overlap_counts, refresh_contact_bridges,
     serial_contact_bridges, suction_bridges, suction_interfaces, volume_bridges,
     volume_interfaces)
-from pendular.capillary.bridge_state import FIELDS, BridgeState
+from pendular.capillary.bridge_state import FIELDS, OWNER, BridgeState
 from pendular.capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from pendular.capillary.validation import (check_bridge_stiffness, check_contact_angle,
     check_pendular_suction)
 from pendular.capillary.volume_table import VolumeBridgeTable
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.neighbors import gather_pair_forces, gather_pair_forces_virial
-from pendular.utils.validate import check_positive, check_range
+from pendular.dem.protocols import state_array
+from pendular.utils.validate import check_int, check_positive, check_range
 
 #: Surface tension of water [N/m] (thesis Ch. 5, Table 5.2); the default everywhere.
 SURFACE_TENSION = 0.073
@@ -195,6 +196,7 @@ class CapillaryBridges(metaclass=_ByControl):
     #: The per-pair quantities the bridges keep (pendular.dem.protocols.PairField), in
     #: ``sim.contacts.extra["bridge.<name>"]``.
     pair_state = FIELDS
+    pair_owner = OWNER
     #: "suction" or "volume" (CONTROLS), set by each operation.
     control = None
     #: Whether bridges live across gaps up to their rupture distance.
@@ -225,6 +227,22 @@ class CapillaryBridges(metaclass=_ByControl):
         self._radius_bounds = None
         self._checked_stiffness = False
         self._state = None
+
+    # ---------------------------------------------------------------- checkpoints
+    def state_dict(self):
+        """What the bridges keep besides their per-pair state (``pair_state``, the
+        contacts'): ``suction`` [Pa] (imposed, or the formation suction), ``required_range``
+        [m] (the reach, which never shrinks: set_suction) and ``bridges`` (their number at
+        the last step, which the next neighbour list must carry). The tables are rebuilt from
+        the parameters and radii."""
+        return {"suction": self.suction, "required_range": self.required_range,
+                "bridges": self._bridges}
+
+    def load_state(self, state):
+        suction = check_range("suction", state["suction"], 0.0, unit="Pa")
+        reach = check_range("required_range", state["required_range"], 0.0, unit="m")
+        bridges = check_int("bridges", state["bridges"])
+        self.suction, self.required_range, self._bridges = suction, reach, bridges
 
     # ---------------------------------------------------------------- set-up, once per sample
     def reach(self, sim):
@@ -280,7 +298,8 @@ class CapillaryBridges(metaclass=_ByControl):
         self._load_control_tables()
         self._lookup = self.suction_table.arrays()
         self._radius_bounds = (low, high, radius_ratios)
-        self.required_range = self._rupture_range(low, high)
+        # never shrinks: a lower suction imposed earlier (set_suction) may reach farther
+        self.required_range = max(self.required_range, self._rupture_range(low, high))
 
     def _load_control_tables(self):
         """Load what this control reads besides the suction table (nothing)."""
@@ -423,6 +442,18 @@ class SuctionBridges(CapillaryBridges):
         self.persist = bool(persist)
         self._applied_suction = None
 
+    def state_dict(self):
+        """CapillaryBridges' and ``applied_suction`` [Pa], the suction the bridges at contact
+        were last looked up at (None before the first step)."""
+        return {**super().state_dict(), "applied_suction": self._applied_suction}
+
+    def load_state(self, state):
+        applied = state["applied_suction"]
+        applied = None if applied is None else check_range("applied_suction", applied, 0.0,
+                                                           unit="Pa")
+        super().load_state(state)
+        self._applied_suction = applied
+
     @property
     def joins_contact_gather(self):
         """Whether the contact law's gather adds these bridges' forces
@@ -540,6 +571,31 @@ class VolumeBridges(CapillaryBridges):
         self._released = None
         self._events = None
         self._set_liquid(liquid)
+
+    def state_dict(self):
+        """CapillaryBridges' and the liquid's account: ``liquid`` (the model, which
+        close_liquid changes), ``liquid_initial`` [m^3] (None while open), ``liquid_lost``
+        [m^3] and ``film`` (N,) [m^3] on each grain (None before the first step)."""
+        return {**super().state_dict(), "liquid": self.liquid,
+                "liquid_initial": self.liquid_initial, "liquid_lost": self.liquid_lost,
+                "film": None if self.film is None else self.film.copy()}
+
+    def load_state(self, state):
+        if state["liquid"] not in LIQUID_MODELS:
+            raise ValueError(f"liquid = {state['liquid']!r} is not one of {LIQUID_MODELS}")
+        initial = state["liquid_initial"]
+        initial = None if initial is None else check_range("liquid_initial", initial, 0.0,
+                                                           unit="m^3")
+        lost = check_range("liquid_lost", state["liquid_lost"], 0.0, unit="m^3")
+        film = None if state["film"] is None else state_array(state, "film", np.float64,
+                                                               (None,))
+        if film is not None and (film < 0.0).any():
+            index = int(np.argmax(film < 0.0))
+            raise ValueError(f"film[{index}] = {film[index]:g} m^3 is outside the valid range "
+                             "[0, inf)")
+        super().load_state(state)
+        self._set_liquid(state["liquid"])
+        self.liquid_initial, self.liquid_lost, self.film = initial, lost, film
 
     def _set_liquid(self, liquid):
         """The liquid model (LIQUID_MODELS) and what it decides each step: whether the amount

@@ -343,6 +343,14 @@ class ConstantShearRate:
     def __init__(self, rate):
         self.rate = check_range("shear_rate", rate, -self.MAX_RATE, self.MAX_RATE, unit="1/s")
 
+    def state_dict(self):
+        """The ``rate`` [1/s] its stage set."""
+        return {"rate": self.rate}
+
+    def load_state(self, state):
+        self.rate = check_range("rate", state["rate"], -self.MAX_RATE, self.MAX_RATE,
+                                unit="1/s")
+
     def steps_to(self, strain, dt, start=0.0):
         """Steps [-] of ``dt`` [s] to bring the shear strain from ``start`` to ``strain`` [-];
         ValueError unless the rate is non-zero and of the sign of the change."""

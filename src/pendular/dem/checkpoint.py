@@ -2,53 +2,47 @@
 
 A checkpoint is one HDF5 file::
 
-    attrs        format, version, step, time [s], dt [s], pipeline (the types of the neighbour
-                 list, forces, controls, integrator and writers, JSON), skipped (per operation,
-                 the attributes not saved, JSON)
+    attrs        format, version, step, time [s], dt [s], has_contacts, extra_state (the
+                 caller's, JSON)
     particles/   every array attribute of ``sim.particles`` (position, radius, velocity, ...);
                  scalar attributes (density) as attributes of the group
-    walls/       likewise for ``sim.walls``
+    walls/       likewise for ``sim.walls`` (a periodic cell's shear offset and strain too)
     contacts/    every per-pair array of ``sim.contacts`` (CSR indices, shear history, forces);
-                 contacts/extra/ the arrays of ``Contacts.extra`` (absent if no contacts yet)
-    state        pickled state of every operation and writer, and the caller's ``extra_state``
+                 contacts/extra/ the per-pair fields that the operations declare
+                 (``pair_owner``, ``pair_state``: pendular.dem.protocols.PairField), each
+                 described by its declaration (absent if no contacts yet)
+    operations/  <kind>/<index>/ for each operation in step order (kind: neighbors, forces,
+                 controls, integrator, writers): attribute ``type`` (module.Class) and, for a
+                 Stateful operation, its ``state_dict()`` in state/: numbers, strings and None
+                 as attributes, arrays and lists as datasets, dicts as groups
 
-Every dataset has ``units`` and ``description`` attributes (DATASETS; an array this module does
-not know, e.g. another operation's ``Contacts.extra`` entry, gets units "unknown" and a
-description naming it), and the file ``pendular_version`` and ``schema_version`` (VERSION).
-
-The state of an operation is its ``vars(op)``: arrays, scalars and any picklable value
-(``StressServo.previous``, the NeighborList's reference positions and rebuild count,
-``HistoryRecorder.rows``, a writer's list of frames ...). Values that cannot be pickled
-(functions such as the recorder's quantities) are configuration that the scene rebuilds: they
-are skipped at saving, listed in the ``skipped`` attribute, and the freshly built operation
-keeps its own (at loading nothing is skipped: a saved value that cannot be restored is an
-error).
-An operation may name attributes not worth saving in a class attribute ``checkpoint_exclude``.
-References to the simulation's own objects (the simulation, particles, walls, contacts, their
-arrays, ``contacts.extra``, other operations) are saved as references and point, after loading,
-to the loaded simulation's objects, so an operation that caches ``sim.contacts`` stays in sync.
+Every dataset has ``units`` and ``description`` attributes (DATASETS; an operation's state:
+its ``state_dict`` docstring), and the file ``pendular_version`` and ``schema_version``
+(VERSION). Nothing is pickled: an operation says what it keeps (pendular.dem.protocols:
+``state_dict``/``load_state``, or ``stateless = True``), and one that says neither is refused
+when saved, so that nothing is skipped silently.
 
 ``load_checkpoint`` restores into a simulation built the same way (same operation types in
-the same places, in the same order; the scene's closures are not saved) and raises ValueError
-otherwise; a checkpoint of another format version (1: before the declared pipeline; 2:
-with per-pair torques, which the contact law no longer stores) is refused with its version.
-A checksum only proves a file unchanged since it was stamped, so the content is checked before
-use as well: arrays of the right dtype, shape and finiteness, pair indices within the particles
-and consistent with their CSR indices (a bad index would crash a compiled kernel), and an
-operation state that unpickles, fits the pipeline and holds values of the types the freshly
-built operations hold; anything else is refused with one ValueError naming the file.
+the same places, in the same order; what the scene builds, its configuration and functions,
+is not saved) and raises ValueError otherwise; a checkpoint of another format version (1:
+before the declared pipeline; 2: with per-pair torques; 3: the operations' attributes
+pickled) is refused with its version. A checksum only proves a file unchanged since it was
+stamped, so the content is checked before use as well: arrays of the right dtype, shape and
+finiteness, pair indices within the particles and consistent with their CSR indices (a bad
+index would crash a compiled kernel), per-pair fields as declared, and each operation's state
+with the keys of its own ``state_dict``, values of the same kinds (arrays of the same dtype),
+accepted by its ``load_state``; anything else is refused with one ValueError naming the file
+(and the operation and key), before anything of the simulation changes.
 The file is written under a temporary name, flushed to disk (fsync) and renamed over the
 previous checkpoint, so a run killed at any moment (kill -9 included) leaves the previous
-checkpoint intact. Checkpoints hold pickles: load only files you trust.
+checkpoint intact.
 """
 
 import dataclasses
-import io
 import json
 import math
 import numbers
 import os
-import pickle
 
 import h5py
 import numpy as np
@@ -56,12 +50,12 @@ import numpy as np
 from pendular.utils.atomic import replacing
 from pendular.utils.integrity import software_version, stamp, verify
 from pendular.dem.neighbors import Contacts, second_index
+from pendular.dem.protocols import pair_key
 from pendular.utils.validate import check_int, reading
 from pendular.dem.virial import SUM_BLOCKS, face_block_starts
 
 FORMAT = "pendular-checkpoint"
-VERSION = 3
-_SCALARS = (bool, int, float, str, np.generic)
+VERSION = 4
 
 #: Units and description of the datasets of a checkpoint, by group (dataset attributes).
 DATASETS = {
@@ -81,7 +75,9 @@ DATASETS = {
         "rate": ("1/s", "periodic cell: stretching rate L'/L of each axis, extension positive"),
         "stress_tensor": ("Pa", "periodic cell: Love-Weber stress of the pair forces (3, 3), "
                                 "compression positive"),
-        "wraps": ("1", "periodic cell: periods crossed by each particle (N, 3)")},
+        "wraps": ("1", "periodic cell: periods crossed by each particle (N, 3)"),
+        "virial_blocks": ("N m", "periodic cell: face terms of the pair forces' sum of l f "
+                                 "gathered this step (pendular.dem.virial)")},
     "contacts": {
         "pair_i": ("1", "first particle of each candidate pair (K,), i < j"),
         "pair_j": ("1", "second particle of each candidate pair (K,)"),
@@ -99,18 +95,19 @@ DATASETS = {
                             "(pendular.dem.virial.face_block_starts)"),
         "near_wall": ("1", "the particles within the skin of a wall at the last rebuild "
                            "(the wall forces visit only these; absent: every particle)")},
-    "": {"state": ("1", "pickled state of every operation and writer and the caller's "
-                        "extra_state (bytes; see pendular.dem.checkpoint)")},
+    # written as declared, listed for the outputs reference
+    "contacts/extra": {"<owner>.<field>": (
+        "declared", "a per-pair field an operation declares (pair_owner, pair_state: a "
+                    "pendular.dem.protocols.PairField, whose units and description it has)")},
+    "operations": {"<kind>/<index>/state/<key>": (
+        "see description", "state_dict()[key] of a Stateful operation, whose docstring gives "
+                           "the units; the group <kind>/<index> has the operation's type")},
 }
+#: The kinds of the simulation's operations, in step order (operations/<kind>).
+KINDS = ("neighbors", "forces", "controls", "integrator", "writers")
 
 
-def _describe(dataset, group, name):
-    """Set the ``units`` and ``description`` attributes of a dataset (DATASETS), "unknown"
-    units for a name not declared there."""
-    units, description = DATASETS.get(group, {}).get(
-        name, ("unknown", f"{group}/{name}: an array of the simulation's state not declared "
-                          "in pendular.dem.checkpoint.DATASETS (e.g. another operation's per-pair "
-                          "Contacts.extra entry); see pendular.dem.checkpoint"))
+def _describe(dataset, units, description):
     dataset.attrs["units"] = units
     dataset.attrs["description"] = description
 
@@ -126,7 +123,7 @@ def _owned_arrays(obj, owner):
     for name, value in vars(obj).items():
         if isinstance(value, np.ndarray):
             arrays[name] = value
-        elif isinstance(value, _SCALARS):
+        elif isinstance(value, (bool, int, float, str, np.generic)):
             scalars[name] = value
         else:
             raise TypeError(f"cannot checkpoint {owner}.{name} of type {type(value).__name__}: "
@@ -136,81 +133,164 @@ def _owned_arrays(obj, owner):
 
 def _pipeline(sim):
     """Kind -> list of the simulation's operations of that kind, in step order."""
-    return {"neighbors": [sim.neighbors], "forces": sim.forces, "controls": sim.controls,
-            "integrator": [sim.integrator], "writers": sim.writers}
+    return dict(zip(KINDS, ([sim.neighbors], sim.forces, sim.controls, [sim.integrator],
+                            sim.writers)))
 
 
-def _references(sim, particle_arrays, wall_arrays, contacts):
-    """Path -> object of the simulation's own objects, saved by reference in the state pickle."""
-    references = {("sim",): sim, ("particles",): sim.particles, ("walls",): sim.walls,
-                  ("contacts",): contacts}
-    for kind, ops in _pipeline(sim).items():
-        for index, op in enumerate(ops):
-            references[(kind, index)] = op
-    for kind in ("forces", "controls", "writers"):
-        references[(kind,)] = getattr(sim, kind)
-    for owner, arrays in (("particles", particle_arrays), ("walls", wall_arrays)):
-        for name, value in arrays.items():
-            references[(owner, name)] = value
-    if contacts is not None:
-        references[("contacts", "extra")] = contacts.extra
-        for name, value in vars(contacts).items():
-            if isinstance(value, np.ndarray):
-                references[("contacts", name)] = value
-        for name, value in contacts.extra.items():
-            references[("extra", name)] = value
-    return references
+def _operations(sim):
+    """(kind, index, 'kind[index] Type', operation) of every operation, in step order."""
+    return [(kind, index, f"{kind}[{index}] {type(op).__name__}", op)
+            for kind, ops in _pipeline(sim).items() for index, op in enumerate(ops)]
 
 
-class _Pickler(pickle.Pickler):
-    def __init__(self, handle, references):
-        super().__init__(handle, protocol=5)
-        self._paths = {id(obj): path for path, obj in references.items() if obj is not None}
-
-    def persistent_id(self, obj):
-        return self._paths.get(id(obj))
-
-
-class _Unpickler(pickle.Unpickler):
-    def __init__(self, handle, references):
-        super().__init__(handle)
-        self._references = references
-
-    def persistent_load(self, path):
-        try:
-            return self._references[tuple(path)]
-        except KeyError:
-            raise ValueError(f"checkpoint refers to {path}, absent from this simulation") from None
+def _stateful(op, owner):
+    """Whether ``op`` keeps state (Stateful) rather than none (``stateless``); TypeError for
+    an operation that declares neither (pendular.dem.protocols)."""
+    if getattr(op, "stateless", False):
+        return False
+    if callable(getattr(op, "state_dict", None)) and callable(getattr(op, "load_state", None)):
+        return True
+    raise TypeError(f"cannot checkpoint {owner}: it declares neither state_dict() and "
+                    "load_state(state) nor stateless = True (pendular.dem.protocols)")
 
 
-class _Discard:
-    def write(self, data):
-        return len(data)
-
-
-def _operation_state(op, references):
-    """(picklable attributes of ``op``, names skipped)."""
-    exclude = set(getattr(op, "checkpoint_exclude", ()))
-    state, skipped = {}, []
-    for name, value in vars(op).items():
-        if name in exclude:
-            skipped.append(name)
+def _pair_fields(sim):
+    """Key in Contacts.extra -> (owner, PairField) of the per-pair fields the forces declare
+    (``pair_owner``, ``pair_state``); TypeError for one declared without an owner or twice
+    with different declarations."""
+    fields = {}
+    for op in sim.forces:
+        declared = getattr(op, "pair_state", ())
+        if not declared:
             continue
-        try:
-            _Pickler(_Discard(), references).dump(value)
-        except Exception:      # functions, lambdas, open files: configuration, rebuilt by the scene
-            skipped.append(name)
-            continue
-        state[name] = value
-    return state, skipped
+        owner = getattr(op, "pair_owner", None)
+        if not isinstance(owner, str):
+            raise TypeError(f"{type(op).__name__} declares pair_state but no pair_owner (the "
+                            "name of its per-pair fields in Contacts.extra)")
+        for field in declared:
+            key = pair_key(owner, field)
+            if fields.setdefault(key, (owner, field)) != (owner, field):
+                raise TypeError(f"per-pair field {key} is declared twice, differently")
+    return fields
 
 
-def _write_group(handle, name, arrays, scalars=None, kind=None):
-    """Group ``name`` with a described dataset per array (``kind``: its DATASETS key, default
-    ``name``) and the ``scalars`` as group attributes."""
+# ---------------------------------------------------------------- the state of an operation
+def _value_kind(value):
+    """The kind of a state value (pendular.dem.protocols.Stateful.state_dict), None for
+    another."""
+    if value is None:
+        return "none"
+    if isinstance(value, (bool, np.bool_)):
+        return "bool"
+    if isinstance(value, numbers.Real):
+        return "number"
+    for kind, types in (("str", str), ("array", np.ndarray), ("list", list), ("dict", dict)):
+        if isinstance(value, types):
+            return kind
+    return None
+
+
+def _storable(kind, value):
+    """Whether a state value of ``kind`` is stored as a dataset: an array of numbers or
+    booleans, a list of numbers or of strings."""
+    if kind == "array":
+        return value.dtype.kind in "biuf"
+    return kind == "list" and (all(isinstance(v, str) for v in value) or
+                               all(_value_kind(v) in ("bool", "number") for v in value))
+
+
+def _write_state(group, state, where):
+    """``state`` (a state_dict) into ``group``; TypeError naming ``where`` and the key for a
+    value that is not a plain value (Stateful.state_dict)."""
+    for key, value in state.items():
+        kind = _value_kind(value)
+        if not isinstance(key, str) or not key or "/" in key or key == ".":
+            raise TypeError(f"cannot checkpoint {where}: its state key {key!r} is not a name")
+        if kind == "none":
+            group.attrs[key] = h5py.Empty("f8")
+        elif kind in ("bool", "number", "str"):
+            group.attrs[key] = value
+        elif kind == "dict":
+            _write_state(group.create_group(key), value, f"{where}/{key}")
+        elif _storable(kind, value):
+            strings = kind == "list" and bool(value) and isinstance(value[0], str)
+            data = np.array(value, dtype=h5py.string_dtype() if strings else None)
+            dataset = group.create_dataset(key, data=data)
+            if kind == "list":
+                dataset.attrs["list"] = True
+            _describe(dataset, "see description",
+                      f"state_dict()[{key!r}] of {where}, whose docstring gives the units")
+        else:
+            raise TypeError(f"cannot checkpoint {where}: its state {key!r} is a "
+                            f"{type(value).__name__}; valid: None, bool, int, float, str, "
+                            "an array of numbers, a list of numbers or strings, a dict")
+
+
+def _read_state(group):
+    """The state_dict written into ``group`` by _write_state."""
+    state = {}
+    for key, value in group.attrs.items():
+        if isinstance(value, h5py.Empty):
+            value = None
+        elif isinstance(value, np.generic):
+            value = value.item()
+        elif isinstance(value, bytes):
+            value = value.decode()
+        state[key] = value
+    for key, item in group.items():
+        if isinstance(item, h5py.Group):
+            state[key] = _read_state(item)
+        elif item.attrs.get("list", False):
+            state[key] = [v.decode() if isinstance(v, bytes) else v for v in item[()].tolist()]
+        else:
+            state[key] = item[()]
+    return state
+
+
+def _state_fault(template, saved, key=""):
+    """Why ``saved`` cannot be loaded where the operation's own state_dict holds
+    ``template`` (text beginning with the key), or None: a dict with the same keys, values of
+    the same kinds (None fits any: an optional value) and arrays of the same dtype."""
+    where = key or "its state"
+    if isinstance(template, dict) and isinstance(saved, dict):
+        inner = {name: f"{key}/{name}" if key else name for name in {*template, *saved}}
+        for name in template:
+            if name not in saved:
+                return f"{inner[name]} is missing"
+        for name in saved:
+            if name not in template:
+                return f"{inner[name]} is not a key of its state"
+        for name in template:
+            fault = _state_fault(template[name], saved[name], inner[name])
+            if fault is not None:
+                return fault
+        return None
+    wanted, found = _value_kind(template), _value_kind(saved)
+    if found is None:
+        return f"{where} holds a {type(saved).__name__}"
+    if "none" in (wanted, found):
+        return None
+    if wanted != found:
+        return f"{where} = {_shown(saved)} is a {found}; valid: a {wanted}"
+    if wanted == "array" and saved.dtype != template.dtype:
+        return f"{where} holds {saved.dtype}; valid: an array of {template.dtype}"
+    return None
+
+
+def _shown(value):
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _write_group(handle, name, arrays, scalars=None):
+    """Group ``name`` with a dataset per array, described by DATASETS[name] ("unknown" units
+    for an array it does not declare), and the ``scalars`` as group attributes."""
     group = handle.create_group(name)
     for key, value in arrays.items():
-        _describe(group.create_dataset(key, data=value), name if kind is None else kind, key)
+        units, description = DATASETS[name].get(key, (
+            "unknown", f"{name}/{key}: an array of the simulation's state not declared in "
+                       "pendular.dem.checkpoint.DATASETS"))
+        _describe(group.create_dataset(key, data=value), units, description)
     for key, value in (scalars or {}).items():
         group.attrs[key] = value
     return group
@@ -219,80 +299,100 @@ def _write_group(handle, name, arrays, scalars=None, kind=None):
 def save_checkpoint(path, sim, extra_state=None, identity=None):
     """Write the complete state of ``sim`` to ``path`` atomically (module docstring).
 
-    ``extra_state``: any picklable value (e.g. the scenario's phase), returned by
-    ``load_checkpoint``; ``identity``: what made the run (dict, e.g. its configuration hash and
-    seed), stamped with a content checksum (pendular.utils.integrity) and checked by ``load_checkpoint``.
-    Returns the names of the operation attributes not saved ({"forces[i] Type": [names]}).
+    ``extra_state``: what the caller needs to resume besides the simulation (e.g. the
+    scenario's phase), a JSON value (numbers, strings, lists, dicts, None), returned by
+    ``load_checkpoint``; ``identity``: what made the run (dict, e.g. its configuration hash
+    and seed), stamped with a content checksum (pendular.utils.integrity) and checked by
+    ``load_checkpoint``. TypeError, the previous checkpoint left as it was, for an operation
+    that declares no state (pendular.dem.protocols), a state or an extra_state that is not
+    plain values, or a per-pair array that no operation declares.
     """
     path = os.fspath(path)
+    sim.release()                   # a device run's state back on the host first
     contacts = sim.contacts
     particle_arrays, particle_scalars = _owned_arrays(sim.particles, "particles")
     wall_arrays, wall_scalars = _owned_arrays(sim.walls, "walls")
-    references = _references(sim, particle_arrays, wall_arrays, contacts)
-    skipped = {}
-    tree = {"extra_state": extra_state}
-    pipeline = _pipeline(sim)
-    for kind, ops in pipeline.items():
-        tree[kind] = []
-        for index, op in enumerate(ops):
-            state, names = _operation_state(op, references)
-            tree[kind].append(state)
-            if names:
-                skipped[f"{kind}[{index}] {type(op).__name__}"] = names
-    buffer = io.BytesIO()
-    _Pickler(buffer, references).dump(tree)
-    blob = np.frombuffer(buffer.getbuffer(), np.uint8)
+    states = [(kind, index, op, op.state_dict() if _stateful(op, owner) else None)
+              for kind, index, owner, op in _operations(sim)]
+    try:
+        extra_json = json.dumps(extra_state)
+    except TypeError as error:
+        raise TypeError(f"cannot checkpoint extra_state: {error} (valid: a JSON value)") \
+            from None
+    fields = _pair_fields(sim)
+    if contacts is not None:
+        arrays = {k: v for k, v in vars(contacts).items() if k != "extra"}
+        for key, value in arrays.items():
+            if not isinstance(value, np.ndarray):
+                raise TypeError(f"cannot checkpoint contacts.{key} of type "
+                                f"{type(value).__name__}: only arrays are supported")
+        for key in contacts.extra:
+            if key not in fields:
+                raise TypeError(f"cannot checkpoint contacts.extra[{key!r}]: no operation of "
+                                "this simulation declares it (pair_owner, pair_state; "
+                                "pendular.dem.protocols)")
 
     with replacing(path, durable=True) as temporary, h5py.File(temporary, "w") as handle:
         handle.attrs.update({
             "format": FORMAT, "version": VERSION, "step": int(sim.step),
-            "time": float(sim.time), "dt": float(sim.dt),
-            "pipeline": json.dumps({kind: [_type_name(op) for op in ops]
-                                    for kind, ops in pipeline.items()}),
-            "skipped": json.dumps(skipped), "has_contacts": contacts is not None})
+            "time": float(sim.time), "dt": float(sim.dt), "has_contacts": contacts is not None,
+            "extra_state": extra_json})
         _write_group(handle, "particles", particle_arrays, particle_scalars)
         _write_group(handle, "walls", wall_arrays, wall_scalars)
         if contacts is not None:
-            arrays = {k: v for k, v in vars(contacts).items() if k != "extra"}
-            for key, value in arrays.items():
-                if not isinstance(value, np.ndarray):
-                    raise TypeError(f"cannot checkpoint contacts.{key} of type "
-                                    f"{type(value).__name__}: only arrays are supported")
             group = _write_group(handle, "contacts", arrays)
+            extra = group.create_group("extra")
             for key, value in contacts.extra.items():
-                if not isinstance(value, np.ndarray):
-                    raise TypeError(f"cannot checkpoint contacts.extra[{key!r}] of type "
-                                    f"{type(value).__name__}: only arrays are supported")
-            _write_group(group, "extra", contacts.extra, kind="contacts/extra")
-        _describe(handle.create_dataset("state", data=blob), "", "state")
+                owner, field = fields[key]
+                _describe(extra.create_dataset(key, data=value), field.unit,
+                          f"{field.description} (per pair: {owner}'s {field.name})")
+        operations = handle.create_group("operations")
+        for kind in KINDS:
+            operations.create_group(kind)
+        for kind, index, op, state in states:
+            group = operations[kind].create_group(str(index))
+            group.attrs["type"] = _type_name(op)
+            if state is not None:
+                _write_state(group.create_group("state"), state, _type_name(op))
         handle.attrs["pendular_version"] = software_version()
         handle.attrs["schema_version"] = VERSION
         stamp(handle, {"kind": "checkpoint", "format": FORMAT, "version": VERSION,
                        **(identity or {})})
-    return skipped
 
 
 def _read_group(group):
     return {key: group[key][()] for key in group if isinstance(group[key], h5py.Dataset)}
 
 
-def _check_types(handle, sim):
-    try:
-        saved_pipeline = json.loads(handle.attrs["pipeline"])
-    except json.JSONDecodeError as error:
-        raise ValueError(f"checkpoint {handle.filename!r}: its pipeline attribute is not JSON "
-                         f"({error})") from None
-    if not isinstance(saved_pipeline, dict):
-        raise ValueError(f"checkpoint {handle.filename!r}: its pipeline attribute is not a JSON "
-                         "object of the operation types by kind")
+def _read_operations(source, handle, sim):
+    """Kind -> the saved state of each of the checkpoint's operations of that kind (None:
+    stateless), after checking that their types are those of ``sim``'s pipeline, in the
+    same order."""
+    operations = handle.get("operations")
+    if not isinstance(operations, h5py.Group):
+        raise ValueError(f"{source}: its operations group is missing")
+    saved = {}
     for kind, ops in _pipeline(sim).items():
-        saved = saved_pipeline.get(kind)
-        current = [_type_name(op) for op in ops]
-        if saved != current:
+        group = operations.get(kind)
+        names = sorted(group, key=lambda n: (len(n), n)) if isinstance(group, h5py.Group) \
+            else None
+        if names != [str(i) for i in range(len(names or ()))]:
+            raise ValueError(f"{source}: operations/{kind} is not a group of operations "
+                             "numbered 0, 1, ...")
+        entries = []
+        for name in names:
+            item = group[name]
+            state = item.get("state")
+            entries.append((item.attrs.get("type"),
+                            _read_state(state) if isinstance(state, h5py.Group) else None))
+        found, current = [name for name, _ in entries], [_type_name(op) for op in ops]
+        if found != current:
             raise ValueError(
-                f"checkpoint {handle.filename!r} does not match this simulation's {kind}: "
-                f"saved {saved}, this simulation has {current}; build the simulation the way "
-                "the checkpointed one was built")
+                f"{source} does not match this simulation's {kind}: saved {found}, this "
+                f"simulation has {current}; build the simulation the way the checkpointed one "
+                "was built")
+        saved[kind] = [state for _, state in entries]
+    return saved
 
 
 #: Per-pair arrays of Contacts: name -> (dtype, trailing shape); each holds one row per pair.
@@ -396,11 +496,11 @@ def _check_particles(source, arrays, scalars, particles):
     return count
 
 
-def _check_contacts(source, arrays, extra, count):
+def _check_contacts(source, arrays, extra, count, fields):
     """ValueError unless the contact arrays of a checkpoint form a valid neighbour list of
     ``count`` particles (pendular.dem.neighbors.Contacts): dtypes and shapes, finite per-pair
     state, 0 <= i < j < count, CSR indices that match the pairs, and per-pair ``extra``
-    arrays of numbers with one row per pair."""
+    arrays of the fields declared (``fields``, _check_pair_fields)."""
     unknown = sorted(set(arrays) - set(_PAIR_ARRAYS) - set(_INDEX_ARRAYS))
     if unknown:
         raise ValueError(f"{source}: contacts/{unknown[0]} is not an array of "
@@ -466,33 +566,32 @@ def _check_contacts(source, arrays, extra, count):
             near_wall[0] < 0 or near_wall[-1] >= count or (np.diff(near_wall) <= 0).any()):
         raise ValueError(f"{source}: contacts/near_wall is not an ascending list of particle "
                          f"indices in [0, {count})")
-    for name, values in extra.items():
-        if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf" or \
-                values.ndim == 0 or len(values) != pairs:
-            raise ValueError(f"{source}: contacts/extra/{name} holds {np.asarray(values).dtype} "
-                             f"of shape {np.shape(values)}; valid: numbers, one row per pair "
-                             f"({pairs}, ...)")
-        if values.dtype.kind == "f" and not np.isfinite(values).all():
-            index = _first(~np.isfinite(values))
-            raise ValueError(f"{source}: contacts/extra/{name}{list(index)} = {values[index]} "
-                             "is not finite")
+    _check_pair_fields(source, extra, fields, pairs)
+
+
+def _check_pair_fields(source, extra, fields, pairs):
+    """ValueError unless every per-pair array of ``extra`` is a field that the simulation's
+    operations declare (``fields``: key -> (owner, PairField)), of its declared dtype and
+    shape with one row per pair, finite; each owner's fields all there or none (none: its
+    operation had not run yet, ``pair_arrays`` creates them)."""
+    for key, values in extra.items():
+        if key not in fields:
+            raise ValueError(f"{source}: contacts/extra/{key} is not a per-pair field of an "
+                             "operation of this simulation (pair_owner, pair_state)")
+        field = fields[key][1]
+        _check_array(source, f"contacts/extra/{key}", values, field.dtype,
+                     (pairs, *field.shape))
+    present = {owner for key, (owner, _) in fields.items() if key in extra}
+    for key, (owner, _) in fields.items():
+        if owner in present and key not in extra:
+            raise ValueError(f"{source}: contacts/extra/{key} is missing (the other per-pair "
+                             f"fields of {owner!r} are there)")
 
 
 def _unfit(fresh, value):
-    """Why ``value`` cannot replace an operation's attribute ``fresh`` (the value its freshly
-    built operation holds), or None: an array for an array (same dtype and trailing shape),
-    a boolean for a boolean, a number for a number, else an instance of the same type. None on
-    either side fits (attributes set when first needed, caches cleared)."""
-    if fresh is None or value is None:
-        return None
-    if isinstance(fresh, np.ndarray):
-        if not isinstance(value, np.ndarray):
-            return f"of type {type(value).__name__}, not an array"
-        if value.dtype != fresh.dtype or value.ndim != fresh.ndim or \
-                value.shape[1:] != fresh.shape[1:]:
-            return (f"an array of {value.dtype} and shape {value.shape}; this simulation's is "
-                    f"{fresh.dtype} of shape {fresh.shape}")
-        return None
+    """Why the scalar ``value`` cannot replace a particles' or walls' attribute ``fresh`` (its
+    value in the simulation loaded into), or None: a boolean for a boolean, a number for a
+    number, else an instance of the same type."""
     if isinstance(fresh, (bool, np.bool_)):
         return None if isinstance(value, (bool, np.bool_)) else f"{value!r}, not a boolean"
     if isinstance(fresh, numbers.Number):
@@ -504,48 +603,34 @@ def _unfit(fresh, value):
     return None
 
 
-def _operation_states(source, blob, references, sim):
-    """The unpickled state tree of a checkpoint after checking that it fits ``sim``'s pipeline:
-    a state per operation, each attribute of the type the operation holds (an attribute absent
-    from the state, e.g. one added to the operation after the checkpoint was written, keeps
-    the operation's own value); ValueError naming the file otherwise. Nothing of ``sim`` is
-    changed."""
-    try:
-        tree = _Unpickler(io.BytesIO(blob), references).load()
-    except Exception as error:      # garbage bytes raise any of pickle's many errors
-        raise ValueError(f"{source}: the saved state of its operations (dataset 'state') cannot "
-                         f"be restored: {type(error).__name__}: {error}") from None
-    pipeline = _pipeline(sim)
-    if not isinstance(tree, dict) or set(tree) != {"extra_state", *pipeline}:
-        found = sorted(map(str, tree)) if isinstance(tree, dict) else type(tree).__name__
-        raise ValueError(f"{source}: the saved state of its operations holds {found}; valid: "
-                         f"{sorted(['extra_state', *pipeline])}")
-    for kind, ops in pipeline.items():
-        states = tree[kind]
-        if not isinstance(states, list) or len(states) != len(ops):
-            found = len(states) if isinstance(states, list) else type(states).__name__
-            raise ValueError(f"{source}: the saved state of its {kind} holds {found} entries; "
-                             f"this simulation has {len(ops)} {kind}")
-        for index, (op, state) in enumerate(zip(ops, states)):
-            owner = f"{kind}[{index}] {type(op).__name__}"
-            if not isinstance(state, dict) or not all(isinstance(name, str) for name in state):
-                raise ValueError(f"{source}: the saved state of {owner} is of type "
-                                 f"{type(state).__name__}, not attributes by name")
-            current = vars(op)
-            exclude = set(getattr(op, "checkpoint_exclude", ()))
-            for name, value in state.items():
-                if name in exclude:         # kept from the operation, not restored
-                    continue
-                defined = getattr(type(op), name, None)
-                if name not in current and (name.startswith("__") or callable(defined)
-                                            or isinstance(defined, property)):
-                    raise ValueError(f"{source}: the saved state of {owner} names {name!r}, "
-                                     "a method or property of its class, not an attribute")
-                reason = _unfit(current.get(name), value)
-                if reason is not None:
-                    raise ValueError(f"{source}: the saved {owner}.{name} cannot be restored: "
-                                     f"it is {reason}")
-    return tree
+def _load_operations(source, sim, saved):
+    """Every operation's saved state into ``sim``'s operations: checked against its own
+    state_dict (_state_fault), then ``load_state``; ValueError naming the operation and the
+    key, the operations already loaded taken back to their own state first, so that a
+    refused checkpoint changes nothing."""
+    loaded = []
+    for kind, index, owner, op in _operations(sim):
+        state = saved[kind][index]
+        try:
+            own = op.state_dict() if _stateful(op, owner) else None
+            if (own is None) != (state is None):
+                raise ValueError(f"the saved {owner} " + (
+                    "has a state; this simulation's declares none" if own is None
+                    else "has no state; this simulation's declares one"))
+            if own is not None:
+                fault = _state_fault(own, state)
+                if fault is not None:
+                    raise ValueError(f"the saved state of {owner} is refused: {fault}")
+                try:
+                    op.load_state(state)
+                except ValueError as error:
+                    raise ValueError(f"the saved state of {owner} is refused: {error}") \
+                        from None
+                loaded.append((op, own))
+        except (TypeError, ValueError) as error:
+            for earlier, earlier_state in reversed(loaded):
+                earlier.load_state(earlier_state)
+            raise ValueError(f"{source}: {error}") from None
 
 
 def load_checkpoint(path, sim, expected_identity=None):
@@ -556,21 +641,23 @@ def load_checkpoint(path, sim, expected_identity=None):
     ``sim`` must have neighbour list, forces, controls, integrator and writers of the same
     types in the same order, and the content must be valid (module docstring): ValueError
     naming the file and what is wrong otherwise, before anything is changed. Particles,
-    walls, contacts, step, time, dt and the saved attributes of every operation and writer are
-    replaced; attributes skipped at saving, or excluded (``checkpoint_exclude``), keep the
-    values of ``sim``'s own operations.
+    walls, contacts (with the declared per-pair fields), step, time, dt and the state of
+    every Stateful operation (``load_state``) are replaced; what the scene built (its
+    operations' configuration) stays.
     """
     path = os.fspath(path)
     verify(path, expected_identity, kind="checkpoint")
+    source = f"checkpoint {path!r}"
     with reading(path, "pendular checkpoint"), h5py.File(path, "r") as handle:
         if handle.attrs.get("format") != FORMAT:
             raise ValueError(f"{path!r} is not a pendular checkpoint")
         if int(handle.attrs["version"]) != VERSION:
             raise ValueError(f"{path!r} has checkpoint version {handle.attrs['version']}; "
                              f"this code reads version {VERSION} only (version 1 was written "
-                             "before the declared pipeline, 2 with per-pair torques): restart "
-                             "the run from its sample")
-        _check_types(handle, sim)
+                             "before the declared pipeline, 2 with per-pair torques, 3 with "
+                             "the operations' attributes pickled): restart the run from its "
+                             "sample")
+        operations = _read_operations(source, handle, sim)
         particle_arrays = _read_group(handle["particles"])
         particle_scalars = dict(handle["particles"].attrs)
         wall_arrays = _read_group(handle["walls"])
@@ -579,19 +666,25 @@ def load_checkpoint(path, sim, expected_identity=None):
         if has_contacts:
             contact_arrays = _read_group(handle["contacts"])
             extra = _read_group(handle["contacts/extra"])
-        blob = handle["state"][()].tobytes()
         step, time, dt = (handle.attrs[name] for name in ("step", "time", "dt"))
+        extra_json = handle.attrs.get("extra_state")
 
-    source = f"checkpoint {path!r}"
+    try:
+        extra_state = json.loads(extra_json)
+    except (TypeError, json.JSONDecodeError) as error:
+        raise ValueError(f"{source}: its extra_state attribute is not JSON ({error})") from None
     step, time, dt = _check_clock(source, step, time, dt)
     count = _check_particles(source, particle_arrays, particle_scalars, sim.particles)
     _check_owned(source, "walls", wall_arrays, wall_scalars, sim.walls, count, False)
     contacts = None
     if has_contacts:
-        _check_contacts(source, contact_arrays, extra, count)
+        try:
+            fields = _pair_fields(sim)
+        except TypeError as error:
+            raise ValueError(f"{source}: {error}") from None
+        _check_contacts(source, contact_arrays, extra, count, fields)
         contacts = Contacts(**contact_arrays, extra=extra)
-    references = _references(sim, particle_arrays, wall_arrays, contacts)
-    tree = _operation_states(source, blob, references, sim)
+    _load_operations(source, sim, operations)
 
     for obj, arrays, scalars in ((sim.particles, particle_arrays, particle_scalars),
                                  (sim.walls, wall_arrays, wall_scalars)):
@@ -603,26 +696,18 @@ def load_checkpoint(path, sim, expected_identity=None):
     sim.step = step
     sim.time = time
     sim.dt = dt
-    for kind, ops in _pipeline(sim).items():
-        for op, state in zip(ops, tree[kind]):
-            exclude = set(getattr(op, "checkpoint_exclude", ()))
-            for name, value in state.items():
-                if name not in exclude:     # saved by a pendular that did not exclude it
-                    setattr(op, name, value)
-    return tree["extra_state"]
+    return extra_state
 
 
 class CheckpointWriter:
     """Writer saving a checkpoint to ``path`` every ``period`` steps (``sim.step % period == 0``).
 
     Append it after the other writers, so that the checkpoint holds the record of its own step.
-    ``extra_state``: None, a picklable value, or a function of sim returning one; ``identity``:
-    see ``save_checkpoint``. Only the count of checkpoints written is restored on resuming:
-    the resumed run's own path, period, extra_state and identity hold (a run folder copied and
-    resumed writes its checkpoints into itself, not into the folder it was copied from).
+    ``extra_state``: None, a JSON value, or a function of sim returning one; ``identity``:
+    see ``save_checkpoint``. Only the count of checkpoints written is its state: the resumed
+    run's own path, period, extra_state and identity hold (a run folder copied and resumed
+    writes its checkpoints into itself, not into the folder it was copied from).
     """
-
-    checkpoint_exclude = ("path", "period", "extra_state", "identity")
 
     def __init__(self, path, period, extra_state=None, identity=None):
         self.path = os.fspath(path)
@@ -630,6 +715,13 @@ class CheckpointWriter:
         self.extra_state = extra_state
         self.identity = identity
         self.written = 0
+
+    def state_dict(self):
+        """``written``: the checkpoints written so far."""
+        return {"written": self.written}
+
+    def load_state(self, state):
+        self.written = check_int("written", state["written"])
 
     def apply(self, sim):
         if sim.step % self.period == 0:

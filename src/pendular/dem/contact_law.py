@@ -479,9 +479,18 @@ class ContactForces:
 
     @friction_deg.setter
     def friction_deg(self, value):
-        self._friction_deg = check_range("friction", value, 0.0, 90.0, high_inclusive=False,
+        self._friction_deg = check_range("friction_deg", value, 0.0, 90.0, high_inclusive=False,
                                          unit="deg")
         self._tan_friction = float(np.tan(np.radians(self._friction_deg)))
+
+    def state_dict(self):
+        """``friction_deg`` [deg], which a procedure may change after building the law (the
+        preparation sets the test's after the growth); the springs' history is the
+        contacts'."""
+        return {"friction_deg": self.friction_deg}
+
+    def load_state(self, state):
+        self.friction_deg = state["friction_deg"]
 
     def pair_forces(self, sim):
         """Contact force on j from i (K, 3) [N] of the last evaluation."""

@@ -67,6 +67,8 @@ def _advance(p, position, velocity, angular_velocity, force, torque, mass, inert
 class Integrator:
     """Leapfrog with Cundall local damping ``damping`` (YADE NewtonIntegrator, default 0.2)."""
 
+    stateless = True
+
     def __init__(self, damping=0.2):
         self.damping = check_range("damping", damping, 0.0, 1.0, high_inclusive=False)
 

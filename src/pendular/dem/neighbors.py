@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from pendular.utils.validate import check_positive, check_range
+from pendular.dem.protocols import state_array
+from pendular.utils.validate import check_int, check_positive, check_range
 from pendular.dem.virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
 
@@ -636,6 +637,12 @@ class NeighborList:
     and a change of reach forces a rebuild. ``interaction_range`` [m]: the reach in use.
     """
 
+    #: The rebuild test's references (``state_dict``): attribute -> (dtype, shape).
+    _REFERENCES = {"reference_position": (np.float64, (None, 3)),
+                   "reference_radius": (np.float64, (None,)),
+                   "reference_lengths": (np.float64, (None,)),
+                   "reference_walls": (np.float64, (6,))}
+
     def __init__(self, skin):
         self.skin = check_positive("skin", skin, "m")
         self.rebuilds = 0
@@ -646,6 +653,47 @@ class NeighborList:
         self._reference_walls = None
         self._reference_skin = None
         self._shortest_unlisted = 0.0
+
+    def state_dict(self):
+        """``skin`` [m] (a procedure may change it), ``rebuilds``, ``interaction_range`` [m]
+        and the rebuild test's references of the last rebuild, None before the first: the
+        positions (N, 3) [m], radii (N,) [m], box lengths (3,) [m] (a sheared cell's period,
+        (4,)), wall positions (6,) [m], the skin [m] and the shortest unlisted distance [m]."""
+        state = {"skin": self.skin, "rebuilds": self.rebuilds,
+                 "interaction_range": self.interaction_range,
+                 "reference_skin": self._reference_skin,
+                 "shortest_unlisted": self._shortest_unlisted}
+        for name in self._REFERENCES:
+            value = getattr(self, "_" + name)
+            state[name] = None if value is None else value.copy()
+        return state
+
+    def load_state(self, state):
+        loaded = {"skin": check_positive("skin", state["skin"], "m"),
+                  "rebuilds": check_int("rebuilds", state["rebuilds"]),
+                  "interaction_range": check_range("interaction_range",
+                                                   state["interaction_range"], 0.0, unit="m"),
+                  "_shortest_unlisted": check_range("shortest_unlisted",
+                                                    state["shortest_unlisted"], 0.0, unit="m")}
+        built = state["reference_position"] is not None
+        for name, (dtype, shape) in self._REFERENCES.items():
+            if (state[name] is not None) != built:
+                raise ValueError(f"{name} is {'missing' if built else 'set'} while "
+                                 f"reference_position is {'set' if built else 'missing'}")
+            loaded["_" + name] = state_array(state, name, dtype, shape) if built else None
+        loaded["_reference_skin"] = (check_positive("reference_skin", state["reference_skin"],
+                                                    "m") if built else None)
+        if built:
+            count, radii, lengths = (len(loaded["_reference_" + name])
+                                     for name in ("position", "radius", "lengths"))
+            if radii != count:
+                raise ValueError(f"reference_radius has {radii} entries; valid: one per "
+                                 f"reference position ({count})")
+            if lengths not in (3, 4):
+                raise ValueError(f"reference_lengths has {lengths} entries; valid: 3 (4: a "
+                                 "sheared cell)")
+        for name, value in loaded.items():
+            setattr(self, name, value)
 
     def required_reach(self, sim):
         """Largest reach [m] the simulation's forces declare (0: contacts only). A reach is

@@ -10,11 +10,25 @@ neighbour list, the forces in order, the controls in order, the integrator, then
 - ``reach(sim)`` [m]: how far beyond touching it needs pairs (the list rebuilds when the
   largest reach of the scene's forces changes); none: touching pairs and the skin;
 - ``pair_state``: the per-pair quantities it keeps (``PairField``\\ s), held in
-  ``sim.contacts.extra`` under ``pair_key(owner, field)``, carried to the same pair across
-  rebuilds (new pairs start at zero) and saved by checkpoints;
+  ``sim.contacts.extra`` under ``pair_key(pair_owner, field)`` (``pair_owner``: its name
+  there), carried to the same pair across rebuilds (new pairs start at zero) and saved by
+  checkpoints, which store only declared fields and check each against its declaration;
 - ``joins_contact_gather``: its pair forces are central along the contact normals and are
   added in the contact law's gather, one pass over the pairs instead of two
   (pendular.dem.contact_law.ContactForces.joined_by).
+
+Every operation says what a checkpoint (pendular.dem.checkpoint) must keep of it:
+
+- one that keeps something across steps (a servo's memory, a recorder's rows, a counter) or
+  whose settings its procedure changes after building it (a stage's target or strain rate)
+  is ``Stateful``: ``state_dict()`` returns that, as plain values only (no object, no
+  function), and ``load_state(state)`` takes it back from a dict of the same keys, checking every value
+  before changing anything (ValueError naming the key; ``state_array`` checks an array).
+  What the scene builds (parameters of its configuration, functions, references to other
+  objects) is not state: the scene that loads a checkpoint builds it again;
+- one that keeps nothing declares ``stateless = True`` (class attribute).
+
+A checkpoint refuses an operation that does neither, so that nothing is skipped silently.
 """
 
 from __future__ import annotations
@@ -40,6 +54,40 @@ class ReachingForce(Operation, Protocol):
 
     def reach(self, sim) -> float:
         """Largest distance [m] between two surfaces at which this force still acts."""
+
+
+@runtime_checkable
+class Stateful(Protocol):
+    """An operation that keeps something across steps (module docstring)."""
+
+    def state_dict(self) -> dict:
+        """What a checkpoint must keep of this operation, by name, as copies (the dict does
+        not change as the operation runs) of plain values: None (an optional value not
+        set), bool, int, float, str, NumPy arrays of numbers or booleans, lists of numbers
+        or of strings, and dicts of these by name."""
+
+    def load_state(self, state: dict) -> None:
+        """Take back ``state`` (a ``state_dict`` of an operation of this type, the same
+        keys): every value checked before anything changes, ValueError naming the key."""
+
+
+def state_array(state, key, dtype, shape, finite=True):
+    """A copy of the array ``state[key]`` after checking that it holds ``dtype``, has
+    ``shape`` (None: any length on that axis) and, if ``finite``, finite numbers only;
+    ValueError naming ``key`` otherwise."""
+    value = state[key]
+    if not isinstance(value, np.ndarray) or value.dtype != np.dtype(dtype):
+        found = value.dtype if isinstance(value, np.ndarray) else type(value).__name__
+        raise ValueError(f"{key} holds {found}; valid: an array of {np.dtype(dtype)}")
+    if value.ndim != len(shape) or any(want is not None and got != want
+                                       for got, want in zip(value.shape, shape)):
+        wanted = ", ".join("any" if n is None else str(n) for n in shape)
+        raise ValueError(f"{key} has shape {value.shape}; valid: ({wanted}"
+                         f"{',' if len(shape) == 1 else ''})")
+    if finite and value.dtype.kind == "f" and not np.isfinite(value).all():
+        index = [int(i) for i in np.argwhere(~np.isfinite(value))[0]]
+        raise ValueError(f"{key}{index} = {value[tuple(index)]} is not finite")
+    return np.array(value, dtype=dtype)
 
 
 @dataclass(frozen=True)

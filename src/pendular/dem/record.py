@@ -3,6 +3,7 @@
 import h5py
 import numpy as np
 
+from pendular.dem.protocols import state_array
 from pendular.utils.atomic import replacing
 from pendular.utils.validate import check_int
 
@@ -25,6 +26,41 @@ class HistoryRecorder:
             if not callable(quantity):
                 raise TypeError(f"quantities[{name!r}] = {quantity!r} is not a function of sim")
         self.rows = {name: [] for name in self.quantities}
+
+    def state_dict(self):
+        """``origin`` and ``end`` (the steps its records count from and end at, None: no
+        end; a resumed run builds its recorder at another step) and ``rows``: each
+        quantity's values so far, stacked (records, ...) float64 (a column may hold one more
+        row than another: a row cut short by an interrupt)."""
+        rows = {}
+        for name, values in self.rows.items():
+            try:
+                rows[name] = np.stack(values) if values else np.zeros(0)
+            except ValueError:
+                raise ValueError(f"cannot checkpoint {name!r} of the HistoryRecorder: its "
+                                 "values are not all of one shape") from None
+        return {"origin": self.origin, "end": self.end, "rows": rows}
+
+    def load_state(self, state):
+        origin = check_int("origin", state["origin"])
+        end = None if state["end"] is None else check_int("end", state["end"], low=origin)
+        rows = state["rows"]
+        if not isinstance(rows, dict) or set(rows) != set(self.quantities):
+            found = sorted(rows) if isinstance(rows, dict) else type(rows).__name__
+            raise ValueError(f"rows holds {found}; valid: the quantities "
+                             f"{sorted(self.quantities)}")
+        columns = {}
+        for name in self.quantities:
+            column = rows[name]
+            axes = max(1, column.ndim) if isinstance(column, np.ndarray) else 1
+            try:                # NaN is a value (e.g. k0 while the axial stress is 0)
+                columns[name] = state_array(rows, name, np.float64, (None,) * axes,
+                                            finite=False)
+            except ValueError as error:
+                raise ValueError(f"rows/{error}") from None
+        self.origin, self.end = origin, end
+        self.rows = {name: [np.array(row) for row in column]
+                     for name, column in columns.items()}
 
     def apply(self, sim):
         if (sim.step - self.origin) % self.period == 0 or sim.step == self.end:

@@ -9,6 +9,7 @@ import numpy as np
 
 from pendular.dem.cell import servo_cell
 from pendular.dem.contact_law import wall_forces
+from pendular.dem.protocols import state_array
 from pendular.utils.validate import check_int, check_positive, check_range
 
 AXES = {"x": 0, "y": 1, "z": 2}
@@ -17,8 +18,13 @@ AXES = {"x": 0, "y": 1, "z": 2}
 def _axes(names):
     try:
         return tuple(AXES[name] for name in names)
-    except KeyError:
+    except (KeyError, TypeError):
         raise ValueError(f"axes must be letters among 'x', 'y', 'z', got {names!r}") from None
+
+
+def _axis_names(axes):
+    """The letters of the axis indices ``axes`` (e.g. "xy")."""
+    return "".join("xyz"[axis] for axis in axes)
 
 
 @numba.njit(cache=True)
@@ -64,6 +70,8 @@ class WallForces:
     """Frictionless sphere–wall springs with kn = E R
     (YADE's Ig2_Box_Sphere_ScGeom, docs/physics.md 'The contact law')."""
 
+    stateless = True
+
     def __init__(self, young):
         self.young = check_positive("young", young, "Pa")
 
@@ -108,10 +116,7 @@ class StressServo:
 
     def __init__(self, axes, target, max_velocity, gain=GAIN, memory=MEMORY,
                  scale_max_velocity=False, stiffness_every=1):
-        self.axes = _axes(axes)
-        self.walls = tuple(w for axis in self.axes for w in (2 * axis, 2 * axis + 1))
-        self._wall_index = np.array(self.walls, dtype=np.int64)
-        self._axis_index = np.array(self.axes, dtype=np.int64)
+        self._set_axes(_axes(axes))
         self.target = check_range("target stress", target, 0.0, unit="Pa")
         self.max_velocity = check_positive("max_velocity", max_velocity, "m/s")
         self.gain = check_range("servo gain", gain, 0.0, 1.0, low_inclusive=False)
@@ -121,6 +126,34 @@ class StressServo:
         self.previous = np.zeros(len(self.walls))
         self.stiffness = np.zeros(len(self.walls))
         self.calls = 0
+
+    def _set_axes(self, axes):
+        """The servoed axes (indices) and their walls."""
+        self.axes = axes
+        self.walls = tuple(w for axis in axes for w in (2 * axis, 2 * axis + 1))
+        self._wall_index = np.array(self.walls, dtype=np.int64)
+        self._axis_index = np.array(axes, dtype=np.int64)
+
+    def state_dict(self):
+        """The servo as its path left it: ``axes`` (letters), ``target`` [Pa] and
+        ``max_velocity`` [m/s] (a path's stages change them), and its memory: ``previous``
+        (shifts of the last step [m], one per wall), ``stiffness`` (K_wall [N/m], or a
+        cell's S [Pa], per wall) and ``calls``."""
+        return {"axes": _axis_names(self.axes), "target": self.target,
+                "max_velocity": self.max_velocity, "previous": self.previous.copy(),
+                "stiffness": self.stiffness.copy(), "calls": self.calls}
+
+    def load_state(self, state):
+        axes = _axes(state["axes"])
+        walls = (2 * len(axes),)
+        loaded = {"target": check_range("target", state["target"], 0.0, unit="Pa"),
+                  "max_velocity": check_positive("max_velocity", state["max_velocity"], "m/s"),
+                  "previous": state_array(state, "previous", np.float64, walls),
+                  "stiffness": state_array(state, "stiffness", np.float64, walls),
+                  "calls": check_int("calls", state["calls"])}
+        self._set_axes(axes)
+        for name, value in loaded.items():
+            setattr(self, name, value)
 
     @classmethod
     def max_velocity_for(cls, strain_rate, length):
@@ -159,13 +192,31 @@ class ConstantStrainRate:
     L the current length (YADE's TriaxialStressController: the true strain rate is ``rate``).
     """
 
+    #: Largest strain rate [1/s].
+    MAX_RATE = 1e6
+
     def __init__(self, axis, rate, reference_length, on_current_length=False):
         (self.axis,) = _axes(axis)
-        self.rate = check_range("strain_rate", rate, -1e6, 1e6, unit="1/s")
+        self.rate = check_range("strain_rate", rate, -self.MAX_RATE, self.MAX_RATE, unit="1/s")
         self.reference_length = check_positive("reference_length", reference_length, "m")
         self.on_current_length = bool(on_current_length)
         self._walls = np.array([2 * self.axis, 2 * self.axis + 1], dtype=np.int64)
         self._shift = np.zeros(2)
+
+    def state_dict(self):
+        """The drive its stage set: ``axis`` (a letter), ``rate`` [1/s] and
+        ``reference_length`` [m]."""
+        return {"axis": _axis_names((self.axis,)), "rate": self.rate,
+                "reference_length": self.reference_length}
+
+    def load_state(self, state):
+        axes = _axes(state["axis"])
+        if len(axes) != 1:
+            raise ValueError(f"axis = {state['axis']!r}; valid: one of 'x', 'y', 'z'")
+        rate = check_range("rate", state["rate"], -self.MAX_RATE, self.MAX_RATE, unit="1/s")
+        length = check_positive("reference_length", state["reference_length"], "m")
+        (self.axis,), self.rate, self.reference_length = axes, rate, length
+        self._walls = np.array([2 * self.axis, 2 * self.axis + 1], dtype=np.int64)
 
     def strain(self, walls):
         """Engineering strain of the axis, compression positive."""

@@ -65,6 +65,7 @@ import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
 from pendular.dem.neighbors import branch_vectors
+from pendular.dem.protocols import state_array
 from pendular.io.schema import VTK_FIELDS
 from pendular.utils.atomic import replacing
 from pendular.utils.validate import check_int
@@ -285,9 +286,6 @@ class VtkWriter:
     each new phase and stores the phase's index as field data ``phase``.
     """
 
-    #: Not restored from a checkpoint: a resumed run writes into its own folder.
-    checkpoint_exclude = ("folder",)
-
     def __init__(self, folder, period, compression="zlib", field_data=None, time_axis="time",
                  phases=None):
         if time_axis not in VTK_FIELDS:
@@ -305,6 +303,27 @@ class VtkWriter:
         self.compression = compression
         self.frames = []
         os.makedirs(self.folder, exist_ok=True)
+
+    def state_dict(self):
+        """The frames written so far: ``frame_steps`` (F,) and ``frame_values`` (F,), their
+        steps and time-axis values (the .pvd index of a resumed run lists them); with
+        ``phases``, ``phase`` and ``frame_phase`` (that of the last frame), None before one.
+        A resumed run writes into its own folder."""
+        state = {"frame_steps": np.array([step for step, _ in self.frames], np.int64),
+                 "frame_values": np.array([value for _, value in self.frames], np.float64)}
+        if self.phases is not None:
+            state.update(phase=self.phase, frame_phase=self._frame_phase)
+        return state
+
+    def load_state(self, state):
+        steps = state_array(state, "frame_steps", np.int64, (None,))
+        values = state_array(state, "frame_values", np.float64, (len(steps),))
+        if self.phases is not None:
+            for key in ("phase", "frame_phase"):
+                if state[key] is not None and state[key] not in self.phases:
+                    raise ValueError(f"{key} = {state[key]!r} is not one of {self.phases}")
+            self.phase, self._frame_phase = state["phase"], state["frame_phase"]
+        self.frames = [(int(step), float(value)) for step, value in zip(steps, values)]
 
     def apply(self, sim):
         if (not self.frames or sim.step % self.period == 0

@@ -239,19 +239,24 @@ class BridgeConfig:
                 raise fail(self, "table_resolution", f"table_resolution = "
                            f"{self.table_resolution!r}: two integers (nodes in suction, nodes in "
                            "distance) expected")
-            self.table_resolution = tuple(check_int(name, value, low=4, high=MAX_TABLE_NODES // 4)
-                                          for name, value in
-                                          zip(("table_resolution[0]", "table_resolution[1]"),
-                                              self.table_resolution))
+            try:
+                self.table_resolution = tuple(
+                    check_int(f"table_resolution[{k}]", value, low=4, high=MAX_TABLE_NODES // 4)
+                    for k, value in enumerate(self.table_resolution))
+            except ValueError as error:
+                raise fail(self, "table_resolution", str(error)) from None
             nodes = self.table_resolution[0] * self.table_resolution[1]
             if nodes > MAX_TABLE_NODES:
                 raise fail(self, "table_resolution", f"table_resolution = "
                            f"{self.table_resolution!r} has {nodes} nodes, outside the valid range "
                            f"[16, {MAX_TABLE_NODES}] (suction nodes x distance nodes)")
 
-    def build(self, suction=None):
+    def build(self, suction=None, closed=False):
         """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
-        water content, ``suction`` [Pa] is the formation suction found at wetting."""
+        water content, ``suction`` [Pa] is the formation suction found at wetting, and
+        ``closed`` builds the bridges with the liquid model ``liquid`` of the loading (a resumed
+        run, whose checkpoint holds the liquid's account) instead of the open reservoir of the
+        wetting."""
         from pendular.capillary import CapillaryBridges   # a dry run never builds one
 
         if suction is None:
@@ -261,10 +266,12 @@ class BridgeConfig:
             suction = self.suction
         table_options = (None if self.table_resolution is None else
                          dict(zip(("n_suction", "n_distance"), self.table_resolution)))
+        liquid = self.liquid if closed and self.control == "volume" else "reservoir"
         return CapillaryBridges(suction, surface_tension=self.surface_tension,
                                 contact_angle=self.contact_angle, model=self.model,
                                 control=self.control, persist=self.persist,
-                                roughness=self.roughness, table_options=table_options)
+                                roughness=self.roughness, table_options=table_options,
+                                liquid=liquid)
 
 
 @dataclass

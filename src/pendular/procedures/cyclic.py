@@ -72,6 +72,8 @@ class AxialStressGuard:
     sample is in tension), which a cyclic test does not measure. ``describe(sim)``: where the
     path stands (text); ``remedy``: what to change (text)."""
 
+    stateless = True
+
     def __init__(self, describe, remedy):
         self.describe = describe
         self.remedy = remedy

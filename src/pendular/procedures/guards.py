@@ -47,6 +47,8 @@ class SampleGuard:
     the step, ``describe(sim)`` (text, e.g. the axial strain) when given, and ``remedy``: the
     options to change."""
 
+    stateless = True
+
     def __init__(self, period, *, max_overlap=MAX_OVERLAP_OVER_RADIUS, porosity_range=None,
                  describe=None, remedy=SHEAR_REMEDY):
         self.period = check_int("guard period", period, low=1)

@@ -275,6 +275,33 @@ class MixedStress:
         self.free = tuple(AXES[a] for a in stage.free)
         self.servos = servos                # {axis index: the StressServo of that axis}
 
+    def state_dict(self):
+        """The condition its stage set: ``mean_stress`` [Pa] and ``b`` (None: not held),
+        ``stress`` ({axis letter: stress given [Pa]}) and ``free`` (the letters of the axes it
+        sets); its servos are the scene's."""
+        return {"mean_stress": self.mean_stress, "b": self.b,
+                "stress": {AXIS_NAMES[a]: value for a, value in self.stress.items()},
+                "free": "".join(AXIS_NAMES[a] for a in self.free)}
+
+    def load_state(self, state):
+        mean = state["mean_stress"]
+        mean = None if mean is None else check_positive("mean_stress", mean, "Pa")
+        b = None if state["b"] is None else check_range("b", state["b"], 0.0, 1.0)
+        if mean is None and b is None:
+            raise ValueError("mean_stress and b are both None; valid: one of them or both")
+        given = state["stress"]
+        if not isinstance(given, dict):
+            raise ValueError(f"stress holds {type(given).__name__}; valid: axis -> Pa")
+        stress = {AXES[_axis_name("stress axis", a)]: check_range(f"stress/{a}", value, 0.0,
+                                                                  unit="Pa")
+                  for a, value in given.items()}
+        free = tuple(AXES[_axis_name("free axis", a)] for a in state["free"])
+        unserved = [AXIS_NAMES[a] for a in free if a not in self.servos]
+        if not free or unserved:
+            raise ValueError(f"free = {state['free']!r}: valid: axes of this scene's servos "
+                             f"({''.join(AXIS_NAMES[a] for a in sorted(self.servos))})")
+        self.mean_stress, self.b, self.stress, self.free = mean, b, stress, free
+
     def targets(self, sigma):
         """{axis index: target [Pa]} of the free axes for the stresses ``sigma`` (3,) [Pa]."""
         given = {a: self.stress.get(a, sigma[a]) for a in range(3)}

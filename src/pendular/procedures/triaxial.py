@@ -39,7 +39,7 @@ from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
-from pendular.utils.parameters import flat_options
+from pendular.utils.parameters import fail, flat_options
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
@@ -411,8 +411,8 @@ def check_feasible(config, force=False):
     for name in ("vtk_every", "checkpoint_every"):
         value = getattr(config, name)
         if steps is not None and value is not None and value > max(steps, 1.0) + 1:
-            raise ValueError(f"{name} = {value} is outside the valid range [0, {int(steps) + 1}]"
-                             f": the shear has about {int(steps)} steps")
+            raise fail(config, name, f"{name} = {value} is outside the valid range "
+                       f"[0, {int(steps) + 1}]: the shear has about {int(steps)} steps")
 
 
 def check_device(config, device):
@@ -633,7 +633,7 @@ class LaboratoryTest:
                                      threads=threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
                 sim.forces.append(config.bridges.build(
-                    before_shear["wetting"].get("formation_suction_pa")))
+                    before_shear["wetting"].get("formation_suction_pa"), closed=True))
             identity = run_identity(config, sample_file)
             test = cls.__new__(cls)          # the stored run, checked when it started
             test.config = config
