@@ -58,6 +58,7 @@ def test_a_stress_controlled_run_gives_its_loops_modulus_and_damping(cyclic_run)
     lateral = history["sigma_wall"][:, :2]
     assert np.abs(lateral / 500.0 - 1.0).max() < 0.02      # the lateral walls servoed
     assert (cyclic_run / "cyclic.png").stat().st_size > 0
+    assert (cyclic_run / "plots" / "stress_path.png").stat().st_size > 0
 
 
 def test_a_resumed_cyclic_run_has_the_history_of_an_uninterrupted_one(tmp_path, capsys):

@@ -77,6 +77,7 @@ def test_isotropic_path_gives_e_log_p_and_its_indices(tmp_path, capsys):
     assert summary["compression_index"] > 0.0 and summary["swelling_index"] > 0.0
     assert list(np.unique(history["stage"])) == list(range(len(stresses)))
     assert (out / "isotropic.png").stat().st_size > 0
+    assert (out / "plots" / "stress_path.png").stat().st_size > 0
 
 
 def test_extension_and_compression_of_the_same_dry_sample_fail_at_close_friction_angles(

@@ -27,7 +27,7 @@ import os
 import numpy as np
 
 from pendular.homogenize.invariants import deviator_stress
-from pendular.io.plots import plot_cyclic
+from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.config import CyclicConfig
 from pendular.procedures.loading import (LoadingPath, Stage, StageFailed, Strain, Stress,
@@ -252,7 +252,8 @@ class CyclicTest(LaboratoryTest):
         config = self.config
         amplitude = (f"q = ±{config.amplitude_q:g} Pa" if config.stress_controlled
                      else f"εa = ±{100.0 * config.amplitude_strain:g} %")
+        label = f"{title}, {amplitude}, {config.cycles} cycle" + ("s" if config.cycles > 1
+                                                                 else "")
         plot_cyclic(history, cyclic_summary(history, config.cycles)["cycles"],
-                    os.path.join(out, self.FIGURE),
-                    f"{title}, {amplitude}, {config.cycles} cycle"
-                    + ("s" if config.cycles > 1 else ""))
+                    os.path.join(out, self.FIGURE), label)
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), label)

@@ -767,6 +767,7 @@ class IsotropicTest(LaboratoryTest):
 
     def plot(self, history, out, title):
         plot_compression(history, os.path.join(out, self.FIGURE), title, stress="mean")
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
 
 
 def run_identity(config, sample_file):
