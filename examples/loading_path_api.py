@@ -16,7 +16,6 @@ suction paths compose in any order.
 """
 
 import matplotlib.pyplot as plt
-import numpy as np
 
 from pendular import BridgeConfig, PrepareConfig, Stage, Stress, prepare_sample, wet
 from pendular.procedures.config import quasi_static_rate
