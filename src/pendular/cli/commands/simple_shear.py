@@ -28,7 +28,8 @@ OWN = ("normal_stress", "constant_volume", "max_strain", "inertial_number", "str
 #: Summary keys printed at the end.
 SHOWN = ("peak_shear_stress", "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak",
          "normal_stress_at_peak", "residual_stress_ratio", "phi_residual_deg",
-         "normal_stress_final", "max_dilatancy", "dilatancy_angle_deg", "max_volume_change",
+         "phi_peak_effective_deg", "phi_residual_effective_deg", "normal_stress_final",
+         "max_dilatancy", "dilatancy_angle_deg", "max_volume_change", "liquid_balance_error",
          "initial_porosity", "wall_time_s", "particle_steps_per_s")
 
 
