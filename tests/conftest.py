@@ -4,6 +4,7 @@ The tests are split by reach: tests/unit (one function or kernel against a close
 independent computation), tests/integration (simulations through the library), tests/e2e (the
 commands as a user runs them, marked ``slow``: ``pytest -m "not slow"`` leaves them out)."""
 
+import json
 import os
 import subprocess
 import sys
@@ -134,3 +135,34 @@ def refused(status, err, *words):
     for word in words:
         assert word in lines[0], (word, lines[0])
     return lines[0]
+
+
+def summary_of(out):
+    """The summary.json of the run folder ``out`` (dict)."""
+    return json.loads((out / "summary.json").read_text())
+
+
+def history_of(out, units=False):
+    """The history.h5 columns of the run folder ``out`` (name -> array, the dimension labels
+    left out); with ``units``, (columns, name -> unit attribute)."""
+    with h5py.File(out / "history.h5") as handle:
+        group = handle["history"]
+        history = {name: group[name][()] for name in group
+                   if name not in ("record", "axis", "component")}
+        found = {name: group[name].attrs.get("units") for name in group}
+    return (history, found) if units else history
+
+
+class StressScene:
+    """Stand-in for a scene whose walls report the stresses ``sigma`` (3,) [Pa] at ``step``:
+    what a control or guard reading ``sim.walls.stress()`` and ``sim.step`` sees."""
+
+    class _Walls:
+        def __init__(self, sigma):
+            self.sigma = np.asarray(sigma, float)
+
+        def stress(self):
+            return self.sigma
+
+    def __init__(self, sigma, step=0):
+        self.walls, self.step = self._Walls(sigma), step

@@ -1,30 +1,18 @@
 """pendular cyclic as a user runs it: a small stress-controlled run, its outputs and summary,
 a resumed run, and bad input refused in one line."""
 
-import json
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 import pytest
 
-from conftest import refused, run_in_process
+from conftest import history_of, summary_of, refused, run_in_process
 
 SMALL = ["--particles", "200", "--confining", "500", "--seed", "2", "--quiet",
          "--amplitude-q", "100", "--cycles", "2", "--vtk-every", "0"]
 CYCLE_KEYS = {"cycle", "secant_modulus", "damping_ratio", "axial_strain_max", "axial_strain_min",
               "axial_strain_accumulated", "volumetric_strain"}
-
-
-def summary_of(out):
-    return json.loads((out / "summary.json").read_text())
-
-
-def history_of(out):
-    with h5py.File(out / "history.h5") as handle:
-        return {name: handle["history"][name][()] for name in handle["history"]
-                if name not in ("record", "axis", "component")}
 
 
 @pytest.fixture(scope="module")

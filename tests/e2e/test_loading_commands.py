@@ -2,28 +2,16 @@
 triaxial --direction extension / --b / --constant-p (pendular.cli), their outputs, a resumed
 path, and their bad input refused in one line."""
 
-import json
 import os
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 import pytest
 
-from conftest import ROOT, refused, run_in_process
+from conftest import history_of, summary_of, ROOT, refused, run_in_process
 
 SMALL = ["--particles", "150", "--confining", "500", "--seed", "2", "--quiet"]
-
-
-def summary_of(out):
-    return json.loads((out / "summary.json").read_text())
-
-
-def history_of(out):
-    with h5py.File(out / "history.h5") as handle:
-        return {name: handle["history"][name][()] for name in handle["history"]
-                if name not in ("record", "axis", "component")}
 
 
 @pytest.fixture(scope="module")

@@ -3,28 +3,16 @@ for bit, the history of ``pendular triaxial``; each shipped table of examples/pa
 small size; a multi-stage path resumes without its table; bad input is refused in one line;
 and the Python API example of a hydro-mechanical path (examples/loading_path_api.py) runs."""
 
-import json
 import os
 import runpy
 
-import h5py
 import numpy as np
 import pytest
 
-from conftest import ROOT, refused, run_in_process
+from conftest import history_of, summary_of, ROOT, refused, run_in_process
 
 PATHS = os.path.join(ROOT, "examples", "paths")
 SMALL = ["--particles", "150", "--confining", "750", "--seed", "2", "--quiet"]
-
-
-def summary_of(out):
-    return json.loads((out / "summary.json").read_text())
-
-
-def history_of(out):
-    with h5py.File(out / "history.h5") as handle:
-        return {name: handle["history"][name][()] for name in handle["history"]
-                if name not in ("record", "axis", "component")}
 
 
 @pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])

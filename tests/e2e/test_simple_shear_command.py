@@ -2,29 +2,15 @@
 stress) and wet at constant volume, their outputs and keys, a resumed run bit for bit, and bad
 input refused in one line."""
 
-import json
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 import pytest
 
-from conftest import refused, run_in_process
+from conftest import history_of, summary_of, refused, run_in_process
 
 SMALL = ["--particles", "200", "--seed", "4", "--max-strain", "0.02", "--quiet"]
-
-
-def summary_of(out):
-    return json.loads((out / "summary.json").read_text())
-
-
-def history_of(out):
-    with h5py.File(out / "history.h5") as handle:
-        history = {name: handle["history"][name][()] for name in handle["history"]
-                   if name not in ("record", "axis", "component")}
-        units = {name: handle["history"][name].attrs.get("units") for name in handle["history"]}
-    return history, units
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +24,7 @@ def drained_run(tmp_path_factory):
 
 
 def test_a_drained_shear_writes_its_history_summary_and_figures(drained_run):
-    summary, (history, units) = summary_of(drained_run), history_of(drained_run)
+    summary, (history, units) = summary_of(drained_run), history_of(drained_run, units=True)
     rows = len(history["step"])
     assert history["sigma_wall"].shape == (rows, 3) and history["axial_strain"].shape == (rows,)
     for name in ("shear_strain", "shear_stress", "normal_stress", "stage"):
@@ -80,7 +66,7 @@ def test_the_paraview_frames_follow_the_shear_strain_and_draw_pairs_through_the_
     pvd = (drained_run / "vtk" / "particles.pvd").read_text()
     assert "shear_strain_percent" in pvd
     times = [float(part.split('"')[0]) for part in pvd.split('timestep="')[1:]]
-    history, _ = history_of(drained_run)
+    history = history_of(drained_run)
     assert times[-1] == pytest.approx(100.0 * history["shear_strain"][-1], rel=0.05)
     last = sorted((drained_run / "vtk").glob("contacts_*.vtu"))[-1]
     lines = meshio.read(last)
@@ -101,7 +87,7 @@ def test_a_resumed_shear_has_the_history_of_an_uninterrupted_one(drained_run, tm
     assert status == 130 and summary_of(out)["completed"] is False
     status, err = run_in_process("simple-shear", ["--resume", out, "--quiet"], capsys)
     assert status == 0, err
-    (expected, _), (got, _) = history_of(drained_run), history_of(out)
+    expected, got = history_of(drained_run), history_of(out)
     for name in expected:
         assert np.array_equal(got[name], expected[name], equal_nan=True), name
 
@@ -111,7 +97,7 @@ def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
     status, err = run_in_process("simple-shear", [*SMALL, "--suction", "30000",
                                                   "--constant-volume", "--out", out], capsys)
     assert status == 0, err
-    summary, (history, _) = summary_of(out), history_of(out)
+    summary, history = summary_of(out), history_of(out)
     assert "stage" not in history                 # at the confining stress: no consolidation
     assert summary["max_volume_change"] == 0.0
     assert np.all(history["volumetric_strain"] == 0.0)

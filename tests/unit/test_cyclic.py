@@ -8,6 +8,8 @@ import math
 import numpy as np
 import pytest
 
+from conftest import StressScene
+
 from pendular.dem.state import Particles, Walls
 from pendular.procedures.config import (MIN_AXIAL_STRAIN, CyclicConfig, PrepareConfig,
     config_from_dict, config_to_dict)
@@ -163,26 +165,13 @@ def test_a_softening_half_cycle_is_a_failure_peak():
     assert summary["phi_peak_deg"] == pytest.approx(math.degrees(math.asin(60.0 / 1060.0)))
 
 
-class Box:
-    def __init__(self, sigma):
-        self.sigma = np.asarray(sigma, float)
-
-    def stress(self):
-        return self.sigma
-
-
-class Scene:
-    def __init__(self, sigma):
-        self.walls, self.step = Box(sigma), 42
-
-
 def test_an_axial_stress_falling_to_zero_stops_the_path():
     guard = AxialStressGuard(lambda s: "stage 3", "lower --amplitude-strain")
-    guard.apply(Scene((500.0, 500.0, 1e-3)))                  # still pushing: nothing
+    guard.apply(StressScene((500.0, 500.0, 1e-3), step=42))                  # still pushing: nothing
     for axial in (0.0, -20.0):
         with pytest.raises(StageFailed, match=r"stage 3: the axial stress fell to .* at step "
                                               r"42 and the axial walls cannot pull; lower"):
-            guard.apply(Scene((500.0, 500.0, axial)))
+            guard.apply(StressScene((500.0, 500.0, axial), step=42))
 
 
 def cubic_lattice(n, radius, young, confining):

@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from conftest import StressScene
+
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.procedures.config import (IsotropicConfig, OedometerConfig, PrepareConfig,
     ShearConfig, TriaxialConfig, config_from_dict, config_to_dict)
@@ -64,21 +66,6 @@ def test_a_stage_refuses_what_it_cannot_hold_naming_it(build, words):
         build()
 
 
-class Walls:
-    """Stand-in for the box: ``stress()`` returns the given stresses."""
-
-    def __init__(self, sigma):
-        self.sigma = np.asarray(sigma, float)
-
-    def stress(self):
-        return self.sigma
-
-
-class Scene:
-    def __init__(self, sigma):
-        self.walls, self.step = Walls(sigma), 7
-
-
 def mixed(stage):
     servos = {axis: StressServo("xyz"[axis], 1.0, 1.0) for axis in (0, 1)}
     return MixedStress(stage, servos), servos
@@ -90,17 +77,17 @@ def test_mixed_conditions_set_the_lateral_targets_of_their_closed_forms(b):
     # constant p: sigma_x = sigma_y = (3 p - sigma_z) / 2
     control, servos = mixed(Stage(strain_rate={"z": 1.0}, mean_stress=1000.0,
                                   until=Strain(0.1)))
-    control.apply(Scene(sigma))
+    control.apply(StressScene(sigma))
     assert servos[0].target == servos[1].target == pytest.approx((3000.0 - 1200.0) / 2)
     # b alone: sigma_y = sigma_3 + b (sigma_1 - sigma_3), sigma_3 the target of x
     control, servos = mixed(Stage(stress={"x": 750.0}, strain_rate={"z": 1.0}, b=b,
                                   until=Strain(0.1)))
-    control.apply(Scene(sigma))
+    control.apply(StressScene(sigma))
     assert servos[1].target == pytest.approx(750.0 + b * (1200.0 - 750.0))
     # both: p and b hold together
     control, servos = mixed(Stage(strain_rate={"z": 1.0}, mean_stress=1000.0, b=b,
                                   until=Strain(0.1)))
-    control.apply(Scene(sigma))
+    control.apply(StressScene(sigma))
     s3, s2 = servos[0].target, servos[1].target
     assert (s3 + s2 + 1200.0) / 3.0 == pytest.approx(1000.0)
     assert (s2 - s3) / (1200.0 - s3) == pytest.approx(b)
@@ -109,7 +96,7 @@ def test_mixed_conditions_set_the_lateral_targets_of_their_closed_forms(b):
 def test_a_mixed_condition_that_needs_walls_to_pull_stops_the_stage():
     control, _ = mixed(Stage(strain_rate={"z": 1.0}, mean_stress=1000.0, until=Strain(0.1)))
     with pytest.raises(StageFailed, match="walls cannot pull"):
-        control.apply(Scene((700.0, 700.0, 3500.0)))        # 3 p - sigma_z < 0
+        control.apply(StressScene((700.0, 700.0, 3500.0)))        # 3 p - sigma_z < 0
 
 
 def test_steps_to_a_strain_from_a_strain_in_either_direction():

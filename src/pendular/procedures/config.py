@@ -432,6 +432,11 @@ class PathConfig(LaboratoryConfig):
         """Steps of ``dt`` [s] between history rows [-]: ``record_strain`` at ``rate``."""
         return max(1, int(round(self.record_strain / (self.rate() * dt))))
 
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        raise NotImplementedError
+
 
 @dataclass
 class OedometerConfig(PathConfig):
@@ -468,6 +473,9 @@ class OedometerConfig(PathConfig):
         """The lowest axial stress of the path [Pa]: the confining stress, or ``unload_to``."""
         return min(self.sample.confining, self.unload_to or math.inf)
 
+    def path_parameters(self):
+        return {"axial_stress": self.axial_stress, "unload_to": self.unload_to}
+
 
 #: Fewest stresses of an isotropic path: a loading (or unloading) needs two.
 MIN_ISOTROPIC_STAGES = 2
@@ -503,6 +511,10 @@ class IsotropicConfig(PathConfig):
     def reference_pressure(self):
         """The lowest stress of the path [Pa]: the confining or the least of ``stresses``."""
         return min(self.sample.confining, *self.stresses)
+
+    def path_parameters(self):
+        return {"stresses": ",".join(f"{v:g}" for v in self.stresses),
+                "stage_steps": self.stage_steps}
 
 
 #: Density of water [kg/m^3]: the specific gravity of the grains is their density over it

@@ -439,8 +439,7 @@ def check_device(config, device):
 
 
 def parameters(config):
-    """Flat name -> value of a configuration (TriaxialConfig, OedometerConfig,
-    IsotropicConfig), named as the command's options (history file attributes, campaign
+    """Flat name -> value of a configuration (TriaxialConfig or a PathConfig), named as the command's options (history file attributes, campaign
     tables): the sample's and the shear's from their fields' Parameters; the rest, values
     derived from the fields (the suction, the water content in %), in the columns' order of
     earlier campaign tables."""
@@ -450,14 +449,8 @@ def parameters(config):
         # a conventional run's rows stay as they were, without the path's options
         flat.update(flat_options(config.shear, () if not config.shear.conventional else
                                  ("direction", "b", "constant_p")))
-    else:
-        if isinstance(config, OedometerConfig):
-            flat.update({"axial_stress": config.axial_stress, "unload_to": config.unload_to})
-        elif isinstance(config, IsotropicConfig):
-            flat.update({"stresses": ",".join(f"{v:g}" for v in config.stresses),
-                         "stage_steps": config.stage_steps})
-        else:                       # a path that names its own options (CyclicConfig)
-            flat.update(config.path_parameters())
+    else:                           # a path (PathConfig) names its own options
+        flat.update(config.path_parameters())
         flat.update({"inertial_number": config.inertial_number,
                      "strain_rate": config.strain_rate, "record_strain": config.record_strain})
     flat.update({"suction": config.suction, "wet_steps": config.wet_steps,
