@@ -153,6 +153,19 @@ def history_of(out, units=False):
     return (history, found) if units else history
 
 
+def assert_drawn(path, min_size=(200, 150), min_inked=0.01):
+    """Check that ``path`` is a PNG image of at least ``min_size`` (width, height) pixels in
+    which more than ``min_inked`` of the pixels differ from its background (the colour of its
+    corner): a figure with something drawn, not an empty or blank file."""
+    import matplotlib.image
+
+    pixels = matplotlib.image.imread(str(path))
+    height, width = pixels.shape[:2]
+    assert width >= min_size[0] and height >= min_size[1], (path, pixels.shape)
+    inked = np.any(np.abs(pixels[..., :3] - pixels[0, 0, :3]) > 0.05, axis=-1).mean()
+    assert inked > min_inked, (path, inked)
+
+
 class StressScene:
     """Stand-in for a scene whose walls report the stresses ``sigma`` (3,) [Pa] at ``step``:
     what a control or guard reading ``sim.walls.stress()`` and ``sim.step`` sees."""

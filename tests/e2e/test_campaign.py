@@ -13,7 +13,7 @@ import time
 import h5py
 import pytest
 
-from conftest import refused, run_in_process
+from conftest import refused, run_in_process, summary_of
 
 import pendular.studies.campaign as campaign_module
 from pendular.procedures.preparation import PrepareConfig
@@ -53,11 +53,18 @@ def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
         rows = list(csv.DictReader(handle))
     assert sorted((float(r["suction"]), float(r["confining"])) for r in rows) == [
         (0, 250), (0, 750), (30000, 250), (30000, 750)]
+    peak = {}
     for row in rows:
-        assert row["status"] == "run" and float(row["peak_q"]) > 0 and row["particles"] == "150"
+        assert row["status"] == "run" and row["particles"] == "150"
         folder = out / "runs" / row["run"]
+        assert float(row["peak_q"]) == pytest.approx(summary_of(folder)["peak_q"], rel=1e-6)
+        peak[float(row["suction"]), float(row["confining"])] = float(row["peak_q"])
         assert (folder / "history.h5").exists()
         assert "shear: 100%" in (folder / "log.txt").read_text()     # the run's own progress
+    for suction in (0, 30000):               # a higher confining stress carries more
+        assert peak[suction, 750] > peak[suction, 250]
+    for confining in (250, 750):             # the bridges' cohesion adds strength
+        assert peak[30000, confining] > peak[0, confining]
     assert {r["run"] for r in rows} == {"suction0_confining250", "suction0_confining750",
                                         "suction30000_confining250",
                                         "suction30000_confining750"}

@@ -17,7 +17,7 @@ from pendular.studies.chapter5 import Chapter5Grid, chapter5_campaign, envelopes
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.reference import FIG_5_5, TABLE_5_3
 
-from conftest import ROOT
+from conftest import ROOT, assert_drawn
 
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
 KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
@@ -188,14 +188,14 @@ def test_report_and_plot(campaign):
     assert "| 0 | 500 |" in report and "| 1207 |" in report      # thesis Table 5.3 beside ours
     assert "| 300000 | 750 |  | 8289 |" in report                 # thesis cell we did not run
     assert "2.20" in report                                       # Fig. 5.5 at 30 kPa
-    assert (out / "plots" / "envelopes.png").stat().st_size > 0
+    assert_drawn(out / "plots" / "envelopes.png")
 
 
 def test_campaign_figures(campaign):
     out, _ = campaign
     for name in ("q_ev", "q_p_effective", "polar_psi", "polar_fabric", "anisotropy"):
         path = out / "plots" / f"{name}.png"
-        assert path.stat().st_size > 0, path
+        assert_drawn(path)
         assert f"plots/{name}.png" in (out / "report.md").read_text()
 
 

@@ -7,7 +7,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import history_of, summary_of, refused, run_in_process
+from conftest import assert_drawn, history_of, refused, run_in_process, summary_of
 
 SMALL = ["--particles", "200", "--confining", "500", "--seed", "2", "--quiet",
          "--amplitude-q", "100", "--cycles", "2", "--vtk-every", "0"]
@@ -45,8 +45,8 @@ def test_a_stress_controlled_run_gives_its_loops_modulus_and_damping(cyclic_run)
     assert list(np.unique(history["stage"])) == list(range(5))
     lateral = history["sigma_wall"][:, :2]
     assert np.abs(lateral / 500.0 - 1.0).max() < 0.02      # the lateral walls servoed
-    assert (cyclic_run / "cyclic.png").stat().st_size > 0
-    assert (cyclic_run / "plots" / "stress_path.png").stat().st_size > 0
+    assert_drawn(cyclic_run / "cyclic.png")
+    assert_drawn(cyclic_run / "plots" / "stress_path.png")
 
 
 def test_a_resumed_cyclic_run_has_the_history_of_an_uninterrupted_one(tmp_path, capsys):

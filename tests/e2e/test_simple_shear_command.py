@@ -8,7 +8,7 @@ import sys
 import numpy as np
 import pytest
 
-from conftest import history_of, summary_of, refused, run_in_process
+from conftest import assert_drawn, history_of, refused, run_in_process, summary_of
 
 SMALL = ["--particles", "200", "--seed", "4", "--max-strain", "0.02", "--quiet"]
 
@@ -52,7 +52,9 @@ def test_a_drained_shear_writes_its_history_summary_and_figures(drained_run):
     assert summary["phi_peak_deg"] == pytest.approx(np.degrees(np.arctan(np.max(ratio))))
     assert 0.1 < summary["peak_stress_ratio"] < 1.0 and summary["completed"]
     assert "max_volume_change" not in summary
-    for name in ("simple_shear.png", "sample.h5", "checkpoint.h5", "vtk/particles.pvd"):
+    assert_drawn(drained_run / "simple_shear.png")
+    # read back by the tests below: the frames, and the checkpoint that --resume continues
+    for name in ("sample.h5", "checkpoint.h5", "vtk/particles.pvd"):
         assert (drained_run / name).stat().st_size > 0, name
 
 
@@ -112,7 +114,7 @@ def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
     assert summary["phi_peak_effective_deg"] == pytest.approx(
         np.degrees(np.arctan(ratio.max())))
     assert summary["phi_peak_effective_deg"] < summary["phi_peak_deg"]   # psi_zz > 0
-    assert (out / "simple_shear.png").stat().st_size > 0
+    assert_drawn(out / "simple_shear.png")
 
 
 @pytest.mark.parametrize("arguments, words", [

@@ -14,7 +14,7 @@ import pytest
 from pendular.studies import tradeoff
 from pendular.procedures.config import config_to_dict
 
-from conftest import ROOT
+from conftest import ROOT, assert_drawn
 
 SCENARIO = os.path.join(ROOT, "scenarios", "tradeoff.py")
 
@@ -159,7 +159,7 @@ def test_report_and_plot(quick_grid):
     text = (out / "tradeoff.md").read_text()
     assert "Paper figure" in text and "Quick look" in text
     assert "| table_resolution | 350,80 |" in text
-    assert (out / "tradeoff.png").stat().st_size > 0
+    assert_drawn(out / "tradeoff.png")
     # each run keeps its configuration beside its timing
     timing = json.loads((out / "runs" / "reference" / "timing.json").read_text())
     run = out / "runs" / "reference"        # its history and summary, no figures (untimed)

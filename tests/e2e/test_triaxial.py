@@ -16,7 +16,7 @@ from pendular.homogenize import contact_stress
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.triaxial import TriaxialShear, summarize
 
-from conftest import ROOT
+from conftest import ROOT, assert_drawn
 
 
 
@@ -108,11 +108,26 @@ def test_triaxial_scenario_writes_its_outputs(tmp_path):
                   "coordination": (rows,), "unbalanced_force": (rows,), "time": (rows,)}
         for name, shape in shapes.items():
             assert history[name].shape == shape, name
+        sigma = history["sigma_wall"][()]
+        assert sigma[0] == pytest.approx([750.0] * 3, rel=1e-3)   # from the isotropic state
+        assert np.abs(sigma[:, :2] / 750.0 - 1.0).max() < 0.03      # the servo holds the sides
+        love_weber = np.diagonal(history["sigma_contact"][0])      # Love-Weber at equilibrium
+        assert love_weber == pytest.approx(sigma[0], rel=0.01)
+        strain = history["axial_strain"][()]
+        assert strain[0] == 0.0 and np.all(np.diff(strain) > 0.0)
+        assert strain[-1] == pytest.approx(0.01, abs=2 * strain[1])
+        # the solid volume is conserved: 1 - V/V0 = 1 - (1 - n0) / (1 - n)
+        porosity = history["porosity"][()]
+        assert history["volumetric_strain"][()] == pytest.approx(
+            1.0 - (1.0 - porosity[0]) / (1.0 - porosity), rel=1e-9, abs=1e-15)
+        assert 0.3 < porosity[0] < 0.5 and np.all(history["coordination"][()] > 3.0)
+        dt = np.diff(history["time"][()]) / np.diff(history["step"][()])
+        assert dt == pytest.approx(np.full(rows - 1, dt[0]), rel=1e-9)    # one time step
         assert handle.attrs["particles"] == 200
         assert handle.attrs["confining"] == 750.0
         fabric = history["fabric"][0]
         assert np.trace(fabric) == pytest.approx(1.0)
-    assert (out / "triaxial.png").stat().st_size > 0
+    assert_drawn(out / "triaxial.png")
 
 
 @pytest.mark.parametrize("arguments, message", [

@@ -11,7 +11,7 @@ import meshio
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, assert_drawn
 
 SCENARIO = os.path.join(ROOT, "scenarios", "triaxial.py")
 PARTICLES = 150
@@ -49,24 +49,44 @@ def test_paraview_series_read_back_with_meshio(finished):
     with h5py.File(out / "history.h5") as handle:          # the time axis is the strain [%]
         assert times[-1] == pytest.approx(100 * handle["history"]["axial_strain"][-1], rel=1e-12)
         assert handle.attrs["vtk_every"] > 0
+    with h5py.File(out / "sample.h5") as handle:
+        radius = handle["radius"][()]
+    with h5py.File(out / "history.h5") as handle:
+        history = {name: handle["history"][name][()] for name in ("axial_strain", "sigma_wall",
+                                                                   "coordination")}
     for _, path in (particles[0], particles[-1]):
         mesh = meshio.read(path)
-        assert len(mesh.points) == PARTICLES
-        assert mesh.point_data["radius"].shape == (PARTICLES,)
-        assert np.all(mesh.point_data["radius"] > 0)
-        for name in ("velocity", "contact_force", "coordination", "bridges"):
-            assert len(mesh.point_data[name]) == PARTICLES, name
+        order = np.argsort(mesh.point_data["id"])
+        assert np.array_equal(mesh.point_data["id"][order], np.arange(PARTICLES))
+        assert np.array_equal(mesh.point_data["radius"][order], radius)    # the sample's
+        # the frame is a history record: its strain, and its contacts the record's 2 Nc / N
+        row = np.flatnonzero(history["axial_strain"] == mesh.field_data["axial_strain"][0])
+        assert len(row) == 1
+        coordination = mesh.point_data["coordination"]
+        assert coordination.mean() == pytest.approx(history["coordination"][row[0]], rel=1e-12)
+        force = mesh.point_data["contact_force"]
+        assert np.all((force > 0.0) == (coordination > 0))        # rattlers carry nothing
+        assert np.all(np.isfinite(mesh.point_data["velocity"]))
         bridges = mesh.point_data["bridges"]
         assert (bridges.sum() > 0) == (kind == "wet")
+        assert np.all(bridges >= coordination) if kind == "wet" else not bridges.any()
     walls = meshio.read(frames(out / "vtk" / "walls.pvd")[-1][1])
     assert walls.cells_dict["quad"].shape == (6, 4)
+    # the mean of each axis's two walls is the history's wall stress of the last record
+    stress = walls.cell_data["normal_stress"][0]
+    assert 0.5 * (stress[0::2] + stress[1::2]) == pytest.approx(history["sigma_wall"][-1],
+                                                                rel=1e-12)
     assert len(frames(out / "vtk" / "bridges.pvd")) == len(particles)
     if kind == "wet":          # meshio cannot read the empty (cell-less) files of a dry run
         lines = meshio.read(frames(out / "vtk" / "bridges.pvd")[-1][1])
         count = len(lines.cells_dict["line"])
         assert 2 * count == meshio.read(particles[-1][1]).point_data["bridges"].sum()
-        for name in ("force", "volume", "delta1", "delta2"):
-            assert lines.cell_data[name][0].shape == (count,), name
+        force, volume = lines.cell_data["force"][0], lines.cell_data["volume"][0]
+        assert np.all(force > 0.0) and np.all(volume > 0.0)       # attractive, holds liquid
+        # a bridge's filling angles [deg] lie in (0, 90)
+        for name in ("delta1", "delta2"):
+            angle = lines.cell_data[name][0]
+            assert np.all((angle > 0.0) & (angle < 90.0)), name
 
 
 def test_plots_are_written(finished):
@@ -75,8 +95,8 @@ def test_plots_are_written(finished):
         {"capillary_stress.png", "saturation.png"} if kind == "wet" else set())
     assert set(os.listdir(out / "plots")) == names
     for name in names:
-        assert (out / "plots" / name).stat().st_size > 0
-    assert (out / "triaxial.png").stat().st_size > 0
+        assert_drawn(out / "plots" / name)
+    assert_drawn(out / "triaxial.png")
 
 
 def test_resumed_run_has_the_history_of_an_uninterrupted_one(finished, tmp_path):

@@ -29,7 +29,7 @@ from pendular.studies import crosscheck
 from pendular.procedures.config import YADE_CHOICES
 from pendular.io.history import read_history
 
-from conftest import ROOT
+from conftest import ROOT, assert_drawn
 
 HAVE_YADE = shutil.which("yade") is not None or shutil.which("yadedaily") is not None
 SCENARIO = os.path.join(ROOT, "scenarios", "yade_crosscheck.py")
@@ -69,7 +69,7 @@ def test_wet_crosscheck_agrees(tmp_path):
     result = crosscheck.run_crosscheck(config, tmp_path, progress=False)
     assert json.loads((tmp_path / "crosscheck.json").read_text())["peak_q_rel_diff"] == \
         result["peak_q_rel_diff"]
-    assert (tmp_path / "crosscheck.png").stat().st_size > 0
+    assert_drawn(tmp_path / "crosscheck.png")
     check_result(result, 0.01)
     # same packing, same bridges: the start of the shear is the same state in both codes
     assert result["start_sigma_rel_diff"] < START_TOLERANCE

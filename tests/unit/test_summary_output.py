@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from conftest import assert_drawn
 from pendular.cli import format_summary, format_table, format_value, main, print_summary
 from pendular.io.schema import peak_reached, still_rising
 
@@ -203,4 +204,4 @@ def test_the_terminal_summary_of_a_wet_run(tmp_path, capsys):
         assert time_value == mesh.field_data["axial_strain_percent"][0]
         assert time_value == pytest.approx(100.0 * mesh.field_data["axial_strain"][0])
     assert "axial_strain_percent" in (out / "vtk" / "particles.pvd").read_text()
-    assert (out / "plots" / "stress_path.png").stat().st_size > 0
+    assert_drawn(out / "plots" / "stress_path.png")
