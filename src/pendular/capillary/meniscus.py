@@ -112,33 +112,43 @@ def end_tangent_angle(radius_ratio, theta, suction1, force_invariant):
     return phi
 
 
-@numba.njit(cache=True)
-def _tau_panel(tau_a, tau_b, force_invariant, suction1, nodes, weights):
-    """Gauss–Legendre quadrature over tau in [tau_a, tau_b] of the profile integrals (R1 units).
+@numba.njit(inline="always")
+def _gauss_panel(integrands, a, b, args, nodes, weights):
+    """Gauss–Legendre quadrature over [a, b] of the four profile integrals (R1 units): (axial
+    length, ∫ pi y**2 dx, pi ∫ y cos(phi)**2 dl, 2 pi ∫ y sin(phi)**2 dl).
 
-    Returns (axial length, ∫ pi y**2 dx, pi ∫ y cos(phi)**2 dl, 2 pi ∫ y sin(phi)**2 dl),
-    with cos(phi) = sech(tau), sin(phi) = tanh(tau), dphi/dtau = cos(phi), dl/dphi = y / S,
-    S = sqrt(cos(phi)**2 + 2 u f).
+    integrands(x, w, args) returns the four integrands at x times the node's weight w (each
+    parametrisation keeps its own order of operations). Inlined into its callers, as the
+    root finders are (pendular.capillary.roots), so that they stay cacheable.
     """
-    half = 0.5 * (tau_b - tau_a)
-    mid = 0.5 * (tau_b + tau_a)
+    half = 0.5 * (b - a)
+    mid = 0.5 * (b + a)
     length = 0.0
     volume = 0.0
     area11 = 0.0
     area33 = 0.0
     for k in range(nodes.size):
-        tau = mid + half * nodes[k]
-        c = 1.0 / math.cosh(tau)
-        s = math.tanh(tau)
-        root = math.sqrt(c * c + 2.0 * suction1 * force_invariant)
-        y = 2.0 * force_invariant / (c + root)
-        w = weights[k] * half
-        dx = y * c * c / root
-        length += w * dx
-        volume += w * math.pi * y * y * dx
-        area11 += w * math.pi * y * y * c * c * c / root
-        area33 += w * 2.0 * math.pi * y * y * s * s * c / root
+        d_length, d_volume, d_area11, d_area33 = integrands(mid + half * nodes[k], weights[k] * half, args)
+        length += d_length
+        volume += d_volume
+        area11 += d_area11
+        area33 += d_area33
     return length, volume, area11, area33
+
+
+@numba.njit(cache=True)
+def _tau_integrands(tau, w, args):
+    """The weighted integrands of _gauss_panel at tau = artanh(sin phi), args = (f, u R1/gamma):
+    cos(phi) = sech(tau), sin(phi) = tanh(tau), dphi/dtau = cos(phi), dl/dphi = y / S,
+    S = sqrt(cos(phi)**2 + 2 u f)."""
+    force_invariant, suction1 = args
+    c = 1.0 / math.cosh(tau)
+    s = math.tanh(tau)
+    root = math.sqrt(c * c + 2.0 * suction1 * force_invariant)
+    y = 2.0 * force_invariant / (c + root)
+    dx = y * c * c / root
+    return (w * dx, w * math.pi * y * y * dx, w * math.pi * y * y * c * c * c / root,
+            w * 2.0 * math.pi * y * y * s * s * c / root)
 
 
 @numba.njit(cache=True)
@@ -177,24 +187,11 @@ def _unduloid_contact_gap_at_v(v, args):
 
 
 @numba.njit(cache=True)
-def _unduloid_panel(sigma_a, sigma_b, suction_abs, force_invariant, k, one_minus_k, eps, nodes, weights):
-    """Same integrals as _tau_panel, over sigma in [sigma_a, sigma_b] of the unduloid."""
-    half = 0.5 * (sigma_b - sigma_a)
-    mid = 0.5 * (sigma_b + sigma_a)
-    length = 0.0
-    volume = 0.0
-    area11 = 0.0
-    area33 = 0.0
-    for j in range(nodes.size):
-        y, cos_phi, sin_phi, dx, dl = _unduloid_point(
-            mid + half * nodes[j], suction_abs, force_invariant, k, one_minus_k, eps
-        )
-        w = weights[j] * half
-        length += w * dx
-        volume += w * math.pi * y * y * dx
-        area11 += w * math.pi * y * cos_phi * cos_phi * dl
-        area33 += w * 2.0 * math.pi * y * sin_phi * sin_phi * dl
-    return length, volume, area11, area33
+def _unduloid_integrands(sigma, w, args):
+    """The weighted integrands of _gauss_panel at sigma of the unduloid, args = (a, f, k, 1 - k, eps)."""
+    y, cos_phi, sin_phi, dx, dl = _unduloid_point(sigma, *args)
+    return (w * dx, w * math.pi * y * y * dx, w * math.pi * y * cos_phi * cos_phi * dl,
+            w * 2.0 * math.pi * y * sin_phi * sin_phi * dl)
 
 
 @numba.njit(cache=True)
@@ -236,9 +233,9 @@ def _unduloid_profile(radius_ratio, theta, suction1, force_invariant, delta1):
     sigma_end = math.asinh(math.tan(0.5 * v_end) / eps)
     _, cos_phi, sin_phi, _, _ = _unduloid_point(sigma_end, a, force_invariant, k, one_minus_k, eps)
     phi_end = math.atan2(sin_phi, cos_phi)
-    shape = (a, force_invariant, k, one_minus_k, eps, _GAUSS_NODES, _GAUSS_WEIGHTS)
-    l1, v1, a1, b1 = _unduloid_panel(sigma0, 0.0, *shape)
-    l2, v2, a2, b2 = _unduloid_panel(0.0, sigma_end, *shape)
+    shape = (a, force_invariant, k, one_minus_k, eps)
+    l1, v1, a1, b1 = _gauss_panel(_unduloid_integrands, sigma0, 0.0, shape, _GAUSS_NODES, _GAUSS_WEIGHTS)
+    l2, v2, a2, b2 = _gauss_panel(_unduloid_integrands, 0.0, sigma_end, shape, _GAUSS_NODES, _GAUSS_WEIGHTS)
     return phi_end, l1 + l2, v1 + v2, a1 + a2, b1 + b2
 
 
@@ -250,8 +247,9 @@ def _tau_profile(radius_ratio, theta, suction1, force_invariant, delta1):
     # tau = artanh(sin phi) = ln tan((phi + 90 deg)/2) at both ends of the profile
     tau_start = math.log(math.tan(0.5 * (delta1 + theta)))
     tau_end = -math.log(math.tan(0.5 * (delta2 + theta)))
-    l1, v1, a1, b1 = _tau_panel(tau_start, 0.0, force_invariant, suction1, _GAUSS_NODES, _GAUSS_WEIGHTS)
-    l2, v2, a2, b2 = _tau_panel(0.0, tau_end, force_invariant, suction1, _GAUSS_NODES, _GAUSS_WEIGHTS)
+    shape = (force_invariant, suction1)
+    l1, v1, a1, b1 = _gauss_panel(_tau_integrands, tau_start, 0.0, shape, _GAUSS_NODES, _GAUSS_WEIGHTS)
+    l2, v2, a2, b2 = _gauss_panel(_tau_integrands, 0.0, tau_end, shape, _GAUSS_NODES, _GAUSS_WEIGHTS)
     return phi_end, l1 + l2, v1 + v2, a1 + a2, b1 + b2
 
 
@@ -304,8 +302,18 @@ def solve_bridge(radius_ratio, contact_angle, suction_star, filling_angle):
     contact_angle = check_contact_angle(contact_angle)
     suction_star = check_suction(suction_star)
     filling_angle = check_filling_angle(filling_angle, contact_angle)
+    return bridge_from_kernel(radius_ratio, contact_angle, suction_star, math.radians(filling_angle),
+                              filling_angle)
+
+
+def bridge_from_kernel(radius_ratio, contact_angle, suction_star, delta1, filling_angle=None):
+    """Bridge record of the exact kernel (bridge_kernel) at delta1 [rad], input already checked.
+
+    contact_angle [deg]; suction_star: u* = s R2/gamma, any sign; filling_angle: delta1 in
+    degrees as the caller was given it, recorded as is (default: math.degrees(delta1)).
+    """
     distance, volume, force, delta2, nn11, nn33 = bridge_kernel(
-        radius_ratio, math.radians(contact_angle), suction_star, math.radians(filling_angle)
+        radius_ratio, math.radians(contact_angle), suction_star, delta1
     )
     return Bridge(
         radius_ratio=radius_ratio,
@@ -314,7 +322,7 @@ def solve_bridge(radius_ratio, contact_angle, suction_star, filling_angle):
         distance=distance,
         volume=volume,
         force=force,
-        delta1=filling_angle,
+        delta1=math.degrees(delta1) if filling_angle is None else filling_angle,
         delta2=math.degrees(delta2),
         nn11=nn11,
         nn33=nn33,

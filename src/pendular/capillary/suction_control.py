@@ -14,7 +14,7 @@ import math
 import numba
 import numpy as np
 
-from pendular.capillary.meniscus import Bridge, bridge_kernel
+from pendular.capillary.meniscus import bridge_from_kernel, bridge_kernel
 from pendular.capillary.roots import brent_maximum, brent_root
 from pendular.capillary.validation import (check_contact_angle, check_distance, check_radius_ratio,
     check_suction)
@@ -126,22 +126,3 @@ def bridge_at_distance(radius_ratio, contact_angle, suction_star, distance_star)
             f"suction_star = {suction_star}: {reason}"
         )
     return bridge_from_kernel(radius_ratio, contact_angle, suction_star, delta1)
-
-
-def bridge_from_kernel(radius_ratio, contact_angle, suction_star, delta1):
-    """Bridge record from the exact kernel at delta1 (rad); contact_angle in degrees."""
-    distance, volume, force, delta2, nn11, nn33 = bridge_kernel(
-        radius_ratio, math.radians(contact_angle), suction_star, delta1
-    )
-    return Bridge(
-        radius_ratio=radius_ratio,
-        contact_angle=contact_angle,
-        suction=suction_star,
-        distance=distance,
-        volume=volume,
-        force=force,
-        delta1=math.degrees(delta1),
-        delta2=math.degrees(delta2),
-        nn11=nn11,
-        nn33=nn33,
-    )

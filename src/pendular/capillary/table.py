@@ -28,9 +28,8 @@ import h5py
 import numba
 import numpy as np
 
-from pendular.capillary.meniscus import bridge_kernel
-from pendular.capillary.suction_control import (bridge_at_distance, bridge_from_kernel,
-    rupture_point, stable_filling_angle)
+from pendular.capillary.meniscus import bridge_from_kernel, bridge_kernel
+from pendular.capillary.suction_control import bridge_at_distance, rupture_point, stable_filling_angle
 from pendular.capillary.validation import check_contact_angle, check_positive, check_radius_ratio
 from pendular.utils.atomic import replacing
 from pendular.utils.integrity import stamp, verify
@@ -161,8 +160,105 @@ def compare_node(where, name, found, exact, scale=0.0):
                          f"the exact solver (valid: within a relative {NODE_TOLERANCE:g})")
 
 
+def check_radius_ratios(radius_ratios):
+    """The radius ratios of a table to build as a float64 array: each in [1,
+    MAX_SOLVER_RADIUS_RATIO], at least one, strictly increasing."""
+    radius_ratios = np.array([check_radius_ratio(r) for r in radius_ratios], dtype=np.float64)
+    if radius_ratios.size == 0 or np.any(np.diff(radius_ratios) <= 0.0):
+        raise ValueError(f"radius_ratios = {radius_ratios.tolist()} must be non-empty and strictly increasing")
+    return radius_ratios
+
+
+def check_node_count(name, n):
+    """The number of nodes ``n`` of a table's axis as an int: an integer >= 2."""
+    if int(n) != n or n < 2:
+        raise ValueError(f"{name} = {n} is outside the valid range: an integer >= 2")
+    return int(n)
+
+
+class TabulatedBridges:
+    """What the suction- and volume-controlled tables share: exact bridges for one contact angle
+    on a grid (r, axis node, z), and the HDF5 file that holds them.
+
+    contact_angle [deg]; radius_ratios (n_r,); distance_low and distance_rupture (n_r, n_axis),
+    D/R2 at z = 1 and z = 0 of each axis node; values (n_r, n_axis, n_distance, 6) in the
+    subclass's ``fields`` order. The file: root attributes kind, format (TABLE_FORMAT),
+    contact_angle_deg, the subclass's ``file_scalars``, fields (joined by commas), then one
+    dataset per name of ``file_arrays``; each scalar and array is the table's attribute and its
+    constructor's argument of that name. In the cache directory the file is named
+    ``{file_prefix}_{cache_key}.h5``; ``axis_nodes`` names the build parameter counting the
+    axis nodes.
+    """
+
+    kind = ""
+    description = ""
+    fields = ()
+    file_scalars = ()
+    file_arrays = ()
+    file_prefix = ""
+    axis_nodes = ""
+
+    def __init__(self, contact_angle, radius_ratios, distance_low, distance_rupture, values):
+        self.contact_angle = float(contact_angle)
+        self.radius_ratios = np.ascontiguousarray(radius_ratios, dtype=np.float64)
+        self.distance_low = np.ascontiguousarray(distance_low, dtype=np.float64)
+        self.distance_rupture = np.ascontiguousarray(distance_rupture, dtype=np.float64)
+        self.values = np.ascontiguousarray(values, dtype=np.float64)
+        self._log_distance_rupture = np.log(self.distance_rupture)
+
+    @property
+    def n_distance(self):
+        return self.values.shape[2]
+
+    @classmethod
+    def array_shapes(cls, parameters):
+        """Shapes (name -> tuple) of the arrays of the table of these build ``parameters``."""
+        n_r, n_axis = len(parameters["radius_ratios"]), parameters[cls.axis_nodes]
+        return {"values": (n_r, n_axis, parameters["n_distance"], len(cls.fields)),
+                "distance_low": (n_r, n_axis), "distance_rupture": (n_r, n_axis)}
+
+    @classmethod
+    def from_cache(cls, parameters, directory, build):
+        """The table of these build ``parameters`` (the cache key's content) cached in
+        ``directory`` (default: cache_directory()), else ``build()`` saved there (cached_table).
+        A cached table is used only with the array shapes and settings (contact angle, radius
+        ratios, ``file_scalars``) of the key, and its ``check_nodes`` passed."""
+        path = Path(directory or cache_directory()) / f"{cls.file_prefix}_{cache_key(cls.kind, parameters)}.h5"
+        settings = ("contact_angle", "radius_ratios", *cls.file_scalars)
+
+        def check(table):
+            check_table_nodes(table, cls.array_shapes(parameters), {name: parameters[name] for name in settings})
+            table.check_nodes()
+
+        return cached_table(path, cache_identity(cls.kind, parameters), cls.load, check, build)
+
+    def save(self, path):
+        """Write the table to an HDF5 file, atomically (pendular.utils.atomic.replacing)."""
+        with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
+            h5.attrs["kind"] = self.kind
+            h5.attrs["format"] = TABLE_FORMAT
+            h5.attrs["contact_angle_deg"] = self.contact_angle
+            for name in self.file_scalars:
+                h5.attrs[name] = getattr(self, name)
+            h5.attrs["fields"] = ",".join(self.fields)
+            for name in self.file_arrays:
+                h5[name] = getattr(self, name)
+
+    @classmethod
+    def load(cls, path):
+        """Read a table written by save()."""
+        with reading(path, cls.description), h5py.File(path, "r") as h5:
+            if h5.attrs.get("kind") != cls.kind or h5.attrs.get("format") != TABLE_FORMAT:
+                raise ValueError(f"{path} is not a {cls.description} of format {TABLE_FORMAT}")
+            return cls(contact_angle=h5.attrs["contact_angle_deg"],
+                       **{name: h5.attrs[name] for name in cls.file_scalars},
+                       **{name: h5[name][...] for name in cls.file_arrays})
+
+
 @numba.njit(cache=True)
-def _stable_bridge_fields(radius_ratio, theta, suction_star, delta1, out):
+def write_bridge_fields(radius_ratio, theta, suction_star, delta1, out):
+    """The exact bridge at delta1 [rad] (theta [rad]) into ``out`` in FIELDS order: F*, V*,
+    delta1 and delta2 [deg], nn11, nn33."""
     _, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, suction_star, delta1)
     out[0] = force
     out[1] = volume
@@ -201,7 +297,7 @@ def build_suction_grid(radius_ratios, theta, suction_nodes, n_distance):
             else:
                 d = d_low + (d_rupture - d_low) * distance_fraction(j / (n_distance - 1))
                 delta1 = stable_filling_angle(r, theta, u, d, delta1_rupture, d_rupture)
-            _stable_bridge_fields(r, theta, u, delta1, values[i, k, j])
+            write_bridge_fields(r, theta, u, delta1, values[i, k, j])
     return distance_low, distance_rupture, values
 
 
@@ -353,7 +449,7 @@ def suction_nodes(suction_scale, suction_max, n_suction):
     return suction_scale * np.expm1(xi)
 
 
-class BridgeTable:
+class BridgeTable(TabulatedBridges):
     """Exact suction-controlled bridges tabulated over (r, u*, d*) for one contact angle.
 
     Build with BridgeTable.build(...) or, cached on disk, BridgeTable.cached(...). Inside Numba
@@ -361,26 +457,25 @@ class BridgeTable:
     Covered range: u* in [0, suction_max]; d* from max(0, d* at delta1 = 90 - theta) to rupture.
     """
 
+    kind = "suction"
+    description = "suction-controlled bridge table"
+    fields = FIELDS
+    file_scalars = ("suction_scale", "suction_max")
+    file_arrays = ("radius_ratios", "distance_low", "distance_rupture", "values")
+    file_prefix = "bridge_table"
+    axis_nodes = "n_suction"
+
     def __init__(
         self, contact_angle, radius_ratios, suction_scale, suction_max, distance_low, distance_rupture, values
     ):
-        self.contact_angle = float(contact_angle)
-        self.radius_ratios = np.ascontiguousarray(radius_ratios, dtype=np.float64)
+        super().__init__(contact_angle, radius_ratios, distance_low, distance_rupture, values)
         self.suction_scale = float(suction_scale)
         self.suction_max = float(suction_max)
-        self.distance_low = np.ascontiguousarray(distance_low, dtype=np.float64)
-        self.distance_rupture = np.ascontiguousarray(distance_rupture, dtype=np.float64)
-        self.values = np.ascontiguousarray(values, dtype=np.float64)
-        self._log_distance_rupture = np.log(self.distance_rupture)
         self._log_values = np.log(self.values)
 
     @property
     def n_suction(self):
         return self.values.shape[1]
-
-    @property
-    def n_distance(self):
-        return self.values.shape[2]
 
     @property
     def suction(self):
@@ -425,17 +520,14 @@ class BridgeTable:
         and suction_scale > 0 (u* units); n_suction, n_distance >= 2.
         """
         contact_angle = check_contact_angle(contact_angle)
-        radius_ratios = np.array([check_radius_ratio(r) for r in radius_ratios], dtype=np.float64)
-        if radius_ratios.size == 0 or np.any(np.diff(radius_ratios) <= 0.0):
-            raise ValueError(f"radius_ratios = {list(radius_ratios)} must be non-empty and strictly increasing")
+        radius_ratios = check_radius_ratios(radius_ratios)
         suction_max = check_positive("suction_max", suction_max)
         suction_scale = check_positive("suction_scale", suction_scale)
-        for name, n in (("n_suction", n_suction), ("n_distance", n_distance)):
-            if int(n) != n or n < 2:
-                raise ValueError(f"{name} = {n} is outside the valid range: an integer >= 2")
-        nodes = suction_nodes(suction_scale, suction_max, int(n_suction))
+        n_suction = check_node_count("n_suction", n_suction)
+        n_distance = check_node_count("n_distance", n_distance)
+        nodes = suction_nodes(suction_scale, suction_max, n_suction)
         distance_low, distance_rupture, values = build_suction_grid(
-            radius_ratios, math.radians(contact_angle), nodes, int(n_distance)
+            radius_ratios, math.radians(contact_angle), nodes, n_distance
         )
         return cls(contact_angle, radius_ratios, suction_scale, suction_max, distance_low, distance_rupture, values)
 
@@ -445,24 +537,8 @@ class BridgeTable:
         """Load the table with these parameters from the cache directory, building and saving it if
         absent; a cached file failing its checksum, identity or node checks is rebuilt (cached_table)."""
         parameters = cls._parameters(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale)
-        path = Path(directory or cache_directory()) / f"bridge_table_{cache_key('suction', parameters)}.h5"
-        n_r = len(parameters["radius_ratios"])
-
-        def check(table):
-            check_table_nodes(
-                table,
-                {"values": (n_r, parameters["n_suction"], parameters["n_distance"], len(FIELDS)),
-                 "distance_low": (n_r, parameters["n_suction"]),
-                 "distance_rupture": (n_r, parameters["n_suction"])},
-                {name: parameters[name] for name in ("contact_angle", "radius_ratios", "suction_scale",
-                                                     "suction_max")},
-            )
-            table.check_nodes()
-
-        return cached_table(
-            path, cache_identity("suction", parameters), cls.load, check,
-            lambda: cls.build(contact_angle, radius_ratios, n_suction, n_distance, suction_max, suction_scale),
-        )
+        return cls.from_cache(parameters, directory, lambda: cls.build(contact_angle, radius_ratios, n_suction,
+                                                                       n_distance, suction_max, suction_scale))
 
     def check_nodes(self, count=SPOT_NODES):
         """ValueError naming the first of the ``spot_nodes`` whose rupture distance, smallest
@@ -505,36 +581,6 @@ class BridgeTable:
         """Python-side lookup_interface: (exists, nn11*, nn33*)."""
         return lookup_interface(*self.arrays(), float(radius_ratio), float(suction_star),
                                 float(distance_star))
-
-    def save(self, path):
-        """Write the table to an HDF5 file, atomically (pendular.utils.atomic.replacing)."""
-        with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
-            h5.attrs["kind"] = "suction"
-            h5.attrs["format"] = TABLE_FORMAT
-            h5.attrs["contact_angle_deg"] = self.contact_angle
-            h5.attrs["suction_scale"] = self.suction_scale
-            h5.attrs["suction_max"] = self.suction_max
-            h5.attrs["fields"] = ",".join(FIELDS)
-            h5["radius_ratios"] = self.radius_ratios
-            h5["distance_low"] = self.distance_low
-            h5["distance_rupture"] = self.distance_rupture
-            h5["values"] = self.values
-
-    @classmethod
-    def load(cls, path):
-        """Read a table written by save()."""
-        with reading(path, "suction-controlled bridge table"), h5py.File(path, "r") as h5:
-            if h5.attrs.get("kind") != "suction" or h5.attrs.get("format") != TABLE_FORMAT:
-                raise ValueError(f"{path} is not a suction-controlled bridge table of format {TABLE_FORMAT}")
-            return cls(
-                h5.attrs["contact_angle_deg"],
-                h5["radius_ratios"][...],
-                h5.attrs["suction_scale"],
-                h5.attrs["suction_max"],
-                h5["distance_low"][...],
-                h5["distance_rupture"][...],
-                h5["values"][...],
-            )
 
     def write_yade(self, folder, n_distance=80):
         """Write YADE capillary files M(r=...) for the table's radius ratios (pendular.capillary.yade_files)."""

@@ -21,7 +21,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from pendular.capillary.meniscus import Bridge, bridge_kernel
+from pendular.capillary.meniscus import bridge_from_kernel, bridge_kernel
 from pendular.capillary.suction_control import contact_filling_angle
 from pendular.capillary.validation import (check_contact_angle, check_distance, check_positive,
     check_radius_ratio)
@@ -267,17 +267,4 @@ def bridge_with_volume(radius_ratio, contact_angle, volume_star, distance_star):
         )
     nu, delta1 = contour_point_at_distance(contour, distance_star)
     suction = suction_at(contour.radius_ratio, nu)
-    theta = math.radians(contour.contact_angle)
-    distance, volume, force, delta2, nn11, nn33 = bridge_kernel(contour.radius_ratio, theta, suction, delta1)
-    return Bridge(
-        radius_ratio=contour.radius_ratio,
-        contact_angle=float(contact_angle),
-        suction=suction,
-        distance=distance,
-        volume=volume,
-        force=force,
-        delta1=math.degrees(delta1),
-        delta2=math.degrees(delta2),
-        nn11=nn11,
-        nn33=nn33,
-    )
+    return bridge_from_kernel(contour.radius_ratio, contour.contact_angle, suction, delta1)

@@ -11,21 +11,16 @@ z relative to the interpolated rupture distance.
 from concurrent.futures import ProcessPoolExecutor
 import math
 import os
-from pathlib import Path
 
-import h5py
 import numba
 import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
 from pendular.capillary.suction_control import contact_filling_angle
-from pendular.capillary.table import (SPOT_NODES, TABLE_FORMAT, YADE_RADIUS_RATIOS, along_axis,
-    bilinear, cache_directory, cache_identity, cache_key, cached_table, check_table_nodes,
-    compare_node, distance_cell, distance_fraction, grid_position, radius_ratio_bracket,
-    spot_nodes)
-from pendular.capillary.validation import check_contact_angle, check_radius_ratio
-from pendular.utils.atomic import replacing
-from pendular.utils.validate import reading
+from pendular.capillary.table import (SPOT_NODES, YADE_RADIUS_RATIOS, TabulatedBridges,
+    along_axis, bilinear, check_node_count, check_radius_ratios, compare_node, distance_cell,
+    distance_fraction, grid_position, radius_ratio_bracket, spot_nodes)
+from pendular.capillary.validation import check_contact_angle
 from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, contour_point_at_distance,
     suction_at, trace_contour)
 
@@ -157,7 +152,7 @@ def _build_one_radius_ratio(job):
     return build_volume_rows(*job)
 
 
-class VolumeBridgeTable:
+class VolumeBridgeTable(TabulatedBridges):
     """Exact volume-controlled bridges tabulated over (r, V*, d*) for one contact angle.
 
     Build with VolumeBridgeTable.build(...) or, cached on disk, VolumeBridgeTable.cached(...).
@@ -166,24 +161,22 @@ class VolumeBridgeTable:
     Covered range per radius ratio: volume_range(i); distances from contact to rupture.
     """
 
+    kind = "volume"
+    description = "volume-controlled bridge table"
+    fields = VOLUME_FIELDS
+    file_arrays = ("radius_ratios", "volume_axes", "distance_low", "distance_rupture", "values")
+    file_prefix = "volume_bridge_table"
+    axis_nodes = "n_volume"
+
     def __init__(self, contact_angle, radius_ratios, volume_axes, distance_low, distance_rupture, values):
-        self.contact_angle = float(contact_angle)
-        self.radius_ratios = np.ascontiguousarray(radius_ratios, dtype=np.float64)
+        super().__init__(contact_angle, radius_ratios, distance_low, distance_rupture, values)
         self.volume_axes = np.ascontiguousarray(volume_axes, dtype=np.float64)
-        self.distance_low = np.ascontiguousarray(distance_low, dtype=np.float64)
-        self.distance_rupture = np.ascontiguousarray(distance_rupture, dtype=np.float64)
-        self.values = np.ascontiguousarray(values, dtype=np.float64)
-        self._log_distance_rupture = np.log(self.distance_rupture)
         self._grid = np.log(np.abs(self.values))
         self._grid[..., VOLUME_FIELDS.index("suction")] = self.values[..., VOLUME_FIELDS.index("suction")]
 
     @property
     def n_volume(self):
         return self.values.shape[1]
-
-    @property
-    def n_distance(self):
-        return self.values.shape[2]
 
     def volume_range(self, index):
         """(smallest, largest) V* tabulated for radius ratio radius_ratios[index]."""
@@ -203,13 +196,10 @@ class VolumeBridgeTable:
     def build(cls, contact_angle=0.0, radius_ratios=YADE_RADIUS_RATIOS, n_volume=80, n_distance=80, workers=None):
         """Solve every node exactly, radius ratios in parallel processes (workers, default: CPU count)."""
         contact_angle = check_contact_angle(contact_angle)
-        radius_ratios = np.array([check_radius_ratio(r) for r in radius_ratios], dtype=np.float64)
-        if radius_ratios.size == 0 or np.any(np.diff(radius_ratios) <= 0.0):
-            raise ValueError(f"radius_ratios = {list(radius_ratios)} must be non-empty and strictly increasing")
-        for name, n in (("n_volume", n_volume), ("n_distance", n_distance)):
-            if int(n) != n or n < 2:
-                raise ValueError(f"{name} = {n} is outside the valid range: an integer >= 2")
-        jobs = [(float(r), contact_angle, int(n_volume), int(n_distance)) for r in radius_ratios]
+        radius_ratios = check_radius_ratios(radius_ratios)
+        n_volume = check_node_count("n_volume", n_volume)
+        n_distance = check_node_count("n_distance", n_distance)
+        jobs = [(float(r), contact_angle, n_volume, n_distance) for r in radius_ratios]
         workers = min(workers or os.cpu_count() or 1, len(jobs))
         if workers > 1:
             with ProcessPoolExecutor(workers) as pool:
@@ -230,24 +220,13 @@ class VolumeBridgeTable:
         """Load the table with these parameters from the cache directory, building and saving it if
         absent; a cached file failing its checksum, identity or node checks is rebuilt (cached_table)."""
         parameters = cls._parameters(contact_angle, radius_ratios, n_volume, n_distance)
-        path = Path(directory or cache_directory()) / f"volume_bridge_table_{cache_key('volume', parameters)}.h5"
-        n_r = len(parameters["radius_ratios"])
+        return cls.from_cache(parameters, directory,
+                              lambda: cls.build(contact_angle, radius_ratios, n_volume, n_distance))
 
-        def check(table):
-            check_table_nodes(
-                table,
-                {"values": (n_r, parameters["n_volume"], parameters["n_distance"], len(VOLUME_FIELDS)),
-                 "volume_axes": (n_r, 2),
-                 "distance_low": (n_r, parameters["n_volume"]),
-                 "distance_rupture": (n_r, parameters["n_volume"])},
-                {name: parameters[name] for name in ("contact_angle", "radius_ratios")},
-            )
-            table.check_nodes()
-
-        return cached_table(
-            path, cache_identity("volume", parameters), cls.load, check,
-            lambda: cls.build(contact_angle, radius_ratios, n_volume, n_distance),
-        )
+    @classmethod
+    def array_shapes(cls, parameters):
+        """Shapes (name -> tuple) of the arrays of the table of these build ``parameters``."""
+        return {**super().array_shapes(parameters), "volume_axes": (len(parameters["radius_ratios"]), 2)}
 
     def check_nodes(self, count=SPOT_NODES):
         """ValueError naming the first of the ``spot_nodes`` whose stored state is not the exact
@@ -296,31 +275,3 @@ class VolumeBridgeTable:
     def lookup(self, radius_ratio, volume_star, distance_star):
         """Python-side lookup_volume: (exists, F*, u*, delta1, delta2)."""
         return lookup_volume(*self.arrays(), float(radius_ratio), float(volume_star), float(distance_star))
-
-    def save(self, path):
-        """Write the table to an HDF5 file, atomically (pendular.utils.atomic.replacing)."""
-        with replacing(path) as temporary, h5py.File(temporary, "w") as h5:
-            h5.attrs["kind"] = "volume"
-            h5.attrs["format"] = TABLE_FORMAT
-            h5.attrs["contact_angle_deg"] = self.contact_angle
-            h5.attrs["fields"] = ",".join(VOLUME_FIELDS)
-            h5["radius_ratios"] = self.radius_ratios
-            h5["volume_axes"] = self.volume_axes
-            h5["distance_low"] = self.distance_low
-            h5["distance_rupture"] = self.distance_rupture
-            h5["values"] = self.values
-
-    @classmethod
-    def load(cls, path):
-        """Read a table written by save()."""
-        with reading(path, "volume-controlled bridge table"), h5py.File(path, "r") as h5:
-            if h5.attrs.get("kind") != "volume" or h5.attrs.get("format") != TABLE_FORMAT:
-                raise ValueError(f"{path} is not a volume-controlled bridge table of format {TABLE_FORMAT}")
-            return cls(
-                h5.attrs["contact_angle_deg"],
-                h5["radius_ratios"][...],
-                h5["volume_axes"][...],
-                h5["distance_low"][...],
-                h5["distance_rupture"][...],
-                h5["values"][...],
-            )

@@ -25,6 +25,7 @@ import numpy as np
 
 from pendular.capillary.meniscus import bridge_kernel
 from pendular.capillary.suction_control import rupture_point, stable_filling_angle
+from pendular.capillary.table import write_bridge_fields
 from pendular.utils.atomic import replacing
 from pendular.utils.validate import reading
 
@@ -74,16 +75,11 @@ def yade_rows(radius_ratio, theta, suction_values, n_distance):
             continue
         u = suction_values[k]
         delta1 = stable_filling_angle(radius_ratio, theta, u, d, delta1_rupture[k], distance_rupture[k])
-        _, volume, force, delta2, nn11, nn33 = bridge_kernel(radius_ratio, theta, u, delta1)
         row = rows[j, k]
         row[0] = distances[j]
         row[1] = u
-        row[2] = volume
-        row[3] = force
-        row[4] = math.degrees(delta1)
-        row[5] = math.degrees(delta2)
-        row[6] = nn11
-        row[7] = nn33
+        write_bridge_fields(radius_ratio, theta, u, delta1, row[2:])
+        row[2], row[3] = row[3], row[2]  # the table's fields start F*, V*; YADE's columns V*, F*
     return distances, rows
 
 

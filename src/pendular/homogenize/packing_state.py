@@ -147,10 +147,9 @@ def packing_state(packing, *, radius, contact_angle, surface_tension, saturation
     saturation = bridges * bridge.volume / pore_volume
     suction = bridge.suction_star * surface_tension / radius
     volume = packing.cell_volume * radius**3
-    chi = effective_stress_parameter(packing.bridge_normals, radius, radius, bridge.filling_angle,
-                                     bridge.filling_angle, bridges * bridge.volume * radius**3, volume)
-    tension = surface_tension_stress(packing.bridge_normals, radius, radius, bridge.filling_angle,
-                                     bridge.filling_angle, contact_angle, surface_tension, volume)
+    caps = (packing.bridge_normals, radius, radius, bridge.filling_angle, bridge.filling_angle)
+    chi = effective_stress_parameter(*caps, bridges * bridge.volume * radius**3, volume)
+    tension = surface_tension_stress(*caps, contact_angle, surface_tension, volume)
     psi = capillary_stress(chi, tension, suction)
     return PackingState(
         packing=packing,
