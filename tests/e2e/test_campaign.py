@@ -17,10 +17,10 @@ from conftest import refused, run_in_process, summary_of
 
 import pendular.studies.campaign as campaign_module
 from pendular.procedures.preparation import PrepareConfig
-from pendular.cli.tables import options_argv, sweep_from_table
 from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs,
                                        executor, finished_summary, max_jobs, run_name,
-                                       run_progress, table_rows, write_campaign_csv)
+                                       run_progress, sweep_from_table, table_rows,
+                                       write_campaign_csv)
 from pendular.procedures.config import (ShearConfig, TensionConfig, TriaxialConfig, config_to_dict,
     tension_sample)
 from pendular.io.outputs import OutputFolder
@@ -155,9 +155,6 @@ def test_table_rows_cartesian_and_explicit():
                                  "t")
     assert rows == [{"particles": 100, "void_ratio": 0.7}, {"particles": 200, "name": "x"}]
     assert [run_name(r, v) for r, v in zip(rows, varied)] == ["void_ratio0.7", "x"]
-    assert options_argv({"max_strain": 0.02, "persist_bridges": True, "quiet": False,
-                         "table_resolution": [350, 80], "sample": "-s.h5"}) == [
-        "--max-strain=0.02", "--persist-bridges", "--table-resolution=350,80", "--sample=-s.h5"]
 
 
 def test_tables_build_validated_configs(tmp_path):
@@ -171,6 +168,10 @@ def test_tables_build_validated_configs(tmp_path):
     assert runs[0].config.sample_path == str(tmp_path / "s.h5")      # relative to the table
     table.write_text('[fixed]\nparticles = 200\nsample = "-s.h5"\n')   # a value, not an option
     assert sweep_from_table(table)[1][0].config.sample_path == str(tmp_path / "-s.h5")
+    table.write_text('[fixed]\nparticles = 200\nforce = true\nsuction = 1000\n'
+                     'table_resolution = [100, 40]\n')
+    run = sweep_from_table(table)[1][0]
+    assert run.force and run.config.bridges.table_resolution == (100, 40)
     table.write_text('command = "tension"\n[fixed]\nparticles = 300\n'
                      '[sweep]\nwater_content = [0.5, 1.0]\n')
     command, runs = sweep_from_table(table)
@@ -209,20 +210,27 @@ def test_tables_build_validated_configs(tmp_path):
     ('[fixed]\nmax-strain = 0.1\n', "max-strain ([fixed]: write max_strain)"),
     ('[fixed]\nparticles = -3\n', "run run: particles = -3 ([fixed]): particles = -3 is "
                                    "outside the valid range"),
-    ('[fixed]\nparticles = "many"\n', 'run run: particles = "many" ([fixed]): argument '
-                                       "--particles: invalid int value: 'many'"),
-    ('[fixed]\nparticles = false\n', "particles = false ([fixed]): --particles takes a value, "
-                                      "not true or false"),
-    ('[fixed]\npersist_bridges = 1\n', "persist_bridges = 1 ([fixed]): a flag, true or false "
-                                        "expected"),
+    ('[fixed]\nparticles = "many"\n', 'run run: particles = "many" ([fixed]): particles = '
+                                       "'many': an integer expected"),
+    ('[fixed]\nparticles = false\n', "particles = false ([fixed]): particles = False: a value "
+                                      "expected, not true or false"),
+    ('[fixed]\npersist_bridges = 1\n', "persist_bridges = 1 ([fixed]): persist_bridges = 1: a "
+                                        "flag, true or false expected"),
+    ('[fixed]\nforce = "yes"\n', "force = \"yes\" ([fixed]): force = 'yes': a flag, true or "
+                                  "false expected"),
     ('[fixed]\nparticles = 300\n[sweep]\nsuction = [1000, -5]\n',
-     "run suction-5: suction = -5 ([sweep]): --suction = -5.0 Pa is outside the valid range"),
+     "run suction-5: suction = -5 ([sweep]): suction = -5.0 Pa is outside the valid range"),
     ('[fixed]\nwater_content = 5\n[sweep]\nsuction = [0, 1000]\n',
-     "run suction1000: water_content = 5 ([fixed]), suction = 1000 ([sweep]): --suction and "
-     "--water-content: give one"),
+     "run suction1000: water_content = 5 ([fixed]), suction = 1000 ([sweep]): suction and "
+     "water_content: give one"),
     ('[[runs]]\nseed = 1\n[[runs]]\nvtk_every = 5\nvtk_frames = 3\n',
-     "vtk_every = 5 (row 2 of [[runs]]), vtk_frames = 3 (row 2 of [[runs]]): argument "
-     "--vtk-frames: not allowed with argument --vtk-every"),
+     "vtk_every = 5 (row 2 of [[runs]]), vtk_frames = 3 (row 2 of [[runs]]): vtk_every and "
+     "vtk_frames: give one"),
+    ('[fixed]\nparticles = 300\nsuction = 1000\ntable_resolution = [3, 40]\n',
+     "table_resolution = [3, 40] ([fixed]): table_resolution [3, 40]: two integers NS,ND"),
+    ('command = "tension"\n[fixed]\nparticles = 200\nperiodic = true\ngrip_depth = 2\n',
+     "periodic = true ([fixed]), grip_depth = 2 ([fixed]): grip_depth = 2 does not apply to "
+     "periodic: a periodic cell has no walls"),
     ('[[runs]]\nname = "a/b"\nseed = 1\n', 'name = "a/b" (row 1 of [[runs]]): run name '
                                             "'a/b' is not a folder name"),
     ('[[runs]]\nname = [1]\nseed = 1\n', "name = [1] (row 1 of [[runs]]): a folder name"),

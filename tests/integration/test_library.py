@@ -177,6 +177,31 @@ def test_configurations_round_trip_through_json():
         config_from_dict(data, "old.h5")
 
 
+def test_no_module_below_the_command_line_parses_arguments():
+    """Options become configurations in the library (pendular.procedures.options); only the
+    command line parses a command line."""
+    parsing = [path for path in _python_files(os.path.join(SRC, "pendular"))
+               if _layer(_module_name(path)) not in ("pendular.cli", "pendular")
+               and os.sep + "scripts" + os.sep not in path
+               and any(module == "argparse" or module.startswith("argparse.")
+                       for module in _imports(path))]
+    assert not parsing
+
+
+def test_a_campaign_table_builds_its_configurations_without_the_command_line(tmp_path):
+    table = tmp_path / "t.toml"
+    table.write_text('[fixed]\nparticles = 300\nmax_strain = 0.02\n'
+                      '[sweep]\nsuction = [0, 30000]\n')
+    code = ("import sys; from pendular.studies.campaign import sweep_from_table; "
+            f"command, runs = sweep_from_table({str(table)!r}); "
+            "print(command, [run.config.suction for run in runs], "
+            "sorted(m for m in sys.modules if m.startswith('pendular.cli')))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["triaxial", "[0.0,", "30000.0]", "[]"]
+
+
 def test_pendular_command_lists_its_commands_and_version():
     result = subprocess.run([sys.executable, "-m", "pendular.cli", "--help"],
                             capture_output=True, text=True, check=True)

@@ -1,6 +1,7 @@
 """Parameters declared once (pendular.utils.parameters): a field's metadata drives its
-validation, its command-line option, its flat key and its unit; errors name the field in Python
-and tables and the flag on the command line."""
+validation, its option (pendular.procedures.options), its flat key and its unit; the command
+line and Python build the same configuration from the same options; errors name the field in
+Python, the key in tables and options given by key, and the flag on the command line."""
 
 import dataclasses
 import math
@@ -8,14 +9,15 @@ import math
 import pytest
 
 from pendular.cli import command_parser, main
-from pendular.cli.tables import sweep_from_table
 from pendular.io.schema import OPTION_UNITS
+from pendular.procedures.options import COMMANDS, config_from_options, options_of
+from pendular.studies.campaign import sweep_from_table
 from pendular.procedures.config import (BridgeConfig, CyclicConfig, IsotropicConfig,
     LaboratoryConfig, OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig,
     TablePathConfig, TensionConfig, TriaxialConfig, tension_sample)
 from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
-from pendular.utils.parameters import (ParameterError, default_of, parameters_of, spec_of,
-    validate)
+from pendular.utils.parameters import (Option, OptionError, ParameterError, default_of,
+    parameters_of, spec_of, validate)
 
 #: (config, field, low, high, low inclusive, high inclusive)
 BOUNDS = [
@@ -28,30 +30,40 @@ BOUNDS = [
     (BridgeConfig, "contact_angle", 0.0, 90.0, True, False),
 ]
 #: The options of ``pendular triaxial`` made from their fields' metadata.
-GENERATED = {"particles", "confining", "seed", "periodic", "porosity", "friction",
-             "prep_friction", "young", "damping", "timestep_safety", "timestep_rule",
-             "skin_factor", "sample", "contact_angle", "bridges", "surface_tension", "liquid",
-             "wetting", "persist_bridges", "wet_steps", "max_strain", "direction", "b",
-             "constant_p", "inertial_number", "strain_rate", "records"}
+GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spread",
+             "porosity", "friction", "prep_friction", "young", "damping", "timestep_safety",
+             "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
+             "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
+             "table_resolution", "max_strain", "direction", "b", "constant_p",
+             "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
+             "checkpoint_every"}
 LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
-#: The sample and wetting options every laboratory command shares (generated on the triaxial).
+#: The sample, wetting and output options every laboratory command shares (generated on the
+#: triaxial).
 LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "records",
-                          "inertial_number", "strain_rate"}
+                          "inertial_number", "strain_rate", "vtk_frames"}
 RATE = {"inertial_number", "strain_rate"}
+SIZES = {"radius", "radius_spread"}
 #: Each command's own options made from their fields' metadata: an option written by hand
 #: instead would be missing.
 OWN_GENERATED = {
     "oedometer": {"axial_stress", "unload_to", "record_strain"} | RATE,
-    "isotropic": {"stage_steps", "record_strain"} | RATE,
+    "isotropic": {"stresses", "stage_steps", "record_strain"} | RATE,
     "cyclic": {"amplitude_q", "amplitude_strain", "cycles", "record_strain"} | RATE,
     "path": {"record_strain", "records"} | RATE,
     "simple-shear": {"normal_stress", "constant_volume", "max_strain", "inertial_number",
                      "shear_rate", "record_strain", "stage_steps"},
     "tension": {"roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
-                "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames"},
-    "swcc": {"confining", "contact_angle", "surface_tension", "form_gap", "stage_steps",
-             "record_every", "friction", "prep_friction", "seed"},
+                "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
+                "vtk_every", "particles", "confining", "friction", "young", "seed",
+                "periodic"} | SIZES,
+    "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
+             "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
+             "seed"} | SIZES,
 }
+#: Options whose default is the command's own, not its field's (the field's otherwise).
+COMMAND_DEFAULTS = {("tension", "particles"), ("tension", "confining"), ("swcc", "particles"),
+                    ("simple-shear", "periodic")}
 #: Configurations whose every field declares a Parameter, but their nested configurations.
 DECLARED = (PrepareConfig, ShearConfig, BridgeConfig, LaboratoryConfig, PathConfig,
             OedometerConfig, IsotropicConfig, CyclicConfig, TablePathConfig, SimpleShearConfig,
@@ -139,16 +151,19 @@ def test_generated_options_hold_the_dataclass_defaults(command):
     else:
         shared = LABORATORY if command in LOADING_COMMANDS else set()
         assert {action.dest for action in generated} == shared | OWN_GENERATED[command]
+    declared = {option.key: option for option in options_of(command)}
     for action in generated:
-        if action.dest in parser._defaults:     # a command's own set_defaults (simple shear)
-            continue
         config, name = action.parameter
         spec = spec_of(config, name)
-        assert action.option_strings == [spec.flag]
-        assert action.default == (None if spec.unset else default_of(config, name)), spec.flag
+        option = declared[action.dest]
+        assert action.option_strings == [spec.flag] == [option.flag]
+        if (command, action.dest) not in COMMAND_DEFAULTS:     # None: the field's default
+            assert option.default in (None, default_of(config, name)), spec.flag
+        shown = option.default if not spec.many else ",".join(f"{v:g}" for v in option.default)
+        assert action.default == shown, spec.flag         # the command line's is the declared
         if spec.choices is not None:
             assert tuple(action.choices) == spec.choices
-        elif spec.kind in (int, float):
+        elif spec.kind in (int, float) and not spec.many and option.least is None:
             assert action.type is spec.kind
 
 
@@ -196,6 +211,8 @@ SMALL = PrepareConfig(particles=100)
 def test_the_default_command_line_builds_the_dataclass_defaults(command, argv, expected):
     parser, module = command_parser(command)
     assert module.config_from(parser.parse_args(argv)) == expected
+    given = {"amplitude_q": 300} if argv else {}            # as a table or Python gives it
+    assert config_from_options(command, given) == expected
 
 
 #: (command, option, value, the configuration refusing the field's value, field, its message)
@@ -246,3 +263,84 @@ def test_a_list_field_checks_each_value():
         IsotropicConfig(sample=SMALL, stresses=[500.0, 0])
     with pytest.raises(ParameterError, match=r"^suctions = 3000.0: a list of numbers expected"):
         SwccConfig(sample=SMALL, suctions=3000.0)
+
+
+@pytest.mark.parametrize("command, argv, options", [
+    ("triaxial", ["--particles", "300", "--suction", "30000", "--table-resolution", "100,40",
+                  "--persist-bridges", "--max-strain", "0.02", "--vtk-every", "0"],
+     {"particles": 300, "suction": 30000, "table_resolution": [100, 40],
+      "persist_bridges": True, "max_strain": "0.02", "vtk_every": 0}),
+    ("triaxial", ["--water-content", "1.5", "--liquid", "lost", "--friction", "20"],
+     {"water_content": 1.5, "liquid": "lost", "friction": 20}),
+    ("isotropic", ["--stresses", "500,1000", "--sample", "s.h5"],
+     {"stresses": [500, 1000], "sample": "s.h5"}),
+    ("isotropic", ["--stresses", "800"] + ["--stresses", "500,1000"],
+     {"stresses": "500,1000"}),
+    ("simple-shear", ["--shear-rate", "2", "--constant-volume"],
+     {"shear_rate": 2, "constant_volume": True, "periodic": False}),
+    ("tension", ["--void-ratio", "0.72", "--water-content", "1,2", "--specific-gravity", "2.7"],
+     {"void_ratio": 0.72, "water_content": [1, 2], "specific_gravity": 2.7}),
+    ("swcc", ["--suctions", "3000,30000", "--radius-spread", "0.2", "--particles", "60"],
+     {"suctions": [3000, 30000], "radius_spread": 0.2, "particles": 60}),
+])
+def test_python_and_the_command_line_build_the_same_configuration(command, argv, options):
+    """config_from_options takes the options by key as a table or Python gives them (numbers,
+    their text, lists, comma text, flags) and builds what the command line builds."""
+    parser, module = command_parser(command)
+    assert config_from_options(command, options) == module.config_from(parser.parse_args(argv))
+
+
+def test_options_given_by_key_are_refused_naming_the_key():
+    with pytest.raises(OptionError) as refused:
+        config_from_options("triaxial", {"suction": 1000, "water_content": 1})
+    assert str(refused.value).startswith("suction and water_content: give one")
+    assert refused.value.keys == ["suction", "water_content"]
+    assert refused.value.on_command_line().startswith("--suction and --water-content: give one")
+    with pytest.raises(ParameterError) as refused:       # a field's error, named by its key
+        config_from_options("triaxial", {"prep_friction": 95})
+    assert str(refused.value).startswith("prep_friction = 95.0 deg is outside the valid range")
+    assert refused.value.on_command_line().startswith("--prep-friction = 95.0 deg")
+    for options, message in (
+            ({"partciles": 300}, r"^partciles: not an option of triaxial; valid: particles, "),
+            ({"vtk_every": 5, "vtk_frames": 3}, r"^vtk_every and vtk_frames: give one$"),
+            ({"particles": "many"}, r"^particles = 'many': an integer expected$"),
+            ({"particles": 300.5}, r"^particles = 300.5: an integer expected$"),
+            ({"particles": False}, r"^particles = False: a value expected, not true or false"),
+            ({"persist_bridges": 1}, r"^persist_bridges = 1: a flag, true or false expected$"),
+            ({"bridges": "cylinder"}, r"^bridges = 'cylinder' is not one of \('exact', "),
+            ({"vtk_every": -1}, r"^vtk_every = -1 is outside the valid range \[0, inf\)$"),
+            ({"suction": 1000, "table_resolution": "3,40"},
+             r"^table_resolution '3,40': two integers NS,ND, each in \[4, inf\), expected$")):
+        with pytest.raises(ValueError, match=message):
+            config_from_options("triaxial", options)
+    with pytest.raises(OptionError, match=r"^stresses = '500,x' is not a comma-separated list"):
+        config_from_options("isotropic", {"stresses": "500,x"})
+    with pytest.raises(OptionError, match=r"^void_ratio = \[0.72, 0.72\] repeats 0.72"):
+        config_from_options("tension", {"void_ratio": [0.72, 0.72]})
+    with pytest.raises(ValueError, match="command = 'dance' builds no configuration"):
+        config_from_options("dance", {})
+
+
+def test_an_option_reads_numbers_text_and_lists():
+    number = Option("x", "a number")
+    assert number.read("2.5") == 2.5 and number.read(3) == 3.0 and type(number.read(3)) is float
+    count = Option("n", "a count", kind=int, least=1)
+    assert count.read("12") == 12 and count.read(4.0) == 4
+    assert count.read(2**70) == 2**70                       # exact beyond float's 2**53
+    with pytest.raises(OptionError, match=r"^n = 0 is outside the valid range \[1, inf\)"):
+        count.read(0)
+    values = Option("v", "a list", many=True)
+    assert values.read("1,2.5") == values.read([1, 2.5]) == [1.0, 2.5]
+    assert values.read(7) == [7.0]                          # a table's single value
+    assert Option("flag", "a flag", kind=bool).read(True) is True
+    assert Option("raw", "as given", kind=None).read([3, 4]) == [3, 4]
+
+
+def test_every_option_of_a_command_is_declared_once():
+    for command in COMMANDS:
+        keys = [option.key for option in options_of(command)]
+        assert len(keys) == len(set(keys)), command
+        for option in options_of(command):
+            if option.field is not None:
+                config, name = option.field
+                assert spec_of(config, name).flag == option.flag, (command, option.key)

@@ -121,37 +121,61 @@ def add_executor_options(parser):
     add_run_options(parser, threads_default=1)
 
 
-def add_size_options(parser, default_radius):
-    """Sphere-size options of commands that prepare a sample: --radius (the mean radius,
-    ``default_radius`` [m] when not given), --radius-spread, --psd (pendular.dem.grading)."""
-    parser.add_argument("--radius", type=float, default=None,
-                        help=f"sphere radius [m], the mean radius of a graded sample (default "
-                             f"{default_radius:g})")
-    from pendular.dem.grading import MAX_RADIUS_RATIO, MAX_RADIUS_SPREAD
+def add_declared_options(parser, options):
+    """Add to ``parser`` the declared ``options`` (pendular.utils.parameters.Option; a
+    command's: pendular.procedures.options.options_of) in their order: flag, default (a
+    list's as its comma text), type (an integer with a least value checked as it is parsed),
+    choices, metavar, help; a flag stores true; the options of one group exclude each other.
+    Each action of an option that sets a configuration field records it as
+    ``action.parameter`` = (config, field)."""
+    groups = {}
+    for option in options:
+        where = parser
+        if option.group is not None:
+            if option.group not in groups:
+                groups[option.group] = parser.add_mutually_exclusive_group()
+            where = groups[option.group]
+        settings = {"help": option.help.replace("%", "%%")}
+        if option.positional:
+            action = where.add_argument(option.key, metavar=option.metavar, nargs="?",
+                                        default=option.default, **settings)
+        elif option.kind is bool:
+            action = where.add_argument(option.flag, action="store_true",
+                                        default=option.default, **settings)
+        else:
+            settings["default"] = option.default
+            if option.many and option.default is not None:
+                settings["default"] = ",".join(f"{value:g}" for value in option.default)
+            if option.choices is not None:
+                settings["choices"] = option.choices
+            elif option.least is not None:
+                settings["type"] = positive_int(option.flag, option.least)
+            elif option.kind in (int, float) and not option.many:
+                settings["type"] = option.kind
+            if option.metavar is not None:
+                settings["metavar"] = option.metavar
+            action = where.add_argument(option.flag, **settings)
+        if option.field is not None:
+            action.parameter = option.field
 
-    parser.add_argument("--radius-spread", type=float, default=0.0,
-                        help="radii uniform in R(1 ± S), R = --radius [-] (0: equal spheres; "
-                             f"at most {MAX_RADIUS_SPREAD:.4g}, a radius ratio of "
-                             f"{MAX_RADIUS_RATIO:g})")
-    parser.add_argument("--psd", metavar="FILE", default=None,
-                        help="grading curve, CSV rows 'diameter [m], percent passing by mass' "
-                             "from 0 to 100 %% (a sieve analysis); sets the sizes instead of "
-                             "--radius")
+
+def add_command_options(parser, command):
+    """Add to ``parser`` the options of the configuration of ``command``
+    (pendular.procedures.options)."""
+    from pendular.procedures.options import options_of
+
+    add_declared_options(parser, options_of(command))
 
 
-def sizes_from(args):
-    """The size settings (radius, radius_spread, psd) of parsed add_size_options options; a
-    radius not given is left to the configuration's default."""
-    if args.psd is not None and args.radius is not None:
-        raise UsageError("--radius and --psd: give one (the grading curve sets the sizes)")
-    from pendular.dem.grading import read_grading_curve
+def command_config(command, args):
+    """The configuration of ``command`` from the parsed options ``args`` (those it declares:
+    pendular.procedures.options.config_from_options; its errors name the keys, and
+    ``on_command_line`` the flags)."""
+    from pendular.procedures.options import config_from_options, options_of
 
-    sizes = {"radius_spread": args.radius_spread}
-    if args.radius is not None:
-        sizes["radius"] = args.radius
-    if args.psd is not None:
-        sizes["psd"] = read_grading_curve(args.psd)
-    return sizes
+    keys = {option.key for option in options_of(command)}
+    return config_from_options(command, {key: value for key, value in vars(args).items()
+                                         if key in keys})
 
 
 def set_threads(threads):

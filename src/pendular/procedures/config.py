@@ -56,6 +56,9 @@ MIN_AXIAL_STRAIN = 1e-6
 #: Why MAX_AXIAL_STRAIN (the end of the error refusing more).
 AXIAL_STRAIN_LIMIT = ("a triaxial test ends by 20-30 % axial strain (the thesis's 25 %); at "
                       "half its height the sample is no test any more")
+#: Most steps of a stage run to equilibrium (wetting, an isotropic or SWCC stage, a
+#: consolidation): beyond, a stage that has not settled will not.
+MAX_STAGE_STEPS = 100_000_000
 #: Most history rows of a shear (each a few hundred bytes; one a step at most).
 MAX_RECORDS = 10_000_000
 #: Fewest spheres of a triaxial test or an SWCC: their stresses and saturation are averages
@@ -78,6 +81,13 @@ def inertial_number_parameter():
     """The field of a loading's target inertial number [-] (ShearConfig, PathConfig)."""
     return parameter(3e-4, low=0.0, high=1.0, low_inclusive=False, flag="--inertial-number",
                      help="target inertial number setting the strain rate")
+
+
+def stage_steps_parameter(default, help):
+    """The field of the most steps of a stage run to equilibrium [-] (``default``; ``help``:
+    which stage)."""
+    return parameter(default, kind=int, low=1, high=MAX_STAGE_STEPS, flag="--stage-steps",
+                     help=help)
 
 
 def strain_rate_parameter():
@@ -300,7 +310,7 @@ class LaboratoryConfig:
     sample_path: str | None = parameter(None, kind=str, flag="--sample", metavar="PATH",
                                         help="start from this prepared sample (sample.h5) "
                                              "instead of preparing one")
-    wet_steps: int = parameter(200000, kind=int, low=1, high=100_000_000, flag="--wet-steps",
+    wet_steps: int = parameter(200000, kind=int, low=1, high=MAX_STAGE_STEPS, flag="--wet-steps",
                                help="most steps to equilibrate the wetted (or loaded) sample")
     vtk_frames: int = parameter(50, kind=int, low=0, flag="--vtk-frames",
                                 help="ParaView frames over the loading")
@@ -492,9 +502,8 @@ class IsotropicConfig(PathConfig):
         default_factory=lambda: [500.0, 1000.0, 2000.0, 5000.0, 2000.0, 500.0], many=True,
         unit="Pa", low=0.0, high=1e7, low_inclusive=False, flag="--stresses",
         metavar="P1,P2,...", help="isotropic stresses of the stages, each > 0, in any order")
-    stage_steps: int = parameter(2_000_000, kind=int, low=1, high=100_000_000,
-                                 flag="--stage-steps",
-                                 help="most steps of a stage to reach equilibrium")
+    stage_steps: int = stage_steps_parameter(2_000_000,
+                                             "most steps of a stage to reach equilibrium")
 
     TEST = "an isotropic test"
 
@@ -534,7 +543,10 @@ TENSION_RANGES = {"radius": (1e-6, 1e-2), "confining": (1.0, 1e5), "young": (0.0
 #: The specific gravity Gs = density / WATER_DENSITY of a direct tension's grains, as its
 #: command sets it.
 SPECIFIC_GRAVITY_PARAMETER = Parameter(
-    "1", "specific gravity Gs of the grains", *SPECIFIC_GRAVITY_RANGE, flag="--specific-gravity")
+    "1", f"specific gravity Gs of the grains: sets their density, Gs x {WATER_DENSITY:g} "
+    "kg/m^3, which gives their mass (time step, strain rate) and the water volume of a water "
+    "content by mass",
+    *SPECIFIC_GRAVITY_RANGE, flag="--specific-gravity")
 #: The core void ratio of a direct tension's case: denser than random close packing or looser
 #: than the loosest growth is unreachable.
 VOID_RATIO_PARAMETER = Parameter("1", "core void ratio", 0.5, 1.2, flag="--void-ratio")
@@ -739,7 +751,7 @@ class SwccConfig:
     sample: PrepareConfig = field(default_factory=PrepareConfig)
     suctions: list[float] = parameter(
         default_factory=lambda: [3000.0, 10000.0, 30000.0, 100000.0, 300000.0], many=True,
-        unit="Pa", low=0.0, low_inclusive=False, flag="--suctions",
+        unit="Pa", low=0.0, low_inclusive=False, flag="--suctions", metavar="S1,S2,...",
         help="suctions of the drying path, ascending; wetting goes back along them")
     surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
@@ -750,8 +762,7 @@ class SwccConfig:
                                 help="at wetting, bridges also form across gaps up to this many "
                                      "mean radii (0: at contacts only; 1: wherever a bridge of "
                                      "the lowest suction can exist)")
-    stage_steps: int = parameter(200000, kind=int, low=1, high=100_000_000, flag="--stage-steps",
-                                 help="most steps per stage to reach equilibrium")
+    stage_steps: int = stage_steps_parameter(200000, "most steps per stage to reach equilibrium")
     record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
                                   help="steps between history records")
 
@@ -991,9 +1002,8 @@ class SimpleShearConfig(PathConfig):
                                            "--normal-stress")
     max_strain: float = parameter(0.2, low=MIN_AXIAL_STRAIN, high=MAX_SHEAR_STRAIN,
                                   flag="--max-strain", help="final shear strain gamma")
-    stage_steps: int = parameter(2_000_000, kind=int, low=1, high=100_000_000,
-                                 flag="--stage-steps",
-                                 help="most steps of the consolidation to --normal-stress")
+    stage_steps: int = stage_steps_parameter(
+        2_000_000, "most steps of the consolidation to --normal-stress")
 
     TEST = "a simple shear test"
 

@@ -20,7 +20,7 @@ fails does not stop the others: ``CampaignResult.failed`` names it with its erro
 summary is its summary.json (triaxial) or the scalars of its first case (tension: give each
 run one void ratio and one water content).
 
-``pendular.cli.tables.sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
+``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 
     command = "triaxial"            # or "tension"
     [fixed]                         # options of the command, underscores for dashes
@@ -34,10 +34,12 @@ run one void ratio and one water content).
     # name = "loose"                # optional folder name
     # prep_friction = 3
 
-Any option of the command can be fixed or swept; each run's configuration is built by the
-command's own option parser and ``config_from``, so it is validated as on the command line.
-Flags take true/false, list values are joined with commas (``table_resolution = [350, 80]``),
-relative ``sample`` and ``psd`` paths are relative to the table's folder. A table must set at
+Any option of the command's configuration can be fixed or swept, and ``force`` (Run.force) of a
+triaxial; each run's configuration is built by
+pendular.procedures.options.config_from_options, as the command line builds it, so it is
+validated as there. Flags take true/false, a list option a list or its comma text
+(``table_resolution = [350, 80]``, ``stresses = "500,1000"``); relative ``sample`` and ``psd``
+paths are relative to the table's folder. A table must set at
 least one option (an empty table, ``[sweep]`` or ``runs = []`` is refused: it would run the
 command's default test) and hold at most MAX_RUNS runs. Every refusal names the table and the
 key, with its section (``[fixed]``, ``[sweep]``, ``row 2 of [[runs]]``).
@@ -72,8 +74,10 @@ from pendular.utils.validate import check_int
 
 from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
                                         same_config, sample_made_with, stored_config)
+from pendular.procedures.options import config_from_options, options_of
 from pendular.procedures.tension import TensionTest
 from pendular.procedures.triaxial import Interrupted, TriaxialTest, parameters
+from pendular.utils.parameters import Option
 
 #: Seconds between updates of the campaign's progress bar.
 PROGRESS_PERIOD = 5.0
@@ -81,6 +85,10 @@ PROGRESS_PERIOD = 5.0
 RunConfig = Union[TriaxialConfig, TensionConfig]
 #: Options a parameter table cannot set: the campaign decides them.
 CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep", "device")
+#: A run's own options of a table beside its command's configuration (Run's), by command.
+RUN_OPTIONS = {"triaxial": (Option("force", "run settings refused as not quasi-static or too "
+                                            "long (experts)", kind=bool),),
+               "tension": ()}
 #: Options of a table that are paths, relative to the table's folder.
 PATH_OPTIONS = ("sample", "psd")
 #: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra
@@ -514,6 +522,90 @@ def _text(value: Any) -> str:
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     return re.sub(r"[^\w.+-]", "-", str(value))
+
+
+def _mentions(text: str, key: str) -> bool:
+    """Whether the error ``text`` names the option ``key`` (as --key-with-dashes or key)."""
+    flag = "--" + key.replace("_", "-")
+    return re.search(rf"(?<![\w-])({re.escape(flag)}|{re.escape(key)})(?![\w-])",
+                     text) is not None
+
+
+def _named(error: Exception, options: dict) -> list[str]:
+    """The keys of ``options`` that ``error`` names (its ``keys``, else those its text
+    mentions), all of them when it names none."""
+    keys = getattr(error, "keys", None)
+    named = [key for key in options
+             if (key in keys if keys is not None else _mentions(str(error), key))]
+    return named or list(options)
+
+
+def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
+    """(command, [Run]) of the TOML table at ``path``; each run's configuration is built and
+    validated from its options by pendular.procedures.options.config_from_options (ValueError
+    naming the table, the run and the table key with its section)."""
+    source = f"table = {os.fspath(path)!r}"
+    table = read_table(path)
+    command, rows, varied = table_rows(table, source)
+    declared = [option.key for option in options_of(command)]
+    own = {option.key: option for option in RUN_OPTIONS[command]}
+    known = set(declared) | set(own)
+
+    def where(index, key):
+        """The section of the table that gives run ``index`` its ``key``."""
+        if key not in varied[index]:
+            return "[fixed]"
+        return "[sweep]" if table.get("sweep") else f"row {index + 1} of [[runs]]"
+
+    def setting(index, key):
+        return f"{key} = {json.dumps(rows[index][key], default=str)} ({where(index, key)})"
+
+    unknown = {}
+    for index, row in enumerate(rows):
+        for key in row:
+            if key != "name" and key not in known:
+                unknown.setdefault(key, index)
+    if unknown:
+        described = []
+        for key, index in unknown.items():
+            note = ("set by the campaign" if key in CAMPAIGN_OPTIONS else
+                    f"write {key.replace('-', '_')}" if key.replace("-", "_") in known else "")
+            described.append(f"{key} ({where(index, key)}{': ' + note if note else ''})")
+        raise ValueError(f"{source}: {', '.join(described)}: not an option of {command} in a "
+                         f"table; see 'pendular {command} --help'")
+    folder = os.path.dirname(os.path.abspath(os.fspath(path)))
+    runs = []
+    for index, (row, keys) in enumerate(zip(rows, varied)):
+        name = run_name(row, keys)
+        if "name" in row and (isinstance(row["name"], bool)
+                              or not isinstance(row["name"], (str, int))):
+            raise ValueError(f"{source}: {setting(index, 'name')}: a folder name (a string) "
+                             "expected")
+        options = {key: os.path.join(folder, value)
+                   if key in PATH_OPTIONS and isinstance(value, str)
+                   and not os.path.isabs(value) else value
+                   for key, value in row.items() if key != "name"}
+        try:
+            run_settings = {key: own[key].read(options.pop(key)) for key in own
+                            if key in options}
+            config = config_from_options(command, options)
+        except (ValueError, ArithmeticError) as error:
+            named = _named(error, {key: None for key in row if key != "name"})
+            raise ValueError(f"{source}: run {name}: "
+                             f"{', '.join(setting(index, key) for key in named)}: "
+                             f"{error}") from None
+        try:
+            runs.append(Run(name, config, **run_settings))
+        except ValueError as error:
+            raise ValueError(f"{source}: "
+                             f"{setting(index, 'name') if 'name' in row else 'run ' + name}: "
+                             f"{error}") from None
+    names = [run.name for run in runs]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise ValueError(f"{source}: runs {', '.join(repeated)} repeat a folder name: give "
+                         "each [[runs]] row a distinct name or distinct values")
+    return command, runs
 
 
 def run_options(config: RunConfig) -> dict:

@@ -1,11 +1,14 @@
 """Parameters declared once: a configuration field carries its unit, valid range, help text and
 command-line flag as metadata (``parameter``); from it ``validate`` checks a configuration,
-``add_options`` makes the command-line options, ``fields_from`` reads the fields back from the
-parsed options and ``flat_options`` makes the flat rows of a run.
+``option_of`` declares the option that sets it (``Option``: key, flag, default, kind, help with
+unit and range), ``fields_of`` reads the fields back from options given by key and
+``flat_options`` makes the flat rows of a run. pendular.procedures.options declares each
+command's options with them; the command line and campaign tables read options through it.
 
-Errors name the field in Python and tables (``particles = 1 is outside the valid range [2,
-...]``); ``ParameterError`` carries the field's name and flag, so that the command line names
-the option the user typed instead (``ParameterError.on_command_line``).
+Errors name the field in Python and the option's key in tables (``particles = 1 is outside the
+valid range [2, ...]``); ``ParameterError`` carries the field's name and flag, and
+``OptionError`` the keys of the options it names, so that the command line names the option the
+user typed instead (``on_command_line``).
 """
 
 from __future__ import annotations
@@ -40,11 +43,48 @@ class ParameterError(ValueError):
     def key(self):
         """The name of a table key or flat row: the flag's (``--prep-friction`` ->
         prep_friction), else the field's."""
-        return self.flag[2:].replace("-", "_") if self.flag else self.name
+        return key_of(self.flag) if self.flag else self.name
+
+    @property
+    def keys(self):
+        """The options the error names (its key)."""
+        return (self.key,)
 
     def on_command_line(self):
         """The message as the command line says it: naming the flag."""
         return self.named(self.flag) if self.flag else str(self)
+
+
+class OptionError(ValueError):
+    """An error of options given by key (a parsed command line, a table row, a Python mapping):
+    ``say(name)`` writes the message, naming each option as ``name(key)`` gives it. str()
+    names them by key, as tables and Python do; ``on_command_line()`` by flag. ``keys``: the
+    options it names, in the order it names them."""
+
+    def __init__(self, say):
+        self.keys = []
+        super().__init__(say(self._keyed))
+        self._say = say
+
+    def _keyed(self, key):
+        if key not in self.keys:
+            self.keys.append(key)
+        return key
+
+    def on_command_line(self):
+        """The message as the command line says it: naming the flags."""
+        return self._say(flag_of)
+
+
+def flag_of(key):
+    """The command-line flag of the option ``key``: prep_friction -> --prep-friction."""
+    return "--" + key.replace("_", "-")
+
+
+def key_of(flag):
+    """The key of the option ``flag`` (its argparse dest, a table's key): --prep-friction ->
+    prep_friction."""
+    return flag[2:].replace("-", "_")
 
 
 @dataclass(frozen=True)
@@ -83,7 +123,7 @@ class Parameter:
     def key(self, name):
         """The field's name in flat rows and tables: its option's (``--prep-friction`` ->
         prep_friction), else the field's ``name``."""
-        return self.flag[2:].replace("-", "_") if self.flag else name
+        return key_of(self.flag) if self.flag else name
 
     def check(self, name, value, optional=False):
         """``value`` of field ``name`` converted to its kind (ParameterError outside the
@@ -130,7 +170,7 @@ class Parameter:
         if self.unset and "default" not in text:
             text += f" (default {default:g})" if isinstance(default, float) else \
                 f" (default {default})"
-        return text.replace("%", "%%")
+        return text
 
 
 def parameter(default=dataclasses.MISSING, *, unit="1", help, low=None, high=None,
@@ -186,44 +226,128 @@ def default_of(config, name):
     return item.default
 
 
-def add_options(parser, config, names):
-    """Add to ``parser`` the options of fields ``names`` of the dataclass ``config`` from their
-    Parameters: flag, type, choices, default (the field's, or None where ``unset``) and help
-    with unit and range. Each action records its field as ``action.parameter`` = (config,
-    name)."""
-    for name in names:
-        spec = spec_of(config, name)
-        if spec.many or spec.flag is None:
-            raise ValueError(f"{config.__name__}.{name}: no option of its own value (a list, "
-                             "or no flag)")
-        default = default_of(config, name)
-        options = {"help": spec.option_help(default)}
-        if spec.kind is bool:
-            if default is not False:
-                raise ValueError(f"{config.__name__}.{name}: a flag's default is False")
-            options["action"] = "store_true"
+@dataclass(frozen=True)
+class Option:
+    """An option of a command, given by ``key`` (its argparse dest and a table's key; its flag
+    ``--key-with-dashes``): ``help`` as the command's help shows it, ``default`` when not given
+    (None: the configuration's, or none), ``kind`` of its value (float, int, str, bool: a flag
+    given or not; None: passed as given, read by the configuration that takes it),
+    ``choices``, ``metavar``, ``many``: a list of ``kind``, on the command line a comma list
+    (``distinct``: no value twice), ``least``: an integer refused below this as it is read,
+    ``group``: the options of one group exclude each other, ``positional``: the command line
+    takes it without a flag, ``field``: the (configuration, field) it sets as it is, whose
+    Parameter declares it (``option_of``)."""
+
+    key: str
+    help: str
+    default: object = None
+    kind: type | None = float
+    choices: tuple | None = None
+    metavar: str | None = None
+    many: bool = False
+    distinct: bool = False
+    least: int | None = None
+    group: str | None = None
+    positional: bool = False
+    field: tuple | None = None
+
+    @property
+    def flag(self):
+        """The command-line flag: --key-with-dashes."""
+        return flag_of(self.key)
+
+    def read(self, value):
+        """``value`` given to the option (from a command line, a table or Python) as its kind
+        (a text parsed, a comma list split); OptionError naming the key when it is not one."""
+        if self.kind is None:
+            return value
+        if self.kind is bool:
+            if not isinstance(value, (bool, np.bool_)):
+                raise OptionError(lambda name: f"{name(self.key)} = {value!r}: a flag, true or "
+                                               "false expected")
+            return bool(value)
+        if not self.many:
+            return self._one(value)
+        items = value.split(",") if isinstance(value, str) else (
+            list(value) if isinstance(value, (list, tuple)) else [value])
+        try:
+            values = [self._one(item) for item in items]
+        except OptionError:
+            raise OptionError(lambda name: f"{name(self.key)} = {value!r} is not a "
+                                           "comma-separated list of numbers") from None
+        for k, item in enumerate(values):
+            if self.distinct and item in values[:k]:
+                raise OptionError(lambda name: f"{name(self.key)} = {value!r} repeats "
+                                               f"{item:g}: give each value once")
+        return values
+
+    def _one(self, value):
+        """One value of the option's kind (not a list)."""
+        if isinstance(value, (bool, np.bool_)):
+            raise OptionError(lambda name: f"{name(self.key)} = {value!r}: a value expected, "
+                                           "not true or false")
+        if self.kind is str:
+            if not isinstance(value, str):
+                raise OptionError(lambda name: f"{name(self.key)} = {value!r}: a text expected")
         else:
-            options["default"] = None if spec.unset else default
-            if spec.choices is not None:
-                options["choices"] = spec.choices
-            elif spec.kind in (int, float):
-                options["type"] = spec.kind
-            if spec.metavar is not None:
-                options["metavar"] = spec.metavar
-        action = parser.add_argument(spec.flag, **options)
-        action.parameter = (config, name)
+            value = self._number(value)
+        if self.choices is not None and value not in self.choices:
+            raise OptionError(lambda name: f"{name(self.key)} = {value!r} is not one of "
+                                           f"{self.choices}")
+        if self.least is not None and value < self.least:
+            raise OptionError(lambda name: f"{name(self.key)} = {value} is outside the valid "
+                                           f"range [{self.least}, inf)")
+        return value
+
+    def _number(self, value):
+        """``value`` (a number or its text) as the option's kind, int or float."""
+        what = "an integer" if self.kind is int else "a number"
+        try:
+            if self.kind is float:
+                return float(value)
+            if isinstance(value, (int, np.integer)):
+                return int(value)
+            if isinstance(value, str):
+                return int(value.strip())
+            if float(value).is_integer():
+                return int(value)
+        except (TypeError, ValueError, OverflowError):
+            pass
+        raise OptionError(lambda name: f"{name(self.key)} = {value!r}: {what} expected")
 
 
-def fields_from(args, config, names):
-    """{field: value} of fields ``names`` of the dataclass ``config`` from the parsed options
-    ``args`` of ``add_options`` (an option left at None where ``unset``: the field's default)."""
-    fields = {}
-    for name in names:
-        spec = spec_of(config, name)
-        value = getattr(args, spec.key(name))
-        if not (spec.unset and value is None):
-            fields[name] = value
-    return fields
+def option_of(config, name, default=dataclasses.MISSING, **changes):
+    """The Option of field ``name`` of the dataclass ``config`` from its Parameter: key and
+    flag, kind, choices, metavar, a list's comma form, help with unit and range, default (the
+    field's, or None where ``unset``). A command's own setting overrides: ``default`` (the
+    field's value when not given; with ``unset``, stated in the help) and ``changes`` to the
+    Parameter (e.g. ``help``, ``low``, ``high``, ``unset``)."""
+    spec = dataclasses.replace(spec_of(config, name), **changes)
+    if spec.flag is None:
+        raise ValueError(f"{config.__name__}.{name}: no option (no flag)")
+    value = default_of(config, name) if default is dataclasses.MISSING else default
+    if spec.kind is bool and value is not False:
+        raise ValueError(f"{config.__name__}.{name}: a flag's default is False")
+    return option_from(spec, value, field=(config, name))
+
+
+def option_from(spec, default, field=None, **changes):
+    """The Option of the Parameter ``spec`` (its flag, kind, choices, help with unit and
+    range) whose value is ``default`` when not given (None on the option where ``unset``);
+    ``changes``: the Option's own (e.g. ``many``, ``group``)."""
+    declared = {"key": key_of(spec.flag), "help": spec.option_help(default),
+                "default": None if spec.unset else default, "kind": spec.kind,
+                "choices": spec.choices, "metavar": spec.metavar, "many": spec.many,
+                "field": field}
+    return Option(**{**declared, **changes})
+
+
+def fields_of(values, options):
+    """{field: value} of the ``options`` (Option) that set a configuration field as it is,
+    from ``values`` (key -> value, every key present); an option at None leaves its field at
+    the configuration's default."""
+    return {option.field[1]: values[option.key] for option in options
+            if option.field is not None and values[option.key] is not None}
 
 
 def flat_options(config, exclude=()):

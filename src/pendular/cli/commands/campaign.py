@@ -23,8 +23,8 @@ command then ends with an error naming it (its traceback is in its log.txt).
 
 import os
 
-from pendular.cli.tables import sweep_from_table
-from pendular.studies.campaign import Campaign, RunRefused, check_jobs, write_campaign_csv
+from pendular.studies.campaign import (Campaign, RunRefused, check_jobs, sweep_from_table,
+                                       write_campaign_csv)
 from pendular.cli import UsageError, add_executor_options, set_threads
 from pendular.io.outputs import OutputFolder
 

@@ -16,10 +16,9 @@ import math
 
 import numba
 
-from pendular.procedures.preparation import PrepareConfig
-
-from pendular.cli import (UsageError, add_size_options, positive_int, print_summary, set_threads,
-    sizes_from)
+from pendular.cli import (UsageError, add_declared_options, positive_int, print_summary,
+    set_threads)
+from pendular.procedures.options import sample_sizes, size_options
 from pendular.procedures.config import (AVERAGES, AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN,
     MIN_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES)
 from pendular.studies.crosscheck import (SHOWN, check_mirrored, check_packing, crosscheck_config,
@@ -32,7 +31,7 @@ def add_arguments(parser):
     parser.add_argument("--suction", type=float, default=0.0, help="matric suction [Pa] (0: dry)")
     parser.add_argument("--confining", type=float, default=750.0, help="lateral stress [Pa]")
     parser.add_argument("--max-strain", type=float, default=0.25, help="final axial strain")
-    add_size_options(parser, PrepareConfig.radius)
+    add_declared_options(parser, size_options())
     parser.add_argument("--seed", type=int, default=0, help="random seed of the sample")
     parser.add_argument("--out", default="runs/crosscheck", help="output folder")
     parser.add_argument("--periodic", action="store_true",
@@ -89,7 +88,7 @@ def config_from(args):
                              confining=args.confining, max_strain=args.max_strain,
                              records=args.records, mimic_yade=args.mimic_yade,
                              settle_steps=max(args.settle_steps, 1), seed=args.seed,
-                             periodic=args.periodic, **sizes_from(args))
+                             periodic=args.periodic, **sample_sizes(vars(args)))
 
 
 def run(args):

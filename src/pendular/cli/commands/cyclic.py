@@ -20,17 +20,10 @@ and output options are those of ``pendular triaxial``. Stresses compression posi
 
 from __future__ import annotations
 
-from pendular.procedures.config import CyclicConfig, PathConfig
 from pendular.procedures.cyclic import CyclicTest
-from pendular.utils.parameters import add_options, fields_from
 
-from pendular.cli import UsageError
-from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
-    add_sample_options, add_wetting_options, laboratory_fields, run_test)
+from pendular.cli.commands.triaxial import loading_command
 
-#: The path's own fields, each set by its option.
-OWN = ("amplitude_q", "amplitude_strain", "cycles", "inertial_number", "strain_rate",
-       "record_strain")
 #: Summary keys printed at the end.
 SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
          "damping_ratio_last", "secant_modulus_first_effective",
@@ -39,26 +32,4 @@ SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio
          "volumetric_strain_accumulated", "phi_peak_deg", "initial_porosity", "wall_time_s",
          "particle_steps_per_s")
 
-
-def add_arguments(parser):
-    add_sample_options(parser)
-    add_wetting_options(parser)
-    add_options(parser.add_mutually_exclusive_group(), CyclicConfig,
-                ("amplitude_q", "amplitude_strain"))
-    add_options(parser, CyclicConfig, ("cycles",))
-    add_rate_options(parser)
-    add_options(parser, PathConfig, ("record_strain",))
-    add_output_options(parser, "runs/cyclic", frames=False)
-
-
-def config_from(args):
-    """The CyclicConfig of parsed options (ValueError / UsageError naming the option)."""
-    if args.amplitude_q is None and args.amplitude_strain is None:
-        raise UsageError("give --amplitude-q PA (stress control) or --amplitude-strain X "
-                         "(strain control)")
-    return CyclicConfig(**laboratory_fields(args, add_arguments, lambda: fields_from(
-        args, CyclicConfig, OWN)))
-
-
-def run(args):
-    return run_test(args, CyclicTest, config_from, SHOWN, add_arguments)
+add_arguments, config_from, run = loading_command("cyclic", CyclicTest, SHOWN)

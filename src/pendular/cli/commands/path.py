@@ -34,41 +34,13 @@ run without its table. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.config import PathConfig, TablePathConfig
-from pendular.procedures.path_table import PathTest, read_table
-from pendular.utils.parameters import add_options, fields_from
+from pendular.procedures.path_table import PathTest
 
-from pendular.cli import UsageError
-from pendular.cli.commands.triaxial import (add_output_options, add_rate_options,
-    add_sample_options, add_wetting_options, laboratory_fields, run_test)
+from pendular.cli.commands.triaxial import loading_command
 
-#: The path's own fields set by their options (the stages and source: the table's).
-OWN = ("inertial_number", "strain_rate", "record_strain", "records")
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
          "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
          "phi_peak_effective_deg", "initial_porosity", "wall_time_s", "particle_steps_per_s")
 
-
-def add_arguments(parser):
-    parser.add_argument("table", metavar="PATH.toml", nargs="?", default=None,
-                        help="the path table (not with --resume: the run keeps its own)")
-    add_sample_options(parser)
-    add_wetting_options(parser)
-    add_rate_options(parser)
-    add_options(parser, PathConfig, ("record_strain",))
-    add_options(parser, TablePathConfig, ("records",))
-    add_output_options(parser, "runs/path", frames=False)
-
-
-def config_from(args):
-    """The TablePathConfig of parsed options and the table (ValueError / UsageError naming the
-    option, or the table's file, entry and key)."""
-    if args.table is None:
-        raise UsageError("PATH.toml is missing: give the path table (or --resume DIR)")
-    return TablePathConfig(**laboratory_fields(args, add_arguments, lambda: {
-        **read_table(args.table), **fields_from(args, TablePathConfig, OWN)}))
-
-
-def run(args):
-    return run_test(args, PathTest, config_from, SHOWN, add_arguments)
+add_arguments, config_from, run = loading_command("path", PathTest, SHOWN)

@@ -15,16 +15,10 @@ options are those of ``pendular triaxial``. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.config import SimpleShearConfig
 from pendular.procedures.simple_shear import SimpleShearTest
-from pendular.utils.parameters import add_options, fields_from
 
-from pendular.cli.commands.triaxial import (add_output_options, add_sample_options,
-    add_wetting_options, laboratory_fields, run_test)
+from pendular.cli.commands.triaxial import loading_command
 
-#: The path's own fields, each set by its option (the strain rate by --shear-rate).
-OWN = ("normal_stress", "constant_volume", "max_strain", "inertial_number", "strain_rate",
-       "record_strain", "stage_steps")
 #: Summary keys printed at the end.
 SHOWN = ("peak_shear_stress", "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak",
          "normal_stress_at_peak", "residual_stress_ratio", "phi_residual_deg",
@@ -32,20 +26,4 @@ SHOWN = ("peak_shear_stress", "peak_stress_ratio", "phi_peak_deg", "shear_strain
          "max_dilatancy", "dilatancy_angle_deg", "max_volume_change", "liquid_balance_error",
          "initial_porosity", "wall_time_s", "particle_steps_per_s")
 
-
-def add_arguments(parser):
-    add_sample_options(parser)
-    parser.set_defaults(periodic=True)          # walls cannot shear a sample
-    add_wetting_options(parser)
-    add_options(parser, SimpleShearConfig, OWN)
-    add_output_options(parser, "runs/simple_shear", frames=False)
-
-
-def config_from(args):
-    """The SimpleShearConfig of parsed options (ValueError / UsageError naming the option)."""
-    return SimpleShearConfig(**laboratory_fields(args, add_arguments, lambda: fields_from(
-        args, SimpleShearConfig, OWN)))
-
-
-def run(args):
-    return run_test(args, SimpleShearTest, config_from, SHOWN, add_arguments)
+add_arguments, config_from, run = loading_command("simple-shear", SimpleShearTest, SHOWN)

@@ -14,52 +14,23 @@ from __future__ import annotations
 
 import sys
 
-from pendular.procedures.preparation import PrepareConfig
-
-from pendular.cli import (UsageError, add_run_options, add_size_options, print_summary,
-    set_threads, sizes_from)
-from pendular.procedures.config import SwccConfig
+from pendular.cli import (add_command_options, add_run_options, command_config,
+    print_summary, set_threads)
 from pendular.procedures.swcc import SwccTest
-from pendular.utils.parameters import add_options, fields_from, spec_of
-
-#: The fields set by their options as they are (--suctions, a comma list, by hand).
-OWN = ("contact_angle", "surface_tension", "form_gap", "stage_steps", "record_every")
-#: The sample's options whose defaults are PrepareConfig's (--particles, 1000 here, by hand).
-SAMPLE = ("friction_deg", "prep_friction_deg", "seed")
 
 #: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
 SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
 
 
 def add_arguments(parser):
-    parser.add_argument("--particles", type=int, default=1000, help="number of spheres")
-    add_options(parser, PrepareConfig, ("confining",))
-    suctions = spec_of(SwccConfig, "suctions")         # a comma list: by hand
-    parser.add_argument(suctions.flag, default=",".join(
-        f"{v:g}" for v in SwccConfig().suctions), help=f"{suctions.help} [{suctions.unit}], "
-        "comma separated")
-    add_options(parser, SwccConfig, OWN)
-    add_size_options(parser, PrepareConfig.radius)
-    add_options(parser, PrepareConfig, SAMPLE)
+    add_command_options(parser, "swcc")
     parser.add_argument("--out", default="runs/swcc", help="output folder")
     add_run_options(parser)
 
 
-def suctions_of(text):
-    """Floats of --suctions (UsageError naming it)."""
-    try:
-        return [float(item) for item in text.split(",")]
-    except ValueError:
-        raise UsageError(f"--suctions = {text!r} is not a comma-separated list of numbers") \
-            from None
-
-
 def config_from(args):
-    """The SwccConfig of parsed options (ValueError / UsageError naming the option)."""
-    sample = PrepareConfig(particles=args.particles, **sizes_from(args),
-                           **fields_from(args, PrepareConfig, ("confining", *SAMPLE)))
-    return SwccConfig(sample=sample, suctions=suctions_of(args.suctions),
-                      **fields_from(args, SwccConfig, OWN))
+    """The SwccConfig of parsed options (ValueError naming the option)."""
+    return command_config("swcc", args)
 
 
 def run(args):
