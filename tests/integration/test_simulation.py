@@ -129,3 +129,61 @@ def test_an_interrupt_during_a_record_leaves_whole_rows_only():
     assert columns["step"].tolist() == [1] and columns["twice"].tolist() == [2.0]
     recorder.rows["step"].append(np.float64(3.0))        # an append cut short
     assert len(recorder) == 1 and recorder.arrays()["step"].tolist() == [1]
+
+
+def test_the_run_loop_checks_after_each_chunk_then_until():
+    """Simulation.run_chunks (the loop of every device's run): ``advance`` step by step in
+    chunks of check_every, after each chunk ``check`` and then ``until``; it stops at the
+    first chunk whose until holds, or at the step limit (a short last chunk)."""
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    journal = []
+
+    def advance():
+        sim.step += 1
+        journal.append(("step", sim.step))
+
+    def check():
+        journal.append(("check", sim.step))
+
+    def until(s):
+        journal.append(("until", s.step))
+        return s.step >= 6
+
+    assert sim.run_chunks(10, advance, check=check, until=until, check_every=3) == 6
+    assert journal == [("step", 1), ("step", 2), ("step", 3), ("check", 3), ("until", 3),
+                       ("step", 4), ("step", 5), ("step", 6), ("check", 6), ("until", 6)]
+    journal.clear()
+    assert sim.run_chunks(4, advance, check=check, check_every=3) == 4
+    assert [entry for entry in journal if entry[0] == "check"] == [("check", 9), ("check", 10)]
+
+
+def test_a_check_that_raises_stops_the_run():
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+
+    def check():
+        if sim.step >= 4:
+            raise RuntimeError("the device's flags")
+
+    with pytest.raises(RuntimeError, match="device's flags"):
+        sim.run_chunks(10, sim.advance, check=check, check_every=2)
+    assert sim.step == 4
+
+
+def test_peek_reads_the_scene_without_bringing_a_device_run_state_back():
+    """While a device run holds the state, ``peek`` gives the host's objects (what the scene
+    is made of) and copies nothing; reading the attribute brings the state back."""
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    walls, controls = sim.walls, sim.controls
+
+    class Device:
+        copies = []
+
+        def copy_back(self, part):
+            self.copies.append(part)
+
+    sim.hold(Device())
+    assert sim.peek("walls") is walls and sim.peek("controls") is controls
+    assert Device.copies == []
+    assert sim.walls is walls and Device.copies == ["walls"]
+    assert sim.peek("controls") is controls and sim.peek("walls") is walls
+    assert sim.controls is controls and Device.copies == ["walls", None]

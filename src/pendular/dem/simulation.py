@@ -54,8 +54,9 @@ _DEVICES = {}
 def register_device(name, start, unavailable):
     """Declare how device ``name`` (a key of DEVICE_MODULES; its module calls this when
     imported) runs a Simulation: ``start(sim)`` returns a run with ``run(steps, until=,
-    check_every=, progress=, status=)`` as Simulation.run, which holds the state (``hold``)
-    after each of its steps, and ``copy_back(part)``, which writes the device's state into sim
+    check_every=, progress=, status=)`` as Simulation.run (its loop ``run_chunks``, with the
+    device's step and checks), which holds the state (``hold``) after each of its steps, and
+    ``copy_back(part)``, which writes the device's state into sim
     (``part`` "walls": those alone); ``unavailable()`` says why the device cannot run here
     (text), or None."""
     if name not in DEVICE_MODULES or DEVICE_MODULES[name] is None:
@@ -170,6 +171,13 @@ class Simulation:
         del state["_holder"]
         run.copy_back(None)
 
+    def peek(self, name):
+        """The host's ``name`` (one of DEVICE_HELD) without bringing a device run's state back:
+        what the scene is made of (the box's type, the control list), whose values may be
+        stale while a device run holds them."""
+        state = self.__dict__
+        return state[name] if name in state else state["_held"][name]
+
     @property
     def operations(self):
         """The step's operations in order (read-only tuple): neighbour list, forces, controls,
@@ -218,7 +226,9 @@ class Simulation:
         numba.set_num_threads(self.threads)
         try:
             if self._device_start is None:
-                return self._run_here(steps, until, check_every, progress, status)
+                return self.run_chunks(steps, self.advance, until=until,
+                                       check_every=check_every, progress=progress,
+                                       status=status)
             try:
                 return self._device_start(self).run(steps, until=until, check_every=check_every,
                                                     progress=progress, status=status)
@@ -227,8 +237,13 @@ class Simulation:
         finally:
             numba.set_num_threads(caller_threads)
 
-    def _run_here(self, steps, until, check_every, progress, status):
-        """``run`` on the CPU."""
+    def run_chunks(self, steps, advance, *, check=None, until=None, check_every=100,
+                   progress=None, status=None):
+        """The loop of ``run`` on every device: ``advance()`` (one step, its writers
+        included) ``steps`` times, in chunks of ``check_every``; after each chunk ``check()``
+        (a device's own checks, which raise; None: none), the progress bar and ``status``,
+        then ``until``. Arguments otherwise as ``run``, which checks them; returns the steps
+        taken."""
         bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
                    mininterval=1.0, smoothing=0.05, disable=progress is None)
         taken = 0
@@ -237,9 +252,11 @@ class Simulation:
             while taken < steps:
                 chunk = min(check_every, steps - taken)
                 for _ in range(chunk):
-                    self.advance()
+                    advance()
                 taken += chunk
                 bar.update(chunk)
+                if check is not None:
+                    check()
                 if status is not None and time.perf_counter() - started > 1.0:
                     bar.set_postfix(status(self), refresh=False)
                 if until is not None and until(self):

@@ -40,8 +40,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from pendular.dem import mixed_stress
 from pendular.dem.cell import ConstantShearRate
 from pendular.dem.measure import coordination, porosity, unbalanced_force
+from pendular.dem.mixed_stress import StageFailed
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
@@ -60,11 +62,6 @@ VTK_RECORDS = 10
 #: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b
 #: (its ratio is noise over nearly zero at the start of a true triaxial shear).
 B_MEASURE_FROM = 0.1
-
-
-class StageFailed(ValueError):
-    """A stage cannot go on: a mixed condition needs walls to pull, or its end was not reached
-    within its limit."""
 
 
 # ---------------------------------------------------------------- ends of a stage
@@ -260,73 +257,18 @@ class Stage:
         return "; ".join(parts)
 
 
-class MixedStress:
-    """A control that sets, each step before the servos run, the targets of the servos of the
-    free axes of a Stage from the stresses now (module docstring): with ``mean_stress`` alone,
-    each free axis (3 p - the other axes' stresses) / (number of free axes); with ``b`` alone,
-    sigma_y = sigma_3 + b (sigma_z - sigma_3), sigma_3 x's target; with both, sigma_3 =
-    (3 p - (1 + b) sigma_z) / (2 - b) on x and sigma_y as above. StageFailed when a target
-    falls below zero (walls cannot pull)."""
+class MixedStress(mixed_stress.MixedStress):
+    """The mixed condition of a Stage (module docstring): a control that sets, each step
+    before the servos run, the targets of the servos of the stage's free axes from the
+    stresses now (pendular.dem.mixed_stress.MixedStress, with the stage's mean_stress, b and
+    given stresses); StageFailed when a target falls below zero (walls cannot pull).
+    ``servos``: {axis index: the StressServo of that axis}. A class of its own here because a
+    checkpoint names each operation's type (pendular.dem.checkpoint): those written with it
+    load as before."""
 
     def __init__(self, stage, servos):
-        self.mean_stress = stage.mean_stress
-        self.b = stage.b
-        self.stress = {AXES[a]: value for a, value in stage.stress.items()}
-        self.free = tuple(AXES[a] for a in stage.free)
-        self.servos = servos                # {axis index: the StressServo of that axis}
-
-    def state_dict(self):
-        """The condition its stage set: ``mean_stress`` [Pa] and ``b`` (None: not held),
-        ``stress`` ({axis letter: stress given [Pa]}) and ``free`` (the letters of the axes it
-        sets); its servos are the scene's."""
-        return {"mean_stress": self.mean_stress, "b": self.b,
-                "stress": {AXIS_NAMES[a]: value for a, value in self.stress.items()},
-                "free": "".join(AXIS_NAMES[a] for a in self.free)}
-
-    def load_state(self, state):
-        mean = state["mean_stress"]
-        mean = None if mean is None else check_positive("mean_stress", mean, "Pa")
-        b = None if state["b"] is None else check_range("b", state["b"], 0.0, 1.0)
-        if mean is None and b is None:
-            raise ValueError("mean_stress and b are both None; valid: one of them or both")
-        given = state["stress"]
-        if not isinstance(given, dict):
-            raise ValueError(f"stress holds {type(given).__name__}; valid: axis -> Pa")
-        stress = {AXES[_axis_name("stress axis", a)]: check_range(f"stress/{a}", value, 0.0,
-                                                                  unit="Pa")
-                  for a, value in given.items()}
-        free = tuple(AXES[_axis_name("free axis", a)] for a in state["free"])
-        unserved = [AXIS_NAMES[a] for a in free if a not in self.servos]
-        if not free or unserved:
-            raise ValueError(f"free = {state['free']!r}: valid: axes of this scene's servos "
-                             f"({''.join(AXIS_NAMES[a] for a in sorted(self.servos))})")
-        self.mean_stress, self.b, self.stress, self.free = mean, b, stress, free
-
-    def targets(self, sigma):
-        """{axis index: target [Pa]} of the free axes for the stresses ``sigma`` (3,) [Pa]."""
-        given = {a: self.stress.get(a, sigma[a]) for a in range(3)}
-        if self.b is None:
-            others = sum(given[a] for a in range(3) if a not in self.free)
-            share = (3.0 * self.mean_stress - others) / len(self.free)
-            return {a: share for a in self.free}
-        axial = sigma[2]
-        if self.mean_stress is None:
-            minor = given[0]
-            return {1: minor + self.b * (axial - minor)}
-        minor = (3.0 * self.mean_stress - (1.0 + self.b) * axial) / (2.0 - self.b)
-        return {0: minor, 1: minor + self.b * (axial - minor)}
-
-    def apply(self, sim):
-        sigma = sim.walls.stress()
-        for axis, target in self.targets(sigma).items():
-            if not target >= 0.0:
-                condition = ("the mean stress" if self.b is None else "b") + " condition"
-                raise StageFailed(
-                    f"{condition} cannot be held at step {sim.step}: it needs "
-                    f"{target:.4g} Pa on {AXIS_NAMES[axis]} with sigma_z = {sigma[2]:.4g} Pa, "
-                    "and walls cannot pull; end the shear earlier (--max-strain) or raise "
-                    "the confining stress")
-            self.servos[axis].target = target
+        super().__init__(servos, stage.free, mean_stress=stage.mean_stress, b=stage.b,
+                         stress=stage.stress)
 
 
 # ---------------------------------------------------------------- a path
