@@ -79,6 +79,10 @@ def test_reads_yade_export(tmp_path):
     ("#format x_y_z_r_matId\n0 0 0 1e-5 1\n", "line 1: unsupported sphere format 'x_y_z_r_matId'"),
     ("#format x_y_z_r\n# box_lo 0 0 0 box_hi 1 1\n", "line 2: box line must read"),
     ("#format x_y_z_r\n# box_lo 0 0 0 box_hi 1 -1 1\n0 0 0 1\n", "line 2: box_hi"),
+    ("#format x_y_z_r\n# box_lo 0 0 0 box_hi 1 one 1\n0 0 0 1\n",
+     "line 2: box coordinate 'one' is not a number"),
+    ("#format x_y_z_r\n# box_lo 0 inf 0 box_hi 1 1 1\n0 0 0 1\n",
+     "line 2: box coordinate 'inf' is not finite"),
     ("#format x_y_z_r\n# only comments\n", "no sphere found"),
 ])
 def test_bad_sphere_file_refused(tmp_path, text, message):

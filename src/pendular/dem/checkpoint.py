@@ -57,15 +57,20 @@ from pendular.dem.virial import SUM_BLOCKS, face_block_starts
 FORMAT = "pendular-checkpoint"
 VERSION = 4
 
+#: Units and description of the particle arrays (pendular.dem.state.Particles), as a
+#: checkpoint and a sample file (pendular.dem.sample) describe them.
+PARTICLE_DATASETS = {
+    "position": ("m", "sphere centres (N, 3): x, y, z"),
+    "radius": ("m", "sphere radii (N,)"),
+    "velocity": ("m/s", "sphere translational velocities (N, 3)"),
+    "angular_velocity": ("rad/s", "sphere angular velocities (N, 3)"),
+    "force": ("N", "resultant force on each sphere (N, 3)"),
+    "torque": ("N m", "resultant torque on each sphere (N, 3)"),
+    "mass": ("kg", "sphere masses"), "inertia": ("kg m^2", "sphere moments of inertia")}
+
 #: Units and description of the datasets of a checkpoint, by group (dataset attributes).
 DATASETS = {
-    "particles": {
-        "position": ("m", "sphere centres (N, 3)"), "radius": ("m", "sphere radii"),
-        "velocity": ("m/s", "translational velocities (N, 3)"),
-        "angular_velocity": ("rad/s", "angular velocities (N, 3)"),
-        "force": ("N", "resultant force on each sphere (N, 3)"),
-        "torque": ("N m", "resultant torque on each sphere (N, 3)"),
-        "mass": ("kg", "sphere masses"), "inertia": ("kg m^2", "sphere moments of inertia")},
+    "particles": PARTICLE_DATASETS,
     "walls": {
         "position": ("m", "wall plane coordinates (6,), x-, x+, y-, y+, z-, z+"),
         "velocity": ("m/s", "outward wall speeds of the last step (6,)"),

@@ -48,7 +48,7 @@ def serial_leapfrog(position, velocity, angular_velocity, force, torque, mass, i
 def _advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
              affine_rate, stretched, dt):
     """Particle p's leapfrog step (leapfrog)."""
-    dt_mass = dt / mass[p]          # [s/kg], once: 17 % off the integration (measured)
+    dt_mass = dt / mass[p]          # [s/kg], once a particle, not a product per component
     dt_inertia = dt / inertia[p]
     height = position[p, 2]
     for c in range(3):

@@ -98,20 +98,21 @@ ROW_CAPACITY = 16
 
 
 @numba.njit(cache=True)
-def _cell_members(cell_of, cell_count):
-    """(cell_start, cell_particles): the particles of each cell in CSR order, cell c holding
-    cell_particles[cell_start[c]:cell_start[c + 1]] in index order."""
-    cell_start = np.zeros(cell_count + 1, np.int64)
-    for p in range(len(cell_of)):
-        cell_start[cell_of[p] + 1] += 1
-    for c in range(cell_count):
-        cell_start[c + 1] += cell_start[c]
-    fill = cell_start[:-1].copy()
-    cell_particles = np.empty(len(cell_of), np.int64)
-    for p in range(len(cell_of)):
-        cell_particles[fill[cell_of[p]]] = p
-        fill[cell_of[p]] += 1
-    return cell_start, cell_particles
+def _group_members(group_of, group_count):
+    """(group_start, members): the indices k of ``group_of`` (each one's group, in
+    [0, group_count)) sorted by group in CSR order, group g holding
+    members[group_start[g]:group_start[g + 1]] in index order (a counting sort)."""
+    group_start = np.zeros(group_count + 1, np.int64)
+    for k in range(len(group_of)):
+        group_start[group_of[k] + 1] += 1
+    for g in range(group_count):
+        group_start[g + 1] += group_start[g]
+    fill = group_start[:-1].copy()
+    members = np.empty(len(group_of), np.int64)
+    for k in range(len(group_of)):
+        members[fill[group_of[k]]] = k
+        fill[group_of[k]] += 1
+    return group_start, members
 
 
 @numba.njit(cache=True)
@@ -129,7 +130,7 @@ def _sort_into_cells(position, lo, hi, dims):
             c = min(max(c, 0), dims[axis] - 1)
             index = index * dims[axis] + c
         cell_of[p] = index
-    cell_start, cell_particles = _cell_members(cell_of, dims[0] * dims[1] * dims[2])
+    cell_start, cell_particles = _group_members(cell_of, dims[0] * dims[1] * dims[2])
     return dims, cell_of, cell_start, cell_particles
 
 
@@ -156,16 +157,20 @@ def _cell_grid(position, cell_size):
     return _sort_into_cells(position, lo, hi, dims)
 
 
+@numba.njit(cache=True, inline="always")
+def _cell_coordinates(cell, dims):
+    """(x, y, z) coordinates of the cell numbered ``cell`` in the ``dims`` grid (x-major
+    numbering, as _sort_into_cells)."""
+    return cell // (dims[1] * dims[2]), (cell // dims[2]) % dims[1], cell % dims[2]
+
+
 @numba.njit(cache=True)
 def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles, out):
     """Count the j > p within r_p + r_j + skin; return how many. While ``out`` has room they
     are written into it, sorted (all of them if it is long enough: compare the count)."""
     room = len(out)
     found = 0
-    cell = cell_of[p]
-    cz = cell % dims[2]
-    cy = (cell // dims[2]) % dims[1]
-    cx = cell // (dims[1] * dims[2])
+    cx, cy, cz = _cell_coordinates(cell_of[p], dims)
     for dx in range(-1, 2):
         x = cx + dx
         if x < 0 or x >= dims[0]:
@@ -273,10 +278,7 @@ def _periodic_neighbors_of(p, position, radius, skin, period, shear, dims, cell_
     are searched around p's x less their offset sz * delta."""
     room = len(out)
     found = 0
-    cell = cell_of[p]
-    cz = cell % dims[2]
-    cy = (cell // dims[2]) % dims[1]
-    cx = cell // (dims[1] * dims[2])
+    cx, cy, cz = _cell_coordinates(cell_of[p], dims)
     width = period[0] / dims[0]
     for dx in range(-1, 2):
         for dy in range(-1, 2):
@@ -347,20 +349,11 @@ def build_periodic_pairs(position, radius, skin, period):
 
 @numba.njit(cache=True)
 def second_index(row_start, pair_j, count):
-    """For each particle, the pair indices in which it is the second member (CSR)."""
-    second_start = np.zeros(count + 1, np.int64)
-    for k in range(len(pair_j)):
-        second_start[pair_j[k] + 1] += 1
-    for p in range(count):
-        second_start[p + 1] += second_start[p]
-    fill = second_start[:-1].copy()
-    second_pair = np.empty(len(pair_j), np.int64)
-    for i in range(count):
-        for k in range(row_start[i], row_start[i + 1]):
-            j = pair_j[k]
-            second_pair[fill[j]] = k
-            fill[j] += 1
-    return second_start, second_pair
+    """(second_start, second_pair): for each of the ``count`` particles, the pair indices in
+    which it is the second member (CSR), in pair order. The pairs of a CSR list (``row_start``,
+    ``pair_j``) are numbered row after row, so this is pair_j's counting sort: ``row_start``
+    is not read."""
+    return _group_members(pair_j, count)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -498,7 +491,8 @@ def gather_pair_forces_virial(pair_force, row_start, second_start, second_pair, 
                               through_face, face_start, period, virial):
     """gather_pair_forces in a periodic cell, which also adds the face terms of the forces'
     Love–Weber sum [N m] to ``virial`` (SUM_BLOCKS, 9), block by block (pendular.dem.virial). A kernel
-    apart: the blocked loop in the walled kernel, even behind a branch, cost walls 5-15 %."""
+    apart: the blocked loop in the walled kernel, even behind a branch, slowed walled scenes
+    (docs/performance.md)."""
     count = len(row_start) - 1
     for block in numba.prange(SUM_BLOCKS):
         start, stop = block_bounds(count, block)

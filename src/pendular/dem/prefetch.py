@@ -7,18 +7,9 @@ pairs further on hides most of that wait (LLVM's ``llvm.prefetch``, a hint with 
 results). Below ``PREFETCH_MIN_PAIRS`` the rows are in cache already and the hint costs more
 than it saves.
 
-Measured on the 2-core machine (2026-11-26), dry shear of the thesis samples, with and without
-in alternating turns of one run: the pair kernel alone, 16 ahead, ns per pair, 1 thread /
-2 threads: 10,000 spheres 40.6 → 42.1 / 23.4 → 23.7, 30,000 47.3 → 43.2 / 27.9 → 25.0,
-100,000 49.0 → 41.2 / 32.7 → 26.6; whole steps (benchmarks/bench_sizes.py's shear), 1 thread /
-2 threads: 30,000 spheres 0.889 / 0.904 of the time without, 100,000 0.890 / 0.931. The same
-hint in the contact gather (the rows of the pairs of which a particle is the second member)
-paid only at 100,000 spheres (-16 %) and cost 11 % at 30,000 on one thread: not used.
-The pair loops also ask for j's radius (an item of a 1-D array; 2026-11-26, evening): the
-one-thread fused pair kernel alone at 100,000 spheres 0.945 / 0.958 of the time without, at
-30,000 1.00; whole one-thread steps (benchmarks/bench_sizes.py, the two codes in alternating
-processes) 100,000 spheres 180 / 168 -> 168 / 163 ns a particle-step, 30,000 within noise;
-two threads within the run-to-run scatter (+-10 %).
+It pays from about 30,000 spheres (docs/performance.md, "Measurements behind design
+choices"); the same hint in the contact gather paid only at 100,000 spheres and is not used.
+The pair loops also ask for j's radius (an item of a 1-D array).
 """
 
 import llvmlite.binding

@@ -1,10 +1,8 @@
 """Recorders: operations that sample the state every ``period`` steps into named columns."""
 
-import h5py
 import numpy as np
 
 from pendular.dem.protocols import state_array
-from pendular.utils.atomic import replacing
 from pendular.utils.validate import check_int
 
 
@@ -86,16 +84,3 @@ class HistoryRecorder:
     def last(self, name):
         return self.rows[name][-1]
 
-
-def write_history(path, columns, attributes, group="history"):
-    """Write ``columns`` as datasets of ``group`` and ``attributes`` on the file, atomically.
-
-    The file is written under a temporary name then renamed, so a killed run never leaves a
-    truncated HDF5 file at ``path``. Attribute values that HDF5 cannot hold are stored as text.
-    """
-    with replacing(path) as temporary, h5py.File(temporary, "w") as handle:
-        for key, value in attributes.items():
-            handle.attrs[key] = value if isinstance(value, (int, float, str, bool)) else str(value)
-        data = handle.create_group(group)
-        for name, values in columns.items():
-            data.create_dataset(name, data=values)

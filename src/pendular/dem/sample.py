@@ -23,6 +23,7 @@ from pendular.utils.atomic import replacing
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.utils.integrity import config_hash, software_version, stamp, verify
 from pendular.dem.cell import PeriodicCell
+from pendular.dem.checkpoint import PARTICLE_DATASETS
 from pendular.dem.state import WALL_NAMES, Particles, Walls
 from pendular.utils.validate import reading
 
@@ -39,10 +40,8 @@ refuses overlapped, edited or misplaced spheres."""
 
 #: Units and description of each dataset of a sample file (its attributes).
 DATASETS = {
-    "position": ("m", "sphere centres (N, 3): x, y, z"),
-    "radius": ("m", "sphere radii (N,)"),
-    "velocity": ("m/s", "sphere translational velocities (N, 3)"),
-    "angular_velocity": ("rad/s", "sphere angular velocities (N, 3)"),
+    **{name: PARTICLE_DATASETS[name]
+       for name in ("position", "radius", "velocity", "angular_velocity")},
     "walls": ("m", "wall plane (or periodic cell face) coordinates along their axis (6,), "
                    "ordered x-, x+, y-, y+, z-, z+ (pendular.dem.state.WALL_NAMES)"),
 }

@@ -36,6 +36,30 @@ from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
 
 
+@numba.njit(cache=True, inline="always")
+def _overlaps_placed(x, r, c, dims, head, following, position, radius):
+    """Whether a sphere of radius ``r`` [m] centred at ``x`` overlaps a placed one in the 27
+    cells around cell ``c`` of the ``dims`` grid (cells as linked lists: ``head`` per cell,
+    ``following`` per sphere, -1 ending a list; cells at least 2 max(radius) wide)."""
+    for dx in range(-1, 2):
+        for dy in range(-1, 2):
+            for dz in range(-1, 2):
+                nx = c[0] + dx
+                ny = c[1] + dy
+                nz = c[2] + dz
+                if nx < 0 or ny < 0 or nz < 0 or nx >= dims[0] or ny >= dims[1] \
+                        or nz >= dims[2]:
+                    continue
+                q = head[(nx * dims[1] + ny) * dims[2] + nz]
+                while q >= 0:
+                    d = x - position[q]
+                    reach = r + radius[q]
+                    if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach:
+                        return True
+                    q = following[q]
+    return False
+
+
 @numba.njit(cache=True)
 def _random_cloud(count, radius, lo, hi, seed, max_attempts):
     """Random sequential insertion of ``count`` equal spheres in [lo, hi] without overlap."""
@@ -44,8 +68,11 @@ def _random_cloud(count, radius, lo, hi, seed, max_attempts):
     dims = np.empty(3, np.int64)
     for a in range(3):
         dims[a] = max(1, int((hi[a] - lo[a] - 2.0 * radius) / cell))
-    # each cell holds at most one centre since its edge is >= the minimum centre distance
+    # a cell admits one centre (random_cloud): one drawn in an occupied cell is refused, so
+    # each cell's list holds one sphere at most
     occupant = -np.ones(dims[0] * dims[1] * dims[2], np.int64)
+    following = -np.ones(count, np.int64)
+    radii = np.full(count, radius)
     position = np.empty((count, 3))
     placed = 0
     attempts = 0
@@ -59,24 +86,11 @@ def _random_cloud(count, radius, lo, hi, seed, max_attempts):
             x[a] = lo[a] + radius + np.random.random() * (hi[a] - lo[a] - 2.0 * radius)
             c[a] = min(int((x[a] - lo[a] - radius) / ((hi[a] - lo[a] - 2.0 * radius) / dims[a])),
                        dims[a] - 1)
-        free = occupant[(c[0] * dims[1] + c[1]) * dims[2] + c[2]] < 0
-        for dx in range(-1, 2):
-            for dy in range(-1, 2):
-                for dz in range(-1, 2):
-                    nx = c[0] + dx
-                    ny = c[1] + dy
-                    nz = c[2] + dz
-                    if not free or nx < 0 or ny < 0 or nz < 0 or nx >= dims[0] \
-                            or ny >= dims[1] or nz >= dims[2]:
-                        continue
-                    q = occupant[(nx * dims[1] + ny) * dims[2] + nz]
-                    if q >= 0:
-                        d = x - position[q]
-                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < cell * cell:
-                            free = False
-        if free:
+        key = (c[0] * dims[1] + c[1]) * dims[2] + c[2]
+        if occupant[key] < 0 and not _overlaps_placed(x, radius, c, dims, occupant, following,
+                                                      position, radii):
             position[placed] = x
-            occupant[(c[0] * dims[1] + c[1]) * dims[2] + c[2]] = placed
+            occupant[key] = placed
             placed += 1
     return position
 
@@ -135,24 +149,7 @@ def _random_cloud_graded(radius, lo, hi, seed, max_attempts):
         for a in range(3):
             x[a] = lo[a] + r + np.random.random() * (hi[a] - lo[a] - 2.0 * r)
             c[a] = min(int((x[a] - lo[a]) / ((hi[a] - lo[a]) / dims[a])), dims[a] - 1)
-        free = True
-        for dx in range(-1, 2):
-            for dy in range(-1, 2):
-                for dz in range(-1, 2):
-                    nx = c[0] + dx
-                    ny = c[1] + dy
-                    nz = c[2] + dz
-                    if not free or nx < 0 or ny < 0 or nz < 0 or nx >= dims[0] \
-                            or ny >= dims[1] or nz >= dims[2]:
-                        continue
-                    q = head[(nx * dims[1] + ny) * dims[2] + nz]
-                    while q >= 0 and free:
-                        d = x - position[q]
-                        reach = r + radius[q]
-                        if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach * reach:
-                            free = False
-                        q = following[q]
-        if free:
+        if not _overlaps_placed(x, r, c, dims, head, following, position, radius):
             position[i] = x
             key = (c[0] * dims[1] + c[1]) * dims[2] + c[2]
             following[i] = head[key]
@@ -266,12 +263,12 @@ class PrepareConfig:
     The time step is ``timestep_safety`` times the estimate of ``timestep_rule`` (``timestep``):
     'stiffness' (default), the critical step of the contacts (pendular.dem.timestep), 1.4-1.5 times
     the P-wave estimate on prepared samples; 'pwave', YADE's P-wave estimate of the smallest
-    sphere (the thesis's, and pendular's default until 2026-11-26; across six 2,000-sphere
-    samples both give the same peaks within the scatter between samples,
-    docs/seeds_timestep_rule.md). ``skin_factor``: the neighbour list's Verlet skin / mean
-    radius, a speed knob only (between walls results are bit-identical for any skin; in a
-    periodic cell they differ at round-off, docs/periodic.md); 0.1 shears 5-8 %
-    faster than 0.3 at 1,000 and 10,000 spheres (fewer pairs, still rare rebuilds).
+    sphere (the thesis's, and pendular's former default; across six 2,000-sphere samples both
+    give the same peaks within the scatter between samples, docs/seeds_timestep_rule.md).
+    ``skin_factor``: the neighbour list's Verlet skin / mean radius, a speed knob only (between
+    walls results are bit-identical for any skin; in a periodic cell they differ at round-off,
+    docs/periodic.md); 0.1 shears faster than 0.3 (fewer pairs, still rare rebuilds;
+    docs/performance.md).
     """
 
     particles: int = parameter(10000, kind=int, low=2, high=MAX_PARTICLES, flag="--particles",
@@ -456,8 +453,8 @@ def rescale(sim, factor):
 
 #: Verlet skin / radius of the radius growth, whatever ``skin_factor``: every sphere grows each
 #: step and the list is rebuilt as the surfaces move, so a thicker skin than the test's pays
-#: there (1,000 spheres prepared in 3.3 s with 0.3 R, 3.8-4.7 s with 0.1 R). One value for
-#: every sample: GrowthTimeStep sets the step at the rebuilds, so the sample depends on it.
+#: there (docs/performance.md). One value for every sample: GrowthTimeStep sets the step at
+#: the rebuilds, so the sample depends on it.
 GROWTH_SKIN_FACTOR = 0.3
 
 

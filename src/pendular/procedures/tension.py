@@ -72,8 +72,8 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION,
     comparison_packing)
+from pendular.procedures.triaxial import frame_period, frames_writer
 from pendular.io.schema import TENSION_SUMMARY_UNITS
-from pendular.io.vtk import VtkWriter
 from pendular.procedures.water_content import wet_to_water_volume
 
 #: Surface tension [N/m] of the Chapter 4 comparison (docs/physics.md 'Errata').
@@ -290,14 +290,8 @@ class Pull:
         self.recorder = HistoryRecorder(period, columns, origin=sim.step)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
-        self.vtk_period = config.vtk_every
-        if self.vtk_period is None:
-            self.vtk_period = (max(1, self.steps // config.vtk_frames) if config.vtk_frames > 0
-                               else 0)
-        self.vtk = None
-        if self.vtk_period > 0:
-            self.vtk = VtkWriter(os.path.join(folder, "vtk"), self.vtk_period)
-            sim.writers.append(self.vtk)
+        self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
+                                                           self.steps))
 
     def tensile_stress(self, sim: Simulation) -> float:
         """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over

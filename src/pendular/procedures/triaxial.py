@@ -143,8 +143,16 @@ def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, prog
     started = time.perf_counter()
     steps = equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
                         progress=progress, phase="equilibrium after wetting")
+    return wetting_report(sim, bridges, steps, started)
+
+
+def wetting_report(sim, bridges, steps, started, **details):
+    """The report of a wetting that took ``steps`` steps from ``started`` (time.perf_counter,
+    [s]): steps and time, ``details`` (what the protocol adds), then the wet state: Sr, the
+    bridges of the operation ``bridges`` and the porosity."""
     return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
-            "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
+            **details, "initial_saturation": bridges.saturation(sim),
+            "initial_bridges": bridges.count(sim),
             "wet_porosity": porosity(sim.particles, sim.walls)}
 
 
@@ -184,11 +192,7 @@ def wet_sample(sim, config, *, progress=None):
         sim.controls = servo
         steps += equilibrate(sim, phase="equilibrium after wetting at constant volume",
                              progress=progress, **thresholds)
-    report = {"wetting": config.wetting, "wetting_steps": steps,
-              "wetting_time_s": time.perf_counter() - started,
-              "initial_saturation": bridges.saturation(sim),
-              "initial_bridges": bridges.count(sim),
-              "wet_porosity": porosity(sim.particles, sim.walls)}
+    report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
     if config.wetting == "constant-volume":
         report["sigma_wall_at_constant_volume"] = fixed_stress
     return sim, bridges, report
@@ -221,16 +225,12 @@ def _wet_at_water_content(dry, config, thresholds, progress):
         raise ValueError(f"--water-content = {100 * bridges_config.water_content:g} %: {error}") \
             from None
     bridges.close_liquid(sim, bridges_config.liquid)
-    solid = particles.solid_volume()
-    return sim, bridges, {
-        "wetting": "water-content", "wetting_steps": sum(t["steps"] for t in tries),
-        "wetting_time_s": time.perf_counter() - started,
-        "formation_suction_pa": tries[-1]["formation_suction_pa"],
-        "water_content": gravimetric_water_content(bridges.liquid_initial, solid,
-                                                   specific_gravity),
-        "wetting_attempts": tries, "liquid_initial": bridges.liquid_initial,
-        "initial_saturation": bridges.saturation(sim), "initial_bridges": bridges.count(sim),
-        "wet_porosity": porosity(sim.particles, sim.walls)}
+    water_content = gravimetric_water_content(bridges.liquid_initial,
+                                              particles.solid_volume(), specific_gravity)
+    return sim, bridges, {"wetting": "water-content", **wetting_report(
+        sim, bridges, sum(t["steps"] for t in tries), started,
+        formation_suction_pa=tries[-1]["formation_suction_pa"], water_content=water_content,
+        wetting_attempts=tries, liquid_initial=bridges.liquid_initial)}
 
 
 @contextlib.contextmanager
@@ -254,6 +254,30 @@ def prep_vtk_period(sample):
     (``unload_steps`` / 20, 500 steps by default), so that a preparation (a radius growth of at
     least 5,000 steps, the unload, the equilibria) gives a few tens of frames."""
     return max(1, sample.unload_steps // 20)
+
+
+def frame_period(vtk_every, vtk_frames, steps, unknown_length_period=0):
+    """Steps between the ParaView frames of a loading of ``steps`` steps (0: no frames):
+    ``vtk_every`` when given, else ``vtk_frames`` frames over the loading (0: none), or, for a
+    loading whose length is not known before it runs (``steps`` None), one every
+    ``unknown_length_period`` steps."""
+    if vtk_every is not None:
+        return vtk_every
+    if not vtk_frames:
+        return 0
+    if steps is not None:
+        return max(1, steps // vtk_frames)
+    return unknown_length_period
+
+
+def frames_writer(sim, out, period, **options):
+    """The VtkWriter of ``out``/vtk/, a frame every ``period`` steps (``options``: VtkWriter's),
+    appended to ``sim.writers``; None when ``period`` is 0 (no frames)."""
+    if period <= 0:
+        return None
+    writer = VtkWriter(os.path.join(out, "vtk"), period, **options)
+    sim.writers.append(writer)
+    return writer
 
 
 class TriaxialShear:
@@ -785,20 +809,11 @@ class _PathRun:
         self.steps = self.path.steps           # None: known only as the path runs
         self.start_step = sim.step
         self.shear_time = 0.0        # seconds spent loading by earlier (interrupted) runs
-        self.vtk_period = config.vtk_every
-        if self.vtk_period is None:
-            if not config.vtk_frames:
-                self.vtk_period = 0
-            elif self.steps is not None:
-                self.vtk_period = max(1, self.steps // config.vtk_frames)
-            else:
-                self.vtk_period = self.path.recorder.period * VTK_RECORDS
-        self.vtk = None
-        if self.vtk_period > 0:
-            field_data, time_axis = test.frame_fields(self.path)
-            self.vtk = VtkWriter(os.path.join(out, "vtk"), self.vtk_period,
-                                 field_data=field_data, time_axis=time_axis)
-            sim.writers.append(self.vtk)
+        self.vtk_period = frame_period(config.vtk_every, config.vtk_frames, self.steps,
+                                       self.path.recorder.period * VTK_RECORDS)
+        field_data, time_axis = test.frame_fields(self.path)
+        self.vtk = frames_writer(sim, out, self.vtk_period, field_data=field_data,
+                                 time_axis=time_axis)
         self.checkpoint = None
         if config.checkpoint_every > 0:
             self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),

@@ -231,6 +231,11 @@ def two_panels(plt, title):
     return fig, axes
 
 
+def panel_title(kind):
+    """The title of a packing's panel: "(a) SCP" or "(b) FCP"."""
+    return f"({'ab'[kind == 'fcp']}) {kind.upper()}"
+
+
 def fig_4_8(plt, folder, points):
     fig, axes = two_panels(plt, "Fig. 4.8: contact angle θ (drying θ = 0°, wetting θ = 30°), H = 0")
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (30, 40)):
@@ -241,39 +246,46 @@ def fig_4_8(plt, folder, points):
                 ax.semilogy(percent(curve), column(curve, "suction_star"), style, color=color,
                             label=f"contact angle θ = {theta:g}°" if method == "exact" else None)
         ax.set(xlim=(0, xmax), ylim=(0.01, 100), xlabel="degree of saturation (%)",
-               ylabel="dimensionless matric suction s R / gamma", title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
+               ylabel="dimensionless matric suction s R / gamma", title=panel_title(kind))
         ax.legend()
     save(fig, folder, "fig4_08_swcc_contact_angle.png")
 
 
-def fig_4_9(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.9: separation distance, contact angle θ = 0")
+def separation_figure(plt, folder, points, title, separations, draw, name, **settings):
+    """Figure ``name`` of two panels, SCP and FCP (Sr up to 20 and 30 %): a curve of each
+    surface separation H/R of ``separations`` [-], exact and toroidal, each plotted by
+    ``draw(ax, curve, style, color, label)``; ``settings``: the panels' other axes settings."""
+    fig, axes = two_panels(plt, title)
     for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
-        for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2")):
+        for separation, color in zip(separations, ("C0", "C1", "C2", "C3")):
             packing = regular_packing(kind, separation=separation)
             for method, style in METHODS.items():
                 curve = saturation_curve(packing, points, method=method)
-                ax.semilogy(percent(curve), column(curve, "suction_star"), style, color=color,
-                            label=f"H/R = {separation:g}" if method == "exact" else None)
-        ax.set(xlim=(0, xmax), ylim=(0.1, 100), xlabel="degree of saturation (Sr %)",
-               ylabel="dimensionless matric suction s R / gamma", title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
+                draw(ax, curve, style, color,
+                     f"H/R = {separation:g}" if method == "exact" else None)
+        ax.set(xlim=(0, xmax), title=panel_title(kind), **settings)
         ax.legend()
-    save(fig, folder, "fig4_09_swcc_separation.png")
+    save(fig, folder, name)
+
+
+def fig_4_9(plt, folder, points):
+    def draw(ax, curve, style, color, label):
+        ax.semilogy(percent(curve), column(curve, "suction_star"), style, color=color,
+                    label=label)
+
+    separation_figure(plt, folder, points, "Fig. 4.9: separation distance, contact angle θ = 0",
+                      (0.0, 0.05, 0.1), draw, "fig4_09_swcc_separation.png", ylim=(0.1, 100),
+                      xlabel="degree of saturation (Sr %)",
+                      ylabel="dimensionless matric suction s R / gamma")
 
 
 def fig_4_10(plt, folder, points):
-    fig, axes = two_panels(plt, "Fig. 4.10: isotropic chi_ij, contact angle θ = 0")
-    for ax, kind, xmax in zip(axes, ("scp", "fcp"), (20, 30)):
-        for separation, color in ((0.0, "C0"), (0.05, "C1"), (0.1, "C2"), (0.2, "C3")):
-            packing = regular_packing(kind, separation=separation)
-            for method, style in METHODS.items():
-                curve = saturation_curve(packing, points, method=method)
-                ax.plot(percent(curve), diagonal(curve, "chi"), style, color=color,
-                        label=f"H/R = {separation:g}" if method == "exact" else None)
-        ax.set(xlim=(0, xmax), ylim=(0, 0.7), xlabel="degree of saturation (%)", ylabel="chi_ij",
-               title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
-        ax.legend()
-    save(fig, folder, "fig4_10_chi.png")
+    def draw(ax, curve, style, color, label):
+        ax.plot(percent(curve), diagonal(curve, "chi"), style, color=color, label=label)
+
+    separation_figure(plt, folder, points, "Fig. 4.10: isotropic chi_ij, contact angle θ = 0",
+                      (0.0, 0.05, 0.1, 0.2), draw, "fig4_10_chi.png", ylim=(0, 0.7),
+                      xlabel="degree of saturation (%)", ylabel="chi_ij")
 
 
 def fig_stress_components(plt, folder, points, kind, number, xmin):
@@ -305,7 +317,7 @@ def fig_4_14(plt, folder, points):
                                         (diagonal(curve, "psi"), "psi_ij", "k")):
                 ax.semilogx(s / 1e3, values / 1e3, style, color=color, label=name if method == "exact" else None)
         ax.set(xlim=(xmin, 1e4), xlabel="matric suction (kPa)", ylabel="capillary stress (kPa)",
-               title=f"({'ab'[kind == 'fcp']}) {kind.upper()}")
+               title=panel_title(kind))
         ax.set_ylim(bottom=0.0)
         ax.legend()
     save(fig, folder, "fig4_14_total_capillary_stress.png")

@@ -102,24 +102,25 @@ def write_spheres(path, positions, radii, box_lo=None, box_hi=None):
     return position.shape[0]
 
 
+def _finite_number(path, lineno, label, word):
+    """``word`` as a float; ValueError naming the file, the line and ``label`` (what the word
+    is) when it is not a finite number."""
+    try:
+        value = float(word)
+    except ValueError:
+        raise ValueError(f"{path}, line {lineno}: {label} is not a number") from None
+    if not math.isfinite(value):
+        raise ValueError(f"{path}, line {lineno}: {label} is not finite")
+    return value
+
+
 def _parse_box(path, lineno, words):
     """Parse the words after '#' of a ``box_lo x y z box_hi x y z`` line."""
     if len(words) != 8 or words[0] != _BOX_TAGS[0] or words[4] != _BOX_TAGS[1]:
         raise ValueError(f"{path}, line {lineno}: box line must read "
                          f"'# box_lo x y z box_hi x y z', got {' '.join(words)!r}")
-    corners = []
-    for offset in (1, 5):
-        values = []
-        for word in words[offset:offset + 3]:
-            try:
-                value = float(word)
-            except ValueError:
-                raise ValueError(f"{path}, line {lineno}: box coordinate {word!r} "
-                                 "is not a number") from None
-            if not math.isfinite(value):
-                raise ValueError(f"{path}, line {lineno}: box coordinate {word!r} is not finite")
-            values.append(value)
-        corners.append(np.array(values))
+    corners = [np.array([_finite_number(path, lineno, f"box coordinate {word!r}", word)
+                         for word in words[offset:offset + 3]]) for offset in (1, 5)]
     try:
         return _check_box(*corners)
     except ValueError as error:
@@ -157,16 +158,8 @@ def read_spheres(path):
             if len(words) != 4:
                 raise ValueError(f"{path}, line {lineno}: expected 4 columns (x y z r), "
                                  f"got {len(words)}: {line.strip()!r}")
-            values = []
-            for name, word in zip("xyzr", words):
-                try:
-                    value = float(word)
-                except ValueError:
-                    raise ValueError(f"{path}, line {lineno}: {name} = {word!r} "
-                                     "is not a number") from None
-                if not math.isfinite(value):
-                    raise ValueError(f"{path}, line {lineno}: {name} = {word!r} is not finite")
-                values.append(value)
+            values = [_finite_number(path, lineno, f"{name} = {word!r}", word)
+                      for name, word in zip("xyzr", words)]
             if values[3] <= 0.0:
                 raise ValueError(f"{path}, line {lineno}: radius r = {words[3]} must be > 0")
             rows.append(values)
