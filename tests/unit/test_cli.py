@@ -1,11 +1,12 @@
 """The command line's own manners: short answers, no abbreviations, a suggestion for a typo,
 each default stated once, a run's summary with units."""
 
+import argparse
 import re
 
 import pytest
 
-from pendular.cli import command_parser, format_summary, main
+from pendular.cli import COMMANDS, command_parser, format_summary, main
 
 
 def run(argv, capsys):
@@ -56,3 +57,13 @@ def test_a_summary_is_printed_with_units_and_four_figures():
     assert [line.split() for line in lines] == [["peak_q", "5088", "Pa"],
                                                 ["initial_porosity", "0.4357"],
                                                 ["steps", "12000"]]
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_command_has_a_help_listing_its_options(command, capsys):
+    status, out, err = run([command, "--help"], capsys)
+    assert status == 0 and err == "" and out.startswith(f"usage: pendular {command}")
+    parser, _ = command_parser(command)
+    for action in parser._actions:
+        for flag in action.option_strings if action.help != argparse.SUPPRESS else ():
+            assert flag in out, (command, flag)

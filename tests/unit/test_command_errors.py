@@ -1,4 +1,4 @@
-"""What a user can do wrong with chapter4, chapter5, extremes, swcc and crosscheck ends in one
+"""What a user can do wrong with chapter4, chapter5, extremes, swcc, tradeoff and crosscheck ends in one
 ``<prog>: error: ...`` line naming the option or the path (exit status 2), never a traceback
 (issue 36): an output folder that is a file or lies under one, values beyond 2**63 and NaN,
 a damaged sample (JSON attributes) or run history, a non-finite tensor reaching the
@@ -75,6 +75,34 @@ def test_values_beyond_range_are_refused_naming_the_option(case, tmp_path, capsy
     name, argv, words = CASES[case]
     refused(*run_in_process(name, BASE[name] + argv + ["--out", str(tmp_path / "out")], capsys),
             *words)
+    assert not (tmp_path / "out").exists()
+
+
+#: A study's option refused as it is read, naming the flag (command, argv, words).
+STUDY_OPTIONS = {
+    "chapter4 points 9": ("chapter4", ["--points", "9"], ["--points = 9", "[10, 400]"]),
+    "chapter5 suctions not numbers": ("chapter5", ["--suctions", "0,a"],
+                                      ["--suctions = '0,a'", "comma-separated"]),
+    "tradeoff particles 10": ("tradeoff", ["--particles", "10"],
+                              ["--particles = 10", "[50, inf]"]),
+    "tradeoff seeds 1": ("tradeoff", ["--knob", "damping", "--seeds", "1"],
+                         ["--seeds = 1", "[2, 100]"]),
+    "tradeoff seeds without knob": ("tradeoff", ["--seeds", "3"],
+                                    ["--seeds and --jobs belong to a --knob study"]),
+    "crosscheck settle steps -1": ("crosscheck", ["--settle-steps", "-1"],
+                                   ["--settle-steps = -1", "[0, inf]"]),
+    "crosscheck records 1": ("crosscheck", ["--records", "1"], ["--records = 1", "[2, "]),
+    "crosscheck wet periodic": ("crosscheck", ["--periodic", "--suction", "1e4"],
+                                ["--suction 10000.0 Pa with --periodic"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(STUDY_OPTIONS))
+def test_a_studys_options_are_checked_as_they_are_read_naming_the_flag(case, tmp_path, capsys):
+    name, argv, words = STUDY_OPTIONS[case]
+    line = refused(*run_in_process(name, argv + ["--out", str(tmp_path / "out")], capsys),
+                   *words)
+    assert "no YADE executable" not in line           # checked before YADE is looked for
     assert not (tmp_path / "out").exists()
 
 

@@ -16,8 +16,10 @@ from pendular.procedures.config import (BridgeConfig, CyclicConfig, IsotropicCon
     LaboratoryConfig, OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig,
     TablePathConfig, TensionConfig, TriaxialConfig, tension_sample)
 from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
-from pendular.utils.parameters import (Option, OptionError, ParameterError, default_of,
-    parameters_of, spec_of, validate)
+from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError,
+    default_of, option_from, option_values, parameters_of, spec_of, validate)
+from pendular.cli.commands import chapter4 as chapter4_command
+from pendular.studies import chapter5, crosscheck, extremes, tradeoff
 
 #: (config, field, low, high, low inclusive, high inclusive)
 BOUNDS = [
@@ -344,3 +346,132 @@ def test_every_option_of_a_command_is_declared_once():
             if option.field is not None:
                 config, name = option.field
                 assert spec_of(config, name).flag == option.flag, (command, option.key)
+
+
+def test_a_checked_option_refuses_values_outside_its_parameter():
+    points = option_from(Parameter("1", "states", 10, 400, kind=int, flag="--points"), 40,
+                         checked=True)
+    assert points.read("12") == 12 and points.default == 40
+    assert "[-], valid range [10, 400]" in points.help
+    with pytest.raises(ParameterError) as refused:
+        points.read(401)
+    assert str(refused.value) == "points = 401 is outside the valid range [10, 400]"
+    assert refused.value.on_command_line() == "--points = 401 is outside the valid range [10, 400]"
+    stresses = option_from(Parameter("Pa", "stresses", 0.0, low_inclusive=False,
+                                     flag="--stresses"), None, checked=True, many=True)
+    assert stresses.read("5,7") == [5.0, 7.0]
+    with pytest.raises(ParameterError, match=r"^stresses = 0.0 Pa is outside the valid range "
+                                             r"\(0, inf\] Pa$"):
+        stresses.read("5,0")
+    unchecked = option_from(Parameter("1", "states", 10, 400, kind=int, flag="--points"), 40)
+    assert unchecked.read(5) == 5                      # left to the configuration
+
+
+def test_option_values_take_defaults_and_refuse_unknown_keys_and_two_of_a_group():
+    options = (Option("a", "a number", default=1.0), Option("b", "b", kind=int, group="g"),
+               Option("c", "c", kind=int, group="g"))
+    assert option_values(options, {"a": "2", "b": None}) == ({"a": 2.0, "b": None, "c": None},
+                                                             {"a"})
+    assert option_values(options, {"a": 1})[1] == set()          # at its default: not given
+    with pytest.raises(OptionError, match=r"^d: not an option of a study; valid: a, b, c$"):
+        option_values(options, {"d": 1}, "a study")
+    with pytest.raises(OptionError, match=r"^b and c: give one$"):
+        option_values(options, {"b": 1, "c": 2})
+
+
+# ---------------------------------------------------------------- the studies' options
+
+#: Each study command's declared options.
+STUDY_OPTIONS = {"chapter4": lambda: (chapter4_command.POINTS,),
+                 "chapter5": chapter5.grid_options, "crosscheck": lambda: crosscheck.OPTIONS,
+                 "tradeoff": lambda: tradeoff.OPTIONS, "extremes": lambda: extremes.OPTIONS}
+#: Each study command's options of how it runs (folder, threads, processes, output), the only
+#: ones written by hand.
+RUN_OPTIONS = {"chapter4": {"out", "threads", "quiet"},
+               "chapter5": {"out", "jobs", "scheduler", "threads", "quiet"},
+               "crosscheck": {"out", "threads", "concurrent", "quiet"},
+               "tradeoff": {"out"}, "extremes": {"out", "threads", "quiet"}}
+
+
+@pytest.mark.parametrize("command", sorted(STUDY_OPTIONS))
+def test_a_study_command_makes_its_parser_from_its_declared_options(command):
+    parser, _ = command_parser(command)
+    declared = {option.key: option for option in STUDY_OPTIONS[command]()}
+    actions = {action.dest: action for action in parser._actions if action.dest != "help"}
+    assert set(actions) == set(declared) | RUN_OPTIONS[command]
+    for key, option in declared.items():
+        action = actions[key]
+        assert action.option_strings == [option.flag, *option.aliases]
+        shown = option.default if not option.many or option.default is None else \
+            ",".join(f"{v:g}" for v in option.default)
+        assert action.default == shown and action.metavar == option.metavar, key
+        assert tuple(action.choices or ()) == tuple(option.choices or ()), key
+        if option.field is not None:         # made from the field it sets
+            assert action.parameter == option.field
+            assert spec_of(*option.field).flag == option.flag, key
+
+
+def test_the_tradeoff_study_declares_its_fields_options():
+    assert [(option.key, option.default) for option in tradeoff.OPTIONS[:4]] == [
+        (name, default_of(tradeoff.Study, name)) for name in ("particles", "max_strain",
+                                                              "seed", "quick")]
+    values = option_values(tradeoff.OPTIONS, {"particles": "300", "max_strain": 0.02})[0]
+    assert tradeoff.study_of("t", values) == tradeoff.Study("t", particles=300, max_strain=0.02)
+    seeds = tradeoff.study_of("t", {**values, "knob": "damping", "jobs": 2})
+    assert seeds == tradeoff.SeedStudy("t", "damping", seeds=6, particles=300, max_strain=0.02,
+                                       jobs=2)
+    for given, message, line in (
+            ({"knob": "damping", "quick": True},
+             "knob studies one knob across samples: quick and docs belong",
+             "--knob studies one knob across samples: --quick and --docs belong"),
+            ({"seeds": 3}, "seeds and jobs belong to a knob study: give knob",
+             "--seeds and --jobs belong to a --knob study: give --knob")):
+        with pytest.raises(OptionError) as refused:
+            tradeoff.study_of("t", {**values, **given})
+        assert str(refused.value).startswith(message)
+        assert refused.value.on_command_line().startswith(line)
+    with pytest.raises(ParameterError) as refused:
+        tradeoff.Study("t", particles=10)
+    assert str(refused.value).startswith("particles = 10 is outside the valid range [50, inf]")
+    assert refused.value.on_command_line().startswith("--particles = 10 is outside")
+    with pytest.raises(ParameterError) as refused:            # the last sample's seed
+        tradeoff.SeedStudy("t", "damping", seeds=6, seed=tradeoff.MAX_SEED - 2)
+    assert refused.value.on_command_line().startswith("--seed = ")
+
+
+def test_the_chapter5_options_state_the_tables_values_and_override_them(tmp_path):
+    table = tmp_path / "grid.toml"
+    table.write_text("[fixed]\nparticles = 200\ninertial_number = 1e-3\n[sweep]\n"
+                     "suction = [0, 30000]\nconfining = [250]\n")
+    options = {option.key: option for option in chapter5.grid_options(str(table))}
+    assert "(table: 200)" in options["particles"].help
+    assert "(table: 0,30000)" in options["suctions"].help
+    assert "(table: 0.001)" in options["inertial_number"].help
+    assert all(option.default is None for option in options.values())
+    values = option_values(options.values(), {"confining": "500,750", "seed": 3})[0]
+    assert chapter5.grid_from_options(values, str(table)) == chapter5.Chapter5Grid(
+        suctions=[0.0, 30000.0], confining=[500.0, 750.0], particles=200, seed=3,
+        inertial_number=1e-3)
+    parser, _ = command_parser("chapter5")
+    assert parser.parse_args(["--suction", "0,1000"]).suctions == "0,1000"     # its alias
+
+
+def test_the_crosscheck_options_build_its_default_configuration():
+    values = option_values(crosscheck.OPTIONS, {})[0]
+    assert crosscheck.crosscheck_from_options(values) == crosscheck.crosscheck_config()
+    given = option_values(crosscheck.OPTIONS, {"suction": "1e4", "settle_steps": 0,
+                                               "records": 50, "mimic_yade": True})[0]
+    assert crosscheck.crosscheck_from_options(given) == crosscheck.crosscheck_config(
+        suction=1e4, settle_steps=1, records=50, mimic_yade=True)
+    for given, message in (({"confining": "inf"}, "confining = inf is not finite; valid range "
+                                                  "(0, inf) Pa"),
+                           ({"suction": -5}, "suction = -5.0 Pa is outside the valid range "
+                                             "[0, inf) Pa"),
+                           ({"settle_steps": -1}, "settle_steps = -1 is outside the valid range "
+                                                  "[0, inf]")):
+        with pytest.raises(ParameterError) as refused:
+            option_values(crosscheck.OPTIONS, given)
+        assert str(refused.value) == message
+        assert refused.value.on_command_line() == "--" + message.replace("_", "-", 1)
+    with pytest.raises(OptionError, match=r"^suction 10000.0 Pa with periodic: "):
+        crosscheck.crosscheck_from_options({**values, "suction": 1e4, "periodic": True})

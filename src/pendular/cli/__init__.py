@@ -123,11 +123,11 @@ def add_executor_options(parser):
 
 def add_declared_options(parser, options):
     """Add to ``parser`` the declared ``options`` (pendular.utils.parameters.Option; a
-    command's: pendular.procedures.options.options_of) in their order: flag, default (a
-    list's as its comma text), type (an integer with a least value checked as it is parsed),
-    choices, metavar, help; a flag stores true; the options of one group exclude each other.
-    Each action of an option that sets a configuration field records it as
-    ``action.parameter`` = (config, field)."""
+    laboratory command's: pendular.procedures.options.options_of, a study's: its module's) in
+    their order: flag and aliases, default (a list's as its comma text), type (an integer with
+    a least value checked as it is parsed), choices, metavar, help; a flag stores true; the
+    options of one group exclude each other. Each action of an option that sets a
+    configuration field records it as ``action.parameter`` = (config, field)."""
     groups = {}
     for option in options:
         where = parser
@@ -140,7 +140,7 @@ def add_declared_options(parser, options):
             action = where.add_argument(option.key, metavar=option.metavar, nargs="?",
                                         default=option.default, **settings)
         elif option.kind is bool:
-            action = where.add_argument(option.flag, action="store_true",
+            action = where.add_argument(option.flag, *option.aliases, action="store_true",
                                         default=option.default, **settings)
         else:
             settings["default"] = option.default
@@ -154,7 +154,7 @@ def add_declared_options(parser, options):
                 settings["type"] = option.kind
             if option.metavar is not None:
                 settings["metavar"] = option.metavar
-            action = where.add_argument(option.flag, **settings)
+            action = where.add_argument(option.flag, *option.aliases, **settings)
         if option.field is not None:
             action.parameter = option.field
 
@@ -176,6 +176,17 @@ def command_config(command, args):
     keys = {option.key for option in options_of(command)}
     return config_from_options(command, {key: value for key, value in vars(args).items()
                                          if key in keys})
+
+
+def declared_values(options, args):
+    """The values of the declared ``options`` (add_declared_options) from the parsed options
+    ``args``: each read and checked as its Option declares (pendular.utils.parameters.
+    option_values; its errors name the keys, and ``on_command_line`` the flags)."""
+    from pendular.utils.parameters import option_values
+
+    keys = {option.key for option in options}
+    return option_values(options, {key: value for key, value in vars(args).items()
+                                   if key in keys})[0]
 
 
 def set_threads(threads):

@@ -30,7 +30,7 @@ from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN,
 from pendular.procedures.preparation import PrepareConfig
 from pendular.procedures.reference import KIM_RADIUS, SPECIFIC_GRAVITY
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError, fields_of,
-    flag_of, option_from, option_of, spec_of)
+    flag_of, option_from, option_of, option_values, spec_of)
 
 
 def _options(config, names, **changes):
@@ -92,8 +92,8 @@ WATER_CONTENT = Parameter("%", "gravimetric water content held by volume-control
 #: The bridges' own fields set by their options as they are, at a suction or a water content.
 BRIDGES = _options(BridgeConfig, ("contact_angle", "model", "surface_tension", "liquid"))
 #: A wet laboratory test: at a suction or a water content.
-WETTING = ((option_from(SUCTION, 0.0),) + BRIDGES[:3]
-           + (option_from(WATER_CONTENT, None), BRIDGES[3],
+WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
+           + (option_from(WATER_CONTENT, None, checked=True), BRIDGES[3],
               option_of(LaboratoryConfig, "wetting"), option_of(BridgeConfig, "persist"),
               option_of(LaboratoryConfig, "wet_steps"),
               option_of(BridgeConfig, "table_resolution", metavar="NS,ND",
@@ -152,8 +152,7 @@ def laboratory_fields(values, given, path):
     after the sample and before the bridges: a ShearConfig or the path's fields as a dict.
     OptionError naming the options for a wetting option without a wet test, a preparation
     option with --sample."""
-    suction = SUCTION.check("suction", values["suction"])
-    water = values["water_content"]
+    suction, water = values["suction"], values["water_content"]
     if water is not None and suction > 0.0:
         raise OptionError(lambda name: f"{name('suction')} and {name('water_content')}: give "
                                        "one (at a water content the suction is an output)")
@@ -178,8 +177,6 @@ def laboratory_fields(values, given, path):
     own = path()
     own = {"shear": own} if isinstance(own, ShearConfig) else own
     bridges = None
-    if water is not None:
-        water = WATER_CONTENT.check("water_content", water)
     options = {**fields_of(values, BRIDGES),
                "table_resolution": table_resolution(values["table_resolution"])}
     if suction > 0.0:
@@ -208,14 +205,20 @@ SHEAR = (_options(ShearConfig, ("max_strain", "direction", "b", "constant_p"))
          + rate_options(ShearConfig) + (option_of(ShearConfig, "records"),))
 
 
-def triaxial_config(values, given):
-    """The TriaxialConfig of ``values`` (its shear's steps bounding --vtk-frames and
-    --records)."""
-    strain = values["max_strain"]
+def axial_strain(strain):
+    """The final axial strain ``strain`` of a triaxial shear (--max-strain); ParameterError
+    outside [MIN_AXIAL_STRAIN, MAX_AXIAL_STRAIN], saying why (AXIAL_STRAIN_LIMIT)."""
     if not MIN_AXIAL_STRAIN <= strain <= MAX_AXIAL_STRAIN:              # NaN included
         raise ParameterError("max_strain", f"max_strain = {strain:g} is outside the valid "
                              f"range [{MIN_AXIAL_STRAIN:g}, {MAX_AXIAL_STRAIN:g}]: "
                              f"{AXIAL_STRAIN_LIMIT}", "--max-strain")
+    return strain
+
+
+def triaxial_config(values, given):
+    """The TriaxialConfig of ``values`` (its shear's steps bounding --vtk-frames and
+    --records)."""
+    axial_strain(values["max_strain"])
     if values["records"] is not None:
         spec_of(ShearConfig, "records").check("records", values["records"])
     fields = laboratory_fields(values, given, lambda: ShearConfig(**fields_of(values, SHEAR)))
@@ -317,9 +320,11 @@ TENSION_SIZES = size_options(default=KIM_RADIUS, low=TENSION_RANGES["radius"][0]
 TENSION_VOID_RATIO = option_from(dataclasses.replace(
     VOID_RATIO_PARAMETER, help="void ratio(s) of the core, comma separated (default: Kim's "
                                "0.72, 0.58)"), None, many=True, distinct=True)
-TENSION_WATER_CONTENT = Option("water_content", "gravimetric water content(s) [%], comma "
-                               "separated (default: Kim's for his void ratios, else 0.5,1,2)",
-                               many=True, distinct=True)
+TENSION_WATER_CONTENT = option_from(dataclasses.replace(
+    WATER_CONTENT, low=None, high=None,
+    help="gravimetric water content(s), comma separated, each at most the pendular limit of "
+         "its void ratio's packing (default: Kim's for his void ratios, else 0.5,1,2)"),
+    None, many=True, distinct=True)
 #: A direct tension's own fields set by their options as they are.
 TENSION_OWN = {name: option_of(TensionConfig, name) for name in (
     "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
@@ -422,22 +427,7 @@ def config_from_options(command, options=None):
     not given, or given None, take their declared defaults. OptionError or ParameterError
     naming the key (``on_command_line``: the flag), ValueError naming the file of a path
     table or grading curve."""
-    declared = {option.key: option for option in options_of(command)}
-    options = dict(options or {})
-    unknown = [key for key in options if key not in declared]
-    if unknown:
-        raise OptionError(lambda name: f"{', '.join(map(name, unknown))}: not an option of "
-                                       f"{command}; valid: {', '.join(declared)}")
-    values = {key: option.default if options.get(key) is None else option.read(options[key])
-              for key, option in declared.items()}
-    given = {key for key, option in declared.items() if values[key] != option.default}
-    groups = {}
-    for key, option in declared.items():
-        if key in given and option.group is not None:
-            groups.setdefault(option.group, []).append(key)
-    for keys in groups.values():
-        if len(keys) > 1:
-            raise OptionError(lambda name: f"{' and '.join(map(name, keys))}: give one")
+    values, given = option_values(options_of(command), options, command)
     try:
         return COMMANDS[command].build(values, given)
     except ParameterError as error:

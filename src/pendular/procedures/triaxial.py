@@ -446,16 +446,12 @@ def check_device(config, device):
     label = f"--device {device}"
     if device == "gpu":
         bridges = config.bridges
-        stages = ([shear_stage(config.shear, config.confining, config.rate())]
-                  if isinstance(config, TriaxialConfig) else
-                  config.loading_stages() if hasattr(config, "loading_stages") else ())
         missing = [what for what, used in (
             ("the periodic cell (--periodic)", config.sample.periodic),
             ("volume-controlled bridges (--water-content)",
              bridges is not None and bridges.control == "volume"),
-            ("bridges across gaps (--persist-bridges)", bridges is not None and bridges.persist),
-            ("mixed stress conditions (--b, --constant-p, a stage holding p or b)",
-             any(stage.free for stage in stages))) if used]
+            ("bridges across gaps (--persist-bridges)", bridges is not None and bridges.persist))
+                   if used]
         if missing:
             raise ValueError(f"{label} does not run {' nor '.join(missing)} yet: run this test "
                              "on the CPU (--device cpu)")

@@ -17,7 +17,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from pendular.utils.atomic import write_text
-from pendular.utils.validate import check_int
+from pendular.utils.parameters import Parameter
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.cell_bridge import largest_filling_angle
 
@@ -381,11 +381,15 @@ def save(fig, folder, name):
     print(f"  wrote {name}", flush=True)
 
 
+#: States per curve of the figures.
+POINTS = Parameter("1", "states per curve", 10, 400, kind=int, flag="--points")
+
+
 def write_chapter4(out: str, points: int = 40) -> None:
     """Tables (printed and DIR/chapter4_tables.txt) and figures of thesis Chapter 4 into
     ``out`` (pendular.io.outputs.OutputFolder: ValueError naming the path when it cannot be an
     output folder); ``points`` states per curve (10-400)."""
-    check_int("points", points, low=10, high=400)
+    points = POINTS.check("points", points)
     with OutputFolder(out, "chapter4") as folder:
         start = time.time()
         sections = [table_4_1(), pendular_limits(), high_suction_limits(), crossovers(),

@@ -32,6 +32,7 @@ DIR/campaign.csv: one row per run, its options and its whole summary (pendular.s
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 from dataclasses import dataclass
@@ -44,7 +45,10 @@ from pendular.procedures.preparation import PrepareConfig
 
 from pendular.studies.campaign import Campaign, Run, read_table, write_campaign_csv
 from pendular.studies.chapter5_figures import campaign_figures
-from pendular.procedures.config import BridgeConfig, ShearConfig, TriaxialConfig
+from pendular.procedures.config import (MIN_SAMPLE_PARTICLES, BridgeConfig, ShearConfig,
+    TriaxialConfig)
+from pendular.procedures.options import SUCTION
+from pendular.utils.parameters import option_from, option_of, spec_of
 from pendular.studies.envelope import mohr_coulomb_fit
 from pendular.io.outputs import OutputFolder
 from pendular.procedures.reference import DRY_FRICTION_DEG, FIG_5_5, TABLE_5_3
@@ -124,6 +128,42 @@ class Chapter5Grid:
             shear=ShearConfig(max_strain=self.max_strain, inertial_number=self.inertial_number),
             bridges=BridgeConfig(suction) if suction > 0 else None,
             sample_path=sample_path(out, confining))
+
+
+def grid_options(path: str = TABLE) -> tuple:
+    """The options of a Chapter 5 campaign (``pendular chapter5``; how it runs apart): the
+    settings of the grid of the table ``path``, each from the field it sets (its unit and
+    range), None when not given: the table's value then, stated in its help."""
+    table = Chapter5Grid.from_table(path)
+
+    def listed(values):
+        return ",".join(f"{value:g}" for value in values)
+
+    suctions = dataclasses.replace(SUCTION, help="matric suctions, comma-separated, 0: dry "
+                                                 f"(table: {listed(table.suctions)})")
+    confining = dataclasses.replace(
+        spec_of(PrepareConfig, "confining"), low_inclusive=False,
+        help=f"lateral stresses, comma-separated (table: {listed(table.confining)})")
+    return (option_of(PrepareConfig, "particles", default=None, low=MIN_SAMPLE_PARTICLES,
+                      help=f"number of spheres (table: {table.particles})"),
+            option_from(suctions, None, key="suctions", aliases=("--suction",), many=True),
+            option_from(confining, None, many=True),
+            option_of(PrepareConfig, "seed", default=None,
+                      help=f"random seed of every sample (table: {table.seed})"),
+            option_of(ShearConfig, "max_strain", default=None,
+                      help=f"final axial strain (table: {table.max_strain:g})"),
+            option_of(ShearConfig, "inertial_number", default=None,
+                      help="target inertial number setting the strain rate (table: "
+                           f"{table.inertial_number:g})"),
+            option_of(PrepareConfig, "prep_friction_deg", default=None,
+                      help=f"contact friction during the radius growth (table: "
+                           f"{table.prep_friction:g}; higher gives looser samples)"))
+
+
+def grid_from_options(values: dict, path: str = TABLE) -> Chapter5Grid:
+    """The Chapter5Grid of the table ``path`` with ``values`` of grid_options
+    (pendular.utils.parameters.option_values) given (not None) instead of its own."""
+    return Chapter5Grid.from_table(path, **values)
 
 
 def label(value):

@@ -62,8 +62,11 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.interop.yade.formats import read_spheres, write_spheres
 from pendular.homogenize.invariants import stress_ratio
 
-from pendular.procedures.config import (YADE_CHOICES, BridgeConfig, ShearConfig, TriaxialConfig,
-    config_to_dict)
+from pendular.procedures.config import (MIN_SAMPLE_PARTICLES, YADE_CHOICES, BridgeConfig,
+    ShearConfig, TriaxialConfig, config_to_dict)
+from pendular.procedures.options import SUCTION, axial_strain, sample_sizes, size_options
+from pendular.utils.parameters import (Option, OptionError, Parameter, default_of, option_from,
+    option_of)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -87,9 +90,17 @@ SETUP = ("pendular prepares and settles the sample at the confining stress (wett
          "contacts and bridges formed afresh")
 
 
-def crosscheck_config(particles=1000, suction=0.0, confining=750.0, max_strain=0.25,
-                      records=200, mimic_yade=False, settle_steps=200000, seed=0,
-                      periodic=False, **sizes):
+#: The cross-check's sample size and history rows over the shear (thesis Table 5.2 otherwise).
+PARTICLES, RECORDS = 1000, 200
+#: The most steps that bring the (wetted) sample to rest before the export, by default.
+SETTLE_STEPS = 200000
+
+
+def crosscheck_config(particles=PARTICLES, suction=0.0,
+                      confining=default_of(PrepareConfig, "confining"),
+                      max_strain=default_of(ShearConfig, "max_strain"), records=RECORDS,
+                      mimic_yade=False, settle_steps=SETTLE_STEPS, seed=0, periodic=False,
+                      **sizes):
     """The TriaxialConfig of a cross-check: the thesis-default sample (Table 5.2) of
     ``particles`` spheres at ``confining`` [Pa] from ``seed``, of the ``sizes`` given
     (PrepareConfig's radius, radius_spread, psd), in a periodic cell if ``periodic`` (YADE:
@@ -106,6 +117,52 @@ def crosscheck_config(particles=1000, suction=0.0, confining=750.0, max_strain=0
                           **(YADE_CHOICES if mimic_yade else {})),
         bridges=BridgeConfig(suction) if suction else None,
         wet_steps=settle_steps, vtk_frames=0)
+
+
+#: The options of ``pendular crosscheck`` (how it runs apart: folder, threads, concurrency):
+#: the sample's and the shear's from their fields, at the cross-check's defaults (the
+#: suction and confining stress checked as they are read: the ranges the cross-check takes),
+#: YADE's choices, the settling and a packing to start from.
+OPTIONS = (option_of(PrepareConfig, "particles", default=PARTICLES, low=MIN_SAMPLE_PARTICLES),
+           option_from(dataclasses.replace(SUCTION, high_inclusive=False), 0.0, checked=True),
+           option_of(PrepareConfig, "confining", checked=True, low_inclusive=False, high=None,
+                     high_inclusive=False, help="lateral stress"),
+           option_of(ShearConfig, "max_strain", help="final axial strain"),
+           *size_options(),
+           option_of(PrepareConfig, "seed"),
+           option_of(PrepareConfig, "periodic",
+                     help="a periodic cell instead of six walls: pendular's cell servo against "
+                          "YADE's PeriTriaxController"),
+           Option("mimic_yade", "pendular takes YADE's wall-control choices "
+                                "(pendular.procedures.config.YADE_CHOICES)",
+                  default=False, kind=bool),
+           option_of(ShearConfig, "records", default=RECORDS, unset=False,
+                     help="history rows over the shear"),
+           option_from(Parameter("1", "most steps to bring the (wetted) sample to rest before "
+                                      "export (0: export it as loaded)", low=0, kind=int,
+                                 flag="--settle-steps"), SETTLE_STEPS, checked=True),
+           Option("packing", "shear this exported packing (DIR/packing.txt of an earlier "
+                             "cross-check of the same sample and suction) instead of settling",
+                  kind=str, metavar="FILE"))
+
+
+def crosscheck_from_options(values):
+    """The cross-check's TriaxialConfig (crosscheck_config) of ``values`` of OPTIONS
+    (pendular.utils.parameters.option_values); ParameterError naming an option outside its
+    range, OptionError naming the options of a wet periodic cross-check, which YADE cannot
+    mirror."""
+    axial_strain(values["max_strain"])
+    suction = values["suction"]
+    if values["periodic"] and suction > 0.0:
+        raise OptionError(lambda name: f"{name('suction')} {suction} Pa with {name('periodic')}: "
+                                       "YADE's PeriTriaxController servoes the stress of the "
+                                       "contact forces alone (without the capillary forces); "
+                                       f"valid: 0 with {name('periodic')}")
+    return crosscheck_config(particles=values["particles"], suction=suction,
+                             confining=values["confining"], max_strain=values["max_strain"],
+                             records=values["records"], mimic_yade=values["mimic_yade"],
+                             settle_steps=max(values["settle_steps"], 1), seed=values["seed"],
+                             periodic=values["periodic"], **sample_sizes(values))
 
 
 def mimics_yade(shear):

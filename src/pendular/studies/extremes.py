@@ -29,7 +29,7 @@ import numpy as np
 
 from pendular.capillary import CapillaryBridges
 from pendular.utils.atomic import replacing
-from pendular.utils.parameters import default_of
+from pendular.utils.parameters import Option, default_of
 from pendular.dem.measure import kinetic_energy
 from pendular.procedures.config import BridgeConfig
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, servoed_simulation
@@ -62,6 +62,9 @@ QUICK = [("suction", 1.0), ("suction", 1e7), ("suction", 1e8), ("contact_angle",
          ("contact_angle", 90.0), ("radius", 1e-6), ("young", 1e9), ("timestep_safety", 0.9),
          ("timestep_safety", 1.5), ("particles", 10), ("particles", 10000), ("confining", 0.0),
          ("confining", 1e6), ("water", 1e4)]
+
+#: The grid's options (``pendular extremes``; its output folder apart).
+OPTIONS = (Option("quick", "a small subset of the grid", default=False, kind=bool),)
 
 #: Steps of the wet phase (servoed at the confining stress), and of the lattice scenes.
 WET_STEPS = 2000

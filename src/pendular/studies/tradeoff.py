@@ -57,8 +57,9 @@ from pendular.utils.atomic import write_json, write_text
 from pendular.procedures.preparation import MAX_SEED, PrepareConfig
 from pendular.dem.sample import load_sample
 from pendular.utils.threads import use_threads
-from pendular.utils.parameters import option_field
-from pendular.utils.validate import check_int, check_range
+from pendular.utils.parameters import (Option, OptionError, default_of, fail, option_field,
+    option_of, parameter, validate)
+from pendular.utils.validate import check_int
 
 from pendular.procedures.config import sample_made_with
 from pendular.studies.campaign import check_jobs, executor, prepare_one
@@ -136,20 +137,21 @@ def text(value):
 class Study:
     """The study's inputs: output folder ``out``, ``particles`` of the reference sample
     (>= 50), ``max_strain`` in (0, 0.5], the samples' ``seed``; ``quick``: three knobs, three
-    settings each (QUICK_KNOBS, a smoke test)."""
+    settings each (QUICK_KNOBS, a smoke test). Each field but ``out`` declares its option
+    (OPTIONS)."""
 
     out: str
-    particles: int = 2000
-    max_strain: float = 0.15
-    seed: int = 0
-    quick: bool = False
+    particles: int = parameter(2000, kind=int, low=MIN_PARTICLES, flag="--particles",
+                               help="spheres of the reference sample")
+    max_strain: float = parameter(0.15, low=0.0, high=0.5, low_inclusive=False,
+                                  flag="--max-strain", help="final axial strain")
+    seed: int = parameter(0, kind=int, low=0, high=MAX_SEED - NOISE_SEEDS, flag="--seed",
+                          help="random seed of the samples")
+    quick: bool = parameter(False, kind=bool, flag="--quick",
+                            help="three knobs, three settings each (a smoke test)")
 
     def __post_init__(self):
-        self.particles = check_int("particles", self.particles, low=MIN_PARTICLES)
-        self.max_strain = check_range("max_strain", self.max_strain, 0.0, 0.5,
-                                      low_inclusive=False)
-        self.seed = check_int("seed", self.seed, high=MAX_SEED - NOISE_SEEDS)
-        self.quick = bool(self.quick)
+        validate(self)
         if not str(self.out).strip():
             raise ValueError(f"out = {self.out!r} is empty: give a folder name")
 
@@ -454,6 +456,10 @@ QUANTITIES = (("peak_q", "peak q"), ("saturation_at_peak", "Sr at peak"),
               ("stress_ratio_at_peak", "q'/p' at peak"))
 
 
+#: The knobs a seed study takes (the sample size is not one: each size is a sample of its own).
+SEED_KNOBS = tuple(knob for knob in KNOBS if knob != "particles")
+
+
 @dataclass
 class SeedStudy:
     """``knob`` across ``seeds`` samples (seeds seed ... seed + seeds - 1) of ``particles``
@@ -461,24 +467,28 @@ class SeedStudy:
     and every setting of the knob (KNOBS), each compared with the same sample's reference
     (paired: the knob's effect without the scatter between samples); the references'
     scatter across samples; and, for a knob of the preparation (PREPARATION_KNOBS), each
-    setting also on samples prepared with it. ``jobs`` runs at a time, one thread each."""
+    setting also on samples prepared with it. ``jobs`` runs at a time, one thread each.
+    ``knob`` and ``seeds`` declare their options (OPTIONS); the sample's settings are the
+    one-sample Study's."""
 
     out: str
-    knob: str
-    seeds: int = 6
-    particles: int = 2000
-    max_strain: float = 0.15
-    seed: int = 0
+    knob: str = parameter(kind=str, choices=SEED_KNOBS, flag="--knob",
+                          help="study this knob across --seeds samples instead")
+    seeds: int = parameter(6, kind=int, low=2, high=100, flag="--seeds",
+                           help="samples of the --knob study (seeds SEED ... SEED + SEEDS - 1)")
+    particles: int = default_of(Study, "particles")
+    max_strain: float = default_of(Study, "max_strain")
+    seed: int = default_of(Study, "seed")
     jobs: int = 1
 
     def __post_init__(self):
-        if self.knob not in KNOBS or self.knob == "particles":
-            raise ValueError(f"knob = {self.knob!r}: valid knobs are "
-                             f"{', '.join(k for k in KNOBS if k != 'particles')}")
-        self.seeds = check_int("seeds", self.seeds, low=2, high=100)
+        validate(self)
         self.jobs = check_jobs(self.jobs)
         Study(self.out, self.particles, self.max_strain, self.seed)   # checks the rest
-        self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
+        try:                                    # the last sample's seed within MAX_SEED
+            self.seed = check_int("seed", self.seed, high=MAX_SEED - self.seeds + 1)
+        except ValueError as error:
+            raise fail(Study, "seed", str(error)) from None
 
     def study(self, seed):
         """The one-sample Study of the sample of ``seed`` (its default, reference, variants)."""
@@ -504,6 +514,38 @@ class SeedStudy:
                     runs.append((f"{name}_prepared", dataclasses.replace(config, sample_path=path),
                                  config.sample))
         return runs
+
+
+#: Runs at a time of a seed study (pendular.studies.campaign.check_jobs).
+JOBS = Option("jobs", "runs at a time in the --knob study (one thread each)", default=1,
+              kind=int)
+#: The options of ``pendular tradeoff`` (its output folder apart): the one-sample Study's,
+#: the folder its report is also copied into, and a SeedStudy's.
+OPTIONS = (option_of(Study, "particles"), option_of(Study, "max_strain"),
+           option_of(Study, "seed"), option_of(Study, "quick"),
+           Option("docs", "also copy tradeoff.json/.md/.png into FOLDER", kind=str,
+                  metavar="FOLDER"),
+           option_of(SeedStudy, "knob", default=None), option_of(SeedStudy, "seeds", unset=True),
+           JOBS)
+
+
+def study_of(out, values):
+    """The Study in ``out`` of ``values`` of OPTIONS (pendular.utils.parameters.option_values)
+    or, with a ``knob``, the SeedStudy; OptionError naming the options that belong to the
+    other one."""
+    sample = {key: values[key] for key in ("particles", "max_strain", "seed")}
+    if values["knob"] is not None:
+        if values["quick"] or values["docs"]:
+            raise OptionError(lambda name: f"{name('knob')} studies one knob across samples: "
+                                           f"{name('quick')} and {name('docs')} belong to the "
+                                           "one-sample study")
+        seeds = default_of(SeedStudy, "seeds") if values["seeds"] is None else values["seeds"]
+        return SeedStudy(out=out, knob=values["knob"], seeds=seeds, jobs=values["jobs"],
+                         **sample)
+    if values["seeds"] is not None or values["jobs"] != JOBS.default:
+        raise OptionError(lambda name: f"{name('seeds')} and {name('jobs')} belong to a "
+                                       f"{name('knob')} study: give {name('knob')}")
+    return Study(out=out, quick=values["quick"], **sample)
 
 
 def _run_named(name, config, sample, out):

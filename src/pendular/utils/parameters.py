@@ -1,9 +1,11 @@
 """Parameters declared once: a configuration field carries its unit, valid range, help text and
 command-line flag as metadata (``parameter``); from it ``validate`` checks a configuration,
 ``option_of`` declares the option that sets it (``Option``: key, flag, default, kind, help with
-unit and range), ``fields_of`` reads the fields back from options given by key and
-``flat_options`` makes the flat rows of a run. pendular.procedures.options declares each
-command's options with them; the command line and campaign tables read options through it.
+unit and range; ``option_from`` one of a Parameter of its own, such as a study's knob, checked as
+it is read), ``option_values`` reads a command's options given by key, ``fields_of`` reads the
+fields back from them and ``flat_options`` makes the flat rows of a run.
+pendular.procedures.options declares each laboratory command's options with them, each study
+(pendular.studies) its own; the command line and campaign tables read options through them.
 
 Errors name the field in Python and the option's key in tables (``particles = 1 is outside the
 valid range [2, ...]``); ``ParameterError`` carries the field's name and flag, and
@@ -235,8 +237,10 @@ class Option:
     ``choices``, ``metavar``, ``many``: a list of ``kind``, on the command line a comma list
     (``distinct``: no value twice), ``least``: an integer refused below this as it is read,
     ``group``: the options of one group exclude each other, ``positional``: the command line
-    takes it without a flag, ``field``: the (configuration, field) it sets as it is, whose
-    Parameter declares it (``option_of``)."""
+    takes it without a flag, ``aliases``: its other flags on the command line, ``field``: the
+    (configuration, field) it sets as it is, whose Parameter declares it (``option_of``),
+    ``valid``: the Parameter whose valid set each value is checked against as it is read (a
+    study's own knob; an option that sets a field leaves that to its configuration)."""
 
     key: str
     help: str
@@ -249,7 +253,9 @@ class Option:
     least: int | None = None
     group: str | None = None
     positional: bool = False
+    aliases: tuple = ()
     field: tuple | None = None
+    valid: Parameter | None = None
 
     @property
     def flag(self):
@@ -258,7 +264,8 @@ class Option:
 
     def read(self, value):
         """``value`` given to the option (from a command line, a table or Python) as its kind
-        (a text parsed, a comma list split); OptionError naming the key when it is not one."""
+        (a text parsed, a comma list split); OptionError naming the key when it is not one,
+        ParameterError naming it (and the flag) outside the option's ``valid`` set."""
         if self.kind is None:
             return value
         if self.kind is bool:
@@ -267,7 +274,16 @@ class Option:
                                                "false expected")
             return bool(value)
         if not self.many:
-            return self._one(value)
+            return self._checked(self._one(value))
+        return [self._checked(item) for item in self._list(value)]
+
+    def _checked(self, value):
+        """One ``value`` checked against the option's ``valid`` set, where it declares one."""
+        return value if self.valid is None else self.valid.check(self.key, value)
+
+    def _list(self, value):
+        """The values of a list option (a comma text, a list or one value), each of its kind,
+        none twice where ``distinct``."""
         items = value.split(",") if isinstance(value, str) else (
             list(value) if isinstance(value, (list, tuple)) else [value])
         try:
@@ -316,30 +332,63 @@ class Option:
         raise OptionError(lambda name: f"{name(self.key)} = {value!r}: {what} expected")
 
 
-def option_of(config, name, default=dataclasses.MISSING, **changes):
+def option_of(config, name, default=dataclasses.MISSING, checked=False, **changes):
     """The Option of field ``name`` of the dataclass ``config`` from its Parameter: key and
     flag, kind, choices, metavar, a list's comma form, help with unit and range, default (the
     field's, or None where ``unset``). A command's own setting overrides: ``default`` (the
     field's value when not given; with ``unset``, stated in the help) and ``changes`` to the
-    Parameter (e.g. ``help``, ``low``, ``high``, ``unset``)."""
+    Parameter (e.g. ``help``, ``low``, ``high``, ``unset``); ``checked``: the option checks
+    its values against that Parameter as it reads them (a range of the command's own, beside
+    the configuration's)."""
     spec = dataclasses.replace(spec_of(config, name), **changes)
     if spec.flag is None:
         raise ValueError(f"{config.__name__}.{name}: no option (no flag)")
     value = default_of(config, name) if default is dataclasses.MISSING else default
     if spec.kind is bool and value is not False:
         raise ValueError(f"{config.__name__}.{name}: a flag's default is False")
-    return option_from(spec, value, field=(config, name))
+    return option_from(spec, value, field=(config, name), checked=checked)
 
 
-def option_from(spec, default, field=None, **changes):
+def option_from(spec, default, field=None, checked=False, **changes):
     """The Option of the Parameter ``spec`` (its flag, kind, choices, help with unit and
     range) whose value is ``default`` when not given (None on the option where ``unset``);
-    ``changes``: the Option's own (e.g. ``many``, ``group``)."""
+    ``checked``: each value read is checked against ``spec`` (ParameterError naming the
+    option), as a study's own knob is; ``changes``: the Option's own (e.g. ``many``,
+    ``group``)."""
     declared = {"key": key_of(spec.flag), "help": spec.option_help(default),
                 "default": None if spec.unset else default, "kind": spec.kind,
                 "choices": spec.choices, "metavar": spec.metavar, "many": spec.many,
                 "field": field}
-    return Option(**{**declared, **changes})
+    option = Option(**{**declared, **changes})
+    if checked:
+        valid = dataclasses.replace(spec, flag=option.flag, many=False)
+        option = dataclasses.replace(option, valid=valid)
+    return option
+
+
+def option_values(options, given, owner="the command"):
+    """(values, keys given) of the declared ``options`` (Option) from ``given``: key -> value
+    (a number or its text, a flag's bool, a list or comma text of a list), each read as its
+    option's kind (Option.read); a key not given, or given None, takes its declared default,
+    and a value equal to its default counts as not given. OptionError naming an unknown key
+    (not an option of ``owner``) or two given options of one group."""
+    declared = {option.key: option for option in options}
+    given = dict(given or {})
+    unknown = [key for key in given if key not in declared]
+    if unknown:
+        raise OptionError(lambda name: f"{', '.join(map(name, unknown))}: not an option of "
+                                       f"{owner}; valid: {', '.join(declared)}")
+    values = {key: option.default if given.get(key) is None else option.read(given[key])
+              for key, option in declared.items()}
+    changed = {key for key, option in declared.items() if values[key] != option.default}
+    groups = {}
+    for key, option in declared.items():
+        if key in changed and option.group is not None:
+            groups.setdefault(option.group, []).append(key)
+    for keys in groups.values():
+        if len(keys) > 1:
+            raise OptionError(lambda name: f"{' and '.join(map(name, keys))}: give one")
+    return values, changed
 
 
 def fields_of(values, options):

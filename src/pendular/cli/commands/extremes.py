@@ -4,18 +4,18 @@ across its range and beyond; every case ends ok (finite, every check within its 
 refused (an error naming the parameter, its value and the valid range), never failed. Writes
 DIR/extremes.json and prints the table; exit status 1 if a case failed (pendular.studies.extremes)."""
 
-from pendular.cli import add_run_options, set_threads
-from pendular.studies.extremes import run_grid
+from pendular.cli import add_declared_options, add_run_options, declared_values, set_threads
+from pendular.studies.extremes import OPTIONS, run_grid
 
 
 def add_arguments(parser):
     parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--quick", action="store_true", help="a small subset of the grid")
+    add_declared_options(parser, OPTIONS)
     add_run_options(parser)
 
 
 def run(args):
     set_threads(args.threads)
-    counts = run_grid(args.out, args.quick)
+    counts = run_grid(args.out, declared_values(OPTIONS, args)["quick"])
     print(f"outputs in {args.out}")
     return 1 if counts["failed"] else 0

@@ -10,26 +10,15 @@ knob of the preparation the samples prepared with each setting), --jobs runs at 
 
 import sys
 
-from pendular.studies.tradeoff import KNOBS, SeedStudy, Study, write_seed_study, write_study
+from pendular.studies.tradeoff import (OPTIONS, SeedStudy, study_of, write_seed_study,
+    write_study)
+
+from pendular.cli import add_declared_options, declared_values
 
 
 def add_arguments(parser):
     parser.add_argument("--out", required=True, help="output folder")
-    parser.add_argument("--particles", type=int, default=2000,
-                        help="spheres of the reference sample")
-    parser.add_argument("--max-strain", type=float, default=0.15, help="final axial strain [-]")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the samples")
-    parser.add_argument("--quick", action="store_true",
-                        help="three knobs, three settings each (a smoke test)")
-    parser.add_argument("--docs", metavar="FOLDER", default=None,
-                        help="also copy tradeoff.json/.md/.png into FOLDER")
-    parser.add_argument("--knob", choices=[k for k in KNOBS if k != "particles"], default=None,
-                        help="study this knob across --seeds samples instead")
-    parser.add_argument("--seeds", type=int, default=None,
-                        help="samples of the --knob study (seeds SEED ... SEED + SEEDS - 1; "
-                             "default 6)")
-    parser.add_argument("--jobs", type=int, default=1,
-                        help="runs at a time in the --knob study (one thread each)")
+    add_declared_options(parser, OPTIONS)
 
 
 def _log(message):
@@ -37,22 +26,14 @@ def _log(message):
 
 
 def run(args):
-    if args.knob is not None:
-        if args.quick or args.docs:
-            raise ValueError("--knob studies one knob across samples: --quick and --docs "
-                             "belong to the one-sample study")
-        study = SeedStudy(out=args.out, knob=args.knob, seeds=6 if args.seeds is None
-                          else args.seeds, particles=args.particles,
-                          max_strain=args.max_strain, seed=args.seed, jobs=args.jobs)
+    values = declared_values(OPTIONS, args)
+    study = study_of(args.out, values)
+    if isinstance(study, SeedStudy):
         data = write_seed_study(study, log=_log)
         print(f"tradeoff: {len(data['runs'])} runs; outputs in {args.out} "
-              f"(seeds_{args.knob}.json, seeds_{args.knob}.md)")
+              f"(seeds_{study.knob}.json, seeds_{study.knob}.md)")
         return 0
-    if args.seeds is not None or args.jobs != 1:
-        raise ValueError("--seeds and --jobs belong to a --knob study: give --knob")
-    study = Study(out=args.out, particles=args.particles, max_strain=args.max_strain,
-                  seed=args.seed, quick=args.quick)
-    data = write_study(study, docs=args.docs, log=_log)
+    data = write_study(study, docs=values["docs"], log=_log)
     print(f"tradeoff: {len(data['rows'])} rows; outputs in {args.out} "
           "(tradeoff.json, tradeoff.md, tradeoff.png)")
     return 0
