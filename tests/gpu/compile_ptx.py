@@ -1,24 +1,43 @@
-"""Compile every kernel of a dry and a wet step for a real GPU (PTX for compute capability 9.0,
-an H100) without one, as a script in its own process: the simulator runs kernels as Python and
-would not see code that the CUDA target cannot compile (a NumPy ufunc, a global it cannot
-type). Needs NVVM and NVRTC (``pip install nvidia-nvvm nvidia-cuda-nvrtc`` with CUDA_HOME at
-their nvidia/cu13 folder); prints {"skip": reason} without them, else {kernel: PTX lines}.
+"""Compile every kernel of a dry and a wet step for a real GPU (PTX, by default for compute
+capability 9.0, an H100) without one, as a script in its own process: the simulator runs
+kernels as Python and would not see code that the CUDA target cannot compile (a NumPy ufunc, a
+global it cannot type).
+
+It needs NVVM and NVRTC. The gpu extra installs CUDA 13's (the wheels nvidia-nvvm and
+nvidia-cuda-nvrtc, in site-packages/nvidia/cu13), which numba-cuda finds there itself
+(through cuda-pathfinder; no CUDA_HOME needed). Where those wheels are installed, a compiler
+is expected: any failure to compile, the first small kernel's included, ends the script with
+an error. Without them it tries a CUDA toolkit found otherwise (CUDA_HOME, the system's) and
+prints {"skip": reason} when there is none. Else it prints {"wheels": the wheels' folder (or
+null), "kernels": {kernel: PTX lines}}.
+
+``python compile_ptx.py [MAJOR.MINOR]`` compiles for another compute capability.
 
 Arrays stay on the host (the kernels' argument types are those of the device arrays), and
-device functions are compiled for compute capability 9.0 where numba-cuda would ask a driver.
+device functions are compiled for the compute capability asked where numba-cuda would ask a
+driver.
 """
 
 import json
 import sys
 import types
+from importlib.metadata import PackageNotFoundError, distribution
+from pathlib import Path
 
-import numba
 import numpy as np
 
-from numba import cuda
-import numba.cuda.dispatcher as dispatcher
+#: The gpu extra's compiler wheels (pyproject.toml), both in site-packages/nvidia/cu13.
+COMPILER_WHEELS = ("nvidia-nvvm", "nvidia-cuda-nvrtc")
 
-from simulated import scene
+
+def extra_compiler_folder():
+    """The folder (lib/, nvvm/) of the gpu extra's NVVM, or None unless both of its compiler
+    wheels are installed."""
+    try:
+        nvvm, _ = (distribution(name) for name in COMPILER_WHEELS)
+    except PackageNotFoundError:
+        return None
+    return Path(nvvm.locate_file("nvidia/cu13"))
 
 
 class HostArray(np.ndarray):
@@ -31,15 +50,16 @@ class HostArray(np.ndarray):
         return np.array(self)
 
 
-def main():
-    try:
-        cuda.compile_ptx(lambda a: None, (numba.float64[:],), cc=(9, 0))
-    except Exception as error:  # no NVVM or NVRTC here: nothing to check
-        print(json.dumps({"skip": f"{type(error).__name__}: {str(error).splitlines()[0]}"}))
-        return
-    dispatcher.get_current_device = lambda: types.SimpleNamespace(compute_capability=(9, 0))
+def compile_step_kernels(cuda, capability):
+    """{kernel (and " wet"): PTX lines} of every kernel of a dry and a wet step."""
+    import numba
+    import numba.cuda.dispatcher as dispatcher
+
+    dispatcher.get_current_device = lambda: types.SimpleNamespace(
+        compute_capability=capability)
     cuda.to_device = lambda values: np.array(values, copy=True).view(HostArray)
     from pendular.gpu import GpuSimulation
+    from simulated import scene
 
     compiled = {}
     for wet in (False, True):
@@ -48,10 +68,28 @@ def main():
         for kernel, _, args in gpu._steps:
             signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
                               for a in args)
-            ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=(9, 0))
+            ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
-    print(json.dumps(compiled))
+    return compiled
+
+
+def main(arguments):
+    capability = tuple(int(part) for part in (arguments[0] if arguments else "9.0").split("."))
+    folder = extra_compiler_folder()
+    import numba
+    from numba import cuda
+
+    try:
+        cuda.compile_ptx(lambda a: None, (numba.float64[:],), cc=capability)
+    except Exception as error:
+        if folder is not None:      # the gpu extra's compiler is installed: a failure
+            raise
+        print(json.dumps({"skip": f"{type(error).__name__}: {str(error).splitlines()[0]}"}))
+        return 0
+    print(json.dumps({"wheels": None if folder is None else str(folder),
+                      "kernels": compile_step_kernels(cuda, capability)}))
+    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

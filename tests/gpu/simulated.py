@@ -26,13 +26,15 @@ from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import GpuSimulation
-from pendular.gpu.bridges import lookup_suction as device_lookup
-from pendular.gpu.cuda import cuda
+from pendular.gpu.cuda import cuda, device_twin
 
 RADIUS = 1e-3
 YOUNG = 1e7
 STEPS = 200
 RECORD_PERIOD = 50
+
+#: The CPU's table lookup compiled for the device (the function the bridges' twins call).
+device_lookup = device_twin(lookup_suction)
 
 
 def scene(wet=False, side=3, seed=1):

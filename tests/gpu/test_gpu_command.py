@@ -135,9 +135,7 @@ def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
 @pytest.mark.parametrize("options, words", [
     (["--periodic"], ["periodic cell"]),
     (["--water-content", "5"], ["volume-controlled bridges"]),
-    (["--suction", "30000", "--persist-bridges"], ["bridges across gaps"]),
-    (["--b", "0.5"], ["mixed stress conditions"]),
-    (["--constant-p"], ["mixed stress conditions"])])
+    (["--suction", "30000", "--persist-bridges"], ["bridges across gaps"])])
 def test_what_the_gpu_does_not_run_is_refused_before_any_work(tmp_path, capsys, options,
                                                              words):
     out = tmp_path / "out"

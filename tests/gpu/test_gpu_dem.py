@@ -4,8 +4,8 @@ leapfrog, neighbour list rebuilt on the device) over 200 steps. The simulator ru
 process of its own (tests/gpu/simulated.py), so that no other test meets it.
 
 Measured (simulator, 27 spheres, 200 steps, 7 rebuilds): largest relative differences from
-the CPU 8.7e-16 in positions, 8.3e-13 in velocities, 1.0e-12 in forces, 1.3e-12 in torques,
-1.5e-14 in wall stresses, 6.6e-13 in the tangential springs (the CPU's hot kernels contract
+the CPU 1.0e-15 in positions, 9.4e-13 in velocities, 9.1e-13 in forces, 1.1e-12 in torques,
+9.3e-15 in wall stresses, 6.1e-13 in the tangential springs (the CPU's hot kernels contract
 multiply-adds and take reciprocals; the simulator computes each operation as written).
 """
 
@@ -16,6 +16,7 @@ import sys
 
 import pytest
 
+from compile_ptx import extra_compiler_folder
 from conftest import ROOT
 
 try:
@@ -96,17 +97,53 @@ def test_a_diverged_run_stops_with_an_error(dry):
     assert "not finite" in dry["diverged"]
 
 
+def compile_ptx(*arguments):
+    """tests/gpu/compile_ptx.py run in a process of its own (CompletedProcess)."""
+    return subprocess.run([sys.executable, os.path.join(ROOT, "tests", "gpu", "compile_ptx.py"),
+                           *arguments], capture_output=True, text=True,
+                          cwd=os.path.join(ROOT, "tests", "gpu"), timeout=600)
+
+
 def test_every_kernel_compiles_for_a_gpu():
     """PTX for an H100 of every kernel of a dry and a wet step (tests/gpu/compile_ptx.py),
-    where NVVM is installed: the simulator would run code that the CUDA target rejects."""
-    done = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "gpu", "compile_ptx.py")],
-                          capture_output=True, text=True, cwd=os.path.join(ROOT, "tests", "gpu"),
-                          timeout=600)
+    where a CUDA compiler is installed (the gpu extra installs one): the simulator would run
+    code that the CUDA target rejects."""
+    done = compile_ptx()
     assert done.returncode == 0, done.stderr[-3000:]
     compiled = json.loads(done.stdout.strip().splitlines()[-1])
     if "skip" in compiled:
         pytest.skip(f"no CUDA compiler here: {compiled['skip']}")
     kernels = ("bin_particles", "find_pairs", "finish_rebuild", "pair_forces", "gather",
                "wall_partials", "wall_sums", "wall_controls", "leapfrog")
-    assert set(compiled) == {*kernels, *(f"{name} wet" for name in kernels)}
-    assert all(lines > 0 for lines in compiled.values())
+    assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels)}
+    assert all(lines > 0 for lines in compiled["kernels"].values())
+
+
+def test_a_compile_failure_fails_where_the_gpu_extra_installed_the_compiler():
+    """With the gpu extra's NVVM and NVRTC installed, code the compiler rejects (here every
+    kernel, for compute capability 5.0, which CUDA 13 no longer targets) fails the check: it
+    does not skip."""
+    if extra_compiler_folder() is None:
+        pytest.skip("the gpu extra's CUDA compiler (nvidia-nvvm, nvidia-cuda-nvrtc) is not "
+                    "installed")
+    done = compile_ptx("5.0")
+    assert done.returncode != 0
+    assert "skip" not in done.stdout and "compute capability 5.0" in done.stderr
+
+
+def test_a_device_twin_is_the_cpu_source_calling_the_twins_of_what_it_calls():
+    """pendular.gpu.cuda.device_twin: the device function of a CPU function runs the CPU's own
+    code object, and each CPU function it calls by name is replaced by that function's twin,
+    down the call tree (the bridges at contact: _follow_contact -> _form_at_contact ->
+    lookup_suction -> _suction_cell); one twin per function."""
+    from pendular.capillary.bridge_kernels import _follow_contact, _form_at_contact
+    from pendular.capillary.table import _suction_cell, lookup_suction
+    from pendular.gpu.cuda import device_twin
+
+    chain = (_follow_contact, _form_at_contact, lookup_suction, _suction_cell)
+    twins = [device_twin(function) for function in chain]
+    assert all(device_twin(function) is twin for function, twin in zip(chain, twins))
+    for function, twin, callee in zip(chain, twins, chain[1:]):
+        assert twin.py_func.__code__ is function.py_func.__code__
+        assert twin.py_func.__globals__[callee.__name__] is device_twin(callee)
+        assert function.py_func.__globals__[callee.__name__] is callee   # the CPU's unchanged

@@ -11,6 +11,9 @@ Lookups (the units of docs/units.md): r = R2/R1 with R2 the larger radius, u* = 
 d* = max(gap, 0) / R2, F = F* 2 pi gamma R2, V = V* R2^3, filling angles delta1 on the smaller
 sphere and delta2 on the larger one.
 
+The GPU engine's bridges at contact are _follow_contact and what it calls, compiled for the
+device from this source (pendular.gpu.cuda.device_twin).
+
 The kernels take their arrays in tuples, one per kind, each unpacked at the kernel's top:
 ``pairs`` (pair_geometry: what they read of the particles and the neighbour list), ``rows``
 (particle_pairs: each particle's pairs, for per-particle loops), ``table`` / ``volume_table``

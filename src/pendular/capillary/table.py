@@ -414,7 +414,9 @@ def lookup_suction(
     outside [0, suction_max] or non-finite input. The rupture distance and the quantities are
     interpolated as logarithms (power laws in u* at high suction), linearly in (r, xi), and
     the distance coordinate z is taken relative to the interpolated rupture distance, so every
-    radius ratio is read at the same stage of its family.
+    radius ratio is read at the same stage of its family. The GPU's bridges read the table
+    through this function and what it calls, compiled for the device from this source
+    (pendular.gpu.cuda.device_twin; its checks there end the thread, the host checks first).
     """
     exists, i_r, i_next, t_r, i_u, t_u, j, t_z = _suction_cell(
         radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values, radius_ratio,

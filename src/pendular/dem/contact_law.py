@@ -10,12 +10,16 @@ scatter_contact_forces): the sums of the multi-thread gather in the same order, 
 not depend on the thread count. Those serial kernels are compiled without Numba's reference
 counting (``_nrt=False``; they allocate nothing): a serial loop that hands arrays to
 ``inline="always"`` helpers counts references on every array at every pair, which a prange
-loop does not (measured at 10,000 spheres: 94 against 42 ns a pair for the same evaluation).
-They run row by row, the first member's state and sums in registers through its row (measured
-2026-11-26 against the pair-by-pair loop, whole one-thread shear steps in alternating turns:
-dry 0.95-0.98 at 1,000 spheres, 0.98-1.01 at 10,000, 0.986 at 100,000; wet 0.94-0.96 at
-1,000, 0.98 at 10,000).
+loop does not. They run row by row, the first member's state and sums in registers through
+its row, which a pair-by-pair loop would read again at every pair (docs/performance.md).
+
+The GPU engine runs this module's per-pair functions (_first_member, _evaluate_pair,
+_sum_pair_terms and what they call), compiled for the device from this source
+(pendular.gpu.cuda.device_twin): they keep to what both targets compile (``math`` on scalars,
+not NumPy's ufuncs).
 """
+
+import math
 
 import numba
 import numpy as np
@@ -81,7 +85,7 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
             d2 += m2 * period[2]
             if len(period) > 3:     # Lees–Edwards: the images above in z offset along x
                 d0 += m2 * period[3]
-    distance = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    distance = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     rj = radius[j]
     gap_overlap = ri + rj - distance
     was_touching = overlap[k] > 0.0
@@ -135,7 +139,7 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
     fs2 -= ks * (v2 - vn * n2) * dt
     fn = kn * gap_overlap
     cap = fn * tan_friction
-    magnitude = np.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
+    magnitude = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
     # a select, not a branch: whether a contact slides is unpredictable pair to pair (a fifth
     # of a dry shear's contacts slide); x * 1.0 == x, so a sticking contact is unchanged
     scale = cap / magnitude if magnitude > cap else 1.0
@@ -167,8 +171,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
 
     pair_i, pair_j: the pairs (pendular.dem.neighbors.Contacts), taken one by one; the one-thread
     kernels take them row by row, from row_start instead of pair_i (a prange over the rows
-    was no faster on two threads: 1.08 at 10,000 spheres, then 0.93-1.03 at 10,000-100,000
-    with both kernels loaded from Numba's cache). image, period: each pair's
+    was no faster on two threads). image, period: each pair's
     periodic image and the box period (pendular.dem.neighbors.branch_vector; zeros inside walls);
     affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell, whose velocity
     affine_rate * l adds to the relative velocity of a pair of branch l; a sheared cell's
@@ -261,33 +264,43 @@ def _add_contact_forces(p, pair_force, attraction, normal, overlap, radius, row_
     which a loop over the pairs meets them (scatter_contact_forces), so that the one-thread
     kernels give the same sums: first the pairs in which p is the second member (their first
     member is below p, so they come before p's own in the CSR list; second_pair holds them in
-    pair order), then p's own."""
-    f0, f1, f2 = force[p, 0], force[p, 1], force[p, 2]
-    t0, t1, t2 = torque[p, 0], torque[p, 1], torque[p, 2]
-    r = radius[p]
-    for slot in range(second_start[p], second_start[p + 1]):
+    pair order), then p's own (_sum_pair_terms)."""
+    sums = _sum_pair_terms(_row_sums(p, force, torque), radius[p], pair_force, attraction,
+                           normal, overlap, second_pair,
+                           range(second_start[p], second_start[p + 1]),
+                           range(row_start[p], row_start[p + 1]))
+    _store_row_sums(p, sums, force, torque)
+
+
+@numba.njit(cache=True, inline="always")
+def _sum_pair_terms(sums, radius_p, pair_force, attraction, normal, overlap, second_pair,
+                    second_slots, own_pairs):
+    """``sums`` (_row_sums) of a particle p of radius ``radius_p`` [m] with its pairs' terms
+    (_pair_terms) added one by one: +F and its torque for the pairs in which p is the second
+    member, second_pair[slot] for slot in the range ``second_slots``, then -F and its torque
+    for its own pairs, the range ``own_pairs`` (_add_contact_forces). The ranges step by 1 in
+    the CPU's list (CSR), by the particle count in the device's rows (pendular.gpu.neighbors).
+    """
+    f0, f1, f2, t0, t1, t2 = sums
+    for slot in second_slots:
         a0, a1, a2, m0, m1, m2 = _pair_terms(pair_force, attraction, normal, overlap,
-                                             second_pair[slot], r)
+                                             second_pair[slot], radius_p)
         f0 += a0
         f1 += a1
         f2 += a2
         t0 += m0
         t1 += m1
         t2 += m2
-    for k in range(row_start[p], row_start[p + 1]):
-        a0, a1, a2, m0, m1, m2 = _pair_terms(pair_force, attraction, normal, overlap, k, r)
+    for k in own_pairs:
+        a0, a1, a2, m0, m1, m2 = _pair_terms(pair_force, attraction, normal, overlap, k,
+                                             radius_p)
         f0 -= a0
         f1 -= a1
         f2 -= a2
         t0 += m0
         t1 += m1
         t2 += m2
-    force[p, 0] = f0
-    force[p, 1] = f1
-    force[p, 2] = f2
-    torque[p, 0] = t0
-    torque[p, 1] = t1
-    torque[p, 2] = t2
+    return f0, f1, f2, t0, t1, t2
 
 
 @numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
@@ -429,9 +442,8 @@ def wall_forces(position, radius, near_wall, wall_position, young, force, wall_f
     wall_force[w] is the compressive normal force the particles exert on wall w [N],
     wall_stiffness[w] the sum of its contacts' kn [N/m] (used by the stress servo) and
     wall_moment[w] the sum of (centre-to-wall distance) * force [N m] (Love–Weber, Eq. 3.41).
-    Serial: a pass over the particles near the walls (a fifth of a 10,000-sphere sample, a
-    tenth of a 100,000; over every particle, skipping those off the walls, it took 4-5 % of a
-    two-thread step at 10,000).
+    Serial: a pass over the particles near the walls only (a fifth of a 10,000-sphere sample,
+    a tenth of a 100,000), cheaper than a parallel pass over every particle.
     """
     wall_force[:] = 0.0
     wall_stiffness[:] = 0.0

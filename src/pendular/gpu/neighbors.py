@@ -42,6 +42,14 @@ def grid_dims(wall_position, cell_size, max_dims, axis):
 
 
 @device
+def grid_shape(wall_position, cell_size, max_dims):
+    """(cells along x, y, z) of the grid in the walls' box now (grid_dims)."""
+    return (grid_dims(wall_position, cell_size, max_dims, 0),
+            grid_dims(wall_position, cell_size, max_dims, 1),
+            grid_dims(wall_position, cell_size, max_dims, 2))
+
+
+@device
 def cell_coordinate(x, wall_position, dims, axis):
     """Cell index along ``axis`` of coordinate x [m], clamped into [0, dims) (0 for a
     coordinate or box that is not finite)."""
@@ -61,9 +69,7 @@ def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
-    d0 = grid_dims(wall_position, cell_size, max_dims, 0)
-    d1 = grid_dims(wall_position, cell_size, max_dims, 1)
-    d2 = grid_dims(wall_position, cell_size, max_dims, 2)
+    d0, d1, d2 = grid_shape(wall_position, cell_size, max_dims)
     c = ((cell_coordinate(position[p, 0], wall_position, d0, 0) * d1
           + cell_coordinate(position[p, 1], wall_position, d1, 1)) * d2
          + cell_coordinate(position[p, 2], wall_position, d2, 2))
@@ -110,9 +116,7 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
-    d0 = grid_dims(wall_position, cell_size, max_dims, 0)
-    d1 = grid_dims(wall_position, cell_size, max_dims, 1)
-    d2 = grid_dims(wall_position, cell_size, max_dims, 2)
+    d0, d1, d2 = grid_shape(wall_position, cell_size, max_dims)
     cell = cell_of[p]
     cz = cell % d2
     cy = (cell // d2) % d1

@@ -10,28 +10,32 @@ CPU pipeline (pendular.dem.simulation) on the device::
     leapfrog                                    integrator (+ the rebuild test)
 
 The host reads nothing per step. It reads the device's flags at its checks (every
-``check_every`` steps, as Simulation.run checks ``until``). After each step the Simulation's
-state is held by the device (Simulation.hold) and the writers are called as on the CPU: one
-that reads the state (a HistoryRecorder at its recording steps, a checkpoint at its period)
-brings it back first (``copy_back``; the walls alone when only they are read, as a stress
-``until`` does every step), one that is not due reads nothing and costs no copy.
-Simulation.run brings the state back as it returns; a GpuSimulation driven directly leaves it
-held until read (or ``to_host``), so that runs in a row copy nothing between them.
+``check_every`` steps, as Simulation.run checks ``until``: the loop is Simulation.run_chunks).
+After each step the Simulation's state is held by the device (Simulation.hold) and the writers
+are called as on the CPU: one that reads the state (a HistoryRecorder at its recording steps,
+a checkpoint at its period) brings it back first (``copy_back``; the walls alone when only
+they are read, as a stress ``until`` does every step), one that is not due reads nothing and
+costs no copy. Simulation.run brings the state back as it returns; a GpuSimulation driven
+directly leaves it held until read (or ``to_host``), so that runs in a row copy nothing
+between them (a run's set-up reads what the scene is made of with Simulation.peek).
+
+A mixed stress condition (MixedStress) sets its servos' targets on the device from the walls'
+stresses, as the CPU does. When a target falls below zero the device records it and the host
+raises the CPU's StageFailed at its next check or, earlier, when anything reads the state
+(``copy_back``), so that no writer records a state past the failure.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
-wet, SuctionBridges at contact (``persist`` False); controls StressServo and
-ConstantStrainRate; the Integrator. Anything else is refused by name (ValueError), so that a
-scene never runs with part of its physics missing.
+wet, SuctionBridges at contact (``persist`` False); controls StressServo, ConstantStrainRate
+and MixedStress (its servos among the controls); the Integrator. Anything else is refused by
+name (ValueError), so that a scene never runs with part of its physics missing.
 """
 
-import time
-
 import numpy as np
-from tqdm import tqdm
 
 from pendular.capillary.bridges import SuctionBridges
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
+from pendular.dem.mixed_stress import MixedStress
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
@@ -58,10 +62,12 @@ def _one(sim, kind, required=True):
 
 
 def check_scene(sim):
-    """ValueError naming what of ``sim`` the GPU path does not run yet (module docstring)."""
-    if not isinstance(sim.walls, Walls):
+    """ValueError naming what of ``sim`` the GPU path does not run yet (module docstring).
+    Reads what the scene is made of, not its state (Simulation.peek)."""
+    box = sim.peek("walls")
+    if not isinstance(box, Walls):
         raise ValueError(f"device='gpu' runs walled scenes only so far; the box is a "
-                         f"{type(sim.walls).__name__}")
+                         f"{type(box).__name__}")
     if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
@@ -72,20 +78,26 @@ def check_scene(sim):
     if bridges is not None and bridges.persist:
         raise ValueError("device='gpu' runs suction-controlled bridges at contact only so far "
                          "(persist = False)")
-    for op in sim.controls:
-        if type(op) not in (StressServo, ConstantStrainRate):
+    controls = sim.peek("controls")
+    for op in controls:
+        if type(op) not in (StressServo, ConstantStrainRate) and not isinstance(op, MixedStress):
             raise ValueError(f"device='gpu' does not run the control {type(op).__name__} yet "
-                             "(valid: StressServo, ConstantStrainRate)")
+                             "(valid: StressServo, ConstantStrainRate, MixedStress)")
+        if isinstance(op, MixedStress) and not all(
+                any(op.servos[axis] is other for other in controls) for axis in op.free):
+            raise ValueError("device='gpu' runs a MixedStress whose servos are among the "
+                             "scene's controls only")
 
 
 class GpuSimulation:
     """Runs ``sim`` (a pendular.dem.simulation.Simulation whose scene the GPU path supports,
-    ``check_scene``) on the GPU: ``run(steps)`` as Simulation.run, ``to_host()`` to bring the
+    ``check_scene``) on the GPU: ``run(steps)`` as Simulation.run (its loop,
+    Simulation.run_chunks, with the device's steps and checks), ``to_host()`` to bring the
     state back into ``sim`` (done whenever anything reads it from sim: module docstring).
-    ``sim.step`` and
-    ``sim.time`` advance with the device. Parameters of the operations (friction, servo
-    target, dt, ...) are read at every ``run``; a scene whose operations change (a new
-    control list) needs ``to_host()`` and a new GpuSimulation.
+    ``sim.step`` and ``sim.time`` advance with the device. Parameters of the operations
+    (friction, servo target, dt, ...) are read at every ``run`` (the targets a MixedStress
+    sets are the device's); a scene whose operations change (a new control list) needs
+    ``to_host()`` and a new GpuSimulation.
     """
 
     def __init__(self, sim):
@@ -105,11 +117,24 @@ class GpuSimulation:
             self._suction = 0.0
         self.state = DeviceState(sim, sim.neighbors.skin, bridges is not None)
         self._controls = tuple(sim.controls)
+        self._mixed = tuple(c for c, op in enumerate(self._controls)
+                            if isinstance(op, MixedStress))
+        # the rows of the servos whose targets a MixedStress sets on the device
+        driven = set()
+        for c in self._mixed:
+            mixed = self._controls[c]
+            driven.update(self._row(mixed.servos[axis]) for axis in mixed.free)
+        self._driven = tuple(sorted(driven))
+        self._holding = False
         self._upload_controls()
         self._steps = []
         self._launches = []
 
     # ---------------------------------------------------------------- set-up
+    def _row(self, control):
+        """The row of ``control`` (one of the scene's, by identity) in the controls' program."""
+        return next(c for c, op in enumerate(self._controls) if op is control)
+
     def _upload_controls(self):
         """The controls' program and memory (pendular.gpu.walls) from the host's operations."""
         count = max(1, len(self._controls))
@@ -126,9 +151,16 @@ class GpuSimulation:
                 previous[c, :len(walls)] = op.previous
                 stiffness[c, :len(walls)] = op.stiffness
                 calls[c] = op.calls
-            else:
+            elif type(op) is ConstantStrainRate:
                 kinds[c] = device_walls.STRAIN_RATE
                 walls = (2 * op.axis, 2 * op.axis + 1)
+            else:
+                kinds[c] = device_walls.MIXED_STRESS
+                control_walls[c, :3] = [self._row(op.servos[axis]) if axis in op.free else -1
+                                        for axis in range(3)]
+                control_walls[c, 3:3 + len(op.free)] = op.free
+                wall_counts[c] = len(op.free)
+                continue
             control_walls[c, :len(walls)] = walls
             wall_counts[c] = len(walls)
         s = self.state
@@ -139,6 +171,8 @@ class GpuSimulation:
         s.stiffness = cuda.to_device(stiffness)
         s.calls = cuda.to_device(calls)
         s.parameters = cuda.to_device(self._control_parameters())
+        s.control_step = cuda.to_device(np.zeros(1, np.int64))
+        s.failure = cuda.to_device(np.zeros(len(device_walls.FAILURE_FIELDS)))
 
     def _control_parameters(self):
         """(controls, 6) parameters of the controls now (pendular.gpu.walls's fields)."""
@@ -147,15 +181,26 @@ class GpuSimulation:
             if type(op) is StressServo:
                 parameters[c] = (op.target, op.gain, op.memory, op.max_velocity,
                                  float(op.scale_max_velocity), float(op.stiffness_every))
-            else:
+            elif type(op) is ConstantStrainRate:
                 parameters[c, :3] = (op.rate, op.reference_length, float(op.on_current_length))
+            else:
+                parameters[c, :5] = (np.nan if op.mean_stress is None else op.mean_stress,
+                                     np.nan if op.b is None else op.b,
+                                     *(op.stress.get(axis, np.nan) for axis in range(3)))
         return parameters
+
+    def _targets_to_host(self):
+        """The targets the device's MixedStress controls set, into their servos on the host."""
+        if self._driven:
+            targets = self.state.parameters.copy_to_host()[:, 0]
+            for c in self._driven:
+                self._controls[c].target = float(targets[c])
 
     def _configure(self):
         """The step's launches (``_launches``: configured kernel, arguments) with the
         operations' parameters now."""
         sim = self.sim
-        if tuple(sim.controls) != self._controls:
+        if tuple(sim.peek("controls")) != self._controls:
             raise ValueError("the scene's controls changed since the GPU copy was made: call "
                              "to_host() and build a new GpuSimulation")
         check_scene(sim)
@@ -163,7 +208,10 @@ class GpuSimulation:
             raise ValueError(f"suction = {self._bridges.suction:g} Pa changed since the GPU "
                              f"copy was made at {self._suction:g} Pa: a suction path does not "
                              "run on the GPU yet")
+        if self._holding:           # the host's targets of a MixedStress's servos are stale
+            self._targets_to_host()
         self.state.parameters.copy_to_device(self._control_parameters())
+        self.state.control_step.copy_to_device(np.array([sim.step], np.int64))
         contact = _one(sim, ContactForces)
         wall_law = _one(sim, WallForces)
         tan_friction = float(np.tan(np.radians(contact.friction_deg)))
@@ -198,7 +246,8 @@ class GpuSimulation:
                                            s.reference_walls, s.cell_count, s.cell_of,
                                            s.flags, s.rebuilds)),
             (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
-                                     s.pair_count, s.pair_j, s.shear_force, s.normal,
+                                     s.pair_count, s.pair_i, s.pair_j, s.no_image,
+                                     s.no_period, s.shear_force, s.normal,
                                      s.overlap, s.normal_force, s.pair_force, young,
                                      contact.shear_ratio, tan_friction, sim.dt, s.flags,
                                      s.wet, *columns, self._suction,
@@ -215,7 +264,8 @@ class GpuSimulation:
             (device_walls.wall_controls, 1,
              (s.wall_force, s.wall_stiffness, s.kinds, s.control_walls, s.wall_counts,
               s.parameters, s.previous, s.stiffness, s.calls, s.wall_position,
-              s.wall_velocity, s.reference_walls, limit, sim.dt, s.flags)),
+              s.wall_velocity, s.reference_walls, limit, sim.dt, s.control_step, s.failure,
+              s.flags)),
             (integrate.leapfrog, n, (s.position, s.velocity, s.angular_velocity, s.force,
                                      s.torque, s.mass, s.inertia, sim.integrator.damping,
                                      sim.dt, s.reference_position, limit, s.flags)),
@@ -233,10 +283,32 @@ class GpuSimulation:
         self.sim.step += 1
         self.sim.time += self.sim.dt
         self.sim.hold(self)
+        self._holding = True
+
+    def _advance_and_write(self):
+        """One step on the device, then the writers (Simulation.advance's order)."""
+        self.advance()
+        for writer in self.sim.writers:
+            writer.apply(self.sim)
+
+    def _report_failure(self):
+        """StageFailed (MixedStress.failure) of a mixed condition the device could not hold,
+        the first since the last report; nothing when none."""
+        if not self._mixed:
+            return
+        record = self.state.failure.copy_to_host()
+        if record[0] == 0.0:
+            return
+        self.state.failure.copy_to_device(np.zeros_like(record))
+        _, row, step, axis, target, axial = record
+        raise self._controls[int(row)].failure(int(step), int(axis), float(target),
+                                               float(axial))
 
     def check(self):
-        """Read the device's flags: RuntimeError when a cell or a row overflowed (the list
-        would miss pairs), FloatingPointError when a position is not finite."""
+        """Read the device's flags: StageFailed when a mixed condition could not be held,
+        RuntimeError when a cell or a row overflowed (the list would miss pairs),
+        FloatingPointError when a position is not finite."""
+        self._report_failure()
         _, overflow, not_finite = self.state.flags_now()
         if not_finite:
             raise FloatingPointError("a particle's position is not finite on the GPU: the "
@@ -255,33 +327,15 @@ class GpuSimulation:
     def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
         """Advance ``steps`` steps on the device, or fewer if ``until(sim)`` becomes true
         (checked every ``check_every`` steps); the writers after every step, as on the CPU
-        (module docstring). Arguments and result as Simulation.run; the state stays held by
-        the device until read (``to_host``; Simulation.run brings it back as it returns)."""
+        (module docstring), and ``check`` after every ``check_every`` steps. Arguments and
+        result as Simulation.run; the state stays held by the device until read
+        (``to_host``; Simulation.run brings it back as it returns)."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
         self._configure()
-        sim = self.sim
-        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
-                   mininterval=1.0, smoothing=0.05, disable=progress is None)
-        taken = 0
-        started = time.perf_counter()
-        try:
-            while taken < steps:
-                chunk = min(check_every, steps - taken)
-                for _ in range(chunk):
-                    self.advance()
-                    for writer in sim.writers:
-                        writer.apply(sim)
-                taken += chunk
-                bar.update(chunk)
-                self.check()
-                if status is not None and time.perf_counter() - started > 1.0:
-                    bar.set_postfix(status(sim), refresh=False)
-                if until is not None and until(sim):
-                    break
-        finally:
-            bar.close()
-        return taken
+        return self.sim.run_chunks(steps, self._advance_and_write, check=self.check,
+                                   until=until, check_every=check_every, progress=progress,
+                                   status=status)
 
     def to_host(self):
         """Bring the device's state into ``sim`` now (Simulation.release; nothing to do when
@@ -292,12 +346,16 @@ class GpuSimulation:
         """Copy the device's state into ``sim`` (called by Simulation.release): particles,
         walls, the neighbour list with its per-pair state (rebuilt by the CPU's NeighborList
         from it, so that the CPU can go on from here) and the servos' memory; with ``part``
-        "walls", the walls alone."""
+        "walls", the walls alone. Then StageFailed if a mixed condition could not be held
+        (``check``), so that nothing reads a state past the failure."""
         sim = self.sim
         if part == "walls":
             self.state.walls_to_host(sim.walls)
+            self._report_failure()
             return
+        self._holding = False
         self.state.to_host(sim)
+        self._targets_to_host()
         s = self.state
         previous = s.previous.copy_to_host()
         stiffness = s.stiffness.copy_to_host()
@@ -316,6 +374,7 @@ class GpuSimulation:
                                     sim.contacts.pair_j)
         sim.contacts.force = carry_pair_array(listed.force, index)
         sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
+        self._report_failure()
 
     @property
     def rebuilds(self):

@@ -98,6 +98,13 @@ class DeviceState:
         self.normal = to(rows["normal"])
         self.overlap = to(rows["overlap"])
         self.bridges = to(rows["bridges"])
+        # each slot's first member (k = s * N + p: p), which the CPU's bridge law reads as
+        # pair_i when a bridge forms (pendular.gpu.forces.pair_forces); wet scenes only
+        self.pair_i = to(np.tile(np.arange(count, dtype=np.int32), self.width) if wet
+                         else np.zeros(1, np.int32))
+        # the periodic image and period the CPU's contact law takes, not read inside walls
+        self.no_image = to(np.zeros((1, 3), np.int8))
+        self.no_period = to(np.zeros(3))
         self.normal_force = to(np.zeros(pairs))
         self.pair_force = to(np.zeros((pairs, 3)))
         self.second_count = to(np.zeros(count, np.int32))

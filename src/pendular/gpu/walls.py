@@ -1,17 +1,26 @@
 """The six walls on the device: the particles' forces on them reduced in a fixed order, then
-the walls' controls (stress servo, constant strain rate) in the scene's order, with no host
-round trip (pendular.dem.walls on the CPU).
+the walls' controls (stress servo, constant strain rate, mixed stress condition) in the scene's
+order, with no host round trip (pendular.dem.walls and pendular.dem.mixed_stress on the CPU).
 
 The reduction: each block of REDUCE_CHUNK particles sums its contacts with each wall in
 particle order (``wall_partials``), then one thread per wall quantity adds the blocks in order
 (``wall_sums``): for up to REDUCE_CHUNK particles the CPU's sum (pendular.dem.contact_law.
 wall_forces) in the CPU's order.
 
-The controls are a small program: row c of ``kinds`` is STRESS_SERVO or STRAIN_RATE, its walls
-in ``control_walls[c, :wall_counts[c]]``, its parameters in ``parameters[c]`` (SERVO_FIELDS or
-STRAIN_RATE_FIELDS) and a servo's memory in ``previous[c]``, ``stiffness[c]`` and
-``calls[c]`` (pendular.dem.walls.StressServo's ``previous``, ``stiffness``, ``calls``).
+The controls are a small program: row c of ``kinds`` is STRESS_SERVO, STRAIN_RATE or
+MIXED_STRESS, its walls in ``control_walls[c, :wall_counts[c]]``, its parameters in
+``parameters[c]`` (SERVO_FIELDS, STRAIN_RATE_FIELDS or MIXED_FIELDS) and a servo's memory in
+``previous[c]``, ``stiffness[c]`` and ``calls[c]`` (pendular.dem.walls.StressServo's
+``previous``, ``stiffness``, ``calls``). A mixed condition's row holds no walls:
+``control_walls[c, axis]`` (axis 0-2) is the row of the servo it sets on that axis (-1: none),
+``control_walls[c, 3:3 + wall_counts[c]]`` its free axes in order; it writes the servos'
+targets (``parameters[row, 0]``), and a target below zero is written instead into
+``failure`` (FAILURE_FIELDS), the first since the host last read it, for the host to raise
+(pendular.dem.mixed_stress.MixedStress.failure). ``step[0]`` counts the steps as the
+Simulation does (its ``step`` when the run started), for that message.
 """
+
+import math
 
 from pendular.dem.walls import StressServo
 from pendular.gpu.cuda import cuda, device
@@ -26,10 +35,16 @@ WALL_SUMS = 3
 
 STRESS_SERVO = 0
 STRAIN_RATE = 1
-#: parameters[c] of a servo and of a constant strain rate.
+MIXED_STRESS = 2
+#: parameters[c] of a servo, of a constant strain rate and of a mixed condition (NaN: a mean
+#: stress or b not held, an axis given no stress).
 SERVO_FIELDS = ("target", "gain", "memory", "max_velocity", "scale_max_velocity",
                 "stiffness_every")
 STRAIN_RATE_FIELDS = ("rate", "reference_length", "on_current_length")
+MIXED_FIELDS = ("mean_stress", "b", "stress_x", "stress_y", "stress_z")
+#: failure[:] of a mixed condition that cannot hold (failed: 0 none, 1 one to report; row:
+#: the control's; step, axis, target [Pa] and sigma_z [Pa] of the message).
+FAILURE_FIELDS = ("failed", "row", "step", "axis", "target", "sigma_z")
 
 
 @cuda.jit
@@ -114,6 +129,80 @@ def strain_rate(c, control_walls, parameters, previous, wall_position, wall_velo
     move_walls(wall_position, wall_velocity, c, control_walls, 2, previous, dt)
 
 
+@device
+def wall_stress(axis, wall_force, wall_position):
+    """Mean normal stress [Pa] of the two walls of ``axis``, compression positive
+    (pendular.dem.state.Walls.stress: each wall's force over the face's area, then their
+    mean)."""
+    lx = wall_position[1] - wall_position[0]
+    ly = wall_position[3] - wall_position[2]
+    lz = wall_position[5] - wall_position[4]
+    area = ly * lz if axis == 0 else (lx * lz if axis == 1 else lx * ly)
+    return 0.5 * (wall_force[2 * axis] / area + wall_force[2 * axis + 1] / area)
+
+
+@device
+def given_stress(c, axis, parameters, wall_force, wall_position):
+    """The stress of ``axis`` [Pa] a mixed condition counts: the one given its servo, else
+    the walls' now (MixedStress.targets's ``given``)."""
+    given = parameters[c, 2 + axis]
+    if math.isnan(given):
+        return wall_stress(axis, wall_force, wall_position)
+    return given
+
+
+@device
+def set_target(c, axis, target, control_walls, parameters, step, axial, failure):
+    """Give the servo of ``axis`` the ``target`` [Pa] of mixed condition c; False (and the
+    failure recorded, unless one is waiting for the host) when the target is below zero or
+    not a number (MixedStress.apply)."""
+    if not target >= 0.0:
+        if failure[0] == 0.0:
+            failure[1] = c
+            failure[2] = step
+            failure[3] = axis
+            failure[4] = target
+            failure[5] = axial
+            failure[0] = 1.0
+        return False
+    parameters[control_walls[c, axis], 0] = target
+    return True
+
+
+@device
+def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position, step,
+                 failure):
+    """One call of MixedStress c (pendular.dem.mixed_stress.MixedStress.targets and apply:
+    the same operations in the same order), setting its servos' targets in its order; stops
+    at a target below zero."""
+    mean = parameters[c, 0]
+    b = parameters[c, 1]
+    axial = wall_stress(2, wall_force, wall_position)
+    if math.isnan(b):
+        others = 0.0
+        for axis in range(3):
+            free = False
+            for slot in range(count):
+                free = free or control_walls[c, 3 + slot] == axis
+            if not free:
+                others += given_stress(c, axis, parameters, wall_force, wall_position)
+        share = (3.0 * mean - others) / count
+        for slot in range(count):
+            if not set_target(c, control_walls[c, 3 + slot], share, control_walls, parameters,
+                              step, axial, failure):
+                return
+        return
+    if math.isnan(mean):
+        minor = given_stress(c, 0, parameters, wall_force, wall_position)
+        set_target(c, 1, minor + b * (axial - minor), control_walls, parameters, step, axial,
+                   failure)
+        return
+    minor = (3.0 * mean - (1.0 + b) * axial) / (2.0 - b)
+    if set_target(c, 0, minor, control_walls, parameters, step, axial, failure):
+        set_target(c, 1, minor + b * (axial - minor), control_walls, parameters, step, axial,
+                   failure)
+
+
 @cuda.jit
 def wall_sums(partial, wall_force, wall_stiffness, wall_moment):
     """One thread per wall and quantity: the blocks' partial sums added in order into the
@@ -137,18 +226,22 @@ def wall_sums(partial, wall_force, wall_stiffness, wall_moment):
 @cuda.jit
 def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts, parameters,
                   previous, stiffness, calls, wall_position, wall_velocity, reference_walls,
-                  limit, dt, flags):
-    """One thread: the controls in order, then a neighbour-list rebuild asked when a wall has
-    moved more than ``limit`` [m] since the last one."""
+                  limit, dt, step, failure, flags):
+    """One thread: the controls in order, the step counted, then a neighbour-list rebuild
+    asked when a wall has moved more than ``limit`` [m] since the last one."""
     if cuda.grid(1) != 0:
         return
     for c in range(kinds.shape[0]):
         if kinds[c] == STRESS_SERVO:
             servo(c, control_walls, wall_counts[c], parameters, previous, stiffness, calls,
                   wall_position, wall_velocity, wall_force, wall_stiffness, dt)
-        else:
+        elif kinds[c] == STRAIN_RATE:
             strain_rate(c, control_walls, parameters, previous, wall_position,
                         wall_velocity, dt)
+        else:
+            mixed_stress(c, control_walls, wall_counts[c], parameters, wall_force,
+                         wall_position, step[0], failure)
+    step[0] += 1
     for w in range(6):
         if abs(wall_position[w] - reference_walls[w]) > limit:
             flags[0] = 1
