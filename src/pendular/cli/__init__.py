@@ -121,6 +121,17 @@ def add_executor_options(parser):
     add_run_options(parser, threads_default=1)
 
 
+def start_executor_run(args):
+    """Check the options of add_executor_options and --out before anything is made (errors
+    naming the option), and apply --threads."""
+    from pendular.studies.campaign import check_jobs
+
+    if args.out == "":
+        raise UsageError("--out '': an output folder is required")
+    set_threads(args.threads)
+    check_jobs(args.jobs)
+
+
 def add_declared_options(parser, options):
     """Add to ``parser`` the declared ``options`` (pendular.utils.parameters.Option; a
     laboratory command's: pendular.procedures.options.options_of, a study's: its module's) in

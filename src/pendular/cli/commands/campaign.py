@@ -23,9 +23,9 @@ command then ends with an error naming it (its traceback is in its log.txt).
 
 import os
 
-from pendular.studies.campaign import (Campaign, RunRefused, check_jobs, sweep_from_table,
+from pendular.studies.campaign import (Campaign, RunRefused, sweep_from_table,
                                        write_campaign_csv)
-from pendular.cli import UsageError, add_executor_options, set_threads
+from pendular.cli import UsageError, add_executor_options, start_executor_run
 from pendular.io.outputs import OutputFolder
 
 
@@ -36,10 +36,7 @@ def add_arguments(parser):
 
 
 def run(args):
-    if args.out == "":
-        raise UsageError("--out '': an output folder is required")
-    set_threads(args.threads)
-    check_jobs(args.jobs)
+    start_executor_run(args)             # before the output folder is made
     command, runs = sweep_from_table(args.table)
     # keep: the finished runs of an earlier campaign there are reused; runs/ is never owned
     with OutputFolder(args.out, ["campaign", args.table], keep=True) as folder:

@@ -5,10 +5,9 @@ and Sr beside the thesis's, Mohr–Coulomb envelopes in net and effective stress
 override it. Finished runs with equal configurations are reused. Each run has --threads Numba
 threads (one by default) and its own log.txt with its progress."""
 
-from pendular.studies.campaign import check_jobs
 from pendular.studies.chapter5 import chapter5_campaign, grid_from_options, grid_options
-from pendular.cli import (UsageError, add_declared_options, add_executor_options,
-    declared_values, set_threads)
+from pendular.cli import (add_declared_options, add_executor_options, declared_values,
+    start_executor_run)
 
 
 def add_arguments(parser):
@@ -18,10 +17,7 @@ def add_arguments(parser):
 
 
 def run(args):
-    if args.out == "":
-        raise UsageError("--out '': an output folder is required")
-    set_threads(args.threads)
-    check_jobs(args.jobs)                # before the output folder is made
+    start_executor_run(args)             # before the output folder is made
     grid = grid_from_options(declared_values(grid_options(), args))
     campaign, reused = chapter5_campaign(grid, args.out, jobs=args.jobs,
                                          scheduler=args.scheduler, threads=args.threads,
