@@ -164,6 +164,17 @@ def _cell_coordinates(cell, dims):
     return cell // (dims[1] * dims[2]), (cell // dims[2]) % dims[1], cell % dims[2]
 
 
+@numba.njit(cache=True, inline="always")
+def _within_reach(position, radius, skin, p, q):
+    """Whether particles p and q are closer than r_p + r_q + ``skin`` [m] (centre to centre,
+    no periodic image): the Verlet list's test, the GPU's too (pendular.gpu.neighbors)."""
+    reach = radius[p] + radius[q] + skin
+    d0 = position[q, 0] - position[p, 0]
+    d1 = position[q, 1] - position[p, 1]
+    d2 = position[q, 2] - position[p, 2]
+    return d0 * d0 + d1 * d1 + d2 * d2 < reach * reach
+
+
 @numba.njit(cache=True)
 def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles, out):
     """Count the j > p within r_p + r_j + skin; return how many. While ``out`` has room they
@@ -188,11 +199,7 @@ def _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_par
                     q = cell_particles[slot]
                     if q <= p:
                         continue
-                    reach = radius[p] + radius[q] + skin
-                    d0 = position[q, 0] - position[p, 0]
-                    d1 = position[q, 1] - position[p, 1]
-                    d2 = position[q, 2] - position[p, 2]
-                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                    if _within_reach(position, radius, skin, p, q):
                         if found < room:        # insertion keeps the row sorted by j
                             k = found
                             while k > 0 and out[k - 1] > q:

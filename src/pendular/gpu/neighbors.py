@@ -22,7 +22,11 @@ checks (pendular.gpu.simulation).
 
 import math
 
-from pendular.gpu.cuda import cuda, device
+from pendular.dem.neighbors import _cell_coordinates, _within_reach
+from pendular.gpu.cuda import cuda, device, device_twin
+
+within_reach = device_twin(_within_reach)
+cell_coordinates = device_twin(_cell_coordinates)
 
 #: Bits of flags[1].
 CELL_OVERFLOW = 1
@@ -117,10 +121,7 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
     if flags[0] == 0 or p >= position.shape[0]:
         return
     d0, d1, d2 = grid_shape(wall_position, cell_size, max_dims)
-    cell = cell_of[p]
-    cz = cell % d2
-    cy = (cell // d2) % d1
-    cx = cell // (d1 * d2)
+    cx, cy, cz = cell_coordinates(cell_of[p], (d0, d1, d2))
     n = position.shape[0]
     above = 0
     below = 0
@@ -133,11 +134,7 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
                     q = cell_members[slot]
                     if q == p:
                         continue
-                    reach = radius[p] + radius[q] + skin
-                    e0 = position[q, 0] - position[p, 0]
-                    e1 = position[q, 1] - position[p, 1]
-                    e2 = position[q, 2] - position[p, 2]
-                    if e0 * e0 + e1 * e1 + e2 * e2 < reach * reach:
+                    if within_reach(position, radius, skin, p, q):
                         if q > p:
                             above = insert_sorted(new_pair_j, p, n, above, width, q, flags)
                         else:
