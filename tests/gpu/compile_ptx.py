@@ -1,7 +1,7 @@
-"""Compile every kernel of a dry and a wet step for a real GPU (PTX, by default for compute
-capability 9.0, an H100) without one, as a script in its own process: the simulator runs
-kernels as Python and would not see code that the CUDA target cannot compile (a NumPy ufunc, a
-global it cannot type).
+"""Compile every kernel of a dry and a wet step (and a radius growth's) for a real GPU (PTX,
+by default for compute capability 9.0, an H100) without one, as a script in its own process:
+the simulator runs kernels as Python and would not see code that the CUDA target cannot
+compile (a NumPy ufunc, a global it cannot type).
 
 It needs NVVM and NVRTC. The gpu extra installs CUDA 13's (the wheels nvidia-nvvm and
 nvidia-cuda-nvrtc, in site-packages/nvidia/cu13), which numba-cuda finds there itself
@@ -51,7 +51,8 @@ class HostArray(np.ndarray):
 
 
 def compile_step_kernels(cuda, capability):
-    """{kernel (and " wet"): PTX lines} of every kernel of a dry and a wet step."""
+    """{kernel (and " wet"): PTX lines} of every kernel of a dry and a wet step, and of the
+    homogenisation at a record step (pendular.gpu.homogenize)."""
     import numba
     import numba.cuda.dispatcher as dispatcher
 
@@ -59,17 +60,30 @@ def compile_step_kernels(cuda, capability):
         compute_capability=capability)
     cuda.to_device = lambda values: np.array(values, copy=True).view(HostArray)
     from pendular.gpu import GpuSimulation
+    from pendular.gpu.homogenize import COLUMNS, launches
     from simulated import scene
 
     compiled = {}
     for wet in (False, True):
         gpu = GpuSimulation(scene(wet=wet))
         gpu._configure()
-        for kernel, _, args in gpu._steps:
+        reduction = launches(gpu, np.zeros((2, COLUMNS)), np.zeros(COLUMNS))
+        for kernel, _, args in (*gpu._steps, *reduction):
             signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
                               for a in args)
             ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
+    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene)
+    from test_gpu_growth import scene as growth_scene
+
+    gpu = GpuSimulation(growth_scene())
+    gpu._configure()
+    for kernel, _, args in gpu._steps:
+        if kernel.py_func.__name__ not in compiled:
+            signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
+                              for a in args)
+            ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
+            compiled[kernel.py_func.__name__] = ptx.count("\n")
     return compiled
 
 

@@ -18,8 +18,8 @@ SRC = os.path.join(ROOT, "src")
 #: one way up is declared: pendular.dem.simulation imports a device's module (DEVICE_MODULES,
 #: e.g. pendular.gpu) by name when a Simulation first asks for that device
 #: (test_the_device_registry_is_the_one_plug_in_point).
-LAYER_ORDER = ("pendular.utils", "pendular.dem", "pendular.capillary", "pendular.gpu",
-               "pendular.homogenize", "pendular.io", "pendular.procedures", "pendular.interop",
+LAYER_ORDER = ("pendular.utils", "pendular.dem", "pendular.capillary", "pendular.homogenize",
+               "pendular.gpu", "pendular.io", "pendular.procedures", "pendular.interop",
                "pendular.studies", "pendular.cli", "pendular")
 LAYERS = {layer: set(LAYER_ORDER[:rank + 1]) for rank, layer in enumerate(LAYER_ORDER)}
 

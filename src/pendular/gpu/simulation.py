@@ -25,15 +25,17 @@ raises the CPU's StageFailed at its next check or, earlier, when anything reads 
 (``copy_back``), so that no writer records a state past the failure.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
-wet, SuctionBridges at contact (``persist`` False); controls StressServo, ConstantStrainRate
-and MixedStress (its servos among the controls); the Integrator. Anything else is refused by
-name (ValueError), so that a scene never runs with part of its physics missing.
+wet, SuctionBridges at contact (``persist`` False); controls StressServo, ConstantStrainRate,
+MixedStress (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.
+growth); the Integrator. Anything else is refused by name (ValueError), so that a scene never
+runs with part of its physics missing.
 """
 
 import numpy as np
 
 from pendular.capillary.bridges import SuctionBridges
 from pendular.dem.contact_law import ContactForces
+from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.mixed_stress import MixedStress
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
@@ -41,6 +43,8 @@ from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import forces, integrate, neighbors, walls as device_walls
 from pendular.gpu.cuda import configured, cuda, simulated
+from pendular.gpu.growth import DeviceGrowth
+from pendular.gpu.homogenize import device_homogenization
 from pendular.gpu.state import DeviceState
 from pendular.utils.validate import check_int
 
@@ -80,13 +84,18 @@ def check_scene(sim):
                          "(persist = False)")
     controls = sim.peek("controls")
     for op in controls:
-        if type(op) not in (StressServo, ConstantStrainRate) and not isinstance(op, MixedStress):
+        if type(op) not in (StressServo, ConstantStrainRate, RadiusGrowth) \
+                and not isinstance(op, (MixedStress, GrowthTimeStep)):
             raise ValueError(f"device='gpu' does not run the control {type(op).__name__} yet "
-                             "(valid: StressServo, ConstantStrainRate, MixedStress)")
+                             "(valid: StressServo, ConstantStrainRate, MixedStress, "
+                             "RadiusGrowth, GrowthTimeStep)")
         if isinstance(op, MixedStress) and not all(
                 any(op.servos[axis] is other for other in controls) for axis in op.free):
             raise ValueError("device='gpu' runs a MixedStress whose servos are among the "
                              "scene's controls only")
+    for kind in (RadiusGrowth, GrowthTimeStep):
+        if sum(isinstance(op, kind) for op in controls) > 1:
+            raise ValueError(f"device='gpu' runs at most one {kind.__name__} among the controls")
 
 
 class GpuSimulation:
@@ -115,7 +124,10 @@ class GpuSimulation:
             self._table = tuple(cuda.to_device(np.zeros(shape)) for shape in
                                 ((1,), (3,), (1, 1), (1, 1), (1, 1, 1, 1)))
             self._suction = 0.0
-        self.state = DeviceState(sim, sim.neighbors.skin, bridges is not None)
+        self._growth = DeviceGrowth.of(tuple(sim.controls), sim.walls)
+        self.state = (DeviceState(sim, sim.neighbors.skin, bridges is not None)
+                      if self._growth is None else
+                      self._growth.grown_state(sim, sim.neighbors.skin, bridges is not None))
         self._controls = tuple(sim.controls)
         self._mixed = tuple(c for c, op in enumerate(self._controls)
                             if isinstance(op, MixedStress))
@@ -154,6 +166,12 @@ class GpuSimulation:
             elif type(op) is ConstantStrainRate:
                 kinds[c] = device_walls.STRAIN_RATE
                 walls = (2 * op.axis, 2 * op.axis + 1)
+            elif type(op) is RadiusGrowth:
+                kinds[c] = device_walls.RADIUS_GROWTH
+                continue
+            elif isinstance(op, GrowthTimeStep):
+                kinds[c] = device_walls.GROWTH_TIMESTEP
+                continue
             else:
                 kinds[c] = device_walls.MIXED_STRESS
                 control_walls[c, :3] = [self._row(op.servos[axis]) if axis in op.free else -1
@@ -183,7 +201,9 @@ class GpuSimulation:
                                  float(op.scale_max_velocity), float(op.stiffness_every))
             elif type(op) is ConstantStrainRate:
                 parameters[c, :3] = (op.rate, op.reference_length, float(op.on_current_length))
-            else:
+            elif type(op) is RadiusGrowth:
+                parameters[c, :2] = (op.target_stress, op.max_rate)
+            elif isinstance(op, MixedStress):
                 parameters[c, :5] = (np.nan if op.mean_stress is None else op.mean_stress,
                                      np.nan if op.b is None else op.b,
                                      *(op.stress.get(axis, np.nan) for axis in range(3)))
@@ -270,6 +290,8 @@ class GpuSimulation:
                                      s.torque, s.mass, s.inertia, sim.integrator.damping,
                                      sim.dt, s.reference_position, limit, s.flags)),
         ]
+        if self._growth is not None:
+            self._steps = self._growth.launches(self._steps, s, sim, limit)
         self._launches = [(configured(kernel, items), args)
                           for kernel, items, args in self._steps]
 
@@ -278,8 +300,12 @@ class GpuSimulation:
         """One step on the device (launches only); sim.step and sim.time advance, the rest of
         sim's state is held by the device (Simulation.hold) until read."""
         idle = simulated() and self.state.flags[0] == 0
-        for kernel, args in self._launches[REBUILD_LAUNCHES if idle else 0:]:
-            kernel(*args)
+        launches = self._launches[REBUILD_LAUNCHES if idle else 0:]
+        if self._growth is not None:        # sets dt mid-step at a rebuild
+            self._growth.advance(self, launches)
+        else:
+            for kernel, args in launches:
+                kernel(*args)
         self.sim.step += 1
         self.sim.time += self.sim.dt
         self.sim.hold(self)
@@ -355,6 +381,8 @@ class GpuSimulation:
             return
         self._holding = False
         self.state.to_host(sim)
+        if self._growth is not None:
+            self._growth.to_host(sim, self.state)
         self._targets_to_host()
         s = self.state
         previous = s.previous.copy_to_host()
@@ -374,9 +402,31 @@ class GpuSimulation:
                                     sim.contacts.pair_j)
         sim.contacts.force = carry_pair_array(listed.force, index)
         sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
+        if self._growth is not None:
+            self._growth.after_copy_back(sim)
         self._report_failure()
 
     @property
     def rebuilds(self):
         """Neighbour-list rebuilds on the device so far."""
         return int(self.state.rebuilds.copy_to_host()[0])
+
+    #: (step, time, volume) of the last homogenisation and its quantities (``homogenized``).
+    _homogenized = (None, None)
+
+    def homogenized(self, volume=None):
+        """The homogenised quantities of the state the device holds, reduced on the device
+        (pendular.gpu.homogenize.device_homogenization: small arrays named as the history's
+        columns, computed once per step, so that a record's columns share one reduction);
+        ``volume`` [m^3], None: the box inside the walls. No particle state comes back.
+        StageFailed first if a mixed condition could not be held (as ``copy_back``);
+        RuntimeError when the device holds no state (it came back to the host, whose copy may
+        have changed since: homogenise it there)."""
+        if not self._holding:
+            raise RuntimeError("the GPU holds no state now (it came back to the host): "
+                               "homogenise the host's state")
+        self._report_failure()
+        key = (self.sim.step, self.sim.time, volume)
+        if self._homogenized[0] != key:
+            self._homogenized = (key, device_homogenization(self, volume))
+        return self._homogenized[1]

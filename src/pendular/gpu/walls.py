@@ -1,17 +1,19 @@
 """The six walls on the device: the particles' forces on them reduced in a fixed order, then
-the walls' controls (stress servo, constant strain rate, mixed stress condition) in the scene's
-order, with no host round trip (pendular.dem.walls and pendular.dem.mixed_stress on the CPU).
+the walls' controls (stress servo, constant strain rate, mixed stress condition, the rate of a
+radius growth) in the scene's order, with no host round trip (pendular.dem.walls,
+pendular.dem.mixed_stress and pendular.dem.growth on the CPU).
 
 The reduction: each block of REDUCE_CHUNK particles sums its contacts with each wall in
 particle order (``wall_partials``), then one thread per wall quantity adds the blocks in order
 (``wall_sums``): for up to REDUCE_CHUNK particles the CPU's sum (pendular.dem.contact_law.
 wall_forces) in the CPU's order.
 
-The controls are a small program: row c of ``kinds`` is STRESS_SERVO, STRAIN_RATE or
-MIXED_STRESS, its walls in ``control_walls[c, :wall_counts[c]]``, its parameters in
-``parameters[c]`` (SERVO_FIELDS, STRAIN_RATE_FIELDS or MIXED_FIELDS) and a servo's memory in
-``previous[c]``, ``stiffness[c]`` and ``calls[c]`` (pendular.dem.walls.StressServo's
-``previous``, ``stiffness``, ``calls``). A mixed condition's row holds no walls:
+The controls are a small program: row c of ``kinds`` is STRESS_SERVO, STRAIN_RATE,
+MIXED_STRESS, RADIUS_GROWTH or GROWTH_TIMESTEP, its walls in
+``control_walls[c, :wall_counts[c]]``, its parameters in ``parameters[c]`` (SERVO_FIELDS,
+STRAIN_RATE_FIELDS, MIXED_FIELDS or GROWTH_FIELDS) and a servo's memory in ``previous[c]``,
+``stiffness[c]`` and ``calls[c]`` (pendular.dem.walls.StressServo's ``previous``,
+``stiffness``, ``calls``). A mixed condition's row holds no walls:
 ``control_walls[c, axis]`` (axis 0-2) is the row of the servo it sets on that axis (-1: none),
 ``control_walls[c, 3:3 + wall_counts[c]]`` its free axes in order; it writes the servos'
 targets (``parameters[row, 0]``), and a target below zero is written instead into
@@ -36,12 +38,18 @@ WALL_SUMS = 3
 STRESS_SERVO = 0
 STRAIN_RATE = 1
 MIXED_STRESS = 2
+#: A radius growth's row sets its rate (pendular.gpu.growth grows the radii); a growth time
+#: step's row does nothing on the device (the host sets dt at the rebuilds).
+RADIUS_GROWTH = 3
+GROWTH_TIMESTEP = 4
 #: parameters[c] of a servo, of a constant strain rate and of a mixed condition (NaN: a mean
 #: stress or b not held, an axis given no stress).
 SERVO_FIELDS = ("target", "gain", "memory", "max_velocity", "scale_max_velocity",
                 "stiffness_every")
 STRAIN_RATE_FIELDS = ("rate", "reference_length", "on_current_length")
 MIXED_FIELDS = ("mean_stress", "b", "stress_x", "stress_y", "stress_z")
+#: parameters[c] of a radius growth: its target [Pa] and max_rate, the rate g it sets this step.
+GROWTH_FIELDS = ("target_stress", "max_rate", "rate")
 #: failure[:] of a mixed condition that cannot hold (failed: 0 none, 1 one to report; row:
 #: the control's; step, axis, target [Pa] and sigma_z [Pa] of the message).
 FAILURE_FIELDS = ("failed", "row", "step", "axis", "target", "sigma_z")
@@ -203,6 +211,16 @@ def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position,
                    failure)
 
 
+@device
+def growth_rate(c, parameters, wall_force, wall_position):
+    """The rate g of RadiusGrowth c this step into ``parameters[c, 2]``: max_rate clip(1 -
+    sigma_mean / target, -1, 1), sigma_mean the mean of the three axes' wall stresses
+    (pendular.dem.growth.RadiusGrowth.apply, the CPU's mean summed in the same order)."""
+    mean = (wall_stress(0, wall_force, wall_position) + wall_stress(1, wall_force, wall_position)
+            + wall_stress(2, wall_force, wall_position)) / 3.0
+    parameters[c, 2] = parameters[c, 1] * min(max(1.0 - mean / parameters[c, 0], -1.0), 1.0)
+
+
 @cuda.jit
 def wall_sums(partial, wall_force, wall_stiffness, wall_moment):
     """One thread per wall and quantity: the blocks' partial sums added in order into the
@@ -238,9 +256,11 @@ def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts,
         elif kinds[c] == STRAIN_RATE:
             strain_rate(c, control_walls, parameters, previous, wall_position,
                         wall_velocity, dt)
-        else:
+        elif kinds[c] == MIXED_STRESS:
             mixed_stress(c, control_walls, wall_counts[c], parameters, wall_force,
                          wall_position, step[0], failure)
+        elif kinds[c] == RADIUS_GROWTH:
+            growth_rate(c, parameters, wall_force, wall_position)
     step[0] += 1
     for w in range(6):
         if abs(wall_position[w] - reference_walls[w]) > limit:

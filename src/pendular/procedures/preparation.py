@@ -2,7 +2,8 @@
 
 1. A random non-overlapping cloud in a fixed frictionless box, friction ``prep_friction`` (0.5°).
 2. Radii grown homogeneously until the mean wall stress reaches ``prep_stress`` (5 kPa) and the
-   packing is in quasi-static equilibrium.
+   packing is in quasi-static equilibrium (the engine's controls pendular.dem.growth, which the
+   GPU runs too).
 3. The whole sample rescaled so that the mean radius is the nominal one. With linear springs
    kn = E R, forces scale as R^2 and stresses are unchanged.
 4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
@@ -22,9 +23,11 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
+from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.neighbors import NeighborList, spatial_order
@@ -207,24 +210,6 @@ def random_cloud(count, radius, lo, hi, seed):
     return position
 
 
-class RadiusGrowth:
-    """Grow all radii by (1 + g) per step, g = max_rate * clip(1 - sigma_mean / target, -1, 1).
-
-    A control (it reads the wall stress of this step's forces); masses follow the radii
-    (constant density). target_stress [Pa].
-    """
-
-    def __init__(self, target_stress, max_rate):
-        self.target_stress = check_positive("prep_stress", target_stress, "Pa")
-        self.max_rate = check_positive("growth max_rate", max_rate)
-
-    def apply(self, sim):
-        mean_stress = float(np.mean(sim.walls.stress()))
-        rate = self.max_rate * float(np.clip(1.0 - mean_stress / self.target_stress, -1.0, 1.0))
-        sim.particles.radius *= 1.0 + rate
-        sim.particles.update_mass()
-
-
 #: Largest stress / young of a sample: linear springs kn = E R hold a stress sigma with
 #: overlaps of about 8 sigma / E times the radius at the most loaded contact (measured on
 #: prepared samples), so 0.02 keeps every overlap below about 16 % of the radius.
@@ -373,20 +358,13 @@ def timestep(sim, config):
     return pwave_step(sim.particles.radius, config)
 
 
-class GrowthTimeStep:
-    """A control of the radius growth under the 'stiffness' rule: dt = timestep_safety times
-    the P-wave estimate of the current radii, at every neighbour-list rebuild (the spheres grow
-    from 0.6 of their size and the step with them; a cloud whose contacts are still forming
-    has no contact network to read a critical step from)."""
+class GrowthTimeStep(growth.GrowthTimeStep):
+    """The radius growth's time step (pendular.dem.growth.GrowthTimeStep) under the
+    'stiffness' rule, with ``config``'s timestep_safety, young and density: pwave_step of the
+    current radii at every neighbour-list rebuild."""
 
     def __init__(self, config):
-        self.config = config
-        self._rebuilds = None
-
-    def apply(self, sim):
-        if sim.neighbors.rebuilds != self._rebuilds:
-            self._rebuilds = sim.neighbors.rebuilds
-            sim.dt = pwave_step(sim.particles.radius, self.config)
+        super().__init__(config.timestep_safety, config.young, config.density)
 
 
 def static(unbalanced=0.01, tolerance=0.01):
@@ -411,10 +389,11 @@ def equilibrated(config):
     return static(config.equilibrium_unbalanced, config.stress_tolerance)
 
 
-def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None):
+def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None,
+                   device="cpu"):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m], linear
     contacts at ``friction_deg`` [deg], wall springs (none in a periodic cell), the given
-    wall ``controls``, leapfrog."""
+    wall ``controls``, leapfrog; its runs on ``device`` ("cpu" or "gpu")."""
     forces = [ContactForces(config.young, config.shear_ratio, friction_deg)]
     if not walls.periodic:
         forces.append(WallForces(config.young))
@@ -423,7 +402,7 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
                       forces=forces,
                       controls=controls,
                       integrator=Integrator(config.damping),
-                      threads=threads)
+                      threads=threads, device=device)
 
 
 def servoed_simulation(particles, walls, config, target, threads=None):
@@ -458,7 +437,8 @@ def rescale(sim, factor):
 GROWTH_SKIN_FACTOR = 0.3
 
 
-def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, writers=()):
+def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, writers=(),
+                   device="cpu"):
     """Run the preparation of thesis Ch. 5.2.2; return (Simulation at the confining stress, report).
 
     The returned simulation is the dry scene with the six walls servoed at the confining
@@ -468,6 +448,10 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     to the simulation's writers for the whole preparation and removed before it returns; a
     writer with an attribute ``phase`` has it set to the running phase's name
     (PREPARATION_PHASES) when the phase starts. They change no result.
+    ``device``: where the phases run, "cpu" or "gpu" (docs/gpu.md): each phase's run copies
+    the state to the device and back (the rescaling and the change of controls between them
+    run on the host); the returned simulation runs on the CPU (set its ``device`` to go on
+    elsewhere).
     """
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -493,7 +477,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         growth.append(GrowthTimeStep(config))
     sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
                          GROWTH_SKIN_FACTOR * config.radius,
-                         config.prep_friction_deg, growth, threads)
+                         config.prep_friction_deg, growth, threads, device)
     writers = list(writers)
     sim.writers.extend(writers)
     done = equilibrated(config)
@@ -536,6 +520,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)
     sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
+    sim.device = "cpu"
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),
