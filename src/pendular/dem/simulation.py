@@ -171,6 +171,13 @@ class Simulation:
         del state["_holder"]
         run.copy_back(None)
 
+    def homogenized(self):
+        """The homogenised quantities of the state from the device run holding it, reduced
+        there (its ``homogenized()``: a dict named as the history's columns, the state left
+        on the device), or None when the host holds the state (measure it here)."""
+        run = self.__dict__.get("_holder")
+        return None if run is None else run.homogenized()
+
     def peek(self, name):
         """The host's ``name`` (one of DEVICE_HELD) without bringing a device run's state back:
         what the scene is made of (the box's type, the control list), whose values may be

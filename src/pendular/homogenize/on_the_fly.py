@@ -236,7 +236,16 @@ class CapillaryHomogenization:
         self._state = None
 
     def evaluate(self, sim):
-        """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state."""
+        """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state (reduced
+        on the device when a device run holds it, Simulation.homogenized)."""
+        device = sim.homogenized()
+        if device is not None:
+            state = BridgeStress(
+                bridges=device["bridges"], water_volume=device["water_volume"],
+                volume=sim.walls.volume(), chi=device["chi"], B=device["B"], psi=device["psi"],
+                fabric=device["fabric_bridges"], anisotropy=device["anisotropy_bridges"],
+                a_psi=device["a_psi"], interface=device.get("psi_interface"))
+            return state, np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
         if (sim.step, sim.time) != self._step or sim.contacts is not self._contacts:
             op = self.bridges
             suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
@@ -254,7 +263,25 @@ class CapillaryHomogenization:
         return self._state
 
     def sigma_capillary(self, sim):
+        device = sim.homogenized()
+        if device is not None:
+            return device["sigma_capillary"]
         return capillary_force_stress(sim, self.bridges)
+
+    def saturation(self, sim):
+        device = sim.homogenized()
+        if device is None:
+            return self.bridges.saturation(sim)
+        return device["water_volume"] / (sim.walls.volume() - device["solid_volume"])
+
+    def count(self, sim):
+        device = sim.homogenized()
+        return self.bridges.count(sim) if device is None else device["bridges"]
+
+    def pendular_overlaps(self, sim):
+        device = sim.homogenized()
+        return (self.bridges.pendular_overlaps(sim) if device is None
+                else device["pendular_overlaps"])
 
     def chi(self, sim):
         return self.evaluate(sim)[0].chi
@@ -291,11 +318,11 @@ class CapillaryHomogenization:
         the exact model psi_interface and sigma_effective_complete."""
         op = self.bridges
         columns = {
-            "saturation": op.saturation,
+            "saturation": self.saturation,
             "suction": op.mean_suction,
             "sigma_capillary": self.sigma_capillary,
-            "bridges": op.count,
-            "pendular_overlaps": op.pendular_overlaps,
+            "bridges": self.count,
+            "pendular_overlaps": self.pendular_overlaps,
             "chi": self.chi,
             "B": self.B,
             "psi": self.psi,

@@ -73,9 +73,16 @@ class SampleGuard:
     def check(self, sim):
         """Measure the state now; SampleCrushed when a bound is crossed, else (largest overlap
         over the radius, porosity)."""
-        overlap = largest_overlap(sim)
-        measured = porosity(sim.particles, sim.walls)
-        low, high = self.porosity_range or default_porosity_range(sim.particles.radius)
+        device = sim.homogenized()
+        if device is None:
+            overlap = largest_overlap(sim)
+            measured = porosity(sim.particles, sim.walls)
+            radii = (sim.particles.radius.min(), sim.particles.radius.max())
+        else:                       # measured by the device run holding the state
+            overlap = device["largest_overlap"]
+            measured = 1.0 - device["solid_volume"] / sim.walls.volume()
+            radii = (device["smallest_radius"], device["largest_radius"])
+        low, high = self.porosity_range or default_porosity_range(*radii)
         if not overlap <= self.max_overlap:
             self._crushed(sim, f"an overlap of {overlap:.3g} of the radius, beyond the bound "
                                f"{self.max_overlap:g} of a packing of grains")
@@ -90,10 +97,11 @@ class SampleGuard:
                             f"{self.remedy}")
 
 
-def default_porosity_range(radius):
-    """(least, largest) porosity [-] of a packing of spheres of ``radius`` [m]: equal or
-    graded (MIN_POROSITY_EQUAL or MIN_POROSITY_GRADED), and MAX_POROSITY."""
-    equal = radius.min() == radius.max()
+def default_porosity_range(smallest, largest):
+    """(least, largest) porosity [-] of a packing of spheres of radii from ``smallest`` to
+    ``largest`` [m]: equal or graded (MIN_POROSITY_EQUAL or MIN_POROSITY_GRADED), and
+    MAX_POROSITY."""
+    equal = smallest == largest
     return (MIN_POROSITY_EQUAL if equal else MIN_POROSITY_GRADED), MAX_POROSITY
 
 

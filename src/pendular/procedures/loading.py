@@ -291,6 +291,26 @@ def capillary_operation(sim):
     return found[0] if found else None
 
 
+def measured(name, on_host):
+    """Column ``name`` of a history: the device's value when a device run holds sim's state
+    (Simulation.homogenized), else ``on_host(sim)``."""
+
+    def quantity(sim):
+        device = sim.homogenized()
+        return on_host(sim) if device is None else device[name]
+
+    return quantity
+
+
+def solid_fraction_porosity(sim):
+    """Porosity of the box [-] (pendular.dem.measure.porosity), with the spheres' volume from
+    the device run holding the state when one does."""
+    device = sim.homogenized()
+    if device is None:
+        return porosity(sim.particles, sim.walls)
+    return 1.0 - device["solid_volume"] / sim.walls.volume()
+
+
 def history_columns(sim, axial, reference_volume, bridges=None):
     """Recorded columns of a loading path's history (name -> function of sim); ``axial``
     measures the axial strain (``strain(walls)``); pendular.io.schema declares their units. A
@@ -306,12 +326,16 @@ def history_columns(sim, axial, reference_volume, bridges=None):
         "axial_strain": lambda s: axial.strain(s.walls),
         "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
         "sigma_wall": lambda s: s.walls.stress(),
-        "sigma_contact": lambda s: contact_stress(s.particles, s.contacts, s.walls),
-        "porosity": lambda s: porosity(s.particles, s.walls),
-        "coordination": lambda s: coordination(s.contacts, len(s.particles)),
-        "fabric": contact_fabric,
-        "anisotropy": lambda s: principal_anisotropy(contact_fabric(s)),      # Eq. 3.51
-        "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
+        "sigma_contact": measured("sigma_contact", lambda s: contact_stress(
+            s.particles, s.contacts, s.walls)),
+        "porosity": solid_fraction_porosity,
+        "coordination": measured("coordination",
+                                 lambda s: coordination(s.contacts, len(s.particles))),
+        "fabric": measured("fabric", contact_fabric),
+        "anisotropy": measured("anisotropy",                                 # Eq. 3.51
+                               lambda s: principal_anisotropy(contact_fabric(s))),
+        "unbalanced_force": measured("unbalanced_force",
+                                     lambda s: unbalanced_force(s.particles, s.contacts)),
     }
     if bridges is not None:
         from pendular.homogenize.on_the_fly import CapillaryHomogenization

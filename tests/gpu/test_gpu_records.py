@@ -1,0 +1,96 @@
+"""A loading path's history recorded from a GPU run without bringing the state back: every
+column a record needs (pendular.procedures.loading.history_columns, with the bridges' for a wet
+scene) and the crushed-sample guard read the device's homogenisation
+(Simulation.homogenized, pendular.gpu.homogenize), so that a record step copies the walls
+alone and the whole state comes back once, as the run returns. The columns equal the CPU's
+history to round-off (measured: 1.6e-14 at most).
+
+The 64-sphere walled scene of tests/gpu/simulated.py, dry and wet at 30 kPa, 30 steps recorded
+every 10, under Numba's CUDA simulator in a process of its own
+(``NUMBA_ENABLE_CUDASIM=1 python tests/gpu/test_gpu_records.py dry|wet``).
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+STEPS = 30
+RECORD_PERIOD = 10
+
+
+def measure(wet):
+    """(copies back in order, records, {column: largest relative difference from the CPU})."""
+    from simulated import relative, scene
+
+    from pendular.capillary.bridges import CapillaryBridges
+    from pendular.dem.record import HistoryRecorder
+    from pendular.gpu import GpuSimulation
+    from pendular.procedures.guards import SampleGuard
+    from pendular.procedures.loading import AxisStrain, history_columns
+
+    def build(device):
+        sim = scene(wet=wet, side=4)
+        bridges = sim.operation(CapillaryBridges) if wet else None
+        columns = history_columns(sim, AxisStrain(2, sim.walls.lengths()[2]),
+                                  sim.walls.volume(), bridges)
+        sim.writers = [HistoryRecorder(RECORD_PERIOD, columns), SampleGuard(RECORD_PERIOD)]
+        sim.device = device
+        return sim
+
+    copies = []
+    copy_back = GpuSimulation.copy_back
+
+    def counted(self, part=None):
+        copies.append(part or "all")
+        return copy_back(self, part)
+
+    GpuSimulation.copy_back = counted
+    cpu, gpu = build("cpu"), build("gpu")
+    cpu.run(STEPS)
+    gpu.run(STEPS)
+    a, b = cpu.writers[0].arrays(), gpu.writers[0].arrays()
+    return {"copies": copies, "records": len(a["step"]), "columns": sorted(a),
+            "difference": {name: relative(a[name], b[name]) for name in a}}
+
+
+def simulated(check):
+    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    done = subprocess.run([sys.executable, os.path.abspath(__file__), check],
+                          capture_output=True, text=True, env=environment, cwd=ROOT,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+@pytest.fixture(scope="module", params=["dry", "wet"])
+def recorded(request):
+    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
+                        "(pip install -e '.[gpu]')")
+    return request.param == "wet", simulated(request.param)
+
+
+def test_record_steps_copy_the_walls_alone(recorded):
+    _, measured = recorded
+    assert measured["records"] == STEPS // RECORD_PERIOD
+    *during, last = measured["copies"]
+    assert last == "all"                        # once, as the run returns
+    assert during and set(during) == {"walls"}
+
+
+def test_the_recorded_columns_are_the_cpus(recorded):
+    wet, measured = recorded
+    assert {"sigma_contact", "fabric", "porosity", "coordination"} <= set(measured["columns"])
+    if wet:
+        assert {"chi", "psi", "saturation", "bridges"} <= set(measured["columns"])
+    for name, difference in measured["difference"].items():
+        assert difference < 1e-12, name
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, HERE)
+    print(json.dumps(measure(sys.argv[1] == "wet")))
