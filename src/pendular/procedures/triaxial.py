@@ -527,13 +527,15 @@ class LaboratoryTest:
                                                radius_ratios=sample_radius_ratios(radii))
 
     # ------------------------------------------------------------ phases
-    def start(self, progress=True, threads=None, writers=()):
-        """(static sample at the confining stress, preparation report); ``writers`` watch the
-        preparation or the equilibrium of a loaded sample (e.g. the vtk_prep VtkWriter)."""
+    def start(self, progress=True, threads=None, writers=(), device="cpu"):
+        """(static sample at the confining stress, preparation report, the host holding it);
+        ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
+        vtk_prep VtkWriter); ``device``: where a preparation runs (a loaded sample's
+        equilibrium runs on the CPU)."""
         config = self.config
         if config.sample_path is None:
             return prepare_sample(config.sample, progress=progress, threads=threads,
-                                  writers=writers)
+                                  writers=writers, device=device)
         return self.load_sample(config.sample_path, progress, threads, writers)
 
     def load_sample(self, path, progress=True, threads=None, writers=()):
@@ -568,8 +570,8 @@ class LaboratoryTest:
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same.
-        ``device``: where the loading runs, "cpu" or "gpu" (``check_device``; the preparation
-        and wetting run on the CPU); a run option, not part of the configuration."""
+        ``device``: where the preparation and the loading run, "cpu" or "gpu" (``check_device``;
+        the wetting runs on the CPU); a run option, not part of the configuration."""
         check_device(self.config, device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
@@ -600,7 +602,7 @@ class LaboratoryTest:
         writers = () if frames is None else (frames,)
         folder.phase = "prepare"
         pause_point(folder.phase)
-        sim, preparation = self.start(progress, threads, writers)
+        sim, preparation = self.start(progress, threads, writers, device)
         prepared = time.perf_counter()
         wetting = {}
         if config.bridges is not None:

@@ -67,9 +67,9 @@ def add_output_options(parser, out):
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
     parser.add_argument("--device", choices=DEVICES, default="cpu",
-                        help="where the loading runs: cpu, or gpu (numba-cuda, pip install -e "
-                             "'.[gpu]'; the preparation and wetting stay on the CPU; "
-                             "docs/gpu.md); a run option: a checkpoint resumes on either")
+                        help="where the preparation and the loading run: cpu, or gpu "
+                             "(numba-cuda, pip install -e '.[gpu]'; the wetting stays on the "
+                             "CPU; docs/gpu.md); a run option: a checkpoint resumes on either")
     parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
                         type=positive_int("--vtk-prep", low=1),
                         help="also write ParaView frames of the preparation and wetting into "
