@@ -1,4 +1,5 @@
-"""Compile every kernel of a dry and a wet step (and a radius growth's) for a real GPU (PTX,
+"""Compile every kernel of a dry and a wet step (and a radius growth's, and a periodic cell's
+dry and wet) for a real GPU (PTX,
 by default for compute capability 9.0, an H100) without one, as a script in its own process:
 the simulator runs kernels as Python and would not see code that the CUDA target cannot
 compile (a NumPy ufunc, a global it cannot type).
@@ -73,17 +74,22 @@ def compile_step_kernels(cuda, capability):
                               for a in args)
             ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
-    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene)
+    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene) and those
+    # of a dry and a wet step in a periodic cell (test_gpu_periodic.py's)
     from test_gpu_growth import scene as growth_scene
+    from test_gpu_periodic import scene as periodic_scene
 
-    gpu = GpuSimulation(growth_scene())
-    gpu._configure()
-    for kernel, _, args in gpu._steps:
-        if kernel.py_func.__name__ not in compiled:
-            signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
-                              for a in args)
-            ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
-            compiled[kernel.py_func.__name__] = ptx.count("\n")
+    for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
+                       (periodic_scene(wet=True), " periodic wet")):
+        gpu = GpuSimulation(sim)
+        gpu._configure()
+        for kernel, _, args in gpu._steps:
+            name = kernel.py_func.__name__
+            if name not in compiled and f"{name}{label}" not in compiled:
+                signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray)
+                                               else a) for a in args)
+                ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
+                compiled[f"{name}{label}"] = ptx.count("\n")
     return compiled
 
 

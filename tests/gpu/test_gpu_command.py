@@ -133,7 +133,7 @@ def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
 
 
 @pytest.mark.parametrize("options, words", [
-    (["--periodic"], ["periodic cell"]),
+    (["--periodic"], ["periodic cell's preparation", "--sample"]),
     (["--water-content", "5"], ["volume-controlled bridges"]),
     (["--suction", "30000", "--persist-bridges"], ["bridges across gaps"])])
 def test_what_the_gpu_does_not_run_is_refused_before_any_work(tmp_path, capsys, options,

@@ -105,7 +105,8 @@ def compile_ptx(*arguments):
 
 
 def test_every_kernel_compiles_for_a_gpu():
-    """PTX for an H100 of every kernel of a dry and a wet step (tests/gpu/compile_ptx.py),
+    """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic
+    (tests/gpu/compile_ptx.py),
     where a CUDA compiler is installed (the gpu extra installs one): the simulator would run
     code that the CUDA target rejects."""
     done = compile_ptx()
@@ -117,7 +118,11 @@ def test_every_kernel_compiles_for_a_gpu():
                "wall_partials", "wall_sums", "wall_controls", "leapfrog",
                "homogenize_partials", "sum_columns")
     growth = ("grow", "mark_rebuild", "grown_beyond")
-    assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth}
+    periodic = ("bin_periodic", "find_periodic_pairs", "cell_partials", "cell_controls",
+                "cell_leapfrog")
+    assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth,
+                                        *(f"{name} periodic" for name in periodic),
+                                        *(f"{name} periodic wet" for name in periodic)}
     assert all(lines > 0 for lines in compiled["kernels"].values())
 
 

@@ -14,11 +14,12 @@ particle's force is the CPU's sum in the CPU's order.
 
 from pendular.capillary.bridge_kernels import _follow_contact
 from pendular.dem.contact_law import (_evaluate_pair, _first_member, _store_row_sums,
-    _sum_pair_terms, wall_contact_stiffness)
+    _stretched, _sum_pair_terms, wall_contact_stiffness)
 from pendular.gpu.cuda import cuda, device, device_twin
 
 first_member = device_twin(_first_member)
 evaluate_pair = device_twin(_evaluate_pair)
+is_stretched = device_twin(_stretched)
 follow_contact = device_twin(_follow_contact)
 sum_pair_terms = device_twin(_sum_pair_terms)
 store_row_sums = device_twin(_store_row_sums)
@@ -27,15 +28,17 @@ wall_stiffness = device_twin(wall_contact_stiffness)
 
 @cuda.jit
 def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i, pair_j,
-                no_image, no_period, shear_force, normal, overlap, normal_force, force, young,
-                shear_ratio, tan_friction, dt, flags, wet, state, volume, bridge_force,
+                image, period, affine_rate, shear_force, normal, overlap, normal_force, force,
+                young, shear_ratio, tan_friction, dt, flags, wet, state, volume, bridge_force,
                 filling_i, filling_j, suction, surface_tension, radius_ratios, suction_axis,
                 distance_low, log_distance_rupture, log_values):
     """Every pair of particle p's row (one thread per particle): the CPU's contact law
-    (_evaluate_pair inside walls: no periodic image, ``no_image`` (1, 3) int8 and
-    ``no_period`` (3,) zeros standing for the arrays it then does not read, no stretching),
-    then (``wet``) its suction-controlled bridge at contact (_follow_contact: the bridge arrays
-    of pendular.capillary.bridge_state.BridgeState, a BridgeTable's arrays(); ``pair_i``
+    (_evaluate_pair, with its tests as the CPU's pair_forces: images where ``period`` (3,)
+    [m] is not zero, each pair's in ``image`` (K, 3) int8, and stretching where
+    ``affine_rate`` (3,) [1/s] is not; inside walls (1, 3) and (3,) zeros stand for the
+    arrays it then does not read), then (``wet``) its suction-controlled bridge at contact
+    (_follow_contact: the bridge arrays of pendular.capillary.bridge_state.BridgeState, a
+    BridgeTable's arrays(); ``pair_i``
     (K,) the pairs' first members, read when a bridge forms). Thread 0 clears the rebuild
     flag: this step's rebuild, if any, is done."""
     p = cuda.grid(1)
@@ -44,11 +47,13 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
     n = position.shape[0]
     if p >= n:
         return
+    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+    stretched = is_stretched(affine_rate)
     first = first_member(p, position, velocity, angular_velocity, radius)
     for s in range(pair_count[p]):
         k = s * n + p
         evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
-                      no_image, no_period, False, no_period, False, shear_force, normal,
+                      image, period, periodic, affine_rate, stretched, shear_force, normal,
                       overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
         if wet:
             follow_contact(k, radius, pair_i, pair_j, overlap, state, volume, bridge_force,
@@ -93,7 +98,8 @@ def gather(position, radius, pair_count, second_count, second_pair, pair_force, 
     over the device's rows; less the ``attraction`` (K,) [N] along the normals when ``wet``:
     bridges at contact) and the walls, set (not added), in the CPU's order: the walls first
     when WallForces runs before the operation that gathers the pairs (``walls_first``: the
-    contact law, or the bridges that join its gather), else after."""
+    contact law, or the bridges that join its gather), else after; ``wall_young`` 0 [Pa] in
+    a periodic cell, which has no walls (their springs add zeros)."""
     p = cuda.grid(1)
     n = position.shape[0]
     if p >= n:

@@ -44,3 +44,41 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
     if not (math.isfinite(position[p, 0]) and math.isfinite(position[p, 1])
             and math.isfinite(position[p, 2])):
         flags[2] = 1
+
+
+@cuda.jit
+def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+                  affine_rate, dt, reference_position, cell_position, reference_cell, limit,
+                  shortest_unlisted, flags):
+    """leapfrog in a periodic cell not sheared (the CPU's _advance with stretching: the
+    velocity ``affine_rate`` (3,) [1/s] * x carrying the particle on top of its own); the
+    rebuild test is pendular.dem.neighbors.moved_beyond: the displacement from s x_ref,
+    s = L / L_ref (cell faces ``cell_position`` now, ``reference_cell`` at the last rebuild),
+    against ``limit`` [m] less max|s - 1| / 2 times ``shortest_unlisted`` [m]."""
+    p = cuda.grid(1)
+    if p >= position.shape[0]:
+        return
+    stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
+    dt_mass = dt / mass[p]
+    dt_inertia = dt / inertia[p]
+    for c in range(3):
+        f = damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
+        velocity[p, c] += f * dt_mass
+        if stretched:
+            position[p, c] += (velocity[p, c] + affine_rate[c] * position[p, c]) * dt
+        else:
+            position[p, c] += velocity[p, c] * dt
+        t = damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
+        angular_velocity[p, c] += t * dt_inertia
+    s0 = cell_position[1] / reference_cell[1]
+    s1 = cell_position[3] / reference_cell[3]
+    s2 = cell_position[5] / reference_cell[5]
+    reach = limit - 0.5 * max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) * shortest_unlisted
+    d0 = position[p, 0] - s0 * reference_position[p, 0]
+    d1 = position[p, 1] - s1 * reference_position[p, 1]
+    d2 = position[p, 2] - s2 * reference_position[p, 2]
+    if reach <= 0.0 or d0 * d0 + d1 * d1 + d2 * d2 > reach * reach:
+        flags[0] = 1
+    if not (math.isfinite(position[p, 0]) and math.isfinite(position[p, 1])
+            and math.isfinite(position[p, 2])):
+        flags[2] = 1

@@ -22,7 +22,7 @@ checks (pendular.gpu.simulation).
 
 import math
 
-from pendular.dem.neighbors import _cell_coordinates, _within_reach
+from pendular.dem.neighbors import _cell_coordinates, _within_reach, _wrap_cell
 from pendular.gpu.cuda import cuda, device, device_twin
 
 within_reach = device_twin(_within_reach)
@@ -141,6 +141,15 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
                             below = insert_sorted(lower, p, n, below, width, q, flags)
     new_count[p] = min(above, width)
     lower_count[p] = min(below, width)
+    carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
+               bridges, new_shear_force, new_normal, new_overlap, new_bridges)
+
+
+@device
+def carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
+               bridges, new_shear_force, new_normal, new_overlap, new_bridges):
+    """The per-pair state of particle p's new row from the same (p, j) pairs of its old one
+    (find_pairs)."""
     old = 0
     for s in range(new_count[p]):
         k = s * n + p
@@ -202,3 +211,151 @@ def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shea
         for w in range(6):
             reference_walls[w] = wall_position[w]
         rebuilds[0] += 1
+
+
+# ---------------------------------------------------------------- a periodic cell
+# The cells tile the periodic cell [0, L) (pendular.dem.cell.PeriodicCell; its faces in
+# ``cell_position``, as a Walls' position), int(L / cell_size) a side as the CPU's grid
+# (pendular.dem.neighbors._periodic_grid, at most the grid allocated); a pair's image (K, 3)
+# int8 is stored with it (Contacts.image). A cell narrower than 3 cells a side sets NARROW_CELL
+# (the CPU refuses to build such a list: a pair would have more than one image in reach).
+
+#: Bit of flags[1]: the periodic cell is narrower than 3 cells of the grid on an axis.
+NARROW_CELL = 4
+
+wrap_cell = device_twin(_wrap_cell)
+
+
+@device
+def periodic_dims(cell_position, cell_size, max_dims, axis):
+    """Cells along ``axis`` of the periodic grid: int(L / cell_size) (the CPU's), at most
+    max_dims[axis], at least 1 (a cell that is not finite: a diverged run)."""
+    cells = cell_position[2 * axis + 1] / cell_size
+    if not cells >= 1.0:
+        return 1
+    if cells >= max_dims[axis]:
+        return max_dims[axis]
+    return int(cells)
+
+
+@device
+def periodic_shape(cell_position, cell_size, max_dims):
+    """(cells along x, y, z) of the periodic grid now (periodic_dims)."""
+    return (periodic_dims(cell_position, cell_size, max_dims, 0),
+            periodic_dims(cell_position, cell_size, max_dims, 1),
+            periodic_dims(cell_position, cell_size, max_dims, 2))
+
+
+@device
+def wrap_particle(p, position, cell_position, wraps):
+    """Bring particle p into [0, L) and count the periods it crossed in ``wraps`` (N, 3)
+    (pendular.dem.cell.PeriodicCell.wrap of a cell not sheared: floor, subtract, clamp into
+    [0, the largest number below L])."""
+    crossed = False
+    for axis in range(3):
+        periods = math.floor(position[p, axis] / cell_position[2 * axis + 1])
+        if not math.isfinite(periods):      # diverged: the integrator flags it
+            return
+        if periods != 0.0:
+            crossed = True
+    if not crossed:
+        return
+    for axis in range(3):
+        length = cell_position[2 * axis + 1]
+        periods = math.floor(position[p, axis] / length)
+        x = position[p, axis] - periods * length
+        x = min(x, math.nextafter(length, 0.0))
+        position[p, axis] = max(x, 0.0)
+        wraps[p, axis] += int(periods)
+
+
+@cuda.jit
+def bin_periodic(position, cell_position, wraps, cell_size, max_dims, cell_count,
+                 cell_members, cell_width, cell_of, flags):
+    """Wrap each particle into the cell (wrap_particle), then append it to its cell of the
+    periodic grid (x-major numbering, the CPU's _sort_into_cells over [0, L))."""
+    p = cuda.grid(1)
+    if flags[0] == 0 or p >= position.shape[0]:
+        return
+    wrap_particle(p, position, cell_position, wraps)
+    dims = periodic_shape(cell_position, cell_size, max_dims)
+    if p == 0 and (dims[0] < 3 or dims[1] < 3 or dims[2] < 3):
+        cuda.atomic.or_(flags, 1, NARROW_CELL)
+    c = 0
+    for axis in range(3):
+        width = cell_position[2 * axis + 1] / dims[axis]
+        index = int(position[p, axis] / width)
+        index = min(max(index, 0), dims[axis] - 1)
+        c = c * dims[axis] + index
+    cell_of[p] = c
+    slot = cuda.atomic.add(cell_count, c, 1)
+    if slot < cell_width:
+        cell_members[c * cell_width + slot] = p
+    else:
+        cuda.atomic.or_(flags, 1, CELL_OVERFLOW)
+
+
+@device
+def insert_with_image(row, image, p, n, found, width, q, sx, sy, sz, flags):
+    """insert_sorted, the pair's image (sx, sy, sz) moving with q in ``image`` (K, 3)."""
+    if found >= width:
+        cuda.atomic.or_(flags, 1, ROW_OVERFLOW)
+        return found + 1
+    s = found
+    while s > 0 and row[(s - 1) * n + p] > q:
+        row[s * n + p] = row[(s - 1) * n + p]
+        for c in range(3):
+            image[s * n + p, c] = image[(s - 1) * n + p, c]
+        s -= 1
+    row[s * n + p] = q
+    image[s * n + p, 0] = sx
+    image[s * n + p, 1] = sy
+    image[s * n + p, 2] = sz
+    return found + 1
+
+
+@cuda.jit
+def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_dims,
+                        cell_count, cell_members, cell_width, cell_of, width, pair_count,
+                        pair_j, new_count, new_pair_j, image, lower_count, lower, shear_force,
+                        normal, overlap, bridges, new_shear_force, new_normal, new_overlap,
+                        new_bridges, flags):
+    """find_pairs in a periodic cell: particle p's neighbours through the nearest image from
+    the 27 cells around its own, wrapped across the faces (the CPU's _periodic_neighbors_of
+    in a cell not sheared), each with its image into ``image`` (written in place: the forces
+    read it after this rebuild; lower rows hold no image); then the per-pair state carried
+    as find_pairs."""
+    p = cuda.grid(1)
+    if flags[0] == 0 or p >= position.shape[0]:
+        return
+    dims = periodic_shape(cell_position, cell_size, max_dims)
+    cx, cy, cz = cell_coordinates(cell_of[p], dims)
+    n = position.shape[0]
+    above = 0
+    below = 0
+    for dx in range(-1, 2):
+        x, sx = wrap_cell(cx + dx, dims[0])
+        for dy in range(-1, 2):
+            y, sy = wrap_cell(cy + dy, dims[1])
+            for dz in range(-1, 2):
+                z, sz = wrap_cell(cz + dz, dims[2])
+                c = (x * dims[1] + y) * dims[2] + z
+                for slot in range(c * cell_width,
+                                  c * cell_width + min(cell_count[c], cell_width)):
+                    q = cell_members[slot]
+                    if q == p:
+                        continue
+                    reach = radius[p] + radius[q] + skin
+                    d0 = position[q, 0] + sx * cell_position[1] - position[p, 0]
+                    d1 = position[q, 1] + sy * cell_position[3] - position[p, 1]
+                    d2 = position[q, 2] + sz * cell_position[5] - position[p, 2]
+                    if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
+                        if q > p:
+                            above = insert_with_image(new_pair_j, image, p, n, above, width,
+                                                      q, sx, sy, sz, flags)
+                        else:
+                            below = insert_sorted(lower, p, n, below, width, q, flags)
+    new_count[p] = min(above, width)
+    lower_count[p] = min(below, width)
+    carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
+               bridges, new_shear_force, new_normal, new_overlap, new_bridges)

@@ -27,13 +27,18 @@ raises the CPU's StageFailed at its next check or, earlier, when anything reads 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
 wet, SuctionBridges at contact (``persist`` False); controls StressServo, ConstantStrainRate,
 MixedStress (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.
-growth); the Integrator. Anything else is refused by name (ValueError), so that a scene never
-runs with part of its physics missing.
+growth); the Integrator. A periodic cell (``PeriodicCell``, not sheared) with ContactForces
+and, wet, SuctionBridges at contact, under StressServo and ConstantStrainRate (pendular.gpu.
+cell): its step wraps the particles and finds the pairs through the cell's faces at a
+rebuild, reduces the cell's stress, runs its controls and a leapfrog carried by its
+stretching. Anything else (simple shear: ConstantShearRate, a sheared cell) is refused by
+name (ValueError), so that a scene never runs with part of its physics missing.
 """
 
 import numpy as np
 
 from pendular.capillary.bridges import SuctionBridges
+from pendular.dem.cell import ConstantShearRate, PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
@@ -41,7 +46,7 @@ from pendular.dem.mixed_stress import MixedStress
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
-from pendular.gpu import forces, integrate, neighbors, walls as device_walls
+from pendular.gpu import cell as device_cell, forces, integrate, neighbors, walls as device_walls
 from pendular.gpu.cuda import configured, cuda, simulated
 from pendular.gpu.growth import DeviceGrowth
 from pendular.gpu.homogenize import device_homogenization
@@ -69,9 +74,11 @@ def check_scene(sim):
     """ValueError naming what of ``sim`` the GPU path does not run yet (module docstring).
     Reads what the scene is made of, not its state (Simulation.peek)."""
     box = sim.peek("walls")
-    if not isinstance(box, Walls):
-        raise ValueError(f"device='gpu' runs walled scenes only so far; the box is a "
-                         f"{type(box).__name__}")
+    if not isinstance(box, (Walls, PeriodicCell)):
+        raise ValueError(f"device='gpu' runs walled scenes and periodic cells only; the box "
+                         f"is a {type(box).__name__}")
+    if isinstance(box, PeriodicCell):
+        _check_periodic(sim, box)
     if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
@@ -96,6 +103,21 @@ def check_scene(sim):
     for kind in (RadiusGrowth, GrowthTimeStep):
         if sum(isinstance(op, kind) for op in controls) > 1:
             raise ValueError(f"device='gpu' runs at most one {kind.__name__} among the controls")
+
+
+def _check_periodic(sim, cell):
+    """ValueError naming what of a periodic scene the GPU path does not run yet."""
+    if cell.sheared or any(isinstance(op, ConstantShearRate) for op in sim.peek("controls")):
+        raise ValueError("device='gpu' does not run simple shear (ConstantShearRate, a sheared "
+                         "periodic cell) yet: run it on the CPU (device 'cpu')")
+    for op in sim.forces:
+        if type(op) is WallForces:
+            raise ValueError("device='gpu' runs a periodic cell without WallForces (it has no "
+                             "walls)")
+    for op in sim.peek("controls"):
+        if type(op) not in (StressServo, ConstantStrainRate):
+            raise ValueError(f"device='gpu' does not run the control {type(op).__name__} in a "
+                             "periodic cell yet (valid: StressServo, ConstantStrainRate)")
 
 
 class GpuSimulation:
@@ -159,13 +181,15 @@ class GpuSimulation:
         for c, op in enumerate(self._controls):
             if type(op) is StressServo:
                 kinds[c] = device_walls.STRESS_SERVO
-                walls = op.walls
-                previous[c, :len(walls)] = op.previous
-                stiffness[c, :len(walls)] = op.stiffness
+                # a periodic cell's servo reads its axes (pendular.gpu.cell)
+                walls = op.axes if self.state.periodic else op.walls
+                previous[c, :len(op.walls)] = op.previous
+                stiffness[c, :len(op.walls)] = op.stiffness
                 calls[c] = op.calls
             elif type(op) is ConstantStrainRate:
                 kinds[c] = device_walls.STRAIN_RATE
-                walls = (2 * op.axis, 2 * op.axis + 1)
+                walls = ((op.axis,) if self.state.periodic else
+                         (2 * op.axis, 2 * op.axis + 1))
             elif type(op) is RadiusGrowth:
                 kinds[c] = device_walls.RADIUS_GROWTH
                 continue
@@ -232,9 +256,93 @@ class GpuSimulation:
             self._targets_to_host()
         self.state.parameters.copy_to_device(self._control_parameters())
         self.state.control_step.copy_to_device(np.array([sim.step], np.int64))
+        if self.state.periodic:
+            self._steps = self._cell_steps()
+        else:
+            self._steps = self._walled_steps()
+        if self._growth is not None:
+            self._steps = self._growth.launches(self._steps, self.state, sim,
+                                                0.5 * self.state.skin)
+        self._launches = [(configured(kernel, items), args)
+                          for kernel, items, args in self._steps]
+
+    def _force_steps(self, image, period, affine_rate, walls_first, wall_young):
+        """(kernel, items, arguments) of the pair forces and their gather (walls' springs of
+        stiffness ``wall_young`` [Pa] E R, 0: none; images ``image``, ``period`` and
+        stretching ``affine_rate``: pendular.gpu.forces.pair_forces)."""
+        sim = self.sim
+        s = self.state
+        n = s.count
         contact = _one(sim, ContactForces)
-        wall_law = _one(sim, WallForces)
         tan_friction = float(np.tan(np.radians(contact.friction_deg)))
+        # the bridges' columns (pendular.gpu.state.BRIDGE_COLUMNS) as the law's arrays
+        columns = tuple(s.bridges[:, c] for c in range(s.bridges.shape[1]))
+        return [
+            (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
+                                     s.pair_count, s.pair_i, s.pair_j, image, period,
+                                     affine_rate, s.shear_force, s.normal,
+                                     s.overlap, s.normal_force, s.pair_force, contact.young,
+                                     contact.shear_ratio, tan_friction, sim.dt, s.flags,
+                                     s.wet, *columns, self._suction,
+                                     self._bridges.surface_tension if s.wet else 1.0,
+                                     *self._table)),
+            (forces.gather, n, (s.position, s.radius, s.pair_count, s.second_count,
+                                s.second_pair, s.pair_force, s.normal, s.overlap, s.wet,
+                                columns[2], walls_first, s.wall_position, wall_young,
+                                s.force, s.torque)),
+        ]
+
+    def _finish_step(self):
+        """(kernel, items, arguments) of finish_rebuild."""
+        s = self.state
+        return (neighbors.finish_rebuild, s.count,
+                (s.position, s.new_count, s.new_pair_j, s.lower_count, s.lower,
+                 s.new_shear_force, s.new_normal, s.new_overlap, s.new_bridges, s.pair_count,
+                 s.pair_j, s.second_count, s.second_pair, s.shear_force, s.normal, s.overlap,
+                 s.bridges, s.normal_force, s.pair_force, s.reference_position,
+                 s.wall_position, s.reference_walls, s.cell_count, s.cell_of, s.flags,
+                 s.rebuilds))
+
+    def _cell_steps(self):
+        """(kernel, items, arguments) of a step in a periodic cell (pendular.gpu.cell): the
+        rebuild (wrap and bin, pairs through the faces, finish), the forces (no walls), the
+        cell's stress and controls, the leapfrog carried by the cell's stretching."""
+        sim = self.sim
+        s = self.state
+        n = s.count
+        gathered_by = SuctionBridges if s.wet else ContactForces
+        bridges = s.bridges
+        return [
+            (neighbors.bin_periodic, n, (s.position, s.wall_position, s.wraps, s.cell_size,
+                                         s.max_dims, s.cell_count, s.cell_members,
+                                         s.cell_width, s.cell_of, s.flags)),
+            (neighbors.find_periodic_pairs, n,
+             (s.position, s.radius, s.skin, s.wall_position, s.cell_size, s.max_dims,
+              s.cell_count, s.cell_members, s.cell_width, s.cell_of, s.width, s.pair_count,
+              s.pair_j, s.new_count, s.new_pair_j, s.image, s.lower_count, s.lower,
+              s.shear_force, s.normal, s.overlap, bridges, s.new_shear_force, s.new_normal,
+              s.new_overlap, s.new_bridges, s.flags)),
+            self._finish_step(),
+            *self._force_steps(s.image, s.period, s.affine_rate, False, 0.0),
+            (device_cell.cell_partials, s.cell_partial.shape[0],
+             (s.position, s.force, s.radius, s.pair_count, s.pair_j, s.image, s.period,
+              s.pair_force, s.normal, s.overlap, s.normal_force, gathered_by is SuctionBridges,
+              bridges[:, 2], s.kinds, s.parameters, s.calls, s.cell_partial)),
+            (device_cell.cell_controls, 1,
+             (s.cell_partial, s.wall_position, s.cell_rate, s.stress_tensor, s.cell_stiffness,
+              s.period, s.affine_rate, s.kinds, s.control_walls, s.wall_counts, s.parameters,
+              s.previous, s.stiffness, s.calls, sim.dt)),
+            (integrate.cell_leapfrog, n,
+             (s.position, s.velocity, s.angular_velocity, s.force, s.torque, s.mass,
+              s.inertia, sim.integrator.damping, s.affine_rate, sim.dt, s.reference_position,
+              s.wall_position, s.reference_walls, 0.5 * s.skin,
+              2.0 * float(sim.particles.radius.max()) + s.skin, s.flags)),
+        ]
+
+    def _walled_steps(self):
+        """(kernel, items, arguments) of a step inside walls (module docstring)."""
+        sim = self.sim
+        wall_law = _one(sim, WallForces)
         s = self.state
         n = s.count
         order = [type(op) for op in sim.forces]
@@ -242,10 +350,7 @@ class GpuSimulation:
         walls_first = order.index(WallForces) < order.index(gathered_by)
         limit = 0.5 * s.skin
         bridges = s.bridges
-        # the bridges' columns (pendular.gpu.state.BRIDGE_COLUMNS) as the law's arrays
-        columns = tuple(bridges[:, c] for c in range(bridges.shape[1]))
-        young = contact.young
-        self._steps = [
+        return [
             (neighbors.bin_particles, n, (s.position, s.wall_position, s.cell_size, s.max_dims,
                                           s.cell_count, s.cell_members, s.cell_width,
                                           s.cell_of, s.flags)),
@@ -256,27 +361,9 @@ class GpuSimulation:
                                        s.lower, s.shear_force, s.normal, s.overlap, bridges,
                                        s.new_shear_force, s.new_normal, s.new_overlap,
                                        s.new_bridges, s.flags)),
-            (neighbors.finish_rebuild, n, (s.position, s.new_count, s.new_pair_j,
-                                           s.lower_count, s.lower, s.new_shear_force,
-                                           s.new_normal, s.new_overlap, s.new_bridges,
-                                           s.pair_count, s.pair_j, s.second_count,
-                                           s.second_pair, s.shear_force, s.normal, s.overlap,
-                                           bridges, s.normal_force, s.pair_force,
-                                           s.reference_position, s.wall_position,
-                                           s.reference_walls, s.cell_count, s.cell_of,
-                                           s.flags, s.rebuilds)),
-            (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
-                                     s.pair_count, s.pair_i, s.pair_j, s.no_image,
-                                     s.no_period, s.shear_force, s.normal,
-                                     s.overlap, s.normal_force, s.pair_force, young,
-                                     contact.shear_ratio, tan_friction, sim.dt, s.flags,
-                                     s.wet, *columns, self._suction,
-                                     self._bridges.surface_tension if s.wet else 1.0,
-                                     *self._table)),
-            (forces.gather, n, (s.position, s.radius, s.pair_count, s.second_count,
-                                s.second_pair, s.pair_force, s.normal, s.overlap, s.wet,
-                                columns[2], walls_first, s.wall_position, wall_law.young,
-                                s.force, s.torque)),
+            self._finish_step(),
+            *self._force_steps(s.no_image, s.no_period, s.no_period, walls_first,
+                               wall_law.young),
             (device_walls.wall_partials, s.partial.shape[0],
              (s.position, s.radius, s.wall_position, wall_law.young, s.partial)),
             (device_walls.wall_sums, 6 * device_walls.WALL_SUMS,
@@ -290,10 +377,6 @@ class GpuSimulation:
                                      s.torque, s.mass, s.inertia, sim.integrator.damping,
                                      sim.dt, s.reference_position, limit, s.flags)),
         ]
-        if self._growth is not None:
-            self._steps = self._growth.launches(self._steps, s, sim, limit)
-        self._launches = [(configured(kernel, items), args)
-                          for kernel, items, args in self._steps]
 
     # ---------------------------------------------------------------- running
     def advance(self):
@@ -345,6 +428,10 @@ class GpuSimulation:
                                f"{self.state.cell_width} particles (the box grew past the grid "
                                "allocated, or spheres overlap deeply): results after it are "
                                "not valid")
+        if overflow & neighbors.NARROW_CELL:
+            raise RuntimeError("the periodic cell is narrower than 3 cells of 2 max(radius) + "
+                               "skin on an axis on the GPU: results after it are not valid "
+                               "(use more particles)")
         if overflow & neighbors.ROW_OVERFLOW:
             raise RuntimeError(f"a particle has more than {self.state.width} neighbours on "
                                "one side in the GPU's neighbour list: results after it are "
@@ -418,7 +505,9 @@ class GpuSimulation:
         """The homogenised quantities of the state the device holds, reduced on the device
         (pendular.gpu.homogenize.device_homogenization: small arrays named as the history's
         columns, computed once per step, so that a record's columns share one reduction);
-        ``volume`` [m^3], None: the box inside the walls. No particle state comes back.
+        ``volume`` [m^3], None: the box inside the walls. No particle state comes back. None
+        in a periodic cell (no reduction through its faces on the device yet: the caller
+        homogenises the host's state, which brings it back).
         StageFailed first if a mixed condition could not be held (as ``copy_back``);
         RuntimeError when the device holds no state (it came back to the host, whose copy may
         have changed since: homogenise it there)."""
@@ -426,6 +515,8 @@ class GpuSimulation:
             raise RuntimeError("the GPU holds no state now (it came back to the host): "
                                "homogenise the host's state")
         self._report_failure()
+        if self.state.periodic:     # no device reduction through a cell's faces yet
+            return None
         key = (self.sim.step, self.sim.time, volume)
         if self._homogenized[0] != key:
             self._homogenized = (key, device_homogenization(self, volume))

@@ -1,6 +1,7 @@
-"""The device's copy of a walled scene: particles, the neighbour list with its per-pair state,
-the cell grid, the walls and their controls' memory, copied in from a CPU Simulation once and
-out when the host asks (pendular.gpu.simulation).
+"""The device's copy of a scene: particles, the neighbour list with its per-pair state, the
+cell grid, the walls (or a periodic cell: its faces, rate, stress, stiffness, the particles'
+wraps and the pairs' images) and their controls' memory, copied in from a CPU Simulation once
+and out when the host asks (pendular.gpu.simulation).
 
 Per-pair arrays follow the device list's layout (pendular.gpu.neighbors: pair k = s * N + p);
 the bridges' per-pair state is one (K, BRIDGE_COLUMNS) float64 array whose columns are
@@ -13,8 +14,9 @@ import math
 import numpy as np
 
 from pendular.capillary.bridge_state import FIELDS, OWNER
-from pendular.dem.neighbors import Contacts, build_pairs, second_index
+from pendular.dem.neighbors import Contacts, build_pairs, build_periodic_pairs, second_index
 from pendular.dem.protocols import pair_key
+from pendular.gpu.cell import CELL_SUMS
 from pendular.gpu.cuda import cuda
 from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS
 
@@ -30,10 +32,14 @@ GRID_ROOM = 2
 DENSEST = 0.7405
 
 
-def row_width(position, radius, skin, contacts=None):
+def row_width(position, radius, skin, contacts=None, period=None):
     """Slots per row [-]: ROW_ROOM times the most neighbours one particle has above or below it
-    in the CPU's list (``contacts``, or one built here with ``skin`` [m]), at least MIN_WIDTH."""
-    if contacts is None:
+    in the CPU's list (``contacts``, or one built here with ``skin`` [m]; through the images of
+    a periodic cell of edges ``period`` (3,) [m] unless None), at least MIN_WIDTH."""
+    if contacts is None and period is not None:
+        row_start, pair_j, _ = build_periodic_pairs(np.mod(position, period), radius, skin,
+                                                    np.asarray(period, dtype=np.float64))
+    elif contacts is None:
         row_start, pair_j = build_pairs(position, radius, skin)
     else:
         row_start, pair_j = contacts.row_start, contacts.pair_j
@@ -58,8 +64,10 @@ def _to_ell(values, slots, count, width, fill):
 
 
 class DeviceState:
-    """Device arrays of a walled scene (attributes named as on the host). Build with
-    ``from_host``; ``to_host`` writes them back into the Simulation."""
+    """Device arrays of a scene (attributes named as on the host; a periodic cell's faces in
+    ``wall_position``, its other state in the ``cell_`` arrays, ``period``, ``affine_rate``,
+    ``wraps`` and the pairs' ``image``: pendular.gpu.cell). ``to_host`` writes them back into
+    the Simulation."""
 
     def __init__(self, sim, skin, wet):
         p = sim.particles
@@ -68,8 +76,10 @@ class DeviceState:
         self.count = count
         self.skin = skin
         self.wet = wet
+        self.periodic = walls.periodic
         self.cell_size = 2.0 * float(p.radius.max()) + skin
-        self.width = row_width(p.position, p.radius, skin, sim.contacts)
+        self.width = row_width(p.position, p.radius, skin, sim.contacts,
+                               walls.position[1::2] if self.periodic else None)
         self.cell_width = cell_capacity(p.radius, self.cell_size)
         lengths = walls.lengths()
         max_dims = np.array([max(1, int(GRID_ROOM * length / self.cell_size))
@@ -83,8 +93,11 @@ class DeviceState:
         self.torque = to(np.zeros((count, 3)))
         self.reference_position = to(np.ascontiguousarray(p.position))
         for name in ("position", "velocity", "force", "stiffness", "moment"):
-            setattr(self, f"wall_{name}", to(np.ascontiguousarray(getattr(walls, name))))
+            values = (getattr(walls, name) if name == "position" or not self.periodic
+                      else np.zeros(6))       # a cell has no walls: unread
+            setattr(self, f"wall_{name}", to(np.ascontiguousarray(values)))
         self.reference_walls = to(np.ascontiguousarray(walls.position))
+        self._cell_from_host(walls, count)
         self.partial = to(np.zeros((max(1, -(-count // REDUCE_CHUNK)), 6, WALL_SUMS)))
         self.max_dims = to(max_dims)
         self.cell_count = to(np.zeros(cells, np.int32))
@@ -98,6 +111,7 @@ class DeviceState:
         self.normal = to(rows["normal"])
         self.overlap = to(rows["overlap"])
         self.bridges = to(rows["bridges"])
+        self.image = to(rows["image"])
         # each slot's first member (k = s * N + p: p), which the CPU's bridge law reads as
         # pair_i when a bridge forms (pendular.gpu.forces.pair_forces); wet scenes only
         self.pair_i = to(np.tile(np.arange(count, dtype=np.int32), self.width) if wet
@@ -121,6 +135,22 @@ class DeviceState:
         self.flags = to(np.array([1, 0, 0], np.int32))
         self.rebuilds = to(np.zeros(1, np.int64))
 
+    def _cell_from_host(self, cell, count):
+        """A periodic cell's arrays (pendular.gpu.cell; one-entry stand-ins inside walls)."""
+        to = cuda.to_device
+        if not self.periodic:
+            self.wraps = to(np.zeros((1, 3), np.int64))
+            self.cell_partial = to(np.zeros((1, CELL_SUMS)))
+            return
+        self.cell_rate = to(np.ascontiguousarray(cell.rate))
+        self.stress_tensor = to(np.ascontiguousarray(cell.stress_tensor))
+        self.cell_stiffness = to(np.ascontiguousarray(cell.stiffness))
+        self.period = to(np.ascontiguousarray(cell.position[1::2]))
+        self.affine_rate = to(np.ascontiguousarray(cell.rate))
+        wraps = cell.wraps if len(cell.wraps) == count else np.zeros((count, 3), np.int64)
+        self.wraps = to(np.ascontiguousarray(wraps))
+        self.cell_partial = to(np.zeros((max(1, -(-count // REDUCE_CHUNK)), CELL_SUMS)))
+
     def _host_rows(self, contacts, count):
         """The host's list (or none) as device rows: counts, neighbours and per-pair state."""
         width = self.width
@@ -131,7 +161,8 @@ class DeviceState:
                     "shear_force": np.zeros((width * count, 3)),
                     "normal": np.zeros((width * count, 3)),
                     "overlap": np.full(width * count, -np.inf),
-                    "bridges": np.zeros((bridge_rows, len(BRIDGE_COLUMNS)))}
+                    "bridges": np.zeros((bridge_rows, len(BRIDGE_COLUMNS))),
+                    "image": np.zeros((width * count if self.periodic else 1, 3), np.int8)}
         counts = np.diff(contacts.row_start)
         slots = (np.arange(len(contacts)) - contacts.row_start[contacts.pair_i]) * count \
             + contacts.pair_i
@@ -145,7 +176,9 @@ class DeviceState:
                 "shear_force": _to_ell(contacts.shear_force, slots, count, width, 0.0),
                 "normal": _to_ell(contacts.normal, slots, count, width, 0.0),
                 "overlap": _to_ell(contacts.overlap, slots, count, width, -np.inf),
-                "bridges": bridges}
+                "bridges": bridges,
+                "image": (_to_ell(contacts.image, slots, count, width, 0) if self.periodic
+                          else np.zeros((1, 3), np.int8))}
 
     def flags_now(self):
         """(rebuild asked, overflow bits, not-finite flag) read from the device (a sync)."""
@@ -173,10 +206,18 @@ class DeviceState:
                         normal=self.normal.copy_to_host()[slots],
                         overlap=self.overlap.copy_to_host()[slots],
                         normal_force=self.normal_force.copy_to_host()[slots],
-                        force=self.pair_force.copy_to_host()[slots], extra=extra)
+                        force=self.pair_force.copy_to_host()[slots], extra=extra,
+                        image=self.image.copy_to_host()[slots] if self.periodic else None)
 
     def walls_to_host(self, walls):
-        """Write the walls' position, velocity, force, stiffness and moment into ``walls``."""
+        """Write the walls' position, velocity, force, stiffness and moment into ``walls`` (a
+        periodic cell's faces, rate, stress tensor and stiffness into the cell)."""
+        if self.periodic:
+            self.wall_position.copy_to_host(walls.position)
+            self.cell_rate.copy_to_host(walls.rate)
+            self.stress_tensor.copy_to_host(walls.stress_tensor)
+            self.cell_stiffness.copy_to_host(walls.stiffness)
+            return
         for name in ("position", "velocity", "force", "stiffness", "moment"):
             getattr(self, f"wall_{name}").copy_to_host(getattr(walls, name))
 
@@ -186,4 +227,6 @@ class DeviceState:
         for name in ("position", "velocity", "angular_velocity", "force", "torque"):
             getattr(self, name).copy_to_host(getattr(p, name))
         self.walls_to_host(sim.walls)
+        if self.periodic:
+            sim.walls.wraps = self.wraps.copy_to_host()
         sim.contacts = self.contacts()

@@ -447,7 +447,8 @@ def check_device(config, device):
     if device == "gpu":
         bridges = config.bridges
         missing = [what for what, used in (
-            ("the periodic cell (--periodic)", config.sample.periodic),
+            ("a periodic cell's preparation (--periodic without --sample)",
+             config.sample.periodic and config.sample_path is None),
             ("volume-controlled bridges (--water-content)",
              bridges is not None and bridges.control == "volume"),
             ("bridges across gaps (--persist-bridges)", bridges is not None and bridges.persist))
@@ -530,21 +531,20 @@ class LaboratoryTest:
     def start(self, progress=True, threads=None, writers=(), device="cpu"):
         """(static sample at the confining stress, preparation report, the host holding it);
         ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
-        vtk_prep VtkWriter); ``device``: where the preparation or the equilibrium runs."""
+        vtk_prep VtkWriter); ``device``: where a preparation runs (a loaded sample's
+        equilibrium runs on the CPU, as the wetting after it)."""
         config = self.config
         if config.sample_path is None:
             return prepare_sample(config.sample, progress=progress, threads=threads,
                                   writers=writers, device=device)
-        return self.load_sample(config.sample_path, progress, threads, writers, device)
+        return self.load_sample(config.sample_path, progress, threads, writers)
 
-    def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
-        """(sample saved at ``path`` servoed at the confining stress and run until static on
-        ``device``, its report, the host holding it); ``writers`` watch the equilibrium
-        (phase "sample")."""
+    def load_sample(self, path, progress=True, threads=None, writers=()):
+        """(sample saved at ``path`` servoed at the confining stress and run until static,
+        its report); ``writers`` watch the equilibrium (phase "sample")."""
         sample = self.config.sample
         particles, walls, report, _ = load_sample(path, expected=sample)
         sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
-        sim.device = device
         started = time.perf_counter()
         with watched(sim, writers, "sample"):
             steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
@@ -552,7 +552,6 @@ class LaboratoryTest:
                                 max_steps=self.config.wet_steps,
                                 progress="equilibrate sample" if progress else None,
                                 phase=f"equilibrium of sample {path!r} at the confining stress")
-        sim.device = "cpu"
         report = dict(report)
         report.update({"sample": os.path.abspath(path), "sample_equilibration_steps": steps,
                        "sample_equilibration_time_s": time.perf_counter() - started,
