@@ -63,6 +63,19 @@ def pair_virial(position, row_start, pair_j, image, period, pair_force):
     return sum_blocks(sums)
 
 
+@numba.njit(cache=True, inline="always")
+def pair_stiffness(k, i, radius, pair_j, normal, normal_force, overlap):
+    """Pair k's (of particle i) (kn (l_0 n_0)^2, kn (l_1 n_1)^2, kn (l_2 n_2)^2) [N m]
+    (contact_stiffness; nothing from a pair apart: no normal force)."""
+    length = radius[i] + radius[pair_j[k]] - overlap[k]
+    spring_overlap = overlap[k] if overlap[k] > 0.0 else 1.0
+    weight = normal_force[k] * length * length / spring_overlap
+    s0 = normal[k, 0] * normal[k, 0]
+    s1 = normal[k, 1] * normal[k, 1]
+    s2 = normal[k, 2] * normal[k, 2]
+    return weight * (s0 * s0), weight * (s1 * s1), weight * (s2 * s2)
+
+
 @numba.njit(cache=True, parallel=True)
 def contact_stiffness(radius, row_start, pair_j, normal, normal_force, overlap):
     """(3,) sum over the touching pairs of kn (l_a n_a)^2 = kn |l|^2 n_a^4 [N m], with
@@ -76,15 +89,10 @@ def contact_stiffness(radius, row_start, pair_j, normal, normal_force, overlap):
         k0 = k1 = k2 = 0.0
         for i in range(start, stop):
             for k in range(row_start[i], row_start[i + 1]):
-                length = radius[i] + radius[pair_j[k]] - overlap[k]
-                spring_overlap = overlap[k] if overlap[k] > 0.0 else 1.0
-                weight = normal_force[k] * length * length / spring_overlap
-                s0 = normal[k, 0] * normal[k, 0]
-                s1 = normal[k, 1] * normal[k, 1]
-                s2 = normal[k, 2] * normal[k, 2]
-                k0 += weight * (s0 * s0)
-                k1 += weight * (s1 * s1)
-                k2 += weight * (s2 * s2)
+                s0, s1, s2 = pair_stiffness(k, i, radius, pair_j, normal, normal_force, overlap)
+                k0 += s0
+                k1 += s1
+                k2 += s2
         sums[block, 0] = k0
         sums[block, 1] = k1
         sums[block, 2] = k2

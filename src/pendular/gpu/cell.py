@@ -16,7 +16,7 @@ servo_cell) or a strain rate's axis (PeriodicCell.stretch). Last, ``period`` (3,
 and rates.
 """
 
-from pendular.dem.cell import servo_cell
+from pendular.dem.cell import pair_stiffness as cpu_pair_stiffness, servo_cell
 from pendular.dem.virial import add_face_term, add_outer, pair_force_with_attraction
 from pendular.dem.walls import StressServo
 from pendular.gpu.cuda import cuda, device, device_twin
@@ -26,24 +26,12 @@ servo = device_twin(servo_cell)
 outer = device_twin(add_outer)
 face_term = device_twin(add_face_term)
 pull_less = device_twin(pair_force_with_attraction)
+pair_stiffness = device_twin(cpu_pair_stiffness)
 
 #: Columns of a block's partial sums: x (x) F (9), the face terms (9), the stiffness (3).
 CELL_SUMS = 21
 #: Fewest servo calls between refreshes of the cell's stiffness after the warm-up.
 CELL_STIFFNESS_EVERY = StressServo.CELL_STIFFNESS_EVERY
-
-
-@device
-def pair_stiffness(k, p, radius, pair_j, normal, normal_force, overlap):
-    """Pair k's (kn (l_0 n_0)^2, kn (l_1 n_1)^2, kn (l_2 n_2)^2) [N m], pair by pair as
-    pendular.dem.cell.contact_stiffness (nothing from a pair apart: no normal force)."""
-    length = radius[p] + radius[pair_j[k]] - overlap[k]
-    spring_overlap = overlap[k] if overlap[k] > 0.0 else 1.0
-    weight = normal_force[k] * length * length / spring_overlap
-    s0 = normal[k, 0] * normal[k, 0]
-    s1 = normal[k, 1] * normal[k, 1]
-    s2 = normal[k, 2] * normal[k, 2]
-    return weight * (s0 * s0), weight * (s1 * s1), weight * (s2 * s2)
 
 
 @device
