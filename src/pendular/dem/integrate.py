@@ -12,10 +12,11 @@ def _damped(force, velocity, acceleration_dt, damping):
 
     As YADE's NewtonIntegrator, v is the on-step velocity estimate v(t - dt/2) + a dt / 2.
     Written without branches: the signs of F v are random, and mispredicted branches would
-    dominate the cost of the whole integration.
+    dominate the cost of the whole integration (the comparisons as floats, which the GPU's
+    twin and Numba's CUDA simulator take too).
     """
     product = force * (velocity + 0.5 * acceleration_dt)
-    sign = (product > 0.0) - (product < 0.0)
+    sign = (product > 0.0) * 1.0 - (product < 0.0) * 1.0
     return force * (1.0 - damping * sign)
 
 

@@ -1,41 +1,29 @@
-"""Leapfrog with Cundall's local damping on the device (pendular.dem.integrate), one thread per
+"""Leapfrog with Cundall's local damping on the device: the CPU's own particle step
+(pendular.dem.integrate._advance, compiled for the device by device_twin), one thread per
 particle, which also asks for a neighbour-list rebuild when the particle has moved more than
 half the skin since the last one (pendular.dem.neighbors.moved_beyond) and flags a position
 that is not finite (a diverged run, which the CPU catches at its next rebuild)."""
 
 import math
 
-from pendular.gpu.cuda import cuda, device
+from pendular.dem.integrate import _advance
+from pendular.gpu.cuda import cuda, device_twin
 
-
-@device
-def damped(force, velocity, acceleration_dt, damping):
-    """Cundall local damping F (1 - lambda sign(F v)), v the on-step velocity
-    (pendular.dem.integrate._damped; the sign as a select, which the simulator's NumPy
-    scalars take as the compiled code does)."""
-    product = force * (velocity + 0.5 * acceleration_dt)
-    sign = 1.0 if product > 0.0 else (-1.0 if product < 0.0 else 0.0)
-    return force * (1.0 - damping * sign)
+advance = device_twin(_advance)
 
 
 @cuda.jit
-def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping, dt,
-             reference_position, limit, flags):
+def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+             no_stretching, dt, reference_position, limit, flags):
     """Advance particle p's velocities to t + dt/2 and position to t + dt (the CPU's _advance
-    inside walls: no stretching); set flags[0] when it is farther than ``limit`` [m] from its
-    position at the last rebuild, flags[2] when its position is not finite (every thread that
-    sets one writes the same 1)."""
+    inside walls: ``no_stretching`` zeros (3,)); set flags[0] when it is farther than
+    ``limit`` [m] from its position at the last rebuild, flags[2] when its position is not
+    finite (every thread that sets one writes the same 1)."""
     p = cuda.grid(1)
     if p >= position.shape[0]:
         return
-    dt_mass = dt / mass[p]
-    dt_inertia = dt / inertia[p]
-    for c in range(3):
-        f = damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
-        velocity[p, c] += f * dt_mass
-        position[p, c] += velocity[p, c] * dt
-        t = damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
-        angular_velocity[p, c] += t * dt_inertia
+    advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+            no_stretching, False, dt)
     d0 = position[p, 0] - reference_position[p, 0]
     d1 = position[p, 1] - reference_position[p, 1]
     d2 = position[p, 2] - reference_position[p, 2]
@@ -59,17 +47,8 @@ def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, ine
     if p >= position.shape[0]:
         return
     stretched = affine_rate[0] != 0.0 or affine_rate[1] != 0.0 or affine_rate[2] != 0.0
-    dt_mass = dt / mass[p]
-    dt_inertia = dt / inertia[p]
-    for c in range(3):
-        f = damped(force[p, c], velocity[p, c], force[p, c] * dt_mass, damping)
-        velocity[p, c] += f * dt_mass
-        if stretched:
-            position[p, c] += (velocity[p, c] + affine_rate[c] * position[p, c]) * dt
-        else:
-            position[p, c] += velocity[p, c] * dt
-        t = damped(torque[p, c], angular_velocity[p, c], torque[p, c] * dt_inertia, damping)
-        angular_velocity[p, c] += t * dt_inertia
+    advance(p, position, velocity, angular_velocity, force, torque, mass, inertia, damping,
+            affine_rate, stretched, dt)
     s0 = cell_position[1] / reference_cell[1]
     s1 = cell_position[3] / reference_cell[3]
     s2 = cell_position[5] / reference_cell[5]

@@ -375,7 +375,8 @@ class GpuSimulation:
               s.flags)),
             (integrate.leapfrog, n, (s.position, s.velocity, s.angular_velocity, s.force,
                                      s.torque, s.mass, s.inertia, sim.integrator.damping,
-                                     sim.dt, s.reference_position, limit, s.flags)),
+                                     s.no_period, sim.dt, s.reference_position, limit,
+                                     s.flags)),
         ]
 
     # ---------------------------------------------------------------- running
