@@ -66,6 +66,18 @@ def cell_coordinate(x, wall_position, dims, axis):
     return int(cells)
 
 
+@device
+def append_to_cell(p, c, cell_of, cell_count, cell_members, cell_width, flags):
+    """Record particle p in cell c (its slot taken atomically: the order within a cell is
+    the launch's, which the rows' sort makes irrelevant), or flag the cell's overflow."""
+    cell_of[p] = c
+    slot = cuda.atomic.add(cell_count, c, 1)
+    if slot < cell_width:
+        cell_members[c * cell_width + slot] = p
+    else:
+        cuda.atomic.or_(flags, 1, CELL_OVERFLOW)
+
+
 @cuda.jit
 def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell_members,
                   cell_width, cell_of, flags):
@@ -77,12 +89,7 @@ def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell
     c = ((cell_coordinate(position[p, 0], wall_position, d0, 0) * d1
           + cell_coordinate(position[p, 1], wall_position, d1, 1)) * d2
          + cell_coordinate(position[p, 2], wall_position, d2, 2))
-    cell_of[p] = c
-    slot = cuda.atomic.add(cell_count, c, 1)
-    if slot < cell_width:
-        cell_members[c * cell_width + slot] = p
-    else:
-        cuda.atomic.or_(flags, 1, CELL_OVERFLOW)
+    append_to_cell(p, c, cell_of, cell_count, cell_members, cell_width, flags)
 
 
 @device
@@ -227,26 +234,6 @@ wrap_cell = device_twin(_wrap_cell)
 
 
 @device
-def periodic_dims(cell_position, cell_size, max_dims, axis):
-    """Cells along ``axis`` of the periodic grid: int(L / cell_size) (the CPU's), at most
-    max_dims[axis], at least 1 (a cell that is not finite: a diverged run)."""
-    cells = cell_position[2 * axis + 1] / cell_size
-    if not cells >= 1.0:
-        return 1
-    if cells >= max_dims[axis]:
-        return max_dims[axis]
-    return int(cells)
-
-
-@device
-def periodic_shape(cell_position, cell_size, max_dims):
-    """(cells along x, y, z) of the periodic grid now (periodic_dims)."""
-    return (periodic_dims(cell_position, cell_size, max_dims, 0),
-            periodic_dims(cell_position, cell_size, max_dims, 1),
-            periodic_dims(cell_position, cell_size, max_dims, 2))
-
-
-@device
 def wrap_particle(p, position, cell_position, wraps):
     """Bring particle p into [0, L) and count the periods it crossed in ``wraps`` (N, 3)
     (pendular.dem.cell.PeriodicCell.wrap of a cell not sheared: floor, subtract, clamp into
@@ -278,7 +265,7 @@ def bin_periodic(position, cell_position, wraps, cell_size, max_dims, cell_count
     if flags[0] == 0 or p >= position.shape[0]:
         return
     wrap_particle(p, position, cell_position, wraps)
-    dims = periodic_shape(cell_position, cell_size, max_dims)
+    dims = grid_shape(cell_position, cell_size, max_dims)      # low faces at 0: int(L / size)
     if p == 0 and (dims[0] < 3 or dims[1] < 3 or dims[2] < 3):
         cuda.atomic.or_(flags, 1, NARROW_CELL)
     c = 0
@@ -287,12 +274,7 @@ def bin_periodic(position, cell_position, wraps, cell_size, max_dims, cell_count
         index = int(position[p, axis] / width)
         index = min(max(index, 0), dims[axis] - 1)
         c = c * dims[axis] + index
-    cell_of[p] = c
-    slot = cuda.atomic.add(cell_count, c, 1)
-    if slot < cell_width:
-        cell_members[c * cell_width + slot] = p
-    else:
-        cuda.atomic.or_(flags, 1, CELL_OVERFLOW)
+    append_to_cell(p, c, cell_of, cell_count, cell_members, cell_width, flags)
 
 
 @device
@@ -328,7 +310,7 @@ def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_di
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
-    dims = periodic_shape(cell_position, cell_size, max_dims)
+    dims = grid_shape(cell_position, cell_size, max_dims)      # low faces at 0: int(L / size)
     cx, cy, cz = cell_coordinates(cell_of[p], dims)
     n = position.shape[0]
     above = 0
