@@ -93,17 +93,25 @@ def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell
 
 
 @device
-def insert_sorted(row, p, n, found, width, q, flags):
-    """Put q into particle p's row (slots s * n + p, s < ``found``) kept sorted, if there is
-    room (else flag the overflow); returns the new count."""
-    if found >= width:
-        cuda.atomic.or_(flags, 1, ROW_OVERFLOW)
-        return found + 1
+def shift_in(row, p, n, found, q):
+    """Put q into particle p's sorted row of ``found`` entries (slots s * n + p; room checked
+    by the caller), the entries above q moved up a slot; returns q's slot."""
     s = found
     while s > 0 and row[(s - 1) * n + p] > q:
         row[s * n + p] = row[(s - 1) * n + p]
         s -= 1
     row[s * n + p] = q
+    return s
+
+
+@device
+def insert_sorted(row, p, n, found, width, q, flags):
+    """Put q into particle p's row kept sorted (shift_in) if there is room, else flag the
+    overflow; returns the new count."""
+    if found >= width:
+        cuda.atomic.or_(flags, 1, ROW_OVERFLOW)
+    else:
+        shift_in(row, p, n, found, q)
     return found + 1
 
 
@@ -283,13 +291,10 @@ def insert_with_image(row, image, p, n, found, width, q, sx, sy, sz, flags):
     if found >= width:
         cuda.atomic.or_(flags, 1, ROW_OVERFLOW)
         return found + 1
-    s = found
-    while s > 0 and row[(s - 1) * n + p] > q:
-        row[s * n + p] = row[(s - 1) * n + p]
+    s = shift_in(row, p, n, found, q)
+    for t in range(found, s, -1):           # the images of the entries that moved up
         for c in range(3):
-            image[s * n + p, c] = image[(s - 1) * n + p, c]
-        s -= 1
-    row[s * n + p] = q
+            image[t * n + p, c] = image[(t - 1) * n + p, c]
     image[s * n + p, 0] = sx
     image[s * n + p, 1] = sy
     image[s * n + p, 2] = sz
