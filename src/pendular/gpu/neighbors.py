@@ -154,17 +154,20 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
                             above = insert_sorted(new_pair_j, p, n, above, width, q, flags)
                         else:
                             below = insert_sorted(lower, p, n, below, width, q, flags)
-    new_count[p] = min(above, width)
-    lower_count[p] = min(below, width)
-    carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
-               bridges, new_shear_force, new_normal, new_overlap, new_bridges)
+    carry_rows(p, n, min(above, width), min(below, width), new_count, lower_count, pair_count,
+               pair_j, new_pair_j, shear_force, normal, overlap, bridges, new_shear_force,
+               new_normal, new_overlap, new_bridges)
 
 
 @device
-def carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
-               bridges, new_shear_force, new_normal, new_overlap, new_bridges):
-    """The per-pair state of particle p's new row from the same (p, j) pairs of its old one
-    (find_pairs)."""
+def carry_rows(p, n, above, below, new_count, lower_count, pair_count, pair_j, new_pair_j,
+               shear_force, normal, overlap, bridges, new_shear_force, new_normal, new_overlap,
+               new_bridges):
+    """Close particle p's new rows: ``above`` pairs j > p and ``below`` j < p listed (counts
+    within the rows' width), and the per-pair state of the new row from the same (p, j) pairs
+    of its old one (find_pairs)."""
+    new_count[p] = above
+    lower_count[p] = below
     old = 0
     for s in range(new_count[p]):
         k = s * n + p
@@ -342,7 +345,6 @@ def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_di
                                                       q, sx, sy, sz, flags)
                         else:
                             below = insert_sorted(lower, p, n, below, width, q, flags)
-    new_count[p] = min(above, width)
-    lower_count[p] = min(below, width)
-    carry_rows(p, n, pair_count, pair_j, new_count, new_pair_j, shear_force, normal, overlap,
-               bridges, new_shear_force, new_normal, new_overlap, new_bridges)
+    carry_rows(p, n, min(above, width), min(below, width), new_count, lower_count, pair_count,
+               pair_j, new_pair_j, shear_force, normal, overlap, bridges, new_shear_force,
+               new_normal, new_overlap, new_bridges)
