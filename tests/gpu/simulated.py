@@ -27,6 +27,7 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import GpuSimulation
 from pendular.gpu.cuda import cuda, device_twin
+from simulator import counted_copies, relative
 
 RADIUS = 1e-3
 YOUNG = 1e7
@@ -76,13 +77,6 @@ def lookups(radius_ratios, suction_axis, distance_low, log_distance_rupture, log
         out[b, 2] = v
         out[b, 3] = d1
         out[b, 4] = d2
-
-
-def relative(a, b):
-    """max |a - b| / max |a| [-] (0 for two zero arrays)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    scale = np.max(np.abs(a))
-    return float(np.max(np.abs(a - b)) / scale) if scale > 0 else float(np.max(np.abs(b)))
 
 
 def snapshot(sim):
@@ -161,14 +155,6 @@ def device_run():
     """``Simulation(device="gpu").run`` with ``until`` against the CPU: the steps taken, the
     state and the history, and the device's copies back (GpuSimulation.copy_back) by part: an
     ``until`` that reads the walls brings back the walls alone, the recorder everything."""
-    copies = []
-    copy_back = GpuSimulation.copy_back
-
-    def counted(self, part=None):
-        copies.append(part or "all")
-        return copy_back(self, part)
-
-    GpuSimulation.copy_back = counted
     cpu, gpu = scene(), scene()
     gpu.device = "gpu"
     length = cpu.walls.lengths()[2]
@@ -176,8 +162,8 @@ def device_run():
     def until(sim):                 # the axial walls closer by 110 steps of the strain rate
         return sim.walls.lengths()[2] < length * (1.0 - 110 * sim.dt * 1.0)
 
-    taken = [sim.run(STEPS, until=until, check_every=25) for sim in (cpu, gpu)]
-    GpuSimulation.copy_back = copy_back
+    with counted_copies() as copies:
+        taken = [sim.run(STEPS, until=until, check_every=25) for sim in (cpu, gpu)]
     return {"taken": taken, "step": [cpu.step, gpu.step], "copies": copies,
             "agreement": compare(snapshot(cpu), snapshot(gpu)),
             "history": history_difference(cpu, gpu),

@@ -10,12 +10,12 @@ largest relative differences 2.4e-15 in positions, 1.3e-12 in forces.
 
 import pytest
 
-from test_gpu_dem import simulated
+from simulator import simulated
 
 
 @pytest.fixture(scope="module")
 def wet():
-    return simulated("wet")
+    return simulated("simulated.py", "wet")
 
 
 def test_the_device_reads_the_table_as_the_cpu(wet):

@@ -17,7 +17,7 @@ import sys
 import pytest
 
 from compile_ptx import extra_compiler_folder
-from conftest import ROOT
+from simulator import ROOT, simulated
 
 try:
     import numba_cuda  # noqa: F401
@@ -25,19 +25,9 @@ except ImportError:
     pytest.skip("numba-cuda is not installed (pip install -e '.[gpu]')", allow_module_level=True)
 
 
-def simulated(check):
-    """The measurements of tests/gpu/simulated.py ``check``, run under the simulator."""
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "gpu", "simulated.py"),
-                           check], capture_output=True, text=True, env=environment, cwd=ROOT,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 @pytest.fixture(scope="module")
 def dry():
-    return simulated("dry")
+    return simulated("simulated.py", "dry")
 
 
 def test_every_kernel_agrees_with_the_cpu_to_round_off(dry):

@@ -20,35 +20,24 @@ preparation takes thousands of growth steps, beyond the simulator: ``prepare_sam
 import json
 import math
 import os
-import subprocess
-import sys
 
 import pytest
+
+from simulator import relative, simulated
 
 try:
     import numba_cuda  # noqa: F401
 except ImportError:
     pytest.skip("numba-cuda is not installed (pip install -e '.[gpu]')", allow_module_level=True)
 
-#: The repository (this file is also run as a script, without the tests' conftest).
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 RADIUS = 1e-3
 STEPS = 300
 TARGET = 5000.0
 
 
-def measured():
-    """The measurements (module docstring), run under the simulator."""
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.abspath(__file__)], capture_output=True,
-                          text=True, env=environment, cwd=ROOT, timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 @pytest.fixture(scope="module")
 def growth():
-    return measured()
+    return simulated(os.path.basename(__file__))
 
 
 def test_the_growth_on_the_gpu_agrees_with_the_cpu_to_round_off(growth):
@@ -127,15 +116,6 @@ def scene(timestep=True, seed=3):
                       controls=controls, integrator=Integrator(0.2))
 
 
-def largest_relative(a, b):
-    """max |a - b| / max |b| (0 for equal arrays)."""
-    import numpy as np
-
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    scale = float(np.max(np.abs(b)))
-    return float(np.max(np.abs(a - b))) / scale if scale > 0 else float(np.max(np.abs(a)))
-
-
 def growth_run():
     """The scene on the CPU and on the GPU (GpuSimulation driven directly), STEPS steps."""
     import numpy as np
@@ -169,17 +149,17 @@ def growth_run():
         half.to_host()
     p, q = sim.particles, cpu.particles
     return {
-        "split": {"position": largest_relative(split.particles.position, q.position),
-                  "radius": largest_relative(split.particles.radius, q.radius),
+        "split": {"position": relative(split.particles.position, q.position),
+                  "radius": relative(split.particles.radius, q.radius),
                   "dt": abs(split.dt - cpu.dt) / cpu.dt},
         "agreement": {
-            "radius": largest_relative(p.radius, q.radius),
-            "mass": largest_relative(p.mass, q.mass),
-            "inertia": largest_relative(p.inertia, q.inertia),
-            "position": largest_relative(p.position, q.position),
-            "velocity": largest_relative(p.velocity, q.velocity),
-            "wall_position": largest_relative(sim.walls.position, cpu.walls.position),
-            "wall_stress": largest_relative(sim.walls.stress(), cpu.walls.stress()),
+            "radius": relative(p.radius, q.radius),
+            "mass": relative(p.mass, q.mass),
+            "inertia": relative(p.inertia, q.inertia),
+            "position": relative(p.position, q.position),
+            "velocity": relative(p.velocity, q.velocity),
+            "wall_position": relative(sim.walls.position, cpu.walls.position),
+            "wall_stress": relative(sim.walls.stress(), cpu.walls.stress()),
             "dt": abs(sim.dt - cpu.dt) / cpu.dt},
         "touching": {"cpu": int(np.count_nonzero(cpu.contacts.touching())),
                      "gpu": int(np.count_nonzero(sim.contacts.touching()))},

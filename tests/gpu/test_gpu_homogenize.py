@@ -21,14 +21,13 @@ vectorised sums and matrix product).
 
 import json
 import os
-import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+from simulator import relative, simulated
+
 STEPS = 30
 #: Spheres a side of the scene's cubic lattice: 64 spheres, two blocks of CHUNK = 32.
 SIDE = 4
@@ -39,13 +38,6 @@ CHUNK = 32
 WIDE = 50.0
 #: Largest values (exact in any order): the guard's largest overlap, the radii's range.
 MAXIMA = ("largest_overlap", "smallest_radius", "largest_radius")
-
-
-def relative(a, b):
-    """max |a - b| / max |a| [-] (0 for two zero arrays)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    scale = np.max(np.abs(a))
-    return float(np.max(np.abs(a - b)) / scale) if scale > 0 else float(np.max(np.abs(b)))
 
 
 def cpu_homogenization(sim):
@@ -147,22 +139,11 @@ def measure(wet, chunk, filling_angle=None):
             "psi": device["psi"].tolist() if wet else None}
 
 
-def simulated(check):
-    """The measurements of this file's script ``check`` ("dry" or "wet"), run under the
-    simulator."""
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.abspath(__file__), check],
-                          capture_output=True, text=True, env=environment, cwd=ROOT,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 @pytest.fixture(scope="module", params=["dry", "wet"])
 def scene_run(request):
     pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
                         "(pip install -e '.[gpu]')")
-    return request.param == "wet", simulated(request.param)
+    return request.param == "wet", simulated(os.path.basename(__file__), request.param)
 
 
 def test_the_reduction_runs_in_two_blocks():
@@ -238,5 +219,4 @@ def main(check):
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, HERE)
     print(json.dumps(main(sys.argv[1])))

@@ -13,18 +13,16 @@ velocities 5.8e-12, the servos' targets (recorded every 50 steps) 3.7e-14; at co
 
 import json
 import os
-import subprocess
-import sys
 
 import pytest
+
+from simulator import simulated
 
 try:
     import numba_cuda  # noqa: F401
 except ImportError:
     pytest.skip("numba-cuda is not installed (pip install -e '.[gpu]')", allow_module_level=True)
 
-#: The repository (this file is also run as a script, without the tests' conftest).
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 STEPS = 300
 #: The mean stress held [Pa] (the scene's stresses are 3e4-1e5 Pa), and that of the failing
 #: run: 3 p falls below the axial stress within its first 25 steps.
@@ -32,18 +30,9 @@ MEAN_STRESS = 5e4
 FAILING_MEAN_STRESS = 2.5e4
 
 
-def measured():
-    """The measurements (module docstring), run under the simulator."""
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.abspath(__file__)], capture_output=True,
-                          text=True, env=environment, cwd=ROOT, timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 @pytest.fixture(scope="module")
 def mixed():
-    return measured()
+    return simulated(os.path.basename(__file__))
 
 
 @pytest.mark.parametrize("condition", ["constant_p", "constant_b"])

@@ -25,7 +25,8 @@ import sys
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from simulator import ROOT, relative, simulated
+
 RADIUS = 1e-3
 YOUNG = 1e7
 SIDE = 4
@@ -64,13 +65,6 @@ def scene(wet=False, seed=3):
                       controls=[StressServo("xy", 2e4, 0.02), ConstantStrainRate("z", 2.0,
                                                                                  length)],
                       integrator=Integrator(0.2), threads=1)
-
-
-def relative(a, b):
-    """max |a - b| / max |a| [-] (0 for two zero arrays)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    scale = np.max(np.abs(a))
-    return float(np.max(np.abs(a - b)) / scale) if scale > 0 else float(np.max(np.abs(b)))
 
 
 def snapshot(sim):
@@ -118,25 +112,20 @@ def agreement(wet):
 
 
 # ---------------------------------------------------------------- the tests (pytest)
-def simulated(check):
+def measured(check):
     """The measurements of this file's ``check``, run under the simulator."""
     pytest.importorskip("numba_cuda")
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.abspath(__file__), check],
-                          capture_output=True, text=True, env=environment, cwd=ROOT,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    return simulated(os.path.basename(__file__), check)
 
 
 @pytest.fixture(scope="module")
 def dry():
-    return simulated("dry")
+    return measured("dry")
 
 
 @pytest.fixture(scope="module")
 def wet():
-    return simulated("wet")
+    return measured("wet")
 
 
 def assert_agrees(measured):

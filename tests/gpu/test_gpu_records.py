@@ -13,13 +13,12 @@ every 10, under Numba's CUDA simulator in a process of its own
 
 import json
 import os
-import subprocess
 import sys
 
 import pytest
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(os.path.dirname(HERE))
+from simulator import counted_copies, relative, simulated
+
 STEPS = 30
 RECORD_PERIOD = 10
 #: Unbalanced forces of the equilibrium's test: the jittered, moving scene passes the first
@@ -29,11 +28,10 @@ UNBALANCED = (1.0, 0.5)
 
 def measure(wet):
     """(copies back in order, records, {column: largest relative difference from the CPU})."""
-    from simulated import relative, scene
+    from simulated import scene
 
     from pendular.capillary.bridges import CapillaryBridges
     from pendular.dem.record import HistoryRecorder
-    from pendular.gpu import GpuSimulation
     from pendular.procedures.guards import SampleGuard
     from pendular.procedures.loading import AxisStrain, history_columns
     from pendular.procedures.preparation import static
@@ -47,45 +45,28 @@ def measure(wet):
         sim.device = device
         return sim
 
-    copies = []
-    copy_back = GpuSimulation.copy_back
-
-    def counted(self, part=None):
-        copies.append(part or "all")
-        return copy_back(self, part)
-
-    GpuSimulation.copy_back = counted
     cpu, gpu = build("cpu"), build("gpu")
     cpu.run(STEPS)
-    gpu.run(STEPS)
+    with counted_copies() as recorded:
+        gpu.run(STEPS)
     a, b = cpu.writers[0].arrays(), gpu.writers[0].arrays()
-    recorded = list(copies)
     # an equilibrium's test (pendular.procedures.preparation.static, its unbalanced force
     # alone: the servos' tolerance wide open) on the device stops the run at the CPU's check,
     # reading the walls alone until then
-    copies.clear()
-    stopped = [[build(device).run(STEPS, until=static(unbalanced, tolerance=1e9),
-                                  check_every=RECORD_PERIOD) for device in ("cpu", "gpu")]
-               for unbalanced in UNBALANCED]
+    with counted_copies() as copies:
+        stopped = [[build(device).run(STEPS, until=static(unbalanced, tolerance=1e9),
+                                      check_every=RECORD_PERIOD) for device in ("cpu", "gpu")]
+                   for unbalanced in UNBALANCED]
     return {"copies": recorded, "records": len(a["step"]), "columns": sorted(a),
             "difference": {name: relative(a[name], b[name]) for name in a},
             "static": {"stopped": stopped, "copies": copies}}
-
-
-def simulated(check):
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.abspath(__file__), check],
-                          capture_output=True, text=True, env=environment, cwd=ROOT,
-                          timeout=600)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 @pytest.fixture(scope="module", params=["dry", "wet"])
 def recorded(request):
     pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
                         "(pip install -e '.[gpu]')")
-    return request.param == "wet", simulated(request.param)
+    return request.param == "wet", simulated(os.path.basename(__file__), request.param)
 
 
 def test_record_steps_copy_the_walls_alone(recorded):
@@ -114,5 +95,4 @@ def test_an_equilibrium_test_reads_the_walls_alone_and_stops_where_the_cpu_does(
 
 
 if __name__ == "__main__":
-    sys.path.insert(0, HERE)
     print(json.dumps(measure(sys.argv[1] == "wet")))
