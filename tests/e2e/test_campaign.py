@@ -144,6 +144,22 @@ def test_a_run_of_a_table_refused_before_running_names_the_table(tmp_path, capsy
     assert not (tmp_path / "o" / "runs").exists()
 
 
+@pytest.mark.parametrize("command", ["campaign", "chapter5"])
+def test_a_campaign_on_a_device_that_cannot_run_here_is_refused_before_running(
+        tmp_path, capsys, monkeypatch, command):
+    """Without a GPU (and not in Numba's CUDA simulator), --device gpu is refused in one line
+    naming it before anything is made."""
+    monkeypatch.delenv("NUMBA_ENABLE_CUDASIM", raising=False)
+    table = tmp_path / "t.toml"
+    table.write_text('[fixed]\nparticles = 60\nmax_strain = 0.01\n')
+    argv = ([table] if command == "campaign" else
+            ["--particles", 60, "--suctions", 0, "--confining", 750])
+    status, err = run_in_process(command, [*argv, "--out", tmp_path / "o", "--device", "gpu"],
+                                 capsys)
+    refused(status, err, f"pendular {command}: error: --device gpu cannot run here")
+    assert not (tmp_path / "o").exists()
+
+
 def test_table_rows_cartesian_and_explicit():
     command, rows, varied = table_rows({"fixed": {"particles": 10},
                                         "sweep": {"suction": [0, 1], "seed": [1, 2, 3]}}, "t")

@@ -110,26 +110,40 @@ def add_run_options(parser, threads_default=None):
                              "to 4 significant figures, with units)")
 
 
+def add_device_option(parser, runs):
+    """--device: where ``runs`` (what the command runs, in its help) run, "cpu" or "gpu"; a
+    run option, as --threads (docs/gpu.md)."""
+    from pendular.dem.simulation import DEVICES
+
+    parser.add_argument("--device", choices=DEVICES, default="cpu",
+                        help=f"where {runs} run: cpu, or gpu (numba-cuda, pip install -e "
+                             "'.[gpu]'; docs/gpu.md); a run option: a checkpoint resumes on "
+                             "either")
+
+
 def add_executor_options(parser):
     """Options of commands that run many tests: --jobs, --scheduler, and --threads (per run,
-    default 1), --quiet."""
+    default 1), --quiet, --device (every run's)."""
     parser.add_argument("--jobs", type=positive_int("--jobs", 1), default=1,
                         help="parallel processes")
     parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
                         help="run on the Dask cluster of this scheduler (e.g. tcp://host:8786) "
                              "instead of --jobs local processes")
     add_run_options(parser, threads_default=1)
+    add_device_option(parser, "the preparations and the runs")
 
 
 def start_executor_run(args):
     """Check the options of add_executor_options and --out before anything is made (errors
-    naming the option), and apply --threads."""
+    naming the option; --device: that it can run here), and apply --threads."""
+    from pendular.dem.simulation import device_start
     from pendular.studies.campaign import check_jobs
 
     if args.out == "":
         raise UsageError("--out '': an output folder is required")
     set_threads(args.threads)
     check_jobs(args.jobs)
+    device_start(args.device, f"--device {args.device}")
 
 
 def add_declared_options(parser, options):

@@ -76,7 +76,7 @@ from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to
                                         same_config, sample_made_with, stored_config)
 from pendular.procedures.options import config_from_options, options_of
 from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import Interrupted, TriaxialTest, parameters
+from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device, parameters
 from pendular.utils.parameters import Option
 
 #: Seconds between updates of the campaign's progress bar.
@@ -146,27 +146,30 @@ class CampaignResult:
 
 # ---------------------------------------------------------------- workers (top level: picklable)
 
-def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False) -> dict:
-    """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads, its output
-    and progress bars in ``folder``/log.txt (with the traceback if it fails); its summary."""
+def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False,
+            device: str = "cpu") -> dict:
+    """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads on
+    ``device``, its output and progress bars in ``folder``/log.txt (with the traceback if it
+    fails); its summary."""
     use_threads(threads)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w", encoding="utf-8") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
         try:
             if isinstance(config, TriaxialConfig):
-                return TriaxialTest(config, force=force).run(folder, threads=threads)
+                return TriaxialTest(config, force=force).run(folder, threads=threads,
+                                                              device=device)
             return tension_summary(TensionTest(config).run(folder))
         except BaseException:
             traceback.print_exc()
             raise
 
 
-def prepare_one(sample: PrepareConfig, path: str, threads: int = 1) -> str:
-    """Worker: prepare the sample of ``sample`` (a PrepareConfig) and save it at ``path`` with
-    its configuration (``{"sample": config_to_dict(sample)}``)."""
+def prepare_one(sample: PrepareConfig, path: str, threads: int = 1, device: str = "cpu") -> str:
+    """Worker: prepare the sample of ``sample`` (a PrepareConfig) on ``device`` and save it at
+    ``path`` with its configuration (``{"sample": config_to_dict(sample)}``)."""
     use_threads(threads)
-    sim, report = prepare_sample(sample, progress=False, threads=threads)
+    sim, report = prepare_sample(sample, progress=False, threads=threads, device=device)
     save_sample(path, sim, report, {"sample": config_to_dict(sample)},
                 identity={"seed": sample.seed})
     return path
@@ -389,13 +392,15 @@ class Campaign:
         return os.path.join(out, "runs", name)
 
     def run(self, out: str, *, jobs: int = 1, scheduler: str | None = None, threads: int = 1,
-            quiet: bool = False) -> CampaignResult:
+            quiet: bool = False, device: str = "cpu") -> CampaignResult:
         """Run every run into ``out``/runs/<name> (reusing finished ones) with ``threads``
         Numba threads each, in ``jobs`` local processes (check_jobs) or on the Dask cluster
-        at ``scheduler`` (its workers must see ``out`` at the same path). Every configuration
+        at ``scheduler`` (its workers must see ``out`` at the same path), the preparations
+        and the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's
+        identity, so a finished run is reused whichever device ran it). Every configuration
         still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
-        tables), so a bad one is refused before anything runs. The caller holds ``out``
-        (an OutputFolder, module docstring)."""
+        tables; what the device runs), so a bad one is refused before anything runs. The
+        caller holds ``out`` (an OutputFolder, module docstring)."""
         jobs = check_jobs(jobs)
         threads = check_int("threads", threads, low=1)
         out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
@@ -409,18 +414,23 @@ class Campaign:
                 result.summaries[run.name] = summary
                 result.reused.append(run.name)
         for run in todo:
-            if isinstance(run.config, TriaxialConfig):
-                try:
+            try:
+                if isinstance(run.config, TriaxialConfig):
                     TriaxialTest(run.config, force=run.force)
-                except ValueError as error:
-                    raise RunRefused(f"run {run.name}: {error}") from None
+                    check_device(run.config, device)
+                elif device != "cpu":
+                    raise ValueError(f"--device {device} does not run the tension test yet: "
+                                     "run it on the CPU (--device cpu)")
+            except ValueError as error:
+                raise RunRefused(f"run {run.name}: {error}") from None
         preparations = [(sample, path) for sample, path in self.samples
                         if not sample_made_with(path, sample)]
         for _, path in preparations:
             os.makedirs(os.path.dirname(path), exist_ok=True)
         with executor(jobs, scheduler) as pool:
             _, errors = map_tasks(pool, prepare_one,
-                                  [(sample, path, threads) for sample, path in preparations],
+                                  [(sample, path, threads, device)
+                                   for sample, path in preparations],
                                   description="prepare", quiet=quiet)
             unprepared = {os.path.abspath(preparations[i][1]): text
                           for i, text in errors.items()}
@@ -432,7 +442,7 @@ class Campaign:
                                                f"{unprepared[os.path.abspath(path)]}")
             folders = [self.folder(out, run.name) for run in todo]
             results, errors = map_tasks(
-                pool, run_one, [(run.config, folder, threads, run.force)
+                pool, run_one, [(run.config, folder, threads, run.force, device)
                                 for run, folder in zip(todo, folders)],
                 description="runs", folders=folders, quiet=quiet)
         for index, (run, summary) in enumerate(zip(todo, results)):

@@ -352,9 +352,10 @@ def run_row(suction, lateral, summary, folder, out):
 
 def chapter5_campaign(grid: Chapter5Grid, out: str, *, jobs: int = 1,
                       scheduler: str | None = None, threads: int = 1,
-                      quiet: bool = False) -> tuple[dict, int]:
+                      quiet: bool = False, device: str = "cpu") -> tuple[dict, int]:
     """Run the campaign of ``grid`` (Chapter5Grid) into ``out`` (``jobs`` local processes or
-    the Dask cluster at ``scheduler``, ``threads`` Numba threads per run); writes
+    the Dask cluster at ``scheduler``, ``threads`` Numba threads per run, on ``device``:
+    Campaign.run); writes
     campaign.json, campaign.csv, report.md and plots/ (module docstring); returns (campaign
     dict, runs reused). ValueError naming the runs that failed (the others are kept and
     reused when started again)."""
@@ -368,7 +369,7 @@ def chapter5_campaign(grid: Chapter5Grid, out: str, *, jobs: int = 1,
         for name in OUTPUTS:
             folder.claim(name)
         result = Campaign(runs, samples).run(out, jobs=jobs, scheduler=scheduler,
-                                             threads=threads, quiet=quiet)
+                                             threads=threads, quiet=quiet, device=device)
         write_campaign_csv(os.path.join(out, "campaign.csv"), result)
         result.check()
         for s, c in tests:                  # reused runs too: the figures read them all

@@ -44,6 +44,7 @@ def run(args):
         try:
             result = Campaign(runs).run(os.path.abspath(args.out), jobs=args.jobs,
                                         scheduler=args.scheduler, threads=args.threads,
+                                        device=args.device,
                                         quiet=args.quiet)
         except RunRefused as error:
             raise UsageError(f"table = {args.table!r}: {error}") from None

@@ -21,6 +21,7 @@ def run(args):
     grid = grid_from_options(declared_values(grid_options(), args))
     campaign, reused = chapter5_campaign(grid, args.out, jobs=args.jobs,
                                          scheduler=args.scheduler, threads=args.threads,
+                                         device=args.device,
                                          quiet=args.quiet)
     runs = len(campaign["runs"])
     if reused:

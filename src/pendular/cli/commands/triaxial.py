@@ -24,10 +24,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from pendular.dem.simulation import DEVICES
-
-from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_run_options,
-    command_config, positive_int, print_summary, set_threads)
+from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_device_option,
+    add_run_options, command_config, positive_int, print_summary, set_threads)
 from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device
 
 #: Options a resumed run takes from its own command line, not from the stored run.
@@ -66,10 +64,7 @@ def add_output_options(parser, out):
     parser.add_argument("--force", action="store_true",
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
-    parser.add_argument("--device", choices=DEVICES, default="cpu",
-                        help="where the preparation and the loading run: cpu, or gpu "
-                             "(numba-cuda, pip install -e '.[gpu]'; the wetting stays on the "
-                             "CPU; docs/gpu.md); a run option: a checkpoint resumes on either")
+    add_device_option(parser, "the preparation and the loading (the wetting stays on the CPU)")
     parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
                         type=positive_int("--vtk-prep", low=1),
                         help="also write ParaView frames of the preparation and wetting into "
