@@ -112,13 +112,12 @@ def add_run_options(parser, threads_default=None):
 
 def add_device_option(parser, runs):
     """--device: where ``runs`` (what the command runs, in its help) run, "cpu" or "gpu"; a
-    run option, as --threads (docs/gpu.md)."""
+    run option, as --threads: not part of a run's configuration (docs/gpu.md)."""
     from pendular.dem.simulation import DEVICES
 
     parser.add_argument("--device", choices=DEVICES, default="cpu",
                         help=f"where {runs} run: cpu, or gpu (numba-cuda, pip install -e "
-                             "'.[gpu]'; docs/gpu.md); a run option: a checkpoint resumes on "
-                             "either")
+                             "'.[gpu]'; docs/gpu.md)")
 
 
 def add_executor_options(parser):

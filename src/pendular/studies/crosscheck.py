@@ -214,14 +214,16 @@ def check_packing(config, packing):
                          "cell's corner 0; valid: DIR/packing.txt of a periodic cross-check")
 
 
-def static_packing(config, path, *, settle=True, threads=1, progress=True):
-    """Load (or prepare) the cached sample of ``config``, bring it to rest at the confining
-    stress (wetted if ``config.bridges``; ``settle=False``: as loaded), write it to ``path``
+def static_packing(config, path, *, settle=True, threads=1, progress=True, device="cpu"):
+    """Load (or prepare, on the CPU: the cache is shared) the cached sample of ``config``,
+    bring it to rest at the confining stress on ``device`` (wetted if ``config.bridges``;
+    ``settle=False``: as loaded), write it to ``path``
     (pendular.interop.yade.formats.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
     return the settle report (steps, time, wall or cell stresses and, wet, Sr and bridges)."""
     sample = config.sample
     particles, walls, _ = cached_sample(sample, progress=progress, threads=threads)
     sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
+    sim.device = device
     bridges = None
     if config.bridges is not None:
         bridges = config.bridges.build()
@@ -249,15 +251,17 @@ def static_packing(config, path, *, settle=True, threads=1, progress=True):
     return report
 
 
-def pendular_shear(config, packing, threads=1):
-    """The shear of the exported ``packing`` by pendular: (Simulation, TriaxialShear), not yet
-    run; the same scene as a triaxial test's shear (walls or, with ``config.sample.periodic``,
-    the periodic cell of the packing's box), started from the packing at rest."""
+def pendular_shear(config, packing, threads=1, device="cpu"):
+    """The shear of the exported ``packing`` by pendular on ``device``: (Simulation,
+    TriaxialShear), not yet run; the same scene as a triaxial test's shear (walls or, with
+    ``config.sample.periodic``, the periodic cell of the packing's box), started from the
+    packing at rest."""
     sample = config.sample
     position, radius, lo, hi = read_spheres(packing)
     box = (PeriodicCell if sample.periodic else Walls).box(lo, hi)
     sim = servoed_simulation(Particles(position, radius, sample.density), box, sample,
                              sample.confining, threads=threads)
+    sim.device = device
     if config.bridges is not None:
         sim.forces.append(config.bridges.build())
     shear = TriaxialShear(sim, config.shear, sample.confining, sample.radius, sample.density)
@@ -390,15 +394,16 @@ def plot(histories, path):
 
 
 def run_crosscheck(config, out, *, settle=True, packing=None, concurrent=False, threads=1,
-                   progress=True):
+                   progress=True, device="cpu"):
     """The cross-check of ``config`` (a TriaxialConfig, e.g. ``crosscheck_config``) into the
     folder ``out`` (module docstring); returns the crosscheck.json content.
 
     settle: bring the (wetted) sample to rest before the export (False: export it as loaded);
     packing: shear this exported packing instead of settling one; concurrent: run YADE while
     pendular shears (halves the wall time; each code's timing then shares the machine with the
-    other); threads: Numba threads of pendular and OpenMP threads of YADE. RuntimeError when
-    YADE is missing or fails."""
+    other); threads: Numba threads of pendular and OpenMP threads of YADE; device: where
+    pendular settles and shears ("cpu" or "gpu"). RuntimeError when YADE is missing or
+    fails."""
     if not isinstance(config, TriaxialConfig):
         raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
     check_mirrored(config)
@@ -413,17 +418,19 @@ def run_crosscheck(config, out, *, settle=True, packing=None, concurrent=False, 
         exported = os.path.join(out, "packing.txt")
         if packing is None:
             settled = static_packing(config, exported, settle=settle, threads=threads,
-                                     progress=progress)
+                                     progress=progress, device=device)
         else:
             if os.path.abspath(packing) != exported:
                 shutil.copyfile(packing, exported)
             settled = {"from": packing}
-        return _shear_both(config, out, exported, settled, concurrent, threads, progress)
+        return _shear_both(config, out, exported, settled, concurrent, threads, progress,
+                           device)
 
 
-def _shear_both(config, out, packing, settled, concurrent, threads, progress):
-    """Shear ``packing`` with both codes, compare, write the outputs."""
-    sim, shear = pendular_shear(config, packing, threads)
+def _shear_both(config, out, packing, settled, concurrent, threads, progress, device):
+    """Shear ``packing`` with both codes (pendular on ``device``), compare, write the
+    outputs."""
+    sim, shear = pendular_shear(config, packing, threads, device)
     settings = yade_settings(config, packing, sim, shear, out)
     box_volume = sim.walls.volume()
     with ThreadPoolExecutor(max_workers=1) as pool:
@@ -454,7 +461,7 @@ def _shear_both(config, out, packing, settled, concurrent, threads, progress):
         "particles": count, "suction": config.suction, "confining": confining,
         "periodic": config.sample.periodic, "max_strain": config.shear.max_strain,
         "mimic_yade": mimic,
-        "threads": threads, "concurrent": concurrent,
+        "threads": threads, "concurrent": concurrent, "device": device,
         "dt": sim.dt, "strain_rate": shear.rate, "damping": config.sample.damping,
         "servo": {"gain": servo.gain, "memory": servo.memory,
                   "max_velocity": servo.max_velocity},

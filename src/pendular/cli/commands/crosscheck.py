@@ -12,8 +12,9 @@ positive [Pa]. Needs ``yade`` on PATH; docs/yade_crosscheck.md lists the differe
 
 from __future__ import annotations
 
-from pendular.cli import (UsageError, add_declared_options, declared_values, positive_int,
-    print_summary, set_threads)
+from pendular.cli import (UsageError, add_declared_options, add_device_option, declared_values,
+    positive_int, print_summary, set_threads)
+from pendular.dem.simulation import device_start
 from pendular.studies.crosscheck import (OPTIONS, SHOWN, check_mirrored, check_packing,
     crosscheck_from_options, run_crosscheck)
 from pendular.interop.yade.runner import find_yade
@@ -30,6 +31,8 @@ def add_arguments(parser):
                              "timing then shares the machine with the other)")
     parser.add_argument("--quiet", action="store_true",
                         help="no progress bars, and the differences printed as JSON")
+    add_device_option(parser, "pendular's settling and shear (the cached preparation on the "
+                              "CPU)")
 
 
 def config_from(args):
@@ -49,6 +52,7 @@ def check(args):
 def run(args):
     config = check(args)                # every option checked before YADE is looked for
     set_threads(args.threads)
+    device_start(args.device, f"--device {args.device}")
     check_mirrored(config)
     if args.packing is not None:
         check_packing(config, args.packing)
@@ -58,7 +62,7 @@ def run(args):
         raise UsageError(str(error)) from None
     result = run_crosscheck(config, args.out, settle=args.settle_steps > 0,
                             packing=args.packing, concurrent=args.concurrent,
-                            threads=args.threads, progress=not args.quiet)
+                            threads=args.threads, progress=not args.quiet, device=args.device)
     print_summary(result, SHOWN, args.quiet)
     print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)")
     return 0
