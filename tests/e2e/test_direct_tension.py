@@ -16,7 +16,8 @@ from pendular.capillary import BridgeTable, formation_suction
 from pendular.dem.measure import unbalanced_force
 from pendular.procedures.preparation import prepare_sample
 from pendular.dem.state import Particles, Walls
-from pendular.procedures.grips import Grip, grip_members
+from pendular.dem.grips import Grip
+from pendular.procedures.grips import grip_members
 from pendular.procedures import tension as direct_tension
 from pendular.procedures.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser

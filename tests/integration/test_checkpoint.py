@@ -257,7 +257,7 @@ def test_the_state_of_every_operation_survives_a_round_trip(tmp_path):
         with h5py.File(tmp_path / "state.h5", "r") as handle:
             assert_same_state(_read_state(handle["state"]), state)
     assert pairs[2][1].walls == run.controls[0].walls and pairs[3][1].axis == 0
-    assert volume.liquid == "shared" and pairs[-1][1]._shares
+    assert volume.liquid == "shared" and pairs[-1][1].shares
     assert len(recorder) == 3 and len(pairs[6][1]) == 3
     for stateless in (WallForces(1e6), Integrator(), Nudge(), SampleGuard(10),
                       AxialStressGuard(str, "")):

@@ -11,8 +11,9 @@ Lookups (the units of docs/units.md): r = R2/R1 with R2 the larger radius, u* = 
 d* = max(gap, 0) / R2, F = F* 2 pi gamma R2, V = V* R2^3, filling angles delta1 on the smaller
 sphere and delta2 on the larger one.
 
-The GPU engine's bridges at contact are _follow_contact and what it calls, compiled for the
-device from this source (pendular.gpu.cuda.device_twin).
+The GPU engine's bridges are _follow_contact (at contact), _follow_across_gap (persisting)
+and _form_at_contact (a new suction) and what they call, compiled for the device from this
+source (pendular.gpu.cuda.device_twin).
 
 The kernels take their arrays in tuples, one per kind, each unpacked at the kernel's top:
 ``pairs`` (pair_geometry: what they read of the particles and the neighbour list), ``rows``
@@ -277,32 +278,46 @@ def suction_bridges(pairs, bridges, pair_force, suction, surface_tension, table)
     filling_i = bridges.filling_i
     filling_j = bridges.filling_j
     for k in numba.prange(len(pair_i)):
-        i = pair_i[k]
-        j = pair_j[k]
-        if overlap[k] > 0.0:
-            if state[k] != AT_CONTACT:
-                _form_at_contact(k, radius[i], radius[j], state, volume, force, filling_i,
-                                 filling_j, suction, surface_tension, radius_ratios,
-                                 suction_axis, distance_low, log_distance_rupture, log_values)
-            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
-        elif state[k] != NO_BRIDGE:
-            larger = max(radius[i], radius[j])
-            exists, force_star, volume_star, delta1, delta2 = lookup_suction(
-                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
-                larger / min(radius[i], radius[j]), suction * larger / surface_tension,
-                -overlap[k] / larger)
-            if exists:
-                _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
-                       force, filling_i, filling_j)
-                volume[k] = volume_star * larger * larger * larger
-                state[k] = ACROSS_GAP
-                _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
-            else:
-                _clear(k, state, volume, force, filling_i, filling_j, pair_force)
+        _follow_across_gap(k, position, radius, pair_i, pair_j, image, period, overlap, normal,
+                           state, volume, force, filling_i, filling_j, pair_force, suction,
+                           surface_tension, radius_ratios, suction_axis, distance_low,
+                           log_distance_rupture, log_values)
+
+
+@numba.njit(cache=True, inline="always")
+def _follow_across_gap(k, position, radius, pair_i, pair_j, image, period, overlap, normal,
+                       state, volume, force, filling_i, filling_j, pair_force, suction,
+                       surface_tension, radius_ratios, suction_axis, distance_low,
+                       log_distance_rupture, log_values):
+    """Pair k's persisting bridge (suction_bridges): formed or kept at contact, looked up at
+    its gap across one (ruptured where the table has none), and its force on j from i into
+    ``pair_force`` (zeros without a bridge)."""
+    i = pair_i[k]
+    j = pair_j[k]
+    if overlap[k] > 0.0:
+        if state[k] != AT_CONTACT:
+            _form_at_contact(k, radius[i], radius[j], state, volume, force, filling_i,
+                             filling_j, suction, surface_tension, radius_ratios,
+                             suction_axis, distance_low, log_distance_rupture, log_values)
+        _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+    elif state[k] != NO_BRIDGE:
+        larger = max(radius[i], radius[j])
+        exists, force_star, volume_star, delta1, delta2 = lookup_suction(
+            radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+            larger / min(radius[i], radius[j]), suction * larger / surface_tension,
+            -overlap[k] / larger)
+        if exists:
+            _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension,
+                   force, filling_i, filling_j)
+            volume[k] = volume_star * larger * larger * larger
+            state[k] = ACROSS_GAP
+            _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
         else:
-            pair_force[k, 0] = 0.0
-            pair_force[k, 1] = 0.0
-            pair_force[k, 2] = 0.0
+            _clear(k, state, volume, force, filling_i, filling_j, pair_force)
+    else:
+        pair_force[k, 0] = 0.0
+        pair_force[k, 1] = 0.0
+        pair_force[k, 2] = 0.0
 
 
 #: Values of LiquidExchange.events (what exchange_liquid handles).
@@ -331,7 +346,6 @@ def volume_bridges(pairs, bridges, pair_force, formation_suction, surface_tensio
     """
     position, radius, pair_i, pair_j, image, period, overlap, normal = pairs
     radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
-    volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid = volume_table
     film = liquid.film
     state = bridges.state           # written in the loop: named by attribute (module docstring)
     volume = bridges.volume
@@ -343,93 +357,157 @@ def volume_bridges(pairs, bridges, pair_force, formation_suction, surface_tensio
     events = liquid.events
     marked = 0
     for k in numba.prange(len(pair_i)):
-        i = pair_i[k]
-        j = pair_j[k]
-        touching = overlap[k] > 0.0
-        if state[k] == NO_BRIDGE and not touching:
-            pair_force[k, 0] = 0.0
-            pair_force[k, 1] = 0.0
-            pair_force[k, 2] = 0.0
-            continue
-        larger = max(radius[i], radius[j])
-        ratio = larger / min(radius[i], radius[j])
-        cube = larger * larger * larger
-        if state[k] == NO_BRIDGE:
-            pair_force[k, 0] = 0.0
-            pair_force[k, 1] = 0.0
-            pair_force[k, 2] = 0.0
-            if closed:
-                if film[i] + film[j] > 0.0:
-                    events[k] = FORMS_FROM_FILMS
-                    marked += 1
-                continue
-            forms, _, volume_star, _, _ = lookup_suction(
-                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
-                ratio, formation_suction * larger / surface_tension, roughness)
-            if not forms:
-                continue
-            volume[k] = volume_star * cube
-            state[k] = ACROSS_GAP   # not yet evaluated at contact
-        if touching and state[k] == AT_CONTACT:
-            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
-            continue
-        gap_star = roughness if touching else roughness - overlap[k] / larger
-        exists, force_star, suction_star, delta1, delta2 = lookup_volume(
-            volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid, ratio,
-            volume[k] / cube, gap_star)
-        if not exists:
-            if closed:
-                released[k] = volume[k]
-                events[k] = RUPTURED
-                marked += 1
-            _clear(k, state, volume, force, filling_i, filling_j, pair_force)
-            bridge_suction[k] = 0.0
-            continue
-        _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension, force,
-               filling_i, filling_j)
-        bridge_suction[k] = suction_star * surface_tension / larger
-        if touching:
-            state[k] = AT_CONTACT
-            _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
-        else:
-            state[k] = ACROSS_GAP
-            _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
+        marked += _follow_volume(k, position, radius, pair_i, pair_j, image, period, overlap,
+                                 normal, state, volume, force, filling_i, filling_j,
+                                 bridge_suction, pair_force, film, released, events,
+                                 formation_suction, surface_tension, roughness, radius_ratios,
+                                 suction_axis, distance_low, log_distance_rupture, log_values,
+                                 volume_table, closed)
     return marked
 
 
-@numba.njit(cache=True)
-def _give_to_bridges(p, share, rows, pairs, bridges, film, largest_star):
-    """Share ``share`` [m^3] of grain p's liquid equally among its bridges (each capped at
+@numba.njit(cache=True, inline="always")
+def _follow_volume(k, position, radius, pair_i, pair_j, image, period, overlap, normal, state,
+                   volume, force, filling_i, filling_j, bridge_suction, pair_force, film,
+                   released, events, formation_suction, surface_tension, roughness,
+                   radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+                   volume_table, closed):
+    """Pair k's volume-controlled bridge (volume_bridges): formed, looked up at its volume and
+    gap, or ruptured, its force on j from i into ``pair_force``; returns 1 when it marked an
+    event for exchange_liquid, else 0. At most 30 arguments (the volume table's arrays in one
+    tuple): a longer call compiles to a call with *args, which Numba does not inline."""
+    i = pair_i[k]
+    j = pair_j[k]
+    touching = overlap[k] > 0.0
+    if state[k] == NO_BRIDGE and not touching:
+        pair_force[k, 0] = 0.0
+        pair_force[k, 1] = 0.0
+        pair_force[k, 2] = 0.0
+        return 0
+    larger = max(radius[i], radius[j])
+    ratio = larger / min(radius[i], radius[j])
+    cube = larger * larger * larger
+    if state[k] == NO_BRIDGE:
+        pair_force[k, 0] = 0.0
+        pair_force[k, 1] = 0.0
+        pair_force[k, 2] = 0.0
+        if closed:
+            if film[i] + film[j] > 0.0:
+                events[k] = FORMS_FROM_FILMS
+                return 1
+            return 0
+        forms, _, volume_star, _, _ = lookup_suction(
+            radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
+            ratio, formation_suction * larger / surface_tension, roughness)
+        if not forms:
+            return 0
+        volume[k] = volume_star * cube
+        state[k] = ACROSS_GAP   # not yet evaluated at contact
+    if touching and state[k] == AT_CONTACT:
+        _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+        return 0
+    gap_star = roughness if touching else roughness - overlap[k] / larger
+    volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid = volume_table
+    exists, force_star, suction_star, delta1, delta2 = lookup_volume(
+        volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid, ratio,
+        volume[k] / cube, gap_star)
+    if not exists:
+        marked = 0
+        if closed:
+            released[k] = volume[k]
+            events[k] = RUPTURED
+            marked = 1
+        _clear(k, state, volume, force, filling_i, filling_j, pair_force)
+        bridge_suction[k] = 0.0
+        return marked
+    _store(k, radius[i], radius[j], force_star, delta1, delta2, surface_tension, force,
+           filling_i, filling_j)
+    bridge_suction[k] = suction_star * surface_tension / larger
+    if touching:
+        state[k] = AT_CONTACT
+        _apply_along(k, force[k], normal[k, 0], normal[k, 1], normal[k, 2], pair_force)
+    else:
+        state[k] = ACROSS_GAP
+        _apply_across_gap(k, position, i, j, image, period, force[k], pair_force)
+    return 0
+
+
+@numba.njit(cache=True, inline="always")
+def _give_to_bridges(p, share, own_pairs, second_slots, second_pair, radius, pair_i, pair_j,
+                     state, volume, film, largest_star):
+    """Share ``share`` [m^3] of grain p's liquid equally among its bridges (its pairs
+    ``own_pairs``, then ``second_pair[slot]`` for ``slot`` in ``second_slots``; each capped at
     ``largest_star`` R2^3, the volume table's range; the rest stays on the grain as film); a
     grain without bridge keeps it all as film. Bridges that receive liquid are marked
     ACROSS_GAP, so volume_bridges looks them up again."""
-    row_start, second_start, second_pair = rows
-    _, radius, pair_i, pair_j, _, _, _, _ = pairs
-    state, volume = bridges.state, bridges.volume
     count = 0
-    for k in range(row_start[p], row_start[p + 1]):
+    for k in own_pairs:
         count += state[k] != NO_BRIDGE
-    for slot in range(second_start[p], second_start[p + 1]):
+    for slot in second_slots:
         count += state[second_pair[slot]] != NO_BRIDGE
     if count == 0:
         film[p] += share
         return
     each = share / count
     kept = 0.0
-    for n in range(row_start[p + 1] - row_start[p] + second_start[p + 1] - second_start[p]):
-        if n < row_start[p + 1] - row_start[p]:
-            k = row_start[p] + n
-        else:
-            k = second_pair[second_start[p] + n - (row_start[p + 1] - row_start[p])]
-        if state[k] == NO_BRIDGE:
-            continue
-        larger = max(radius[pair_i[k]], radius[pair_j[k]])
-        room = largest_star * larger * larger * larger - volume[k]
-        given = min(each, max(room, 0.0))
-        volume[k] += given
-        kept += each - given
-        state[k] = ACROSS_GAP
+    for k in own_pairs:
+        kept += _give_to_bridge(k, each, radius, pair_i, pair_j, state, volume, largest_star)
+    for slot in second_slots:
+        kept += _give_to_bridge(second_pair[slot], each, radius, pair_i, pair_j, state, volume,
+                                largest_star)
     film[p] += kept
+
+
+@numba.njit(cache=True, inline="always")
+def _give_to_bridge(k, each, radius, pair_i, pair_j, state, volume, largest_star):
+    """Give pair k's bridge ``each`` [m^3] up to its cap (_give_to_bridges); returns what it
+    could not take [m^3] (0 without a bridge)."""
+    if state[k] == NO_BRIDGE:
+        return 0.0
+    larger = max(radius[pair_i[k]], radius[pair_j[k]])
+    room = largest_star * larger * larger * larger - volume[k]
+    given = min(each, max(room, 0.0))
+    volume[k] += given
+    state[k] = ACROSS_GAP
+    return each - given
+
+
+@numba.njit(cache=True, inline="always")
+def _exchange_ruptured(k, share, own_i, second_i, own_j, second_j, second_pair, radius, pair_i,
+                       pair_j, state, volume, film, released, events, largest_star):
+    """The liquid of pair k's ruptured bridge (exchange_liquid's RUPTURED; ``own_i``,
+    ``second_i``, ``own_j``, ``second_j``: the pairs of its two grains, as _give_to_bridges
+    takes them); returns the liquid lost [m^3]."""
+    lost = 0.0
+    if share:
+        _give_to_bridges(pair_i[k], 0.5 * released[k], own_i, second_i, second_pair, radius,
+                         pair_i, pair_j, state, volume, film, largest_star)
+        _give_to_bridges(pair_j[k], 0.5 * released[k], own_j, second_j, second_pair, radius,
+                         pair_i, pair_j, state, volume, film, largest_star)
+    else:
+        lost = released[k]
+    released[k] = 0.0
+    events[k] = NO_EVENT
+    return lost
+
+
+@numba.njit(cache=True, inline="always")
+def _form_from_films(k, radius, pair_i, pair_j, state, volume, film, events, smallest_star,
+                     largest_star):
+    """Pair k's bridge from the films of its two grains (exchange_liquid's
+    FORMS_FROM_FILMS)."""
+    events[k] = NO_EVENT
+    i = pair_i[k]
+    j = pair_j[k]
+    larger = max(radius[i], radius[j])
+    cube = larger * larger * larger
+    held = film[i] + film[j]
+    if state[k] != NO_BRIDGE or not smallest_star * cube <= held <= largest_star * cube:
+        return
+    volume[k] = held
+    state[k] = ACROSS_GAP
+    film[i] = 0.0
+    film[j] = 0.0
 
 
 @numba.njit(cache=True)
@@ -446,34 +524,24 @@ def exchange_liquid(liquid, rows, pairs, bridges, share, smallest_star, largest_
     stay. Events are cleared."""
     events, released, film = liquid.events, liquid.released, liquid.film
     _, radius, pair_i, pair_j, _, _, _, _ = pairs
+    row_start, second_start, second_pair = rows
+    state, volume = bridges.state, bridges.volume
     lost = 0.0
     for k in range(len(events)):
         if events[k] != RUPTURED:
             continue
-        if share:
-            for p in (pair_i[k], pair_j[k]):
-                _give_to_bridges(p, 0.5 * released[k], rows, pairs, bridges, film,
-                                 largest_star)
-        else:
-            lost += released[k]
-        released[k] = 0.0
-        events[k] = NO_EVENT
-    for k in range(len(events)):
-        if events[k] != FORMS_FROM_FILMS:
-            continue
-        events[k] = NO_EVENT
         i = pair_i[k]
         j = pair_j[k]
-        larger = max(radius[i], radius[j])
-        cube = larger * larger * larger
-        held = film[i] + film[j]
-        if (bridges.state[k] != NO_BRIDGE
-                or not smallest_star * cube <= held <= largest_star * cube):
-            continue
-        bridges.volume[k] = held
-        bridges.state[k] = ACROSS_GAP
-        film[i] = 0.0
-        film[j] = 0.0
+        lost += _exchange_ruptured(k, share, range(row_start[i], row_start[i + 1]),
+                                   range(second_start[i], second_start[i + 1]),
+                                   range(row_start[j], row_start[j + 1]),
+                                   range(second_start[j], second_start[j + 1]), second_pair,
+                                   radius, pair_i, pair_j, state, volume, film, released,
+                                   events, largest_star)
+    for k in range(len(events)):
+        if events[k] == FORMS_FROM_FILMS:
+            _form_from_films(k, radius, pair_i, pair_j, state, volume, film, events,
+                             smallest_star, largest_star)
     return lost
 
 

@@ -350,6 +350,13 @@ class CapillaryBridges(metaclass=_ByControl):
         self._prepare(sim)
         self._attach(sim)
 
+    def adopt(self, sim):
+        """Take sim's neighbour list as it is, its bridges those the next list must carry: a
+        state that another engine stepped (the GPU's, brought back) and the CPU goes on from.
+        The per-pair arrays are this list's (``pair_force`` zero: the engine sets it)."""
+        self._bridges = BridgeState.of(sim.contacts).count()
+        self._sync(sim)
+
     def _gather_pair_forces(self, sim):
         """Add ``pair_force`` to the particles (with the face terms of the cell's stress in a
         periodic cell) and count the bridges the next neighbour list must carry."""
@@ -491,15 +498,21 @@ class SuctionBridges(CapillaryBridges):
         nodes = np.log1p(table.suction / table.suction_scale)
         return 1.05 * high * max(np.interp(xi, nodes, row) for row in table.distance_rupture)
 
+    def take_new_suction(self):
+        """Whether the bridges at contact are to be looked up again at ``suction`` before this
+        step (set_suction since the last step), the suction recorded as applied: read once a
+        step by the engine that runs it (``apply``, or the GPU path's)."""
+        new = self._applied_suction is not None and self._applied_suction != self.suction
+        self._applied_suction = self.suction
+        return new
+
     def apply(self, sim):
         self._sync(sim)
         pairs = pair_geometry(sim)
         state = self._state
-        if self._applied_suction != self.suction:
-            if self._applied_suction is not None:          # set_suction: bridges at contact
-                refresh_contact_bridges(pairs, state, self.suction, self.surface_tension,
-                                        self._lookup)
-            self._applied_suction = self.suction
+        if self.take_new_suction():             # set_suction: bridges at contact
+            refresh_contact_bridges(pairs, state, self.suction, self.surface_tension,
+                                    self._lookup)
         if self.persist:
             suction_bridges(pairs, state, self.pair_force, self.suction, self.surface_tension,
                             self._lookup)
@@ -599,12 +612,12 @@ class VolumeBridges(CapillaryBridges):
 
     def _set_liquid(self, liquid):
         """The liquid model (LIQUID_MODELS) and what it decides each step: whether the amount
-        is closed and whether a ruptured bridge's liquid goes to its grains."""
+        is ``closed`` and whether a ruptured bridge's liquid ``shares`` to its grains."""
         if liquid not in LIQUID_MODELS:
             raise ValueError(f"liquid = {liquid!r} is not one of {LIQUID_MODELS}")
         self.liquid = liquid
-        self._closed = liquid != "reservoir"
-        self._shares = liquid == "shared"
+        self.closed = liquid != "reservoir"
+        self.shares = liquid == "shared"
 
     def _load_control_tables(self):
         self.volume_table = VolumeBridgeTable.cached(
@@ -639,10 +652,10 @@ class VolumeBridges(CapillaryBridges):
         liquid = LiquidExchange(self.film, self._released, self._events)
         events = volume_bridges(pairs, state, self.pair_force, self.suction,
                                 self.surface_tension, self.roughness, self._lookup,
-                                self._volume_lookup, liquid, self._closed)
+                                self._volume_lookup, liquid, self.closed)
         if events:
             self.liquid_lost += exchange_liquid(
-                liquid, particle_pairs(sim.contacts), pairs, state, self._shares,
+                liquid, particle_pairs(sim.contacts), pairs, state, self.shares,
                 *self.volume_table.volume_star_bounds())
         self._gather_pair_forces(sim)
 

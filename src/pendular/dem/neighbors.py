@@ -464,18 +464,29 @@ def walls_moved_beyond(wall_position, reference_wall_position, limit):
 
 
 @numba.njit(cache=True, inline="always")
-def _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out):
-    """Add to ``out[p]`` its pair forces (-f where p is i, +f where p is j) in a fixed order."""
+def _sum_pair_forces(pair_force, second_pair, own_pairs, second_slots):
+    """(v0, v1, v2) [N]: a particle's pair forces in a fixed order, -f of its pairs
+    ``own_pairs`` (it is i), then +f of the pairs ``second_pair[slot]`` for ``slot`` in
+    ``second_slots`` (it is j); ranges, so that the GPU's rows (pendular.gpu.forces) sum the
+    same way."""
     v0 = v1 = v2 = 0.0
-    for k in range(row_start[p], row_start[p + 1]):
+    for k in own_pairs:
         v0 -= pair_force[k, 0]
         v1 -= pair_force[k, 1]
         v2 -= pair_force[k, 2]
-    for slot in range(second_start[p], second_start[p + 1]):
+    for slot in second_slots:
         k = second_pair[slot]
         v0 += pair_force[k, 0]
         v1 += pair_force[k, 1]
         v2 += pair_force[k, 2]
+    return v0, v1, v2
+
+
+@numba.njit(cache=True, inline="always")
+def _add_pair_forces(p, pair_force, row_start, second_start, second_pair, out):
+    """Add to ``out[p]`` its pair forces (-f where p is i, +f where p is j) in a fixed order."""
+    v0, v1, v2 = _sum_pair_forces(pair_force, second_pair, range(row_start[p], row_start[p + 1]),
+                                  range(second_start[p], second_start[p + 1]))
     out[p, 0] += v0
     out[p, 1] += v1
     out[p, 2] += v2

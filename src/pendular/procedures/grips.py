@@ -2,12 +2,11 @@
 
 A wall only pushes, so a tension test (Kim 2001, thesis §4.4.1.2 and Table 4.5) grips the
 sample at its ends: the particles whose centre lies within ``depth`` of a wall when the pull
-starts move rigidly with that wall (``Grip``, a prescribed velocity, no rotation), as a sample
-glued to a rough platen. The force the rig needs to hold a grip on its path is minus the
-resultant on its particles; without the wall's own push on them (the wall and its grip are one
-rigid body) that is the force of the specimen on the grip, ``Grip.pull`` [N], positive when the
-specimen pulls the grip inward (tension). Dividing by the cross-section gives the tensile stress,
-the opposite of the compression-positive axial stress (``tensile_stress``).
+starts (``grip_members``) move rigidly with that wall (``Grip``, the engine's control
+pendular.dem.grips), as a sample glued to a rough platen. The force of
+the specimen on a grip is ``Grip.pull`` [N], positive in tension; dividing by the
+cross-section gives the tensile stress, the opposite of the compression-positive axial stress
+(``tensile_stress``).
 """
 
 import math
@@ -25,38 +24,6 @@ def grip_members(position, radius, walls, wall, depth):
     axis = wall // 2
     distance = np.abs(position[:, axis] - walls.position[wall])
     return np.flatnonzero(distance <= depth)
-
-
-class Grip:
-    """Particles ``members`` moving rigidly with wall ``wall`` (0..5): each step their force
-    and torque are replaced by the prescribed motion (velocity = the wall's, along its axis;
-    no spin). Runs after the force operations and the wall control, before the Integrator.
-
-    ``pull`` [N]: force of the rest of the sample on the grip along the wall's axis, positive
-    toward the sample (tension); the wall's push on the members (``walls.force[wall]``) is not
-    part of it: all particles touching the wall must be members (``grip_members``).
-    """
-
-    def __init__(self, wall, members):
-        if wall not in range(6):
-            raise ValueError(f"wall = {wall!r} is outside the valid range 0..5")
-        self.wall = wall
-        self.axis = wall // 2
-        self.inward = 1.0 if wall % 2 == 0 else -1.0   # unit direction from the wall into the box
-        self.members = np.asarray(members, np.int64)
-        if len(self.members) == 0:
-            raise ValueError(f"grip of wall {wall} has no particles: increase the grip depth")
-        self.pull = 0.0
-
-    def apply(self, sim):
-        p = sim.particles
-        resultant = float(np.sum(p.force[self.members, self.axis]))
-        self.pull = self.inward * resultant - sim.walls.force[self.wall]
-        p.force[self.members] = 0.0
-        p.torque[self.members] = 0.0
-        p.angular_velocity[self.members] = 0.0
-        p.velocity[self.members] = 0.0
-        p.velocity[self.members, self.axis] = -self.inward * sim.walls.velocity[self.wall]
 
 
 def tensile_stress(grips, walls):
