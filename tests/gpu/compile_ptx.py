@@ -1,5 +1,5 @@
-"""Compile every kernel of a dry and a wet step (and a radius growth's, and a periodic cell's
-dry and wet) for a real GPU (PTX,
+"""Compile every kernel of a dry and a wet step (and a radius growth's, a periodic cell's
+dry and wet, a simple shear's, and the grips') for a real GPU (PTX,
 by default for compute capability 9.0, an H100) without one, as a script in its own process:
 the simulator runs kernels as Python and would not see code that the CUDA target cannot
 compile (a NumPy ufunc, a global it cannot type).
@@ -69,18 +69,27 @@ def compile_step_kernels(cuda, capability):
         gpu = GpuSimulation(scene(wet=wet))
         gpu._configure()
         reduction = launches(gpu, np.zeros((2, COLUMNS)), np.zeros(COLUMNS))
-        for kernel, _, args in (*gpu._steps, *reduction):
+        # wet, the bridges' refresh at a new suction (a suction path, between runs)
+        refresh = (gpu._refresh_step(),) if wet else ()
+        for kernel, _, args in (*gpu._steps, *reduction, *refresh):
             signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
                               for a in args)
             ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
-    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene) and those
-    # of a dry and a wet step in a periodic cell (test_gpu_periodic.py's)
+    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene), those
+    # of a dry and a wet step in a periodic cell (test_gpu_periodic.py's), of a simple shear
+    # (test_gpu_shear.py's), the grips' (test_gpu_grips.py's) and volume-controlled bridges'
+    # liquid exchange (test_gpu_volume.py's)
+    from test_gpu_grips import scene as grips_scene
     from test_gpu_growth import scene as growth_scene
     from test_gpu_periodic import scene as periodic_scene
+    from test_gpu_shear import scene as shear_scene
+    from test_gpu_volume import scene as volume_scene
 
     for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
-                       (periodic_scene(wet=True), " periodic wet")):
+                       (periodic_scene(wet=True), " periodic wet"),
+                       (shear_scene(), " sheared"),
+                       (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume")):
         gpu = GpuSimulation(sim)
         gpu._configure()
         for kernel, _, args in gpu._steps:

@@ -174,8 +174,8 @@ def device_run():
 def refusals():
     """The messages with which the GPU path refuses what it does not run yet."""
     messages = []
-    persisting = scene()
-    persisting.forces.append(CapillaryBridges(30000.0, persist=True))
+    persisting = scene()        # bridges across gaps gathered before the walls' springs
+    persisting.forces.insert(1, CapillaryBridges(30000.0, persist=True))
     unknown = scene()
     unknown.controls.append(Integrator(0.1))
     for sim in (persisting, unknown):

@@ -1,6 +1,8 @@
-"""What the GPU tests share: a script run under Numba's CUDA simulator in a process of its own
-(``simulated``), the relative difference they judge (``relative``) and a count of the state's
-copies back from the device (``counted_copies``).
+"""What the GPU tests share: a script or a command run under Numba's CUDA simulator in a
+process of its own (``simulated``, ``simulated_command``, ``histories_on_both``), the relative
+difference they judge (``relative``) and a count of the state's copies back from the device
+(``counted_copies``). The simulator runs there with the serial block runner of
+serial_simulator/sitecustomize.py (the same results, sooner).
 
 Nothing here imports pendular.gpu when the module loads: the tests are collected where the
 gpu extra (numba-cuda) is not installed, and skip there.
@@ -17,18 +19,58 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 #: The repository (the scripts run from it).
 ROOT = os.path.dirname(os.path.dirname(HERE))
+#: The folder whose sitecustomize.py makes the simulator run a block's threads serially.
+SERIAL_SIMULATOR = os.path.join(HERE, "serial_simulator")
+
+
+def environment():
+    """This process's environment with Numba's CUDA simulator on and its serial runner loaded
+    (SERIAL_SIMULATOR first on PYTHONPATH)."""
+    path = os.pathsep.join(filter(None, [SERIAL_SIMULATOR, os.environ.get("PYTHONPATH")]))
+    return dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=path)
+
+
+def _run(argv, timeout):
+    """stdout of ``argv`` run under the simulator from ROOT; the test fails with its error when
+    it fails."""
+    done = subprocess.run(argv, capture_output=True, text=True, env=environment(), cwd=ROOT,
+                          timeout=timeout)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return done.stdout
 
 
 def simulated(script, *arguments, timeout=600):
     """The JSON object that ``script`` (a file of tests/gpu, or a path) prints last, run with
-    ``arguments`` under the simulator (NUMBA_ENABLE_CUDASIM=1) in a process of its own; the
-    test fails with the script's error when it fails."""
-    environment = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
-    done = subprocess.run([sys.executable, os.path.join(HERE, script), *arguments],
-                          capture_output=True, text=True, env=environment, cwd=ROOT,
-                          timeout=timeout)
-    assert done.returncode == 0, done.stderr[-3000:]
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    ``arguments`` under the simulator in a process of its own."""
+    stdout = _run([sys.executable, os.path.join(HERE, script), *arguments], timeout)
+    return json.loads(stdout.strip().splitlines()[-1])
+
+
+def simulated_command(command, argv, timeout=600):
+    """Run ``pendular command argv`` under the simulator in a process of its own."""
+    _run([sys.executable, "-m", "pendular", command, *[str(a) for a in argv]], timeout)
+
+
+def history(folder):
+    """The history.h5 columns of a run folder (name -> array)."""
+    import h5py
+
+    with h5py.File(os.path.join(folder, "history.h5")) as handle:
+        return {name: data[()] for name, data in handle["history"].items()}
+
+
+def histories_on_both(command, prepare, argv, folder):
+    """(CPU history, GPU history): a sample prepared on the CPU by ``pendular command
+    *prepare``, then ``pendular command *argv --sample S`` run on the CPU in this process and
+    with ``--device gpu`` under the simulator, in ``folder``'s prep/, cpu/ and gpu/."""
+    from pendular.cli import run_command
+
+    folder = str(folder)
+    assert run_command(command, [*map(str, prepare), "--out", f"{folder}/prep"]) == 0
+    run = [*map(str, argv), "--sample", f"{folder}/prep/sample.h5"]
+    assert run_command(command, [*run, "--out", f"{folder}/cpu"]) == 0
+    simulated_command(command, [*run, "--device", "gpu", "--out", f"{folder}/gpu"])
+    return history(f"{folder}/cpu"), history(f"{folder}/gpu")
 
 
 def relative(a, b):

@@ -385,11 +385,11 @@ def test_option_values_take_defaults_and_refuse_unknown_keys_and_two_of_a_group(
 STUDY_OPTIONS = {"chapter4": lambda: (chapter4_command.POINTS,),
                  "chapter5": chapter5.grid_options, "crosscheck": lambda: crosscheck.OPTIONS,
                  "tradeoff": lambda: tradeoff.OPTIONS, "extremes": lambda: extremes.OPTIONS}
-#: Each study command's options of how it runs (folder, threads, processes, output), the only
-#: ones written by hand.
+#: Each study command's options of how it runs (folder, threads, processes, device, output), the
+#: only ones written by hand.
 RUN_OPTIONS = {"chapter4": {"out", "threads", "quiet"},
-               "chapter5": {"out", "jobs", "scheduler", "threads", "quiet"},
-               "crosscheck": {"out", "threads", "concurrent", "quiet"},
+               "chapter5": {"out", "jobs", "scheduler", "threads", "quiet", "device"},
+               "crosscheck": {"out", "threads", "concurrent", "quiet", "device"},
                "tradeoff": {"out"}, "extremes": {"out", "threads", "quiet"}}
 
 

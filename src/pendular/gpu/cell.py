@@ -1,6 +1,6 @@
-"""A periodic cell on the device (pendular.dem.cell.PeriodicCell, not sheared): its stress
-reduced in a fixed order each step, then its controls (stress servo, constant strain rate) in
-the scene's order, with no host round trip.
+"""A periodic cell on the device (pendular.dem.cell.PeriodicCell): its stress reduced in a
+fixed order each step, then its controls (stress servo, constant strain rate, constant shear
+rate, mixed stress condition, radius growth) in the scene's order, with no host round trip.
 
 The reduction (``cell_partials``): each block of REDUCE_CHUNK particles sums, in particle
 order, x_p (x) F_p over its particles, the face terms (image L) (x) f of its particles' pairs
@@ -11,22 +11,47 @@ pendular.dem.cell.contact_stiffness); then one thread
 store_cell_stress: Love–Weber, Eq. 3.41), sets the rates to zero (PeriodicCell.after_forces)
 and runs the controls: the rows of pendular.gpu.walls's program whose ``control_walls[c,
 :wall_counts[c]]`` hold, in a periodic cell, a servo's axes (StressServo's, the CPU's
-servo_cell) or a strain rate's axis (PeriodicCell.stretch). Last, ``period`` (3,) [m] and
+servo_cell) or a strain rate's axis (PeriodicCell.stretch); a shear rate's row
+(SHEAR_RATE) sets gamma_dot (ConstantShearRate.apply); a mixed condition's row sets its
+servos' targets from the diagonal of the cell's stress (MixedStress.apply reads
+PeriodicCell.stress(); pendular.gpu.walls.mixed_stress, the walls' law), and a radius
+growth's row its rate from their mean (pendular.gpu.walls.growth_rate; the radii grow in
+pendular.gpu.growth, in a cell whose faces no control moves). Last, ``period`` (3,) [m] and
 ``affine_rate`` (3,) [1/s], which the next step's kernels read, take the cell's new lengths
 and rates.
+
+Simple shear (Lees–Edwards, x with z; pendular.dem.cell's module docstring): a scene that
+shears, or whose cell is sheared, holds ``period`` (4,) (Lx, Ly, Lz, delta) and
+``affine_rate`` (4,) (the rates, gamma_dot), which the CPU's kernels compiled for the device
+read behind the same tests of the arrays' lengths as on the CPU (the branch vector, the face
+terms, the contact law's relative velocity, the leapfrog), and ``shear`` (SHEAR_FIELDS) the
+cell's shear state. ``cell_controls`` sets gamma_dot to zero with the rates, runs the
+controls, then advances the offset over the step (PeriodicCell.follow, after the controls as
+the CPU's integrator calls it: the leapfrog does not read the offset); at a rebuild the
+offset is brought into [-Lx/2, Lx/2) (pendular.gpu.neighbors.reduced_offset, the CPU's
+_wrap_sheared: each thread of the wrap and the pair search takes it from the offset of
+before, and pendular.gpu.neighbors.shear_rebuilt stores it after them). A cell that neither
+shears nor is sheared keeps (3,) arrays and a one-entry ``shear``: the code of before.
 """
 
-from pendular.dem.cell import pair_stiffness as cpu_pair_stiffness, servo_cell
+import numpy as np
+
+from pendular.dem.cell import ConstantShearRate, pair_stiffness as cpu_pair_stiffness, servo_cell
 from pendular.dem.virial import add_face_term, add_outer, pair_force_with_attraction
 from pendular.dem.walls import StressServo
 from pendular.gpu.cuda import cuda, device, device_twin
-from pendular.gpu.walls import REDUCE_CHUNK, STIFFNESS_WARMUP, STRAIN_RATE, STRESS_SERVO
+from pendular.gpu.walls import (MIXED_STRESS, RADIUS_GROWTH, REDUCE_CHUNK, SHEAR_RATE,
+    STIFFNESS_WARMUP, STRAIN_RATE, STRESS_SERVO, growth_rate, mixed_stress)
 
 servo = device_twin(servo_cell)
 outer = device_twin(add_outer)
 face_term = device_twin(add_face_term)
 pull_less = device_twin(pair_force_with_attraction)
 pair_stiffness = device_twin(cpu_pair_stiffness)
+
+#: ``shear`` of a sheared cell: PeriodicCell's shear_offset delta [m], shear_rate gamma_dot
+#: [1/s] and shear_strain gamma [-], and delta at the last rebuild (the rebuild test's).
+SHEAR_FIELDS = ("offset", "rate", "strain", "reference_offset")
 
 #: Columns of a block's partial sums: x (x) F (9), the face terms (9), the stiffness (3).
 CELL_SUMS = 21
@@ -95,14 +120,29 @@ def stretch(cell_position, rate, axis, shift, dt):
     rate[axis] = shift / (length * dt)
 
 
+@device
+def follow(cell_position, rate, shear, dt):
+    """The offset and the shear strain in ``shear`` (SHEAR_FIELDS) advanced over the step
+    ``dt`` [s] with the step's lengths ``cell_position`` and rates ``rate`` [1/s]: delta +=
+    (rate_x delta + gamma_dot Lz0) dt, Lz0 the height at the step's start; gamma +=
+    gamma_dot dt (PeriodicCell.follow, a method: restated)."""
+    if shear[0] != 0.0 or shear[1] != 0.0:          # PeriodicCell.sheared
+        height = cell_position[5] / (1.0 + rate[2] * dt)
+        shear[0] += (rate[0] * shear[0] + shear[1] * height) * dt
+        shear[2] += shear[1] * dt
+
+
 @cuda.jit
 def cell_controls(partial, cell_position, rate, stress_tensor, cell_stiffness, period,
-                  affine_rate, kinds, control_walls, wall_counts, parameters, previous,
-                  stiffness, calls, dt):
-    """The cell's stress from the blocks' sums, its rates to zero, its controls, then
-    ``period`` and ``affine_rate`` (module docstring). One thread."""
+                  affine_rate, shear, kinds, control_walls, wall_counts, parameters, previous,
+                  stiffness, calls, dt, step, failure):
+    """The cell's stress from the blocks' sums, its rates (and shear rate) to zero, its
+    controls, the step counted (``step``, for a mixed condition's ``failure``:
+    pendular.gpu.walls), the offset followed over the step (a sheared layout: ``period``
+    (4,)), then ``period`` and ``affine_rate`` (module docstring). One thread."""
     if cuda.grid(1) != 0:
         return
+    sheared = period.shape[0] > 3
     volume = cell_position[1] * cell_position[3] * cell_position[5]
     for c in range(9):
         moments = 0.0
@@ -113,6 +153,8 @@ def cell_controls(partial, cell_position, rate, stress_tensor, cell_stiffness, p
         stress_tensor[c // 3, c % 3] = (moments + faces) / volume
     for axis in range(3):
         rate[axis] = 0.0
+    if sheared:
+        shear[1] = 0.0
     for c in range(kinds.shape[0]):
         if kinds[c] == STRESS_SERVO:
             refresh = refreshes(c, parameters, calls)
@@ -133,6 +175,48 @@ def cell_controls(partial, cell_position, rate, stress_tensor, cell_stiffness, p
             length = (cell_position[2 * axis + 1] - cell_position[2 * axis]
                       if parameters[c, 2] != 0.0 else parameters[c, 1])
             stretch(cell_position, rate, axis, -parameters[c, 0] * length * dt, dt)
+        elif kinds[c] == SHEAR_RATE:
+            shear[1] = parameters[c, 0]
+        elif kinds[c] == MIXED_STRESS:     # from the cell's normal stresses now
+            mixed_stress(c, control_walls, wall_counts[c], parameters,
+                         (stress_tensor[0, 0], stress_tensor[1, 1], stress_tensor[2, 2]),
+                         step[0], failure)
+        elif kinds[c] == RADIUS_GROWTH:
+            growth_rate(c, parameters,
+                        (stress_tensor[0, 0], stress_tensor[1, 1], stress_tensor[2, 2]))
+    step[0] += 1
     for axis in range(3):
         period[axis] = cell_position[2 * axis + 1]
         affine_rate[axis] = rate[axis]
+    if sheared:
+        follow(cell_position, rate, shear, dt)
+        period[3] = shear[0]
+        affine_rate[3] = shear[1]
+
+
+def sheared_layout(cell, controls):
+    """Whether a scene in the periodic cell ``cell`` with ``controls`` needs the sheared
+    layout (module docstring): the cell is sheared or a control shears it."""
+    return cell.sheared or any(isinstance(op, ConstantShearRate) for op in controls)
+
+
+def upload_shear(state, cell, sheared):
+    """A periodic cell's shear on the device (``state``: pendular.gpu.state.DeviceState, its
+    ``period``, ``affine_rate`` and ``shear``): the sheared layout from the host's ``cell``
+    when ``sheared`` (sheared_layout), else a one-entry ``shear`` that nothing reads."""
+    if not sheared:
+        state.shear = cuda.to_device(np.zeros(1))
+        return
+    offset, rate = cell.shear_offset, cell.shear_rate
+    state.period = cuda.to_device(np.array([*cell.position[1::2], offset]))
+    state.affine_rate = cuda.to_device(np.array([*cell.rate, rate]))
+    state.shear = cuda.to_device(np.array([offset, rate, cell.shear_strain, offset]))
+
+
+def shear_to_host(state, cell):
+    """The device's offset, shear rate and shear strain into the host's ``cell`` (nothing in
+    a cell that does not shear)."""
+    if state.period.shape[0] > 3:
+        offset, rate, strain, _ = state.shear.copy_to_host()
+        cell.shear_offset, cell.shear_rate, cell.shear_strain = (float(offset), float(rate),
+                                                                 float(strain))

@@ -1,7 +1,8 @@
 """Contact forces on the device: the CPU's contact law (pendular.dem.contact_law) and, wet,
-its suction-controlled bridges at contact (pendular.capillary.bridge_kernels), compiled from
-the CPU's own source (pendular.gpu.cuda.device_twin), one thread per particle's row of pairs;
-then a gather of each particle's pair forces in a fixed order (no float atomics), with the
+its capillary bridges (pendular.capillary.bridge_kernels: suction-controlled at contact or
+persisting across gaps, volume-controlled with their liquid's exchange), compiled from the
+CPU's own source (pendular.gpu.cuda.device_twin), one thread per particle's row of pairs; then
+a gather of each particle's pair forces in a fixed order (no float atomics), with the
 frictionless walls.
 
 Pairs are kept as rows stored slot by slot (pendular.gpu.neighbors): pair k = s * N + p is
@@ -12,15 +13,25 @@ CPU's sum of a particle's terms (pendular.dem.contact_law._sum_pair_terms) over 
 particle's force is the CPU's sum in the CPU's order.
 """
 
-from pendular.capillary.bridge_kernels import _follow_contact
+from pendular.capillary.bridge_kernels import (FORMS_FROM_FILMS, RUPTURED,
+    _exchange_ruptured, _follow_across_gap, _follow_contact, _follow_volume, _form_at_contact,
+    _form_from_films)
+from pendular.capillary.bridge_state import AT_CONTACT
 from pendular.dem.contact_law import (_evaluate_pair, _first_member, _store_row_sums,
     _stretched, _sum_pair_terms, wall_contact_stiffness)
+from pendular.dem.neighbors import _sum_pair_forces
 from pendular.gpu.cuda import cuda, device, device_twin
 
 first_member = device_twin(_first_member)
 evaluate_pair = device_twin(_evaluate_pair)
 is_stretched = device_twin(_stretched)
 follow_contact = device_twin(_follow_contact)
+follow_across_gap = device_twin(_follow_across_gap)
+form_at_contact = device_twin(_form_at_contact)
+follow_volume = device_twin(_follow_volume)
+exchange_ruptured = device_twin(_exchange_ruptured)
+form_from_films = device_twin(_form_from_films)
+sum_pair_forces = device_twin(_sum_pair_forces)
 sum_pair_terms = device_twin(_sum_pair_terms)
 store_row_sums = device_twin(_store_row_sums)
 wall_stiffness = device_twin(wall_contact_stiffness)
@@ -29,9 +40,12 @@ wall_stiffness = device_twin(wall_contact_stiffness)
 @cuda.jit
 def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i, pair_j,
                 image, period, affine_rate, shear_force, normal, overlap, normal_force, force,
-                young, shear_ratio, tan_friction, dt, flags, wet, state, volume, bridge_force,
-                filling_i, filling_j, suction, surface_tension, radius_ratios, suction_axis,
-                distance_low, log_distance_rupture, log_values):
+                young, shear_ratio, tan_friction, dt, flags, wet, persist, volume_control,
+                state, volume, bridge_force, filling_i, filling_j, bridge_suction,
+                bridge_pair_force, suction, surface_tension, radius_ratios, suction_axis,
+                distance_low, log_distance_rupture, log_values, roughness, closed, film,
+                released, events, marked, volume_ratios, volume_axes, volume_distance_low,
+                volume_log_rupture, grid):
     """Every pair of particle p's row (one thread per particle): the CPU's contact law
     (_evaluate_pair, with its tests as the CPU's pair_forces: images where ``period`` (3,)
     [m] is not zero, each pair's in ``image`` (K, 3) int8, and stretching where
@@ -39,8 +53,15 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
     arrays it then does not read), then (``wet``) its suction-controlled bridge at contact
     (_follow_contact: the bridge arrays of pendular.capillary.bridge_state.BridgeState, a
     BridgeTable's arrays(); ``pair_i``
-    (K,) the pairs' first members, read when a bridge forms). Thread 0 clears the rebuild
-    flag: this step's rebuild, if any, is done."""
+    (K,) the pairs' first members, read when a bridge forms) or, with ``persist``, across
+    gaps up to its rupture distance (_follow_across_gap, the CPU's suction_bridges per pair:
+    its force on j from i [N] into ``bridge_pair_force`` (K, 3), pulling along the branch
+    vector, which reads ``image`` and ``period``: zeros for every pair inside walls); with
+    ``volume_control`` a volume-controlled bridge (_follow_volume, the CPU's volume_bridges per
+    pair: ``suction`` the formation suction, ``roughness``, ``closed`` liquid, the liquid's
+    arrays of pendular.gpu.state and a VolumeBridgeTable's arrays(); the events it marks
+    counted in ``marked``, for exchange_liquid). Thread 0 clears the rebuild flag: this step's
+    rebuild, if any, is done."""
     p = cuda.grid(1)
     if p == 0:
         flags[0] = 0
@@ -50,15 +71,85 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
     periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
     stretched = is_stretched(affine_rate)
     first = first_member(p, position, velocity, angular_velocity, radius)
+    events_marked = 0
     for s in range(pair_count[p]):
         k = s * n + p
         evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
                       image, period, periodic, affine_rate, stretched, shear_force, normal,
                       overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
-        if wet:
+        if wet and volume_control:
+            events_marked += follow_volume(
+                k, position, radius, pair_i, pair_j, image, period, overlap, normal, state,
+                volume, bridge_force, filling_i, filling_j, bridge_suction, bridge_pair_force,
+                film, released, events, suction, surface_tension, roughness, radius_ratios,
+                suction_axis, distance_low, log_distance_rupture, log_values,
+                (volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid),
+                closed)
+        elif wet and persist:
+            follow_across_gap(k, position, radius, pair_i, pair_j, image, period, overlap,
+                              normal, state, volume, bridge_force, filling_i, filling_j,
+                              bridge_pair_force, suction, surface_tension, radius_ratios,
+                              suction_axis, distance_low, log_distance_rupture, log_values)
+        elif wet:
             follow_contact(k, radius, pair_i, pair_j, overlap, state, volume, bridge_force,
                            filling_i, filling_j, suction, surface_tension, radius_ratios,
                            suction_axis, distance_low, log_distance_rupture, log_values)
+    if events_marked > 0:
+        cuda.atomic.add(marked, 0, events_marked)
+
+
+@cuda.jit
+def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pair, state,
+                    volume, film, released, events, marked, share, smallest_star,
+                    largest_star, liquid_lost):
+    """The liquid exchanges of the events pair_forces marked (volume control, a closed amount:
+    the CPU's exchange_liquid), on one thread, in the CPU's pair order (each particle's row in
+    turn): the ruptured bridges' liquid shared among their grains' bridges (``share``) or
+    lost, added to ``liquid_lost`` (1,) [m^3], then the bridges that form from films; nothing
+    when ``marked`` (1,) counted no event (the CPU's test), else it is cleared. The pairs of a
+    grain q are ranges of step N: its own, slots q + s N, and those where it is second,
+    ``second_pair[q + s N]``."""
+    if cuda.grid(1) != 0 or marked[0] == 0:
+        return
+    marked[0] = 0
+    n = radius.shape[0]
+    lost = 0.0
+    for p in range(n):
+        for s in range(pair_count[p]):
+            k = s * n + p
+            if events[k] == RUPTURED:
+                j = pair_j[k]
+                lost += exchange_ruptured(
+                    k, share, range(p, p + pair_count[p] * n, n),
+                    range(p, p + second_count[p] * n, n), range(j, j + pair_count[j] * n, n),
+                    range(j, j + second_count[j] * n, n), second_pair, radius, pair_i, pair_j,
+                    state, volume, film, released, events, largest_star)
+    for p in range(n):
+        for s in range(pair_count[p]):
+            k = s * n + p
+            if events[k] == FORMS_FROM_FILMS:
+                form_from_films(k, radius, pair_i, pair_j, state, volume, film, events,
+                                smallest_star, largest_star)
+    liquid_lost[0] += lost
+
+
+@cuda.jit
+def refresh_bridges(radius, pair_count, pair_j, state, volume, bridge_force, filling_i,
+                    filling_j, suction, surface_tension, radius_ratios, suction_axis,
+                    distance_low, log_distance_rupture, log_values):
+    """Every bridge at contact (AT_CONTACT) of particle p's row looked up again at a new
+    ``suction`` [Pa] (the CPU's refresh_contact_bridges at the first step after
+    SuctionBridges.set_suction; its values depend on the radii alone), one thread per row."""
+    p = cuda.grid(1)
+    n = radius.shape[0]
+    if p >= n:
+        return
+    for s in range(pair_count[p]):
+        k = s * n + p
+        if state[k] == AT_CONTACT:
+            form_at_contact(k, radius[p], radius[pair_j[k]], state, volume, bridge_force,
+                            filling_i, filling_j, suction, surface_tension, radius_ratios,
+                            suction_axis, distance_low, log_distance_rupture, log_values)
 
 
 @device
@@ -93,13 +184,17 @@ def add_wall_pushes(p, f0, f1, f2, position, radius, wall_position, young):
 
 @cuda.jit
 def gather(position, radius, pair_count, second_count, second_pair, pair_force, normal,
-           overlap, wet, attraction, walls_first, wall_position, wall_young, force, torque):
+           overlap, wet, attraction, walls_first, wall_position, wall_young, persist,
+           bridge_pair_force, force, torque):
     """Each particle's force and torque from its pairs, by the CPU's sum (_sum_pair_terms
     over the device's rows; less the ``attraction`` (K,) [N] along the normals when ``wet``:
     bridges at contact) and the walls, set (not added), in the CPU's order: the walls first
     when WallForces runs before the operation that gathers the pairs (``walls_first``: the
     contact law, or the bridges that join its gather), else after; ``wall_young`` 0 [Pa] in
-    a periodic cell, which has no walls (their springs add zeros)."""
+    a periodic cell, which has no walls (their springs add zeros). With ``persist`` the
+    bridges' forces on j from i ``bridge_pair_force`` (K, 3) [N] are added last, by the CPU's
+    sum (_sum_pair_forces, the CPU's gather_pair_forces after the contact law and the
+    walls)."""
     p = cuda.grid(1)
     n = position.shape[0]
     if p >= n:
@@ -121,4 +216,9 @@ def gather(position, radius, pair_count, second_count, second_pair, pair_force, 
     if not walls_first:
         f0, f1, f2 = add_wall_pushes(p, f0, f1, f2, position, radius, wall_position,
                                      wall_young)
+    if persist:
+        v0, v1, v2 = sum_pair_forces(bridge_pair_force, second_pair, own_pairs, second_slots)
+        f0 += v0
+        f1 += v1
+        f2 += v2
     store_row_sums(p, (f0, f1, f2, t0, t1, t2), force, torque)

@@ -1,7 +1,8 @@
 """The radius growth of a preparation on the device (pendular.dem.growth on the CPU).
 
-- RadiusGrowth: its row of the controls' program sets this step's rate g from the walls'
-  stresses (pendular.gpu.walls.growth_rate); ``grow`` then multiplies every radius by (1 + g)
+- RadiusGrowth: its row of the controls' program sets this step's rate g from the box's
+  stresses, the walls' or a periodic cell's (pendular.gpu.walls.growth_rate,
+  pendular.gpu.cell); ``grow`` then multiplies every radius by (1 + g)
   and sets mass and inertia at constant density (Particles.update_mass), before the
   integrator.
 - The neighbour list's rebuild test with growing radii (pendular.dem.neighbors.moved_beyond):
@@ -54,7 +55,8 @@ def mark_rebuild(radius, reference_radius, flags):
 @cuda.jit
 def grown_beyond(position, reference_position, radius, reference_radius, limit, flags):
     """Set flags[0] when particle p's displacement plus radius growth since the last rebuild
-    exceeds ``limit`` [m] (pendular.dem.neighbors.moved_beyond inside walls)."""
+    exceeds ``limit`` [m] (pendular.dem.neighbors.moved_beyond inside walls, or in a periodic
+    cell whose faces do not move: no stretching, s = 1)."""
     p = cuda.grid(1)
     if p >= position.shape[0]:
         return
@@ -90,13 +92,10 @@ class DeviceGrowth:
         self._first = True
 
     @classmethod
-    def of(cls, controls, box):
-        """The growth of ``controls`` (a scene's, in order), or None; ValueError in a periodic
-        ``box`` (the growth reads the walls' stresses)."""
+    def of(cls, controls):
+        """The growth of ``controls`` (a scene's, in order), or None."""
         if not any(type(op) is RadiusGrowth for op in controls):
             return None
-        if box.periodic:
-            raise ValueError("device='gpu' runs a RadiusGrowth inside walls only so far")
         return cls(controls)
 
     def grown_state(self, sim, skin, wet):
@@ -120,12 +119,12 @@ class DeviceGrowth:
 
     def launches(self, steps, state, sim, limit):
         """The step's (kernel, items, arguments) ``steps`` with the growth's kernels in:
-        mark_rebuild after the rebuild's three, grow after the walls' controls, grown_beyond
-        after the integrator (the last)."""
+        mark_rebuild after the rebuild's three, grow after the controls (the walls' or a
+        periodic cell's), grown_beyond after the integrator (the last)."""
         n = state.count
         steps = list(steps)
         controls = next(i for i, step in enumerate(steps) if step[0].py_func.__name__
-                        == "wall_controls")
+                        in ("wall_controls", "cell_controls"))
         steps.insert(controls + 1, (grow, n, (state.radius, state.mass, state.inertia,
                                               float(sim.particles.density), state.parameters,
                                               self.row)))

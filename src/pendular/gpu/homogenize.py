@@ -3,14 +3,17 @@ host receives a few numbers, not the particles (pendular.dem.measure, pendular.h
 the CPU).
 
 From the device's own arrays (pendular.gpu.state; pair k = s * N + p, particle p's s-th
-neighbour j > p):
+neighbour j > p), inside walls or in a periodic cell (no walls; V the cell's volume; each
+branch vector through the faces with its pair's image, by the CPU's
+pendular.dem.neighbors.branch_vector compiled for the device):
 
 - the Love–Weber stress of the contact forces (1/V) [sum l (x) f + walls] (Eq. 3.41,
-  pendular.homogenize.contact_stress.contact_stress), l = x_j - x_i, f the force on j from i;
+  pendular.homogenize.contact_stress.contact_stress), l = x_j - x_i (+ image L in a cell), f
+  the force on j from i;
 - the contact fabric (1/Nc) sum n n (Eq. 4.1, the contact law's normals), the coordination
   2 Nc / N, the unbalanced force and the spheres' volume (pendular.dem.measure,
-  Particles.solid_volume), the largest overlap over the smaller radius, pairs and walls, and
-  the radii's range (pendular.procedures.guards.SampleGuard's measures);
+  Particles.solid_volume), the largest overlap over the smaller radius, pairs and (inside
+  walls) walls, and the radii's range (pendular.procedures.guards.SampleGuard's measures);
 - wet: the bridges' count and water volume V_w, the sums of Eqs. 3.44-3.46 (chi, B, psi; each
   rotated cap tensor summed as a_k I + (c_k - a_k) n n, bridge_tensors.axisymmetric_sum), the
   bridge fabric (Eq. 3.53) over the unit branch vectors, the Love–Weber stress of the
@@ -38,13 +41,14 @@ import numpy as np
 from pendular.capillary.bridge_kernels import _bridge_gap_star
 from pendular.capillary.bridge_state import AT_CONTACT, NO_BRIDGE
 from pendular.capillary.table import lookup_interface
-from pendular.dem.state import Walls
+from pendular.dem.neighbors import branch_vector
 from pendular.gpu.cuda import configured, cuda, device, device_twin
 from pendular.gpu.state import BRIDGE_COLUMNS
 from pendular.homogenize.fabric import principal_anisotropy
 from pendular.utils.validate import check_positive
 
 bridge_gap_star = device_twin(_bridge_gap_star)
+image_branch = device_twin(branch_vector)
 interface_lookup = device_twin(lookup_interface)
 
 #: Particles summed by one thread of homogenize_partials.
@@ -131,6 +135,18 @@ def larger(value, largest):
 
 
 @device
+def branch(position, i, j, k, periodic, image, period):
+    """Branch vector of pair k from i to j [m]: x_j - x_i, through the faces of a ``periodic``
+    cell with the pair's image (pendular.dem.neighbors.branch_vector: image_k L, and a sheared
+    cell's offset when ``period`` holds one); inside walls ``image`` and ``period`` are
+    one-entry stand-ins, not read."""
+    if periodic:
+        return image_branch(position, i, j, image, k, period)
+    return (position[j, 0] - position[i, 0], position[j, 1] - position[i, 1],
+            position[j, 2] - position[i, 2])
+
+
+@device
 def versine(filling_angle):
     """1 - cos(alpha) = 2 sin^2(alpha / 2) [-], alpha [deg] (bridge_tensors._versine)."""
     half = math.sin(0.5 * (filling_angle * RADIAN))
@@ -168,11 +184,12 @@ def add_axisymmetric(partial, b, lateral_column, axial_column, lateral, axial, n
 
 
 @device
-def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j, no_image,
-               no_period, normal, bridges, contact_angle, surface_tension, interface,
+def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j, image,
+               period, normal, bridges, contact_angle, surface_tension, interface,
                radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
                suction):
-    """Bridge k (between i and j, branch vector l) into block b's sums."""
+    """Bridge k (between i and j, branch vector l; ``image`` and ``period`` as ``branch``)
+    into block b's sums."""
     partial[b, BRIDGES] += 1.0
     partial[b, WATER_VOLUME] += bridges[k, VOLUME]
     pull = -bridges[k, FORCE]           # the attraction along the contact's normal, on j
@@ -191,7 +208,7 @@ def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j
     add_outer(partial, b, BRIDGE_FABRIC, n0, n1, n2, n0, n1, n2)
     if interface:
         larger, ratio, distance_star = bridge_gap_star(
-            position, radius, pair_i, pair_j, no_image, no_period, k,
+            position, radius, pair_i, pair_j, image, period, k,
             bridges[k, STATE] == AT_CONTACT, 0.0)
         _, nn11, nn33 = interface_lookup(radius_ratios, suction_axis, distance_low,
                                          log_distance_rupture, log_values, ratio,
@@ -203,10 +220,12 @@ def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j
 
 
 @device
-def meniscus(p, slot, n, position, pair_count, pair_j, second_pair, bridges):
+def meniscus(p, slot, n, position, pair_count, pair_j, second_pair, periodic, image, period,
+             bridges):
     """Particle p's meniscus in its ``slot``-th pair (its own row first, then the pairs in
     which it is the second member): (bridged, unit direction from p to the other sphere,
-    cosine and sine of p's filling angle); bridge_kernels._meniscus_caps."""
+    through the faces in a ``periodic`` cell, cosine and sine of p's filling angle);
+    bridge_kernels._meniscus_caps."""
     if slot < pair_count[p]:
         k = slot * n + p
         i = p
@@ -221,9 +240,7 @@ def meniscus(p, slot, n, position, pair_count, pair_j, second_pair, bridges):
         cap = bridges[k, FILLING_J]
     if bridges[k, STATE] == NO_BRIDGE:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0
-    d0 = position[j, 0] - position[i, 0]
-    d1 = position[j, 1] - position[i, 1]
-    d2 = position[j, 2] - position[i, 2]
+    d0, d1, d2 = branch(position, i, j, k, periodic, image, period)
     scale = sign / math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     return (True, d0 * scale, d1 * scale, d2 * scale, math.cos(cap * RADIAN),
             math.sin(cap * RADIAN))
@@ -231,19 +248,21 @@ def meniscus(p, slot, n, position, pair_count, pair_j, second_pair, bridges):
 
 @device
 def overlapping_menisci(p, n, position, pair_count, pair_j, second_count, second_pair,
-                        bridges):
+                        periodic, image, period, bridges):
     """How many pairs of particle p's menisci overlap: their directions closer than the sum of
     their filling angles (bridge_kernels.pendular_overlap_counts)."""
     slots = pair_count[p] + second_count[p]
     found = 0
     for a in range(slots):
         bridged, a0, a1, a2, cos_a, sin_a = meniscus(p, a, n, position, pair_count, pair_j,
-                                                     second_pair, bridges)
+                                                     second_pair, periodic, image, period,
+                                                     bridges)
         if not bridged:
             continue
         for b in range(a + 1, slots):
             bridged, b0, b1, b2, cos_b, sin_b = meniscus(p, b, n, position, pair_count,
-                                                         pair_j, second_pair, bridges)
+                                                         pair_j, second_pair, periodic, image,
+                                                         period, bridges)
             if bridged and a0 * b0 + a1 * b1 + a2 * b2 > cos_a * cos_b - sin_a * sin_b:
                 found += 1
     return found
@@ -251,7 +270,7 @@ def overlapping_menisci(p, n, position, pair_count, pair_j, second_count, second
 
 @cuda.jit
 def homogenize_partials(position, radius, force, wall_position, pair_count, pair_i, pair_j,
-                        second_count, second_pair, no_image, no_period, overlap, normal,
+                        second_count, second_pair, periodic, image, period, overlap, normal,
                         pair_force, wet, bridges, contact_angle, surface_tension, interface,
                         radius_ratios, suction_axis, distance_low, log_distance_rupture,
                         log_values, suction, partial):
@@ -259,7 +278,8 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
     row of pairs in order: the touching pairs' (overlap > 0) contact terms and, ``wet``, the
     bridges' (BridgeState ``state`` != NO_BRIDGE; ``bridges`` (K, BRIDGE_COLUMNS)); the
     interface term when ``interface`` (the exact table's arrays, the suction [Pa]); then its
-    largest values (MAXIMA)."""
+    largest values (MAXIMA), the walls' overlaps inside walls. ``periodic``: a periodic cell,
+    the pairs' ``image`` (K, 3) and the ``period`` [m] (``branch``)."""
     b = cuda.grid(1)
     if b >= partial.shape[0]:
         return
@@ -272,7 +292,7 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
         partial[b, LARGEST_RADIUS] = larger(radius[p], partial[b, LARGEST_RADIUS])
         partial[b, NEGATIVE_SMALLEST_RADIUS] = larger(-radius[p],
                                                       partial[b, NEGATIVE_SMALLEST_RADIUS])
-        for axis in range(3):
+        for axis in range(0 if periodic else 3):        # a cell has no walls
             inside = min(position[p, axis] - wall_position[2 * axis],
                          wall_position[2 * axis + 1] - position[p, axis])
             partial[b, LARGEST_OVERLAP] = larger(1.0 - inside / radius[p],
@@ -282,14 +302,13 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
         partial[b, RADIUS_CUBED] += radius[p] * radius[p] * radius[p]
         if wet:
             partial[b, PENDULAR_OVERLAPS] += overlapping_menisci(
-                p, n, position, pair_count, pair_j, second_count, second_pair, bridges)
+                p, n, position, pair_count, pair_j, second_count, second_pair, periodic,
+                image, period, bridges)
         for k in range(p, p + pair_count[p] * n, n):
             j = pair_j[k]
             partial[b, LARGEST_OVERLAP] = larger(overlap[k] / min(radius[p], radius[j]),
                                                  partial[b, LARGEST_OVERLAP])
-            l0 = position[j, 0] - position[p, 0]
-            l1 = position[j, 1] - position[p, 1]
-            l2 = position[j, 2] - position[p, 2]
+            l0, l1, l2 = branch(position, p, j, k, periodic, image, period)
             if overlap[k] > 0.0:
                 f0 = pair_force[k, 0]
                 f1 = pair_force[k, 1]
@@ -301,7 +320,7 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
                           normal[k, 0], normal[k, 1], normal[k, 2])
             if wet and bridges[k, STATE] != NO_BRIDGE:
                 add_bridge(partial, b, k, p, j, l0, l1, l2, position, radius, pair_i, pair_j,
-                           no_image, no_period, normal, bridges, contact_angle,
+                           image, period, normal, bridges, contact_angle,
                            surface_tension, interface, radius_ratios, suction_axis,
                            distance_low, log_distance_rupture, log_values, suction)
 
@@ -340,9 +359,10 @@ def launches(gpu, partial, totals):
     bridges = gpu._bridges
     wet = bridges is not None
     interface = wet and bridges.model == "exact"
+    period = s.period if s.periodic else s.no_period
     return ((homogenize_partials, partial.shape[0],
              (s.position, s.radius, s.force, s.wall_position, s.pair_count, s.pair_i, s.pair_j,
-              s.second_count, s.second_pair, s.no_image, s.no_period, s.overlap, s.normal,
+              s.second_count, s.second_pair, s.periodic, s.image, period, s.overlap, s.normal,
               s.pair_force, wet, s.bridges, bridges.contact_angle if wet else 0.0,
               bridges.surface_tension if wet else 1.0, interface, *gpu._table, gpu._suction,
               partial)),
@@ -372,22 +392,21 @@ def device_homogenization(gpu, volume=None):
     [Pa], ``fabric_bridges``, ``anisotropy_bridges``, ``a_psi``, and with the exact model
     ``psi_interface`` (3, 3) [Pa].
 
-    volume: V [m^3] homogenised over; None: the box inside the device's walls. The walls'
-    positions and moments (six numbers each) and the sums come back; the particles do not.
-    Walled scenes only (the branch vectors hold no periodic image): ValueError otherwise."""
-    box = gpu.sim.peek("walls")
-    if not isinstance(box, Walls):
-        raise ValueError(f"homogenisation on the device runs inside walls only so far; the box "
-                         f"is a {type(box).__name__}")
+    volume: V [m^3] homogenised over; None: the box inside the device's walls, or the
+    periodic cell's volume (its faces). The walls' positions and moments (six numbers each;
+    a cell's faces alone) and the sums come back; the particles do not. In a cell the sums
+    run over the branch vectors through its faces and there are no wall terms (the CPU's
+    contact_stress, largest_overlap, homogenize_bridges with the cell's period)."""
     s = gpu.state
     if volume is None:
         wall_position = s.wall_position.copy_to_host()
         volume = float(np.prod(wall_position[1::2] - wall_position[0::2]))
     volume = check_positive("volume", volume, "m^3")
     sums = reduced_sums(gpu)
-    moment = s.wall_moment.copy_to_host()
     stress = _tensor(sums, "stress")
-    stress[np.diag_indices(3)] += moment[0::2] + moment[1::2]
+    if not s.periodic:          # the walls' l f; a cell has none
+        moment = s.wall_moment.copy_to_host()
+        stress[np.diag_indices(3)] += moment[0::2] + moment[1::2]
     touching = sums[TOUCHING]
     fabric = _tensor(sums, "fabric")
     if touching:

@@ -36,13 +36,17 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
 
 @cuda.jit
 def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
-                  affine_rate, dt, reference_position, cell_position, reference_cell, limit,
-                  shortest_unlisted, flags):
-    """leapfrog in a periodic cell not sheared (the CPU's _advance with stretching: the
-    velocity ``affine_rate`` (3,) [1/s] * x carrying the particle on top of its own); the
-    rebuild test is pendular.dem.neighbors.moved_beyond: the displacement from s x_ref,
-    s = L / L_ref (cell faces ``cell_position`` now, ``reference_cell`` at the last rebuild),
-    against ``limit`` [m] less max|s - 1| / 2 times ``shortest_unlisted`` [m]."""
+                  affine_rate, dt, reference_position, cell_position, reference_cell, period,
+                  shear, limit, shortest_unlisted, flags):
+    """leapfrog in a periodic cell (the CPU's _advance with stretching: the velocity
+    ``affine_rate`` (3,) [1/s] * x carrying the particle on top of its own; a sheared cell's
+    (4,) adds gamma_dot * z along x); the rebuild test is pendular.dem.neighbors.moved_beyond
+    (an njit loop over every particle: restated per thread): the displacement from
+    s x_ref + g z_ref along x, s = L / L_ref (cell faces ``cell_position`` now,
+    ``reference_cell`` at the last rebuild) and, in a sheared cell (``period`` (4,), its
+    offset delta now last; ``shear`` pendular.gpu.cell.SHEAR_FIELDS, delta at the last
+    rebuild), g = (delta - s_x delta_ref) / Lz_ref (else 0), against ``limit`` [m] less
+    (max|s - 1| + |g|) / 2 times ``shortest_unlisted`` [m]."""
     p = cuda.grid(1)
     if p >= position.shape[0]:
         return
@@ -52,8 +56,14 @@ def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, ine
     s0 = cell_position[1] / reference_cell[1]
     s1 = cell_position[3] / reference_cell[3]
     s2 = cell_position[5] / reference_cell[5]
-    reach = limit - 0.5 * max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) * shortest_unlisted
+    shear_since = 0.0       # g (docstring)
+    if period.shape[0] > 3:
+        shear_since = (period[3] - s0 * shear[3]) / reference_cell[5]
+    stretch = max(abs(s0 - 1.0), abs(s1 - 1.0), abs(s2 - 1.0)) + abs(shear_since)
+    reach = limit - 0.5 * stretch * shortest_unlisted
     d0 = position[p, 0] - s0 * reference_position[p, 0]
+    if shear_since != 0.0:
+        d0 -= shear_since * reference_position[p, 2]
     d1 = position[p, 1] - s1 * reference_position[p, 1]
     d2 = position[p, 2] - s2 * reference_position[p, 2]
     if reach <= 0.0 or d0 * d0 + d1 * d1 + d2 * d2 > reach * reach:

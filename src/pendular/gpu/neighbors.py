@@ -22,7 +22,8 @@ checks (pendular.gpu.simulation).
 
 import math
 
-from pendular.dem.neighbors import _cell_coordinates, _within_reach, _wrap_cell
+from pendular.dem.neighbors import (_cell_coordinates, _sheared_cell, _within_reach,
+    _wrap_cell)
 from pendular.gpu.cuda import cuda, device, device_twin
 
 within_reach = device_twin(_within_reach)
@@ -237,11 +238,41 @@ def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shea
 # (pendular.dem.neighbors._periodic_grid, at most the grid allocated); a pair's image (K, 3)
 # int8 is stored with it (Contacts.image). A cell narrower than 3 cells a side sets NARROW_CELL
 # (the CPU refuses to build such a list: a pair would have more than one image in reach).
+# A sheared cell (``period`` (4,), its offset delta last: pendular.gpu.cell) wraps its
+# particles through the z faces with x shifted by -+ delta and searches the rows of cells
+# through a z face around x less their offset (Lees–Edwards), with the offset brought into
+# [-Lx/2, Lx/2) at the rebuild (reduced_offset, stored by shear_rebuilt after the search).
 
 #: Bit of flags[1]: the periodic cell is narrower than 3 cells of the grid on an axis.
 NARROW_CELL = 4
 
 wrap_cell = device_twin(_wrap_cell)
+sheared_cell = device_twin(_sheared_cell)
+
+
+@device
+def reduced_offset(period):
+    """(the offset period[3] [m] brought into [-Lx/2, Lx/2), the whole Lx taken out of it
+    [-]) (PeriodicCell._wrap_sheared, a method: restated)."""
+    turns = math.floor(period[3] / period[0] + 0.5)
+    return period[3] - turns * period[0], turns
+
+
+@device
+def wrap_sheared(p, position, period, wraps):
+    """PeriodicCell._wrap_sheared for particle p: its x wraps counted again with the whole Lx
+    taken out of the offset (so that the unwrapped position is unchanged), then, through a z
+    face, x shifted by -+ the reduced offset, z brought into [0, Lz) (clamped) and the z
+    wraps counted."""
+    offset, turns = reduced_offset(period)
+    if turns != 0.0:
+        wraps[p, 0] += int(turns) * wraps[p, 2]
+    crossed = math.floor(position[p, 2] / period[2])
+    if crossed != 0.0 and math.isfinite(crossed):       # diverged: the integrator flags it
+        position[p, 0] -= crossed * offset
+        z = position[p, 2] - crossed * period[2]
+        position[p, 2] = min(max(z, 0.0), math.nextafter(period[2], 0.0))
+        wraps[p, 2] += int(crossed)
 
 
 @device
@@ -268,13 +299,16 @@ def wrap_particle(p, position, cell_position, wraps):
 
 
 @cuda.jit
-def bin_periodic(position, cell_position, wraps, cell_size, max_dims, cell_count,
+def bin_periodic(position, cell_position, period, wraps, cell_size, max_dims, cell_count,
                  cell_members, cell_width, cell_of, flags):
-    """Wrap each particle into the cell (wrap_particle), then append it to its cell of the
-    periodic grid (x-major numbering, the CPU's _sort_into_cells over [0, L))."""
+    """Wrap each particle into the cell (a sheared cell's ``period`` (4,): wrap_sheared first,
+    as PeriodicCell.wrap; then wrap_particle), then append it to its cell of the periodic grid
+    (x-major numbering, the CPU's _sort_into_cells over [0, L))."""
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
+    if period.shape[0] > 3:
+        wrap_sheared(p, position, period, wraps)
     wrap_particle(p, position, cell_position, wraps)
     dims = grid_shape(cell_position, cell_size, max_dims)      # low faces at 0: int(L / size)
     if p == 0 and (dims[0] < 3 or dims[1] < 3 or dims[2] < 3):
@@ -305,30 +339,38 @@ def insert_with_image(row, image, p, n, found, width, q, sx, sy, sz, flags):
 
 
 @cuda.jit
-def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_dims,
+def find_periodic_pairs(position, radius, skin, cell_position, period, cell_size, max_dims,
                         cell_count, cell_members, cell_width, cell_of, width, pair_count,
                         pair_j, new_count, new_pair_j, image, lower_count, lower, shear_force,
                         normal, overlap, bridges, new_shear_force, new_normal, new_overlap,
                         new_bridges, flags):
     """find_pairs in a periodic cell: particle p's neighbours through the nearest image from
-    the 27 cells around its own, wrapped across the faces (the CPU's _periodic_neighbors_of
-    in a cell not sheared), each with its image into ``image`` (written in place: the forces
-    read it after this rebuild; lower rows hold no image); then the per-pair state carried
-    as find_pairs."""
+    the 27 cells around its own, wrapped across the faces (the CPU's _periodic_neighbors_of:
+    in a sheared cell, ``period`` (4,), the rows through a z face around p's x less their
+    offset, with the offset reduced_offset), each with its image into ``image`` (written in
+    place: the forces read it after this rebuild; lower rows hold no image); then the per-pair
+    state carried as find_pairs."""
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
     dims = grid_shape(cell_position, cell_size, max_dims)      # low faces at 0: int(L / size)
     cx, cy, cz = cell_coordinates(cell_of[p], dims)
+    shear = reduced_offset(period)[0] if period.shape[0] > 3 else 0.0
+    along = cell_position[1] / dims[0]                         # a cell's width along x
     n = position.shape[0]
     above = 0
     below = 0
     for dx in range(-1, 2):
-        x, sx = wrap_cell(cx + dx, dims[0])
         for dy in range(-1, 2):
             y, sy = wrap_cell(cy + dy, dims[1])
             for dz in range(-1, 2):
                 z, sz = wrap_cell(cz + dz, dims[2])
+                offset = sz * shear
+                if offset != 0.0:       # the images of that row sit offset along x
+                    x, sx = sheared_cell(
+                        int(math.floor((position[p, 0] - offset) / along)) + dx, dims[0])
+                else:
+                    x, sx = wrap_cell(cx + dx, dims[0])
                 c = (x * dims[1] + y) * dims[2] + z
                 for slot in range(c * cell_width,
                                   c * cell_width + min(cell_count[c], cell_width)):
@@ -336,7 +378,7 @@ def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_di
                     if q == p:
                         continue
                     reach = radius[p] + radius[q] + skin
-                    d0 = position[q, 0] + sx * cell_position[1] - position[p, 0]
+                    d0 = position[q, 0] + sx * cell_position[1] + offset - position[p, 0]
                     d1 = position[q, 1] + sy * cell_position[3] - position[p, 1]
                     d2 = position[q, 2] + sz * cell_position[5] - position[p, 2]
                     if d0 * d0 + d1 * d1 + d2 * d2 < reach * reach:
@@ -348,3 +390,16 @@ def find_periodic_pairs(position, radius, skin, cell_position, cell_size, max_di
     carry_rows(p, n, min(above, width), min(below, width), new_count, lower_count, pair_count,
                pair_j, new_pair_j, shear_force, normal, overlap, bridges, new_shear_force,
                new_normal, new_overlap, new_bridges)
+
+
+@cuda.jit
+def shear_rebuilt(period, shear, flags):
+    """After a rebuild (flags[0]) in a sheared cell: the offset the wrap and the search took
+    (reduced_offset) stored in ``period`` [3] and ``shear`` (pendular.gpu.cell.SHEAR_FIELDS:
+    the offset, and the rebuild test's reference). One thread."""
+    if cuda.grid(1) != 0 or flags[0] == 0:
+        return
+    offset, _ = reduced_offset(period)
+    period[3] = offset
+    shear[0] = offset
+    shear[3] = offset

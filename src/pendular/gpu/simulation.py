@@ -4,9 +4,10 @@ The state is copied to the device once; each step is a fixed sequence of kernel 
 CPU pipeline (pendular.dem.simulation) on the device::
 
     bin_particles, find_pairs, finish_rebuild   neighbour list (only when a rebuild is due)
-    pair_forces                                 contact law (+ bridges at contact, wet)
+    pair_forces                                 contact law (+ bridges, wet)
     gather                                      forces and torques per particle (+ walls)
     wall_partials, wall_sums, wall_controls     walls' force, stiffness, moment; controls
+    grip_partials, grip_hold                    grips: their pulls, members on their walls
     leapfrog                                    integrator (+ the rebuild test)
 
 The host reads nothing per step. It reads the device's flags at its checks (every
@@ -25,21 +26,25 @@ raises the CPU's StageFailed at its next check or, earlier, when anything reads 
 (``copy_back``), so that no writer records a state past the failure.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
-wet, SuctionBridges at contact (``persist`` False); controls StressServo, ConstantStrainRate,
-MixedStress (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.
-growth); the Integrator. A periodic cell (``PeriodicCell``, not sheared) with ContactForces
-and, wet, SuctionBridges at contact, under StressServo and ConstantStrainRate (pendular.gpu.
-cell): its step wraps the particles and finds the pairs through the cell's faces at a
-rebuild, reduces the cell's stress, runs its controls and a leapfrog carried by its
-stretching. Anything else (simple shear: ConstantShearRate, a sheared cell) is refused by
+wet, SuctionBridges at contact or across gaps (``persist``; a new suction between runs, as the
+CPU: GpuSimulation._follow_suction); controls StressServo, ConstantStrainRate, MixedStress
+(its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip
+after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not)
+with ContactForces and, wet, SuctionBridges at contact, under StressServo,
+ConstantStrainRate, ConstantShearRate (simple shear, Lees–Edwards) and MixedStress
+(pendular.gpu.cell): its step wraps the particles and finds the pairs through the cell's
+faces at a rebuild, reduces the cell's stress, runs its controls and a leapfrog carried by
+its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a cell whose
+faces no control moves. Anything else (a radius growth in a moving cell) is refused by
 name (ValueError), so that a scene never runs with part of its physics missing.
 """
 
 import numpy as np
 
-from pendular.capillary.bridges import SuctionBridges
+from pendular.capillary.bridges import CapillaryBridges, SuctionBridges, VolumeBridges
 from pendular.dem.cell import ConstantShearRate, PeriodicCell
 from pendular.dem.contact_law import ContactForces
+from pendular.dem.grips import Grip
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.mixed_stress import MixedStress
@@ -48,6 +53,7 @@ from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import cell as device_cell, forces, integrate, neighbors, walls as device_walls
 from pendular.gpu.cuda import configured, cuda, simulated
+from pendular.gpu.grips import DeviceGrips, check_grips
 from pendular.gpu.growth import DeviceGrowth
 from pendular.gpu.homogenize import device_homogenization
 from pendular.gpu.state import DeviceState
@@ -82,20 +88,22 @@ def check_scene(sim):
     if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
-        if type(op) not in (ContactForces, WallForces, SuctionBridges):
+        if type(op) not in (ContactForces, WallForces, SuctionBridges, VolumeBridges):
             raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
-                             "(valid: ContactForces, WallForces, SuctionBridges)")
-    bridges = _one(sim, SuctionBridges, required=False)
+                             "(valid: ContactForces, WallForces, SuctionBridges, "
+                             "VolumeBridges)")
+    bridges = _bridges_of(sim)
     if bridges is not None and bridges.persist:
-        raise ValueError("device='gpu' runs suction-controlled bridges at contact only so far "
-                         "(persist = False)")
+        _check_persist(sim, box, bridges)
     controls = sim.peek("controls")
     for op in controls:
-        if type(op) not in (StressServo, ConstantStrainRate, RadiusGrowth) \
-                and not isinstance(op, (MixedStress, GrowthTimeStep)):
+        if type(op) not in (StressServo, ConstantStrainRate, RadiusGrowth, Grip) \
+                and not isinstance(op, (MixedStress, GrowthTimeStep)) \
+                and not (type(op) is ConstantShearRate and box.periodic):
             raise ValueError(f"device='gpu' does not run the control {type(op).__name__} yet "
                              "(valid: StressServo, ConstantStrainRate, MixedStress, "
-                             "RadiusGrowth, GrowthTimeStep)")
+                             "RadiusGrowth, GrowthTimeStep, Grip; ConstantShearRate in a "
+                             "periodic cell)")
         if isinstance(op, MixedStress) and not all(
                 any(op.servos[axis] is other for other in controls) for axis in op.free):
             raise ValueError("device='gpu' runs a MixedStress whose servos are among the "
@@ -103,21 +111,56 @@ def check_scene(sim):
     for kind in (RadiusGrowth, GrowthTimeStep):
         if sum(isinstance(op, kind) for op in controls) > 1:
             raise ValueError(f"device='gpu' runs at most one {kind.__name__} among the controls")
+    check_grips(list(controls), len(sim.peek("particles")))
+
+
+def _bridges_of(sim):
+    """The one CapillaryBridges (SuctionBridges or VolumeBridges) among sim's forces, or None;
+    ValueError when there are several."""
+    found = [op for op in sim.forces if isinstance(op, CapillaryBridges)]
+    if len(found) > 1:
+        raise ValueError(f"device='gpu' runs at most one bridge operation among the forces; "
+                         f"found {len(found)}")
+    return found[0] if found else None
+
+
+def _check_persist(sim, box, bridges):
+    """ValueError naming what of bridges across gaps (SuctionBridges ``persist``,
+    VolumeBridges) the GPU path does not run: in a periodic cell, gathered before the contact
+    law or the walls (the device adds their forces last, as the CPU's gather_pair_forces after
+    both), or with radii that grow."""
+    what = f"bridges across gaps ({type(bridges).__name__} with persist = True)"
+    if isinstance(box, PeriodicCell):
+        raise ValueError(f"device='gpu' does not run {what} in a periodic cell yet: run it on "
+                         "the CPU (device 'cpu')")
+    if sim.forces[-1] is not bridges:
+        raise ValueError(f"device='gpu' runs {what} listed after the contact law and the wall "
+                         "forces only")
+    if any(isinstance(op, RadiusGrowth) for op in sim.peek("controls")):
+        raise ValueError(f"device='gpu' does not run {what} while radii grow (RadiusGrowth)")
 
 
 def _check_periodic(sim, cell):
-    """ValueError naming what of a periodic scene the GPU path does not run yet."""
-    if cell.sheared or any(isinstance(op, ConstantShearRate) for op in sim.peek("controls")):
-        raise ValueError("device='gpu' does not run simple shear (ConstantShearRate, a sheared "
-                         "periodic cell) yet: run it on the CPU (device 'cpu')")
+    """ValueError naming what of a periodic scene the GPU path does not run yet (a sheared
+    cell, ConstantShearRate, MixedStress and a radius growth in a fixed cell run:
+    pendular.gpu.cell)."""
     for op in sim.forces:
         if type(op) is WallForces:
             raise ValueError("device='gpu' runs a periodic cell without WallForces (it has no "
                              "walls)")
-    for op in sim.peek("controls"):
-        if type(op) not in (StressServo, ConstantStrainRate):
+    controls = sim.peek("controls")
+    for op in controls:
+        if type(op) not in (StressServo, ConstantStrainRate, ConstantShearRate, RadiusGrowth) \
+                and not isinstance(op, (MixedStress, GrowthTimeStep)):
             raise ValueError(f"device='gpu' does not run the control {type(op).__name__} in a "
-                             "periodic cell yet (valid: StressServo, ConstantStrainRate)")
+                             "periodic cell yet (valid: StressServo, ConstantStrainRate, "
+                             "ConstantShearRate, MixedStress, RadiusGrowth, GrowthTimeStep)")
+    moving = [type(op).__name__ for op in controls
+              if type(op) is not RadiusGrowth and not isinstance(op, GrowthTimeStep)]
+    if any(type(op) is RadiusGrowth for op in controls) and (moving or cell.sheared):
+        raise ValueError("device='gpu' runs a RadiusGrowth in a periodic cell whose faces no "
+                         f"control moves only (its rebuild test: pendular.gpu.growth); found "
+                         f"{', '.join(moving) or 'a sheared cell'}")
 
 
 class GpuSimulation:
@@ -134,20 +177,35 @@ class GpuSimulation:
     def __init__(self, sim):
         check_scene(sim)
         self.sim = sim
-        bridges = _one(sim, SuctionBridges, required=False)
+        bridges = _bridges_of(sim)
         self._bridges = bridges
-        self._table = None
+        self._volume_control = isinstance(bridges, VolumeBridges)
+        reach = 0.0
+        # the tables' arrays (BridgeTable, VolumeBridgeTable: arrays()), stand-ins when unread
+        self._table = tuple(cuda.to_device(np.zeros(shape)) for shape in
+                            ((1,), (3,), (1, 1), (1, 1), (1, 1, 1, 1)))
+        self._volume_table = tuple(cuda.to_device(np.zeros(shape)) for shape in
+                                   ((1,), (1, 2), (1, 1), (1, 1), (1, 1, 1, 1)))
+        self._suction = 0.0
         if bridges is not None:
-            bridges.reach(sim)                  # loads the tables, checks the suction
+            # loads the tables, checks the suction; the list's reach beyond touching (the
+            # CPU's NeighborList.interaction_range: the rupture range of persisting bridges)
+            reach = bridges.reach(sim)
+            sim.neighbors.interaction_range = reach
             self._table = tuple(cuda.to_device(np.ascontiguousarray(a))
                                 for a in bridges.suction_table.arrays())
             self._suction = bridges.suction
-        else:
-            self._table = tuple(cuda.to_device(np.zeros(shape)) for shape in
-                                ((1,), (3,), (1, 1), (1, 1), (1, 1, 1, 1)))
-            self._suction = 0.0
-        self._growth = DeviceGrowth.of(tuple(sim.controls), sim.walls)
-        self.state = (DeviceState(sim, sim.neighbors.skin, bridges is not None)
+        film = None
+        if self._volume_control:
+            self._volume_table = tuple(cuda.to_device(np.ascontiguousarray(a))
+                                       for a in bridges.volume_table.arrays())
+            count = len(sim.particles)
+            film = (bridges.film if bridges.film is not None and len(bridges.film) == count
+                    else np.zeros(count))
+        self._growth = DeviceGrowth.of(tuple(sim.controls))
+        persist = bridges is not None and bridges.persist
+        self.state = (DeviceState(sim, sim.neighbors.skin, bridges is not None, reach, persist,
+                                  film)
                       if self._growth is None else
                       self._growth.grown_state(sim, sim.neighbors.skin, bridges is not None))
         self._controls = tuple(sim.controls)
@@ -196,6 +254,12 @@ class GpuSimulation:
             elif isinstance(op, GrowthTimeStep):
                 kinds[c] = device_walls.GROWTH_TIMESTEP
                 continue
+            elif type(op) is Grip:          # held after the walls' controls (pendular.gpu.grips)
+                kinds[c] = device_walls.GRIP
+                continue
+            elif type(op) is ConstantShearRate:     # a periodic cell's (pendular.gpu.cell)
+                kinds[c] = device_walls.SHEAR_RATE
+                continue
             else:
                 kinds[c] = device_walls.MIXED_STRESS
                 control_walls[c, :3] = [self._row(op.servos[axis]) if axis in op.free else -1
@@ -215,6 +279,10 @@ class GpuSimulation:
         s.parameters = cuda.to_device(self._control_parameters())
         s.control_step = cuda.to_device(np.zeros(1, np.int64))
         s.failure = cuda.to_device(np.zeros(len(device_walls.FAILURE_FIELDS)))
+        self._grips = DeviceGrips.of(self._controls)
+        if s.periodic:          # the shear's layout and state (pendular.gpu.cell)
+            cell = self.sim.walls
+            device_cell.upload_shear(s, cell, device_cell.sheared_layout(cell, self._controls))
 
     def _control_parameters(self):
         """(controls, 6) parameters of the controls now (pendular.gpu.walls's fields)."""
@@ -225,6 +293,8 @@ class GpuSimulation:
                                  float(op.scale_max_velocity), float(op.stiffness_every))
             elif type(op) is ConstantStrainRate:
                 parameters[c, :3] = (op.rate, op.reference_length, float(op.on_current_length))
+            elif type(op) is ConstantShearRate:
+                parameters[c, 0] = op.rate
             elif type(op) is RadiusGrowth:
                 parameters[c, :2] = (op.target_stress, op.max_rate)
             elif isinstance(op, MixedStress):
@@ -248,10 +318,7 @@ class GpuSimulation:
             raise ValueError("the scene's controls changed since the GPU copy was made: call "
                              "to_host() and build a new GpuSimulation")
         check_scene(sim)
-        if self._bridges is not None and self._bridges.suction != self._suction:
-            raise ValueError(f"suction = {self._bridges.suction:g} Pa changed since the GPU "
-                             f"copy was made at {self._suction:g} Pa: a suction path does not "
-                             "run on the GPU yet")
+        self._follow_suction()
         if self._holding:           # the host's targets of a MixedStress's servos are stale
             self._targets_to_host()
         self.state.parameters.copy_to_device(self._control_parameters())
@@ -266,6 +333,54 @@ class GpuSimulation:
         self._launches = [(configured(kernel, items), args)
                           for kernel, items, args in self._steps]
 
+    def _follow_suction(self):
+        """The bridges at the suction imposed now (a suction path: SuctionBridges.set_suction
+        between runs), as the CPU's next step: the bridges at contact looked up again at a new
+        suction on the device (forces.refresh_bridges, the CPU's refresh_contact_bridges),
+        the suction of the next steps' lookups. The list's reach (the rupture range, which
+        never shrinks) must be the one the device's grid and rows were sized for: a farther
+        one needs a new GpuSimulation (Simulation.run makes one for each run)."""
+        bridges = self._bridges
+        if bridges is None:
+            return
+        if bridges.required_range != self.state.reach:
+            raise ValueError(f"the bridges' reach {bridges.required_range:g} m changed since "
+                             f"the GPU copy was made ({self.state.reach:g} m; a lower suction "
+                             "of persisting bridges): call to_host() and build a new "
+                             "GpuSimulation")
+        if self._volume_control:
+            self._liquid_from_host()
+            return
+        self._suction = bridges.suction
+        if bridges.take_new_suction():
+            kernel, items, args = self._refresh_step()
+            configured(kernel, items)(*args)
+
+    def _liquid_from_host(self):
+        """Volume control's film and lost liquid from the host's bridges when the host holds
+        the state (its close_liquid may have changed them since the device's last copy)."""
+        if self._holding:
+            return
+        bridges = self._bridges
+        if bridges.film is not None:        # None: no step yet, no film (the device's zeros)
+            self.state.film.copy_to_device(np.ascontiguousarray(bridges.film,
+                                                                dtype=np.float64))
+        self.state.liquid_lost.copy_to_device(np.array([bridges.liquid_lost]))
+
+    def _refresh_step(self):
+        """(kernel, items, arguments) of the bridges at contact looked up again at the
+        suction now (forces.refresh_bridges)."""
+        s = self.state
+        return (forces.refresh_bridges, s.count,
+                (s.radius, s.pair_count, s.pair_j, *self._bridge_columns()[:5],
+                 self._bridges.suction, self._bridges.surface_tension, *self._table))
+
+    def _bridge_columns(self):
+        """The device's bridge columns (pendular.gpu.state.BRIDGE_COLUMNS) as the law's
+        arrays."""
+        bridges = self.state.bridges
+        return tuple(bridges[:, c] for c in range(bridges.shape[1]))
+
     def _force_steps(self, image, period, affine_rate, walls_first, wall_young):
         """(kernel, items, arguments) of the pair forces and their gather (walls' springs of
         stiffness ``wall_young`` [Pa] E R, 0: none; images ``image``, ``period`` and
@@ -275,22 +390,40 @@ class GpuSimulation:
         n = s.count
         contact = _one(sim, ContactForces)
         tan_friction = float(np.tan(np.radians(contact.friction_deg)))
-        # the bridges' columns (pendular.gpu.state.BRIDGE_COLUMNS) as the law's arrays
-        columns = tuple(s.bridges[:, c] for c in range(s.bridges.shape[1]))
+        columns = self._bridge_columns()
+        # bridges at contact join the contact law's gather; persisting ones are added last
+        joined = s.wet and not s.persist
+        bridges = self._bridges
+        volume = self._volume_control
+        liquid = (bridges.roughness, bridges.closed) if volume else (0.0, False)
         return [
             (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
                                      s.pair_count, s.pair_i, s.pair_j, image, period,
                                      affine_rate, s.shear_force, s.normal,
                                      s.overlap, s.normal_force, s.pair_force, contact.young,
                                      contact.shear_ratio, tan_friction, sim.dt, s.flags,
-                                     s.wet, *columns, self._suction,
-                                     self._bridges.surface_tension if s.wet else 1.0,
-                                     *self._table)),
+                                     s.wet, s.persist, volume, *columns,
+                                     s.bridge_pair_force, self._suction,
+                                     bridges.surface_tension if s.wet else 1.0,
+                                     *self._table, *liquid, s.film, s.released, s.events,
+                                     s.marked, *self._volume_table)),
+            *((self._exchange_step(),) if volume else ()),
             (forces.gather, n, (s.position, s.radius, s.pair_count, s.second_count,
-                                s.second_pair, s.pair_force, s.normal, s.overlap, s.wet,
+                                s.second_pair, s.pair_force, s.normal, s.overlap, joined,
                                 columns[2], walls_first, s.wall_position, wall_young,
-                                s.force, s.torque)),
+                                s.persist, s.bridge_pair_force, s.force, s.torque)),
         ]
+
+    def _exchange_step(self):
+        """(kernel, items, arguments) of volume control's liquid exchange
+        (forces.exchange_liquid: the liquid model's sharing and the volume table's range
+        now)."""
+        s = self.state
+        smallest, largest = self._bridges.volume_table.volume_star_bounds()
+        return (forces.exchange_liquid, 1,
+                (s.radius, s.pair_count, s.pair_i, s.pair_j, s.second_count, s.second_pair,
+                 *self._bridge_columns()[:2], s.film, s.released, s.events, s.marked,
+                 self._bridges.shares, smallest, largest, s.liquid_lost))
 
     def _finish_step(self):
         """(kernel, items, arguments) of finish_rebuild."""
@@ -305,24 +438,27 @@ class GpuSimulation:
 
     def _cell_steps(self):
         """(kernel, items, arguments) of a step in a periodic cell (pendular.gpu.cell): the
-        rebuild (wrap and bin, pairs through the faces, finish), the forces (no walls), the
-        cell's stress and controls, the leapfrog carried by the cell's stretching."""
+        rebuild (wrap and bin, pairs through the faces, finish; in a sheared cell the offset
+        it took stored), the forces (no walls), the cell's stress and controls, the leapfrog
+        carried by the cell's stretching and shear."""
         sim = self.sim
         s = self.state
         n = s.count
         gathered_by = SuctionBridges if s.wet else ContactForces
         bridges = s.bridges
+        sheared = s.period.shape[0] > 3
         return [
-            (neighbors.bin_periodic, n, (s.position, s.wall_position, s.wraps, s.cell_size,
-                                         s.max_dims, s.cell_count, s.cell_members,
-                                         s.cell_width, s.cell_of, s.flags)),
+            (neighbors.bin_periodic, n, (s.position, s.wall_position, s.period, s.wraps,
+                                         s.cell_size, s.max_dims, s.cell_count,
+                                         s.cell_members, s.cell_width, s.cell_of, s.flags)),
             (neighbors.find_periodic_pairs, n,
-             (s.position, s.radius, s.skin, s.wall_position, s.cell_size, s.max_dims,
+             (s.position, s.radius, s.skin, s.wall_position, s.period, s.cell_size, s.max_dims,
               s.cell_count, s.cell_members, s.cell_width, s.cell_of, s.width, s.pair_count,
               s.pair_j, s.new_count, s.new_pair_j, s.image, s.lower_count, s.lower,
               s.shear_force, s.normal, s.overlap, bridges, s.new_shear_force, s.new_normal,
               s.new_overlap, s.new_bridges, s.flags)),
             self._finish_step(),
+            *([(neighbors.shear_rebuilt, 1, (s.period, s.shear, s.flags))] if sheared else []),
             *self._force_steps(s.image, s.period, s.affine_rate, False, 0.0),
             (device_cell.cell_partials, s.cell_partial.shape[0],
              (s.position, s.force, s.radius, s.pair_count, s.pair_j, s.image, s.period,
@@ -330,13 +466,14 @@ class GpuSimulation:
               bridges[:, 2], s.kinds, s.parameters, s.calls, s.cell_partial)),
             (device_cell.cell_controls, 1,
              (s.cell_partial, s.wall_position, s.cell_rate, s.stress_tensor, s.cell_stiffness,
-              s.period, s.affine_rate, s.kinds, s.control_walls, s.wall_counts, s.parameters,
-              s.previous, s.stiffness, s.calls, sim.dt)),
+              s.period, s.affine_rate, s.shear, s.kinds, s.control_walls, s.wall_counts,
+              s.parameters, s.previous, s.stiffness, s.calls, sim.dt, s.control_step,
+              s.failure)),
             (integrate.cell_leapfrog, n,
              (s.position, s.velocity, s.angular_velocity, s.force, s.torque, s.mass,
               s.inertia, sim.integrator.damping, s.affine_rate, sim.dt, s.reference_position,
-              s.wall_position, s.reference_walls, 0.5 * s.skin,
-              2.0 * float(sim.particles.radius.max()) + s.skin, s.flags)),
+              s.wall_position, s.reference_walls, s.period, s.shear, 0.5 * s.skin,
+              2.0 * float(sim.peek("particles").radius.max()) + s.skin, s.flags)),
         ]
 
     def _walled_steps(self):
@@ -346,7 +483,7 @@ class GpuSimulation:
         s = self.state
         n = s.count
         order = [type(op) for op in sim.forces]
-        gathered_by = SuctionBridges if s.wet else ContactForces
+        gathered_by = SuctionBridges if s.wet and not s.persist else ContactForces
         walls_first = order.index(WallForces) < order.index(gathered_by)
         limit = 0.5 * s.skin
         bridges = s.bridges
@@ -373,6 +510,7 @@ class GpuSimulation:
               s.parameters, s.previous, s.stiffness, s.calls, s.wall_position,
               s.wall_velocity, s.reference_walls, limit, sim.dt, s.control_step, s.failure,
               s.flags)),
+            *(self._grips.launches(s) if self._grips is not None else ()),
             (integrate.leapfrog, n, (s.position, s.velocity, s.angular_velocity, s.force,
                                      s.torque, s.mass, s.inertia, sim.integrator.damping,
                                      s.no_period, sim.dt, s.reference_position, limit,
@@ -463,12 +601,18 @@ class GpuSimulation:
         "walls", the walls alone. Then StageFailed if a mixed condition could not be held
         (``check``), so that nothing reads a state past the failure."""
         sim = self.sim
+        if self._grips is not None:     # a grip's pull is a force on its wall's body
+            self._grips.to_host()
         if part == "walls":
             self.state.walls_to_host(sim.walls)
+            if self.state.periodic:     # a cell's shear is the box's too
+                device_cell.shear_to_host(self.state, sim.walls)
             self._report_failure()
             return
         self._holding = False
         self.state.to_host(sim)
+        if self.state.periodic:
+            device_cell.shear_to_host(self.state, sim.walls)
         if self._growth is not None:
             self._growth.to_host(sim, self.state)
         self._targets_to_host()
@@ -490,9 +634,24 @@ class GpuSimulation:
                                     sim.contacts.pair_j)
         sim.contacts.force = carry_pair_array(listed.force, index)
         sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
+        if self.state.persist:
+            self._persisting_to_host(sim, index)
         if self._growth is not None:
             self._growth.after_copy_back(sim)
         self._report_failure()
+
+    def _persisting_to_host(self, sim, index):
+        """The persisting bridges' host state for the CPU's list (``index``: its pairs in the
+        device's, previous_pair_index): their count, which the CPU's next list must carry
+        (CapillaryBridges._attach), and their forces on j from i at the last step, carried
+        to the same pairs (CapillaryBridges.pair_forces reads them); volume control's film on
+        each grain and liquid lost."""
+        bridges = self._bridges
+        bridges.adopt(sim)
+        bridges.pair_force[:] = carry_pair_array(self.state.bridge_pair_forces(), index)
+        if self._volume_control:
+            bridges.film = self.state.film.copy_to_host()
+            bridges.liquid_lost = float(self.state.liquid_lost.copy_to_host()[0])
 
     @property
     def rebuilds(self):
@@ -506,9 +665,9 @@ class GpuSimulation:
         """The homogenised quantities of the state the device holds, reduced on the device
         (pendular.gpu.homogenize.device_homogenization: small arrays named as the history's
         columns, computed once per step, so that a record's columns share one reduction);
-        ``volume`` [m^3], None: the box inside the walls. No particle state comes back. None
-        in a periodic cell (no reduction through its faces on the device yet: the caller
-        homogenises the host's state, which brings it back).
+        ``volume`` [m^3], None: the box inside the walls, or the periodic cell's. No particle
+        state comes back. None with bridges across gaps (``persist``, volume control): the
+        caller homogenises the host's state, which brings it back.
         StageFailed first if a mixed condition could not be held (as ``copy_back``);
         RuntimeError when the device holds no state (it came back to the host, whose copy may
         have changed since: homogenise it there)."""
@@ -516,8 +675,8 @@ class GpuSimulation:
             raise RuntimeError("the GPU holds no state now (it came back to the host): "
                                "homogenise the host's state")
         self._report_failure()
-        if self.state.periodic:     # no device reduction through a cell's faces yet
-            return None
+        if self.state.persist:      # bridges across gaps pull along their branch vectors,
+            return None             # which the device's reduction does not read yet
         key = (self.sim.step, self.sim.time, volume)
         if self._homogenized[0] != key:
             self._homogenized = (key, device_homogenization(self, volume))

@@ -5,8 +5,16 @@ and out when the host asks (pendular.gpu.simulation).
 
 Per-pair arrays follow the device list's layout (pendular.gpu.neighbors: pair k = s * N + p);
 the bridges' per-pair state is one (K, BRIDGE_COLUMNS) float64 array whose columns are
-BridgeState's ``state``, ``volume``, ``force``, ``filling_i``, ``filling_j`` (the ``suction``
-field is 0 under suction control and is not kept on the device).
+BridgeState's fields (``state``, ``volume``, ``force``, ``filling_i``, ``filling_j``,
+``suction``: 0 under suction control). Bridges that persist across gaps (``persist``: suction
+control's option, volume control always) also keep their force on j from i,
+``bridge_pair_force`` (K, 3) [N], written for every pair each step (the CPU's
+CapillaryBridges.pair_force), and the list reaches ``reach`` [m] beyond touching besides the
+skin (their rupture range, the CPU's interaction_range). Volume control's liquid
+(pendular.capillary.bridge_kernels.LiquidExchange): ``film`` (N,) [m^3] on each grain, per
+pair ``released`` [m^3] and ``events`` (int8, cleared by each step's exchange: not carried
+across rebuilds, as the CPU's fresh arrays after one), ``marked`` (1,) the events of the step,
+``liquid_lost`` (1,) [m^3].
 """
 
 import math
@@ -21,7 +29,7 @@ from pendular.gpu.cuda import cuda
 from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS
 
 #: BridgeState fields kept on the device, in the columns of ``bridges``.
-BRIDGE_COLUMNS = ("state", "volume", "force", "filling_i", "filling_j")
+BRIDGE_COLUMNS = tuple(field.name for field in FIELDS)
 #: Room left in each row beyond the longest row of the first list (neighbours come and go).
 ROW_ROOM = 1.5
 #: Fewest slots of a row.
@@ -69,17 +77,22 @@ class DeviceState:
     ``wraps`` and the pairs' ``image``: pendular.gpu.cell). ``to_host`` writes them back into
     the Simulation."""
 
-    def __init__(self, sim, skin, wet):
+    def __init__(self, sim, skin, wet, reach=0.0, persist=False, film=None):
         p = sim.particles
         walls = sim.walls
         count = len(p)
         self.count = count
         self.skin = skin
         self.wet = wet
+        self.persist = persist
+        self.reach = reach
         self.periodic = walls.periodic
-        self.cell_size = 2.0 * float(p.radius.max()) + skin
-        self.width = row_width(p.position, p.radius, skin, sim.contacts,
-                               walls.position[1::2] if self.periodic else None)
+        self.cell_size = 2.0 * float(p.radius.max()) + skin + reach
+        period = walls.position[1::2] if self.periodic else None
+        self.width = row_width(p.position, p.radius, skin, sim.contacts, period)
+        if reach > 0.0:     # the bridges' reach may have grown since the host's list was built
+            self.width = max(self.width, row_width(p.position, p.radius, skin + reach,
+                                                   None, period))
         self.cell_width = cell_capacity(p.radius, self.cell_size)
         lengths = walls.lengths()
         max_dims = np.array([max(1, int(GRID_ROOM * length / self.cell_size))
@@ -116,9 +129,18 @@ class DeviceState:
         # pair_i when a bridge forms (pendular.gpu.forces.pair_forces); wet scenes only
         self.pair_i = to(np.tile(np.arange(count, dtype=np.int32), self.width) if wet
                          else np.zeros(1, np.int32))
-        # the periodic image and period the CPU's contact law takes, not read inside walls
-        self.no_image = to(np.zeros((1, 3), np.int8))
+        # the periodic image and period the CPU's contact law takes, not read inside walls;
+        # zeros for every pair where the persisting bridges' branch vectors read them
+        self.no_image = to(np.zeros((pairs if persist else 1, 3), np.int8))
         self.no_period = to(np.zeros(3))
+        self.bridge_pair_force = to(np.zeros((pairs if persist else 1, 3)))
+        # volume control's liquid (``film`` (N,) [m^3] given: module docstring)
+        liquid = film is not None
+        self.film = to(np.ascontiguousarray(film, dtype=np.float64) if liquid else np.zeros(1))
+        self.released = to(np.zeros(pairs if liquid else 1))
+        self.events = to(np.zeros(pairs if liquid else 1, np.int8))
+        self.marked = to(np.zeros(1, np.int64))
+        self.liquid_lost = to(np.zeros(1))
         self.normal_force = to(np.zeros(pairs))
         self.pair_force = to(np.zeros((pairs, 3)))
         self.second_count = to(np.zeros(count, np.int32))
@@ -169,7 +191,7 @@ class DeviceState:
         bridges = np.zeros((bridge_rows, len(BRIDGE_COLUMNS)))
         if self.wet and pair_key(OWNER, FIELDS[0]) in contacts.extra:
             columns = np.stack([contacts.extra[pair_key(OWNER, field)].astype(np.float64)
-                                for field in FIELDS if field.name in BRIDGE_COLUMNS], axis=1)
+                                for field in FIELDS], axis=1)
             bridges = _to_ell(columns, slots, count, width, 0.0)
         return {"pair_count": counts.astype(np.int32),
                 "pair_j": _to_ell(contacts.pair_j.astype(np.int32), slots, count, width, 0),
@@ -184,22 +206,31 @@ class DeviceState:
         """(rebuild asked, overflow bits, not-finite flag) read from the device (a sync)."""
         return tuple(int(value) for value in self.flags.copy_to_host())
 
-    def contacts(self):
-        """The device's neighbour list and per-pair state as a host Contacts (CSR order)."""
+    def _slots(self):
+        """(row_start, pair_i, slots): the device's list in CSR order, pair k of it in the
+        device's slot slots[k]."""
         count = self.count
         pair_count = self.pair_count.copy_to_host().astype(np.int64)
         row_start = np.concatenate([[0], np.cumsum(pair_count)]).astype(np.int64)
         pair_i = np.repeat(np.arange(count, dtype=np.int64), pair_count)
-        slots = (np.arange(row_start[-1]) - row_start[pair_i]) * count + pair_i
+        return row_start, pair_i, (np.arange(row_start[-1]) - row_start[pair_i]) * count + pair_i
+
+    def bridge_pair_forces(self):
+        """The persisting bridges' forces on j from i (K, 3) [N] of the device's list, in the
+        order of ``contacts()``."""
+        return self.bridge_pair_force.copy_to_host()[self._slots()[2]]
+
+    def contacts(self):
+        """The device's neighbour list and per-pair state as a host Contacts (CSR order)."""
+        count = self.count
+        row_start, pair_i, slots = self._slots()
         pair_j = self.pair_j.copy_to_host()[slots].astype(np.int64)
         second_start, second_pair = second_index(row_start, pair_j, count)
         extra = {}
         if self.wet:
             bridges = self.bridges.copy_to_host()[slots]
-            for field in FIELDS:
-                values = (bridges[:, BRIDGE_COLUMNS.index(field.name)]
-                          if field.name in BRIDGE_COLUMNS else np.zeros(len(slots)))
-                extra[pair_key(OWNER, field)] = values.astype(field.dtype)
+            for column, field in enumerate(FIELDS):
+                extra[pair_key(OWNER, field)] = bridges[:, column].astype(field.dtype)
         return Contacts(pair_i=pair_i, pair_j=pair_j, row_start=row_start,
                         second_start=second_start, second_pair=second_pair,
                         shear_force=self.shear_force.copy_to_host()[slots],

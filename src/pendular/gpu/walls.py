@@ -42,6 +42,12 @@ MIXED_STRESS = 2
 #: step's row does nothing on the device (the host sets dt at the rebuilds).
 RADIUS_GROWTH = 3
 GROWTH_TIMESTEP = 4
+#: A periodic cell's ConstantShearRate, its rate gamma_dot [1/s] in parameters[c, 0]
+#: (pendular.gpu.cell.cell_controls).
+SHEAR_RATE = 5
+#: A Grip's row: no wall control (wall_controls skips it); the grips' own launches hold their
+#: members after every wall control (pendular.gpu.grips).
+GRIP = 6
 #: parameters[c] of a servo, of a constant strain rate and of a mixed condition (NaN: a mean
 #: stress or b not held, an axis given no stress).
 SERVO_FIELDS = ("target", "gain", "memory", "max_velocity", "scale_max_velocity",
@@ -150,12 +156,19 @@ def wall_stress(axis, wall_force, wall_position):
 
 
 @device
-def given_stress(c, axis, parameters, wall_force, wall_position):
+def walls_stress(wall_force, wall_position):
+    """(sigma_x, sigma_y, sigma_z) [Pa] of the walls now (wall_stress; Walls.stress)."""
+    return (wall_stress(0, wall_force, wall_position), wall_stress(1, wall_force, wall_position),
+            wall_stress(2, wall_force, wall_position))
+
+
+@device
+def given_stress(c, axis, parameters, sigma):
     """The stress of ``axis`` [Pa] a mixed condition counts: the one given its servo, else
-    the walls' now (MixedStress.targets's ``given``)."""
+    the box's now, ``sigma`` (3 numbers) [Pa] (MixedStress.targets's ``given``)."""
     given = parameters[c, 2 + axis]
     if math.isnan(given):
-        return wall_stress(axis, wall_force, wall_position)
+        return sigma[axis]
     return given
 
 
@@ -178,14 +191,14 @@ def set_target(c, axis, target, control_walls, parameters, step, axial, failure)
 
 
 @device
-def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position, step,
-                 failure):
+def mixed_stress(c, control_walls, count, parameters, sigma, step, failure):
     """One call of MixedStress c (pendular.dem.mixed_stress.MixedStress.targets and apply:
-    the same operations in the same order), setting its servos' targets in its order; stops
-    at a target below zero."""
+    the same operations in the same order) for the box's stresses now ``sigma`` (3 numbers)
+    [Pa] (the walls', or a periodic cell's: pendular.gpu.cell), setting its servos' targets
+    in its order; stops at a target below zero."""
     mean = parameters[c, 0]
     b = parameters[c, 1]
-    axial = wall_stress(2, wall_force, wall_position)
+    axial = sigma[2]
     if math.isnan(b):
         others = 0.0
         for axis in range(3):
@@ -193,7 +206,7 @@ def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position,
             for slot in range(count):
                 free = free or control_walls[c, 3 + slot] == axis
             if not free:
-                others += given_stress(c, axis, parameters, wall_force, wall_position)
+                others += given_stress(c, axis, parameters, sigma)
         share = (3.0 * mean - others) / count
         for slot in range(count):
             if not set_target(c, control_walls[c, 3 + slot], share, control_walls, parameters,
@@ -201,7 +214,7 @@ def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position,
                 return
         return
     if math.isnan(mean):
-        minor = given_stress(c, 0, parameters, wall_force, wall_position)
+        minor = given_stress(c, 0, parameters, sigma)
         set_target(c, 1, minor + b * (axial - minor), control_walls, parameters, step, axial,
                    failure)
         return
@@ -212,12 +225,12 @@ def mixed_stress(c, control_walls, count, parameters, wall_force, wall_position,
 
 
 @device
-def growth_rate(c, parameters, wall_force, wall_position):
+def growth_rate(c, parameters, sigma):
     """The rate g of RadiusGrowth c this step into ``parameters[c, 2]``: max_rate clip(1 -
-    sigma_mean / target, -1, 1), sigma_mean the mean of the three axes' wall stresses
+    sigma_mean / target, -1, 1), sigma_mean the mean of the box's three stresses now
+    ``sigma`` [Pa] (the walls', or a periodic cell's: pendular.gpu.cell)
     (pendular.dem.growth.RadiusGrowth.apply, the CPU's mean summed in the same order)."""
-    mean = (wall_stress(0, wall_force, wall_position) + wall_stress(1, wall_force, wall_position)
-            + wall_stress(2, wall_force, wall_position)) / 3.0
+    mean = (sigma[0] + sigma[1] + sigma[2]) / 3.0
     parameters[c, 2] = parameters[c, 1] * min(max(1.0 - mean / parameters[c, 0], -1.0), 1.0)
 
 
@@ -257,10 +270,10 @@ def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts,
             strain_rate(c, control_walls, parameters, previous, wall_position,
                         wall_velocity, dt)
         elif kinds[c] == MIXED_STRESS:
-            mixed_stress(c, control_walls, wall_counts[c], parameters, wall_force,
-                         wall_position, step[0], failure)
+            mixed_stress(c, control_walls, wall_counts[c], parameters,
+                         walls_stress(wall_force, wall_position), step[0], failure)
         elif kinds[c] == RADIUS_GROWTH:
-            growth_rate(c, parameters, wall_force, wall_position)
+            growth_rate(c, parameters, walls_stress(wall_force, wall_position))
     step[0] += 1
     for w in range(6):
         if abs(wall_position[w] - reference_walls[w]) > limit:

@@ -6,7 +6,7 @@ column that is not, so a new column cannot be written without its units. Units a
 ``record`` (one row per record, always first), ``axis`` (x, y, z), ``component`` (x, y, z:
 the second index of a 3x3 tensor), ``grip`` (z-, z+: the grips of direct tension).
 
-Columns by test (pendular.procedures.triaxial.history_columns, pendular.procedures.tension):
+Columns by test (pendular.procedures.loading.history_columns, pendular.procedures.tension):
 
 - triaxial, dry: step, time, axial_strain, volumetric_strain, sigma_wall, sigma_contact,
   porosity, coordination, fabric, anisotropy, unbalanced_force;

@@ -26,6 +26,10 @@ chi (tr chi / 3, Eq. 3.44), pendular_overlaps (pairs of menisci merging on a gra
 pendular regime where many), ...}), swcc.png (Sr against log suction, both branches, with
 thesis Fig. 5.5's points and the regular packings' SWCCs of Chapter 4), history.h5 (the wet
 triaxial's columns, pendular.io.schema, recorded through the whole path) and sample.h5.
+
+``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
+(docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
+wetting across gaps and the rows of swcc.json are computed on the host between the stages.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from pendular.dem.measure import coordination, porosity
 from pendular.procedures.preparation import prepare_sample
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import save_sample
+from pendular.dem.simulation import device_start
 from pendular.dem.walls import ConstantStrainRate
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
@@ -52,8 +57,9 @@ from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import FIG_5_5
+from pendular.procedures.loading import history_columns
 from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, equilibrate,
-    equilibrium_status, history_columns, watched)
+    equilibrium_status, watched)
 
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
@@ -95,16 +101,20 @@ class SwccTest:
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
 
-    def run(self, out, *, progress=True, threads=None):
+    def run(self, out, *, progress=True, threads=None, device="cpu"):
+        """Run the path into ``out``; ``device``: where the preparation and the stages run,
+        "cpu" or "gpu" (``check_device``, before anything is made)."""
+        check_device(self.config, device)
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads)
+            return self._run(out, progress, threads, device)
 
-    def _run(self, out, progress, threads):
+    def _run(self, out, progress, threads, device):
         config = self.config
         started = time.perf_counter()
-        sim, preparation = prepare_sample(config.sample, progress=progress, threads=threads)
+        sim, preparation = prepare_sample(config.sample, progress=progress, threads=threads,
+                                          device=device)
         save_sample(os.path.join(out, "sample.h5"), sim, preparation,
                     {"config": config_to_dict(config)}, identity={"seed": config.sample.seed})
         dry_volume = sim.walls.volume()
@@ -119,6 +129,7 @@ class SwccTest:
                                    history_columns(sim, axial, dry_volume, bridges),
                                    origin=sim.step)
         homogenization = CapillaryHomogenization(bridges)
+        sim.device = device
         stages = {"drying": [], "wetting": []}
         suctions = list(config.suctions)
         path = [("drying", s) for s in suctions] + [("wetting", s) for s in suctions[::-1]]
@@ -188,6 +199,19 @@ class SwccTest:
                 "coordination": coordination(sim.contacts, len(sim.particles)),
                 "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
+
+
+def check_device(config: SwccConfig, device: str) -> None:
+    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the path of
+    ``config`` (bridges across gaps in a periodic cell do not run on the GPU yet,
+    docs/gpu.md) or cannot run here (no numba-cuda, no GPU): ValueError naming --device and
+    what is missing."""
+    label = f"--device {device}"
+    if device == "gpu" and config.sample.periodic:
+        raise ValueError(f"{label} does not run bridges across gaps in a periodic cell (a "
+                         "periodic sample's persisting bridges) yet: run this test on the CPU "
+                         "(--device cpu)")
+    device_start(device, label)
 
 
 def hysteresis(stages):

@@ -4,7 +4,9 @@
 ``pendular tension`` (pendular.cli.commands.tension; options named as the TensionConfig fields
 and those of its sample, a PrepareConfig, dashes for underscores; --specific-gravity sets the
 grains' density). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``, a sample
-by ``tension_sample(particles=200)``. By default Kim's six cases: F-75 sand, R = 0.11 mm,
+by ``tension_sample(particles=200)``; ``run(out, device="gpu")`` (--device) runs every phase
+on the GPU, or refuses before anything is made what the GPU does not run yet
+(``check_device``). By default Kim's six cases: F-75 sand, R = 0.11 mm,
 e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
 Gs = 2.65, the grains' density over the water's). Each case:
 
@@ -24,7 +26,7 @@ Gs = 2.65, the grains' density over the water's). Each case:
    get bridges too, so the suction is corrected until w is within 1 %. Walls servoed at
    --confining until static.
 3. Pull: the particles within --grip-depth diameters of each z wall (surface to wall) move
-   rigidly with it (pendular.procedures.grips.Grip), the two z walls move apart at a constant strain rate
+   rigidly with it (pendular.dem.grips.Grip), the two z walls move apart at a constant strain rate
    (from --inertial-number I = rate d sqrt(rho / confining)), the lateral walls stay where they
    are. The tensile stress is the mean force of the specimen on the two grips over the
    cross-section, positive in tension (the compression-positive axial stress's opposite);
@@ -61,12 +63,14 @@ from pendular.dem.measure import coordination, unbalanced_force
 from pendular.procedures.preparation import (PrepareConfig, equilibrated, prepare_sample,
     servo_speed)
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.simulation import Simulation
-from pendular.procedures.grips import Grip, core_void_ratio, grip_members, tensile_stress
+from pendular.dem.simulation import Simulation, device_start
+from pendular.dem.grips import Grip
+from pendular.procedures.grips import core_void_ratio, grip_members, tensile_stress
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize import packing_state, regular_packing
 
 from pendular.procedures.config import TensionConfig, case_name, config_to_dict, inertial_number
+from pendular.procedures.loading import measured
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -126,16 +130,19 @@ def sample_void_ratio(sim: Simulation, radius: float) -> float:
     return core_void_ratio(sim.particles, sim.walls, 2.0 * radius, radius / 8.0)
 
 
-def prepare_void_ratio(config: TensionConfig, target: float,
-                       progress: bool) -> tuple[Simulation, dict]:
+def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
+                       device: str = "cpu") -> tuple[Simulation, dict]:
     """(sim, preparation report) of the sample whose core void ratio is within tolerance of
     ``target``: regula falsi on the growth friction over PREP_FRICTION_RANGE; the closest
     preparation if none is within tolerance after PREPARATIONS tries. ValueError when the
-    target lies outside the void ratios of the range's two ends."""
+    target lies outside the void ratios of the range's two ends. The preparations run on
+    ``device`` ("cpu" or "gpu"), and so do the returned simulation's runs."""
     tried = {}
 
     def prepared(friction):
-        sim, report = prepare_sample(prepare_config(config, friction), progress=False)
+        sim, report = prepare_sample(prepare_config(config, friction), progress=False,
+                                     device=device)
+        sim.device = device
         report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
         report["box_void_ratio"] = report["porosity"] / (1.0 - report["porosity"])
         report["prep_friction_deg"] = friction
@@ -269,36 +276,56 @@ class Pull:
                 op.apply(sim)
         self.steps = int(math.ceil(config.max_strain / (self.rate * sim.dt)))
         period = max(1, self.steps // RECORDS)
+        count = len(sim.particles)
+        # the homogenised columns reduced on the device when a device run holds the state
+        # (loading.measured): a record then brings back the walls alone, with the grips' pulls
         columns = {
             "step": lambda s: s.step,
             "time": lambda s: s.time,
             "axial_strain": lambda s: self.extension.strain(s.walls),
             "tensile_stress": self.tensile_stress,
             "sigma_wall": lambda s: s.walls.stress(),
-            "coordination": lambda s: coordination(s.contacts, len(s.particles)),
-            "unbalanced_force": lambda s: unbalanced_force(s.particles, s.contacts),
+            "coordination": measured("coordination",
+                                     lambda s: coordination(s.contacts, count)),
+            "unbalanced_force": measured("unbalanced_force",
+                                         lambda s: unbalanced_force(s.particles, s.contacts)),
         }
         if self.grips:
-            columns["grip_pull"] = lambda s: [grip.pull for grip in self.grips]
+            columns["grip_pull"] = self.pulls
         if bridges is not None:
             solid = sim.particles.solid_volume()
+            water_volume = measured("water_volume", lambda s: bridges.water_volume(s.contacts))
+
+            def saturation(s):
+                device = s.homogenized()
+                if device is None:
+                    return bridges.saturation(s)
+                return device["water_volume"] / (s.walls.volume() - solid)
+
             columns.update({
-                "bridges": bridges.count,
+                "bridges": measured("bridges", bridges.count),
                 "water_content": lambda s: gravimetric_water_content(
-                    bridges.water_volume(s.contacts), solid, config.specific_gravity),
-                "saturation": bridges.saturation})
+                    water_volume(s), solid, config.specific_gravity),
+                "saturation": saturation})
         self.recorder = HistoryRecorder(period, columns, origin=sim.step)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
                                                            self.steps))
 
+    def pulls(self, sim: Simulation) -> list[float]:
+        """The grips' pulls [N] (z-, z+) of ``sim``'s state."""
+        sim.walls           # on a device the pulls come back with the walls (dem.grips.Grip)
+        return [grip.pull for grip in self.grips]
+
     def tensile_stress(self, sim: Simulation) -> float:
         """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
-        the cross-section (pendular.procedures.grips.tensile_stress), or minus a periodic cell's z stress."""
-        if sim.walls.periodic:
-            return -float(sim.walls.stress()[2])
-        return tensile_stress(self.grips, sim.walls)
+        the cross-section (pendular.procedures.grips.tensile_stress), or minus a periodic cell's
+        z stress."""
+        walls = sim.walls              # on a device, the grips' pulls come back with the walls
+        if walls.periodic:
+            return -float(walls.stress()[2])
+        return tensile_stress(self.grips, walls)
 
     def ruptured(self, sim: Simulation) -> bool:
         """The stress has stayed below the residual fraction of its positive peak for
@@ -516,6 +543,19 @@ def write_report(summaries: list[dict], config: TensionConfig, path: str) -> lis
     return lines
 
 
+def check_device(config: TensionConfig, device: str) -> None:
+    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the phases
+    of ``config`` (what the GPU path does not run yet, docs/gpu.md: each phase runs where the
+    test runs, never part of it elsewhere) or cannot run here (no numba-cuda, no GPU):
+    ValueError naming --device and what is missing."""
+    label = f"--device {device}"
+    if device == "gpu" and config.sample.periodic:
+        raise ValueError(f"{label} does not run bridges across gaps in a periodic cell "
+                         "(--periodic: the wetting's volume-controlled bridges) yet: run this "
+                         "test on the CPU (--device cpu)")
+    device_start(device, label)
+
+
 class TensionTest:
     """The direct-tension cases of ``config`` (TensionConfig): one sample per void ratio, each
     water content wetted and pulled from a copy of it (module docstring)."""
@@ -525,25 +565,30 @@ class TensionTest:
             raise TypeError(f"config must be a TensionConfig, got {type(config).__name__}")
         self.config = config
 
-    def run(self, out: str, *, progress: bool = True, arguments: dict | None = None) -> dict:
+    def run(self, out: str, *, progress: bool = True, arguments: dict | None = None,
+            device: str = "cpu") -> dict:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
         the tension.json content. ``arguments``: what tension.json records under 'arguments'
         and the histories as attributes (the command: its options; default: the
-        configuration's, TensionConfig.options); the configuration itself is under 'config'."""
+        configuration's, TensionConfig.options); the configuration itself is under 'config'.
+        ``device``: where the preparations, wettings and pulls run, "cpu" or "gpu"
+        (``check_device``, before anything is made); a run option, not part of the
+        configuration."""
+        check_device(self.config, device)
         with OutputFolder(out, "tension") as folder:
             for name in ("tension.json", "report.md", "plots", "cases"):
                 folder.claim(name)
             return self._run(out, progress, self.config.options() if arguments is None
-                             else dict(arguments))
+                             else dict(arguments), device)
 
-    def _run(self, out, progress, arguments):
+    def _run(self, out, progress, arguments, device):
         config = self.config
         started = time.perf_counter()
         summaries, histories, samples = [], {}, {}
         for void_ratio in dict.fromkeys(e for e, _ in config.cases):
             if progress:
                 print(f"sample e = {void_ratio}: tuning the growth friction", flush=True)
-            dry, preparation = prepare_void_ratio(config, void_ratio, progress)
+            dry, preparation = prepare_void_ratio(config, void_ratio, progress, device)
             samples[void_ratio] = preparation
             for e, water_content in config.cases:
                 if e != void_ratio:

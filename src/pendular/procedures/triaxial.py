@@ -55,8 +55,6 @@ from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, Oedom
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
     friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
     oedometer_summary, path_deviations, shear_stage, void_ratio)
-# the triaxial's building blocks, named here as before (pendular.procedures.swcc reads them)
-from pendular.procedures.loading import capillary_operation, history_columns  # noqa: F401
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
@@ -169,7 +167,10 @@ def wet_sample(sim, config, *, progress=None):
     At a water content (config.bridges.water_content) the bridges are volume-controlled, their
     formation suction found so that they hold w Gs V_s (Gs = density / 1000 kg/m^3;
     pendular.procedures.water_content), the sample re-equilibrated; the liquid is then closed
-    (CapillaryBridges.close_liquid), so the shear conserves it."""
+    (CapillaryBridges.close_liquid), so the shear conserves it.
+
+    The equilibria run on ``sim``'s device (Simulation.device; the wettings at a water content
+    from copies of ``sim``, which keep it); the bridges of 'at-shear' form on the host."""
     sample = config.sample
     thresholds = {"unbalanced": sample.equilibrium_unbalanced,
                   "tolerance": sample.stress_tolerance, "max_steps": config.wet_steps}
@@ -446,16 +447,11 @@ def check_device(config, device):
     label = f"--device {device}"
     if device == "gpu":
         bridges = config.bridges
-        missing = [what for what, used in (
-            ("a periodic cell's preparation (--periodic without --sample)",
-             config.sample.periodic and config.sample_path is None),
-            ("volume-controlled bridges (--water-content)",
-             bridges is not None and bridges.control == "volume"),
-            ("bridges across gaps (--persist-bridges)", bridges is not None and bridges.persist))
-                   if used]
-        if missing:
-            raise ValueError(f"{label} does not run {' nor '.join(missing)} yet: run this test "
-                             "on the CPU (--device cpu)")
+        if config.sample.periodic and bridges is not None and (
+                bridges.persist or bridges.control == "volume"):
+            raise ValueError(f"{label} does not run bridges across gaps in a periodic cell "
+                             "(--persist-bridges or --water-content with --periodic) yet: run "
+                             "this test on the CPU (--device cpu)")
     device_start(device, label)
 
 
@@ -531,20 +527,24 @@ class LaboratoryTest:
     def start(self, progress=True, threads=None, writers=(), device="cpu"):
         """(static sample at the confining stress, preparation report, the host holding it);
         ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
-        vtk_prep VtkWriter); ``device``: where a preparation runs (a loaded sample's
-        equilibrium runs on the CPU, as the wetting after it)."""
+        vtk_prep VtkWriter); ``device``: where the preparation or the loaded sample's
+        equilibrium runs, and the returned simulation's runs (the wetting after it)."""
         config = self.config
-        if config.sample_path is None:
-            return prepare_sample(config.sample, progress=progress, threads=threads,
-                                  writers=writers, device=device)
-        return self.load_sample(config.sample_path, progress, threads, writers)
+        if config.sample_path is not None:
+            return self.load_sample(config.sample_path, progress, threads, writers, device)
+        sim, report = prepare_sample(config.sample, progress=progress, threads=threads,
+                                     writers=writers, device=device)
+        sim.device = device
+        return sim, report
 
-    def load_sample(self, path, progress=True, threads=None, writers=()):
-        """(sample saved at ``path`` servoed at the confining stress and run until static,
-        its report); ``writers`` watch the equilibrium (phase "sample")."""
+    def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
+        """(sample saved at ``path`` servoed at the confining stress and run until static on
+        ``device``, its report; the simulation's runs go on there); ``writers`` watch the
+        equilibrium (phase "sample")."""
         sample = self.config.sample
         particles, walls, report, _ = load_sample(path, expected=sample)
         sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
+        sim.device = device
         started = time.perf_counter()
         with watched(sim, writers, "sample"):
             steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
@@ -571,8 +571,9 @@ class LaboratoryTest:
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same.
-        ``device``: where the preparation and the loading run, "cpu" or "gpu" (``check_device``;
-        the wetting runs on the CPU); a run option, not part of the configuration."""
+        ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
+        the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
+        the configuration."""
         check_device(self.config, device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
@@ -603,7 +604,7 @@ class LaboratoryTest:
         writers = () if frames is None else (frames,)
         folder.phase = "prepare"
         pause_point(folder.phase)
-        sim, preparation = self.start(progress, threads, writers, device)
+        sim, preparation = self.start(progress, threads, writers, device)   # runs on device
         prepared = time.perf_counter()
         wetting = {}
         if config.bridges is not None:
@@ -621,7 +622,6 @@ class LaboratoryTest:
         sample_file = os.path.join(out, "sample.h5")
         save_sample(sample_file, sim, preparation, before_shear,
                     identity={"seed": config.sample.seed})
-        sim.device = device
         run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)

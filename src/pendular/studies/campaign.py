@@ -75,7 +75,7 @@ from pendular.utils.validate import check_int
 from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
                                         same_config, sample_made_with, stored_config)
 from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.tension import TensionTest
+from pendular.procedures.tension import TensionTest, check_device as check_tension_device
 from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device, parameters
 from pendular.utils.parameters import Option
 
@@ -159,7 +159,7 @@ def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = Fals
             if isinstance(config, TriaxialConfig):
                 return TriaxialTest(config, force=force).run(folder, threads=threads,
                                                               device=device)
-            return tension_summary(TensionTest(config).run(folder))
+            return tension_summary(TensionTest(config).run(folder, device=device))
         except BaseException:
             traceback.print_exc()
             raise
@@ -418,9 +418,8 @@ class Campaign:
                 if isinstance(run.config, TriaxialConfig):
                     TriaxialTest(run.config, force=run.force)
                     check_device(run.config, device)
-                elif device != "cpu":
-                    raise ValueError(f"--device {device} does not run the tension test yet: "
-                                     "run it on the CPU (--device cpu)")
+                else:
+                    check_tension_device(run.config, device)
             except ValueError as error:
                 raise RunRefused(f"run {run.name}: {error}") from None
         preparations = [(sample, path) for sample, path in self.samples

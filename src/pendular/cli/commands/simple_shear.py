@@ -11,6 +11,8 @@ angles, the dilatancy, or at constant volume the volume change), simple_shear.pn
 sigma_n and the volumetric strain against gamma), vtk/, sample.h5, with --checkpoint-every
 checkpoint.h5; --resume DIR continues an interrupted run. The sample, wetting and output
 options are those of ``pendular triaxial``. Stresses compression positive [Pa].
+
+--device gpu prepares and shears on the GPU (docs/gpu.md, "The periodic cell on the GPU").
 """
 
 from __future__ import annotations

@@ -7,15 +7,16 @@ Bridges persist across gaps up to their rupture distance and form again only at 
 the branches differ where bridges across gaps broke (pendular.procedures.swcc). Writes into --out:
 swcc.json (drying and wetting rows: suction, saturation, bridges, porosity, volumetric strain,
 chi), swcc.png (Sr against log suction with thesis Fig. 5.5 and the Chapter 4 packings),
-history.h5 and sample.h5.
+history.h5 and sample.h5. --device gpu runs the preparation and the path on the GPU
+(docs/gpu.md).
 """
 
 from __future__ import annotations
 
 import sys
 
-from pendular.cli import (add_command_options, add_run_options, command_config,
-    print_summary, set_threads)
+from pendular.cli import (add_command_options, add_device_option, add_run_options,
+    command_config, print_summary, set_threads)
 from pendular.procedures.swcc import SwccTest
 
 #: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
@@ -26,6 +27,8 @@ def add_arguments(parser):
     add_command_options(parser, "swcc")
     parser.add_argument("--out", default="runs/swcc", help="output folder")
     add_run_options(parser)
+    add_device_option(parser, "the preparation and the path (the wetting across gaps stays on "
+                              "the CPU)")
 
 
 def config_from(args):
@@ -36,7 +39,7 @@ def config_from(args):
 def run(args):
     set_threads(args.threads)
     result = SwccTest(config_from(args)).run(args.out, progress=not args.quiet,
-                                            threads=args.threads)
+                                            threads=args.threads, device=args.device)
     if args.quiet:
         print(f"{'branch':<8} {'suction [Pa]':>12} {'Sr [%]':>8} {'bridges':>8} "
               f"{'porosity':>9} {'eps_v':>9} {'chi':>8}")

@@ -4,17 +4,19 @@ Without --void-ratio / --water-content it runs Kim's six cases (F-75 sand, R = 0
 e = 0.72 and 0.58, three water contents each): a sample per void ratio (core void ratio reached
 by tuning the growth friction), wetted with volume-controlled bridges to the gravimetric water
 content, pulled apart by grips at its z walls. Writes tension.json, report.md, plots/ and
-cases/<case>/history.h5 and vtk/ (pendular.procedures.tension).
+cases/<case>/history.h5 and vtk/ (pendular.procedures.tension). --device gpu runs the
+preparations, wettings and pulls on the GPU, or refuses in one line, before anything is made,
+what the GPU does not run yet (docs/gpu.md).
 """
 
 from __future__ import annotations
 
 import argparse
 
-from pendular.cli import (add_command_options, add_run_options, command_config,
-    print_summary, set_threads)
+from pendular.cli import (add_command_options, add_device_option, add_run_options,
+    command_config, print_summary, set_threads)
 from pendular.procedures.config import TensionConfig
-from pendular.procedures.tension import TensionTest, report_lines
+from pendular.procedures.tension import TensionTest, check_device, report_lines
 
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
@@ -25,6 +27,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_command_options(parser, "tension")
     parser.add_argument("--out", default="runs/direct_tension", help="output folder")
     add_run_options(parser, threads_default=1)
+    add_device_option(parser, "the preparations, the wettings and the pulls")
 
 
 def config_from(args: argparse.Namespace) -> TensionConfig:
@@ -35,7 +38,9 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
 def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
     config = config_from(args)
-    output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args))
+    check_device(config, args.device)           # before anything is made
+    output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args),
+                                     device=args.device)
     if args.quiet:
         print("\n".join(report_lines(output["cases"], config)))
     else:

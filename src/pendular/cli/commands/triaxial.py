@@ -64,8 +64,8 @@ def add_output_options(parser, out):
     parser.add_argument("--force", action="store_true",
                         help="run settings refused as not quasi-static or too long (experts)")
     add_run_options(parser)
-    add_device_option(parser, "the preparation and the loading (the wetting stays on the CPU; "
-                              "a checkpoint resumes on either device)")
+    add_device_option(parser, "the preparation or a loaded sample's equilibrium, the wetting "
+                              "and the loading (a checkpoint resumes on either device)")
     parser.add_argument("--vtk-prep", metavar="N", nargs="?", const=True, default=False,
                         type=positive_int("--vtk-prep", low=1),
                         help="also write ParaView frames of the preparation and wetting into "

@@ -1,0 +1,150 @@
+"""``pendular tension --device gpu`` (pendular.procedures.tension on the GPU path): the
+wetting to a water content (volume-controlled bridges at contacts and across gaps, the
+formation suction found on the host) and the pull (two grips, the z walls apart at the strain
+rate of the inertial number, the history the test records) run on the device and record the
+CPU's results; what the GPU does not run yet (bridges across gaps in a periodic cell) is
+refused by name in one ``error:`` line before anything is made.
+
+Checked under Numba's CUDA simulator in a process of its own (this file run as a script, as
+tests/gpu/simulated.py is), from tests/gpu/simulated.py's 27 spheres (dry, slightly
+overlapping, servoed at 10 kPa) standing for a prepared sample (a whole preparation is out of
+the simulator's reach): ``wet`` at w = 1 % (WET_STEPS steps of settling), then ``Pull`` (one
+grip layer at each z wall, 1 % of extension, a record every step).
+
+Measured (simulator): the wetting takes one try on both (200 steps, 54 bridges, 27 of them
+across gaps), its formation suction (303 Pa), water content and saturation equal the CPU's,
+the positions after it within 3.1e-15; the pull (334 steps) records the CPU's rows, bridge and
+contact counts, the tensile stress within 2.7e-13 of its largest value, the grips' pulls
+4.2e-13, the wall stresses 2.0e-13, the unbalanced force (a residual ratio) 4.8e-12, the water
+content and saturation exactly. TOLERANCE and UNBALANCED_TOLERANCE hold them with a margin of
+about 20. Each record brings back the walls with the pulls; the contacts' columns bring back
+the rest while the device's homogenisation does not reduce bridges across gaps
+(GpuSimulation.homogenized).
+"""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from simulator import simulated
+
+try:
+    import numba_cuda  # noqa: F401
+    HAVE_NUMBA_CUDA = True
+except ImportError:
+    HAVE_NUMBA_CUDA = False
+needs_numba_cuda = pytest.mark.skipif(not HAVE_NUMBA_CUDA, reason="numba-cuda is not "
+                                      "installed (pip install -e '.[gpu]')")
+
+#: Largest difference of a history column from the CPU's over its largest magnitude [-].
+TOLERANCE = 1e-11
+#: The same for the unbalanced force, a ratio of a residual to the mean force [-].
+UNBALANCED_TOLERANCE = 1e-10
+#: Steps of the wetting's settling (the tension's WET_STEPS, a bound on its run).
+WET_STEPS = 200
+
+
+def test_a_periodic_tension_is_refused_before_any_work(tmp_path, capsys):
+    from conftest import refused, run_in_process
+
+    out = tmp_path / "out"
+    status, err = run_in_process("tension", ["--device", "gpu", "--particles", "100",
+                                             "--periodic", "--out", out], capsys)
+    refused(status, err, "--device gpu", "does not run", "bridges across gaps in a periodic "
+            "cell", "(--periodic")
+    assert not out.exists()
+
+
+@pytest.fixture(scope="module")
+def tension():
+    return simulated(os.path.basename(__file__))
+
+
+@needs_numba_cuda
+def test_the_wetting_on_the_gpu_holds_the_cpus_water(tension):
+    cpu, gpu = tension["wetting"]["cpu"], tension["wetting"]["gpu"]
+    assert cpu["tries"] == gpu["tries"] == 1
+    assert cpu["bridges"] == gpu["bridges"] > 27        # across gaps too
+    for name in ("formation_suction_pa", "water_content", "saturation"):
+        assert gpu[name] == pytest.approx(cpu[name], rel=1e-12, abs=0.0), name
+    assert tension["wetting"]["position"] < 1e-13
+
+
+@needs_numba_cuda
+def test_the_pull_on_the_gpu_records_the_cpu_history(tension):
+    pull = tension["pull"]
+    assert pull["rows"][0] == pull["rows"][1] == pull["steps"] + 1
+    assert pull["equal"] == ["step", "bridges", "coordination"]
+    for name, difference in pull["differences"].items():
+        bound = UNBALANCED_TOLERANCE if name == "unbalanced_force" else TOLERANCE
+        assert difference <= bound, (name, difference)
+    assert pull["members"] == [9, 9]
+
+
+@needs_numba_cuda
+def test_a_record_of_the_pull_brings_back_the_walls_with_the_pulls(tension):
+    """Each record reads the walls first (the pulls come with them); the contacts' columns
+    bring back the rest at most once a record (module docstring), and the run's end once."""
+    copies, steps = tension["pull"]["copies"], tension["pull"]["steps"]
+    assert copies.count("walls") == steps and copies.count("all") <= steps + 1
+    assert copies[0] == "walls" and copies[-1] == "all"
+
+
+# ---------------------------------------------------------------- the script, in the simulator
+
+def wetted_and_pulled(device, folder):
+    """(wetting report, wetted positions, pull steps, history, Pull) of the tension's phases
+    (module docstring) on ``device``; the copies back of the pull (counted_copies)."""
+    from dataclasses import replace
+
+    from pendular.dem.walls import StressServo
+    from pendular.procedures import tension
+    from pendular.procedures.config import TensionConfig, tension_sample
+    from simulated import RADIUS, scene
+    from simulator import counted_copies
+
+    tension.WET_STEPS = WET_STEPS
+    dry = scene(side=3)
+    dry.writers.clear()
+    dry.controls = [StressServo("xyz", 1e4, 0.01)]
+    dry.evaluate_forces()           # the contacts of the state the wetting starts from
+    dry.device = device
+    sample = replace(tension_sample(), radius=RADIUS, density=2650.0, confining=1e4)
+    config = TensionConfig(sample=sample, cases=[(0.7, 0.01)], inertial_number=1e-2,
+                           max_strain=0.01, grip_depth=0.1, vtk_frames=0)
+    sim, bridges, report = tension.wet(dry, config, 0.01, progress=False)
+    position = sim.particles.position.copy()
+    with counted_copies() as copies:
+        pull = tension.Pull(sim, bridges, config, folder, progress=False)
+        steps, history = pull.run(None)
+    return report, position, steps, history, pull, copies
+
+
+def main():
+    import tempfile
+
+    from simulator import relative
+
+    with tempfile.TemporaryDirectory() as folder:
+        cpu_report, cpu_position, steps, cpu, _, _ = wetted_and_pulled("cpu", folder)
+        gpu_report, gpu_position, _, gpu, pull, copies = wetted_and_pulled("gpu", folder)
+    wetting = {"position": relative(cpu_position, gpu_position)}
+    for name, report in (("cpu", cpu_report), ("gpu", gpu_report)):
+        wetting[name] = {"tries": len(report["wetting_attempts"]),
+                         **{key: report[key] for key in ("formation_suction_pa",
+                                                         "water_content", "saturation",
+                                                         "bridges")}}
+    counts = ("step", "bridges", "coordination")
+    print(json.dumps({"wetting": wetting, "pull": {
+        "steps": steps, "rows": [len(cpu["step"]), len(gpu["step"])],
+        "equal": [name for name in counts if np.array_equal(cpu[name], gpu[name])],
+        "differences": {name: relative(cpu[name], gpu[name]) for name in cpu
+                        if name not in counts},
+        "copies": copies, "members": [len(grip.members) for grip in pull.grips]}},
+        default=float))
+
+
+if __name__ == "__main__":
+    main()
