@@ -171,13 +171,14 @@ def growth_run():
     }
 
 
-def prepare_run(max_steps=60):
-    """A 20-sphere preparation cut short at ``max_steps`` on each device: its message, and the
-    steps the device's growth took."""
+def prepare_run(particles=20, periodic=False, max_steps=60):
+    """A preparation of ``particles`` spheres (in a periodic cell with ``periodic``) cut short
+    at ``max_steps`` on each device (prepare_sample): its message, and the steps the device's
+    growth took."""
     from pendular.gpu.growth import DeviceGrowth
     from pendular.procedures.preparation import PrepareConfig, prepare_sample
 
-    config = PrepareConfig(particles=20, seed=1)
+    config = PrepareConfig(particles=particles, seed=1, periodic=periodic)
     messages = {}
     device_steps = []
     advance = DeviceGrowth.advance
@@ -187,12 +188,14 @@ def prepare_run(max_steps=60):
         advance(self, gpu, launches)
 
     DeviceGrowth.advance = counted
-    for device in ("cpu", "gpu"):
-        try:
-            prepare_sample(config, progress=False, max_steps=max_steps, device=device)
-        except ValueError as error:
-            messages[device] = str(error)
-    DeviceGrowth.advance = advance
+    try:
+        for device in ("cpu", "gpu"):
+            try:
+                prepare_sample(config, progress=False, max_steps=max_steps, device=device)
+            except ValueError as error:
+                messages[device] = str(error)
+    finally:
+        DeviceGrowth.advance = advance
     return {**messages, "max_steps": max_steps, "device_steps": len(device_steps)}
 
 

@@ -75,7 +75,8 @@ def scene(seed=4):
 
 def snapshot(sim, bridges):
     """The state a comparison reads: particles, walls, and per pair (i, j) of the list the
-    bridges' state, volume, force, filling angles and force on j from i."""
+    bridges' state, volume, force, filling angles, suction (0 under suction control) and force
+    on j from i."""
     from pendular.capillary.bridge_state import BridgeState
 
     c = sim.contacts
@@ -92,7 +93,7 @@ def snapshot(sim, bridges):
             "pairs": keys, "state": state.state[rows].astype(int).tolist(),
             "volume": state.volume[rows], "bridge_force": state.force[rows],
             "filling": np.stack([state.filling_i[rows], state.filling_j[rows]], axis=1),
-            "pair_force": pair_force[rows]}
+            "suction": state.suction[rows], "pair_force": pair_force[rows]}
 
 
 def compare(cpu, gpu):
@@ -104,7 +105,8 @@ def compare(cpu, gpu):
     for name in cpu:
         if name not in ("pairs", "state"):
             out[name] = (relative(cpu[name], gpu[name]) if same or name not in
-                         ("volume", "bridge_force", "filling", "pair_force") else None)
+                         ("volume", "bridge_force", "filling", "suction", "pair_force")
+                         else None)
     return out
 
 

@@ -50,6 +50,7 @@ import numpy as np
 import pytest
 
 from simulator import histories_on_both, relative, simulated
+from test_gpu_growth import prepare_run
 from test_gpu_periodic import (RADIUS, SIDE, agreement as periodic_agreement, compare,
     scene as periodic_scene, snapshot)
 
@@ -299,35 +300,8 @@ def growth_agreement():
     out["dt_change"] = abs(cpu.dt / start_dt - 1.0)
     out["peak_stress"] = peak
     out["wrapped"] = int(np.count_nonzero(sim.walls.wraps))
-    out["prepare"] = periodic_preparation()
+    out["prepare"] = prepare_run(particles=60, periodic=True)
     return out
-
-
-def periodic_preparation(max_steps=60):
-    """A 60-sphere preparation in a periodic cell cut short at ``max_steps`` on each device
-    (prepare_sample): its message, and the steps the device's growth took."""
-    from pendular.gpu.growth import DeviceGrowth
-    from pendular.procedures.preparation import PrepareConfig, prepare_sample
-
-    config = PrepareConfig(particles=60, seed=1, periodic=True)
-    messages = {}
-    device_steps = []
-    advance = DeviceGrowth.advance
-
-    def counted(self, gpu, launches):
-        device_steps.append(gpu.sim.step)
-        advance(self, gpu, launches)
-
-    DeviceGrowth.advance = counted
-    try:
-        for device in ("cpu", "gpu"):
-            try:
-                prepare_sample(config, progress=False, max_steps=max_steps, device=device)
-            except ValueError as error:
-                messages[device] = str(error)
-    finally:
-        DeviceGrowth.advance = advance
-    return {**messages, "max_steps": max_steps, "device_steps": len(device_steps)}
 
 
 @pytest.fixture(scope="module")

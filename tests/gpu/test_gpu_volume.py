@@ -32,7 +32,7 @@ import numpy as np
 import pytest
 
 from simulator import histories_on_both, relative, simulated
-from test_gpu_persist import scene as persist_scene
+from test_gpu_persist import scene as persist_scene, snapshot as persist_snapshot
 
 #: Steps with the reservoir, then with the closed liquid.
 OPEN_STEPS = 100
@@ -53,26 +53,11 @@ def scene():
 
 
 def snapshot(sim, bridges):
-    """The state a comparison reads: particles, walls, per pair (i, j) holding a bridge its
-    state, volume, force, suction and force on j from i, and the liquid's account."""
-    from pendular.capillary.bridge_state import BridgeState
-
-    c = sim.contacts
-    state = BridgeState.of(c)
-    pair_force = bridges.pair_forces(sim)
-    held = state.state != 0
-    pairs = {(int(i), int(j)): k for k, (i, j) in enumerate(zip(c.pair_i, c.pair_j))
-             if held[k]}
-    keys = sorted(pairs)
-    rows = [pairs[key] for key in keys]
+    """test_gpu_persist.py's snapshot (particles, walls, each bridge per pair (i, j)) and the
+    liquid's account."""
     in_bridges, film, lost, error = bridges.liquid_balance(sim)
-    return {"position": sim.particles.position.copy(),
-            "velocity": sim.particles.velocity.copy(), "stress": sim.walls.stress(),
-            "pairs": keys, "state": state.state[rows].astype(int).tolist(),
-            "volume": state.volume[rows], "bridge_force": state.force[rows],
-            "suction": state.suction[rows], "pair_force": pair_force[rows],
-            "film": bridges.film.copy(), "liquid": [in_bridges, film, lost],
-            "balance_error": error}
+    return {**persist_snapshot(sim, bridges), "film": bridges.film.copy(),
+            "liquid": [in_bridges, film, lost], "balance_error": error}
 
 
 def compare(cpu, gpu):
