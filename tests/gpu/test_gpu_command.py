@@ -1,8 +1,8 @@
 """``--device gpu`` on the commands (issue 38's done-means): a wet triaxial on the GPU path
 (the loaded sample's equilibrium, the wetting and the loading), under Numba's CUDA simulator
 in a process of its own, records the history of the same command on the CPU; a checkpoint
-written on either device resumes on the other; what the GPU path does not run yet is refused
-in one line before any work.
+written on either device resumes on the other; a GPU run where no GPU can run is refused in
+one line before any work.
 
 The run: a 60-sphere sample prepared on the CPU (``pendular triaxial --particles 60``, its
 sample.h5), then ``pendular triaxial --sample S --particles 60 --suction 30000 --max-strain
@@ -167,20 +167,6 @@ def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
     again = history(copy)
     assert np.array_equal(again["step"], steps)
     assert_agrees(history(runs / "cpu"), again, sensitivity(runs))
-
-
-@pytest.mark.parametrize("options, words", [
-    (["--suction", "30000", "--persist-bridges", "--periodic", "--sample", "S.h5"],
-     ["bridges across gaps in a periodic cell"]),
-    (["--water-content", "5", "--periodic", "--sample", "S.h5"],
-     ["bridges across gaps in a periodic cell"])])
-def test_what_the_gpu_does_not_run_is_refused_before_any_work(tmp_path, capsys, options,
-                                                             words):
-    out = tmp_path / "out"
-    status, err = run_in_process("triaxial", ["--device", "gpu", "--particles", "60",
-                                              "--out", out, *options], capsys)
-    refused(status, err, "--device gpu", "does not run", *words)
-    assert not out.exists()
 
 
 def test_a_gpu_run_without_a_gpu_says_how_to_get_one(tmp_path, capsys):

@@ -228,37 +228,16 @@ def test_the_triaxial_command_with_persisting_bridges_records_the_cpu_history(tm
         assert difference <= (2e-6 if name == "unbalanced_force" else 2e-8), (name, difference)
 
 
-def test_the_swcc_takes_the_device_and_refuses_a_periodic_sample(capsys):
+def test_the_swcc_takes_the_device(capsys):
     """``pendular swcc --device gpu`` runs the path on the device (its stages: the tests
-    above); a periodic sample (SwccConfig's sample), whose persisting bridges the device does
-    not run in a cell yet, is refused by name before anything is made."""
+    above; in a periodic cell, tests/gpu/test_gpu_persist_cell.py)."""
     from pendular.cli import run_command
-    from pendular.procedures.config import PrepareConfig, SwccConfig
-    from pendular.procedures.swcc import SwccTest
 
     try:
         run_command("swcc", ["--help"])
     except SystemExit:
         pass
     assert "--device {cpu,gpu}" in capsys.readouterr().out
-    config = SwccConfig(sample=PrepareConfig(periodic=True))
-    with pytest.raises(ValueError, match="--device gpu does not run bridges across gaps in "
-                                         "a periodic cell"):
-        SwccTest(config).run("never_made", device="gpu")
-    assert not os.path.exists("never_made")
-
-
-def test_persisting_bridges_are_refused_in_a_periodic_cell():
-    pytest.importorskip("numba_cuda")
-    from test_gpu_periodic import scene as periodic_scene
-
-    from pendular.capillary.bridges import CapillaryBridges
-    from pendular.gpu.simulation import check_scene
-
-    sim = periodic_scene()
-    sim.forces.append(CapillaryBridges(30000.0, persist=True))
-    with pytest.raises(ValueError, match="bridges across gaps"):
-        check_scene(sim)
 
 
 if __name__ == "__main__":

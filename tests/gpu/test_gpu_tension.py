@@ -2,8 +2,7 @@
 wetting to a water content (volume-controlled bridges at contacts and across gaps, the
 formation suction found on the host) and the pull (two grips, the z walls apart at the strain
 rate of the inertial number, the history the test records) run on the device and record the
-CPU's results; what the GPU does not run yet (bridges across gaps in a periodic cell) is
-refused by name in one ``error:`` line before anything is made.
+CPU's results (in a periodic cell: tests/gpu/test_gpu_persist_cell.py).
 
 Checked under Numba's CUDA simulator in a process of its own (this file run as a script, as
 tests/gpu/simulated.py is), from tests/gpu/simulated.py's 27 spheres (dry, slightly
@@ -44,17 +43,6 @@ TOLERANCE = 1e-11
 UNBALANCED_TOLERANCE = 1e-10
 #: Steps of the wetting's settling (the tension's WET_STEPS, a bound on its run).
 WET_STEPS = 200
-
-
-def test_a_periodic_tension_is_refused_before_any_work(tmp_path, capsys):
-    from conftest import refused, run_in_process
-
-    out = tmp_path / "out"
-    status, err = run_in_process("tension", ["--device", "gpu", "--particles", "100",
-                                             "--periodic", "--out", out], capsys)
-    refused(status, err, "--device gpu", "does not run", "bridges across gaps in a periodic "
-            "cell", "(--periodic")
-    assert not out.exists()
 
 
 @pytest.fixture(scope="module")

@@ -135,14 +135,14 @@ def add_executor_options(parser):
 def start_executor_run(args):
     """Check the options of add_executor_options and --out before anything is made (errors
     naming the option; --device: that it can run here), and apply --threads."""
-    from pendular.dem.simulation import device_start
+    from pendular.dem.simulation import check_device
     from pendular.studies.campaign import check_jobs
 
     if args.out == "":
         raise UsageError("--out '': an output folder is required")
     set_threads(args.threads)
     check_jobs(args.jobs)
-    device_start(args.device, f"--device {args.device}")
+    check_device(args.device)
 
 
 def add_declared_options(parser, options):

@@ -88,6 +88,13 @@ def device_start(device, label=None):
     return start
 
 
+def check_device(device):
+    """A run's device option (a test's ``device``, a command's --device) checked before
+    anything is made: ValueError naming ``--device <device>`` when it is unknown or cannot run
+    here (device_start)."""
+    device_start(device, f"--device {device}")
+
+
 def _check_operation(op):
     """``op`` if it meets the Operation contract (pendular.dem.protocols), else TypeError."""
     if not isinstance(op, Operation) or not callable(op.apply):

@@ -4,9 +4,10 @@ rate, mixed stress condition, radius growth) in the scene's order, with no host 
 
 The reduction (``cell_partials``): each block of REDUCE_CHUNK particles sums, in particle
 order, x_p (x) F_p over its particles, the face terms (image L) (x) f of its particles' pairs
-through a face (f with the bridges' attraction, wet) and, at a step where a servo refreshes
-the cell's stiffness (``refreshes``), the pairs' stiffness kn (l_a n_a)^2 (pendular.dem.virial,
-pendular.dem.cell.contact_stiffness); then one thread
+through a face (f with the attraction of bridges at contact, wet, and the forces of bridges
+across gaps on their own, the CPU's gather_pair_forces_virial) and, at a step where a servo
+refreshes the cell's stiffness (``refreshes``), the pairs' stiffness kn (l_a n_a)^2
+(pendular.dem.virial, pendular.dem.cell.contact_stiffness); then one thread
 (``cell_controls``) adds the blocks in order, divides by the volume (the CPU's
 store_cell_stress: Love–Weber, Eq. 3.41), sets the rates to zero (PeriodicCell.after_forces)
 and runs the controls: the rows of pendular.gpu.walls's program whose ``control_walls[c,
@@ -70,10 +71,12 @@ def refreshes(c, parameters, calls):
 
 @cuda.jit
 def cell_partials(position, force, radius, pair_count, pair_j, image, period, pair_force,
-                  normal, overlap, normal_force, wet, attraction, kinds, parameters, calls,
-                  partial):
+                  normal, overlap, normal_force, wet, attraction, persist, bridge_pair_force,
+                  kinds, parameters, calls, partial):
     """partial[b]: block b's sums (module docstring), its particles in order; the face terms
-    with the ``attraction`` (K,) [N] along the normals when ``wet``; the stiffness when a
+    with the ``attraction`` (K,) [N] along the normals when ``wet`` (bridges at contact),
+    with ``persist`` those of the bridges' forces on j from i ``bridge_pair_force`` (K, 3) [N]
+    too (bridges across gaps: the CPU's gather_pair_forces_virial); the stiffness when a
     servo among the controls (``kinds``) refreshes it this step."""
     b = cuda.grid(1)
     n = position.shape[0]
@@ -97,6 +100,9 @@ def cell_partials(position, force, radius, pair_count, pair_j, image, period, pa
                 else:
                     f0, f1, f2 = pull_less(pair_force, None, normal, k)
                 faces = face_term(faces, image, k, period, f0, f1, f2)
+                if persist:
+                    faces = face_term(faces, image, k, period, bridge_pair_force[k, 0],
+                                      bridge_pair_force[k, 1], bridge_pair_force[k, 2])
             if stiffness:
                 s0, s1, s2 = pair_stiffness(k, p, radius, pair_j, normal, normal_force,
                                             overlap)

@@ -30,12 +30,13 @@ wet, SuctionBridges at contact or across gaps (``persist``; a new suction betwee
 CPU: GpuSimulation._follow_suction); controls StressServo, ConstantStrainRate, MixedStress
 (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip
 after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not)
-with ContactForces and, wet, SuctionBridges at contact, under StressServo,
-ConstantStrainRate, ConstantShearRate (simple shear, Lees–Edwards) and MixedStress
-(pendular.gpu.cell): its step wraps the particles and finds the pairs through the cell's
-faces at a rebuild, reduces the cell's stress, runs its controls and a leapfrog carried by
-its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a cell whose
-faces no control moves. Anything else (a radius growth in a moving cell) is refused by
+with ContactForces and, wet, SuctionBridges at contact or across gaps or VolumeBridges, under
+StressServo, ConstantStrainRate, ConstantShearRate (simple shear, Lees–Edwards) and
+MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
+cell's faces at a rebuild (as far as the bridges' rupture range), reduces the cell's stress
+(with the face terms of the forces of bridges across gaps), runs its controls and a leapfrog
+carried by its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a
+cell whose faces no control moves. Anything else (a radius growth in a moving cell) is refused by
 name (ValueError), so that a scene never runs with part of its physics missing.
 """
 
@@ -94,7 +95,7 @@ def check_scene(sim):
                              "VolumeBridges)")
     bridges = _bridges_of(sim)
     if bridges is not None and bridges.persist:
-        _check_persist(sim, box, bridges)
+        _check_persist(sim, bridges)
     controls = sim.peek("controls")
     for op in controls:
         if type(op) not in (StressServo, ConstantStrainRate, RadiusGrowth, Grip) \
@@ -124,15 +125,12 @@ def _bridges_of(sim):
     return found[0] if found else None
 
 
-def _check_persist(sim, box, bridges):
+def _check_persist(sim, bridges):
     """ValueError naming what of bridges across gaps (SuctionBridges ``persist``,
-    VolumeBridges) the GPU path does not run: in a periodic cell, gathered before the contact
-    law or the walls (the device adds their forces last, as the CPU's gather_pair_forces after
-    both), or with radii that grow."""
+    VolumeBridges) the GPU path does not run: gathered before the contact law or the walls
+    (the device adds their forces last, as the CPU's gather_pair_forces after both), or with
+    radii that grow."""
     what = f"bridges across gaps ({type(bridges).__name__} with persist = True)"
-    if isinstance(box, PeriodicCell):
-        raise ValueError(f"device='gpu' does not run {what} in a periodic cell yet: run it on "
-                         "the CPU (device 'cpu')")
     if sim.forces[-1] is not bridges:
         raise ValueError(f"device='gpu' runs {what} listed after the contact law and the wall "
                          "forces only")
@@ -444,7 +442,10 @@ class GpuSimulation:
         sim = self.sim
         s = self.state
         n = s.count
-        gathered_by = SuctionBridges if s.wet else ContactForces
+        # bridges at contact join the contact law's gather (their attraction in the face
+        # terms); persisting ones add their own forces' face terms (the CPU's
+        # gather_pair_forces_virial)
+        joined = s.wet and not s.persist
         bridges = s.bridges
         sheared = s.period.shape[0] > 3
         return [
@@ -452,18 +453,19 @@ class GpuSimulation:
                                          s.cell_size, s.max_dims, s.cell_count,
                                          s.cell_members, s.cell_width, s.cell_of, s.flags)),
             (neighbors.find_periodic_pairs, n,
-             (s.position, s.radius, s.skin, s.wall_position, s.period, s.cell_size, s.max_dims,
-              s.cell_count, s.cell_members, s.cell_width, s.cell_of, s.width, s.pair_count,
-              s.pair_j, s.new_count, s.new_pair_j, s.image, s.lower_count, s.lower,
-              s.shear_force, s.normal, s.overlap, bridges, s.new_shear_force, s.new_normal,
-              s.new_overlap, s.new_bridges, s.flags)),
+             (s.position, s.radius, s.skin + s.reach, s.wall_position, s.period, s.cell_size,
+              s.max_dims, s.cell_count, s.cell_members, s.cell_width, s.cell_of, s.width,
+              s.pair_count, s.pair_j, s.new_count, s.new_pair_j, s.image, s.lower_count,
+              s.lower, s.shear_force, s.normal, s.overlap, bridges, s.new_shear_force,
+              s.new_normal, s.new_overlap, s.new_bridges, s.flags)),
             self._finish_step(),
             *([(neighbors.shear_rebuilt, 1, (s.period, s.shear, s.flags))] if sheared else []),
             *self._force_steps(s.image, s.period, s.affine_rate, False, 0.0),
             (device_cell.cell_partials, s.cell_partial.shape[0],
              (s.position, s.force, s.radius, s.pair_count, s.pair_j, s.image, s.period,
-              s.pair_force, s.normal, s.overlap, s.normal_force, gathered_by is SuctionBridges,
-              bridges[:, 2], s.kinds, s.parameters, s.calls, s.cell_partial)),
+              s.pair_force, s.normal, s.overlap, s.normal_force, joined, bridges[:, 2],
+              s.persist, s.bridge_pair_force, s.kinds, s.parameters, s.calls,
+              s.cell_partial)),
             (device_cell.cell_controls, 1,
              (s.cell_partial, s.wall_position, s.cell_rate, s.stress_tensor, s.cell_stiffness,
               s.period, s.affine_rate, s.shear, s.kinds, s.control_walls, s.wall_counts,
@@ -473,7 +475,8 @@ class GpuSimulation:
              (s.position, s.velocity, s.angular_velocity, s.force, s.torque, s.mass,
               s.inertia, sim.integrator.damping, s.affine_rate, sim.dt, s.reference_position,
               s.wall_position, s.reference_walls, s.period, s.shear, 0.5 * s.skin,
-              2.0 * float(sim.peek("particles").radius.max()) + s.skin, s.flags)),
+              2.0 * float(sim.peek("particles").radius.max()) + s.skin + s.reach,
+              s.flags)),
         ]
 
     def _walled_steps(self):
@@ -491,13 +494,13 @@ class GpuSimulation:
             (neighbors.bin_particles, n, (s.position, s.wall_position, s.cell_size, s.max_dims,
                                           s.cell_count, s.cell_members, s.cell_width,
                                           s.cell_of, s.flags)),
-            (neighbors.find_pairs, n, (s.position, s.radius, s.skin, s.wall_position,
-                                       s.cell_size, s.max_dims, s.cell_count, s.cell_members,
-                                       s.cell_width, s.cell_of, s.width, s.pair_count,
-                                       s.pair_j, s.new_count, s.new_pair_j, s.lower_count,
-                                       s.lower, s.shear_force, s.normal, s.overlap, bridges,
-                                       s.new_shear_force, s.new_normal, s.new_overlap,
-                                       s.new_bridges, s.flags)),
+            (neighbors.find_pairs, n, (s.position, s.radius, s.skin + s.reach,
+                                       s.wall_position, s.cell_size, s.max_dims, s.cell_count,
+                                       s.cell_members, s.cell_width, s.cell_of, s.width,
+                                       s.pair_count, s.pair_j, s.new_count, s.new_pair_j,
+                                       s.lower_count, s.lower, s.shear_force, s.normal,
+                                       s.overlap, bridges, s.new_shear_force, s.new_normal,
+                                       s.new_overlap, s.new_bridges, s.flags)),
             self._finish_step(),
             *self._force_steps(s.no_image, s.no_period, s.no_period, walls_first,
                                wall_law.young),

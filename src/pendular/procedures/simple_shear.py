@@ -15,9 +15,8 @@ tau = -(sigma_xz + sigma_zx) / 2 of the cell's Love–Weber stress (compression 
 stress whose power tau gamma_dot per unit volume the shear puts in: positive where the sample
 resists a positive shear (PeriodicCell.shear_stress). Friction angles atan(tau / sigma_n).
 
-``run(out, device="gpu")`` shears on the GPU (pendular.gpu.cell: the sheared cell step for
-step as on the CPU) from a loaded sample only: the preparation is a periodic cell's, which
-the device does not run yet (pendular.procedures.triaxial.check_device refuses it by name).
+``run(out, device="gpu")`` prepares and shears on the GPU (pendular.gpu.cell: the sheared
+cell step for step as on the CPU).
 """
 
 from __future__ import annotations

@@ -46,7 +46,7 @@ from pendular.dem.measure import coordination, porosity
 from pendular.procedures.preparation import prepare_sample
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import save_sample
-from pendular.dem.simulation import device_start
+from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
@@ -104,7 +104,7 @@ class SwccTest:
     def run(self, out, *, progress=True, threads=None, device="cpu"):
         """Run the path into ``out``; ``device``: where the preparation and the stages run,
         "cpu" or "gpu" (``check_device``, before anything is made)."""
-        check_device(self.config, device)
+        check_device(device)
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -199,19 +199,6 @@ class SwccTest:
                 "coordination": coordination(sim.contacts, len(sim.particles)),
                 "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
-
-
-def check_device(config: SwccConfig, device: str) -> None:
-    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the path of
-    ``config`` (bridges across gaps in a periodic cell do not run on the GPU yet,
-    docs/gpu.md) or cannot run here (no numba-cuda, no GPU): ValueError naming --device and
-    what is missing."""
-    label = f"--device {device}"
-    if device == "gpu" and config.sample.periodic:
-        raise ValueError(f"{label} does not run bridges across gaps in a periodic cell (a "
-                         "periodic sample's persisting bridges) yet: run this test on the CPU "
-                         "(--device cpu)")
-    device_start(device, label)
 
 
 def hysteresis(stages):

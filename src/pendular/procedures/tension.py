@@ -5,8 +5,7 @@
 and those of its sample, a PrepareConfig, dashes for underscores; --specific-gravity sets the
 grains' density). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``, a sample
 by ``tension_sample(particles=200)``; ``run(out, device="gpu")`` (--device) runs every phase
-on the GPU, or refuses before anything is made what the GPU does not run yet
-(``check_device``). By default Kim's six cases: F-75 sand, R = 0.11 mm,
+on the GPU. By default Kim's six cases: F-75 sand, R = 0.11 mm,
 e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
 Gs = 2.65, the grains' density over the water's). Each case:
 
@@ -63,7 +62,7 @@ from pendular.dem.measure import coordination, unbalanced_force
 from pendular.procedures.preparation import (PrepareConfig, equilibrated, prepare_sample,
     servo_speed)
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.simulation import Simulation, device_start
+from pendular.dem.simulation import Simulation, check_device
 from pendular.dem.grips import Grip
 from pendular.procedures.grips import core_void_ratio, grip_members, tensile_stress
 from pendular.dem.walls import ConstantStrainRate, StressServo
@@ -543,19 +542,6 @@ def write_report(summaries: list[dict], config: TensionConfig, path: str) -> lis
     return lines
 
 
-def check_device(config: TensionConfig, device: str) -> None:
-    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the phases
-    of ``config`` (what the GPU path does not run yet, docs/gpu.md: each phase runs where the
-    test runs, never part of it elsewhere) or cannot run here (no numba-cuda, no GPU):
-    ValueError naming --device and what is missing."""
-    label = f"--device {device}"
-    if device == "gpu" and config.sample.periodic:
-        raise ValueError(f"{label} does not run bridges across gaps in a periodic cell "
-                         "(--periodic: the wetting's volume-controlled bridges) yet: run this "
-                         "test on the CPU (--device cpu)")
-    device_start(device, label)
-
-
 class TensionTest:
     """The direct-tension cases of ``config`` (TensionConfig): one sample per void ratio, each
     water content wetted and pulled from a copy of it (module docstring)."""
@@ -574,7 +560,7 @@ class TensionTest:
         ``device``: where the preparations, wettings and pulls run, "cpu" or "gpu"
         (``check_device``, before anything is made); a run option, not part of the
         configuration."""
-        check_device(self.config, device)
+        check_device(device)
         with OutputFolder(out, "tension") as folder:
             for name in ("tension.json", "report.md", "plots", "cases"):
                 folder.claim(name)

@@ -44,7 +44,7 @@ from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
 from pendular.dem.sample import load_sample, save_sample
-from pendular.dem.simulation import device_start
+from pendular.dem.simulation import check_device
 from pendular.utils.validate import check_int
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
@@ -440,21 +440,6 @@ def check_feasible(config, force=False):
                        f"[0, {int(steps) + 1}]: the shear has about {int(steps)} steps")
 
 
-def check_device(config, device):
-    """Refuse, before anything runs, a ``device`` ("cpu" or "gpu") that cannot run the loading
-    of ``config`` (what the GPU path does not run yet, docs/gpu.md) or cannot run here (no
-    numba-cuda, no GPU): ValueError naming --device and what is missing."""
-    label = f"--device {device}"
-    if device == "gpu":
-        bridges = config.bridges
-        if config.sample.periodic and bridges is not None and (
-                bridges.persist or bridges.control == "volume"):
-            raise ValueError(f"{label} does not run bridges across gaps in a periodic cell "
-                             "(--persist-bridges or --water-content with --periodic) yet: run "
-                             "this test on the CPU (--device cpu)")
-    device_start(device, label)
-
-
 def parameters(config):
     """Flat name -> value of a configuration (TriaxialConfig or a PathConfig), named as the command's options (history file attributes, campaign
     tables): the sample's and the shear's from their fields' Parameters; the rest, values
@@ -574,7 +559,7 @@ class LaboratoryTest:
         ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
         the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
         the configuration."""
-        check_device(self.config, device)
+        check_device(device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         if self.config.sample_path is not None:       # checked before the folder is touched
@@ -644,7 +629,7 @@ class LaboratoryTest:
             if not isinstance(config, cls.CONFIG):
                 raise ValueError(f"resume = {out!r} holds a run of another test "
                                  f"({type(config).__name__}), not of pendular {cls.NAME}")
-            check_device(config, device)
+            check_device(device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint

@@ -68,6 +68,7 @@ from tqdm import tqdm
 from pendular.utils.atomic import replacing
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.sample import save_sample
+from pendular.dem.simulation import check_device
 from pendular.utils.threads import use_threads
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
@@ -75,8 +76,8 @@ from pendular.utils.validate import check_int
 from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
                                         same_config, sample_made_with, stored_config)
 from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.tension import TensionTest, check_device as check_tension_device
-from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device, parameters
+from pendular.procedures.tension import TensionTest
+from pendular.procedures.triaxial import Interrupted, TriaxialTest, parameters
 from pendular.utils.parameters import Option
 
 #: Seconds between updates of the campaign's progress bar.
@@ -399,7 +400,7 @@ class Campaign:
         and the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's
         identity, so a finished run is reused whichever device ran it). Every configuration
         still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
-        tables; what the device runs), so a bad one is refused before anything runs. The
+        tables), and the device, so a bad one is refused before anything runs. The
         caller holds ``out`` (an OutputFolder, module docstring)."""
         jobs = check_jobs(jobs)
         threads = check_int("threads", threads, low=1)
@@ -413,15 +414,13 @@ class Campaign:
             else:
                 result.summaries[run.name] = summary
                 result.reused.append(run.name)
+        check_device(device)
         for run in todo:
-            try:
-                if isinstance(run.config, TriaxialConfig):
+            if isinstance(run.config, TriaxialConfig):
+                try:
                     TriaxialTest(run.config, force=run.force)
-                    check_device(run.config, device)
-                else:
-                    check_tension_device(run.config, device)
-            except ValueError as error:
-                raise RunRefused(f"run {run.name}: {error}") from None
+                except ValueError as error:
+                    raise RunRefused(f"run {run.name}: {error}") from None
         preparations = [(sample, path) for sample, path in self.samples
                         if not sample_made_with(path, sample)]
         for _, path in preparations:

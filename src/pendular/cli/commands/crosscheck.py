@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pendular.cli import (UsageError, add_declared_options, add_device_option, declared_values,
     positive_int, print_summary, set_threads)
-from pendular.dem.simulation import device_start
+from pendular.dem.simulation import check_device
 from pendular.studies.crosscheck import (OPTIONS, SHOWN, check_mirrored, check_packing,
     crosscheck_from_options, run_crosscheck)
 from pendular.interop.yade.runner import find_yade
@@ -52,7 +52,7 @@ def check(args):
 def run(args):
     config = check(args)                # every option checked before YADE is looked for
     set_threads(args.threads)
-    device_start(args.device, f"--device {args.device}")
+    check_device(args.device)
     check_mirrored(config)
     if args.packing is not None:
         check_packing(config, args.packing)

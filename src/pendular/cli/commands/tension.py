@@ -16,7 +16,8 @@ import argparse
 from pendular.cli import (add_command_options, add_device_option, add_run_options,
     command_config, print_summary, set_threads)
 from pendular.procedures.config import TensionConfig
-from pendular.procedures.tension import TensionTest, check_device, report_lines
+from pendular.dem.simulation import check_device
+from pendular.procedures.tension import TensionTest, report_lines
 
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
@@ -38,7 +39,7 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
 def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
     config = config_from(args)
-    check_device(config, args.device)           # before anything is made
+    check_device(args.device)                   # before anything is made
     output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args),
                                      device=args.device)
     if args.quiet:

@@ -26,7 +26,8 @@ import sys
 
 from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_device_option,
     add_run_options, command_config, positive_int, print_summary, set_threads)
-from pendular.procedures.triaxial import Interrupted, TriaxialTest, check_device
+from pendular.dem.simulation import check_device
+from pendular.procedures.triaxial import Interrupted, TriaxialTest
 
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
@@ -106,7 +107,7 @@ def run_test(args, test, config_from, shown, add_arguments):
             out = args.resume
         else:
             config = config_from(args)
-            check_device(config, args.device)       # before the test loads its tables
+            check_device(args.device)               # before the test loads its tables
             summary = test(config, force=args.force).run(
                 args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
                 vtk_prep=args.vtk_prep, device=args.device)

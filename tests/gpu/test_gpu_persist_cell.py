@@ -1,0 +1,226 @@
+"""Bridges across gaps in a periodic cell on the GPU against the CPU under Numba's CUDA
+simulator: the 64 spheres of test_gpu_periodic.py in their periodic cell, pulled apart along z
+(a constant strain rate of negative rate) under the cell's stress servo on x and y, wet with
+suction-controlled bridges that persist across gaps (SuctionBridges ``persist``, 30 kPa) or
+volume-controlled ones (VolumeBridges, formed at contact at 30 kPa from a reservoir). Bridges
+form at contact, stretch across the gaps that open (through the faces too) and rupture at
+their rupture distance; their forces enter the cell's stress through the faces (the CPU's
+gather_pair_forces_virial). The simulator runs in a process of its own (this file as a script:
+``NUMBA_ENABLE_CUDASIM=1 python test_gpu_persist_cell.py CONTROL`` prints one JSON object of
+measurements), so that no other test meets it.
+
+Checked too: persisting bridges in test_gpu_shear.py's simple shear (a sheared cell), and
+the periodic tension's phases (pendular.procedures.tension: the wetting to a water content,
+volume-controlled bridges at contacts and across gaps, and the pull).
+
+Measured (simulator, 64 spheres): suction control, 300 steps at 30 kPa (212 bridges formed,
+69 stretched across a gap, 39 ruptured over the path; 70 bridges held through a face), 100 at
+90 kPa in the same device run, 80 at 10 kPa in a new one (a farther reach); volume control,
+300 steps; the simple shear, 300 steps to a shear strain of 0.46 (139 bridges ruptured): at
+the end of each stage the same pairs hold bridges in the same states as on the CPU, the
+cell's faces are equal and the largest relative differences are 1.4e-14 in unwrapped
+positions, 7.0e-12 in velocities, 5.2e-14 in the cell's stress tensor, 9.6e-12 in bridge
+volumes (volume control: equal), 1.1e-11 in bridge forces, 9.5e-12 in forces on j from i,
+7.0e-12 in filling angles. Without the bridges' face terms the stress would differ by 1e-3.
+The periodic tension (w = 0.5 %, 200 steps of settling, 334 of pull): the formation suction,
+water content, bridge count and the rows equal the CPU's, the wetted positions within 1.2e-15,
+the tensile stress 8.5e-14, the cell's stress 1.6e-13, the unbalanced force 9.6e-12. The
+tests hold 1e-12 (positions, faces), 1e-10 (the rest), and the tension's columns 1e-11 (the
+unbalanced force 1e-10).
+"""
+
+import json
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from simulator import relative, simulated
+from test_gpu_periodic import RADIUS, SIDE, SPACING, scene as periodic_scene
+from test_gpu_shear import scene as shear_scene
+from test_gpu_persist import bridge_events, compare, snapshot as persist_snapshot
+
+#: Steps of each comparison; (suction [Pa], steps) of the suction path's later stages
+#: ("suction": a higher suction in the same device run, a lower one, which reaches farther,
+#: in a new one).
+STEPS = 300
+PATH = ((90000.0, 100), (10000.0, 80))
+#: The periodic tension's water content [-] (its bridges' reach fits the 64 spheres' cell)
+#: and steps of its wetting's settling (the tension's WET_STEPS, a bound on its run).
+WATER_CONTENT = 0.005
+WET_STEPS = 200
+
+
+def pulled_apart(length):
+    """The controls in a cell of edge ``length`` [m]: the stress servo on x and y, z pulled
+    apart at a strain rate of -20 /s."""
+    from pendular.dem.walls import ConstantStrainRate, StressServo
+
+    return [StressServo("xy", 1e4, 0.01), ConstantStrainRate("z", -20.0, length)]
+
+
+def scene(control):
+    """The module docstring's scene on the CPU with bridges of ``control`` ("suction":
+    persisting, "volume"; "sheared": persisting, in test_gpu_shear.py's sheared cell), and its
+    bridges."""
+    from pendular.capillary.bridges import CapillaryBridges
+
+    if control == "sheared":
+        sim = shear_scene(wet=True)
+    else:
+        sim = periodic_scene(wet=True, controls=pulled_apart)
+    bridges = (CapillaryBridges(30000.0, control="volume") if control == "volume" else
+               CapillaryBridges(30000.0, persist=True))
+    sim.forces[-1] = bridges        # in place of the bridges at contact
+    return sim, bridges
+
+
+def snapshot(sim, bridges):
+    """test_gpu_persist.py's snapshot (each bridge per pair (i, j)) with the positions
+    unwrapped (the runs may wrap at other steps) and the cell's faces and stress tensor."""
+    cell = sim.walls
+    return {**persist_snapshot(sim, bridges), "position": cell.unwrapped(sim.particles),
+            "walls": cell.position.copy(), "stress": cell.stress_tensor.copy()}
+
+
+def agreement(control):
+    """STEPS steps of the scene with bridges of ``control`` on the CPU (one at a time, counting
+    the bridges' events) and on the GPU, compared, then ("suction") each stage of PATH; the
+    CPU's and the GPU's rebuilds, the particles wrapped through the faces (per axis), the
+    axial and shear strains and the bridges held through a face, at the end of each stage."""
+    from pendular.gpu import GpuSimulation
+
+    cpu, cpu_bridges = scene(control)
+    gpu_sim, gpu_bridges = scene(control)
+    gpu = GpuSimulation(gpu_sim)
+    out = {"stages": [], "events": [0, 0, 0]}
+    stages = ((None, STEPS), *(PATH if control == "suction" else ()))
+    for stage, (suction, steps) in enumerate(stages):
+        if suction is not None:
+            cpu_bridges.set_suction(suction)
+            gpu_bridges.set_suction(suction)
+        events = bridge_events(cpu, cpu_bridges, steps)
+        out["events"] = [a + b for a, b in zip(out["events"], events)]
+        if stage < 2:
+            gpu.run(steps)
+        else:               # a farther reach: Simulation.run's new device run
+            gpu_sim.device = "gpu"
+            gpu_sim.run(steps)
+        if stage == 0:      # the device run's own count
+            out["rebuilds"] = [cpu.neighbors.rebuilds, gpu.rebuilds]
+        held = snapshot(cpu, cpu_bridges)
+        result = compare(held, snapshot(gpu_sim, gpu_bridges))
+        c = cpu.contacts
+        through = {(int(i), int(j)) for i, j, image in zip(c.pair_i, c.pair_j, c.image)
+                   if image.any()}
+        result["through_faces"] = len(through.intersection(held["pairs"]))
+        result["wrapped"] = [int(n) for n in (gpu_sim.walls.wraps != 0).sum(axis=0)]
+        result["strain"] = 1.0 - gpu_sim.walls.position[5] / (SIDE * SPACING)
+        result["gamma"] = gpu_sim.walls.shear_strain
+        result["reach"] = [cpu.neighbors.interaction_range,
+                           gpu_sim.neighbors.interaction_range]
+        out["stages"].append(result)
+    return out
+
+
+def wetted_and_pulled(device, folder):
+    """(wetting report, wetted positions unwrapped, pull steps, history) of the periodic
+    tension's phases on ``device``: the scene dry under a stress servo at 10 kPa, wetted to a
+    water content of 0.5 % (volume-controlled bridges at contacts and across gaps, WET_STEPS
+    steps of settling), then pulled along z (the cell stretched, x and y servoed at zero) 1 %."""
+    from dataclasses import replace
+
+    from pendular.dem.walls import StressServo
+    from pendular.procedures import tension
+    from pendular.procedures.config import TensionConfig, tension_sample
+
+    tension.WET_STEPS = WET_STEPS
+    dry = periodic_scene()
+    dry.writers.clear()
+    dry.controls = [StressServo("xyz", 1e4, 0.01)]
+    dry.evaluate_forces()           # the contacts of the state the wetting starts from
+    dry.device = device
+    sample = replace(tension_sample(), radius=RADIUS, density=2650.0, confining=1e4,
+                     periodic=True)
+    config = TensionConfig(sample=sample, cases=[(0.7, WATER_CONTENT)], inertial_number=1e-2,
+                           max_strain=0.01, vtk_frames=0)
+    sim, bridges, report = tension.wet(dry, config, WATER_CONTENT, progress=False)
+    position = sim.walls.unwrapped(sim.particles)
+    steps, history = tension.Pull(sim, bridges, config, folder, progress=False).run(None)
+    return report, position, steps, history
+
+
+def tension_agreement():
+    """The periodic tension's wetting and pull (wetted_and_pulled) on the CPU and on the GPU:
+    the wettings' reports, the wetted positions' and each history column's largest relative
+    difference."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        cpu_report, cpu_position, steps, cpu = wetted_and_pulled("cpu", folder)
+        gpu_report, gpu_position, _, gpu = wetted_and_pulled("gpu", folder)
+    reported = ("formation_suction_pa", "water_content", "bridges")
+    return {"steps": steps, "position": relative(cpu_position, gpu_position),
+            "reports": [[report[key] for key in reported] for report in (cpu_report,
+                                                                         gpu_report)],
+            "rows": [len(cpu["step"]), len(gpu["step"])],
+            "differences": {name: relative(cpu[name], gpu[name]) for name in cpu
+                            if np.asarray(cpu[name]).dtype != object}}
+
+
+# ---------------------------------------------------------------- the tests (pytest)
+def run(control):
+    """The measurements of ``control``'s comparison, run under the simulator."""
+    pytest.importorskip("numba_cuda")
+    return simulated(os.path.basename(__file__), control)
+
+
+def assert_agrees(measured):
+    assert measured["rebuilds"][0] == measured["rebuilds"][1] > 1
+    formed, stretched, ruptured = measured["events"]
+    assert formed > 5 and stretched > 5 and ruptured > 2     # the physics is exercised
+    for stage in measured["stages"]:
+        assert stage["same_bridges"], stage
+        assert stage["through_faces"] > 0
+        assert stage["reach"][0] == stage["reach"][1] > 0.0
+        assert stage["position"] < 1e-12 and stage["walls"] < 1e-12
+        assert stage["stress"] < 1e-10 and stage["velocity"] < 1e-10
+        for name in ("volume", "bridge_force", "filling", "pair_force"):
+            assert stage[name] < 1e-10, name
+
+
+def test_persisting_bridges_and_a_suction_path_in_a_periodic_cell_agree_with_the_cpu():
+    measured = run("suction")
+    assert_agrees(measured)
+    assert measured["stages"][0]["strain"] < 0.0                 # pulled apart
+    assert measured["stages"][-1]["reach"][0] > measured["stages"][0]["reach"][0]
+
+
+def test_volume_bridges_in_a_periodic_cell_agree_with_the_cpu():
+    measured = run("volume")
+    assert_agrees(measured)
+    assert measured["stages"][0]["strain"] < 0.0
+
+
+def test_persisting_bridges_in_a_sheared_cell_agree_with_the_cpu():
+    measured = run("sheared")
+    assert_agrees(measured)
+    assert measured["stages"][0]["gamma"] > 0.4
+
+
+def test_the_periodic_tension_wets_and_pulls_as_on_the_cpu():
+    """pendular.procedures.tension in a periodic cell (``pendular tension --periodic``'s
+    phases): the wetting to a water content and the pull record the CPU's history."""
+    measured = run("tension")
+    assert measured["reports"][0] == measured["reports"][1]
+    assert measured["reports"][0][2] > 50                       # bridges formed
+    assert measured["position"] < 1e-12
+    assert measured["rows"][0] == measured["rows"][1] > 100
+    for name, difference in measured["differences"].items():
+        assert difference <= (1e-10 if name == "unbalanced_force" else 1e-11), name
+
+
+if __name__ == "__main__":
+    print(json.dumps(tension_agreement() if sys.argv[1] == "tension" else
+                     agreement(sys.argv[1]), default=float))
