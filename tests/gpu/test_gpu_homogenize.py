@@ -29,6 +29,15 @@ included. In the sheared cell (65 of 169 touching pairs through the faces): 6.3e
 (sigma_contact), 4.9e-16 (fabrics), 3.0e-16 (water volume), 4.2e-16 (chi), 2.1e-14 (B),
 4.5e-16 (psi), 2.7e-16 (sigma_capillary and the interface term), 7.6e-15 (the anisotropies),
 the CPU's 595 overlapping menisci widened.
+Bridges across gaps (GAPS: the 27 spheres of test_gpu_persist.py, persisting bridges, and of
+test_gpu_volume.py, volume-controlled, after GAP_STEPS = 75 steps pulled apart: 48 bridges, 4
+across gaps, and 54, 10 across gaps), two blocks of 16 and one, the largest: 2.1e-16
+(sigma_contact), 1.4e-16 (fabric), 2.8e-16 (unbalanced force), 2.7e-16 (water volume),
+5.2e-16 (chi), 8.2e-15 (B), 5.7e-16 (psi, volume control's at each bridge's own suction),
+1.9e-16 (sigma_capillary, from the forces applied along the branch vectors), 3.4e-16
+(interface term, at each gap; volume control's from the volume table), 3.3e-16 (bridge
+fabric), 2.2e-13 (the anisotropies); the counts equal; in one block the contact quantities
+and sigma_capillary bit for bit.
 """
 
 import json
@@ -50,6 +59,12 @@ CHUNK = 32
 WIDE = 50.0
 #: Largest values (exact in any order): the guard's largest overlap, the radii's range.
 MAXIMA = ("largest_overlap", "smallest_radius", "largest_radius")
+#: Scenes with bridges across gaps: the 27 spheres of test_gpu_persist.py (persisting
+#: suction-controlled bridges) and of test_gpu_volume.py (volume-controlled), pulled apart for
+#: GAP_STEPS steps, reduced in blocks of GAP_CHUNK (two blocks) and in one.
+GAPS = ("persist", "volume")
+GAP_STEPS = 75
+GAP_CHUNK = 16
 
 
 def cpu_homogenization(sim):
@@ -98,7 +113,7 @@ def widen_menisci(gpu, filling_angle):
     gpu.state.bridges.copy_to_device(bridges)
 
 
-def measure(wet, chunk, filling_angle=None, cell=None):
+def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
     """{quantity: relative difference device vs CPU}, {quantity: equal bit for bit}, the
     device's counts, the copies back during the device's homogenisation (device_homogenization,
     then GpuSimulation.homogenized, which must repeat it bit for bit: the same result for the
@@ -106,10 +121,15 @@ def measure(wet, chunk, filling_angle=None, cell=None):
     it, and the error of GpuSimulation.homogenized once the state is back; the reduction in
     blocks of ``chunk`` particles; ``filling_angle`` [deg]: the bridges' widened to it first
     (widen_menisci); ``cell``: "periodic" or "sheared", the cell of test_gpu_periodic.py or
-    of test_gpu_shear.py instead of the walls, and the touching pairs through its faces."""
+    of test_gpu_shear.py instead of the walls, and the touching pairs through its faces;
+    "persist" or "volume", GAPS' scenes after ``steps``, and their bridges across gaps."""
     from simulated import scene
     from test_gpu_periodic import scene as periodic_scene
+    from test_gpu_persist import scene as persist_scene
     from test_gpu_shear import scene as sheared_scene
+    from test_gpu_volume import scene as volume_scene
+
+    from pendular.capillary.bridge_state import ACROSS_GAP, BridgeState
 
     from pendular.gpu import GpuSimulation, homogenize
     from pendular.gpu.homogenize import device_homogenization
@@ -123,9 +143,10 @@ def measure(wet, chunk, filling_angle=None, cell=None):
         copies.append(part or "all")
         return copy_back(self, part)
 
-    cells = {"periodic": periodic_scene, "sheared": sheared_scene}
+    cells = {"periodic": periodic_scene, "sheared": sheared_scene,
+             "persist": lambda wet: persist_scene()[0], "volume": lambda wet: volume_scene()[0]}
     gpu = GpuSimulation(cells[cell](wet) if cell else scene(wet=wet, side=SIDE))
-    gpu.run(STEPS)
+    gpu.run(steps)
     if filling_angle is not None:
         widen_menisci(gpu, filling_angle)
     GpuSimulation.copy_back = counted
@@ -144,7 +165,9 @@ def measure(wet, chunk, filling_angle=None, cell=None):
     contacts = gpu.sim.contacts
     through_faces = (int(np.count_nonzero(contacts.touching() & np.any(contacts.image != 0,
                                                                          axis=1)))
-                     if cell else 0)
+                     if cell in ("periodic", "sheared") else 0)
+    across_gaps = (int(np.count_nonzero(BridgeState.of(contacts).state == ACROSS_GAP))
+                   if wet else 0)
     gpu.run(1)
     fresh = gpu.homogenized() is not again
     return {"names": sorted(device), "cpu_names": sorted(cpu),
@@ -154,7 +177,7 @@ def measure(wet, chunk, filling_angle=None, cell=None):
             "touching": device["coordination"] * len(gpu.sim.particles) / 2.0,
             "bridges": device.get("bridges", 0),
             "pendular_overlaps": device.get("pendular_overlaps", 0), "copies": copies,
-            "held": held, "through_faces": through_faces,
+            "held": held, "through_faces": through_faces, "across_gaps": across_gaps,
             "released": released, "cached": cached, "fresh": fresh,
             "psi": device["psi"].tolist() if wet else None}
 
@@ -239,10 +262,42 @@ def test_the_wet_capillary_stress_is_compressive(scene_run):
         assert min(np.diag(measured["blocks"]["psi"])) > 0.0
 
 
+@pytest.fixture(scope="module", params=GAPS)
+def gap_run(request):
+    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
+                        "(pip install -e '.[gpu]')")
+    return simulated(os.path.basename(__file__), request.param)
+
+
+def test_bridges_across_gaps_are_reduced_on_the_device_as_on_the_cpu(gap_run):
+    """Persisting and volume-controlled bridges, some across gaps: every quantity the CPU's
+    functions give (the capillary forces' stress from the forces applied at the last step,
+    the interface term at each bridge's gap, volume control's psi at each bridge's own
+    suction and its interface from the volume table), no copy of the state."""
+    expected = {"sigma_contact", "coordination", "fabric", "anisotropy", "unbalanced_force",
+                "solid_volume", *MAXIMA, "bridges", "pendular_overlaps", "water_volume", "chi",
+                "B", "psi", "sigma_capillary", "fabric_bridges", "anisotropy_bridges", "a_psi",
+                "psi_interface"}
+    for run in (gap_run["blocks"], gap_run["one_block"]):
+        assert run["copies"] == [] and run["held"]
+        assert run["across_gaps"] >= 2 and run["bridges"] > run["across_gaps"]
+        assert set(run["names"]) == set(run["cpu_names"]) == expected
+        for name, difference in run["difference"].items():
+            bound = 1e-12 if name.startswith(("anisotropy", "a_psi")) else 1e-13
+            assert difference < bound, name
+        assert all(run["equal"][name] for name in MAXIMA)
+        assert run["equal"]["bridges"] and run["equal"]["pendular_overlaps"]
+        assert run["repeatable"] and run["cached"] and run["fresh"]
+        assert min(np.diag(run["psi"])) > 0.0
+
+
 def main(check):
     """The measurements of ``check`` ("dry" or "wet", inside walls; "periodic-dry",
     "periodic-wet" or "sheared-wet", in a periodic cell, sheared in the last) in two blocks and
-    in one."""
+    in one; GAPS' scenes in two blocks of GAP_CHUNK and in one."""
+    if check in GAPS:
+        return {name: measure(True, chunk, cell=check, steps=GAP_STEPS)
+                for name, chunk in (("blocks", GAP_CHUNK), ("one_block", 2 * GAP_CHUNK))}
     cell, _, kind = check.rpartition("-")
     cell = cell or None
     wet = kind == "wet"

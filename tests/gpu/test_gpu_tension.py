@@ -16,9 +16,9 @@ the positions after it within 3.1e-15; the pull (334 steps) records the CPU's ro
 contact counts, the tensile stress within 2.7e-13 of its largest value, the grips' pulls
 4.2e-13, the wall stresses 2.0e-13, the unbalanced force (a residual ratio) 4.8e-12, the water
 content and saturation exactly. TOLERANCE and UNBALANCED_TOLERANCE hold them with a margin of
-about 20. Each record brings back the walls with the pulls; the contacts' columns bring back
-the rest while the device's homogenisation does not reduce bridges across gaps
-(GpuSimulation.homogenized).
+about 20. Each record brings back the walls with the pulls alone: the contacts' and the
+bridges' columns read the device's homogenisation (GpuSimulation.homogenized), bridges across
+gaps included; the whole state comes back once, as the run returns.
 """
 
 import json
@@ -73,10 +73,10 @@ def test_the_pull_on_the_gpu_records_the_cpu_history(tension):
 
 @needs_numba_cuda
 def test_a_record_of_the_pull_brings_back_the_walls_with_the_pulls(tension):
-    """Each record reads the walls first (the pulls come with them); the contacts' columns
-    bring back the rest at most once a record (module docstring), and the run's end once."""
+    """Each record reads the walls alone (the pulls come with them; module docstring), and
+    the run's end the whole state once."""
     copies, steps = tension["pull"]["copies"], tension["pull"]["steps"]
-    assert copies.count("walls") == steps and copies.count("all") <= steps + 1
+    assert copies.count("walls") == steps and copies.count("all") == 1
     assert copies[0] == "walls" and copies[-1] == "all"
 
 

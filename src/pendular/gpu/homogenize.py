@@ -17,11 +17,14 @@ pendular.dem.neighbors.branch_vector compiled for the device):
 - wet: the bridges' count and water volume V_w, the sums of Eqs. 3.44-3.46 (chi, B, psi; each
   rotated cap tensor summed as a_k I + (c_k - a_k) n n, bridge_tensors.axisymmetric_sum), the
   bridge fabric (Eq. 3.53) over the unit branch vectors, the Love–Weber stress of the
-  capillary forces (on_the_fly.capillary_force_stress) and, with the exact model, the
-  liquid-gas interface term (on_the_fly's I_ij, from the exact table at each bridge, read by
-  the CPU's own lookup: bridge_kernels._bridge_gap_star and table.lookup_interface compiled
-  for the device, pendular.gpu.cuda.device_twin), and the overlapping menisci on a same
-  particle (capillary.bridges.CapillaryBridges.pendular_overlaps).
+  capillary forces (on_the_fly.capillary_force_stress; bridges across gaps, ``persist``: the
+  forces on j from i applied at the last step, SuctionBridges.pair_forces) and, with the exact
+  model, the liquid-gas interface term (on_the_fly's I_ij, from the exact table at each
+  bridge's gap, read by the CPU's own lookup: bridge_kernels._bridge_gap_star and
+  table.lookup_interface compiled for the device, pendular.gpu.cuda.device_twin; volume
+  control: the volume table's, bridge_kernels.volume_interfaces), and the overlapping menisci
+  on a same particle (capillary.bridges.CapillaryBridges.pendular_overlaps). Volume control's
+  psi weighs each bridge by its own suction (on_the_fly.homogenize_bridges).
 
 The reduction, fixed in order (the result does not depend on the launch): each thread sums the
 rows of CHUNK particles, particle after particle and each row in order, into its block's row
@@ -41,6 +44,7 @@ import numpy as np
 from pendular.capillary.bridge_kernels import _bridge_gap_star
 from pendular.capillary.bridge_state import AT_CONTACT, NO_BRIDGE
 from pendular.capillary.table import lookup_interface
+from pendular.capillary.volume_table import lookup_volume_interface
 from pendular.dem.neighbors import branch_vector
 from pendular.gpu.cuda import configured, cuda, device, device_twin
 from pendular.gpu.state import BRIDGE_COLUMNS
@@ -50,6 +54,7 @@ from pendular.utils.validate import check_positive
 bridge_gap_star = device_twin(_bridge_gap_star)
 image_branch = device_twin(branch_vector)
 interface_lookup = device_twin(lookup_interface)
+volume_interface_lookup = device_twin(lookup_volume_interface)
 
 #: Particles summed by one thread of homogenize_partials.
 CHUNK = 32
@@ -61,12 +66,15 @@ RADIAN = math.pi / 180.0
 #: n n; sum of the radii cubed [m^3]; bridges; water volume [m^3]; capillary stress sum
 #: l (x) f_cap [N m]; wetted caps (Eq. 3.44: sum a_k [m^3], sum (c_k - a_k) n n [m^3]); contact
 #: lines (Eq. 3.45: [N m]); bridge fabric sum n n; interface (sum a_k, sum (c_k - a_k) n n
-#: [m^2]); overlapping menisci. 3x3 sums row by row.
+#: [m^2]); overlapping menisci; with each bridge's own suction s_k (volume control), sum s_k V_k
+#: [N m] and the wetted caps weighted by s_k (sum s_k a_k, sum s_k (c_k - a_k) n n [N m]).
+#: 3x3 sums row by row.
 SUMS = (("touching", 1), ("resultant", 1), ("contact_force", 1), ("stress", 9),
         ("fabric", 9), ("radius_cubed", 1), ("bridges", 1), ("water_volume", 1),
         ("capillary", 9), ("cap_lateral", 1), ("cap_axial", 9), ("line_lateral", 1),
         ("line_axial", 9), ("bridge_fabric", 9), ("interface_lateral", 1),
-        ("interface_axial", 9), ("pendular_overlaps", 1))
+        ("interface_axial", 9), ("pendular_overlaps", 1), ("suction_water", 1),
+        ("suction_cap_lateral", 1), ("suction_cap_axial", 9))
 #: The columns after SUMS, reduced to their largest value: the largest overlap over the smaller
 #: radius [-] (at least 0, as guards.largest_overlap), the largest radius and minus the
 #: smallest [m].
@@ -101,6 +109,9 @@ BRIDGE_FABRIC = _FIRST["bridge_fabric"]
 INTERFACE_LATERAL = _FIRST["interface_lateral"]
 INTERFACE_AXIAL = _FIRST["interface_axial"]
 PENDULAR_OVERLAPS = _FIRST["pendular_overlaps"]
+SUCTION_WATER = _FIRST["suction_water"]
+SUCTION_CAP_LATERAL = _FIRST["suction_cap_lateral"]
+SUCTION_CAP_AXIAL = _FIRST["suction_cap_axial"]
 LARGEST_OVERLAP = _FIRST["largest_overlap"]
 LARGEST_RADIUS = _FIRST["largest_radius"]
 NEGATIVE_SMALLEST_RADIUS = _FIRST["negative_smallest_radius"]
@@ -110,6 +121,7 @@ VOLUME = BRIDGE_COLUMNS.index("volume")
 FORCE = BRIDGE_COLUMNS.index("force")
 FILLING_I = BRIDGE_COLUMNS.index("filling_i")
 FILLING_J = BRIDGE_COLUMNS.index("filling_j")
+SUCTION = BRIDGE_COLUMNS.index("suction")
 
 
 @device
@@ -185,16 +197,26 @@ def add_axisymmetric(partial, b, lateral_column, axial_column, lateral, axial, n
 
 @device
 def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j, image,
-               period, normal, bridges, contact_angle, surface_tension, interface,
-               radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values,
-               suction):
+               period, normal, bridges, persist, bridge_pair_force, own_suction,
+               contact_angle, surface_tension, interface, radius_ratios, suction_axis,
+               distance_low, log_distance_rupture, log_values, suction, roughness,
+               volume_ratios, volume_axes, volume_distance_low, volume_log_rupture,
+               volume_grid):
     """Bridge k (between i and j, branch vector l; ``image`` and ``period`` as ``branch``)
-    into block b's sums."""
+    into block b's sums: its force on j from i, ``persist``: as applied at the last step
+    (``bridge_pair_force``, along the branch vector across a gap; SuctionBridges.pair_forces),
+    else the attraction along the contact's normal; ``own_suction`` (volume control): its
+    caps weighted by its own suction too, and its interface from the volume table at its
+    volume and gap (``roughness`` [-]; bridge_kernels.volume_interfaces)."""
     partial[b, BRIDGES] += 1.0
     partial[b, WATER_VOLUME] += bridges[k, VOLUME]
-    pull = -bridges[k, FORCE]           # the attraction along the contact's normal, on j
-    add_outer(partial, b, CAPILLARY, l0, l1, l2, pull * normal[k, 0], pull * normal[k, 1],
-              pull * normal[k, 2])
+    if persist:
+        add_outer(partial, b, CAPILLARY, l0, l1, l2, bridge_pair_force[k, 0],
+                  bridge_pair_force[k, 1], bridge_pair_force[k, 2])
+    else:
+        pull = -bridges[k, FORCE]       # the attraction along the contact's normal, on j
+        add_outer(partial, b, CAPILLARY, l0, l1, l2, pull * normal[k, 0], pull * normal[k, 1],
+                  pull * normal[k, 2])
     distance = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
     n0 = l0 / distance
     n1 = l1 / distance
@@ -202,6 +224,11 @@ def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j
     a_i, c_i = wetted_cap(radius[i], bridges[k, FILLING_I])
     a_j, c_j = wetted_cap(radius[j], bridges[k, FILLING_J])
     add_axisymmetric(partial, b, CAP_LATERAL, CAP_AXIAL, a_i + a_j, c_i + c_j, n0, n1, n2)
+    if own_suction:
+        own = bridges[k, SUCTION]
+        partial[b, SUCTION_WATER] += own * bridges[k, VOLUME]
+        add_axisymmetric(partial, b, SUCTION_CAP_LATERAL, SUCTION_CAP_AXIAL, own * (a_i + a_j),
+                         own * (c_i + c_j), n0, n1, n2)
     a_i, c_i = contact_line(radius[i], bridges[k, FILLING_I], contact_angle, surface_tension)
     a_j, c_j = contact_line(radius[j], bridges[k, FILLING_J], contact_angle, surface_tension)
     add_axisymmetric(partial, b, LINE_LATERAL, LINE_AXIAL, a_i + a_j, c_i + c_j, n0, n1, n2)
@@ -209,10 +236,17 @@ def add_bridge(partial, b, k, i, j, l0, l1, l2, position, radius, pair_i, pair_j
     if interface:
         larger, ratio, distance_star = bridge_gap_star(
             position, radius, pair_i, pair_j, image, period, k,
-            bridges[k, STATE] == AT_CONTACT, 0.0)
-        _, nn11, nn33 = interface_lookup(radius_ratios, suction_axis, distance_low,
-                                         log_distance_rupture, log_values, ratio,
-                                         suction * larger / surface_tension, distance_star)
+            bridges[k, STATE] == AT_CONTACT, roughness if own_suction else 0.0)
+        if own_suction:
+            _, nn11, nn33 = volume_interface_lookup(
+                volume_ratios, volume_axes, volume_distance_low, volume_log_rupture,
+                volume_grid, ratio, bridges[k, VOLUME] / (larger * larger * larger),
+                distance_star)
+        else:
+            _, nn11, nn33 = interface_lookup(radius_ratios, suction_axis, distance_low,
+                                             log_distance_rupture, log_values, ratio,
+                                             suction * larger / surface_tension,
+                                             distance_star)
         nn11 = nn11 * larger * larger
         nn33 = nn33 * larger * larger
         add_axisymmetric(partial, b, INTERFACE_LATERAL, INTERFACE_AXIAL, nn11 + nn33,
@@ -271,13 +305,17 @@ def overlapping_menisci(p, n, position, pair_count, pair_j, second_count, second
 @cuda.jit
 def homogenize_partials(position, radius, force, wall_position, pair_count, pair_i, pair_j,
                         second_count, second_pair, periodic, image, period, overlap, normal,
-                        pair_force, wet, bridges, contact_angle, surface_tension, interface,
-                        radius_ratios, suction_axis, distance_low, log_distance_rupture,
-                        log_values, suction, partial):
+                        pair_force, wet, bridges, persist, bridge_pair_force, own_suction,
+                        contact_angle, surface_tension, interface, radius_ratios, suction_axis,
+                        distance_low, log_distance_rupture, log_values, suction, roughness,
+                        volume_ratios, volume_axes, volume_distance_low, volume_log_rupture,
+                        volume_grid, partial):
     """partial[b, :]: block b's sums (SUMS) over its CHUNK particles in order and, for each, its
     row of pairs in order: the touching pairs' (overlap > 0) contact terms and, ``wet``, the
     bridges' (BridgeState ``state`` != NO_BRIDGE; ``bridges`` (K, BRIDGE_COLUMNS)); the
-    interface term when ``interface`` (the exact table's arrays, the suction [Pa]); then its
+    interface term when ``interface`` (the exact table's arrays, the suction [Pa]; with
+    ``own_suction``, the volume table's and the roughness); ``persist``, ``bridge_pair_force``
+    and ``own_suction`` as ``add_bridge``; then its
     largest values (MAXIMA), the walls' overlaps inside walls. ``periodic``: a periodic cell,
     the pairs' ``image`` (K, 3) and the ``period`` [m] (``branch``)."""
     b = cuda.grid(1)
@@ -320,9 +358,11 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
                           normal[k, 0], normal[k, 1], normal[k, 2])
             if wet and bridges[k, STATE] != NO_BRIDGE:
                 add_bridge(partial, b, k, p, j, l0, l1, l2, position, radius, pair_i, pair_j,
-                           image, period, normal, bridges, contact_angle,
-                           surface_tension, interface, radius_ratios, suction_axis,
-                           distance_low, log_distance_rupture, log_values, suction)
+                           image, period, normal, bridges, persist, bridge_pair_force,
+                           own_suction, contact_angle, surface_tension, interface,
+                           radius_ratios, suction_axis, distance_low, log_distance_rupture,
+                           log_values, suction, roughness, volume_ratios, volume_axes,
+                           volume_distance_low, volume_log_rupture, volume_grid)
 
 
 @cuda.jit
@@ -360,11 +400,14 @@ def launches(gpu, partial, totals):
     wet = bridges is not None
     interface = wet and bridges.model == "exact"
     period = s.period if s.periodic else s.no_period
+    image = s.image if s.periodic else s.no_image   # zeros where bridges across gaps read it
+    roughness = bridges.roughness if gpu._volume_control else 0.0
     return ((homogenize_partials, partial.shape[0],
              (s.position, s.radius, s.force, s.wall_position, s.pair_count, s.pair_i, s.pair_j,
-              s.second_count, s.second_pair, s.periodic, s.image, period, s.overlap, s.normal,
-              s.pair_force, wet, s.bridges, bridges.contact_angle if wet else 0.0,
-              bridges.surface_tension if wet else 1.0, interface, *gpu._table, gpu._suction,
+              s.second_count, s.second_pair, s.periodic, image, period, s.overlap, s.normal,
+              s.pair_force, wet, s.bridges, s.persist, s.bridge_pair_force, gpu._volume_control,
+              bridges.contact_angle if wet else 0.0, bridges.surface_tension if wet else 1.0,
+              interface, *gpu._table, gpu._suction, roughness, *gpu._volume_table,
               partial)),
             (sum_columns, COLUMNS, (partial, totals)))
 
@@ -429,7 +472,11 @@ def device_homogenization(gpu, volume=None):
     water_volume = float(sums[WATER_VOLUME])
     chi = (water_volume * np.eye(3) + _axisymmetric_sum(sums, "cap")) / volume   # Eq. 3.44
     tension = _axisymmetric_sum(sums, "line") / volume                          # Eq. 3.45
-    psi = chi * gpu._suction + tension                                          # Eq. 3.46
+    if gpu._volume_control:     # each bridge at its own suction (on_the_fly's psi)
+        psi = (sums[SUCTION_WATER] * np.eye(3) + _axisymmetric_sum(sums, "suction_cap")
+               ) / volume + tension
+    else:
+        psi = chi * gpu._suction + tension                                      # Eq. 3.46
     bridge_count = sums[BRIDGES]
     bridge_fabric = _tensor(sums, "bridge_fabric")
     if bridge_count:

@@ -669,8 +669,7 @@ class GpuSimulation:
         (pendular.gpu.homogenize.device_homogenization: small arrays named as the history's
         columns, computed once per step, so that a record's columns share one reduction);
         ``volume`` [m^3], None: the box inside the walls, or the periodic cell's. No particle
-        state comes back. None with bridges across gaps (``persist``, volume control): the
-        caller homogenises the host's state, which brings it back.
+        state comes back, bridges across gaps (``persist``, volume control) included.
         StageFailed first if a mixed condition could not be held (as ``copy_back``);
         RuntimeError when the device holds no state (it came back to the host, whose copy may
         have changed since: homogenise it there)."""
@@ -678,8 +677,6 @@ class GpuSimulation:
             raise RuntimeError("the GPU holds no state now (it came back to the host): "
                                "homogenise the host's state")
         self._report_failure()
-        if self.state.persist:      # bridges across gaps pull along their branch vectors,
-            return None             # which the device's reduction does not read yet
         key = (self.sim.step, self.sim.time, volume)
         if self._homogenized[0] != key:
             self._homogenized = (key, device_homogenization(self, volume))
