@@ -59,6 +59,17 @@ def history(folder):
         return {name: data[()] for name, data in handle["history"].items()}
 
 
+def assert_same_records(cpu, gpu, rows, counts=("coordination",)):
+    """Two histories with the same columns, more than ``rows`` rows at the same steps and the
+    same ``counts`` columns (bridges: more than 20 at every row)."""
+    assert cpu.keys() == gpu.keys() and len(cpu["step"]) > rows
+    assert np.array_equal(cpu["step"], gpu["step"])
+    for name in counts:
+        assert np.array_equal(cpu[name], gpu[name]), name
+    if "bridges" in counts:
+        assert cpu["bridges"].min() > 20
+
+
 def histories_on_both(command, prepare, argv, folder):
     """(CPU history, GPU history): a sample prepared on the CPU by ``pendular command
     *prepare``, then ``pendular command *argv --sample S`` run on the CPU in this process and

@@ -24,7 +24,7 @@ import sys
 import numpy as np
 import pytest
 
-from simulator import histories_on_both, relative, simulated
+from simulator import assert_same_records, histories_on_both, relative, simulated
 
 RADIUS = 1e-3
 YOUNG = 1e7
@@ -127,10 +127,11 @@ def agreement(wet, build=scene):
 
 
 # ---------------------------------------------------------------- the tests (pytest)
-def measured(check):
-    """The measurements of this file's ``check``, run under the simulator."""
+def measured(check, script=os.path.basename(__file__)):
+    """The measurements of ``script``'s ``check`` (this file's by default), run under the
+    simulator."""
     pytest.importorskip("numba_cuda")
-    return simulated(os.path.basename(__file__), check)
+    return simulated(script, check)
 
 
 @pytest.fixture(scope="module")
@@ -183,9 +184,7 @@ def test_the_periodic_triaxial_command_records_the_cpu_history(tmp_path):
     pytest.importorskip("numba_cuda")
     cpu, gpu = histories_on_both("triaxial", ["--particles", 60, "--periodic", "--max-strain",
                                               1e-4, "--quiet"], COMMAND, tmp_path)
-    assert cpu.keys() == gpu.keys() and len(cpu["step"]) > 100
-    assert np.array_equal(cpu["step"], gpu["step"])
-    assert np.array_equal(cpu["coordination"], gpu["coordination"])
+    assert_same_records(cpu, gpu, 100)
     for name, values in cpu.items():
         if values.dtype == object:
             continue

@@ -49,10 +49,10 @@ import sys
 import numpy as np
 import pytest
 
-from simulator import histories_on_both, relative, simulated
+from simulator import histories_on_both, relative
 from test_gpu_growth import prepare_run
 from test_gpu_periodic import (RADIUS, SIDE, agreement as periodic_agreement, compare,
-    scene as periodic_scene, snapshot)
+    measured as periodic_measured, scene as periodic_scene, snapshot)
 
 #: Shear rate gamma_dot [1/s]: a shear strain of about 0.46 in the dry run's steps.
 SHEAR_RATE = 500.0
@@ -83,8 +83,7 @@ def agreement(wet):
 # ---------------------------------------------------------------- the tests (pytest)
 def measured(check):
     """The measurements of this file's ``check``, run under the simulator."""
-    pytest.importorskip("numba_cuda")
-    return simulated(os.path.basename(__file__), check)
+    return periodic_measured(check, os.path.basename(__file__))
 
 
 @pytest.fixture(scope="module")
