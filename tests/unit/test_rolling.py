@@ -18,7 +18,9 @@ from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
 from pendular.dem.contact_law import ContactForces
-from pendular.procedures.preparation import random_cloud
+from pendular.dem.gravity import Gravity
+from pendular.procedures.preparation import (PrepareConfig, check_engine, random_cloud,
+    servoed_simulation)
 
 OVERLAP = 1e-5                                  # [m], 0.01 R
 REDUCED = 0.5 * RADIUS                          # R* of two equal spheres [m]
@@ -231,3 +233,28 @@ def test_a_coefficient_out_of_range_is_refused_naming_the_option(option, value, 
 def test_gravity_in_a_periodic_cell_is_refused(capsys):
     refused(*run_in_process("triaxial", ["--particles", "60", "--gravity", "9.81",
                                          "--periodic"], capsys), "--gravity", "--periodic")
+
+
+def test_a_loaded_sample_gets_the_resistance_and_the_weight_and_a_plain_one_neither():
+    """A sample's scene (preparation.servoed_simulation, as a loaded --sample and a resumed run
+    build it) holds the forces its configuration asks for, after the contact law."""
+    position = random_cloud(30, RADIUS, np.zeros(3), np.full(3, 0.01), seed=1)
+    kinds = {}
+    for name, options in (("plain", {}), ("resisting", {"rolling_friction": 0.2,
+                                                       "twisting_friction": 0.1,
+                                                       "gravity": 9.81})):
+        config = PrepareConfig(particles=30, radius=RADIUS, **options)
+        sim = servoed_simulation(Particles(position, np.full(30, RADIUS), config.density),
+                                 Walls.box(np.zeros(3), np.full(3, 0.01)), config, 750.0)
+        kinds[name] = [type(op) for op in sim.forces]
+    assert kinds["plain"] == [ContactForces, WallForces]
+    assert kinds["resisting"] == [ContactForces, WallForces, Gravity, RollingResistance]
+
+
+def test_the_gpu_engine_is_refused_the_forces_it_does_not_run_naming_them():
+    config = PrepareConfig(particles=30, rolling_friction=0.2, gravity=9.81)
+    with pytest.raises(ValueError, match="--device gpu does not run --rolling-friction, "
+                                         "--gravity"):
+        check_engine(config, "gpu")
+    check_engine(config, "cpu")
+    check_engine(PrepareConfig(particles=30), "gpu")
