@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from conftest import RADIUS, YOUNG, refused, run_in_process, two_body_scene
+from pendular.capillary import CapillaryBridges
 from pendular.dem.contact_law import normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
@@ -258,3 +259,15 @@ def test_the_gpu_engine_is_refused_the_forces_it_does_not_run_naming_them():
         check_engine(config, "gpu")
     check_engine(config, "cpu")
     check_engine(PrepareConfig(particles=30), "gpu")
+
+
+def test_a_capillary_bridge_does_not_raise_the_limit_moment():
+    """The limit is mu_r R* F_n of the contact law's normal force alone: the bridge's
+    attraction pulls the spheres together but is not part of F_n (as for the Coulomb cap)."""
+    sim = pressed_pair([0, 0, 1000.0], 0.2)
+    sim.forces.append(CapillaryBridges(2000.0, 0.073))
+    sim.run(300)
+    assert sim.operation(CapillaryBridges).count(sim) == 1
+    assert sim.particles.force[0, 0] != pytest.approx(-NORMAL_FORCE, rel=1e-3)   # attracted
+    assert sim.particles.torque[0] == pytest.approx([0, 0, -0.2 * REDUCED * NORMAL_FORCE],
+                                                    rel=1e-12)
