@@ -255,6 +255,10 @@ class PrepareConfig:
     the P-wave estimate on prepared samples; 'pwave', YADE's P-wave estimate of the smallest
     sphere (the thesis's, and pendular's former default; across six 2,000-sphere samples both
     give the same peaks within the scatter between samples, docs/seeds_timestep_rule.md).
+    ``rolling_friction``, ``twisting_friction``: the coefficients of the rolling and twisting
+    resistance (pendular.dem.rolling; 0: none), switched on with the test friction;
+    ``gravity`` [m/s^2]: the weight along -z in every phase (pendular.dem.gravity; 0: none;
+    walls only).
     ``skin_factor``: the neighbour list's Verlet skin / mean radius, a speed knob only (between
     walls results are bit-identical for any skin; in a periodic cell they differ at round-off,
     docs/periodic.md); 0.1 shears faster than 0.3 (fewer pairs, still rare rebuilds;
@@ -421,7 +425,7 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
     (``config.gravity`` > 0), the rolling and twisting resistance (``resistance`` and one of
     ``config``'s coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its
     runs on ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity
-    and resistance it holds the forces it held before they existed, bit for bit."""
+    and resistance it holds the contacts and the walls alone."""
     forces = [ContactForces(config.young, config.shear_ratio, friction_deg)]
     if not walls.periodic:
         forces.append(WallForces(config.young))
