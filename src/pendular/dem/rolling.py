@@ -5,8 +5,8 @@ A pair in contact (normal n from i to j, overlap δ > 0, mechanical normal force
 contact law, R* = R_i R_j / (R_i + R_j)) carries a rolling moment M_r (tangent to the contact)
 and a twisting moment M_t n, both on i (j gets their opposite):
 
-- rolling: stiffness k_r = 2.25 k_n μ_r² R*² (Ai et al., after Iwashita & Oda 1998), limit
-  μ_r R* F_n; each step the stored moment turns with the contact (as the shear force:
+- rolling: stiffness k_r = 2.25 k_n μ_r² R*² (Ai et al.'s; the spring, dashpot and slider
+  are Iwashita & Oda 1998's), limit μ_r R* F_n; each step the stored moment turns with the contact (as the shear force:
   tilt of the normal, then the mean spin about it), loses its normal part and is incremented by
   -k_r Δθ_r, Δθ_r = (ω_i - ω_j)_tangential dt, then capped at the limit, on which it stays while
   the pair rolls;
