@@ -6,10 +6,10 @@ contact law, R* = R_i R_j / (R_i + R_j)) carries a rolling moment M_r (tangent t
 and a twisting moment M_t n, both on i (j gets their opposite):
 
 - rolling: stiffness k_r = 2.25 k_n μ_r² R*² (Ai et al.'s; the spring, dashpot and slider
-  are Iwashita & Oda 1998's), limit μ_r R* F_n; each step the stored moment turns with the contact (as the shear force:
-  tilt of the normal, then the mean spin about it), loses its normal part and is incremented by
-  -k_r Δθ_r, Δθ_r = (ω_i - ω_j)_tangential dt, then capped at the limit, on which it stays while
-  the pair rolls;
+  are Iwashita & Oda 1998's), limit μ_r R* F_n; each step the stored moment turns with the
+  contact (as the shear force: tilt of the normal, then the mean spin about it), loses its
+  normal part and is incremented by -k_r Δθ_r, Δθ_r = (ω_i - ω_j)_tangential dt, then capped
+  at the limit, on which it stays while the pair rolls;
 - twisting: the same spring about the normal, k_t = 2.25 k_n μ_t² R*², limit μ_t R* F_n, on
   Δθ_t = n · (ω_i - ω_j) dt (the torsion analogue of Luding 2008);
 - viscous part (Ai et al.'s dashpot): -η C_crit ω_rel, C_crit = 2 sqrt(I k), I the pair's
@@ -21,10 +21,9 @@ and a twisting moment M_t n, both on i (j gets their opposite):
 k_n is the pair's secant stiffness F_n / δ, read from the per-pair arrays that every contact law
 fills (``Contacts.normal_force``, ``overlap``, ``normal``): the linear law's k_n itself, and for
 a Hertz law 4/3 E* sqrt(R* δ), the k_n LIGGGHTS's ``rolling_friction epsd`` takes from its
-Hertz law. F_n is
-the contact law's mechanical force alone: a capillary bridge's attraction does not raise the
-limit, as it does not raise the Coulomb cap. Sphere–wall contacts are frictionless and carry no
-moment.
+Hertz law. F_n is the contact law's mechanical force alone: a capillary bridge's attraction
+does not raise the limit, as it does not raise the Coulomb cap. Sphere–wall contacts are
+frictionless and carry no moment.
 """
 
 import math
@@ -37,7 +36,7 @@ from pendular.utils.validate import check_range
 
 #: Largest rolling or twisting coefficient: k_r grows as μ_r², and the time step is set by the
 #: normal and shear springs alone; up to 0.5 a rolling spring's k_r / I stays below
-#: 0.36 k_n / m, well under the normal springs' 2 k_n / m.
+#: 0.36 k_n / m for equal spheres, well under the normal springs' 2 k_n / m (docs/physics.md).
 MAX_RESISTANCE = 0.5
 
 OWNER = "rolling"
