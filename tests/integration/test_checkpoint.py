@@ -46,6 +46,15 @@ def prepared():
     return config, sim
 
 
+@pytest.fixture(scope="module")
+def prepared_rolling():
+    """A sample with rolling and twisting resistance: their springs are per-pair state."""
+    config = PrepareConfig(particles=60, unload_steps=200, confining=750.0,
+                           rolling_friction=0.2, twisting_friction=0.1)
+    sim, _ = prepare_sample(config, progress=False)
+    return config, sim
+
+
 def sheared(prepared, checkpoint_path):
     """The prepared sample in triaxial shear, built the same way every time."""
     config, sample = prepared
@@ -56,7 +65,9 @@ def sheared(prepared, checkpoint_path):
     return sim, run.recorder
 
 
-def test_resumed_shear_is_bit_identical_to_an_uninterrupted_one(prepared, tmp_path):
+@pytest.mark.parametrize("sample", ["prepared", "prepared_rolling"])
+def test_resumed_shear_is_bit_identical_to_an_uninterrupted_one(sample, request, tmp_path):
+    prepared = request.getfixturevalue(sample)
     path = tmp_path / "checkpoint.h5"
     whole, whole_history = sheared(prepared, path)
     steps = 40 * whole_history.period
@@ -77,6 +88,10 @@ def test_resumed_shear_is_bit_identical_to_an_uninterrupted_one(prepared, tmp_pa
     assert np.array_equal(resumed.walls.position, whole.walls.position)
     assert resumed.time == whole.time
     assert resumed.operation(NeighborList).rebuilds == whole.operation(NeighborList).rebuilds
+    for key, array in whole.contacts.extra.items():            # the rolling springs
+        assert np.array_equal(resumed.contacts.extra[key], array), key
+    if sample == "prepared_rolling":
+        assert any(key.startswith("rolling.") for key in whole.contacts.extra)
     expected, got = whole_history.arrays(), resumed_history.arrays()
     assert len(got["step"]) == len(expected["step"]) > 40
     for name in expected:

@@ -226,7 +226,8 @@ TENSION_SUMMARY_UNITS = {
 #: of the columns a Chapter 5 campaign.json adds.
 OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
-    "friction": "deg", "prep_friction": "deg", "density": "kg/m^3", "damping": "1",
+    "friction": "deg", "prep_friction": "deg", "rolling_friction": "1",
+    "twisting_friction": "1", "gravity": "m/s^2", "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",

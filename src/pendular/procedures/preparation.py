@@ -6,8 +6,11 @@
    GPU runs too).
 3. The whole sample rescaled so that the mean radius is the nominal one. With linear springs
    kn = E R, forces scale as R^2 and stresses are unchanged.
-4. Friction set to the test value (18°), the six walls servoed at ``prep_stress``, then the
+4. Friction set to the test value (18°) and the rolling and twisting resistance, if any,
+   switched on (pendular.dem.rolling), the six walls servoed at ``prep_stress``, then the
    target lowered slowly to the confining stress, and equilibrium again.
+
+With ``gravity`` the particles have their weight in every phase (pendular.dem.gravity).
 
 With ``periodic`` the box is a periodic cell (pendular.dem.cell) instead of six walls: the same
 procedure, the cell's stress (the Love–Weber stress of the contacts) servoed instead of the
@@ -27,10 +30,12 @@ from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
+from pendular.dem.gravity import MAX_GRAVITY, Gravity
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.neighbors import NeighborList, spatial_order
+from pendular.dem.rolling import MAX_RESISTANCE, RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import TIMESTEP_RULES, critical_timestep, pwave_timestep
@@ -250,6 +255,10 @@ class PrepareConfig:
     the P-wave estimate on prepared samples; 'pwave', YADE's P-wave estimate of the smallest
     sphere (the thesis's, and pendular's former default; across six 2,000-sphere samples both
     give the same peaks within the scatter between samples, docs/seeds_timestep_rule.md).
+    ``rolling_friction``, ``twisting_friction``: the coefficients of the rolling and twisting
+    resistance (pendular.dem.rolling; 0: none), switched on with the test friction;
+    ``gravity`` [m/s^2]: the weight along -z in every phase (pendular.dem.gravity; 0: none;
+    walls only).
     ``skin_factor``: the neighbour list's Verlet skin / mean radius, a speed knob only (between
     walls results are bit-identical for any skin; in a periodic cell they differ at round-off,
     docs/periodic.md); 0.1 shears faster than 0.3 (fewer pairs, still rare rebuilds;
@@ -277,8 +286,19 @@ class PrepareConfig:
         0.5, unit="deg", low=0.0, high=90.0, high_inclusive=False, flag="--prep-friction",
         help="contact friction during the radius growth (thesis 0.5; higher gives a looser "
              "sample; not with --sample)")
+    rolling_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--rolling-friction",
+        help="rolling resistance coefficient mu_r: limit moment mu_r R* Fn (pendular.dem."
+             "rolling; 0: none; with the test friction, not during the radius growth)")
+    twisting_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--twisting-friction",
+        help="twisting resistance coefficient mu_t: limit moment mu_t R* Fn about the normal "
+             "(0: none)")
     density: float = parameter(2650.0, unit="kg/m^3", low=0.0, low_inclusive=False,
                                help="grain density")
+    gravity: float = parameter(0.0, unit="m/s^2", low=0.0, high=MAX_GRAVITY, flag="--gravity",
+                               help="gravitational acceleration along -z (0: none; walls "
+                                    "only, not with --periodic)")
     damping: float = parameter(0.2, low=0.0, high=1.0, high_inclusive=False, flag="--damping",
                                help="Cundall local damping")
     timestep_safety: float = parameter(0.7, low=0.0, high=1.0, low_inclusive=False,
@@ -315,6 +335,10 @@ class PrepareConfig:
 
     def __post_init__(self):
         validate(self)
+        if self.gravity > 0.0 and self.periodic:
+            raise fail(self, "gravity", f"gravity = {self.gravity:g} m/s^2 is outside the "
+                       "valid range [0, 0] in a periodic cell (--periodic: no floor to carry "
+                       "the weight); leave out gravity or the periodic cell")
         if self.psd is not None:
             if self.radius_spread > 0.0:
                 raise fail(self, "radius_spread",
@@ -395,19 +419,48 @@ def equilibrated(config):
 
 
 def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None,
-                   device="cpu"):
+                   device="cpu", resistance=True):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m], linear
-    contacts at ``friction_deg`` [deg], wall springs (none in a periodic cell), the given
-    wall ``controls``, leapfrog; its runs on ``device`` ("cpu" or "gpu")."""
+    contacts at ``friction_deg`` [deg], wall springs (none in a periodic cell), the weight
+    (``config.gravity`` > 0), the rolling and twisting resistance (``resistance`` and one of
+    ``config``'s coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its
+    runs on ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity
+    and resistance it holds the contacts and the walls alone."""
     forces = [ContactForces(config.young, config.shear_ratio, friction_deg)]
     if not walls.periodic:
         forces.append(WallForces(config.young))
+    if config.gravity > 0.0:
+        forces.append(Gravity(config.gravity))
+    if resistance:
+        forces.extend(resisting(config))
     return Simulation(particles, walls, dt,
                       neighbors=NeighborList(skin),
                       forces=forces,
                       controls=controls,
                       integrator=Integrator(config.damping),
                       threads=threads, device=device)
+
+
+def resisting(config):
+    """The rolling and twisting resistance of ``config`` as a list of forces: one
+    RollingResistance when its rolling_friction or twisting_friction is above 0, else none."""
+    if config.rolling_friction > 0.0 or config.twisting_friction > 0.0:
+        return [RollingResistance(config.rolling_friction, config.twisting_friction)]
+    return []
+
+
+#: The sample's forces that the CPU engine alone runs, by PrepareConfig field.
+CPU_ONLY = ("rolling_friction", "twisting_friction", "gravity")
+
+
+def check_engine(config, device):
+    """ValueError naming --device and the options when ``device`` is not "cpu" and
+    ``config`` (a PrepareConfig) asks for a force that only the CPU engine runs (CPU_ONLY
+    above 0), before anything runs."""
+    asked = [spec_of(config, name).flag for name in CPU_ONLY if getattr(config, name) > 0.0]
+    if device != "cpu" and asked:
+        raise ValueError(f"--device {device} does not run {', '.join(asked)} yet (the CPU "
+                         f"engine alone has them): leave them at 0 or run on --device cpu")
 
 
 def servoed_simulation(particles, walls, config, target, threads=None):
@@ -482,7 +535,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
         growth.append(GrowthTimeStep(config))
     sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
                          GROWTH_SKIN_FACTOR * config.radius,
-                         config.prep_friction_deg, growth, threads, device)
+                         config.prep_friction_deg, growth, threads, device, resistance=False)
     writers = list(writers)
     sim.writers.extend(writers)
     done = equilibrated(config)
@@ -507,6 +560,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     sim.controls = [servo]
     sim.dt = timestep(sim, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
+    sim.forces.extend(resisting(config))        # with the test friction, as in a loaded sample
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=label and "set friction", status=status)
