@@ -53,8 +53,9 @@ from pendular.procedures.guards import SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
     WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
-    friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
-    oedometer_summary, path_deviations, shear_stage, void_ratio)
+    excess_pore_pressure, friction_angle, isotropic_stages, isotropic_summary, k0,
+    oedometer_stages, oedometer_summary, path_deviations, shear_stage, undrained_summary,
+    void_ratio)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
@@ -164,6 +165,10 @@ def wet_sample(sim, config, *, progress=None):
     - 'constant-volume': bridges added with the walls fixed, run until the unbalanced force is
       below the threshold, then the servo brings the walls to the confining stress.
 
+    Undrained (TriaxialConfig.undrained) at a suction, the bridges are volume-controlled,
+    formed at the suction from a reservoir, and the liquid is then closed
+    (CapillaryBridges.close_liquid), so that the shear holds the water content.
+
     At a water content (config.bridges.water_content) the bridges are volume-controlled, their
     formation suction found so that they hold w Gs V_s (Gs = density / 1000 kg/m^3;
     pendular.procedures.water_content), the sample re-equilibrated; the liquid is then closed
@@ -196,6 +201,9 @@ def wet_sample(sim, config, *, progress=None):
     report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
     if config.wetting == "constant-volume":
         report["sigma_wall_at_constant_volume"] = fixed_stress
+    if config.undrained:                # the water cannot leave during the shear
+        bridges.close_liquid(sim, config.bridges.liquid)
+        report["liquid_initial"] = bridges.liquid_initial
     return sim, bridges, report
 
 
@@ -450,7 +458,7 @@ def parameters(config):
     if isinstance(config, TriaxialConfig):
         # a conventional run's rows stay as they were, without the path's options
         flat.update(flat_options(config.shear, () if not config.shear.conventional else
-                                 ("direction", "b", "constant_p")))
+                                 ("direction", "b", "constant_p", "drainage")))
     else:                           # a path (PathConfig) names its own options
         flat.update(config.path_parameters())
         flat.update({"inertial_number": config.inertial_number,
@@ -669,6 +677,11 @@ class LaboratoryTest:
         """The test's results from its ``history`` (dict of arrays)."""
         raise NotImplementedError
 
+    def derived(self, history):
+        """The recorded ``history`` (dict of arrays) with the columns the test computes from
+        its rows (none here)."""
+        return history
+
     def frame_fields(self, path):
         """(field data function of sim, time axis name) of the ParaView frames of the loading
         ``path`` (pendular.io.vtk.VtkWriter): the axial strain, in % on the time axis."""
@@ -700,7 +713,16 @@ class TriaxialTest(LaboratoryTest):
         summary["peak_reached"] = peak_reached(history["axial_strain"],
                                                sign * deviator_stress(history["sigma_wall"]))
         summary.update(path_deviations(history, shear, self.config.confining))
+        if self.config.undrained:
+            summary.update(undrained_summary(history, summary["peak_index"]))
         return summary
+
+    def derived(self, history):
+        """Undrained, the history with ``excess_pore_pressure`` (loading.excess_pore_pressure
+        of the wall stresses)."""
+        if self.config.undrained:
+            history["excess_pore_pressure"] = excess_pore_pressure(history["sigma_wall"])
+        return history
 
     def plot(self, history, out, title):
         direction = self.config.shear.direction
@@ -867,7 +889,7 @@ class _PathRun:
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
-        history = self.path.recorder.arrays()
+        history = self.test.derived(self.path.recorder.arrays())
         summary = self.test.summarize(history)
         rate = config.rate()
         sheared = sim.step - self.start_step
@@ -894,11 +916,14 @@ class _PathRun:
             **self.before_shear["wetting"],
         })
         if "liquid_bridges" in history:
-            initial = self.before_shear["wetting"]["liquid_initial"]
+            # the closed amount, which water-content stages change (path_table.liquid_total)
+            initial = np.asarray(history.get("liquid_total",
+                                             self.before_shear["wetting"]["liquid_initial"]))
             total = history["liquid_bridges"] + history["liquid_film"] + history["liquid_lost"]
             summary.update({
-                "liquid_balance_error": float(np.max(np.abs(total - initial)) / initial),
-                "liquid_lost_fraction": float(history["liquid_lost"][-1] / initial)})
+                "liquid_balance_error": float(np.max(np.abs(total - initial) / initial)),
+                "liquid_lost_fraction": float(history["liquid_lost"][-1]
+                                              / np.ravel(initial)[-1])})
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
