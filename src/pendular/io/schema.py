@@ -214,8 +214,15 @@ OEDOMETER_SUMMARY_UNITS = {
 ISOTROPIC_SUMMARY_UNITS = {
     "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa", "q_effective": "Pa",
                "sigma_wall": "Pa", "void_ratio": "1", "axial_strain": "1",
-               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1"},
+               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1",
+               "axial_strain_change": "1", "volumetric_strain_change": "1", "suction": "Pa",
+               "saturation": "1", "water_content": "1"},
     "final_void_ratio": "1", "peak_stage": "1",
+    "water_stages": {"stage": "1", "axial_strain_change": "1",
+                     "volumetric_strain_change": "1",
+                     "suction_before": "Pa", "suction_after": "Pa",
+                     "water_content_before": "1", "water_content_after": "1"},
+    "collapse_strain": "1", "collapse_axial_strain": "1",
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).

@@ -978,8 +978,11 @@ class TablePathConfig(PathConfig):
         source, the entry and the key)."""
         from pendular.procedures.path_table import build_stages
 
+        from pendular.procedures.path_table import wetting_of
+
         return build_stages(self.stages, self.source, confining=self.sample.confining,
-                            rate=self.rate(), young=self.sample.young)
+                            rate=self.rate(), young=self.sample.young,
+                            wetting=wetting_of(self.bridges))
 
     def reference_pressure(self):
         """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining
