@@ -100,7 +100,7 @@ class WaterContentChange:
             self.done = True
 
 
-def solid_mass_water(particles):
+def unit_water_volume(particles):
     """Water volume [m^3] of a gravimetric water content of 1 (100 %) for ``particles``: the
     grains' mass over the density of water, Gs V_s (Gs = rho_s / WATER_DENSITY)."""
     return particles.density / WATER_DENSITY * particles.solid_volume()
@@ -108,9 +108,9 @@ def solid_mass_water(particles):
 
 def water_content(sim, bridges):
     """Gravimetric water content [%] held by the volume-controlled ``bridges`` of ``sim``: the
-    liquid of the bridges and the grains' films over Gs V_s (solid_mass_water)."""
+    liquid of the bridges and the grains' films over Gs V_s (unit_water_volume)."""
     held, film, _, _ = bridges.liquid_balance(sim)
-    return 100.0 * (held + film) / solid_mass_water(sim.particles)
+    return 100.0 * (held + film) / unit_water_volume(sim.particles)
 
 
 def set_water_content(sim, bridges, percent):
@@ -128,13 +128,13 @@ def set_water_content(sim, bridges, percent):
     state = bridges.state(sim)
     held, film, _, _ = bridges.liquid_balance(sim)
     present = held + film
-    target = percent / 100.0 * solid_mass_water(sim.particles)
+    target = percent / 100.0 * unit_water_volume(sim.particles)
     mask = state.mask()
     radius = sim.particles.radius
     larger = np.maximum(radius[sim.contacts.pair_i[mask]], radius[sim.contacts.pair_j[mask]])
     volume_star = state.volume[mask] / larger ** 3
     low, high = bridges.volume_table.volume_star_bounds()
-    now = 100.0 * present / solid_mass_water(sim.particles)
+    now = 100.0 * present / unit_water_volume(sim.particles)
     most = now * high / volume_star.max() if mask.any() else now
     least = now * low / volume_star.min() if mask.any() else now
     if not mask.any() or not least <= percent <= most:

@@ -183,7 +183,17 @@ def wet_sample(sim, config, *, progress=None):
         return _wet_at_water_content(sim, config, thresholds, progress)
     bridges = config.bridges.build()
     if config.wetting == "isotropic":
-        return sim, bridges, wet(sim, bridges, progress=progress, **thresholds)
+        report = wet(sim, bridges, progress=progress, **thresholds)
+    else:
+        report = _wet_by_protocol(sim, config, bridges, thresholds, progress)
+    if config.undrained:                # the water cannot leave during the shear
+        bridges.close_liquid(sim, config.bridges.liquid)
+        report["liquid_initial"] = bridges.liquid_initial
+    return sim, bridges, report
+
+
+def _wet_by_protocol(sim, config, bridges, thresholds, progress):
+    """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols."""
     started = time.perf_counter()
     sim.forces.append(bridges)
     steps = 0
@@ -201,10 +211,7 @@ def wet_sample(sim, config, *, progress=None):
     report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
     if config.wetting == "constant-volume":
         report["sigma_wall_at_constant_volume"] = fixed_stress
-    if config.undrained:                # the water cannot leave during the shear
-        bridges.close_liquid(sim, config.bridges.liquid)
-        report["liquid_initial"] = bridges.liquid_initial
-    return sim, bridges, report
+    return report
 
 
 def _wet_at_water_content(dry, config, thresholds, progress):
