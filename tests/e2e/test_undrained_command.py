@@ -1,15 +1,18 @@
 """Undrained triaxial and water stages as a user runs them: ``pendular triaxial --drainage
 undrained`` dry and wet (the volume held within 1e-6, the excess pore pressure its
 definition, the wet sample's water held), a path table with a ramped and a stepped suction
-stage and one with a water-content stage and a constant-volume stage, and bad stage entries
-refused in one line naming the table, the stage and the key with its range."""
+stage and one with a water-content stage and a constant-volume stage, the shipped collapse
+table (examples/paths/wetting_collapse.toml), and bad stage entries refused in one line naming
+the table, the stage and the key with its range."""
+
+import os
 
 import numpy as np
 import pytest
 
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 
-from conftest import history_of, refused, run_in_process, summary_of
+from conftest import ROOT, history_of, refused, run_in_process, summary_of
 
 SMALL = ["--particles", "60", "--confining", "750", "--seed", "1", "--quiet", "--vtk-every",
          "0"]
@@ -121,3 +124,22 @@ def test_undrained_refuses_b_in_one_line(tmp_path, capsys):
     status, err = run_in_process("triaxial", ["--drainage", "undrained", "--b", "0.5",
                                               "--out", tmp_path / "out"], capsys)
     refused(status, err, "drainage = 'undrained' holds the volume", "--b")
+
+
+def test_the_shipped_collapse_table_runs_and_gives_the_strain_of_its_wetting(tmp_path, capsys):
+    out = tmp_path / "collapse"
+    status, err = run_in_process("path", [os.path.join(ROOT, "examples", "paths",
+                                                       "wetting_collapse.toml"),
+                                          *SMALL, "--suction", "30000", "--radius", "0.0001",
+                                          "--inertial-number", "2e-3", "--out", out], capsys)
+    assert status == 0, err
+    summary = summary_of(out)
+    (wetting,) = summary["water_stages"]
+    assert (wetting["stage"], wetting["suction_before"], wetting["suction_after"]) == (
+        2, 30000.0, 1000.0)
+    assert summary["collapse_strain"] == wetting["volumetric_strain_change"]
+    # oedometric: the lateral walls held, so the volumetric strain is the axial one
+    assert summary["collapse_axial_strain"] == pytest.approx(summary["collapse_strain"],
+                                                             abs=1e-12)
+    axial = [row["sigma_wall"][2] for row in summary["stages"]]
+    assert axial == pytest.approx([10000.0] * 3, rel=0.01)
