@@ -143,3 +143,20 @@ def test_the_shipped_collapse_table_runs_and_gives_the_strain_of_its_wetting(tmp
                                                              abs=1e-12)
     axial = [row["sigma_wall"][2] for row in summary["stages"]]
     assert axial == pytest.approx([10000.0] * 3, rel=0.01)
+
+
+@pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])
+def test_an_interrupted_undrained_shear_resumes_to_the_same_history(wet, tmp_path, capsys):
+    options = [*SMALL, *SHEAR, *wet, "--checkpoint-every", "200"]
+    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
+    status, err = run_in_process("triaxial", [*options, "--out", whole], capsys)
+    assert status == 0, err
+    steps = summary_of(whole)["steps"]
+    status, _ = run_in_process("triaxial", [*options, "--out", stopped,
+                                            "--stop-after", str(steps // 2)], capsys)
+    assert status == 130
+    status, err = run_in_process("triaxial", ["--resume", stopped, "--quiet"], capsys)
+    assert status == 0, err
+    expected, got = history_of(whole), history_of(stopped)
+    for name in expected:
+        assert np.array_equal(got[name], expected[name], equal_nan=True), name

@@ -126,3 +126,15 @@ def test_undrained_refuses_b_and_constant_p_and_holds_the_water_of_a_wet_sample(
     with pytest.raises(ParameterError, match="--persist-bridges do not apply"):
         TriaxialConfig(sample=sample, bridges=BridgeConfig(30000.0, persist=True),
                        shear=ShearConfig(drainage="undrained"))
+
+
+def test_a_device_other_than_the_cpu_refuses_the_host_only_stages():
+    from pendular.procedures.loading import check_stages_device
+
+    undrained = Stage(strain_rate={"z": 1.0}, volume="constant", until=Strain(0.1))
+    wetting = Stage(stress={a: 500.0 for a in "xyz"}, suction=1000.0)
+    for stage, key in ((undrained, "volume = 'constant'"), (wetting, "suction = 1000.0")):
+        check_stages_device([stage], "cpu")
+        with pytest.raises(ValueError, match=f"--device gpu: stage 2 has {key}, whose control "
+                                             "runs on the CPU only; valid: --device cpu"):
+            check_stages_device([Stage(stress={a: 500.0 for a in "xyz"}), stage], "gpu")

@@ -336,6 +336,24 @@ def water_controls(stage, bridges):
     return []
 
 
+#: Stage keys whose controls run on the CPU only (pendular.gpu.simulation.check_scene refuses
+#: ConstantVolume, SuctionChange and WaterContentChange).
+HOST_ONLY_KEYS = ("volume", "suction", "water_content")
+
+
+def check_stages_device(stages, device):
+    """ValueError naming ``--device`` when ``device`` is not "cpu" and a stage of ``stages``
+    has a key of HOST_ONLY_KEYS, before anything runs."""
+    if device == "cpu":
+        return
+    for number, stage in enumerate(stages, 1):
+        for key in HOST_ONLY_KEYS:
+            if getattr(stage, key) is not None:
+                raise ValueError(f"--device {device}: stage {number} has {key} = "
+                                 f"{getattr(stage, key)!r}, whose control runs on the CPU "
+                                 "only; valid: --device cpu")
+
+
 class MixedStress(mixed_stress.MixedStress):
     """The mixed condition of a Stage (module docstring): a control that sets, each step
     before the servos run, the targets of the servos of the stage's free axes from the

@@ -7,7 +7,10 @@ A path table is a TOML file of ``[[stage]]`` entries, run in their order by
 - a stage: the keys of pendular.procedures.loading.Stage, read from its fields, so that a
   field added to Stage is a key here: ``stress = {x = 500, y = 500}`` [Pa],
   ``strain_rate = {z = 0.5}`` [1/s, compression positive; 0 holds the walls], ``mean_stress``
-  [Pa], ``b``, ``max_strain_rate`` [1/s], and ``until``, its end (``UNTIL_KINDS``):
+  [Pa], ``b``, ``max_strain_rate`` [1/s], ``volume = "constant"`` (undrained: x and y hold
+  the volume), ``suction`` [Pa] with ``suction_rate`` [Pa/s] (a ramp; none: a step) on a
+  sample wetted at a suction, ``water_content`` [%, as --water-content] on one wetted at a
+  water content (pendular.procedures.hydraulic), and ``until``, its end (``UNTIL_KINDS``):
   ``{strain = 0.05, axis = "z"}``, ``{stress = 5000, axis = "z", strain_limit = 0.2}``,
   ``"static"`` or ``{static = true, max_steps = 100000, unbalanced = 0.01, tolerance = 0.01,
   check_every = 200}`` (no ``until``: static);
@@ -28,8 +31,14 @@ entry of the group at entry 3) and the valid keys; a value Stage refuses, with i
 prefixed by the same. The parsed entries are stored as plain data in the configuration
 (pendular.procedures.config.TablePathConfig), so a run resumes without its table.
 
-In Python, ``run_path`` runs stages on a scene and returns their history, ``change_suction``
-brings suction-controlled bridges to a new suction at a held stress; with
+A stage's water key needs the sample wetted as it says (``check_water``), and a suction
+within the bridge tables for the sample's radii (``check_suctions``), both refused before
+anything runs. The summary (``path_summary``) gives each stage's strain changes and, for the
+stages that change the water, ``water_stages`` and the ``collapse_strain`` of wetting.
+
+In Python, ``run_path`` runs stages on a scene and returns their history (a Stage's
+``suction`` or ``water_content`` changes the water within a path), ``change_suction``
+brings suction-controlled bridges to a new suction at a held stress in increments; with
 pendular.procedures.triaxial's ``equilibrate`` and ``wet`` they compose any path of stress
 and suction (examples/loading_path_api.py). Stresses compression positive [Pa].
 """
@@ -346,6 +355,9 @@ class PathTest(LaboratoryTest):
     def __init__(self, config, *, force=False):
         super().__init__(config, force=force)
         check_suctions(config)
+
+    def stages(self):
+        return self.config.loading_stages()
 
     def loading(self, sim):
         config = self.config

@@ -53,7 +53,7 @@ from pendular.procedures.guards import SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
     WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
-    excess_pore_pressure, friction_angle, isotropic_stages, isotropic_summary, k0,
+    check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages, isotropic_summary, k0,
     oedometer_stages, oedometer_summary, path_deviations, shear_stage, undrained_summary,
     void_ratio)
 from pendular.io.history import write_history
@@ -575,6 +575,7 @@ class LaboratoryTest:
         the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
         the configuration."""
         check_device(device)
+        check_stages_device(self.stages(), device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         if self.config.sample_path is not None:       # checked before the folder is touched
@@ -680,6 +681,11 @@ class LaboratoryTest:
         """The LoadingPath of the test attached to the static sample ``sim`` (time step set)."""
         raise NotImplementedError
 
+    def stages(self):
+        """The stages of the loading known before it runs, for the checks made then
+        (loading.check_stages_device); [] by default."""
+        return []
+
     def summarize(self, history):
         """The test's results from its ``history`` (dict of arrays)."""
         raise NotImplementedError
@@ -712,6 +718,10 @@ class TriaxialTest(LaboratoryTest):
     def loading(self, sim):
         config = self.config
         return shear_path(sim, config.shear, config.confining, config.rate())
+
+    def stages(self):
+        config = self.config
+        return [shear_stage(config.shear, config.confining, config.rate())]
 
     def summarize(self, history):
         shear = self.config.shear
