@@ -36,7 +36,7 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "porosity", "friction", "prep_friction", "young", "damping", "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
              "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
-             "table_resolution", "max_strain", "direction", "b", "constant_p",
+             "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}
 LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
