@@ -42,7 +42,7 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
 LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
 #: The sample, wetting and output options every laboratory command shares (generated on the
 #: triaxial).
-LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "records",
+LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "drainage", "records",
                           "inertial_number", "strain_rate", "vtk_frames"}
 RATE = {"inertial_number", "strain_rate"}
 SIZES = {"radius", "radius_spread"}
