@@ -53,9 +53,9 @@ from pendular.procedures.guards import SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
     WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
-    check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages, isotropic_summary, k0,
-    oedometer_stages, oedometer_summary, path_deviations, shear_stage, undrained_summary,
-    void_ratio)
+    check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages,
+    isotropic_summary, k0, oedometer_stages, oedometer_summary, path_deviations, shear_stage,
+    undrained_summary, void_ratio)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
