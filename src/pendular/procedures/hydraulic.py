@@ -1,7 +1,7 @@
 """The water of a loading path's stage: a new suction, stepped or ramped, or a new water content.
 
 A stage of pendular.procedures.loading may change what the capillary bridges hold while its
-walls do what the stage says (docs/loading_paths.md, 'Suction and water-content stages'):
+walls do what the stage says (docs/loading_paths.md, 'Constant volume, suction and water content in a stage'):
 
 - ``suction`` [Pa], suction-controlled bridges (a sample wetted at a suction): imposed at the
   stage's first step (a step; the stage's end, e.g. static, is the equilibrium after it), or
