@@ -7,7 +7,7 @@ One namespace; its sub-packages are layers, each importing only those to its lef
 
 - scenes: ``Simulation`` (state plus the declared step pipeline), ``Particles``, ``Walls``,
   ``NeighborList``, ``ContactForces``, ``WallForces``, ``StressServo``, ``ConstantStrainRate``,
-  ``Integrator``, ``HistoryRecorder``, ``CapillaryBridges``;
+  ``ConstantVolume``, ``Integrator``, ``HistoryRecorder``, ``CapillaryBridges``;
 - preparation: ``PrepareConfig``, ``prepare_sample``;
 - loading paths: ``Stage`` (per-axis stress or strain-rate control, ends at a ``Strain``, a
   ``Stress`` or ``Static``), ``LoadingPath``; ``OedometerConfig``, ``OedometerTest``,
@@ -38,6 +38,7 @@ _EXPORTS = {
     "Walls": "pendular.dem.state",
     "ConstantShearRate": "pendular.dem.cell",
     "ConstantStrainRate": "pendular.dem.walls",
+    "ConstantVolume": "pendular.dem.walls",
     "StressServo": "pendular.dem.walls",
     "WallForces": "pendular.dem.walls",
     "Campaign": "pendular.studies.campaign",

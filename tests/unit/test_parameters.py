@@ -37,13 +37,13 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "gravity", "young", "damping", "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
              "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
-             "table_resolution", "max_strain", "direction", "b", "constant_p",
+             "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}
 LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "simple-shear")
 #: The sample, wetting and output options every laboratory command shares (generated on the
 #: triaxial).
-LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "records",
+LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "drainage", "records",
                           "inertial_number", "strain_rate", "vtk_frames"}
 RATE = {"inertial_number", "strain_rate"}
 SIZES = {"radius", "radius_spread"}

@@ -21,8 +21,9 @@ WET = DRY + ["saturation", "suction", "sigma_capillary", "bridges", "pendular_ov
 TENSION = ["step", "time", "axial_strain", "tensile_stress", "grip_pull", "sigma_wall",
            "coordination", "unbalanced_force", "bridges", "water_content", "saturation"]
 #: Columns of a triaxial at constant water content (closed liquid), besides WET.
-LIQUID = ["liquid_bridges", "liquid_film", "liquid_lost"]
-PATHS = ["void_ratio", "k0", "stage", "cycle", "shear_strain", "shear_stress", "normal_stress"]
+LIQUID = ["liquid_bridges", "liquid_film", "liquid_lost", "liquid_total"]
+PATHS = ["void_ratio", "k0", "stage", "cycle", "shear_strain", "shear_stress", "normal_stress",
+         "excess_pore_pressure"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}
 ROWS = 7
 

@@ -1,8 +1,10 @@
-"""Wall operations: sphere–wall forces, stress servo and constant strain rate (docs/physics.md
-'Walls, servo and preparation').
+"""Wall operations: sphere–wall forces, stress servo, constant strain rate and constant volume
+(docs/physics.md 'Walls, servo and preparation').
 
 A wall displacement ``outward`` > 0 opens the box: the low wall moves to -axis, the high to +axis.
 """
+
+import math
 
 import numba
 import numpy as np
@@ -248,4 +250,40 @@ class ConstantStrainRate:
             walls.stretch(self.axis, -self.rate * length * sim.dt, sim.dt)
             return
         self._shift[:] = -0.5 * self.rate * length * sim.dt
+        move_walls(walls.position, walls.velocity, self._walls, self._shift, sim.dt)
+
+
+class ConstantVolume:
+    """Hold the volume of the box at ``volume`` [m^3] by moving the two lateral axes x and y
+    (the walls of each, or a periodic cell's lengths): each call scales both lengths by
+    sqrt(volume / (L_x L_y L_z)), their ratio kept, so that after it L_x L_y L_z = volume to
+    round-off, whatever the axial (z) control did before it in the step. Listed after the
+    control that drives z: an undrained (constant-volume) shear of a saturated sample, whose
+    pore water keeps the volume while the axial strain is imposed."""
+
+    #: The axes it moves.
+    AXES = (0, 1)
+
+    def __init__(self, volume):
+        self.volume = check_positive("volume", volume, "m^3")
+        self._walls = np.array([0, 1, 2, 3], dtype=np.int64)
+        self._shift = np.zeros(4)
+
+    def state_dict(self):
+        """The ``volume`` [m^3] its stage holds."""
+        return {"volume": self.volume}
+
+    def load_state(self, state):
+        self.volume = check_positive("volume", state["volume"], "m^3")
+
+    def apply(self, sim):
+        walls = sim.walls
+        lengths = walls.lengths()
+        factor = math.sqrt(self.volume / (lengths[0] * lengths[1] * lengths[2]))
+        change = (factor - 1.0) * lengths[:2]
+        if walls.periodic:
+            for axis in self.AXES:
+                walls.stretch(axis, change[axis], sim.dt)
+            return
+        self._shift[:] = np.repeat(0.5 * change, 2)
         move_walls(walls.position, walls.velocity, self._walls, self._shift, sim.dt)

@@ -117,7 +117,8 @@ def write_plots(history, folder, title="", direction="compression"):
     """The plots of a triaxial run into ``folder``, each against axial strain [%] with the run's
     parameters in the title: q_p.png (q/p of the net stress and, wet, q'/p' of the effective
     stress of Eq. 3.43), volumetric_strain.png and, wet, saturation.png (Sr [%]) and
-    capillary_stress.png (capillary_figure); the peak of q (``direction`` 'extension': of -q)
+    capillary_stress.png (capillary_figure); undrained, excess_pore_pressure.png (Delta u
+    [kPa]) and, wet, suction.png (s [kPa]); the peak of q (``direction`` 'extension': of -q)
     marked, none for ``direction`` None (a path without a failure). Returns the paths."""
     plt = pyplot()
     strain = 100.0 * history["axial_strain"]
@@ -149,6 +150,13 @@ def write_plots(history, folder, title="", direction="compression"):
     if "saturation" in history:
         single("saturation.png", "Degree of saturation", "degree of saturation Sr [%]",
                [("Sr", 100.0 * history["saturation"])])
+    if "excess_pore_pressure" in history:           # an undrained shear
+        single("excess_pore_pressure.png", "Undrained: excess pore pressure "
+               "Δu = Δp_total − Δp′ (σ3 held)", "excess pore pressure Δu [kPa]",
+               [("Δu", history["excess_pore_pressure"] / 1000.0)])
+        if "suction" in history:                    # at a constant water content
+            single("suction.png", "Suction at constant water content (undrained)",
+                   "suction s [kPa]", [("s", history["suction"] / 1000.0)])
     figure = capillary_figure(history, title)
     if figure is not None:
         paths.append(save_figure(figure, os.path.join(folder, "capillary_stress.png")))

@@ -20,6 +20,9 @@ Columns by test (pendular.procedures.loading.history_columns, pendular.procedure
 - cyclic triaxial (pendular.procedures.cyclic.CyclicTest): the oedometer's less k0, and cycle;
 - simple shear (pendular.procedures.simple_shear.SimpleShearTest): the loading path's,
   shear_strain, shear_stress and normal_stress;
+- undrained triaxial (--drainage undrained): the triaxial's and excess_pore_pressure;
+- a path with water-content stages: water_content and liquid_total besides the liquid
+  columns;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
   coordination, unbalanced_force, and wet: bridges, water_content, saturation.
 """
@@ -122,6 +125,14 @@ HISTORY_COLUMNS = {
     "liquid_lost": Column("m^3", "liquid of ruptured bridges removed (closed liquid, model "
                                  "'lost'); bridges + film + lost = the liquid at the start of "
                                  "the shear"),
+    "liquid_total": Column("m^3", "closed amount of liquid: the wetting's, plus what the "
+                                  "water-content stages of a path added (bridges + film + lost "
+                                  "= it)"),
+    "excess_pore_pressure": Column("Pa", "undrained shear: excess pore pressure of a "
+                                         "saturated sample from the start, Delta p_total - "
+                                         "Delta p' with p_total = sigma_3 + q/3 (the "
+                                         "conventional total path, sigma_3 held) and p' the "
+                                         "mean wall stress"),
     "tensile_stress": Column("Pa", "mean pull of the grips over the cross-section, tension "
                                    "positive"),
     "grip_pull": Column("N", "force of the specimen on each grip, toward the specimen",
@@ -203,8 +214,15 @@ OEDOMETER_SUMMARY_UNITS = {
 ISOTROPIC_SUMMARY_UNITS = {
     "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa", "q_effective": "Pa",
                "sigma_wall": "Pa", "void_ratio": "1", "axial_strain": "1",
-               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1"},
+               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1",
+               "axial_strain_change": "1", "volumetric_strain_change": "1", "suction": "Pa",
+               "saturation": "1", "water_content": "1"},
     "final_void_ratio": "1", "peak_stage": "1",
+    "water_stages": {"stage": "1", "axial_strain_change": "1",
+                     "volumetric_strain_change": "1",
+                     "suction_before": "Pa", "suction_after": "Pa",
+                     "water_content_before": "1", "water_content_after": "1"},
+    "collapse_strain": "1", "collapse_axial_strain": "1",
 }
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
@@ -268,12 +286,23 @@ SIMPLE_SHEAR_SUMMARY_UNITS = {
     "normal_stress": "Pa",
 }
 
+#: Units of the keys an undrained triaxial adds to its summary.json
+#: (pendular.procedures.loading.undrained_summary).
+UNDRAINED_SUMMARY_UNITS = {
+    "excess_pore_pressure_at_peak": "Pa", "excess_pore_pressure_final": "Pa",
+    "excess_pore_pressure_max": "Pa", "p_min": "Pa", "axial_strain_at_p_min": "1",
+    "max_volume_change": "1", "suction_final": "Pa", "saturation_final": "1",
+    "effective_stress_path": {"axial_strain": "1", "p": "Pa", "q": "Pa",
+                              "excess_pore_pressure": "Pa", "p_effective": "Pa",
+                              "suction": "Pa", "saturation": "1"},
+}
+
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
                  **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS}
+                 **SIMPLE_SHEAR_SUMMARY_UNITS, **UNDRAINED_SUMMARY_UNITS}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

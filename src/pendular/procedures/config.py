@@ -43,6 +43,10 @@ WETTING_PROTOCOLS = ("isotropic", "at-shear", "constant-volume")
 #: constant rate, the lateral stress held (compression), or pulled apart (extension).
 SHEAR_DIRECTIONS = ("compression", "extension")
 
+#: Drainage of a triaxial shear (ShearConfig.drainage): the lateral stress held and the volume
+#: free (drained), or the volume held (undrained: the pore water cannot leave).
+DRAINAGES = ("drained", "undrained")
+
 #: Version of the configuration layout saved in outputs (samples, checkpoints, histories).
 CONFIG_SCHEMA_VERSION = 2
 
@@ -118,7 +122,9 @@ class ShearConfig:
     ``b``: the intermediate principal stress ratio (sigma_2 - sigma_3) / (sigma_1 - sigma_3)
     held through a compression, sigma_1 on z, sigma_3 on x (None: sigma_x = sigma_y, a
     conventional triaxial); ``constant_p``: the lateral stresses follow the axial one so that
-    the mean stress stays the confining stress.
+    the mean stress stays the confining stress; ``drainage`` (DRAINAGES): "undrained" holds the
+    sample's volume, the lateral walls moving with the axial ones (neither b nor constant_p:
+    the volume sets the lateral walls).
     """
 
     max_strain: float = parameter(0.25, low=MIN_AXIAL_STRAIN, high=MAX_AXIAL_STRAIN,
@@ -149,6 +155,11 @@ class ShearConfig:
     constant_p: bool = parameter(False, kind=bool, flag="--constant-p",
                                  help="hold the mean stress p at --confining while q rises (the "
                                       "lateral stresses follow the axial one)")
+    drainage: str = parameter("drained", kind=str, choices=DRAINAGES, flag="--drainage",
+                              help="drained: the lateral stress held, the volume free; "
+                                   "undrained: the volume held (the lateral walls follow the "
+                                   "axial ones), the excess pore pressure of a saturated "
+                                   "sample an output; wet, the water content held too")
 
     def __post_init__(self):
         validate(self)
@@ -156,6 +167,10 @@ class ShearConfig:
             raise fail(self, "b", f"b = {self.b:g} needs --direction compression: b = "
                        "(sigma_2 - sigma_3) / (sigma_1 - sigma_3) is held with sigma_1 on the "
                        "axial walls")
+        if self.drainage == "undrained" and (self.b is not None or self.constant_p):
+            raise fail(self, "drainage", "drainage = 'undrained' holds the volume with the "
+                       "lateral walls: --b and --constant-p, which set their stresses, do not "
+                       "apply")
 
     def rate(self, radius, density, confining):
         """Axial strain rate [1/s]: the given one, or the one of the target inertial number at
@@ -167,7 +182,8 @@ class ShearConfig:
     def conventional(self):
         """Whether this is the conventional triaxial compression of thesis Ch. 5 (lateral stress
         held, sigma_x = sigma_y)."""
-        return self.direction == "compression" and self.b is None and not self.constant_p
+        return (self.direction == "compression" and self.b is None and not self.constant_p
+                and self.drainage == "drained")
 
 
 #: ShearConfig options that reproduce YADE's TriaxialStressController (stiffnessUpdateInterval 10).
@@ -326,6 +342,8 @@ class LaboratoryConfig:
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
+    #: Whether the loading holds the sample's volume and water (TriaxialConfig.undrained).
+    undrained = False
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -384,6 +402,19 @@ class TriaxialConfig(LaboratoryConfig):
         if not isinstance(self.shear, ShearConfig):
             raise TypeError(f"shear must be a ShearConfig, got {type(self.shear).__name__}")
         super().__post_init__()
+        bridges = self.bridges
+        if self.undrained and bridges is not None and bridges.control != "volume":
+            # the water cannot leave either: bridges of constant volume, formed at the suction
+            if bridges.model != "exact" or bridges.persist:
+                raise fail(self.shear, "drainage", "drainage = 'undrained' of a wet sample "
+                           "holds its water in volume-controlled exact bridges: --bridges "
+                           "toroidal and --persist-bridges do not apply")
+            self.bridges = dataclasses.replace(bridges, control="volume")
+
+    @property
+    def undrained(self):
+        """Whether the shear holds the volume (and, wet, the water content)."""
+        return self.shear.drainage == "undrained"
 
     def rate(self):
         """Axial strain rate of the shear [1/s] (ShearConfig.rate at the confining stress)."""
@@ -947,8 +978,11 @@ class TablePathConfig(PathConfig):
         source, the entry and the key)."""
         from pendular.procedures.path_table import build_stages
 
+        from pendular.procedures.path_table import wetting_of
+
         return build_stages(self.stages, self.source, confining=self.sample.confining,
-                            rate=self.rate(), young=self.sample.young)
+                            rate=self.rate(), young=self.sample.young,
+                            wetting=wetting_of(self.bridges))
 
     def reference_pressure(self):
         """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining

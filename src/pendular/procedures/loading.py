@@ -8,7 +8,12 @@ axes given neither (``MixedStress``): a constant mean stress p = (sigma_x + sigm
 sigma_z) / 3 (``mean_stress``), a constant b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) with
 sigma_1 on z and sigma_3 on x (``b``), or both; and an end (``until``): ``Strain`` (the
 engineering strain of an axis, from the start of the path), ``Stress`` (the stress of a
-strain-driven axis reaching a value) or ``Static`` (equilibrium). In a periodic cell a stage
+strain-driven axis reaching a value) or ``Static`` (equilibrium). With ``volume =
+"constant"`` the lateral axes x and y move so that the box keeps its volume while z is driven
+at its strain rate (pendular.dem.walls.ConstantVolume: an undrained shear of a saturated
+sample). A stage may change the water of a wet sample (pendular.procedures.hydraulic): a new
+``suction`` [Pa], stepped or ramped at ``suction_rate`` [Pa/s], or a new ``water_content``
+[%]. In a periodic cell a stage
 may also shear x with z at ``shear_rate`` gamma_dot (simple shear, Lees–Edwards:
 pendular.dem.cell), to an end ``ShearStrain`` (the shear strain gamma imposed since the start of
 the path). ``LoadingPath`` runs the stages of a static sample in turn and records one
@@ -20,7 +25,7 @@ The paths of the laboratory:
 
 - ``shear_stage``: the triaxial shear of thesis Ch. 5.2.3 (lateral walls at the confining
   stress, axial walls at the rate of ShearConfig, to the final strain), in compression or
-  extension, at a constant b or a constant mean stress;
+  extension, at a constant b or a constant mean stress, or undrained (at constant volume);
 - ``oedometer_stages``: lateral walls fixed, axial compression to a stress, then unloading;
 - ``isotropic_stages``: the six walls servoed to each stress in turn, each stage until static;
 - ``simple_shear_stages`` (pendular.procedures.simple_shear): a periodic cell brought to a
@@ -45,11 +50,12 @@ from pendular.dem.cell import ConstantShearRate
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.dem.mixed_stress import StageFailed
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.walls import AXES, ConstantStrainRate, StressServo
+from pendular.dem.walls import AXES, ConstantStrainRate, ConstantVolume, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN
 from pendular.procedures.guards import SampleGuard
+from pendular.procedures.hydraulic import SuctionChange, WaterContentChange
 from pendular.procedures.preparation import servo_speed, static
 from pendular.utils.validate import check_int, check_positive, check_range
 
@@ -59,6 +65,12 @@ AXIS_NAMES = tuple(AXES)
 MAX_STRAIN_RATE = 1e6
 #: A path of unknown length writes a ParaView frame every this many history rows.
 VTK_RECORDS = 10
+#: What a stage's ``volume`` may hold: "constant" (x and y keep the box's volume).
+VOLUME_CONTROLS = ("constant",)
+#: Largest suction a stage may name [Pa] (the bridge tables refuse far less), and its largest
+#: rate of change [Pa/s].
+MAX_SUCTION = 1e9
+MAX_SUCTION_RATE = 1e12
 #: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b
 #: (its ratio is noise over nearly zero at the start of a true triaxial shear).
 B_MEASURE_FROM = 0.1
@@ -150,7 +162,13 @@ class Stage:
     path's servo speed), the quasi-static bound of a stage the servo drives; shear_rate:
     gamma_dot [1/s] of x with z, a simple shear of a periodic cell (pendular.dem.cell; walls
     refuse it when the path starts), ending with ``until`` ShearStrain, or any end but
-    Static.
+    Static; volume: "constant" (VOLUME_CONTROLS), x and y given neither a stress nor a strain
+    rate, moved so that the box keeps the volume it has when the stage starts while z is
+    driven at a non-zero strain rate (an undrained shear). The water of a wet sample
+    (pendular.procedures.hydraulic): ``suction`` [Pa] of suction-controlled bridges, imposed
+    at the stage's first step or, with ``suction_rate`` [Pa/s] > 0, ramped to (a Static end
+    is checked once the ramp is over), or ``water_content`` [%, of the grains' mass, as
+    --water-content] of a closed amount of liquid, set at the first step.
     """
 
     stress: dict = field(default_factory=dict)
@@ -160,6 +178,10 @@ class Stage:
     b: float | None = None
     max_strain_rate: float | None = None
     shear_rate: float = 0.0
+    volume: str | None = None
+    suction: float | None = None
+    suction_rate: float | None = None
+    water_content: float | None = None
 
     def __post_init__(self):
         self.stress = {_axis_name("stress axis", axis): check_range(
@@ -182,6 +204,7 @@ class Stage:
         if self.max_strain_rate is not None:
             self.max_strain_rate = check_range("max_strain_rate", self.max_strain_rate, 0.0,
                                                MAX_STRAIN_RATE, low_inclusive=False, unit="1/s")
+        self._check_water()
         self._check_mixed()
         self._check_until()
 
@@ -190,8 +213,45 @@ class Stage:
         """The axes a mixed condition sets (neither a stress nor a strain rate given)."""
         return tuple(a for a in AXIS_NAMES if a not in self.stress and a not in self.strain_rate)
 
+    @property
+    def mixed(self):
+        """The axes a mixed condition of stresses sets: ``free``, unless the volume does."""
+        return () if self.volume is not None else self.free
+
+    def _check_water(self):
+        """The stage's volume and water keys, each in its range."""
+        if self.volume is not None and self.volume not in VOLUME_CONTROLS:
+            raise ValueError(f"volume = {self.volume!r}; valid: "
+                             f"{', '.join(repr(v) for v in VOLUME_CONTROLS)} (or leave it out)")
+        if self.suction is not None:
+            self.suction = check_range("suction", self.suction, 0.0, MAX_SUCTION,
+                                       low_inclusive=False, unit="Pa")
+        if self.suction_rate is not None:
+            if self.suction is None:
+                raise ValueError(f"suction_rate = {self.suction_rate!r} needs a suction, the "
+                                 "target of the ramp")
+            self.suction_rate = check_range("suction_rate", self.suction_rate, 0.0,
+                                            MAX_SUCTION_RATE, low_inclusive=False, unit="Pa/s")
+        if self.water_content is not None:
+            if self.suction is not None:
+                raise ValueError("suction and water_content: give one (suction-controlled "
+                                 "bridges hold a suction, a closed amount of liquid a water "
+                                 "content)")
+            self.water_content = check_range("water_content", self.water_content, 0.0, 100.0,
+                                             low_inclusive=False, unit="%")
+
     def _check_mixed(self):
         free = self.free
+        if self.volume is not None:
+            if free != ("x", "y") or self.mean_stress is not None or self.b is not None:
+                raise ValueError(f"volume = {self.volume!r} moves x and y to hold the volume: "
+                                 "give them neither a stress nor a strain rate (nor a "
+                                 "mean_stress or b), and z a strain rate")
+            if self.strain_rate.get("z", 0.0) == 0.0 or self.shear_rate != 0.0:
+                raise ValueError(f"volume = {self.volume!r} needs z driven at a non-zero strain "
+                                 "rate, and no shear_rate (the lateral walls follow the axial "
+                                 "ones)")
+            return
         if self.mean_stress is None and self.b is None:
             if free:
                 raise ValueError(f"axis {', '.join(free)} has neither a stress nor a strain "
@@ -245,6 +305,13 @@ class Stage:
             parts.append(f"b {self.b:g}")
         if self.shear_rate != 0.0:
             parts.append(f"shear xz {self.shear_rate:.3g} 1/s")
+        if self.volume is not None:
+            parts.append(f"volume {self.volume}")
+        if self.suction is not None:
+            parts.append(f"suction {self.suction:g} Pa" + (
+                "" if self.suction_rate is None else f" at {self.suction_rate:.3g} Pa/s"))
+        if self.water_content is not None:
+            parts.append(f"water content {self.water_content:g} %")
         until = self.until
         if isinstance(until, Strain):
             parts.append(f"until {until.axis} strain {until.value:g}")
@@ -255,6 +322,36 @@ class Stage:
         else:
             parts.append("until static")
         return "; ".join(parts)
+
+
+def water_controls(stage, bridges):
+    """The controls that bring the water of the wet scene's ``bridges`` (its capillary
+    operation, None dry) where ``stage`` says (pendular.procedures.hydraulic): [] for a stage
+    that leaves it; ValueError naming the key for a dry scene or bridges of the other
+    control."""
+    if stage.suction is not None:
+        return [SuctionChange(bridges, stage.suction, stage.suction_rate)]
+    if stage.water_content is not None:
+        return [WaterContentChange(bridges, stage.water_content)]
+    return []
+
+
+#: Stage keys whose controls run on the CPU only (pendular.gpu.simulation.check_scene refuses
+#: ConstantVolume, SuctionChange and WaterContentChange).
+HOST_ONLY_KEYS = ("volume", "suction", "water_content")
+
+
+def check_stages_device(stages, device):
+    """ValueError naming ``--device`` when ``device`` is not "cpu" and a stage of ``stages``
+    has a key of HOST_ONLY_KEYS, before anything runs."""
+    if device == "cpu":
+        return
+    for number, stage in enumerate(stages, 1):
+        for key in HOST_ONLY_KEYS:
+            if getattr(stage, key) is not None:
+                raise ValueError(f"--device {device}: stage {number} has {key} = "
+                                 f"{getattr(stage, key)!r}, whose control runs on the CPU "
+                                 "only; valid: --device cpu")
 
 
 class MixedStress(mixed_stress.MixedStress):
@@ -404,6 +501,12 @@ class LoadingPath:
         self.servo_scale_max_velocity = servo_scale_max_velocity
         self.servo_stiffness_every = servo_stiffness_every
         self.rate_on_current_length = rate_on_current_length
+        bridges = capillary_operation(sim)
+        for number, stage in enumerate(self.stages, 1):   # refused before anything runs
+            try:
+                water_controls(stage, bridges)
+            except ValueError as error:
+                raise ValueError(f"stage {number}: {error}") from None
         self.stage, self.stage_start = 0, sim.step
         self.controls = self._controls(sim, self.stages[0], ())
         if sim.contacts is None:
@@ -449,7 +552,7 @@ class LoadingPath:
                 groups[axis] = target
             else:
                 groups[same + axis] = groups.pop(same)
-        free = stage.free
+        free = stage.mixed
         if free:
             start = stage.mean_stress if stage.mean_stress is not None else stage.stress["x"]
             if stage.b is None:
@@ -478,9 +581,11 @@ class LoadingPath:
                 controls.append(ConstantStrainRate(
                     axis, rate, self.reference_length[AXES[axis]],
                     on_current_length=self.rate_on_current_length))
+        if stage.volume == "constant":      # after z's drive: x and y undo its volume change
+            controls.append(ConstantVolume(sim.walls.volume()))
         if self._shears:
             controls.append(ConstantShearRate(stage.shear_rate))
-        return controls
+        return controls + water_controls(stage, capillary_operation(sim))
 
     def _driver(self, axis):
         """The ConstantStrainRate of ``axis`` in the running stage's controls."""
@@ -551,6 +656,7 @@ class LoadingPath:
             sigma = sim.walls.stress()[AXES[until.axis]]
             return (sigma - until.value) * stage.strain_rate[until.axis] >= 0.0
         return ((sim.step - self.stage_start) % until.check_every == 0
+                and all(op.done for op in self.controls if hasattr(op, "done"))
                 and static(until.unbalanced, until.tolerance)(sim))
 
     def run(self, sim, *, max_steps=None, progress=None, status=None):
@@ -638,10 +744,15 @@ def shear_stage(shear, confining, rate):
     axial walls compressed (or, in extension, pulled apart) to ``shear.max_strain``; the lateral
     walls at the confining stress, or with ``shear.b`` sigma_3 = confining on x and sigma_y =
     sigma_3 + b (sigma_z - sigma_3), or with ``shear.constant_p`` at the stresses that keep
-    p = confining (and b, when given). b = 0 alone is the conventional compression."""
+    p = confining (and b, when given), or with ``shear.drainage`` "undrained" the lateral
+    walls moved so that the volume stays that of the start (the pore water of a saturated
+    sample, or the closed liquid of a wet one, cannot leave). b = 0 alone is the conventional
+    compression."""
     sign = 1.0 if shear.direction == "compression" else -1.0
     until = Strain(sign * shear.max_strain)
     axial = {"z": sign * rate}
+    if shear.drainage == "undrained":
+        return Stage(strain_rate=axial, volume="constant", until=until)
     if shear.constant_p:
         return Stage(strain_rate=axial, mean_stress=confining, b=shear.b, until=until)
     if shear.b is not None and shear.b > 0.0:
@@ -707,6 +818,59 @@ def path_deviations(history, shear, confining):
         found["b_deviation"] = (float(np.nanmax(np.abs(b - shear.b)))
                                 if np.isfinite(b).any() else None)
     return found
+
+
+#: Rows of the effective stress path an undrained summary lists (undrained_summary).
+PATH_POINTS = 21
+
+
+def excess_pore_pressure(sigma):
+    """Excess pore pressure Delta u [Pa] of each record of wall stresses ``sigma`` (n, 3) [Pa]
+    from the first: the pressure a saturating, incompressible pore fluid takes up in an
+    undrained shear along the conventional total stress path (the cell pressure sigma_3
+    held): Delta u = Delta p_total - Delta p', p_total = sigma_3 + q / 3 and p' the mean wall
+    stress, the skeleton's (the effective stress of a saturated sample); = -Delta sigma'_3
+    (q = sigma_z - (sigma_x + sigma_y) / 2, pendular.homogenize.invariants)."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    q, p = deviator_stress(sigma), mean_stress(sigma)
+    return (q - q[0]) / 3.0 - (p - p[0])
+
+
+def undrained_summary(history, peak):
+    """Results of an undrained (constant-volume) shear's ``history`` (column
+    ``excess_pore_pressure``, excess_pore_pressure), ``peak`` the row of the peak of q:
+    ``excess_pore_pressure_at_peak``, ``_final``, ``_max`` [Pa]; ``p_min`` [Pa], the least
+    mean effective stress, and ``axial_strain_at_p_min`` (where a contracting sample turns to
+    dilating, the phase transformation); ``max_volume_change``, max |V / V0 - 1| [-], the
+    volume held; ``effective_stress_path``, PATH_POINTS rows evenly spaced over the history:
+    axial strain, p' and q of the wall stresses, Delta u, and wet p' of Eq. 3.43, suction and
+    saturation Sr, which change at a constant water content."""
+    sigma = history["sigma_wall"]
+    change = history["excess_pore_pressure"]
+    p = mean_stress(sigma)
+    least = int(np.argmin(p))
+    summary = {
+        "drainage": "undrained",
+        "excess_pore_pressure_at_peak": float(change[peak]),
+        "excess_pore_pressure_final": float(change[-1]),
+        "excess_pore_pressure_max": float(change.max()),
+        "p_min": float(p[least]),
+        "axial_strain_at_p_min": float(history["axial_strain"][least]),
+        "max_volume_change": float(np.max(np.abs(history["volumetric_strain"]))),
+    }
+    rows = np.unique(np.linspace(0, len(p) - 1, PATH_POINTS).round().astype(int))
+    path = {"axial_strain": history["axial_strain"][rows], "p": p[rows],
+            "q": deviator_stress(sigma[rows]), "excess_pore_pressure": change[rows]}
+    effective = _effective(history)
+    if effective is not None:
+        path["p_effective"] = mean_stress(effective[rows])
+    for name in ("suction", "saturation"):
+        if name in history:
+            path[name] = history[name][rows]
+            summary[f"{name}_final"] = float(history[name][-1])
+    summary["effective_stress_path"] = {k: [float(v) for v in values]
+                                        for k, values in path.items()}
+    return summary
 
 
 def _stage_ends(history, count):

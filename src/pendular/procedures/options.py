@@ -202,7 +202,7 @@ def _steps_count(key, value, steps, phase, low=0):
 # ---------------------------------------------------------------- the commands
 
 #: A triaxial shear's own options.
-SHEAR = (_options(ShearConfig, ("max_strain", "direction", "b", "constant_p"))
+SHEAR = (_options(ShearConfig, ("max_strain", "direction", "b", "constant_p", "drainage"))
          + rate_options(ShearConfig) + (option_of(ShearConfig, "records"),))
 
 

@@ -7,7 +7,10 @@ A path table is a TOML file of ``[[stage]]`` entries, run in their order by
 - a stage: the keys of pendular.procedures.loading.Stage, read from its fields, so that a
   field added to Stage is a key here: ``stress = {x = 500, y = 500}`` [Pa],
   ``strain_rate = {z = 0.5}`` [1/s, compression positive; 0 holds the walls], ``mean_stress``
-  [Pa], ``b``, ``max_strain_rate`` [1/s], and ``until``, its end (``UNTIL_KINDS``):
+  [Pa], ``b``, ``max_strain_rate`` [1/s], ``volume = "constant"`` (undrained: x and y hold
+  the volume), ``suction`` [Pa] with ``suction_rate`` [Pa/s] (a ramp; none: a step) on a
+  sample wetted at a suction, ``water_content`` [%, as --water-content] on one wetted at a
+  water content (pendular.procedures.hydraulic), and ``until``, its end (``UNTIL_KINDS``):
   ``{strain = 0.05, axis = "z"}``, ``{stress = 5000, axis = "z", strain_limit = 0.2}``,
   ``"static"`` or ``{static = true, max_steps = 100000, unbalanced = 0.01, tolerance = 0.01,
   check_every = 200}`` (no ``until``: static);
@@ -28,8 +31,14 @@ entry of the group at entry 3) and the valid keys; a value Stage refuses, with i
 prefixed by the same. The parsed entries are stored as plain data in the configuration
 (pendular.procedures.config.TablePathConfig), so a run resumes without its table.
 
-In Python, ``run_path`` runs stages on a scene and returns their history, ``change_suction``
-brings suction-controlled bridges to a new suction at a held stress; with
+A stage's water key needs the sample wetted as it says (``check_water``), and a suction
+within the bridge tables for the sample's radii (``check_suctions``), both refused before
+anything runs. The summary (``path_summary``) gives each stage's strain changes and, for the
+stages that change the water, ``water_stages`` and the ``collapse_strain`` of wetting.
+
+In Python, ``run_path`` runs stages on a scene and returns their history (a Stage's
+``suction`` or ``water_content`` changes the water within a path), ``change_suction``
+brings suction-controlled bridges to a new suction at a held stress in increments; with
 pendular.procedures.triaxial's ``equilibrate`` and ``wet`` they compose any path of stress
 and suction (examples/loading_path_api.py). Stresses compression positive [Pa].
 """
@@ -48,6 +57,7 @@ from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.plots import plot_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.config import TablePathConfig
+from pendular.procedures.hydraulic import water_content
 from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
     Strain, Stress, capillary_operation, friction_angle, history_columns, k0, void_ratio)
 from pendular.procedures.preparation import check_soft_contacts, servo_speed
@@ -230,11 +240,19 @@ def _stage(entry, values):
     return Stage(**fields)
 
 
-def build_stages(entries, source, *, confining, rate, young=None):
+def build_stages(entries, source, *, confining, rate, young=None, wetting=None):
     """The loading.Stage list of a table's ``entries`` (read_table), groups repeated;
     ``confining`` [Pa] and ``rate`` [1/s] are the values of the names 'confining' and
     'quasi-static'; with ``young`` [Pa], every stress is checked against it
-    (preparation.check_soft_contacts). ValueError naming ``source`` and the entry."""
+    (preparation.check_soft_contacts); with ``wetting`` (WETTINGS: how the sample is wetted),
+    every stage's water keys against it (check_water). ValueError naming ``source`` and the
+    entry."""
+    return [stage for _, stage in labelled_stages(entries, source, confining=confining,
+                                                  rate=rate, young=young, wetting=wetting)]
+
+
+def labelled_stages(entries, source, *, confining, rate, young=None, wetting=None):
+    """[(label, loading.Stage)] of a table's ``entries``, as build_stages."""
     values = {"confining": confining, "quasi-static": rate, "-quasi-static": -rate}
     stages = []
     for label, entry in parse_entries(entries, source):
@@ -242,10 +260,62 @@ def build_stages(entries, source, *, confining, rate, young=None):
             stage = _stage(entry, values)
             for name, value in stage_stresses(stage) if young is not None else ():
                 check_soft_contacts(name, value, young)
+            if wetting is not None:
+                check_water(stage, wetting)
         except (ValueError, TypeError) as error:
             raise ValueError(f"{source}: {label}: {error}") from None
-        stages.append(stage)
+        stages.append((label, stage))
     return stages
+
+
+#: How a path's sample is wetted, for its stages' water keys: dry, at a suction
+#: (suction-controlled bridges: ``suction`` stages), at a water content (a closed amount of
+#: liquid: ``water_content`` stages).
+WETTINGS = ("dry", "suction", "water_content")
+
+
+def wetting_of(bridges):
+    """The WETTINGS entry of a configuration's bridges (pendular.procedures.config.BridgeConfig
+    or None)."""
+    if bridges is None:
+        return "dry"
+    return "suction" if bridges.water_content is None else "water_content"
+
+
+def check_water(stage, wetting):
+    """ValueError naming the key when ``stage`` changes water that a sample wetted as
+    ``wetting`` (WETTINGS) does not hold that way."""
+    if stage.suction is not None and wetting != "suction":
+        raise ValueError(f"suction = {stage.suction:g} Pa needs a sample wetted at a suction "
+                         "(--suction > 0: suction-controlled bridges)" + (
+                             "; at --water-content give water_content [%]"
+                             if wetting == "water_content" else ""))
+    if stage.water_content is not None and wetting != "water_content":
+        raise ValueError(f"water_content = {stage.water_content:g} % needs a sample wetted at "
+                         "a water content (--water-content: a closed amount of liquid)" + (
+                             "; at --suction give suction [Pa]" if wetting == "suction" else ""))
+
+
+def check_suctions(config):
+    """ValueError naming the table, the stage and ``suction`` when a stage's suction is outside
+    the range of the bridge tables for the sample's radii (CapillaryBridges.set_suction),
+    before anything runs. ``config``: a TablePathConfig."""
+    stages = labelled_stages(config.stages, config.source, confining=config.sample.confining,
+                             rate=1.0)
+    asked = [(label, stage.suction) for label, stage in stages if stage.suction is not None]
+    if not asked or config.bridges is None or config.bridges.suction is None:
+        return
+    from pendular.capillary import sample_radius_ratios
+
+    radii = config.sample.radii()
+    bridges = config.bridges.build()
+    bridges.load_tables(float(radii.min()), float(radii.max()),
+                        radius_ratios=sample_radius_ratios(radii))
+    for label, value in asked:
+        try:
+            bridges.set_suction(value)
+        except ValueError as error:
+            raise ValueError(f"{config.source}: {label}: {error}") from None
 
 
 def stage_stresses(stage):
@@ -282,18 +352,29 @@ class PathTest(LaboratoryTest):
     FIGURE = "path.png"
     PROGRESS = "stage"
 
+    def __init__(self, config, *, force=False):
+        super().__init__(config, force=force)
+        check_suctions(config)
+
+    def stages(self):
+        return self.config.loading_stages()
+
     def loading(self, sim):
         config = self.config
         stages = config.loading_stages()
         columns = dict(PATH_COLUMNS)
+        if any(stage.water_content is not None for stage in stages):
+            bridges = capillary_operation(sim)
+            columns.update({"water_content": lambda s: water_content(s, bridges) / 100.0,
+                            "liquid_total": lambda s: bridges.liquid_initial})
         if len(stages) == 1:                  # LoadingPath names the stages of a longer path
             columns["stage"] = lambda s: 0
         return LoadingPath(sim, stages, records=config.records,
                            record_every=config.record_every(sim.dt), columns=columns)
 
     def summarize(self, history):
-        count = len(self.config.loading_stages())
-        return {**path_summary(history, count), **stress_balance(history)}
+        stages = self.config.loading_stages()
+        return {**path_summary(history, len(stages), stages), **stress_balance(history)}
 
     def plot(self, history, out, title):
         stages = len(self.config.loading_stages())
@@ -309,7 +390,47 @@ def _diagonal(history, name):
     return np.diagonal(history[name], axis1=1, axis2=2)
 
 
-def path_summary(history, count=None):
+#: Columns of a wet history each stage's end lists (path_summary).
+WATER_COLUMNS = ("suction", "saturation", "water_content")
+
+
+def wetting_strains(rows, stages, history):
+    """The strains of the stages of a path (loading.Stage list ``stages``, their end rows
+    ``rows`` of path_summary) that change its water: ``water_stages``, one entry per such
+    stage (its index, ``suction_before`` and ``suction_after`` [Pa], or
+    ``water_content_before`` and ``water_content_after`` [-, a fraction, as the history's
+    column], the axial and volumetric strain changes over
+    the stage, compression positive), and, when one of them wets the sample (the suction
+    lowered, the water content raised), ``collapse_strain`` [-]: the volumetric strain of
+    those stages (at a held stress, the collapse on wetting; positive a compression) and
+    ``collapse_axial_strain`` [-]."""
+    found, collapse, axial = [], 0.0, 0.0
+    wets = False
+    for number, (stage, row) in enumerate(zip(stages, rows)):
+        key = ("suction" if stage.suction is not None else
+               "water_content" if stage.water_content is not None else None)
+        if key is None or key not in history:
+            continue
+        start = rows[number - 1]["row"] if number else 0
+        was, now = float(history[key][start]), row[key]
+        entry = {"stage": number, f"{key}_before": was, f"{key}_after": now,
+                 "axial_strain_change": row["axial_strain_change"],
+                 "volumetric_strain_change": row["volumetric_strain_change"]}
+        found.append(entry)
+        wetting = now < was if key == "suction" else now > was
+        if wetting:
+            wets = True
+            collapse += entry["volumetric_strain_change"]
+            axial += entry["axial_strain_change"]
+    if not found:
+        return {}
+    summary = {"water_stages": found}
+    if wets:
+        summary.update({"collapse_strain": collapse, "collapse_axial_strain": axial})
+    return summary
+
+
+def path_summary(history, count=None, stages=None):
     """Results of a loading path's history (columns sigma_wall, axial_strain,
     volumetric_strain, void_ratio and, for several stages, stage) of ``count`` stages (None:
     those recorded): ``stages``, the end state of each (its row, step, axial and volumetric
@@ -320,27 +441,41 @@ def path_summary(history, count=None):
     stage went past (pendular.io.schema.peak_reached over its rows), and then ``peak_q``,
     ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (loading.friction_angle),
     ``peak_index``, ``peak_stage`` and, wet, ``peak_q_effective``, ``p_effective_at_peak``,
-    ``phi_peak_effective_deg``."""
+    ``phi_peak_effective_deg``. Each stage's entry also gives its ``axial_strain_change`` and
+    ``volumetric_strain_change`` and, wet, the WATER_COLUMNS at its end; with the path's
+    ``stages`` (loading.Stage), the strains of those that change the water
+    (wetting_strains)."""
     sigma = history["sigma_wall"]
     stage = np.asarray(history.get("stage", np.zeros(len(sigma), dtype=np.int64)))
     count = int(stage[-1]) + 1 if count is None else count
     effective = _diagonal(history, "sigma_effective")
     p, q = mean_stress(sigma), deviator_stress(sigma)
     rows = []
+    before = 0
     for number in range(count):
         row = int(np.flatnonzero(stage <= number)[-1])
         entry = {"stage": number, "row": row, "step": int(history["step"][row]),
                  "axial_strain": float(history["axial_strain"][row]),
                  "volumetric_strain": float(history["volumetric_strain"][row]),
+                 "axial_strain_change": float(history["axial_strain"][row]
+                                              - history["axial_strain"][before]),
+                 "volumetric_strain_change": float(history["volumetric_strain"][row]
+                                                   - history["volumetric_strain"][before]),
                  "void_ratio": float(history["void_ratio"][row]),
                  "sigma_wall": sigma[row].tolist(), "p": float(p[row]), "q": float(q[row])}
         if effective is not None:
             entry.update({"p_effective": float(mean_stress(effective[row])),
                           "q_effective": float(deviator_stress(effective[row]))})
+        for name in WATER_COLUMNS:
+            if name in history:
+                entry[name] = float(history[name][row])
         rows.append(entry)
+        before = row
     void = history["void_ratio"]
     summary = {"stages": rows, "initial_void_ratio": float(void[0]),
                "final_void_ratio": float(void[-1])}
+    if stages is not None:
+        summary.update(wetting_strains(rows, stages, history))
     peak = int(np.argmax(q))
     within = np.flatnonzero(stage == stage[peak])
     summary["has_peak"] = bool(q[peak] > 0.0 and peak > within[0]

@@ -53,8 +53,9 @@ from pendular.procedures.guards import SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
     WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
-    friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
-    oedometer_summary, path_deviations, shear_stage, void_ratio)
+    check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages,
+    isotropic_summary, k0, oedometer_stages, oedometer_summary, path_deviations, shear_stage,
+    undrained_summary, void_ratio)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import SUMMARY_UNITS, peak_reached
@@ -164,6 +165,10 @@ def wet_sample(sim, config, *, progress=None):
     - 'constant-volume': bridges added with the walls fixed, run until the unbalanced force is
       below the threshold, then the servo brings the walls to the confining stress.
 
+    Undrained (TriaxialConfig.undrained) at a suction, the bridges are volume-controlled,
+    formed at the suction from a reservoir, and the liquid is then closed
+    (CapillaryBridges.close_liquid), so that the shear holds the water content.
+
     At a water content (config.bridges.water_content) the bridges are volume-controlled, their
     formation suction found so that they hold w Gs V_s (Gs = density / 1000 kg/m^3;
     pendular.procedures.water_content), the sample re-equilibrated; the liquid is then closed
@@ -178,7 +183,17 @@ def wet_sample(sim, config, *, progress=None):
         return _wet_at_water_content(sim, config, thresholds, progress)
     bridges = config.bridges.build()
     if config.wetting == "isotropic":
-        return sim, bridges, wet(sim, bridges, progress=progress, **thresholds)
+        report = wet(sim, bridges, progress=progress, **thresholds)
+    else:
+        report = _wet_by_protocol(sim, config, bridges, thresholds, progress)
+    if config.undrained:                # the water cannot leave during the shear
+        bridges.close_liquid(sim, config.bridges.liquid)
+        report["liquid_initial"] = bridges.liquid_initial
+    return sim, bridges, report
+
+
+def _wet_by_protocol(sim, config, bridges, thresholds, progress):
+    """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols."""
     started = time.perf_counter()
     sim.forces.append(bridges)
     steps = 0
@@ -196,7 +211,7 @@ def wet_sample(sim, config, *, progress=None):
     report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
     if config.wetting == "constant-volume":
         report["sigma_wall_at_constant_volume"] = fixed_stress
-    return sim, bridges, report
+    return report
 
 
 def _wet_at_water_content(dry, config, thresholds, progress):
@@ -450,7 +465,7 @@ def parameters(config):
     if isinstance(config, TriaxialConfig):
         # a conventional run's rows stay as they were, without the path's options
         flat.update(flat_options(config.shear, () if not config.shear.conventional else
-                                 ("direction", "b", "constant_p")))
+                                 ("direction", "b", "constant_p", "drainage")))
     else:                           # a path (PathConfig) names its own options
         flat.update(config.path_parameters())
         flat.update({"inertial_number": config.inertial_number,
@@ -561,6 +576,7 @@ class LaboratoryTest:
         the configuration."""
         check_device(device)
         check_engine(self.config.sample, device)
+        check_stages_device(self.stages(), device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
         if self.config.sample_path is not None:       # checked before the folder is touched
@@ -667,9 +683,19 @@ class LaboratoryTest:
         """The LoadingPath of the test attached to the static sample ``sim`` (time step set)."""
         raise NotImplementedError
 
+    def stages(self):
+        """The stages of the loading known before it runs, for the checks made then
+        (loading.check_stages_device); [] by default."""
+        return []
+
     def summarize(self, history):
         """The test's results from its ``history`` (dict of arrays)."""
         raise NotImplementedError
+
+    def derived(self, history):
+        """The recorded ``history`` (dict of arrays) with the columns the test computes from
+        its rows (none here)."""
+        return history
 
     def frame_fields(self, path):
         """(field data function of sim, time axis name) of the ParaView frames of the loading
@@ -695,6 +721,10 @@ class TriaxialTest(LaboratoryTest):
         config = self.config
         return shear_path(sim, config.shear, config.confining, config.rate())
 
+    def stages(self):
+        config = self.config
+        return [shear_stage(config.shear, config.confining, config.rate())]
+
     def summarize(self, history):
         shear = self.config.shear
         summary = summarize(history, shear.direction)
@@ -702,7 +732,16 @@ class TriaxialTest(LaboratoryTest):
         summary["peak_reached"] = peak_reached(history["axial_strain"],
                                                sign * deviator_stress(history["sigma_wall"]))
         summary.update(path_deviations(history, shear, self.config.confining))
+        if self.config.undrained:
+            summary.update(undrained_summary(history, summary["peak_index"]))
         return summary
+
+    def derived(self, history):
+        """Undrained, the history with ``excess_pore_pressure`` (loading.excess_pore_pressure
+        of the wall stresses)."""
+        if self.config.undrained:
+            history["excess_pore_pressure"] = excess_pore_pressure(history["sigma_wall"])
+        return history
 
     def plot(self, history, out, title):
         direction = self.config.shear.direction
@@ -869,7 +908,7 @@ class _PathRun:
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
-        history = self.path.recorder.arrays()
+        history = self.test.derived(self.path.recorder.arrays())
         summary = self.test.summarize(history)
         rate = config.rate()
         sheared = sim.step - self.start_step
@@ -896,11 +935,14 @@ class _PathRun:
             **self.before_shear["wetting"],
         })
         if "liquid_bridges" in history:
-            initial = self.before_shear["wetting"]["liquid_initial"]
+            # the closed amount, which water-content stages change (path_table.liquid_total)
+            initial = np.asarray(history.get("liquid_total",
+                                             self.before_shear["wetting"]["liquid_initial"]))
             total = history["liquid_bridges"] + history["liquid_film"] + history["liquid_lost"]
             summary.update({
-                "liquid_balance_error": float(np.max(np.abs(total - initial)) / initial),
-                "liquid_lost_fraction": float(history["liquid_lost"][-1] / initial)})
+                "liquid_balance_error": float(np.max(np.abs(total - initial) / initial)),
+                "liquid_lost_fraction": float(history["liquid_lost"][-1]
+                                              / np.ravel(initial)[-1])})
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,

@@ -15,14 +15,18 @@ PATH.toml holds the path, a list of [[stage]] tables with the keys of the Python
     ]
 
 Keys of a stage: stress = {axis = Pa} (servoed walls), strain_rate = {axis = 1/s} (driven
-walls, 0 holds them), mean_stress [Pa], b, max_strain_rate [1/s], until = {strain = X, axis =
-"z"} | {stress = Pa, axis = "z", strain_limit = X} | "static" (the default) | {static = true,
-max_steps = N}; a stress may be "confining" (--confining), a strain rate "quasi-static" or
+walls, 0 holds them), mean_stress [Pa], b, max_strain_rate [1/s], volume = "constant" (x and y
+hold the volume as z is driven: undrained), suction = Pa (a sample at --suction; stepped, or
+ramped at suction_rate = Pa/s), water_content = % (a sample at --water-content), until =
+{strain = X, axis = "z"} | {stress = Pa, axis = "z", strain_limit = X} | "static" (the
+default) | {static = true, max_steps = N}; a stress may be "confining" (--confining), a strain
+rate "quasi-static" or
 "-quasi-static" (--inertial-number at the lowest stress of the path, or --strain-rate). A
 group {repeat = N, stages = [...]} runs its stages N times (they may follow instead as
 [[stage.stages]] tables). examples/paths/ holds the triaxial of thesis Ch. 5 (with --records
 500, row for row the history of ``pendular triaxial``), an oedometric loading, unloading and
-reloading, and a cyclic loading. The sample, wetting and output options are those of
+reloading, a cyclic loading and a collapse on wetting (wetting_collapse.toml: summary
+collapse_strain). The sample, wetting and output options are those of
 ``pendular triaxial``.
 
 Writes into --out: history.h5 (with void_ratio, k0 and stage at every row), summary.json (the
@@ -41,6 +45,7 @@ from pendular.cli.commands.triaxial import loading_command
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
          "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
-         "phi_peak_effective_deg", "initial_porosity", "wall_time_s", "particle_steps_per_s")
+         "phi_peak_effective_deg", "water_stages", "collapse_strain", "collapse_axial_strain",
+         "initial_porosity", "wall_time_s", "particle_steps_per_s")
 
 add_arguments, config_from, run = loading_command("path", PathTest, SHOWN)

@@ -11,7 +11,10 @@ the grains' mass, the liquid then conserved during the shear (--liquid) and the 
 output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
 extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
 axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises
-(pendular.procedures.loading.shear_stage).
+(pendular.procedures.loading.shear_stage). --drainage undrained holds the volume (the lateral
+walls follow the axial ones): summary excess_pore_pressure_at_peak [Pa] of a saturated sample
+and effective_stress_path; wet, the water content is held too (volume-controlled bridges,
+closed liquid) and the suction and Sr change.
 
 The sample, wetting and output options are shared with every laboratory command (``pendular
 oedometer``, ``isotropic``, ``simple-shear``, ``cyclic``, ``path``): pendular.procedures.options
@@ -36,8 +39,9 @@ SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_
          "phi_peak_deg", "peak_q_effective", "p_effective_at_peak", "phi_peak_effective_deg",
          "peak_q_effective_complete", "p_effective_complete_at_peak", "mean_stress_deviation",
          "b_deviation", "axial_contact_lost", "initial_porosity", "saturation_at_peak",
-         "suction_at_peak", "liquid_balance_error", "liquid_lost_fraction", "wall_time_s",
-         "particle_steps_per_s")
+         "suction_at_peak", "excess_pore_pressure_at_peak", "excess_pore_pressure_final",
+         "p_min", "max_volume_change", "suction_final", "saturation_final",
+         "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
 
 
 def loading_command(name, test, shown):
