@@ -51,7 +51,7 @@ def test_an_envelope_of_three_tests_is_fitted_drawn_and_its_tests_reused(tmp_pat
     (["--confining", "0,500"], ("--confining = 0.0 Pa is outside the valid range (0",)),
     (["--confining=-1,500"], ("--confining = -1.0 Pa",)),
     ([], ("--confining is missing",)),
-    (["--confining", "500,1000", "--b", "0.5"], ("--direction, --b, --constant-p",)),
+    (["--confining", "500,1000", "--b", "0.5"], ("unrecognized arguments: --b",)),
     (["--confining", "500,1000", "--particles", "3"], ("--particles = 3 is outside",)),
 ])
 def test_bad_envelopes_are_refused_in_one_line(tmp_path, capsys, argv, words):

@@ -136,8 +136,8 @@ def test_an_envelope_is_one_triaxial_per_confining_stress():
     ({"confining": "0,500"}, "confining = 0.0 Pa is outside the valid range (0, 1e+07]"),
     ({"confining": "-250,500"}, "confining = -250.0 Pa is outside the valid range"),
     ({"confining": "250,x"}, "confining = '250,x' is not a comma-separated list"),
-    ({"confining": "250,500", "direction": "extension"}, "direction, b, constant_p: an "
-                                                         "envelope is fitted to conventional"),
+    ({"confining": "250,500", "direction": "extension"}, "direction: not an option of an "
+                                                         "envelope"),
     ({"confining": "250,500", "particles": 3}, "particles = 3 is outside the valid range"),
 ])
 def test_bad_envelopes_are_refused_naming_the_option(options, message):

@@ -28,7 +28,7 @@ COMMANDS = {
     "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
     "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
-    "campaign": ("campaign", "sweep of any command's options from a TOML parameter table"),
+    "campaign": ("campaign", "sweep of a laboratory command's options from a TOML table"),
     "envelope": ("envelope", "Mohr–Coulomb strength envelope of triaxials at several stresses"),
     "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
     "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),

@@ -215,8 +215,7 @@ class Procedure:
 
 #: Each laboratory command a campaign runs, by its name.
 PROCEDURES = {
-    "triaxial": Procedure(TriaxialTest, TriaxialConfig,
-                          keys=SUMMARY_KEYS + LABORATORY_KEYS),
+    "triaxial": Procedure(TriaxialTest, TriaxialConfig, keys=SUMMARY_KEYS),
     "oedometer": Procedure(OedometerTest, OedometerConfig),
     "isotropic": Procedure(IsotropicTest, IsotropicConfig),
     "cyclic": Procedure(CyclicTest, CyclicConfig),

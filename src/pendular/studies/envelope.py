@@ -32,7 +32,7 @@ from pendular.procedures.preparation import PrepareConfig
 from pendular.studies.campaign import Campaign, Run, run_name, write_campaign_csv
 from pendular.studies.envelope_figures import plot_mohr_circles, plot_peaks
 from pendular.utils.atomic import write_json
-from pendular.utils.parameters import OptionError, option_from, spec_of
+from pendular.utils.parameters import OptionError, option_from, option_values, spec_of
 
 
 class MohrCoulombFit(NamedTuple):
@@ -119,17 +119,24 @@ PEAK_KEYS = ("peak_q", "p_at_peak", "peak_axial_stress", "axial_strain_at_peak",
              "phi_peak_deg", "peak_reached", "saturation_at_peak", "suction_at_peak")
 
 
+#: Triaxial options an envelope leaves out: its tests are conventional compressions.
+NOT_CONVENTIONAL = ("direction", "b", "constant_p")
+
+
 def envelope_options():
-    """The options of ``pendular envelope``: the triaxial's, its --confining a list."""
+    """The options of ``pendular envelope``: the triaxial's (but NOT_CONVENTIONAL), its
+    --confining a list."""
     return tuple(CONFINING if option.key == "confining" else option
-                 for option in options_of("triaxial"))
+                 for option in options_of("triaxial") if option.key not in NOT_CONVENTIONAL)
 
 
 def envelope_runs(options, force=False):
     """The Runs of an envelope (one triaxial per confining stress, named confining<S>) from
     ``options``: key -> value of envelope_options (a command line's, a dict; ``confining`` a
     list or comma text). OptionError or ParameterError naming the option (fewer than
-    MIN_TESTS confining stresses, one twice, one outside its range, a triaxial option)."""
+    MIN_TESTS confining stresses, one twice, one outside its range, a triaxial option, an
+    option an envelope has not)."""
+    option_values(envelope_options(), options, "an envelope")       # unknown keys refused
     options = dict(options)
     given = options.pop("confining", None)
     if given is None:
@@ -143,11 +150,6 @@ def envelope_runs(options, force=False):
     runs = []
     for stress in stresses:
         config = config_from_options("triaxial", {**options, "confining": stress})
-        if config.shear.direction != "compression" or not config.shear.conventional:
-            raise OptionError(lambda name: f"{name('direction')}, {name('b')}, "
-                                           f"{name('constant_p')}: an envelope is fitted to "
-                                           "conventional compressions (direction compression, "
-                                           "b 0, constant lateral stress)")
         runs.append(Run(run_name({"confining": stress}, ["confining"]), config, force))
     return runs
 

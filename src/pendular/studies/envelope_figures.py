@@ -38,12 +38,11 @@ def plot_mohr_circles(path, summary):
     plt = pyplot()
     figure, panels = plt.subplots(1, 2, figsize=(12, 4.8))
     tests = summary["tests"]
-    top = max(max(t["sigma_1_at_peak"], t["sigma_1_effective_at_peak"]) for t in tests) / 1e3
     angle = np.linspace(0.0, np.pi, 181)
-    radius_max = max(max(t["sigma_1_at_peak"] - t["sigma_3_at_peak"],
-                         t["sigma_1_effective_at_peak"] - t["sigma_3_effective_at_peak"])
-                     for t in tests) / 2e3
     for axes, (suffix, name) in zip(panels, STRESSES):
+        top = max(t[f"sigma_1{suffix}_at_peak"] for t in tests) / 1e3
+        radius_max = max(t[f"sigma_1{suffix}_at_peak"] - t[f"sigma_3{suffix}_at_peak"]
+                         for t in tests) / 2e3
         for test in tests:
             high = test[f"sigma_1{suffix}_at_peak"] / 1e3
             low = test[f"sigma_3{suffix}_at_peak"] / 1e3
@@ -71,8 +70,8 @@ def plot_peaks(path, summary):
     plt = pyplot()
     figure, panels = plt.subplots(1, 2, figsize=(12, 4.8))
     tests = summary["tests"]
-    right = 1.1 * max(max(t["p_at_peak"], t["p_effective_at_peak"]) for t in tests) / 1e3
     for axes, (suffix, name) in zip(panels, STRESSES):
+        right = 1.1 * max(t[f"p{suffix}_at_peak"] for t in tests) / 1e3
         p = np.array([t[f"p{suffix}_at_peak"] for t in tests]) / 1e3
         q = np.array([t[f"peak_q{suffix}"] for t in tests]) / 1e3
         axes.plot(p, q, "o", label="peaks")
