@@ -144,3 +144,41 @@ def test_bad_envelopes_are_refused_naming_the_option(options, message):
     with pytest.raises(ValueError) as error:
         envelope_runs(options)
     assert message in str(error.value)
+
+
+def test_a_summary_of_peaks_on_known_envelopes_gives_them_back_and_draws_them(tmp_path):
+    """Peaks on c = 1.2 kPa, phi = 33 deg in net stresses and on c' = 0, phi' = 25 deg in
+    effective ones (a wet test at a water content): the summary's fits, its tests' principal
+    stresses and both figures."""
+    from conftest import assert_drawn
+
+    from pendular.studies.envelope import envelope_summary, peak_row
+    from pendular.studies.envelope_figures import plot_mohr_circles, plot_peaks
+
+    lateral = np.array([250.0, 500.0, 1000.0, 2000.0])
+    p, q = peaks_on_envelope(33.0, 1200.0, lateral)
+    p_eff, q_eff = peaks_on_envelope(25.0, 0.0, lateral + 4000.0)
+    rows = []
+    for k, confining in enumerate(lateral):
+        summary = {"peak_q": q[k], "p_at_peak": p[k], "peak_q_effective": q_eff[k],
+                   "p_effective_at_peak": p_eff[k], "phi_peak_deg": 40.0,
+                   "phi_peak_effective_deg": 25.0, "peak_reached": k != 3}
+        folder = str(tmp_path / "runs" / f"confining{confining:g}")
+        rows.append({"confining": confining, **peak_row(summary, folder, str(tmp_path), False)})
+    config = envelope_runs({"confining": "250,500", "water_content": 1.0})[0].config
+    summary = envelope_summary(rows[::-1], config)
+    assert summary["phi_deg"] == pytest.approx(33.0) and summary["cohesion"] == pytest.approx(1200)
+    assert summary["phi_effective_deg"] == pytest.approx(25.0)
+    assert summary["cohesion_effective"] == pytest.approx(0.0, abs=1e-6)
+    assert summary["cohesion_error"] == pytest.approx(0.0, abs=1e-6)     # exact points
+    assert summary["suction"] is None and summary["water_content_percent"] == 1.0
+    assert summary["confining"] == lateral.tolist() and summary["peak_not_reached"] == [2000.0]
+    test = summary["tests"][0]
+    assert test["run"] == "runs/confining250"
+    assert test["sigma_3_at_peak"] == pytest.approx(250.0)
+    assert test["sigma_3_effective_at_peak"] == pytest.approx(4250.0)
+    assert test["sigma_1_at_peak"] - test["sigma_3_at_peak"] == pytest.approx(test["peak_q"])
+    assert summary["units"]["tests"]["sigma_1_at_peak"] == "Pa"
+    assert summary["units"]["phi_effective_error_deg"] == "deg"
+    for draw, name in ((plot_mohr_circles, "mohr.png"), (plot_peaks, "pq.png")):
+        assert_drawn(draw(str(tmp_path / name), summary))

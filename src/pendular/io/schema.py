@@ -277,7 +277,7 @@ ENVELOPE_SUMMARY_UNITS = {
         ("failure_line_slope{}_error", "1"), ("failure_line_intercept{}", "Pa"),
         ("failure_line_intercept{}_error", "Pa"))},
     "confining": "Pa", "suction": "Pa", "particles": "1", "fit_points": "1",
-    "degrees_of_freedom": "1", "peak_not_reached": "Pa",
+    "degrees_of_freedom": "1", "peak_not_reached": "Pa", "water_content_percent": "%",
     "tests": {"confining": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "peak_axial_stress": "Pa",
               "axial_strain_at_peak": "1", "phi_peak_deg": "deg", "saturation_at_peak": "1",
               "suction_at_peak": "Pa", "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",

@@ -194,10 +194,15 @@ def fit_keys(fit, suffix):
 def envelope_summary(rows, config):
     """summary.json of an envelope: the fits to the ``rows`` (peak_row) in net and effective
     stresses, each also through the origin, and the tests; ``config`` one test's
-    TriaxialConfig (the suction)."""
+    TriaxialConfig (its suction, or its water content)."""
     rows = sorted(rows, key=lambda row: row["confining"])
-    summary = {"confining": [row["confining"] for row in rows], "suction": config.suction,
+    bridges = config.bridges
+    at_water_content = bridges is not None and bridges.water_content is not None
+    summary = {"confining": [row["confining"] for row in rows],
+               "suction": None if at_water_content else config.suction,
                "particles": config.sample.particles}
+    if at_water_content:                    # the suction is an output of each test
+        summary["water_content_percent"] = 100.0 * bridges.water_content
     for suffix, p, q in (("", "p_at_peak", "peak_q"),
                          ("_effective", "p_effective_at_peak", "peak_q_effective")):
         points = ([row[p] for row in rows], [row[q] for row in rows])

@@ -27,7 +27,8 @@ def fit_label(summary, suffix):
 def title(summary):
     """The figures' title: the tests, their sample and suction."""
     suction = summary["suction"]
-    wet = "dry" if not suction else f"suction {suction / 1e3:g} kPa"
+    wet = ("dry" if suction == 0 else f"suction {suction / 1e3:g} kPa" if suction is not None
+           else f"water content {summary['water_content_percent']:g} %")
     return (f"Drained triaxial compression, {summary['particles']} spheres, {wet}: "
             f"σ3 = {', '.join(f'{c / 1e3:g}' for c in summary['confining'])} kPa")
 
