@@ -18,14 +18,14 @@ from conftest import refused, run_in_process, summary_of
 
 import pendular.studies.campaign as campaign_module
 from pendular.procedures.preparation import PrepareConfig
-from pendular.studies.campaign import (MAX_RUNS, PROCEDURES, Campaign, CampaignResult, Run,
-                                       check_jobs,
+from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, check_jobs,
                                        executor, finished_summary, max_jobs, run_name,
                                        run_progress, sweep_from_table, table_rows,
                                        write_campaign_csv)
 from pendular.procedures.config import (ShearConfig, TensionConfig, TriaxialConfig, config_to_dict,
     tension_sample)
 from pendular.io.outputs import OutputFolder
+from pendular.studies.run_kinds import PROCEDURES
 
 TABLE = """
 command = "triaxial"

@@ -1,15 +1,15 @@
 """Campaigns: many runs of configurations, in parallel processes or on a Dask cluster.
 
-A campaign is a list of runs, each a folder name and the configuration of one of the
-laboratory commands (PROCEDURES: triaxial, oedometer, isotropic, cyclic, simple-shear, path,
-tension, swcc), built e.g. with ``dataclasses.replace``::
+A campaign is a list of runs, each a folder name and the configuration of a laboratory command
+(pendular.studies.run_kinds.PROCEDURES: triaxial, oedometer, isotropic, cyclic, simple-shear,
+path, tension, swcc), built e.g. with ``dataclasses.replace``::
 
     base = TriaxialConfig(sample=PrepareConfig(particles=300), shear=ShearConfig(0.02))
     runs = [Run(f"s{s:g}", dataclasses.replace(base, bridges=BridgeConfig(s))) for s in (1e4, 3e4)]
     result = Campaign(runs).run("runs/mine", jobs=2)      # result.summaries["s10000"] ...
 
 ``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
-progress bars) with its command's test (``Procedure.test``), with ``threads`` Numba threads per
+progress bars) with its command's test (run_kinds.Procedure), with ``threads`` Numba threads per
 run (1 by default), in ``jobs`` spawned processes (at most JOBS_PER_CPU per CPU) or on the
 Dask cluster of ``scheduler``. It does not lock ``out``: a command holds it as its
 pendular.io.outputs.OutputFolder around the campaign, so that a second campaign into it is
@@ -19,9 +19,9 @@ of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted
 on where it stopped; so is a shared sample (``samples``) saved with an equal PrepareConfig. The
 campaign's progress bar shows each running run's own progress. A run that fails does not stop
 the others: ``CampaignResult.failed`` names it with its error. A run's summary is the scalars
-of its result (``Procedure.summary``): a laboratory test's summary.json, the first case of a
-tension run (give each run one void ratio and one water content), the key figures of an SWCC
-(swcc_summary).
+of its result (run_kinds.Procedure.summary): a laboratory test's summary.json, the first case
+of a tension run (give each run one void ratio and one water content), the key figures of an
+SWCC (run_kinds.swcc_summary).
 
 ``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 
@@ -64,7 +64,7 @@ import threading
 import traceback
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Union
+from typing import Any, Callable
 
 from tqdm import tqdm
 
@@ -76,29 +76,15 @@ from pendular.utils.threads import use_threads
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
 
-from pendular.procedures.config import (CyclicConfig, IsotropicConfig, OedometerConfig,
-    SimpleShearConfig, SwccConfig, TablePathConfig, TensionConfig, TriaxialConfig,
-    config_to_dict, same_config, sample_made_with, stored_config)
-from pendular.procedures.cyclic import CyclicTest
+from pendular.procedures.config import config_to_dict, sample_made_with
 from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.path_table import PathTest
-from pendular.procedures.simple_shear import SimpleShearTest
-from pendular.procedures.swcc import SwccTest
-from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import (Interrupted, IsotropicTest, LaboratoryTest,
-    OedometerTest, TriaxialTest, parameters)
-from pendular.utils.parameters import Option, flat_options
+from pendular.procedures.triaxial import Interrupted
+from pendular.studies.run_kinds import PROCEDURES, RunConfig, procedure_of, run_options_of
 
 #: Seconds between updates of the campaign's progress bar.
 PROGRESS_PERIOD = 5.0
-#: What a campaign runs: the configuration of a laboratory command (PROCEDURES).
-RunConfig = Union[TriaxialConfig, OedometerConfig, IsotropicConfig, CyclicConfig,
-                  SimpleShearConfig, TablePathConfig, TensionConfig, SwccConfig]
 #: Options a parameter table cannot set: the campaign decides them.
 CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep", "device")
-#: The option of a laboratory test's run beside its configuration (Run.force).
-FORCE = Option("force", "run settings refused as not quasi-static or too long (experts)",
-               kind=bool)
 #: Options of a table that are paths, relative to the table's folder.
 PATH_OPTIONS = ("sample", "psd", "table")
 #: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra
@@ -108,143 +94,6 @@ MAX_RUNS = 10000
 #: Numba runtime and sample in memory, so beyond the CPUs processes only share them; a few per
 #: CPU leave room for runs waiting on their files, more only multiply the memory.
 JOBS_PER_CPU = 4
-#: Keys of a triaxial summary.json that every finished run has (numbers); a summary without
-#: them is damaged and its run is done again.
-SUMMARY_KEYS = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak")
-#: Keys (numbers) of every finished laboratory test's summary.json (LaboratoryTest).
-LABORATORY_KEYS = ("initial_porosity", "wall_time_s")
-
-
-def tension_summary(result: dict) -> dict:
-    """One summary row of a tension run: its first case's scalars (a campaign run of the
-    tension command holds one void ratio and one water content)."""
-    case = result["cases"][0]
-    return {k: v for k, v in case.items() if isinstance(v, (int, float, str, bool))}
-
-
-def swcc_summary(result: dict) -> dict:
-    """The key figures of an SWCC run (swcc.json, pendular.procedures.swcc): the porosity of
-    the dry sample, the bridges formed across gaps, the largest difference in Sr between the
-    drying and the wetting branch (``max_saturation_hysteresis``), the wall time [s], and at
-    every suction S [Pa] of each branch its Sr, chi and volumetric strain
-    (``saturation_drying_S``, ``chi_wetting_S``, ``volumetric_strain_drying_S``)."""
-    row = {"initial_porosity": float(result["preparation"]["porosity"]),
-           "bridges_formed_across_gaps": int(result["bridges_formed_across_gaps"]),
-           "max_saturation_hysteresis": max(float(h["saturation_difference"])
-                                            for h in result["hysteresis"]),
-           "wall_time_s": float(result["wall_time_s"])}
-    for branch in ("drying", "wetting"):
-        for stage in result[branch]:
-            for key in ("saturation", "chi", "volumetric_strain"):
-                row[f"{key}_{branch}_{_text(float(stage['suction']))}"] = float(stage[key])
-    return row
-
-
-def swcc_options(config: SwccConfig) -> dict:
-    """An SWCC run's options, flat and named as the command's: its sample's and its own."""
-    return {**flat_options(config.sample), **flat_options(config)}
-
-
-def tension_options(config: TensionConfig) -> dict:
-    """A tension run's options, flat and named as the command's (its void ratio and water
-    content are its summary's ``*_target`` columns)."""
-    return {k: v for k, v in config.options().items() if k != "cases"}
-
-
-@dataclass(frozen=True)
-class Procedure:
-    """How a campaign runs the tests of one command: ``test`` its class (``test(config)``,
-    a laboratory test's with ``force``, checks the configuration; ``.run(folder, device=...)``
-    runs it, with ``threads`` where ``threaded``), ``config`` its configuration's class,
-    ``result`` the file a finished run leaves with its result, ``summary(result)`` the run's
-    summary (the scalars of which are its campaign.csv columns), ``options(config)`` its flat
-    options (the other columns), ``keys`` the numbers a finished laboratory summary holds
-    (else it is damaged and the run is done again). A laboratory test
-    (pendular.procedures.triaxial.LaboratoryTest) stores its configuration in its sample.h5,
-    the others in their result."""
-
-    test: type
-    config: type
-    result: str = "summary.json"
-    summary: Callable[[dict], dict] = dict
-    options: Callable[[Any], dict] = parameters
-    keys: tuple = LABORATORY_KEYS
-    threaded: bool = True
-
-    @property
-    def laboratory(self) -> bool:
-        """Whether the test is a LaboratoryTest (run settings checked, ``force`` taken)."""
-        return issubclass(self.test, LaboratoryTest)
-
-    def start(self, config: RunConfig, force: bool = False):
-        """The test of ``config``, checked before anything runs (ValueError)."""
-        return self.test(config, force=force) if self.laboratory else self.test(config)
-
-    def run(self, config: RunConfig, folder: str, threads: int = 1, force: bool = False,
-            device: str = "cpu") -> dict:
-        """Run the test of ``config`` into ``folder``; its summary."""
-        settings = {"threads": threads} if self.threaded else {}
-        return self.summary(self.start(config, force).run(folder, device=device, **settings))
-
-    def finished(self, config: RunConfig, folder: str) -> dict | None:
-        """The summary of a run of ``folder`` that finished with an equal configuration, or
-        None (also for a damaged result: the run is done again)."""
-        path = os.path.join(folder, self.result)
-        if not os.path.isfile(path):
-            return None
-        try:
-            with open(path) as handle:
-                result = json.load(handle)
-        except (OSError, ValueError, RecursionError):
-            return None
-        if not isinstance(result, dict):
-            return None
-        stored = (stored_config(os.path.join(folder, "sample.h5"), "config") if self.laboratory
-                  else result.get("config"))
-        if not same_config(stored, config):
-            return None
-        if self.laboratory:
-            whole = all(isinstance(result.get(key), (int, float))
-                        and not isinstance(result.get(key), bool) for key in self.keys)
-            return result if whole and result.get("completed", True) is True else None
-        try:
-            return self.summary(result)
-        except (KeyError, IndexError, TypeError, AttributeError, ValueError):
-            return None
-
-
-#: Each laboratory command a campaign runs, by its name.
-PROCEDURES = {
-    "triaxial": Procedure(TriaxialTest, TriaxialConfig, keys=SUMMARY_KEYS),
-    "oedometer": Procedure(OedometerTest, OedometerConfig),
-    "isotropic": Procedure(IsotropicTest, IsotropicConfig),
-    "cyclic": Procedure(CyclicTest, CyclicConfig),
-    "simple-shear": Procedure(SimpleShearTest, SimpleShearConfig),
-    "path": Procedure(PathTest, TablePathConfig),
-    "tension": Procedure(TensionTest, TensionConfig, "tension.json", tension_summary,
-                         tension_options, keys=(), threaded=False),
-    "swcc": Procedure(SwccTest, SwccConfig, "swcc.json", swcc_summary, swcc_options,
-                      keys=()),
-}
-
-
-def procedure_of(config: Any) -> Procedure:
-    """The Procedure running ``config`` (TypeError naming the configurations a campaign
-    runs)."""
-    for procedure in PROCEDURES.values():
-        if type(config) is procedure.config:
-            return procedure
-    raise TypeError(f"config must be the configuration of a laboratory command ("
-                    f"{', '.join(p.config.__name__ for p in PROCEDURES.values())}), got "
-                    f"{type(config).__name__}")
-
-
-def run_options_of(command: str) -> tuple:
-    """A run's own options of a table of ``command`` beside its configuration's (Run's):
-    ``force`` for a laboratory test."""
-    return (FORCE,) if PROCEDURES[command].laboratory else ()
-
-
 @dataclass
 class Run:
     """One run of a campaign: its folder name under ``out/runs`` and its configuration (of
@@ -503,7 +352,7 @@ class Campaign:
         at ``scheduler`` (its workers must see ``out`` at the same path), the preparations
         and the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's
         identity, so a finished run is reused whichever device ran it). Every configuration
-        still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
+        still to run is checked here first (its test: quasi-static, duration, bridge
         tables), and the device, so a bad one is refused before anything runs. The
         caller holds ``out`` (an OutputFolder, module docstring)."""
         jobs = check_jobs(jobs)
