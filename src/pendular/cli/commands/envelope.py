@@ -6,8 +6,9 @@ one campaign, and the Mohr–Coulomb line fitted to their peaks in net and in ef
 
 Every other option is the triaxial's (``pendular triaxial --help``), the same for each test.
 Writes into --out: summary.json (phi_deg and cohesion in net stresses, phi_effective_deg and
-cohesion_effective, each with its *_error, and ``tests``, one per confining stress with its
-peak and run folder), mohr_circles.png (Mohr circles at the peaks and the envelope),
+cohesion_effective, each with its standard error ``*_error``, and ``tests``, one per confining
+stress with its peak and run folder), mohr_circles.png (Mohr circles at the peaks and the
+envelope),
 peaks_pq.png (p-q and p'-q' peaks and the failure line), campaign.csv and runs/confining<S>/
 (each test's outputs). The tests run in --jobs local processes with --threads Numba threads
 each, or on an existing Dask cluster with --scheduler; started again, finished tests with equal
