@@ -117,8 +117,6 @@ OUTPUTS = ("summary.json", "campaign.csv", "mohr_circles.png", "peaks_pq.png")
 #: A test's peak figures in summary.json's ``tests`` (its summary.json's keys).
 PEAK_KEYS = ("peak_q", "p_at_peak", "peak_axial_stress", "axial_strain_at_peak",
              "phi_peak_deg", "peak_reached", "saturation_at_peak", "suction_at_peak")
-
-
 #: Triaxial options an envelope leaves out: its tests are conventional compressions.
 NOT_CONVENTIONAL = ("direction", "b", "constant_p")
 
@@ -155,8 +153,8 @@ def envelope_runs(options, force=False):
 
 
 def peak_row(summary, folder, out, dry):
-    """summary.json's ``tests`` entry of one triaxial: its confining stress, run folder
-    (relative to ``out``), peak figures and the principal stresses at the peak of q, net and
+    """summary.json's ``tests`` entry of one triaxial of ``summary``: its run folder (relative
+    to ``out``), peak figures and the principal stresses at the peak of q, net and
     effective (sigma_1 = p + 2q/3, sigma_3 = p - q/3; ``dry``: the effective stress is the net
     one). ValueError naming the run where a figure is missing."""
     missing = [key for key in ("peak_q", "p_at_peak") + (() if dry else (
