@@ -6,6 +6,7 @@ import csv
 import dataclasses
 import json
 import os
+import re
 import subprocess
 import sys
 import time
@@ -24,6 +25,7 @@ from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, 
 from pendular.procedures.config import (ShearConfig, TensionConfig, TriaxialConfig, config_to_dict,
     tension_sample)
 from pendular.io.outputs import OutputFolder
+from pendular.studies.run_kinds import PROCEDURES
 
 TABLE = """
 command = "triaxial"
@@ -121,13 +123,132 @@ def test_a_tension_run_in_a_campaign_is_summarised_and_reused(tmp_path):
     assert again.reused == ["w1"] and again.summaries["w1"] == summary
 
 
+OEDOMETER = """
+command = "oedometer"
+[fixed]
+particles = 60
+confining = 500
+vtk_every = 0
+[sweep]
+axial_stress = [1500, 2000]
+"""
+
+SWCC = """
+command = "swcc"
+[fixed]
+particles = 60
+confining = 750
+suctions = [3000, 30000]
+"""
+
+
+def rows_of(out):
+    with open(out / "campaign.csv") as handle:
+        return list(csv.DictReader(handle))
+
+
+def test_an_oedometer_table_runs_writes_its_table_and_reuses_its_runs(tmp_path, capsys):
+    table = tmp_path / "oedometer.toml"
+    table.write_text(OEDOMETER)
+    out = tmp_path / "out"
+    status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
+    assert status == 0, err
+    rows = rows_of(out)
+    assert [(r["run"], r["status"]) for r in rows] == [("axial_stress1500", "run"),
+                                                       ("axial_stress2000", "run")]
+    for row in rows:
+        summary = summary_of(out / "runs" / row["run"])
+        assert float(row["axial_stress"]) == summary["axial_stress_target"]
+        assert float(row["k0"]) == pytest.approx(summary["k0"], rel=1e-12)
+        assert 0.0 < summary["k0"] < 1.0 and row["particles"] == "60"
+        assert (out / "runs" / row["run"] / "oedometer.png").exists()
+    status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
+    assert status == 0, err
+    assert [r["status"] for r in rows_of(out)] == ["reused", "reused"]
+    assert [r["k0"] for r in rows_of(out)] == [r["k0"] for r in rows]
+
+
+def test_an_swcc_table_runs_writes_its_key_figures_and_reuses_its_run(tmp_path, capsys):
+    table = tmp_path / "swcc.toml"
+    table.write_text(SWCC)
+    out = tmp_path / "out"
+    status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
+    assert status == 0, err
+    [row] = rows_of(out)
+    assert row["run"] == "run" and row["status"] == "run" and row["suctions"] == "[3000.0, 30000.0]"
+    result = json.loads((out / "runs" / "run" / "swcc.json").read_text())
+    for branch in ("drying", "wetting"):
+        for stage in result[branch]:
+            suction = f"{stage['suction']:g}"
+            assert float(row[f"saturation_{branch}_{suction}"]) == stage["saturation"]
+            assert float(row[f"chi_{branch}_{suction}"]) == stage["chi"]
+    assert float(row["initial_porosity"]) == result["preparation"]["porosity"]
+    status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
+    assert status == 0, err
+    assert rows_of(out)[0]["status"] == "reused"
+
+
+#: The least options of each command in a table (runs are built, not run).
+LEAST = {"triaxial": {"particles": 60}, "oedometer": {"axial_stress": 2000},
+         "isotropic": {"stresses": "1000,2000"}, "cyclic": {"amplitude_q": 100},
+         "simple-shear": {"particles": 100}, "path": {"table": "path.toml"},
+         "tension": {"particles": 100}, "swcc": {"particles": 60}}
+
+
+@pytest.mark.parametrize("command", sorted(PROCEDURES))
+def test_a_table_of_every_laboratory_command_builds_its_runs(tmp_path, command):
+    (tmp_path / "path.toml").write_text('[[stage]]\nstrain_rate = {x = 0, y = 0, z = '
+                                        '"quasi-static"}\nuntil = {strain = 0.01, axis = "z"}\n')
+    table = tmp_path / "t.toml"
+    fixed = "".join(f"{key} = {json.dumps(value)}\n" for key, value in LEAST[command].items())
+    table.write_text(f'command = "{command}"\n[fixed]\n{fixed}[sweep]\nseed = [1, 2]\n')
+    found, runs = sweep_from_table(table)
+    assert found == command and [r.name for r in runs] == ["seed1", "seed2"]
+    assert all(type(r.config) is PROCEDURES[command].config for r in runs)
+    assert [r.config.sample.seed for r in runs] == [1, 2]
+    if command == "path":                           # relative to the table's folder
+        assert runs[0].config.source == str(tmp_path / "path.toml")
+
+
+@pytest.mark.parametrize("command, text, message", [
+    ("swcc", "max_strain = 0.1\n", "max_strain ([fixed]): not an option of swcc in a table"),
+    ("swcc", "force = true\n", "force ([fixed]): not an option of swcc"),
+    ("oedometer", "force = \"yes\"\n", "force = 'yes': a flag, true or false expected"),
+    ("oedometer", "axial_stress = -5\n", "axial_stress = -5 ([fixed])"),
+    ("swcc", "suctions = [30000, 3000]\n", "suctions = [30000, 3000] ([fixed]): suctions = "
+                                            "30000,3000: at least two suctions"),
+    ("cyclic", "cycles = 2\n", "give amplitude_q PA (stress control) or amplitude_strain"),
+    ("path", "particles = 60\n", "PATH.toml is missing"),
+])
+def test_bad_tables_of_other_commands_are_refused_naming_the_key(tmp_path, capsys, command,
+                                                                  text, message):
+    table = tmp_path / "bad.toml"
+    table.write_text(f'command = "{command}"\n[fixed]\n{text}')
+    with pytest.raises(ValueError, match=re.escape(message)):
+        sweep_from_table(table)
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o"], capsys)
+    refused(status, err, f"pendular campaign: error: table = {str(table)!r}", message)
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_oedometer_refused_before_running_names_its_run(tmp_path, capsys):
+    table = tmp_path / "fast.toml"
+    table.write_text('command = "oedometer"\n[fixed]\nparticles = 60\n'
+                     '[sweep]\ninertial_number = [0.5]\n')
+    status, err = run_in_process("campaign", [table, "--out", tmp_path / "o", "--quiet"], capsys)
+    refused(status, err, f"table = {str(table)!r}: run inertial_number0.5: strain rate",
+            "quasi-static")
+    assert not (tmp_path / "o" / "runs").exists()
+
+
 def test_campaign_refuses_bad_runs_before_running(tmp_path):
     config = TriaxialConfig(sample=PrepareConfig(particles=100))
     with pytest.raises(ValueError, match="must be unique: a"):
         Campaign([("a", config), ("a", config)])
     with pytest.raises(ValueError, match="not a folder name"):
         Run("../up", config)
-    with pytest.raises(TypeError, match="TriaxialConfig or TensionConfig"):
+    with pytest.raises(TypeError, match="the configuration of a laboratory command .*"
+                                        "SwccConfig.*, got dict"):
         Run("a", config_to_dict(config))
     fast = dataclasses.replace(config, shear=ShearConfig(inertial_number=0.5))
     with pytest.raises(ValueError, match="run fast: strain rate .* quasi-static"):

@@ -19,7 +19,7 @@ from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError,
     default_of, option_from, option_values, parameters_of, spec_of, validate)
 from pendular.cli.commands import chapter4 as chapter4_command
-from pendular.studies import chapter5, crosscheck, extremes, tradeoff
+from pendular.studies import chapter5, crosscheck, envelope, extremes, tradeoff
 
 #: (config, field, low, high, low inclusive, high inclusive)
 BOUNDS = [
@@ -385,11 +385,13 @@ def test_option_values_take_defaults_and_refuse_unknown_keys_and_two_of_a_group(
 #: Each study command's declared options.
 STUDY_OPTIONS = {"chapter4": lambda: (chapter4_command.POINTS,),
                  "chapter5": chapter5.grid_options, "crosscheck": lambda: crosscheck.OPTIONS,
+                 "envelope": envelope.envelope_options,
                  "tradeoff": lambda: tradeoff.OPTIONS, "extremes": lambda: extremes.OPTIONS}
 #: Each study command's options of how it runs (folder, threads, processes, device, output), the
 #: only ones written by hand.
 RUN_OPTIONS = {"chapter4": {"out", "threads", "quiet"},
                "chapter5": {"out", "jobs", "scheduler", "threads", "quiet", "device"},
+               "envelope": {"out", "jobs", "scheduler", "threads", "quiet", "device", "force"},
                "crosscheck": {"out", "threads", "concurrent", "quiet", "device"},
                "tradeoff": {"out"}, "extremes": {"out", "threads", "quiet"}}
 

@@ -297,12 +297,32 @@ UNDRAINED_SUMMARY_UNITS = {
                               "suction": "Pa", "saturation": "1"},
 }
 
+#: Units of a strength envelope's summary.json (pendular.studies.envelope): the Mohr–Coulomb
+#: fits in net and effective stresses with their standard errors, and its ``tests`` rows (each
+#: triaxial's peak, the principal stresses there).
+ENVELOPE_SUMMARY_UNITS = {
+    **{key.format(suffix): unit for suffix in ("", "_effective") for key, unit in (
+        ("phi{}_deg", "deg"), ("phi{}_error_deg", "deg"), ("phi{}_through_origin_deg", "deg"),
+        ("cohesion{}", "Pa"), ("cohesion{}_error", "Pa"), ("failure_line_slope{}", "1"),
+        ("failure_line_slope{}_error", "1"), ("failure_line_intercept{}", "Pa"),
+        ("failure_line_intercept{}_error", "Pa"))},
+    "confining": "Pa", "suction": "Pa", "particles": "1", "fit_points": "1",
+    "degrees_of_freedom": "1", "peak_not_reached": "Pa", "water_content_percent": "%",
+    "tests": {"confining": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "peak_axial_stress": "Pa",
+              "axial_strain_at_peak": "1", "phi_peak_deg": "deg", "saturation_at_peak": "1",
+              "suction_at_peak": "Pa", "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
+              "phi_peak_effective_deg": "deg", "sigma_1_at_peak": "Pa",
+              "sigma_3_at_peak": "Pa", "sigma_1_effective_at_peak": "Pa",
+              "sigma_3_effective_at_peak": "Pa"},
+}
+
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
                  **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS, **UNDRAINED_SUMMARY_UNITS}
+                 **SIMPLE_SHEAR_SUMMARY_UNITS, **UNDRAINED_SUMMARY_UNITS,
+                 **ENVELOPE_SUMMARY_UNITS}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

@@ -1,28 +1,31 @@
 """Campaigns: many runs of configurations, in parallel processes or on a Dask cluster.
 
-A campaign is a list of runs, each a folder name and a TriaxialConfig or TensionConfig (built
-with ``dataclasses.replace``)::
+A campaign is a list of runs, each a folder name and the configuration of a laboratory command
+(pendular.studies.run_kinds.PROCEDURES: triaxial, oedometer, isotropic, cyclic, simple-shear,
+path, tension, swcc), built e.g. with ``dataclasses.replace``::
 
     base = TriaxialConfig(sample=PrepareConfig(particles=300), shear=ShearConfig(0.02))
     runs = [Run(f"s{s:g}", dataclasses.replace(base, bridges=BridgeConfig(s))) for s in (1e4, 3e4)]
     result = Campaign(runs).run("runs/mine", jobs=2)      # result.summaries["s10000"] ...
 
 ``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
-progress bars), with ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned
-processes (at most JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``. It does not
-lock ``out``: a command holds it as its pendular.io.outputs.OutputFolder around the campaign, so
-that a second campaign into it is refused. A run whose folder holds a finished result
-of an equal configuration (``pendular.procedures.config.config_json`` of the configuration stored with it:
-sample.h5 of a triaxial, tension.json of a tension test) is reused, so an interrupted campaign
-goes on where it stopped; so is a shared sample (``samples``) saved with an equal
-PrepareConfig. The campaign's progress bar shows each running run's own progress. A run that
-fails does not stop the others: ``CampaignResult.failed`` names it with its error. A run's
-summary is its summary.json (triaxial) or the scalars of its first case (tension: give each
-run one void ratio and one water content).
+progress bars) with its command's test (run_kinds.Procedure), with ``threads`` Numba threads per
+run (1 by default), in ``jobs`` spawned processes (at most JOBS_PER_CPU per CPU) or on the
+Dask cluster of ``scheduler``. It does not lock ``out``: a command holds it as its
+pendular.io.outputs.OutputFolder around the campaign, so that a second campaign into it is
+refused. A run whose folder holds a finished result of an equal configuration
+(``pendular.procedures.config.same_config`` of the configuration stored with it: in sample.h5
+of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted campaign goes
+on where it stopped; so is a shared sample (``samples``) saved with an equal PrepareConfig. The
+campaign's progress bar shows each running run's own progress. A run that fails does not stop
+the others: ``CampaignResult.failed`` names it with its error. A run's summary is the scalars
+of its result (run_kinds.Procedure.summary): a laboratory test's summary.json, the first case
+of a tension run (give each run one void ratio and one water content), the key figures of an
+SWCC (run_kinds.swcc_summary).
 
 ``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 
-    command = "triaxial"            # or "tension"
+    command = "triaxial"            # or any key of PROCEDURES
     [fixed]                         # options of the command, underscores for dashes
     particles = 300
     max_strain = 0.02
@@ -35,11 +38,11 @@ run one void ratio and one water content).
     # prep_friction = 3
 
 Any option of the command's configuration can be fixed or swept, and ``force`` (Run.force) of a
-triaxial; each run's configuration is built by
+laboratory test; each run's configuration is built by
 pendular.procedures.options.config_from_options, as the command line builds it, so it is
 validated as there. Flags take true/false, a list option a list or its comma text
-(``table_resolution = [350, 80]``, ``stresses = "500,1000"``); relative ``sample`` and ``psd``
-paths are relative to the table's folder. A table must set at
+(``table_resolution = [350, 80]``, ``stresses = "500,1000"``); relative ``sample``, ``psd``
+and ``table`` (a path table) paths are relative to the table's folder. A table must set at
 least one option (an empty table, ``[sweep]`` or ``runs = []`` is refused: it would run the
 command's default test) and hold at most MAX_RUNS runs. Every refusal names the table and the
 key, with its section (``[fixed]``, ``[sweep]``, ``row 2 of [[runs]]``).
@@ -61,7 +64,7 @@ import threading
 import traceback
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Callable, Union
+from typing import Any, Callable
 
 from tqdm import tqdm
 
@@ -73,25 +76,17 @@ from pendular.utils.threads import use_threads
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
 
-from pendular.procedures.config import (TensionConfig, TriaxialConfig, config_to_dict,
-                                        same_config, sample_made_with, stored_config)
+from pendular.procedures.config import config_to_dict, sample_made_with
 from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import Interrupted, TriaxialTest, parameters
-from pendular.utils.parameters import Option
+from pendular.procedures.triaxial import Interrupted
+from pendular.studies.run_kinds import PROCEDURES, RunConfig, procedure_of, run_options_of
 
 #: Seconds between updates of the campaign's progress bar.
 PROGRESS_PERIOD = 5.0
-#: What a campaign runs.
-RunConfig = Union[TriaxialConfig, TensionConfig]
 #: Options a parameter table cannot set: the campaign decides them.
 CAMPAIGN_OPTIONS = ("out", "quiet", "threads", "resume", "stop_after", "vtk_prep", "device")
-#: A run's own options of a table beside its command's configuration (Run's), by command.
-RUN_OPTIONS = {"triaxial": (Option("force", "run settings refused as not quasi-static or too "
-                                            "long (experts)", kind=bool),),
-               "tension": ()}
 #: Options of a table that are paths, relative to the table's folder.
-PATH_OPTIONS = ("sample", "psd")
+PATH_OPTIONS = ("sample", "psd", "table")
 #: Most runs in a table: each is a DEM test of minutes to hours, so more is a mistake (an extra
 #: swept list), and its cartesian product would fill the memory before anything runs.
 MAX_RUNS = 10000
@@ -99,15 +94,11 @@ MAX_RUNS = 10000
 #: Numba runtime and sample in memory, so beyond the CPUs processes only share them; a few per
 #: CPU leave room for runs waiting on their files, more only multiply the memory.
 JOBS_PER_CPU = 4
-#: Keys of a triaxial summary.json that every finished run has (numbers); a summary without
-#: them is damaged and its run is done again.
-SUMMARY_KEYS = ("peak_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak")
-
-
 @dataclass
 class Run:
-    """One run of a campaign: its folder name under ``out/runs`` and its configuration;
-    ``force``: run a triaxial refused as not quasi-static or too long (TriaxialTest)."""
+    """One run of a campaign: its folder name under ``out/runs`` and its configuration (of
+    a command of PROCEDURES); ``force``: run a laboratory test refused as not quasi-static or
+    too long (pendular.procedures.triaxial.check_feasible)."""
 
     name: str
     config: RunConfig
@@ -118,9 +109,7 @@ class Run:
                 or os.sep in self.name or (os.altsep and os.altsep in self.name)):
             raise ValueError(f"run name {self.name!r} is not a folder name (valid: a non-empty "
                              "name without path separators)")
-        if not isinstance(self.config, (TriaxialConfig, TensionConfig)):
-            raise TypeError(f"run {self.name}: config must be a TriaxialConfig or TensionConfig,"
-                            f" got {type(self.config).__name__}")
+        procedure_of(self.config)
 
 
 class RunRefused(ValueError):
@@ -151,16 +140,13 @@ def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = Fals
             device: str = "cpu") -> dict:
     """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads on
     ``device``, its output and progress bars in ``folder``/log.txt (with the traceback if it
-    fails); its summary."""
+    fails); its summary (Procedure.run)."""
     use_threads(threads)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w", encoding="utf-8") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
         try:
-            if isinstance(config, TriaxialConfig):
-                return TriaxialTest(config, force=force).run(folder, threads=threads,
-                                                              device=device)
-            return tension_summary(TensionTest(config).run(folder, device=device))
+            return procedure_of(config).run(config, folder, threads, force, device)
         except BaseException:
             traceback.print_exc()
             raise
@@ -176,45 +162,12 @@ def prepare_one(sample: PrepareConfig, path: str, threads: int = 1, device: str 
     return path
 
 
-def tension_summary(result: dict) -> dict:
-    """One summary row of a tension run: its first case's scalars (a campaign run of the
-    tension command holds one void ratio and one water content)."""
-    case = result["cases"][0]
-    return {k: v for k, v in case.items() if isinstance(v, (int, float, str, bool))}
-
-
 # ---------------------------------------------------------------- reuse
 
 def finished_summary(config: RunConfig, folder: str) -> dict | None:
     """The summary of a run of ``folder`` that finished with an equal configuration, or None
-    (also for a damaged summary: the run is done again)."""
-    if isinstance(config, TriaxialConfig):
-        summary_path = os.path.join(folder, "summary.json")
-        stored = stored_config(os.path.join(folder, "sample.h5"), "config")
-    else:
-        summary_path = os.path.join(folder, "tension.json")
-        stored = None
-    if not os.path.isfile(summary_path):
-        return None
-    try:
-        with open(summary_path) as handle:
-            summary = json.load(handle)
-    except (OSError, ValueError, RecursionError):
-        return None
-    if not isinstance(summary, dict):
-        return None
-    if isinstance(config, TensionConfig):
-        stored = summary.get("config")
-    if not same_config(stored, config):
-        return None
-    if isinstance(config, TriaxialConfig):
-        whole = all(isinstance(summary.get(key), (int, float))
-                    and not isinstance(summary.get(key), bool) for key in SUMMARY_KEYS)
-        return summary if whole and summary.get("completed", True) is True else None
-    try:
-        return tension_summary(summary)
-    except (KeyError, IndexError, TypeError, AttributeError):
-        return None
+    (also for a damaged summary: the run is done again); Procedure.finished."""
+    return procedure_of(config).finished(config, folder)
 
 
 # ---------------------------------------------------------------- execution
@@ -399,7 +352,7 @@ class Campaign:
         at ``scheduler`` (its workers must see ``out`` at the same path), the preparations
         and the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's
         identity, so a finished run is reused whichever device ran it). Every configuration
-        still to run is checked here first (TriaxialTest: quasi-static, duration, bridge
+        still to run is checked here first (its test: quasi-static, duration, bridge
         tables), and the device, so a bad one is refused before anything runs. The
         caller holds ``out`` (an OutputFolder, module docstring)."""
         jobs = check_jobs(jobs)
@@ -416,11 +369,10 @@ class Campaign:
                 result.reused.append(run.name)
         check_device(device)
         for run in todo:
-            if isinstance(run.config, TriaxialConfig):
-                try:
-                    TriaxialTest(run.config, force=run.force)
-                except ValueError as error:
-                    raise RunRefused(f"run {run.name}: {error}") from None
+            try:
+                procedure_of(run.config).start(run.config, run.force)
+            except ValueError as error:
+                raise RunRefused(f"run {run.name}: {error}") from None
         preparations = [(sample, path) for sample, path in self.samples
                         if not sample_made_with(path, sample)]
         for _, path in preparations:
@@ -471,9 +423,9 @@ def table_rows(table: dict, source: str) -> tuple[str, list[dict], list[list[str
         raise ValueError(f"{source}: unknown table key(s) {', '.join(sorted(unknown))}; valid: "
                          "command, fixed, sweep, runs")
     command = table.get("command", "triaxial")
-    if command not in ("triaxial", "tension"):
-        raise ValueError(f"{source}: command = {command!r} is not one of 'triaxial', "
-                         "'tension'")
+    if not isinstance(command, str) or command not in PROCEDURES:
+        raise ValueError(f"{source}: command = {command!r} is not one of "
+                         f"{', '.join(map(repr, PROCEDURES))}")
     for key in ("fixed", "sweep"):
         if not isinstance(table.get(key, {}), dict):
             raise ValueError(f"{source}: {key} must be a table ([{key}])")
@@ -556,7 +508,7 @@ def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
     table = read_table(path)
     command, rows, varied = table_rows(table, source)
     declared = [option.key for option in options_of(command)]
-    own = {option.key: option for option in RUN_OPTIONS[command]}
+    own = {option.key: option for option in run_options_of(command)}
     known = set(declared) | set(own)
 
     def where(index, key):
@@ -617,11 +569,9 @@ def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
 
 
 def run_options(config: RunConfig) -> dict:
-    """A run's options, flat and named as the command's (campaign.csv columns; a tension run's
-    void ratio and water content are its summary's ``*_target`` columns)."""
-    if isinstance(config, TriaxialConfig):
-        return parameters(config)
-    return {k: v for k, v in config.options().items() if k != "cases"}
+    """A run's options, flat and named as the command's (campaign.csv columns;
+    Procedure.options)."""
+    return procedure_of(config).options(config)
 
 
 def write_campaign_csv(path: str, result: CampaignResult) -> None:

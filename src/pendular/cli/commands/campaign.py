@@ -1,9 +1,10 @@
 """Sweeps from a parameter table: ``pendular campaign TABLE.toml --out DIR``.
 
-The TOML table names the command (``command = "triaxial"``, the default, or ``"tension"``),
-holds fixed options in ``[fixed]`` and lists to sweep in ``[sweep]`` (every combination) or
-explicit ``[[runs]]`` rows; keys are the command's options with underscores
-(``max_strain = 0.02``), flags take true/false:
+The TOML table names the laboratory command (``command = "triaxial"``, the default, or
+"oedometer", "isotropic", "cyclic", "simple-shear", "path", "tension", "swcc"), holds fixed
+options in ``[fixed]`` and lists to sweep in ``[sweep]`` (every combination) or explicit
+``[[runs]]`` rows; keys are the command's options with underscores (``max_strain = 0.02``),
+flags take true/false, ``force = true`` runs a laboratory test refused as not quasi-static:
 
     command = "triaxial"
     [fixed]
@@ -15,7 +16,8 @@ explicit ``[[runs]]`` rows; keys are the command's options with underscores
 
 Each run goes to DIR/runs/<name>/ (its outputs and log.txt), in --jobs local processes (at
 most 4 per CPU) with --threads Numba threads each, or on an existing Dask cluster with
---scheduler; DIR/campaign.csv has one row per run with its options and summary. Started
+--scheduler; DIR/campaign.csv has one row per run with its options and its summary's numbers
+(an SWCC's: Sr, chi and volumetric strain at each suction of each branch). Started
 again, finished runs with equal configurations are reused. The campaign holds DIR while it
 runs: a second campaign or run into DIR is refused. A failed run does not stop the others; the
 command then ends with an error naming it (its traceback is in its log.txt).
