@@ -9,7 +9,7 @@ reloading back. Stress control: q = sigma_z - (sigma_x + sigma_y) / 2 between +A
 from the start (``Strain`` ends). Stage 0 is the first loading, stages 2k - 1 and 2k the
 unloading and reloading of cycle k (1-based): the history's ``cycle`` is 0 on the first
 loading and k on cycle k. The axial walls cannot pull: a run whose axial stress falls to 0
-stops (``AxialStressGuard``, StageFailed).
+stops (pendular.procedures.guards.AxialStressGuard, StageFailed).
 
 The measures of a loop (``loop_measures``; Kramer 1996, "Geotechnical Earthquake
 Engineering", Ch. 6, the equivalent linear model, with q for tau and the axial strain for
@@ -30,8 +30,8 @@ from pendular.homogenize.invariants import deviator_stress
 from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.config import CyclicConfig
-from pendular.procedures.loading import (LoadingPath, Stage, StageFailed, Strain, Stress,
-    friction_angle)
+from pendular.procedures.guards import AxialStressGuard
+from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress, friction_angle
 from pendular.procedures.triaxial import COMPRESSION_COLUMNS, LaboratoryTest, stress_balance
 
 #: Least history rows of a half-cycle under strain control: a loop's area needs its shape.
@@ -64,26 +64,6 @@ def cyclic_stages(confining, rate, cycles, *, amplitude_q=None, amplitude_strain
 def cycle_of(stage):
     """The cycle (1-based; 0: the first loading) of the stage of index ``stage``."""
     return (stage + 1) // 2
-
-
-class AxialStressGuard:
-    """A writer: StageFailed when the axial (z) stress is 0 or below after a step. The axial
-    walls cannot pull: at zero stress they have left the sample (in a periodic cell, the
-    sample is in tension), which a cyclic test does not measure. ``describe(sim)``: where the
-    path stands (text); ``remedy``: what to change (text)."""
-
-    stateless = True
-
-    def __init__(self, describe, remedy):
-        self.describe = describe
-        self.remedy = remedy
-
-    def apply(self, sim):
-        sigma = sim.walls.stress()[2]
-        if not sigma > 0.0:
-            raise StageFailed(f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa "
-                              f"at step {sim.step} and the axial walls cannot pull; "
-                              f"{self.remedy}")
 
 
 class CyclicPath(LoadingPath):
