@@ -104,10 +104,10 @@ def add_run_options(parser, threads_default=None):
                             " (None: all from 500 spheres on, else 1)"
                             if threads_default is None else ""))
     parser.add_argument("--quiet", action="store_true",
-                        help="no progress bars, and the results in the form scripts read: a "
-                             "loading test's summary as JSON, tension's and swcc's tables in "
-                             "fixed columns (without --quiet: one line or table row per result, "
-                             "to 4 significant figures, with units)")
+                        help="no progress bars, and the results in the form scripts read: "
+                             "the summary's main keys as JSON, alone on stdout (messages go to "
+                             "stderr; without --quiet: one line or table row per result, to 4 "
+                             "significant figures, with units)")
 
 
 def add_device_option(parser, runs):
@@ -391,6 +391,7 @@ def print_summary(summary, keys, quiet=False, columns=None):
     """Print the ``keys`` of a run's ``summary``: format_summary's lines, or with ``quiet``
     (--quiet, for scripts) the same keys as JSON, values unrounded."""
     if quiet:
-        print(json.dumps({key: summary[key] for key in keys if key in summary}, indent=2))
+        print(json.dumps({key: summary[key] for key in keys if key in summary}, indent=2,
+                         default=lambda value: value.tolist()))
     else:
         print(format_summary(summary, keys, columns))

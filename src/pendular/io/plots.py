@@ -413,35 +413,58 @@ def plot_path(history, path, title=""):
     return save_figure(figure, path)
 
 
-def plot_simple_shear(history, path, title=""):
+def plot_simple_shear(history, path, title="", summary=None):
     """A simple shear's records (pendular.procedures.simple_shear) against the shear strain
-    gamma [%]: the shear stress tau [kPa] with the peak of tau / sigma_n marked and its
-    friction angle, the normal stress sigma_n = sigma_zz [kPa] and the volumetric strain [%]
-    from the shear's start; ``title``: the run's parameters."""
+    gamma [%]: the shear stress tau [kPa] with its largest value marked, tau / sigma_n with
+    its peak and friction angle marked (each "peak" only where ``summary``, the
+    simple_shear_summary, says the test went past it; "largest" otherwise), the normal stress
+    sigma_n = sigma_zz [kPa]; drained, the volumetric strain [%] from the shear's start, at
+    constant volume (where it stays 0) the stress path tau against sigma_n instead;
+    ``title``: the run's parameters."""
+    summary = summary or {}
     gamma = 100.0 * np.asarray(history["shear_strain"])
     tau = np.asarray(history["shear_stress"]) / 1e3
     normal = np.asarray(history["normal_stress"]) / 1e3
     volume = 1.0 - np.asarray(history["volumetric_strain"])
+    volumetric = 100.0 * (1.0 - volume / volume[0])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(normal > 0.0, tau / normal, np.nan)
-    figure, (top, middle, bottom) = pyplot().subplots(3, 1, figsize=(6, 9), sharex=True)
+    figure, (top, second, third, bottom) = pyplot().subplots(4, 1, figsize=(6, 11))
     top.plot(gamma, tau, color="C0")
+    largest = int(np.argmax(tau))
+    word = "peak" if summary.get("peak_shear_stress_reached") else "largest"
+    top.plot(gamma[largest], tau[largest], "o", color="C3",
+             label=f"{word} τ = {tau[largest]:.3g} kPa at γ = {gamma[largest]:.2f} %")
+    top.legend(fontsize=8)
+    top.set_ylabel("shear stress τ [kPa]")
+    second.plot(gamma, ratio, color="C4")
     if np.isfinite(ratio).any():
         peak = int(np.nanargmax(ratio))
-        top.plot(gamma[peak], tau[peak], "o", color="C3",
-                 label=f"peak τ/σn = {ratio[peak]:.3g} (φ = "
-                       f"{np.degrees(np.arctan(ratio[peak])):.1f}°) at γ = {gamma[peak]:.2f} %")
-        top.legend(fontsize=8)
-    top.set_ylabel("shear stress τ [kPa]")
-    middle.plot(gamma, normal, color="C1")
-    middle.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
-    middle.ticklabel_format(axis="y", useOffset=False)
-    middle.set_ylim(0.0, 1.1 * max(float(np.max(normal)), 0.0) or 1.0)   # held: a flat line
-    bottom.plot(gamma, 100.0 * (1.0 - volume / volume[0]), color="C2")
-    bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
-    bottom.set_xlabel("shear strain γ [%]")
-    for axes in (top, middle, bottom):
+        word = "peak" if summary.get("peak_reached") else "largest"
+        second.plot(gamma[peak], ratio[peak], "o", color="C3",
+                    label=f"{word} τ/σn = {ratio[peak]:.3g} (φ = "
+                          f"{np.degrees(np.arctan(ratio[peak])):.1f}°) at γ = "
+                          f"{gamma[peak]:.2f} %")
+        second.legend(fontsize=8)
+    second.set_ylabel("stress ratio τ/σn [-]")
+    third.plot(gamma, normal, color="C1")
+    third.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
+    third.ticklabel_format(axis="y", useOffset=False)
+    third.set_ylim(0.0, 1.1 * max(float(np.max(normal)), 0.0) or 1.0)   # held: a flat line
+    for axes in (top, second, third):
+        axes.set_xlabel("shear strain γ [%]")
+    if np.ptp(volumetric) > 0.0:
+        bottom.plot(gamma, volumetric, color="C2")
+        bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
+        bottom.set_xlabel("shear strain γ [%]")
+    else:                                    # constant volume: the stress path instead
+        bottom.plot(normal, tau, color="C0")
+        bottom.plot(normal[0], tau[0], "s", color="C0", ms=4, label="start")
+        bottom.legend(fontsize=8)
+        bottom.set_xlabel("normal stress σn [kPa]")
+        bottom.set_ylabel("shear stress τ [kPa]")
+    for axes in (top, second, third, bottom):
         axes.grid(alpha=0.3)
-        axes.tick_params(labelbottom=True)
     top.set_title(f"Simple shear (x with z, periodic cell)\n{title}", fontsize=9)
+    figure.tight_layout()
     return save_figure(figure, path)

@@ -166,61 +166,23 @@ VTK_FIELDS = {
                                      "positive"),
 }
 
-#: Units of a triaxial summary.json (pendular.procedures.triaxial.summarize and TriaxialTest).
-TRIAXIAL_SUMMARY_UNITS = {
-    "peak_axial_stress": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "lateral_stress": "Pa",
-    "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
-    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa",
-    "suction_at_peak": "Pa", "liquid_balance_error": "1", "liquid_lost_fraction": "1",
-    "liquid_initial": "m^3", "water_content": "1", "formation_suction_pa": "Pa",
-    "axial_strain_at_peak": "1",
-    "peak_index": "1", "saturation_at_peak": "1", "initial_porosity": "1",
-    "initial_coordination": "1", "wall_time_s": "s", "preparation_time_s": "s",
-    "shear_time_s": "s", "wetting_time_s": "s", "steps": "1", "preparation_steps": "1",
-    "particle_steps_per_s": "1/s", "dt": "s", "strain_rate": "1/s", "inertial_number": "1",
-    "max_unbalanced_force": "1", "mean_unbalanced_force": "1", "threads": "1",
-    "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
-    "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
-    "stress_balance_flagged": "record", "grading": GRADING_UNITS,
-    "min_axial_stress": "Pa", "phi_peak_deg": "deg", "phi_peak_effective_deg": "deg",
-    "mean_stress_deviation": "1", "b_deviation": "1",
-}
+@dataclass(frozen=True)
+class Key:
+    """One summary key: its units (SI, "1" dimensionless, "record" a list of history rows; a
+    dict for a nested record: the units of its fields), what it holds and the commands that
+    write it (names of pendular.cli.COMMANDS)."""
 
-#: Units of an oedometer summary.json (pendular.procedures.loading.oedometer_summary).
-OEDOMETER_SUMMARY_UNITS = {
-    "k0": "1", "k0_effective": "1", "k0_final": "1", "axial_stress_target": "Pa",
-    "axial_stress_at_load": "Pa", "lateral_stress_at_load": "Pa", "axial_strain_at_load": "1",
-    "initial_void_ratio": "1", "void_ratio_at_load": "1", "constrained_modulus": "Pa",
-    "constrained_modulus_tangent": "Pa", "constrained_modulus_unloading": "Pa",
-    "compression_index": "1", "compression_index_effective": "1", "unload_to": "Pa",
-    "axial_stress_final": "Pa", "axial_strain_final": "1", "void_ratio_final": "1",
-    "swelling_index": "1", "swelling_index_effective": "1",
-}
+    units: object
+    description: str
+    commands: tuple
 
-#: Units of an isotropic summary.json (pendular.procedures.loading.isotropic_summary) and of
-#: a path table's (pendular.procedures.path_table.path_summary): their ``stages`` rows hold
-#: the end state of each stage.
-ISOTROPIC_SUMMARY_UNITS = {
-    "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa", "q_effective": "Pa",
-               "sigma_wall": "Pa", "void_ratio": "1", "axial_strain": "1",
-               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1"},
-    "final_void_ratio": "1", "peak_stage": "1",
-}
 
-#: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
-TENSION_SUMMARY_UNITS = {
-    "void_ratio_target": "1", "void_ratio": "1", "void_ratio_box": "1", "void_ratio_wet": "1",
-    "prep_friction_deg": "deg", "water_content_target": "1", "formation_suction_pa": "Pa",
-    "water_content": "1", "saturation": "1", "bridges": "1", "coordination_wet": "1",
-    "unbalanced_force_wet": "1", "tensile_strength_pa": "Pa", "axial_extension_at_peak": "1",
-    "water_content_at_peak": "1", "bridges_at_peak": "1", "final_tensile_stress_pa": "Pa",
-    "final_axial_extension": "1", "kim_measured_pa": "Pa", "packing_state_pa": "Pa",
-    "relative_difference_to_kim": "1", "relative_difference_to_packing_state": "1",
-    "strain_rate": "1/s", "inertial_number": "1", "mean_unbalanced_force_to_peak": "1",
-    "unbalanced_force_at_peak": "1", "pull_steps": "1", "dt": "s", "wetting_time_s": "s",
-    "pull_time_s": "s",
-    "grading": GRADING_UNITS,
-}
+#: The laboratory tests (pendular.procedures.triaxial.LaboratoryTest): what every run writes.
+LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path")
+#: The tests whose summary holds a peak of q.
+SHEARS = ("triaxial", "path")
+_T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
+_COMPRESSION = ("oedometer", "isotropic", "path")
 
 #: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
@@ -238,41 +200,288 @@ OPTION_UNITS = {
     "record_strain": "1", "amplitude_q": "Pa", "amplitude_strain": "1", "unload_to": "Pa",
 }
 
-#: Units of a cyclic triaxial summary.json (pendular.procedures.cyclic.cyclic_summary); its
-#: ``cycles`` rows hold the measures of each cycle's loop.
-CYCLIC_SUMMARY_UNITS = {
-    "cycles": {"cycle": "1", "secant_modulus": "Pa", "damping_ratio": "1",
-               "secant_modulus_effective": "Pa", "damping_ratio_effective": "1",
-               "dissipated_energy": "Pa", "strain_energy": "Pa", "q_max": "Pa", "q_min": "Pa",
-               "axial_strain_max": "1", "axial_strain_min": "1",
-               "axial_strain_increment": "1", "axial_strain_accumulated": "1",
-               "volumetric_strain": "1", "volumetric_strain_increment": "1", "records": "1"},
-    "cycles_completed": "1", "secant_modulus_first": "Pa", "secant_modulus_last": "Pa",
-    "damping_ratio_first": "1", "damping_ratio_last": "1",
-    "secant_modulus_first_effective": "Pa", "secant_modulus_last_effective": "Pa",
-    "damping_ratio_first_effective": "1", "damping_ratio_last_effective": "1",
-    "axial_strain_accumulated": "1", "volumetric_strain_accumulated": "1",
-    "axial_strain_at_load": "1", "q_at_load": "Pa",
+#: Every summary key pendular writes (summary.json of the laboratory tests, tension.json
+#: ``cases``), declared once: docs/outputs.md is generated from it, a summary's ``units`` block
+#: is taken from it, and the tests refuse a written key that is not here. Keys that are text
+#: or flags have units "1". Stresses compression positive; strains compression positive.
+SUMMARY_KEYS = {
+    # -- the peak of a shear (pendular.procedures.triaxial.summarize; path_table.path_summary)
+    "peak_q": Key("Pa", "the peak of q: the largest in compression, the least (most "
+                        "negative) in extension; q = sigma_z - (sigma_x + sigma_y)/2, the von "
+                        "Mises deviatoric stress at b != 0; the '_at_peak' keys are of its "
+                        "record", SHEARS),
+    "peak_index": Key("1", "history row of the peak of q", SHEARS),
+    "peak_axial_stress": Key("Pa", "largest axial (z) wall stress of the shear (compression)",
+                             _T),
+    "min_axial_stress": Key("Pa", "least axial (z) wall stress of the shear (extension)", _T),
+    "axial_contact_lost": Key("1", "extension: whether the axial stress fell to 0, the axial "
+                                   "walls (which cannot pull) having left the sample; the "
+                                   "shear then ends there", _T),
+    "p_at_peak": Key("Pa", "mean stress p = (sigma_x + sigma_y + sigma_z)/3 at the peak of q",
+                     SHEARS),
+    "axial_strain_at_peak": Key("1", "axial strain at the peak of q (negative in extension)",
+                                SHEARS),
+    "principal_difference_at_peak": Key("Pa", "sigma_1 - sigma_3, largest less least wall "
+                                              "stress, at the peak of q", _T),
+    "lateral_stress": Key("Pa", "mean over the shear of (sigma_x + sigma_y)/2", _T),
+    "phi_peak_deg": Key("deg", "mobilised friction angle asin((sigma_1 - sigma_3)/(sigma_1 + "
+                               "sigma_3)) of the net stresses at the peak (simple shear: "
+                               "atan of the peak tau/sigma_n; cyclic: at a failure peak only); "
+                               "null with phi_peak_note when it cannot be measured",
+                        (*SHEARS, "simple-shear", "cyclic")),
+    "phi_peak_note": Key("1", "why phi_peak_deg is null (text)", _T),
+    "peak_reached": Key("1", "whether the maximum of q (simple shear: of tau/sigma_n) is a "
+                             "peak the test went past (pendular.io.schema.peak_reached); false "
+                             "when the test ended on its way up or lost axial contact",
+                        (*_T, *_S)),
+    "has_peak": Key("1", "path: whether a stage went past a peak of q", ("path",)),
+    "peak_stage": Key("1", "path: index of the stage holding the peak of q", ("path",)),
+    "saturation_at_peak": Key("1", "degree of saturation Sr at the peak of q", _T),
+    "suction_at_peak": Key("Pa", "matric suction at the peak of q", _T),
+    "peak_q_effective": Key("Pa", "q' of the effective stress (Eq. 3.43) at the peak of q",
+                            SHEARS),
+    "p_effective_at_peak": Key("Pa", "p' of the effective stress (Eq. 3.43) at the peak of q",
+                               SHEARS),
+    "phi_peak_effective_deg": Key("deg", "friction angle of the effective stress at the peak "
+                                         "of q (simple shear: of tau'/sigma_n'); null with "
+                                         "phi_peak_note when it cannot be measured",
+                                  (*SHEARS, *_S)),
+    "peak_q_effective_complete": Key("Pa", "q' of the complete effective stress (psi and the "
+                                           "liquid-gas interface term) at the peak of q", _T),
+    "p_effective_complete_at_peak": Key("Pa", "p' of the complete effective stress at the "
+                                              "peak of q", _T),
+    # -- the critical state (pendular.procedures.critical_state)
+    "phi_cs_deg": Key("deg", "friction angle at the critical state, of the mean net stresses "
+                             "over the last 5 % of axial strain; null when not reached "
+                             "(critical_state_note)", _T),
+    "M_cs": Key("1", "critical state stress ratio: mean |q| / mean p over that window; null "
+                     "when not reached", _T),
+    "void_ratio_cs": Key("1", "mean void ratio over that window; null when not reached", _T),
+    "critical_state_note": Key("1", "the critical state rule as judged on this test: reached, "
+                                    "or why not (q/p drift, |d eps_v / d eps_a| against their "
+                                    "tolerances)", _T),
+    "phi_cs_effective_deg": Key("deg", "phi_cs_deg of the effective stress (Eq. 3.43)", _T),
+    "M_cs_effective": Key("1", "M_cs of the effective stress (Eq. 3.43)", _T),
+    # -- how closely a shear held its path (loading.path_deviations)
+    "mean_stress_deviation": Key("1", "--constant-p: largest |p / confining - 1| over the "
+                                      "records", _T),
+    "b_deviation": Key("1", "--b: largest |b measured - b| over the records with sigma_z - "
+                            "sigma_x of at least a tenth of the confining stress; null "
+                            "without such records", _T),
+    # -- every laboratory run (TriaxialTest's run, pendular.procedures.triaxial)
+    "completed": Key("1", "whether the loading reached its end (false: interrupted or "
+                          "failed; error says why)", LABORATORY),
+    "phase": Key("1", "the phase a run stopped in: prepare, wet, shear, write", LABORATORY),
+    "error": Key("1", "what stopped the loading, when it failed", LABORATORY),
+    "stopped": Key("1", "why a loading ended before its last stage's end with its results "
+                        "(the axial walls left the sample)", _T),
+    "initial_porosity": Key("1", "porosity of the prepared (or loaded) sample, before any "
+                                 "wetting", LABORATORY),
+    "initial_coordination": Key("1", "coordination number of the prepared sample", LABORATORY),
+    "porosity_before_wetting": Key("1", "wet runs: porosity of the dry sample at the "
+                                        "confining stress", LABORATORY),
+    "porosity_after_wetting": Key("1", "wet runs: porosity once wetted and equilibrated, the "
+                                       "one the loading starts from", LABORATORY),
+    "void_ratio_before_wetting": Key("1", "wet runs: e = n/(1 - n) before wetting",
+                                     LABORATORY),
+    "void_ratio_after_wetting": Key("1", "wet runs: e after wetting", LABORATORY),
+    "wall_time_s": Key("s", "wall-clock time of the run", (*LABORATORY, "swcc", "tension")),
+    "preparation_time_s": Key("s", "wall-clock time of the preparation", LABORATORY),
+    "shear_time_s": Key("s", "wall-clock time of the loading", LABORATORY),
+    "steps": Key("1", "time steps of the loading", LABORATORY),
+    "preparation_steps": Key("1", "time steps of the preparation (by phase when a dict)",
+                             LABORATORY),
+    "particle_steps_per_s": Key("1/s", "particles times steps of the loading per second of "
+                                       "wall-clock time", LABORATORY),
+    "dt": Key("s", "time step", (*LABORATORY, *_TEN)),
+    "strain_rate": Key("1/s", "axial strain rate of the loading (tension: of the pull)",
+                       (*LABORATORY, *_TEN)),
+    "inertial_number": Key("1", "inertial number I = rate 2R sqrt(rho / p) at the reference "
+                                "stress (GDR MiDi 2004)", (*LABORATORY, *_TEN)),
+    "max_unbalanced_force": Key("1", "largest unbalanced force ratio over the records",
+                                LABORATORY),
+    "mean_unbalanced_force": Key("1", "mean unbalanced force ratio over the records",
+                                 LABORATORY),
+    "threads": Key("1", "Numba threads of the run", LABORATORY),
+    "device": Key("1", "where the run ran: cpu or gpu", LABORATORY),
+    "grading": Key(GRADING_UNITS, "the grading of the radii: D10, D30, D50, D60 [m], Cu, Cc, "
+                                  "radius_min, radius_max, radius_mean [m]",
+                   (*LABORATORY, *_TEN)),
+    "stress_balance_error": Key("1", "largest per-record |sigma_wall - Love-Weber stress of "
+                                     "contacts and bridges| / p over the records: how far "
+                                     "from quasi-static equilibrium", LABORATORY),
+    "stress_balance_bound": Key("1", "the bound beyond which a record is flagged (0.05)",
+                                LABORATORY),
+    "stress_balance_flagged": Key("record", "history rows whose stress balance error exceeds "
+                                            "the bound", LABORATORY),
+    # -- the wetting (triaxial.wetting_report)
+    "wetting": Key("1", "the wetting protocol: isotropic, at-shear, constant-volume, "
+                        "water-content", LABORATORY),
+    "wetting_steps": Key("1", "time steps of the wetting's equilibria", LABORATORY),
+    "wetting_time_s": Key("s", "wall-clock time of the wetting", (*LABORATORY, *_TEN)),
+    "initial_saturation": Key("1", "degree of saturation Sr once wetted", LABORATORY),
+    "initial_bridges": Key("1", "liquid bridges once wetted", LABORATORY),
+    "wet_porosity": Key("1", "porosity once wetted (as porosity_after_wetting)", LABORATORY),
+    "sigma_wall_at_constant_volume": Key("Pa", "constant-volume wetting: the wall stresses "
+                                               "(x, y, z) the bridges made, walls fixed",
+                                         LABORATORY),
+    "wetting_attempts": Key({"formation_suction_pa": "Pa", "steps": "1"},
+                            "water-content wetting: each try at a formation suction", LABORATORY),
+    "formation_suction_pa": Key("Pa", "water-content wetting: the suction the bridges formed "
+                                      "at", (*LABORATORY, *_TEN)),
+    "water_content": Key("1", "gravimetric water content w held by the bridges (tension: of "
+                              "the case after wetting)", (*LABORATORY, *_TEN)),
+    "liquid_initial": Key("m^3", "closed liquid: the liquid at the start of the loading",
+                          LABORATORY),
+    "liquid_balance_error": Key("1", "closed liquid: largest |bridges + film + lost - "
+                                     "initial| / initial over the records", LABORATORY),
+    "liquid_lost_fraction": Key("1", "closed liquid: the fraction of the liquid lost by the "
+                                     "end", LABORATORY),
+    # -- a loaded sample (--sample)
+    "sample": Key("1", "--sample: the path of the sample the run started from", LABORATORY),
+    # -- oedometer (loading.oedometer_summary)
+    "k0": Key("1", "K0 = sigma_lateral / sigma_axial of the wall stresses at the axial stress "
+                   "target", ("oedometer",)),
+    "k0_effective": Key("1", "K0 of the effective stress (Eq. 3.43) there", ("oedometer",)),
+    "k0_final": Key("1", "K0 at the end of the unloading", ("oedometer",)),
+    "axial_stress_target": Key("Pa", "--axial-stress, the loading's target", ("oedometer",)),
+    "axial_stress_at_load": Key("Pa", "axial stress at the end of the loading",
+                                ("oedometer", *_C)),
+    "lateral_stress_at_load": Key("Pa", "lateral stress at the end of the loading",
+                                  ("oedometer",)),
+    "axial_strain_at_load": Key("1", "axial strain at the end of the (first) loading",
+                                ("oedometer", *_C)),
+    "initial_void_ratio": Key("1", "void ratio the loading starts from (after any wetting)",
+                              _COMPRESSION),
+    "void_ratio_at_load": Key("1", "void ratio at the end of the loading", ("oedometer",)),
+    "constrained_modulus": Key("Pa", "secant constrained modulus M = delta sigma_v / "
+                                     "delta eps_a over the loading", ("oedometer",)),
+    "constrained_modulus_tangent": Key("Pa", "tangent M over the last 20 % of the loading's "
+                                             "strain", ("oedometer",)),
+    "constrained_modulus_unloading": Key("Pa", "secant M of the unloading", ("oedometer",)),
+    "compression_index": Key("1", "Cc = -delta e / delta log10 sigma over the loading "
+                                  "(isotropic: of p)", _COMPRESSION),
+    "compression_index_effective": Key("1", "Cc against the effective stress", _COMPRESSION),
+    "swelling_index": Key("1", "Cs = -delta e / delta log10 sigma over the unloading",
+                          _COMPRESSION),
+    "swelling_index_effective": Key("1", "Cs against the effective stress", _COMPRESSION),
+    "unload_to": Key("Pa", "--unload-to, the unloading's target", ("oedometer",)),
+    "axial_stress_final": Key("Pa", "axial stress at the end of the path", ("oedometer",)),
+    "axial_strain_final": Key("1", "axial strain at the end of the path", ("oedometer",)),
+    "void_ratio_final": Key("1", "void ratio at the end of the path", ("oedometer",)),
+    # -- isotropic and path tables (loading.isotropic_summary, path_table.path_summary)
+    "stages": Key({"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa",
+                   "q_effective": "Pa", "sigma_wall": "Pa", "void_ratio": "1",
+                   "axial_strain": "1", "volumetric_strain": "1", "stage": "1", "step": "1",
+                   "row": "1"},
+                  "one row per stage, its end state: target stress, p, q (and p', q'), "
+                  "the wall stresses, e, the strains, the stage, step and history row",
+                  ("isotropic", "path")),
+    "final_void_ratio": Key("1", "void ratio at the end of the path", ("isotropic", "path")),
+    # -- cyclic (cyclic.cyclic_summary)
+    "cycles": Key({"cycle": "1", "secant_modulus": "Pa", "damping_ratio": "1",
+                   "damping_ratio_measured": "1", "damping_ratio_resolution": "1",
+                   "damping_ratio_note": "1", "secant_modulus_effective": "Pa",
+                   "damping_ratio_effective": "1", "damping_ratio_effective_measured": "1",
+                   "damping_ratio_effective_resolution": "1",
+                   "damping_ratio_effective_note": "1",
+                   "dissipated_energy": "Pa", "strain_energy": "Pa", "q_max": "Pa",
+                   "q_min": "Pa", "axial_strain_max": "1", "axial_strain_min": "1",
+                   "axial_strain_increment": "1", "axial_strain_accumulated": "1",
+                   "volumetric_strain": "1", "volumetric_strain_increment": "1",
+                   "records": "1"},
+                  "one row per complete cycle: its loop's secant modulus E_sec and damping "
+                  "ratio D = W_D / (4 pi W_S) (null below its resolution, with the measured "
+                  "value, the resolution and a note), W_D, W_S, the extremes of q and "
+                  "strain, the strains' increments and accumulation, the rows of the loop", _C),
+    "cycles_completed": Key("1", "complete cycles", _C),
+    "secant_modulus_first": Key("Pa", "E_sec of the first cycle", _C),
+    "secant_modulus_last": Key("Pa", "E_sec of the last cycle", _C),
+    "damping_ratio_first": Key("1", "D of the first cycle (null below its resolution)", _C),
+    "damping_ratio_last": Key("1", "D of the last cycle (null below its resolution)", _C),
+    "damping_ratio_note": Key("1", "which cycles' D are below their resolution", _C),
+    "secant_modulus_first_effective": Key("Pa", "E_sec of the effective q', first cycle", _C),
+    "secant_modulus_last_effective": Key("Pa", "E_sec of the effective q', last cycle", _C),
+    "damping_ratio_first_effective": Key("1", "D of the effective q', first cycle", _C),
+    "damping_ratio_last_effective": Key("1", "D of the effective q', last cycle", _C),
+    "axial_strain_accumulated": Key("1", "axial strain accumulated over the cycles since the "
+                                         "first loading (ratcheting)", _C),
+    "volumetric_strain_accumulated": Key("1", "volumetric strain accumulated over the cycles",
+                                         _C),
+    "q_at_load": Key("Pa", "q at the end of the first loading", _C),
+    # -- simple shear (simple_shear.simple_shear_summary)
+    "peak_shear_stress": Key("Pa", "the largest shear stress tau; its companions end in "
+                                   "'_at_peak_stress'", _S),
+    "shear_strain_at_peak_stress": Key("1", "gamma at the largest tau", _S),
+    "normal_stress_at_peak_stress": Key("Pa", "sigma_n at the largest tau", _S),
+    "peak_shear_stress_reached": Key("1", "whether the largest tau is a peak the test went "
+                                          "past", _S),
+    "peak_stress_ratio": Key("1", "the peak of tau / sigma_n; its companions end in "
+                                  "'_at_peak'", _S),
+    "shear_strain_at_peak": Key("1", "gamma at the peak of tau / sigma_n", _S),
+    "normal_stress_at_peak": Key("Pa", "sigma_n at the peak of tau / sigma_n", _S),
+    "shear_stress_at_peak": Key("Pa", "tau at the peak of tau / sigma_n", _S),
+    "residual_stress_ratio": Key("1", "mean tau / sigma_n over the last fifth of the shear "
+                                      "strain", _S),
+    "phi_residual_deg": Key("deg", "atan of residual_stress_ratio", _S),
+    "normal_stress_final": Key("Pa", "sigma_n at the end", _S),
+    "max_dilatancy": Key("1", "drained: the largest -d eps_v / d gamma over windows of a "
+                              "tenth of the shear strain range (dilation positive)", _S),
+    "dilatancy_angle_deg": Key("deg", "atan of max_dilatancy", _S),
+    "volumetric_strain_of_shear": Key("1", "drained: eps_v at the end, from the shear's start",
+                                      _S),
+    "max_volume_change": Key("1", "constant volume: the largest |V / V_start - 1| (round-off)",
+                             _S),
+    "peak_stress_ratio_effective": Key("1", "wet: the peak of tau' / sigma_n'", _S),
+    "shear_strain_at_peak_effective": Key("1", "wet: gamma at the peak of tau' / sigma_n'", _S),
+    "phi_residual_effective_deg": Key("deg", "wet: the residual friction angle of tau' / "
+                                             "sigma_n'", _S),
+    # -- direct tension, one case of tension.json (pendular.procedures.tension)
+    "void_ratio_target": Key("1", "the case's void ratio target", _TEN),
+    "void_ratio": Key("1", "void ratio of the sample's core after preparation", _TEN),
+    "void_ratio_box": Key("1", "void ratio of the box inside the walls", _TEN),
+    "void_ratio_wet": Key("1", "void ratio of the core once wetted", _TEN),
+    "prep_friction_deg": Key("deg", "friction angle of the preparation that reached the void "
+                                    "ratio", _TEN),
+    "water_content_target": Key("1", "the case's water content target", _TEN),
+    "saturation": Key("1", "degree of saturation once wetted", _TEN),
+    "bridges": Key("1", "liquid bridges once wetted", _TEN),
+    "coordination_wet": Key("1", "coordination number once wetted", _TEN),
+    "unbalanced_force_wet": Key("1", "unbalanced force ratio once wetted", _TEN),
+    "tensile_strength_pa": Key("Pa", "the peak of the tensile stress", _TEN),
+    "axial_extension_at_peak": Key("1", "axial extension at the peak", _TEN),
+    "water_content_at_peak": Key("1", "water content at the peak", _TEN),
+    "bridges_at_peak": Key("1", "liquid bridges at the peak", _TEN),
+    "final_tensile_stress_pa": Key("Pa", "tensile stress at the end of the pull", _TEN),
+    "final_axial_extension": Key("1", "axial extension at the end of the pull", _TEN),
+    "ruptured": Key("1", "whether the stress fell below --residual of the strength", _TEN),
+    "kim_measured_pa": Key("Pa", "Kim's (2001) measured strength of the case, null outside "
+                                 "his cases", _TEN),
+    "packing_state_pa": Key("Pa", "the packing-state prediction of the strength", _TEN),
+    "packing_state_packing": Key("1", "the regular packing of that prediction (text)", _TEN),
+    "relative_difference_to_kim": Key("1", "strength / Kim's - 1", _TEN),
+    "relative_difference_to_packing_state": Key("1", "strength / prediction - 1", _TEN),
+    "mean_unbalanced_force_to_peak": Key("1", "mean unbalanced force ratio before the peak",
+                                         _TEN),
+    "unbalanced_force_at_peak": Key("1", "unbalanced force ratio at the peak", _TEN),
+    "pull_steps": Key("1", "time steps of the pull", _TEN),
+    "pull_time_s": Key("s", "wall-clock time of the pull", _TEN),
+    "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
 }
 
-#: Units of a simple shear summary.json (pendular.procedures.simple_shear.simple_shear_summary)
-#: and of its options.
-SIMPLE_SHEAR_SUMMARY_UNITS = {
-    "peak_shear_stress": "Pa", "shear_strain_at_peak_stress": "1", "peak_stress_ratio": "1",
-    "shear_strain_at_peak": "1", "normal_stress_at_peak": "Pa", "residual_stress_ratio": "1",
-    "phi_residual_deg": "deg", "normal_stress_final": "Pa", "max_dilatancy": "1",
-    "peak_stress_ratio_effective": "1", "shear_strain_at_peak_effective": "1",
-    "phi_residual_effective_deg": "deg",
-    "dilatancy_angle_deg": "deg", "volumetric_strain_of_shear": "1", "max_volume_change": "1",
-    "normal_stress": "Pa",
-}
+
+def summary_units(command):
+    """Units of the summary keys ``command`` writes (SUMMARY_KEYS)."""
+    return {name: key.units for name, key in SUMMARY_KEYS.items() if command in key.commands}
+
+
+#: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
+TENSION_SUMMARY_UNITS = summary_units("tension")
 
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
-#: rows); keys not listed are text, flags or nested records. A summary.json carries the units
-#: of its own keys in its ``units`` block.
-SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
-                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS}
+#: rows: the run options too); a summary.json carries the units of its own keys in its
+#: ``units`` block.
+SUMMARY_UNITS = {**OPTION_UNITS, **{name: key.units for name, key in SUMMARY_KEYS.items()}}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

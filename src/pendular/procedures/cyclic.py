@@ -26,7 +26,7 @@ import os
 
 import numpy as np
 
-from pendular.homogenize.invariants import deviator_stress
+from pendular.homogenize.invariants import deviator_stress, lateral_stress
 from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.config import CyclicConfig
@@ -102,6 +102,32 @@ def loop_measures(strain, q):
     return modulus, damping, dissipated, stored
 
 
+def damping_resolution(strain, lateral, target, stored):
+    """The resolution [-] of a loop's damping ratio (loop_measures): the largest loop area the
+    lateral stress's departure from its ``target`` [Pa] can add to or take from the oint of q
+    d eps, sum |lateral - target| |d eps| over the loop (trapezoids), over 4 pi W_S
+    (``stored`` [Pa]); ``strain`` [-] and ``lateral`` [Pa] in the order travelled. A damping
+    ratio below it in magnitude is not measured: the servo's lag, not dissipation, may make
+    it (a loop that closes elastically reads a small negative D). None where W_S is 0."""
+    strain = np.asarray(strain, dtype=np.float64)
+    off = np.abs(np.asarray(lateral, dtype=np.float64) - target)
+    area = float(np.sum(0.5 * (off[1:] + off[:-1]) * np.abs(np.diff(strain))))
+    return area / (4.0 * math.pi * stored) if stored > 0.0 else None
+
+
+def _resolved(row, name, damping, resolution):
+    """Fill ``row`` with the damping ratio ``name`` measured against its ``resolution``: the
+    value, or None with a note when it is below the resolution."""
+    row[name] = damping
+    row[f"{name}_measured"] = damping
+    row[f"{name}_resolution"] = resolution
+    if damping is not None and resolution is not None and abs(damping) < resolution:
+        row[name] = None
+        row[f"{name}_note"] = (f"below resolution: |{name}| {abs(damping):.2g} < "
+                                     f"{resolution:.2g}, the loop area the lateral servo's "
+                                     "lag can make")
+
+
 def _stage_end(stage, k):
     """Last row of stage ``k`` (stage index per row), None if it has none."""
     rows = np.flatnonzero(stage == k)
@@ -126,7 +152,7 @@ def _failure_peak(strain, q, stage):
     return found
 
 
-def cyclic_summary(history, cycles, complete=True):
+def cyclic_summary(history, cycles, complete=True, confining=None):
     """Results of a cyclic path's history (cyclic_stages with ``cycles`` cycles; columns
     ``sigma_wall``, ``axial_strain``, ``volumetric_strain``, ``stage``); ``complete``: whether
     the path reached its end (else the last cycle recorded, cut short, is left out).
@@ -141,7 +167,11 @@ def cyclic_summary(history, cycles, complete=True):
     Top level: ``secant_modulus_first`` / ``_last``, ``damping_ratio_first`` / ``_last``,
     ``axial_strain_accumulated``, ``volumetric_strain_accumulated`` after the last cycle,
     ``axial_strain_at_load`` and ``q_at_load`` at the end of the first loading,
-    ``cycles_completed``; ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
+    ``cycles_completed``. A damping ratio below its resolution (``damping_resolution``
+    about the lateral stress ``confining`` [Pa], default the first record's) is None, with
+    ``damping_ratio_measured``, ``damping_ratio_resolution`` and ``damping_ratio_note`` in its
+    row (``damping_ratio_effective_*`` of q') and ``damping_ratio_note`` at the top naming the
+    cycles. ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
     where a half-cycle has a failure peak (q falls after it by FAILURE_DROP or more). A wet
     history adds, per cycle and at the top, the modulus and damping ratio of the effective
     stress (Eq. 3.43; ``*_effective``)."""
@@ -153,6 +183,8 @@ def cyclic_summary(history, cycles, complete=True):
     effective = None
     if "sigma_effective" in history:
         effective = deviator_stress(np.diagonal(history["sigma_effective"], axis1=1, axis2=2))
+    lateral = lateral_stress(sigma)
+    target = lateral[0] if confining is None else confining
     loaded = _stage_end(stage, 0)
     rows = []
     start = loaded
@@ -163,8 +195,8 @@ def cyclic_summary(history, cycles, complete=True):
             break
         loop = slice(start, end + 1)
         modulus, damping, dissipated, stored = loop_measures(strain[loop], q[loop])
-        row = {"cycle": k, "secant_modulus": modulus, "damping_ratio": damping,
-               "dissipated_energy": dissipated, "strain_energy": stored,
+        resolution = damping_resolution(strain[loop], lateral[loop], target, stored)
+        row = {"cycle": k, "secant_modulus": modulus, "dissipated_energy": dissipated, "strain_energy": stored,
                "q_max": float(q[loop].max()), "q_min": float(q[loop].min()),
                "axial_strain_max": float(strain[loop].max()),
                "axial_strain_min": float(strain[loop].min()),
@@ -173,10 +205,12 @@ def cyclic_summary(history, cycles, complete=True):
                "volumetric_strain": float(volumetric[end]),
                "volumetric_strain_increment": float(volumetric[end] - volumetric[start]),
                "records": end + 1 - start}
+        _resolved(row, "damping_ratio", damping, resolution)
         if effective is not None:
-            modulus, damping, _, _ = loop_measures(strain[loop], effective[loop])
-            row.update({"secant_modulus_effective": modulus,
-                        "damping_ratio_effective": damping})
+            modulus, damping, _, stored = loop_measures(strain[loop], effective[loop])
+            row["secant_modulus_effective"] = modulus
+            _resolved(row, "damping_ratio_effective", damping, damping_resolution(
+                strain[loop], lateral[loop], target, stored))
         rows.append(row)
         start = end
     summary = {"cycles": rows, "cycles_completed": len(rows),
@@ -186,6 +220,11 @@ def cyclic_summary(history, cycles, complete=True):
         for name in ("secant_modulus", "damping_ratio"):
             summary[f"{name}_first{suffix}"] = rows[0][name + suffix] if rows else None
             summary[f"{name}_last{suffix}"] = rows[-1][name + suffix] if rows else None
+    below = [row["cycle"] for row in rows if "damping_ratio_note" in row]
+    if below:
+        summary["damping_ratio_note"] = (
+            f"below resolution in cycle(s) {', '.join(map(str, below))}: the damping ratio is "
+            "null there, its measured value, resolution and note in the cycle's row")
     summary["axial_strain_accumulated"] = rows[-1]["axial_strain_accumulated"] if rows else None
     summary["volumetric_strain_accumulated"] = (float(volumetric[start] - volumetric[loaded])
                                                 if rows else None)
@@ -225,7 +264,8 @@ class CyclicTest(LaboratoryTest):
     def summarize(self, history):
         path = getattr(self, "path", None)
         complete = path is None or path.done
-        return {**cyclic_summary(history, self.config.cycles, complete),
+        return {**cyclic_summary(history, self.config.cycles, complete,
+                                 self.config.confining),
                 **stress_balance(history)}
 
     def plot(self, history, out, title):

@@ -90,11 +90,14 @@ def _friction_angle(ratio):
 
 
 def simple_shear_summary(history, constant_volume):
-    """Results of a simple shear's history (``shear_rows``): ``peak_shear_stress`` [Pa] and
-    the shear strain there; at the peak of tau / sigma_n (records with sigma_n above
-    MIN_NORMAL_FRACTION of its initial value) ``peak_stress_ratio``, ``phi_peak_deg`` =
-    atan(tau / sigma_n), ``shear_strain_at_peak``, ``normal_stress_at_peak``, ``peak_reached``
-    (pendular.io.schema.peak_reached); over the last RESIDUAL_FRACTION of the shear strain
+    """Results of a simple shear's history (``shear_rows``). Two peaks, each with the values
+    of its own record: the largest tau, ``peak_shear_stress`` [Pa], with
+    ``shear_strain_at_peak_stress`` and ``normal_stress_at_peak_stress`` and
+    ``peak_shear_stress_reached`` (pendular.io.schema.peak_reached of tau); the peak of tau /
+    sigma_n (records with sigma_n above MIN_NORMAL_FRACTION of its initial value),
+    ``peak_stress_ratio``, with ``phi_peak_deg`` = atan(tau / sigma_n),
+    ``shear_strain_at_peak``, ``normal_stress_at_peak``, ``shear_stress_at_peak`` and
+    ``peak_reached`` (peak_reached of tau / sigma_n); over the last RESIDUAL_FRACTION of the shear strain
     ``residual_stress_ratio`` (mean tau / sigma_n) and ``phi_residual_deg``;
     ``normal_stress_final``. Drained: ``max_dilatancy`` = max -d(eps_v)/d(gamma) over windows
     of DILATANCY_WINDOW of the shear strain (eps_v contraction positive, so dilation is
@@ -110,7 +113,9 @@ def simple_shear_summary(history, constant_volume):
     ratio = np.where(measured, tau / np.where(measured, normal, 1.0), np.nan)
     top = int(np.argmax(tau))
     summary = {"peak_shear_stress": float(tau[top]),
-               "shear_strain_at_peak_stress": float(gamma[top])}
+               "shear_strain_at_peak_stress": float(gamma[top]),
+               "normal_stress_at_peak_stress": float(normal[top]),
+               "peak_shear_stress_reached": peak_reached(gamma, tau)}
     if np.isfinite(ratio).any():
         peak = int(np.nanargmax(ratio))
         span = gamma[-1] - gamma[0]
@@ -121,6 +126,7 @@ def simple_shear_summary(history, constant_volume):
             "phi_peak_deg": _friction_angle(ratio[peak]),
             "shear_strain_at_peak": float(gamma[peak]),
             "normal_stress_at_peak": float(normal[peak]),
+            "shear_stress_at_peak": float(tau[peak]),
             "peak_reached": peak_reached(gamma[measured], ratio[measured]),
             "residual_stress_ratio": residual_ratio if np.isfinite(residual_ratio) else None,
             "phi_residual_deg": _friction_angle(residual_ratio)})
@@ -208,4 +214,5 @@ class SimpleShearTest(LaboratoryTest):
                  if np.ndim(values) and len(values) == len(history["step"])}
         kind = "constant volume" if config.constant_volume else "drained"
         plot_simple_shear(shear, os.path.join(out, self.FIGURE),
-                          f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}")
+                          f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}",
+                          summary=simple_shear_summary(history, config.constant_volume))

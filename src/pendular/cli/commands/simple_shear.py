@@ -22,8 +22,9 @@ from pendular.procedures.simple_shear import SimpleShearTest
 from pendular.cli.commands.triaxial import loading_command
 
 #: Summary keys printed at the end.
-SHOWN = ("peak_shear_stress", "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak",
-         "normal_stress_at_peak", "residual_stress_ratio", "phi_residual_deg",
+SHOWN = ("peak_shear_stress", "shear_strain_at_peak_stress", "normal_stress_at_peak_stress",
+         "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak", "normal_stress_at_peak",
+         "shear_stress_at_peak", "peak_reached", "residual_stress_ratio", "phi_residual_deg",
          "phi_peak_effective_deg", "phi_residual_effective_deg", "normal_stress_final",
          "max_dilatancy", "dilatancy_angle_deg", "max_volume_change", "liquid_balance_error",
          "initial_porosity", "wall_time_s", "particle_steps_per_s")

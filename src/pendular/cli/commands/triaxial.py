@@ -33,11 +33,12 @@ from pendular.procedures.triaxial import Interrupted, TriaxialTest
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
 #: Summary keys printed at the end.
 SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
-         "phi_peak_deg", "peak_q_effective", "p_effective_at_peak", "phi_peak_effective_deg",
-         "peak_q_effective_complete", "p_effective_complete_at_peak", "mean_stress_deviation",
-         "b_deviation", "axial_contact_lost", "initial_porosity", "saturation_at_peak",
-         "suction_at_peak", "liquid_balance_error", "liquid_lost_fraction", "wall_time_s",
-         "particle_steps_per_s")
+         "principal_difference_at_peak", "phi_peak_deg", "peak_q_effective",
+         "p_effective_at_peak", "phi_peak_effective_deg", "peak_q_effective_complete",
+         "p_effective_complete_at_peak", "phi_cs_deg", "M_cs", "void_ratio_cs",
+         "mean_stress_deviation", "b_deviation", "axial_contact_lost", "initial_porosity",
+         "porosity_after_wetting", "saturation_at_peak", "suction_at_peak",
+         "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
 
 
 def loading_command(name, test, shown):
@@ -120,7 +121,8 @@ def run_test(args, test, config_from, shown, add_arguments):
         print("note: q still rises at the end of the test (peak_reached false in "
               "summary.json): the values 'at peak' are those of the highest record; a larger "
               "--max-strain reaches the peak")
-    print(f"outputs in {out}")
+    # with --quiet, stdout holds the JSON alone
+    print(f"outputs in {out}", file=sys.stderr if args.quiet else sys.stdout)
     return 0
 
 
