@@ -11,6 +11,7 @@ import pytest
 
 from conftest import assert_drawn, history_of, summary_of
 from pendular.homogenize.invariants import deviator_stress
+from pendular.io.schema import HISTORY_COLUMNS, undeclared_keys
 from pendular.procedures.critical_state import CRITICAL_STATE_KEYS, critical_state
 
 pytestmark = pytest.mark.slow
@@ -50,6 +51,7 @@ def test_a_wet_extension_stops_when_the_axial_walls_leave_the_sample(tmp_path):
     assert summary["porosity_after_wetting"] == summary["wet_porosity"]
     n = summary["porosity_after_wetting"]
     assert summary["void_ratio_after_wetting"] == pytest.approx(n / (1.0 - n))
+    assert not undeclared_keys(summary, "triaxial")
     assert_drawn(out / "triaxial.png")
 
 
@@ -72,4 +74,6 @@ def test_a_real_run_reports_its_critical_state_by_the_stated_rule(tmp_path):
     assert summary["units"]["phi_cs_deg"] == "deg"
     assert all(type(value) in (float, int, bool, str, list, dict, type(None))
                for value in summary.values())
+    assert not undeclared_keys(summary, "triaxial")
+    assert all("triaxial" in HISTORY_COLUMNS[name].commands for name in history)
     assert np.isfinite(summary["principal_difference_at_peak"])

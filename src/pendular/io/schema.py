@@ -6,27 +6,17 @@ column that is not, so a new column cannot be written without its units. Units a
 ``record`` (one row per record, always first), ``axis`` (x, y, z), ``component`` (x, y, z:
 the second index of a 3x3 tensor), ``grip`` (z-, z+: the grips of direct tension).
 
-Columns by test (pendular.procedures.loading.history_columns, pendular.procedures.tension):
-
-- triaxial, dry: step, time, axial_strain, volumetric_strain, sigma_wall, sigma_contact,
-  porosity, coordination, fabric, anisotropy, unbalanced_force;
-- triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
-  pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
-  and, with exact bridges, psi_interface and sigma_effective_complete
-  (pendular.homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
-  liquid_bridges, liquid_film, liquid_lost;
-- oedometer and isotropic paths (pendular.procedures.triaxial.OedometerTest, IsotropicTest):
-  the triaxial's, and void_ratio; the oedometer k0; stage when the path has several stages;
-- cyclic triaxial (pendular.procedures.cyclic.CyclicTest): the oedometer's less k0, and cycle;
-- simple shear (pendular.procedures.simple_shear.SimpleShearTest): the loading path's,
-  shear_strain, shear_stress and normal_stress;
-- direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
-  coordination, unbalanced_force, and wet: bridges, water_content, saturation.
+The commands that write each column: HISTORY_WRITERS (every loading path records
+pendular.procedures.loading.history_columns; wet, the capillary ones of
+pendular.homogenize.on_the_fly.CapillaryHomogenization; at a water content the closed
+liquid's; each test adds its own). Every summary key, with its units, meaning and the commands
+that write it: SUMMARY_KEYS (docs/outputs.md is generated from both; ``undeclared_keys``
+names what a summary holds beyond them).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,13 +36,15 @@ DIMENSIONS = ("record", *DIMENSION_LABELS)
 @dataclass(frozen=True)
 class Column:
     """One recorded quantity: units (SI, "1" dimensionless), description, the dimensions after
-    ``record`` (names of DIMENSION_LABELS), dtype of the stored values, thesis equation."""
+    ``record`` (names of DIMENSION_LABELS), dtype of the stored values, thesis equation, the
+    commands whose history.h5 holds it (HISTORY_WRITERS)."""
 
     units: str
     description: str
     dims: tuple = ()
     dtype: str = "float64"
     equation: str = ""
+    commands: tuple = ()
 
     @property
     def shape(self):
@@ -63,6 +55,30 @@ class Column:
     def is_integer(self):
         return np.dtype(self.dtype).kind in "iu"
 
+
+#: The laboratory tests (pendular.procedures.triaxial.LaboratoryTest): what every run writes.
+LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path")
+
+#: The commands whose history.h5 holds each column, by column: every loading path's
+#: (pendular.procedures.loading.history_columns) and the SWCC's; wet, the capillary ones; the
+#: closed liquid's; each test's own.
+HISTORY_WRITERS = {
+    **dict.fromkeys(("porosity", "volumetric_strain", "sigma_contact", "fabric", "anisotropy"),
+                    (*LABORATORY, "swcc")),
+    **dict.fromkeys(("step", "time", "axial_strain", "sigma_wall", "coordination",
+                     "unbalanced_force", "bridges", "saturation"),
+                    (*LABORATORY, "swcc", "tension")),
+    **dict.fromkeys(("suction", "sigma_capillary", "pendular_overlaps", "chi", "B", "psi",
+                     "sigma_effective", "psi_interface", "sigma_effective_complete",
+                     "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
+    **dict.fromkeys(("liquid_bridges", "liquid_film", "liquid_lost"), LABORATORY),
+    **dict.fromkeys(("tensile_stress", "grip_pull", "water_content"), ("tension",)),
+    "void_ratio": ("oedometer", "isotropic", "cyclic", "path"),
+    "k0": ("oedometer", "path"),
+    "stage": ("oedometer", "isotropic", "simple-shear", "cyclic", "path"),
+    "cycle": ("cyclic",),
+    **dict.fromkeys(("shear_strain", "shear_stress", "normal_stress"), ("simple-shear",)),
+}
 
 _VECTOR = ("axis",)
 _TENSOR = ("axis", "component")
@@ -144,6 +160,9 @@ HISTORY_COLUMNS = {
                                   "compression positive"),
 }
 
+HISTORY_COLUMNS = {name: replace(column, commands=HISTORY_WRITERS.get(name, ()))
+                   for name, column in HISTORY_COLUMNS.items()}
+
 #: Field data of the ParaView frames (pendular.io.vtk.VtkWriter: one number a .vtu file, the
 #: same in the four series). A series' time axis (the .pvd ``timestep``, ParaView's time
 #: slider) is one of these, named in a comment of its .pvd file.
@@ -177,8 +196,6 @@ class Key:
     commands: tuple
 
 
-#: The laboratory tests (pendular.procedures.triaxial.LaboratoryTest): what every run writes.
-LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path")
 #: The tests whose summary holds a peak of q.
 SHEARS = ("triaxial", "path")
 _T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
@@ -473,6 +490,25 @@ SUMMARY_KEYS = {
 def summary_units(command):
     """Units of the summary keys ``command`` writes (SUMMARY_KEYS)."""
     return {name: key.units for name, key in SUMMARY_KEYS.items() if command in key.commands}
+
+
+def undeclared_keys(summary, command):
+    """The keys of ``summary`` (a summary.json's dict, or one tension.json case) that
+    SUMMARY_KEYS does not declare for ``command``, and ``key.field`` for the fields of a
+    nested record's rows that its units do not declare; its ``units`` block left out."""
+    found = []
+    for name, value in summary.items():
+        key = SUMMARY_KEYS.get(name)
+        if name == "units":
+            continue
+        if key is None or command not in key.commands:
+            found.append(name)
+            continue
+        rows = value if isinstance(value, list) else [value]
+        if isinstance(key.units, dict) and name != "grading":
+            found += [f"{name}.{field}" for row in rows if isinstance(row, dict)
+                      for field in row if field not in key.units]
+    return sorted(set(found))
 
 
 #: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
