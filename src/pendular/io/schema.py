@@ -200,6 +200,14 @@ class Key:
 SHEARS = ("triaxial", "path")
 _T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
 _COMPRESSION = ("oedometer", "isotropic", "path")
+_INDICES = ("oedometer", "isotropic")
+#: The fields of a row of the SWCC (swcc.json ``drying`` and ``wetting``,
+#: pendular.procedures.swcc).
+SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
+                    "bridges_across_gaps": "1", "porosity": "1", "volumetric_strain": "1",
+                    "chi": "1", "chi_tensor": "1", "psi": "Pa", "psi_interface": "Pa",
+                    "sigma_wall": "Pa", "coordination": "1", "pendular_overlaps": "1",
+                    "steps": "1"}
 
 #: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
@@ -323,7 +331,7 @@ SUMMARY_KEYS = {
     "device": Key("1", "where the run ran: cpu or gpu", LABORATORY),
     "grading": Key(GRADING_UNITS, "the grading of the radii: D10, D30, D50, D60 [m], Cu, Cc, "
                                   "radius_min, radius_max, radius_mean [m]",
-                   (*LABORATORY, *_TEN)),
+                   (*LABORATORY, *_TEN, "swcc")),
     "stress_balance_error": Key("1", "largest per-record |sigma_wall - Love-Weber stress of "
                                      "contacts and bridges| / p over the records: how far "
                                      "from quasi-static equilibrium", LABORATORY),
@@ -332,8 +340,9 @@ SUMMARY_KEYS = {
     "stress_balance_flagged": Key("record", "history rows whose stress balance error exceeds "
                                             "the bound", LABORATORY),
     # -- the wetting (triaxial.wetting_report)
-    "wetting": Key("1", "the wetting protocol: isotropic, at-shear, constant-volume, "
-                        "water-content", LABORATORY),
+    "wetting": Key("1", "laboratory tests: the wetting protocol (text: isotropic, "
+                        "at-shear, constant-volume, water-content); swcc: the rows of the "
+                        "wetting branch, their fields as drying's", (*LABORATORY, "swcc")),
     "wetting_steps": Key("1", "time steps of the wetting's equilibria", LABORATORY),
     "wetting_time_s": Key("s", "wall-clock time of the wetting", (*LABORATORY, *_TEN)),
     "initial_saturation": Key("1", "degree of saturation Sr once wetted", LABORATORY),
@@ -342,8 +351,11 @@ SUMMARY_KEYS = {
     "sigma_wall_at_constant_volume": Key("Pa", "constant-volume wetting: the wall stresses "
                                                "(x, y, z) the bridges made, walls fixed",
                                          LABORATORY),
-    "wetting_attempts": Key({"formation_suction_pa": "Pa", "steps": "1"},
-                            "water-content wetting: each try at a formation suction", LABORATORY),
+    "wetting_attempts": Key({"formation_suction_pa": "Pa", "steps": "1",
+                             "water_volume": "m^3", "water_content": "1"},
+                            "water-content wetting: each try at a formation suction, its "
+                            "steps and the liquid its bridges held (tension: as a water "
+                            "content)", (*LABORATORY, *_TEN)),
     "formation_suction_pa": Key("Pa", "water-content wetting: the suction the bridges formed "
                                       "at", (*LABORATORY, *_TEN)),
     "water_content": Key("1", "gravimetric water content w held by the bridges (tension: of "
@@ -354,8 +366,6 @@ SUMMARY_KEYS = {
                                      "initial| / initial over the records", LABORATORY),
     "liquid_lost_fraction": Key("1", "closed liquid: the fraction of the liquid lost by the "
                                      "end", LABORATORY),
-    # -- a loaded sample (--sample)
-    "sample": Key("1", "--sample: the path of the sample the run started from", LABORATORY),
     # -- oedometer (loading.oedometer_summary)
     "k0": Key("1", "K0 = sigma_lateral / sigma_axial of the wall stresses at the axial stress "
                    "target", ("oedometer",)),
@@ -363,7 +373,7 @@ SUMMARY_KEYS = {
     "k0_final": Key("1", "K0 at the end of the unloading", ("oedometer",)),
     "axial_stress_target": Key("Pa", "--axial-stress, the loading's target", ("oedometer",)),
     "axial_stress_at_load": Key("Pa", "axial stress at the end of the loading",
-                                ("oedometer", *_C)),
+                                ("oedometer",)),
     "lateral_stress_at_load": Key("Pa", "lateral stress at the end of the loading",
                                   ("oedometer",)),
     "axial_strain_at_load": Key("1", "axial strain at the end of the (first) loading",
@@ -377,11 +387,11 @@ SUMMARY_KEYS = {
                                              "strain", ("oedometer",)),
     "constrained_modulus_unloading": Key("Pa", "secant M of the unloading", ("oedometer",)),
     "compression_index": Key("1", "Cc = -delta e / delta log10 sigma over the loading "
-                                  "(isotropic: of p)", _COMPRESSION),
-    "compression_index_effective": Key("1", "Cc against the effective stress", _COMPRESSION),
+                                  "(isotropic: of p)", _INDICES),
+    "compression_index_effective": Key("1", "Cc against the effective stress", _INDICES),
     "swelling_index": Key("1", "Cs = -delta e / delta log10 sigma over the unloading",
-                          _COMPRESSION),
-    "swelling_index_effective": Key("1", "Cs against the effective stress", _COMPRESSION),
+                          _INDICES),
+    "swelling_index_effective": Key("1", "Cs against the effective stress", _INDICES),
     "unload_to": Key("Pa", "--unload-to, the unloading's target", ("oedometer",)),
     "axial_stress_final": Key("Pa", "axial stress at the end of the path", ("oedometer",)),
     "axial_strain_final": Key("1", "axial strain at the end of the path", ("oedometer",)),
@@ -484,6 +494,28 @@ SUMMARY_KEYS = {
     "pull_steps": Key("1", "time steps of the pull", _TEN),
     "pull_time_s": Key("s", "wall-clock time of the pull", _TEN),
     "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
+    "case": Key("1", "the case's name: e<void ratio>_w<water content %>", _TEN),
+    # -- the soil-water characteristic curve, swcc.json (pendular.procedures.swcc)
+    "drying": Key(SWCC_STAGE_UNITS, "one row per suction of the drying branch, each stage's "
+                               "equilibrium: suction, Sr, bridges (and across gaps), "
+                               "porosity, eps_v, chi (its trace / 3, and the tensor), psi, "
+                               "the interface term, the wall stresses, coordination, "
+                               "overlapping menisci, steps", ("swcc",)),
+    "hysteresis": Key({"suction": "Pa", "saturation_difference": "1",
+                       "bridges_difference": "1"},
+                      "per suction, drying less wetting: Sr and bridges", ("swcc",)),
+    "bridges_formed_across_gaps": Key("1", "bridges formed across gaps over the path",
+                                      ("swcc",)),
+    "regular_packings": Key("1", "chi of the regular packings (scp, bcc, fcp) at each "
+                                 "suction, null where their bridges merge (thesis Ch. 4)",
+                            ("swcc",)),
+    "thesis_fig_5_5": Key("1", "the thesis's Fig. 5.5 Sr read at its suctions [Pa] "
+                               "(reference values)", ("swcc",)),
+    "preparation": Key({"porosity": "1", "coordination": "1", "steps": "1"},
+                       "the prepared sample: porosity, coordination, steps by phase",
+                       ("swcc",)),
+    "config": Key("1", "the run's configuration (pendular.procedures.config.config_to_dict)",
+                  ("swcc",)),
 }
 
 

@@ -54,6 +54,7 @@ from pendular.homogenize.regular_packing import KINDS
 
 from pendular.procedures.config import SwccConfig, config_to_dict
 from pendular.io.history import write_history
+from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import FIG_5_5
@@ -64,10 +65,7 @@ from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, e
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
 #: Units of the stage rows of swcc.json.
-STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1", "bridges_across_gaps": "1",
-               "porosity": "1", "volumetric_strain": "1", "chi": "1", "chi_tensor": "1",
-               "psi": "Pa", "psi_interface": "Pa", "sigma_wall": "Pa", "coordination": "1",
-               "pendular_overlaps": "1", "steps": "1"}
+STAGE_UNITS = SWCC_STAGE_UNITS
 
 
 def path_bridges(config: SwccConfig, radii) -> CapillaryBridges:
