@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from pendular.dem.sample import load_sample
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
@@ -368,6 +369,34 @@ class LaboratoryConfig:
                              "rate (--strain-rate / --inertial-number) or the time step "
                              "(--timestep-safety) is too small to be represented")
         return per_step
+
+
+#: The fields of a PrepareConfig that a prepared sample fixes: its spheres' count and sizes
+#: (the seed draws a spread of radii).
+SAMPLE_FIELDS = ("particles", "radius", "radius_spread", "psd", "seed")
+
+
+def sized_as_sample(sample, path, given=None):
+    """``sample`` (a PrepareConfig) with the count and sizes (SAMPLE_FIELDS) of the prepared
+    sample at ``path`` for the fields not ``given`` (names; None: the fields at their
+    defaults), read from the configuration the sample was prepared with, else from its
+    spheres (count and mean radius). A field given keeps its value, which
+    pendular.dem.sample.load_sample then refuses when the sample contradicts it. ValueError
+    naming the path for a missing or unreadable sample."""
+    particles, _, _, stored = load_sample(path)
+    made = {"particles": len(particles), "radius": float(np.mean(particles.radius))}
+    if isinstance(stored.get("config"), dict):
+        try:
+            prepared = config_from_dict(stored["config"], f"sample = {path!r}").sample
+        except (AttributeError, TypeError, ValueError):
+            prepared = None            # written by another tool: its spheres say enough
+        if isinstance(prepared, PrepareConfig):
+            made = {name: getattr(prepared, name) for name in SAMPLE_FIELDS}
+    if given is None:
+        given = {name for name in SAMPLE_FIELDS
+                 if getattr(sample, name) != default_of(PrepareConfig, name)}
+    return dataclasses.replace(sample, **{name: value for name, value in made.items()
+                                         if name not in given})
 
 
 @dataclass

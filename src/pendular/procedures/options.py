@@ -24,9 +24,9 @@ from pendular.dem.grading import MAX_RADIUS_RATIO, read_grading_curve
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN,
     MAX_TENSION_PARTICLES, MIN_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES, MIN_TENSION_PARTICLES,
     SPECIFIC_GRAVITY_PARAMETER, TENSION_RANGES, TENSION_SAMPLE, VOID_RATIO_PARAMETER,
-    WATER_DENSITY, BridgeConfig, CyclicConfig, IsotropicConfig, LaboratoryConfig,
+    SAMPLE_FIELDS, WATER_DENSITY, BridgeConfig, CyclicConfig, IsotropicConfig, LaboratoryConfig,
     OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig, TablePathConfig,
-    TensionConfig, TriaxialConfig, check_steps_count, tension_sample)
+    TensionConfig, TriaxialConfig, check_steps_count, sized_as_sample, tension_sample)
 from pendular.procedures.preparation import PrepareConfig
 from pendular.procedures.reference import KIM_RADIUS, SPECIFIC_GRAVITY
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError, fields_of,
@@ -174,6 +174,8 @@ def laboratory_fields(values, given, path):
                               "already prepared (only its equilibrium and the loading run); "
                               f"leave out {name('sample')} to prepare one")
     sample = PrepareConfig(**fields_of(values, PREPARATION), **sample_sizes(values))
+    if values["sample"] is not None:
+        sample = sized_as_sample(sample, values["sample"], set(given) & set(SAMPLE_FIELDS))
     own = path()
     own = {"shear": own} if isinstance(own, ShearConfig) else own
     bridges = None

@@ -25,6 +25,7 @@ positive, volumetric strain positive in contraction (docs/units.md).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -53,7 +54,8 @@ from pendular.homogenize.invariants import (lateral_stress, mean_stress,
 from pendular.procedures.critical_state import critical_state
 from pendular.procedures.guards import AxialContactLost, AxialStressGuard, SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
-    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
+    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number,
+    sized_as_sample)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
     friction_angle, isotropic_stages, isotropic_summary, k0, oedometer_stages,
     oedometer_summary, path_deviations, shear_stage, void_ratio)
@@ -525,6 +527,9 @@ class LaboratoryTest:
         if not isinstance(config, self.CONFIG):
             raise TypeError(f"config must be a {self.CONFIG.__name__}, got "
                             f"{type(config).__name__}")
+        if config.sample_path is not None:      # the sample's count and sizes, unless given
+            config = dataclasses.replace(config, sample=sized_as_sample(config.sample,
+                                                                        config.sample_path))
         self.config = config
         check_feasible(config, force=force)
         if config.bridges is not None and config.bridges.suction is not None:
