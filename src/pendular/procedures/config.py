@@ -376,13 +376,13 @@ class LaboratoryConfig:
 SAMPLE_FIELDS = ("particles", "radius", "radius_spread", "psd", "seed")
 
 
-def sized_as_sample(sample, path, given=None):
+def sized_as_sample(sample, path):
     """``sample`` (a PrepareConfig) with the count and sizes (SAMPLE_FIELDS) of the prepared
-    sample at ``path`` for the fields not ``given`` (names; None: the fields at their
-    defaults), read from the configuration the sample was prepared with, else from its
-    spheres (count and mean radius). A field given keeps its value, which
-    pendular.dem.sample.load_sample then refuses when the sample contradicts it. ValueError
-    naming the path for a missing or unreadable sample."""
+    sample at ``path`` for the fields at their defaults (not given), read from the
+    configuration the sample was prepared with, else from its spheres (count and mean
+    radius). A field given keeps its value, which pendular.dem.sample.load_sample then
+    refuses when the sample contradicts it. ValueError naming the path for an unreadable
+    sample."""
     particles, _, _, stored = load_sample(path)
     made = {"particles": len(particles), "radius": float(np.mean(particles.radius))}
     if isinstance(stored.get("config"), dict):
@@ -392,11 +392,9 @@ def sized_as_sample(sample, path, given=None):
             prepared = None            # written by another tool: its spheres say enough
         if isinstance(prepared, PrepareConfig):
             made = {name: getattr(prepared, name) for name in SAMPLE_FIELDS}
-    if given is None:
-        given = {name for name in SAMPLE_FIELDS
-                 if getattr(sample, name) != default_of(PrepareConfig, name)}
-    return dataclasses.replace(sample, **{name: value for name, value in made.items()
-                                         if name not in given})
+    return dataclasses.replace(sample, **{
+        name: value for name, value in made.items()
+        if getattr(sample, name) == default_of(PrepareConfig, name)})
 
 
 @dataclass

@@ -271,7 +271,7 @@ def frame_period(vtk_every, vtk_frames, steps, unknown_length_period=0):
     if not vtk_frames:
         return 0
     if steps is not None:
-        return max(1, steps // vtk_frames)
+        return max(1, int(steps // vtk_frames))
     return unknown_length_period
 
 
@@ -834,8 +834,11 @@ class _PathRun:
         self.steps = self.path.steps           # None: known only as the path runs
         self.start_step = sim.step
         self.shear_time = 0.0        # seconds spent loading by earlier (interrupted) runs
-        self.vtk_period = frame_period(config.vtk_every, config.vtk_frames, self.steps,
-                                       self.path.recorder.period * VTK_RECORDS)
+        # frames spread over the loading, or over its estimate when its stages end otherwise
+        self.vtk_period = frame_period(
+            config.vtk_every, config.vtk_frames,
+            self.steps if self.steps is not None else config.estimated_steps(),
+            self.path.recorder.period * VTK_RECORDS)
         field_data, time_axis = test.frame_fields(self.path)
         self.vtk = frames_writer(sim, out, self.vtk_period, field_data=field_data,
                                  time_axis=time_axis)
