@@ -7,7 +7,8 @@ On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
   pendular.dem.checkpoint.DATASETS) with its units, the ParaView frames' field data
   (pendular.io.schema.VTK_FIELDS) and the ParaView fields as declared in pendular.io.vtk's
   docstring;
-- ``commands.md``: ``pendular --help`` and every command's ``--help``, as the command prints them;
+- ``commands.md``: ``pendular --help`` and, per command, its worked example (the command module's
+  ``EXAMPLE``) above its ``--help``, as the command prints it;
 - ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
   sub-package, its docstring and every module in it.
 
@@ -122,9 +123,11 @@ def commands_page():
             pass
     lines = ["## `pendular --help`", "", "```text", main.getvalue().rstrip(), "```", ""]
     for name in cli.COMMANDS:
-        parser, _ = cli.command_parser(name)
-        lines += [f"## `pendular {name}`", "", "```text", parser.format_help().rstrip(), "```",
-                  ""]
+        parser, module = cli.command_parser(name)
+        line, gives = module.EXAMPLE
+        gives = gives[0].upper() + gives[1:]
+        lines += [f"## `pendular {name}`", "", "```bash", line, "```", "", f"{gives}.", "",
+                  "```text", parser.format_help().rstrip(), "```", ""]
     return "\n".join(lines)
 
 

@@ -229,10 +229,16 @@ def set_threads(threads):
 
 
 def command_parser(name, prog=None):
-    """(argparse parser of command ``name``, its module)."""
+    """(argparse parser of command ``name``, its module); the help ends with the module's
+    worked ``EXAMPLE`` (command line, what it gives)."""
+    import textwrap
+
     module = importlib.import_module(f"pendular.cli.commands.{COMMANDS[name][0]}")
+    line, gives = module.EXAMPLE
     parser = Parser(prog=prog or f"pendular {name}", description=module.__doc__,
-                    formatter_class=Formatter)
+                    formatter_class=Formatter,
+                    epilog=f"example:\n  {line}\n" + textwrap.fill(
+                        gives, 92, initial_indent="    ", subsequent_indent="    "))
     module.add_arguments(parser)
     return parser, module
 

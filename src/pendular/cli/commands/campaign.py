@@ -28,6 +28,11 @@ from pendular.studies.campaign import (Campaign, RunRefused, sweep_from_table,
 from pendular.cli import UsageError, add_executor_options, start_executor_run
 from pendular.io.outputs import OutputFolder
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular campaign campaign.toml --out runs/campaign --jobs 2",
+           "every row of a table of any command's options, two at a time, collected in "
+           "campaign.csv (the table: the tutorial 'A campaign from a table')")
+
 
 def add_arguments(parser):
     parser.add_argument("table", help="TOML parameter table")

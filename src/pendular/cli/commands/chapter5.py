@@ -9,6 +9,12 @@ from pendular.studies.chapter5 import chapter5_campaign, grid_from_options, grid
 from pendular.cli import (add_declared_options, add_executor_options, declared_values,
     start_executor_run)
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular chapter5 --particles 1000 --suctions 0,30000 --confining 250,750 "
+           "--max-strain 0.1 --out runs/chapter5",
+           "four triaxial tests of thesis Table 5.3 and their strength envelopes; campaign.json, "
+           "report.md, plots/")
+
 
 def add_arguments(parser):
     add_declared_options(parser, grid_options())

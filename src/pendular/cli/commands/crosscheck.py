@@ -20,6 +20,11 @@ from pendular.studies.crosscheck import (OPTIONS, SHOWN, check_mirrored, check_p
 from pendular.interop.yade.runner import find_yade
 from pendular.utils.parameters import OptionError, ParameterError
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular crosscheck --particles 1000 --suction 30000 --out runs/crosscheck",
+           "the same packing sheared by pendular and YADE (when installed) side by side; "
+           "crosscheck.json, crosscheck.png")
+
 
 def add_arguments(parser):
     add_declared_options(parser, OPTIONS)

@@ -24,6 +24,11 @@ from pendular.procedures.cyclic import CyclicTest
 
 from pendular.cli.commands.triaxial import loading_command
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular cyclic --particles 1000 --amplitude-q 200 --cycles 10 --out runs/cyclic",
+           "ten cycles of q = +-200 Pa: the secant modulus and damping ratio of each loop (null "
+           "below its resolution) and the accumulated strains; cyclic.png")
+
 #: Summary keys printed at the end.
 SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
          "damping_ratio_last", "secant_modulus_first_effective",

@@ -7,6 +7,10 @@ DIR/extremes.json and prints the table; exit status 1 if a case failed (pendular
 from pendular.cli import add_declared_options, add_run_options, declared_values, set_threads
 from pendular.studies.extremes import OPTIONS, run_grid
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular extremes --quick --out runs/extremes",
+           "each extreme input of a small wet case: runs, or is refused in one line")
+
 
 def add_arguments(parser):
     parser.add_argument("--out", required=True, help="output folder")

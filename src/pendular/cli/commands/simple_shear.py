@@ -21,6 +21,13 @@ from pendular.procedures.simple_shear import SimpleShearTest
 
 from pendular.cli.commands.triaxial import loading_command
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular simple-shear --particles 1000 --normal-stress 1000 "
+           "--constant-volume --max-strain 0.2 --out runs/simple_shear",
+           "a constant-volume simple shear to gamma 20 %: the peak of tau, the peak of "
+           "tau/sigma_n with its friction angle, each with its own record; simple_shear.png with "
+           "the tau-sigma_n stress path")
+
 #: Summary keys printed at the end.
 SHOWN = ("peak_shear_stress", "shear_strain_at_peak_stress", "normal_stress_at_peak_stress",
          "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak", "normal_stress_at_peak",

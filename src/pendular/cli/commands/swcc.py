@@ -19,6 +19,11 @@ from pendular.cli import (add_command_options, add_device_option, add_run_option
     command_config, print_summary, set_threads)
 from pendular.procedures.swcc import SwccTest
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular swcc --particles 1000 --suctions 3000,10000,30000,100000 --out runs/swcc",
+           "Sr and chi along drying then wetting at these suctions, with the hysteresis; "
+           "swcc.json, swcc.png")
+
 #: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
 SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
 

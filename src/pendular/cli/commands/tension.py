@@ -20,6 +20,11 @@ from pendular.procedures.config import TensionConfig
 from pendular.dem.simulation import check_device
 from pendular.procedures.tension import TensionTest
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tension",
+           "the direct tensile strength of one of Kim's (2001) cases against his measurement and "
+           "the packing-state prediction; tension.json, report.md")
+
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
                  "tensile_strength_pa", "kim_measured_pa", "packing_state_pa")

@@ -29,6 +29,12 @@ from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_devi
 from pendular.dem.simulation import check_device
 from pendular.procedures.triaxial import Interrupted, TriaxialTest
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular triaxial --particles 1000 --suction 30000 --confining 750 --out runs/wet",
+           "a wet drained triaxial compression at 30 kPa suction and 750 Pa confining stress: "
+           "the peak of q and its friction angles (net and effective), the critical state when "
+           "reached, in summary.json; q and the volumetric strain in triaxial.png")
+
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
 #: Summary keys printed at the end.
