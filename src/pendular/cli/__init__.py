@@ -389,8 +389,18 @@ def format_summary(summary, keys, columns=None):
         elif isinstance(value, list):      # e.g. record indices
             value = ", ".join(format_value(item) for item in value) or "none"
         lines.append(f"  {key:<{width}}  {format_value(value)}"
-                     + (f" {unit}" if _shown(unit) else ""))
+                     + (f" {unit}" if _shown(unit) and value is not None else ""))
     return "\n".join(lines)
+
+
+def print_result(quiet, line, **results):
+    """The closing ``line`` of a command (its counts, its folder) on stdout; with ``quiet``
+    (--quiet) on stderr instead, and ``results`` (JSON values) as JSON alone on stdout."""
+    if quiet:
+        print(line, file=sys.stderr)
+        print(json.dumps(results, indent=2))
+    else:
+        print(line)
 
 
 def print_summary(summary, keys, quiet=False, columns=None):

@@ -12,6 +12,8 @@ positive [Pa]. Needs ``yade`` on PATH; docs/yade_crosscheck.md lists the differe
 
 from __future__ import annotations
 
+import sys
+
 from pendular.cli import (UsageError, add_declared_options, add_device_option, declared_values,
     positive_int, print_summary, set_threads)
 from pendular.dem.simulation import check_device
@@ -69,5 +71,7 @@ def run(args):
                             packing=args.packing, concurrent=args.concurrent,
                             threads=args.threads, progress=not args.quiet, device=args.device)
     print_summary(result, SHOWN, args.quiet)
-    print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)")
+    # with --quiet, stdout holds the JSON alone
+    print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)",
+          file=sys.stderr if args.quiet else sys.stdout)
     return 0
