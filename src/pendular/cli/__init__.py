@@ -341,10 +341,12 @@ def format_table(rows, units, columns=None, width=100):
     unit), then one line per row, numbers to 4 significant figures, right-aligned. ``columns``:
     those shown (default: every column holding a number, flag or text). A table wider than
     ``width`` characters is cut into blocks of columns, one under the other (a blank line
-    between), each led by the first column (the row's name: stage, cycle)."""
-    if columns is None:
+    between), each led by the first column (the row's name: stage, cycle). A row's notes
+    (``*_note``) are left out by default."""
+    if columns is None:               # a row's notes are summed up in a line of their own
         columns = [name for name in dict.fromkeys(k for row in rows for k in row)
-                   if all(not isinstance(row.get(name), (list, dict)) for row in rows)]
+                   if all(not isinstance(row.get(name), (list, dict)) for row in rows)
+                   and not name.endswith("_note")]
     header = [_with_unit(name, units.get(name)) for name in columns]
     cells = [[format_value(row.get(name)) for name in columns] for row in rows]
     widths = [max(len(text) for text in column) for column in zip(header, *cells)]

@@ -35,6 +35,6 @@ SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio
          "secant_modulus_last_effective", "damping_ratio_first_effective",
          "damping_ratio_last_effective", "axial_strain_accumulated",
          "volumetric_strain_accumulated", "phi_peak_deg", "initial_porosity", "wall_time_s",
-         "particle_steps_per_s")
+         "particle_steps_per_s", "damping_ratio_note")
 
 add_arguments, config_from, run = loading_command("cyclic", CyclicTest, SHOWN)

@@ -42,6 +42,7 @@ SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_
          "principal_difference_at_peak", "phi_peak_deg", "peak_q_effective",
          "p_effective_at_peak", "phi_peak_effective_deg", "peak_q_effective_complete",
          "p_effective_complete_at_peak", "phi_cs_deg", "M_cs", "void_ratio_cs",
+         "critical_state_note", "phi_peak_note",
          "mean_stress_deviation", "b_deviation", "axial_contact_lost", "initial_porosity",
          "porosity_after_wetting", "saturation_at_peak", "suction_at_peak",
          "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
