@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from pendular.homogenize.invariants import von_mises_stress
-from pendular.procedures.critical_state import (CRITICAL_STATE_KEYS, CRITICAL_STATE_WINDOW,
-    critical_state)
+from pendular.procedures.critical_state import CRITICAL_STATE_KEYS, CRITICAL_STATE_WINDOW
 from pendular.procedures.triaxial import summarize
 
 STRAIN = np.linspace(0.0, 0.25, 251)
