@@ -136,3 +136,23 @@ def test_the_generated_reference_lists_every_key_with_its_meaning_and_commands()
                     if line.startswith(f"| `{name}` |"))
         assert docs._cell(key.description) in line
         assert all(command in line for command in key.commands), name
+
+
+def test_a_measure_that_cannot_be_taken_is_null_with_a_note_saying_why():
+    flat = history(np.full(ROWS, 750.0), np.full(ROWS, 750.0))            # q stays 0
+    deviations = path_deviations(flat, ShearConfig(b=0.5), 750.0)
+    assert deviations["b_deviation"] is None
+    assert deviations["b_deviation_note"].startswith("not measured: no record")
+    gamma = np.linspace(0.0, 0.3, ROWS)
+    unloaded = history(np.full(ROWS, 1000.0), np.full(ROWS, 1000.0), shear_strain=gamma,
+                       shear_stress=600.0 * np.tanh(gamma / 0.02),
+                       normal_stress=np.where(gamma < 0.25, 1000.0, 0.0))
+    summary = simple_shear_summary(unloaded, False)
+    assert summary["phi_residual_deg"] is None and summary["residual_stress_ratio"] is None
+    assert summary["phi_residual_note"].startswith("not measured: no record in the last 10 %")
+    still = history(np.full(3, 1000.0), np.full(3, 1000.0), shear_strain=np.zeros(3),
+                    shear_stress=np.zeros(3), normal_stress=np.full(3, 1000.0))
+    summary = simple_shear_summary(still, False)
+    assert summary["max_dilatancy"] is None and "did not move" in summary["max_dilatancy_note"]
+    for found, command in ((deviations, "triaxial"), (summary, "simple-shear")):
+        assert_declared(found, command)

@@ -293,6 +293,7 @@ SUMMARY_KEYS = {
     "b_deviation": Key("1", "--b: largest |b measured - b| over the records with sigma_z - "
                             "sigma_x of at least a tenth of the confining stress; null "
                             "without such records", _T),
+    "b_deviation_note": Key("1", "why b_deviation is null", _T),
     # -- every laboratory run (TriaxialTest's run, pendular.procedures.triaxial)
     "completed": Key("1", "whether the loading reached its end (false: interrupted or "
                           "failed; error says why)", LABORATORY),
@@ -385,6 +386,8 @@ SUMMARY_KEYS = {
                                      "delta eps_a over the loading", ("oedometer",)),
     "constrained_modulus_tangent": Key("Pa", "tangent M over the last 20 % of the loading's "
                                              "strain", ("oedometer",)),
+    "constrained_modulus_tangent_note": Key("1", "why constrained_modulus_tangent is null",
+                                            ("oedometer",)),
     "constrained_modulus_unloading": Key("Pa", "secant M of the unloading", ("oedometer",)),
     "compression_index": Key("1", "Cc = -delta e / delta log10 sigma over the loading "
                                   "(isotropic: of p)", _INDICES),
@@ -451,10 +454,13 @@ SUMMARY_KEYS = {
     "residual_stress_ratio": Key("1", "mean tau / sigma_n over the last fifth of the shear "
                                       "strain", _S),
     "phi_residual_deg": Key("deg", "atan of residual_stress_ratio", _S),
+    "phi_residual_note": Key("1", "why residual_stress_ratio and phi_residual_deg are null",
+                             _S),
     "normal_stress_final": Key("Pa", "sigma_n at the end", _S),
     "max_dilatancy": Key("1", "drained: the largest -d eps_v / d gamma over windows of a "
                               "tenth of the shear strain range (dilation positive)", _S),
     "dilatancy_angle_deg": Key("deg", "atan of max_dilatancy", _S),
+    "max_dilatancy_note": Key("1", "why max_dilatancy and dilatancy_angle_deg are null", _S),
     "volumetric_strain_of_shear": Key("1", "drained: eps_v at the end, from the shear's start",
                                       _S),
     "max_volume_change": Key("1", "constant volume: the largest |V / V_start - 1| (round-off)",

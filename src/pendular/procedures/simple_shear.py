@@ -130,6 +130,10 @@ def simple_shear_summary(history, constant_volume):
             "peak_reached": peak_reached(gamma[measured], ratio[measured]),
             "residual_stress_ratio": residual_ratio if np.isfinite(residual_ratio) else None,
             "phi_residual_deg": _friction_angle(residual_ratio)})
+        if summary["residual_stress_ratio"] is None:
+            summary["phi_residual_note"] = (
+                f"not measured: no record in the last {100 * RESIDUAL_FRACTION:g} % of the "
+                f"shear strain has sigma_n above {100 * MIN_NORMAL_FRACTION:g} % of its start")
     summary["normal_stress_final"] = float(normal[-1])
     if "psi" in history:
         summary.update(effective_friction(history, rows))
@@ -171,11 +175,14 @@ def dilatancy(gamma, volumetric):
     """``max_dilatancy`` = max over the shear of -d(eps_v)/d(gamma) [-], differences over
     windows of DILATANCY_WINDOW of the shear strain range (eps_v ``volumetric``, contraction
     positive, against ``gamma``, rising), ``dilatancy_angle_deg`` = atan of it and
-    ``volumetric_strain_of_shear`` (the last eps_v); None without a range of shear strain."""
+    ``volumetric_strain_of_shear`` (the last eps_v); None without a range of shear strain,
+    ``max_dilatancy_note`` saying so."""
     span = gamma[-1] - gamma[0]
     found = {"volumetric_strain_of_shear": float(volumetric[-1])}
     if not span > 0.0 or len(gamma) < 3:
-        return {**found, "max_dilatancy": None, "dilatancy_angle_deg": None}
+        return {**found, "max_dilatancy": None, "dilatancy_angle_deg": None,
+                "max_dilatancy_note": "not measured: the shear strain did not move, or fewer "
+                                      "than 3 records"}
     window = DILATANCY_WINDOW * span
     start = np.linspace(gamma[0], gamma[-1] - window, 200)
     slope = -(np.interp(start + window, gamma, volumetric)
