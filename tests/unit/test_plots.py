@@ -200,5 +200,5 @@ def test_a_constant_p_stress_path_is_drawn_upright_and_titled_with_p_and_b():
     assert "constant p = 0.75 kPa" in label and "b = 0.5" in label and "σ3" not in label
     assert "n0 = 0.395" in label
     figure = plots.history_figure(history, label, "compression", b=0.5)
-    assert figure.axes[0].get_ylabel() == "von Mises deviatoric stress q [kPa]"
+    assert figure.axes[0].get_ylabel() == "von Mises stress q [kPa]"
     plots.pyplot().close(figure)

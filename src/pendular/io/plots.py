@@ -77,7 +77,7 @@ def run_label(parameters, initial_porosity=None):
 
 
 #: What q is, by whether the test holds an intermediate principal stress (b != 0).
-Q_WORDS = {False: "deviator stress", True: "von Mises deviatoric stress"}
+Q_WORDS = {False: "deviator stress", True: "von Mises stress"}
 #: Least span of a stress path's p axis, over the span of its q axis.
 MIN_P_SPAN = 0.5
 #: The sign of q = sigma_z - sigma_lateral at the failure of a shear, by direction.

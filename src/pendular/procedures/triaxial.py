@@ -746,8 +746,9 @@ class TriaxialTest(LaboratoryTest):
     def plot(self, history, out, title):
         shear = self.config.shear
         plot_history(history, os.path.join(out, self.FIGURE), title, shear.direction, shear.b)
-        write_plots(history, os.path.join(out, "plots"), title, shear.direction, shear.b)
-        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title,
+        named = f"drained triaxial {shear.direction}; {title}"    # the plots/ name the test
+        write_plots(history, os.path.join(out, "plots"), named, shear.direction, shear.b)
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), named,
                          shear.direction, shear.b)
 
 
