@@ -372,14 +372,14 @@ def summarize(history, direction="compression", b=None):
     if "sigma_effective" in history:
         effective = np.diagonal(history["sigma_effective"], axis1=1, axis2=2)
         summary["peak_q_effective"] = float(shear_deviator(effective[peak], b))
-        summary["p_effective_at_peak"] = float(mean_stress(effective[peak]))
+        summary["p_effective_at_peak"] = float(effective[peak].mean())
         summary["phi_peak_effective_deg"] = (None if contact_lost else
                                              float(friction_angle(effective[peak])))
     if "sigma_effective_complete" in history:
         complete = np.diagonal(history["sigma_effective_complete"][peak])
         summary["peak_q_effective_complete"] = float(shear_deviator(complete, b))
-        summary["p_effective_complete_at_peak"] = float(mean_stress(complete))
-    if "porosity" in history and "volumetric_strain" in history:   # not in a YADE history
+        summary["p_effective_complete_at_peak"] = float(complete.mean())
+    if "porosity" in history and "volumetric_strain" in history:
         strain, volumetric = history["axial_strain"], history["volumetric_strain"]
         summary.update(critical_state(strain, volumetric, sigma, q, history["porosity"]))
         if effective is not None:
