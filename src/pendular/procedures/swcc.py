@@ -64,8 +64,6 @@ from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, e
 
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
-#: Units of the stage rows of swcc.json.
-STAGE_UNITS = SWCC_STAGE_UNITS
 
 
 def path_bridges(config: SwccConfig, radii) -> CapillaryBridges:
@@ -155,7 +153,7 @@ class SwccTest:
             "regular_packings": regular_packing_curves(config, suctions),
             "thesis_fig_5_5": {str(int(s)): v for s, v in FIG_5_5.items()},
             "wall_time_s": time.perf_counter() - started,
-            "units": {**STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
+            "units": {**SWCC_STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
         }
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
@@ -180,7 +178,7 @@ class SwccTest:
 
     @staticmethod
     def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):
-        """The swcc.json row of a static stage (STAGE_UNITS)."""
+        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS)."""
         state = bridges.state(sim)
         chi = homogenization.chi(sim)
         return {"suction": suction,
