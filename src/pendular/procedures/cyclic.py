@@ -102,30 +102,39 @@ def loop_measures(strain, q):
     return modulus, damping, dissipated, stored
 
 
-def damping_resolution(strain, lateral, target, stored):
-    """The resolution [-] of a loop's damping ratio (loop_measures): the largest loop area the
-    lateral stress's departure from its ``target`` [Pa] can add to or take from the oint of q
-    d eps, sum |lateral - target| |d eps| over the loop (trapezoids), over 4 pi W_S
-    (``stored`` [Pa]); ``strain`` [-] and ``lateral`` [Pa] in the order travelled. A damping
-    ratio below it in magnitude is not measured: the servo's lag, not dissipation, may make
-    it (a loop that closes elastically reads a small negative D). None where W_S is 0."""
+def damping_resolution(strain, q, lateral, target, stored):
+    """The resolution [-] of a loop's damping ratio (loop_measures): the loop area that the
+    measurement itself can make, over 4 pi W_S (``stored`` [Pa]). Two parts, each an area
+    over the strain travelled sum |d eps| (``strain`` [-] in the order travelled): the
+    lateral stress's departure from its ``target`` [Pa] (the servo's lag),
+    sum |lateral - target| |d eps| (trapezoids), and the scatter of the records of ``q``
+    [Pa], its noise estimated from their second differences (median absolute deviation,
+    robust to the loop's turning points: s = median |q[i+1] - 2 q[i] + q[i-1]| /
+    (0.6745 sqrt 6)) times sum |d eps|. None where W_S is 0 or the loop has fewer than 3
+    records."""
     strain = np.asarray(strain, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    if not stored > 0.0 or len(q) < 3:
+        return None
+    travel = np.abs(np.diff(strain))
     off = np.abs(np.asarray(lateral, dtype=np.float64) - target)
-    area = float(np.sum(0.5 * (off[1:] + off[:-1]) * np.abs(np.diff(strain))))
-    return area / (4.0 * math.pi * stored) if stored > 0.0 else None
+    lag = float(np.sum(0.5 * (off[1:] + off[:-1]) * travel))
+    noise = float(np.median(np.abs(q[2:] - 2.0 * q[1:-1] + q[:-2]))) / (0.6745 * math.sqrt(6.0))
+    return (lag + noise * float(np.sum(travel))) / (4.0 * math.pi * stored)
 
 
 def _resolved(row, name, damping, resolution):
     """Fill ``row`` with the damping ratio ``name`` measured against its ``resolution``: the
-    value, or None with a note when it is below the resolution."""
+    value, or None with a note when it does not exceed the resolution (a damping ratio is not
+    negative: a negative one is the measurement's own error)."""
     row[name] = damping
     row[f"{name}_measured"] = damping
     row[f"{name}_resolution"] = resolution
-    if damping is not None and resolution is not None and abs(damping) < resolution:
+    if damping is not None and resolution is not None and damping <= resolution:
         row[name] = None
-        row[f"{name}_note"] = (f"below resolution: |{name}| {abs(damping):.2g} < "
-                                     f"{resolution:.2g}, the loop area the lateral servo's "
-                                     "lag can make")
+        row[f"{name}_note"] = (f"below resolution: {name} {damping:.2g} <= {resolution:.2g}, "
+                               "the loop area that the lateral servo's lag and the records' "
+                               "scatter can make")
 
 
 def _stage_end(stage, k):
@@ -195,7 +204,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
             break
         loop = slice(start, end + 1)
         modulus, damping, dissipated, stored = loop_measures(strain[loop], q[loop])
-        resolution = damping_resolution(strain[loop], lateral[loop], target, stored)
+        resolution = damping_resolution(strain[loop], q[loop], lateral[loop], target, stored)
         row = {"cycle": k, "secant_modulus": modulus, "dissipated_energy": dissipated, "strain_energy": stored,
                "q_max": float(q[loop].max()), "q_min": float(q[loop].min()),
                "axial_strain_max": float(strain[loop].max()),
@@ -210,7 +219,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
             modulus, damping, _, stored = loop_measures(strain[loop], effective[loop])
             row["secant_modulus_effective"] = modulus
             _resolved(row, "damping_ratio_effective", damping, damping_resolution(
-                strain[loop], lateral[loop], target, stored))
+                strain[loop], effective[loop], lateral[loop], target, stored))
         rows.append(row)
         start = end
     summary = {"cycles": rows, "cycles_completed": len(rows),
