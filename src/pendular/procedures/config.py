@@ -294,7 +294,9 @@ class LaboratoryConfig:
     sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its
     ``confining`` [Pa] is the isotropic stress the loading path starts from; at least
     MIN_SAMPLE_PARTICLES spheres); bridges: None for a dry test;
-    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
+    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one,
+    whose count and sizes the test takes where ``sample`` leaves them at their defaults
+    (``sized_as_sample``);
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
     vtk_frames: ParaView frames over the loading (0: none; a path whose length is not known
     before it runs writes one every VTK_RECORDS history rows); vtk_every: steps between frames
