@@ -124,10 +124,11 @@ def commands_page():
     lines = ["## `pendular --help`", "", "```text", main.getvalue().rstrip(), "```", ""]
     for name in cli.COMMANDS:
         parser, module = cli.command_parser(name)
-        line, gives = module.EXAMPLE
-        gives = gives[0].upper() + gives[1:]
-        lines += [f"## `pendular {name}`", "", "```bash", line, "```", "", f"{gives}.", "",
-                  "```text", parser.format_help().rstrip(), "```", ""]
+        lines += [f"## `pendular {name}`", ""]
+        if hasattr(module, "EXAMPLE"):
+            line, gives = module.EXAMPLE
+            lines += ["```bash", line, "```", "", f"{gives[0].upper()}{gives[1:]}.", ""]
+        lines += ["```text", parser.format_help().rstrip(), "```", ""]
     return "\n".join(lines)
 
 

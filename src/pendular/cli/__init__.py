@@ -234,11 +234,13 @@ def command_parser(name, prog=None):
     import textwrap
 
     module = importlib.import_module(f"pendular.cli.commands.{COMMANDS[name][0]}")
-    line, gives = module.EXAMPLE
+    epilog = None
+    if hasattr(module, "EXAMPLE"):          # every command has one (tests/unit/test_cli.py)
+        line, gives = module.EXAMPLE
+        epilog = f"example:\n  {line}\n" + textwrap.fill(
+            gives, 92, initial_indent="    ", subsequent_indent="    ")
     parser = Parser(prog=prog or f"pendular {name}", description=module.__doc__,
-                    formatter_class=Formatter,
-                    epilog=f"example:\n  {line}\n" + textwrap.fill(
-                        gives, 92, initial_indent="    ", subsequent_indent="    "))
+                    formatter_class=Formatter, epilog=epilog)
     module.add_arguments(parser)
     return parser, module
 
