@@ -3,11 +3,12 @@
 On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
 
 - ``outputs_tables.md``: every history column (pendular.io.schema.HISTORY_COLUMNS), summary key
-  (SUMMARY_UNITS), sample and checkpoint dataset (pendular.dem.sample.DATASETS,
+  with its meaning and the commands writing it (SUMMARY_KEYS), run option (OPTION_UNITS), sample and checkpoint dataset (pendular.dem.sample.DATASETS,
   pendular.dem.checkpoint.DATASETS) with its units, the ParaView frames' field data
   (pendular.io.schema.VTK_FIELDS) and the ParaView fields as declared in pendular.io.vtk's
   docstring;
-- ``commands.md``: ``pendular --help`` and every command's ``--help``, as the command prints them;
+- ``commands.md``: ``pendular --help`` and, per command, its worked example (the command module's
+  ``EXAMPLE``) above its ``--help``, as the command prints it;
 - ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
   sub-package, its docstring and every module in it.
 
@@ -60,24 +61,35 @@ def outputs_tables():
     lines = ["## History datasets (`history.h5`, group `history`)", "",
              "One row per record; the dimensions after `record` are `axis` and `component` "
              "(x, y, z) or `grip` (z−, z+). `–`: dimensionless.", "",
-             "| dataset | units | dimensions | dtype | equation | description |",
-             "|---|---|---|---|---|---|"]
+             "| dataset | units | dimensions | dtype | written by | equation | description |",
+             "|---|---|---|---|---|---|---|"]
     for name, column in schema.HISTORY_COLUMNS.items():
         dims = ", ".join(("record", *column.dims))
+        commands = ", ".join(f"`{command}`" for command in column.commands)
         lines.append(f"| `{name}` | {_units(column.units)} | {dims} | {column.dtype} | "
-                     f"{_cell(column.equation)} | {_cell(column.description)} |")
+                     f"{commands} | {_cell(column.equation)} | {_cell(column.description)} |")
     lines += ["", "## Summary keys (`summary.json`, `tension.json` cases, campaign rows)", "",
-              "Keys not listed are text, flags or nested records (`units`, `grading`, "
-              "`stress_balance_flagged` lists record indices). Grading keys "
-              "(`grading` block of a summary and of `sample.h5`): "
-              + ", ".join(f"`{key}` [{_units(unit)}]" for key, unit in GRADING_UNITS.items())
-              + ".", "",
-              "| key | units | triaxial | tension | run option |", "|---|---|---|---|---|"]
-    for key in sorted(k for k in schema.SUMMARY_UNITS if k != "grading"):
-        unit = schema.SUMMARY_UNITS[key]
-        marks = ["✓" if key in table else "" for table in (
-            schema.TRIAXIAL_SUMMARY_UNITS, schema.TENSION_SUMMARY_UNITS, schema.OPTION_UNITS)]
-        lines.append(f"| `{key}` | {_units(unit)} | " + " | ".join(marks) + " |")
+              "Every key a command writes, declared once in `pendular.io.schema.SUMMARY_KEYS` "
+              "(a test fails when a command writes a key not declared for it). `null`: a "
+              "measure that could not be taken, its `*_note` saying why. A nested record's "
+              "fields and their units follow its table.", "",
+              "| key | units | written by | meaning |", "|---|---|---|---|"]
+    nested = []
+    for name, key in schema.SUMMARY_KEYS.items():
+        units = "fields below" if isinstance(key.units, dict) else _units(key.units)
+        commands = ", ".join(f"`{command}`" for command in key.commands)
+        lines.append(f"| `{name}` | {units} | {commands} | {_cell(key.description)} |")
+        if isinstance(key.units, dict):
+            nested.append((name, key.units))
+    for name, units in nested:
+        lines += ["", f"Fields of `{name}`: "
+                  + ", ".join(f"`{field}` [{_units(unit)}]" for field, unit in units.items())
+                  + "."]
+    lines += ["", "## Run options (campaign rows, `history.h5` attributes)", "",
+              "The options of a run as its command names them (underscores for dashes; "
+              "`pendular <command> --help` explains each):", "",
+              ", ".join(f"`{name}` [{_units(unit)}]"
+                        for name, unit in sorted(schema.OPTION_UNITS.items())) + "."]
     lines += ["", "## Sample datasets (`sample.h5`)", "",
               "| dataset | units | description |", "|---|---|---|"]
     lines += [f"| `{name}` | {_units(units)} | {_cell(text)} |"
@@ -111,9 +123,12 @@ def commands_page():
             pass
     lines = ["## `pendular --help`", "", "```text", main.getvalue().rstrip(), "```", ""]
     for name in cli.COMMANDS:
-        parser, _ = cli.command_parser(name)
-        lines += [f"## `pendular {name}`", "", "```text", parser.format_help().rstrip(), "```",
-                  ""]
+        parser, module = cli.command_parser(name)
+        lines += [f"## `pendular {name}`", ""]
+        if hasattr(module, "EXAMPLE"):
+            line, gives = module.EXAMPLE
+            lines += ["```bash", line, "```", "", f"{gives[0].upper()}{gives[1:]}.", ""]
+        lines += ["```text", parser.format_help().rstrip(), "```", ""]
     return "\n".join(lines)
 
 

@@ -44,7 +44,9 @@ print(done.stdout)
 # effective stress of thesis Eq. 3.43 (q′, p′), the degree of saturation Sr and the timings.
 # Stresses are in Pa, compression positive; strains are fractions, compression positive
 # (:doc:`/units`). A note follows when q still rises at the end of the test (``peak_reached``
-# false in ``summary.json``): the "peak" is then the highest record, not a peak.
+# false in ``summary.json``): the "peak" is then the highest record, not a peak. The critical
+# state (``phi_cs_deg``, ``M_cs``, ``void_ratio_cs``) is given when the test reaches it; a test
+# to 5 % does not, and ``critical_state_note`` says why (:doc:`/outputs`).
 #
 # What the run left
 # -----------------

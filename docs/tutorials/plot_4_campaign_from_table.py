@@ -39,19 +39,23 @@ with open("campaign.toml", "w") as handle:
 # send them to a Dask cluster instead (:doc:`/howto/dask_campaigns`). In a shell::
 #
 #     pendular campaign campaign.toml --out runs/campaign --jobs 2
+#
+# With ``--quiet`` its standard output is JSON alone (the counts of runs and the folder), which
+# a script reads with ``json.loads``:
 
 # sphinx_gallery_start_ignore
 import shutil
 
 shutil.rmtree("runs/campaign", ignore_errors=True)     # a fresh campaign at every build
 # sphinx_gallery_end_ignore
+import json
 import subprocess
 import sys
 
 done = subprocess.run([sys.executable, "-m", "pendular", "campaign", "campaign.toml",
                        "--out", "runs/campaign", "--jobs", "2", "--quiet"],
                       capture_output=True, text=True, check=True)
-print(done.stdout)
+print(json.loads(done.stdout))
 
 # %%
 # Each run has its folder ``runs/campaign/runs/<name>/`` (its outputs and ``log.txt``), named

@@ -50,7 +50,9 @@ def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
     table.write_text(TABLE)
     out = tmp_path / "out"
     first = pendular("campaign", str(table), "--out", str(out), "--jobs", "2", "--quiet")
-    assert "4 triaxial runs (0 reused, 0 failed)" in first.stdout
+    assert "4 triaxial runs (0 reused, 0 failed)" in first.stderr      # --quiet: JSON alone
+    assert json.loads(first.stdout) == {"command": "triaxial", "runs": 4, "reused": 0,
+                                        "failed": 0, "out": str(out)}
     with open(out / "campaign.csv") as handle:
         rows = list(csv.DictReader(handle))
     assert sorted((float(r["suction"]), float(r["confining"])) for r in rows) == [
@@ -77,7 +79,7 @@ def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
     started = time.perf_counter()
     again = pendular("campaign", str(table), "--out", str(out), "--quiet")
     assert time.perf_counter() - started < 60
-    assert "4 triaxial runs (4 reused, 0 failed)" in again.stdout
+    assert "4 triaxial runs (4 reused, 0 failed)" in again.stderr
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps          # no run touched
     with open(out / "campaign.csv") as handle:
         reread = list(csv.DictReader(handle))

@@ -26,6 +26,7 @@ from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from
 from pendular.procedures.preparation import PrepareConfig
 
 from conftest import ROOT
+from pendular.io.schema import undeclared_keys
 
 GAMMA = 0.074
 WATER = 0.0104       # Kim's middle water content (fraction)
@@ -208,12 +209,14 @@ def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
 
 def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     out = tmp_path / "tension"
-    subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
-                    "--particles", "200", "--void-ratio", "0.65", "--water-content", "1",
-                    "--max-strain", "0.01", "--vtk-every", "2000", "--quiet", "--out", str(out)],
-                   check=True, capture_output=True, text=True)
+    done = subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
+                           "--particles", "200", "--void-ratio", "0.65", "--water-content", "1",
+                           "--max-strain", "0.01", "--vtk-every", "2000", "--quiet", "--out",
+                           str(out)], check=True, capture_output=True, text=True)
+    assert json.loads(done.stdout)["cases"][0]["case"] == "e0.65_w1.00"   # --quiet: JSON alone
     result = json.loads((out / "tension.json").read_text())
     (case,) = result["cases"]
+    assert not undeclared_keys(case, "tension")
     assert case["tensile_strength_pa"] > 0.0 and case["water_content"] == pytest.approx(
         0.01, rel=WATER_TOLERANCE)
     folder = out / "cases" / case["case"]

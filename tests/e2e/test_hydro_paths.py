@@ -12,6 +12,7 @@ import pytest
 
 from pendular import read_history
 from pendular.cli import run_command
+from pendular.io.schema import undeclared_keys
 
 from conftest import ROOT, assert_drawn
 
@@ -34,6 +35,7 @@ def swcc_run(tmp_path_factory):
 
 def test_swcc_has_both_branches_and_their_hysteresis(swcc_run):
     out, result = swcc_run
+    assert not undeclared_keys(result, "swcc")
     for branch in ("drying", "wetting"):
         rows = result[branch]
         assert [r["suction"] for r in rows] == ([3000.0, 30000.0, 300000.0] if branch == "drying"

@@ -86,8 +86,9 @@ def test_extension_and_compression_of_the_same_dry_sample_fail_at_close_friction
     extension = found["extension"]
     assert extension["min_axial_stress"] < 750.0 and extension["axial_strain_at_peak"] < 0.0
     assert extension["axial_contact_lost"] is False
+    # q = sigma_axial - sigma_lateral: negative in extension, as in the history and the plot
     assert extension["peak_q"] == pytest.approx(
-        extension["lateral_stress"] - extension["min_axial_stress"], rel=0.02)
+        extension["min_axial_stress"] - extension["lateral_stress"], rel=0.02)
     assert abs(extension["phi_peak_deg"] - found["compression"]["phi_peak_deg"]) < 5.0
     assert 15.0 < extension["phi_peak_deg"] < 40.0
 

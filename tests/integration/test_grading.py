@@ -13,7 +13,10 @@ from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grad
     sample_radii, size_at_passing)
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.cli import run_command
-from pendular.procedures.config import config_from_dict, config_json, config_to_dict
+from pendular.io.history import read_history
+from pendular.procedures.config import (TriaxialConfig, config_from_dict, config_json,
+    config_to_dict)
+from pendular.procedures.triaxial import TriaxialTest
 
 CURVE = ((30e-6, 0.0), (40e-6, 20.0), (50e-6, 60.0), (80e-6, 100.0))
 
@@ -160,3 +163,30 @@ def test_a_sample_of_another_spread_is_refused_naming_the_sizes(tmp_path, capsys
     capsys.readouterr()
     refused_triaxial(capsys, again + ["--radius-spread", "0.2", "--out", str(tmp_path / "other")],
             "radius_spread = 0.2", sample.rsplit("/", 1)[0])
+
+
+def test_a_sample_gives_its_count_and_sizes_and_refuses_only_a_contradiction(tmp_path,
+                                                                             capsys):
+    """--sample takes the particle count and the radii from the sample (no --particles
+    repeated, on the command line or in the API); a count that contradicts it is refused."""
+    out = tmp_path / "graded"
+    assert run_command("triaxial", ["--particles", "120", "--radius-spread", "0.3",
+                                    "--seed", "3", "--max-strain", "0.002",
+                                    "--inertial-number", "2e-3", "--vtk-frames", "0",
+                                    "--quiet", "--out", str(out)]) == 0
+    sample = str(out / "sample.h5")
+    loaded = tmp_path / "loaded"
+    assert run_command("triaxial", ["--sample", sample, "--max-strain", "0.002",
+                                    "--inertial-number", "2e-3", "--vtk-frames", "0",
+                                    "--quiet", "--out", str(loaded)]) == 0
+    config = config_from_dict(json.loads(read_history(loaded).attrs["config"]))
+    assert (config.sample.particles, config.sample.radius_spread, config.sample.seed) == \
+        (120, 0.3, 3)
+    made = json.loads((out / "summary.json").read_text())["grading"]
+    assert json.loads((loaded / "summary.json").read_text())["grading"] == made
+    test = TriaxialTest(TriaxialConfig(sample_path=sample))          # the API alike
+    assert (test.config.sample.particles, test.config.sample.radius_spread) == (120, 0.3)
+    capsys.readouterr()
+    refused_triaxial(capsys, ["--sample", sample, "--particles", "100", "--max-strain", "0.002",
+                              "--out", str(tmp_path / "other")],
+                     "has 120 particles; the run asks for particles = 100")

@@ -67,3 +67,24 @@ def test_every_command_has_a_help_listing_its_options(command, capsys):
     for action in parser._actions:
         for flag in action.option_strings if action.help != argparse.SUPPRESS else ():
             assert flag in out, (command, flag)
+
+
+def test_every_command_has_a_worked_example_that_its_parser_takes(monkeypatch):
+    """Each command's EXAMPLE (docs/commands.md and the end of --help) is a command line its
+    own parser accepts, with a configuration it builds where the command has one, so that an
+    example cannot outlive a renamed option."""
+    import shlex
+
+    from conftest import ROOT
+    from pendular.cli import COMMANDS, command_parser
+
+    monkeypatch.chdir(ROOT)                       # the path table of the example
+    for name in COMMANDS:
+        parser, module = command_parser(name)
+        line, gives = module.EXAMPLE
+        words = shlex.split(line)
+        assert words[:2] == ["pendular", name] and gives, name
+        args = parser.parse_args(words[2:])
+        if hasattr(module, "config_from"):
+            module.config_from(args)
+        assert line in parser.format_help()

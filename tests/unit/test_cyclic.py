@@ -13,8 +13,9 @@ from conftest import StressScene
 from pendular.dem.state import Particles, Walls
 from pendular.procedures.config import (MIN_AXIAL_STRAIN, CyclicConfig, PrepareConfig,
     config_from_dict, config_to_dict)
-from pendular.procedures.cyclic import (AxialStressGuard, CyclicPath, cycle_of, cyclic_stages,
-    cyclic_summary, loop_measures)
+from pendular.procedures.cyclic import (CyclicPath, cycle_of, cyclic_stages, cyclic_summary,
+    damping_resolution, loop_measures)
+from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.loading import StageFailed, Strain, Stress
 from pendular.procedures.preparation import servoed_simulation
 from pendular.procedures.triaxial import equilibrate
@@ -223,8 +224,41 @@ def test_a_strain_cycle_of_the_smallest_amplitude_leaves_an_elastic_lattice_as_i
     position, walls, stress = ends[0]
     for row, stage in zip(summary["cycles"], (2, 4)):
         assert row["secant_modulus"] == pytest.approx(modulus, rel=1e-3)
-        assert abs(row["damping_ratio"]) < 2e-3
+        assert abs(row["damping_ratio_measured"]) < 2e-3
         assert row["axial_strain_max"] == pytest.approx(-row["axial_strain_min"], rel=1e-9)
         assert np.abs(ends[stage][1] - walls).max() < 1e-12 * radius
         assert np.abs(ends[stage][0] - position).max() < 1e-2 * moved
         assert np.abs(ends[stage][2] - stress).max() < 1e-2 * swing
+
+
+def test_a_damping_ratio_below_its_resolution_is_null_with_the_resolution_given():
+    """A nearly closed loop (delta 0.002: D = 0.001) whose lateral stress stays 2 Pa off the
+    confining stress: such a lag could make a loop area of D = 4 * 2 / (pi * 160) = 0.016, so
+    D is not measured; nor is a negative D, nor one within the records' scatter; a loop of
+    delta 0.3 (D = 0.148), held at the confining stress and smooth, is."""
+    history = synthetic_history(2, 80.0, 2e-4, 0.002)
+    history["sigma_wall"][:, :2] += 2.0         # the axial stress follows: q is unchanged
+    history["sigma_wall"][:, 2] += 2.0
+    summary = cyclic_summary(history, 2, confining=500.0)
+    for row in summary["cycles"]:
+        assert row["damping_ratio"] is None
+        assert row["damping_ratio_measured"] == pytest.approx(0.001, abs=2e-4)
+        assert row["damping_ratio_resolution"] == pytest.approx(4 * 2.0 / (math.pi * 160.0),
+                                                                rel=0.05)
+        assert row["damping_ratio_note"].startswith("below resolution: damping_ratio")
+    assert summary["damping_ratio_first"] is None and summary["damping_ratio_last"] is None
+    assert summary["damping_ratio_note"].startswith("below resolution in cycle(s) 1, 2")
+    measured = cyclic_summary(synthetic_history(2, 80.0, 2e-4, 0.3), 2, confining=500.0)
+    row = measured["cycles"][0]
+    assert row["damping_ratio"] == pytest.approx(0.5 * math.sin(0.3), abs=1e-4)
+    assert row["damping_ratio_resolution"] < 1e-3 and "damping_ratio_note" not in measured
+    # a loop travelled backwards (unloading above loading) reads D < 0: never a measure
+    backwards = synthetic_history(2, 80.0, 2e-4, -0.3)
+    assert cyclic_summary(backwards, 2, confining=500.0)["cycles"][0]["damping_ratio"] is None
+    # scatter of 3 Pa on every record: a loop area of about 3 * 8e-4 / (4 pi 8e-3) = 0.024
+    noisy = synthetic_history(2, 80.0, 2e-4, 0.01)
+    noisy["sigma_wall"][:, 2] += np.random.default_rng(0).normal(0.0, 3.0, len(noisy["stage"]))
+    row = cyclic_summary(noisy, 2, confining=500.0)["cycles"][0]
+    assert row["damping_ratio_resolution"] == pytest.approx(0.024, rel=0.2)
+    assert row["damping_ratio"] is None
+    assert damping_resolution([0.0, 1.0], [0.0, 1.0], [500.0, 500.0], 500.0, 0.0) is None

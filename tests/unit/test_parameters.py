@@ -44,7 +44,7 @@ LOADING_COMMANDS = ("triaxial", "oedometer", "isotropic", "path", "cyclic", "sim
 #: The sample, wetting and output options every laboratory command shares (generated on the
 #: triaxial).
 LABORATORY = GENERATED - {"max_strain", "direction", "b", "constant_p", "drainage", "records",
-                          "inertial_number", "strain_rate", "vtk_frames"}
+                          "inertial_number", "strain_rate"}
 RATE = {"inertial_number", "strain_rate"}
 SIZES = {"radius", "radius_spread"}
 #: Each command's own options made from their fields' metadata: an option written by hand
@@ -478,3 +478,20 @@ def test_the_crosscheck_options_build_its_default_configuration():
         assert refused.value.on_command_line() == "--" + message.replace("_", "-", 1)
     with pytest.raises(OptionError, match=r"^suction 10000.0 Pa with periodic: "):
         crosscheck.crosscheck_from_options({**values, "suction": 1e4, "periodic": True})
+
+
+def test_every_laboratory_command_takes_vtk_frames_where_it_can_spread_them():
+    """--vtk-frames on every command that writes ParaView series: over the loading's length or
+    its estimate (simple shear, strain-controlled cyclic); 0 (none) on a path of unknown
+    length, where other counts are refused naming the option."""
+    for command in ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path",
+                    "tension"):
+        assert "vtk_frames" in {option.key for option in options_of(command)}, command
+    shear = config_from_options("simple-shear", {"vtk_frames": 7})
+    assert shear.vtk_frames == 7 and shear.estimated_steps() > 7
+    cyclic = config_from_options("cyclic", {"vtk_frames": 4, "amplitude_strain": 1e-3})
+    assert cyclic.vtk_frames == 4
+    assert config_from_options("oedometer", {"vtk_frames": 0}).vtk_frames == 0
+    with pytest.raises(OptionError) as refused:
+        config_from_options("oedometer", {"vtk_frames": 5})
+    assert "length is not known before it runs" in str(refused.value)

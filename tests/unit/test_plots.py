@@ -180,3 +180,25 @@ def test_the_tension_plots_are_titled_and_name_the_cases_in_words(saved, tmp_pat
     assert saved["tension_all.png"]["legends"] == ["e = 0.72, w = 1 %"]
     assert ("regular packing prediction (Ch. 4), isotropic BCC"
             in saved["strength_vs_water.png"]["legends"])
+
+
+def test_a_constant_p_stress_path_is_drawn_upright_and_titled_with_p_and_b():
+    """At constant p the path is vertical: its p axis spans at least half the q range around
+    p, not the 0.7500-0.7512 kPa of the round-off; the title names the constant p, and a true
+    triaxial test's b, which its q (von Mises) and the figure's label follow."""
+    history = triaxial_history(wet=False)
+    sigma = history["sigma_wall"]
+    q = sigma[:, 2] - sigma[:, :2].mean(axis=1)
+    sigma[:, :2] = (750.0 - q / 3.0)[:, None] + np.linspace(0.0, 1.2, ROWS)[:, None]
+    sigma[:, 2] = 750.0 + 2.0 * q / 3.0
+    figure = plots.stress_path_figure(history, "constant p", "compression")
+    low, high = figure.axes[0].get_xlim()
+    assert high - low >= 0.49 * np.ptp(q) / 1e3 and low < 0.75 < high
+    plots.pyplot().close(figure)
+    label = plots.run_label({"particles": 200, "confining": 750.0, "constant_p": True,
+                             "b": 0.5}, 0.395)
+    assert "constant p = 0.75 kPa" in label and "b = 0.5" in label and "σ3" not in label
+    assert "n0 = 0.395" in label
+    figure = plots.history_figure(history, label, "compression", b=0.5)
+    assert figure.axes[0].get_ylabel() == "von Mises stress q [kPa]"
+    plots.pyplot().close(figure)

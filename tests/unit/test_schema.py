@@ -292,3 +292,18 @@ def test_a_wet_triaxial_run_describes_itself(wet_triaxial_run):
     assert isinstance(summary["peak_reached"], bool) and summary["completed"] is True
     frame = read_summary(wet_triaxial_run)
     assert len(frame) == 1 and frame.attrs["units"]["peak_q"] == "Pa"
+
+
+def test_a_simple_shear_history_is_indexed_by_its_shear_strain(tmp_path):
+    """A simple shear's records are indexed by gamma, the strain it drives, not by the vertical
+    strain (which may rise too); after a consolidation stage (gamma 0 there) by record."""
+    columns = synthetic(DRY + ["shear_strain", "shear_stress", "normal_stress"])
+    columns["shear_strain"] = np.linspace(0.0, 0.2, len(columns["step"]))
+    write_history(tmp_path / "history.h5", columns, CONFIG)
+    history = read_history(tmp_path)
+    assert history.sigma_wall.dims == ("shear_strain", "axis")
+    assert float(history.shear_stress.sel(shear_strain=0.2)) == columns["shear_stress"][-1]
+    columns["shear_strain"][:2] = 0.0                 # a consolidation first
+    write_history(tmp_path / "history.h5", columns, CONFIG)
+    assert read_history(tmp_path).sigma_wall.dims == ("record", "axis")
+    assert read_history(tmp_path, index="shear_strain").shear_strain.dims == ("shear_strain",)

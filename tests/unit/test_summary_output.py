@@ -190,6 +190,12 @@ def test_the_terminal_summary_of_a_wet_run(tmp_path, capsys):
     assert len(shown) >= 12 and set(lines) == set(shown)
     for key in shown:
         value, *unit = lines[key]
+        if summary[key] is None:               # a measure not taken (its note says why)
+            assert (value, unit) == ("-", []), key
+            continue
+        if isinstance(summary[key], str):      # a note, as it is
+            assert " ".join([value, *unit]) == summary[key], key
+            continue
         assert float(value) == pytest.approx(summary[key], rel=5e-4), key
         digits = value.split("e")[0].replace(".", "").replace("-", "").strip("0")
         assert len(digits) <= 4, (key, value)
@@ -205,3 +211,16 @@ def test_the_terminal_summary_of_a_wet_run(tmp_path, capsys):
         assert time_value == pytest.approx(100.0 * mesh.field_data["axial_strain"][0])
     assert "axial_strain_percent" in (out / "vtk" / "particles.pvd").read_text()
     assert_drawn(out / "plots" / "stress_path.png")
+
+
+def test_quiet_leaves_stdout_to_the_json_alone(capsys):
+    """--quiet: the closing line of a command goes to stderr, its results as JSON to stdout,
+    so that json.loads reads stdout whole."""
+    from pendular.cli import print_result
+
+    print_result(True, "campaign: 4 runs; outputs in out", runs=4, out="out")
+    printed = capsys.readouterr()
+    assert json.loads(printed.out) == {"runs": 4, "out": "out"}
+    assert "outputs in out" in printed.err
+    print_result(False, "campaign: 4 runs; outputs in out", runs=4)
+    assert capsys.readouterr().out == "campaign: 4 runs; outputs in out\n"

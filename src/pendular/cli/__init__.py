@@ -105,10 +105,10 @@ def add_run_options(parser, threads_default=None):
                             " (None: all from 500 spheres on, else 1)"
                             if threads_default is None else ""))
     parser.add_argument("--quiet", action="store_true",
-                        help="no progress bars, and the results in the form scripts read: a "
-                             "loading test's summary as JSON, tension's and swcc's tables in "
-                             "fixed columns (without --quiet: one line or table row per result, "
-                             "to 4 significant figures, with units)")
+                        help="no progress bars, and the results in the form scripts read: "
+                             "the summary's main keys as JSON, alone on stdout (messages go to "
+                             "stderr; without --quiet: one line or table row per result, to 4 "
+                             "significant figures, with units)")
 
 
 def add_device_option(parser, runs):
@@ -230,10 +230,18 @@ def set_threads(threads):
 
 
 def command_parser(name, prog=None):
-    """(argparse parser of command ``name``, its module)."""
+    """(argparse parser of command ``name``, its module); the help ends with the module's
+    worked ``EXAMPLE`` (command line, what it gives)."""
+    import textwrap
+
     module = importlib.import_module(f"pendular.cli.commands.{COMMANDS[name][0]}")
+    epilog = None
+    if hasattr(module, "EXAMPLE"):          # every command has one (tests/unit/test_cli.py)
+        line, gives = module.EXAMPLE
+        epilog = f"example:\n  {line}\n" + textwrap.fill(
+            gives, 92, initial_indent="    ", subsequent_indent="    ")
     parser = Parser(prog=prog or f"pendular {name}", description=module.__doc__,
-                    formatter_class=Formatter)
+                    formatter_class=Formatter, epilog=epilog)
     module.add_arguments(parser)
     return parser, module
 
@@ -336,10 +344,12 @@ def format_table(rows, units, columns=None, width=100):
     unit), then one line per row, numbers to 4 significant figures, right-aligned. ``columns``:
     those shown (default: every column holding a number, flag or text). A table wider than
     ``width`` characters is cut into blocks of columns, one under the other (a blank line
-    between), each led by the first column (the row's name: stage, cycle)."""
-    if columns is None:
+    between), each led by the first column (the row's name: stage, cycle). A row's notes
+    (``*_note``) are left out by default."""
+    if columns is None:               # a row's notes are summed up in a line of their own
         columns = [name for name in dict.fromkeys(k for row in rows for k in row)
-                   if all(not isinstance(row.get(name), (list, dict)) for row in rows)]
+                   if all(not isinstance(row.get(name), (list, dict)) for row in rows)
+                   and not name.endswith("_note")]
     header = [_with_unit(name, units.get(name)) for name in columns]
     cells = [[format_value(row.get(name)) for name in columns] for row in rows]
     widths = [max(len(text) for text in column) for column in zip(header, *cells)]
@@ -384,14 +394,25 @@ def format_summary(summary, keys, columns=None):
         elif isinstance(value, list):      # e.g. record indices
             value = ", ".join(format_value(item) for item in value) or "none"
         lines.append(f"  {key:<{width}}  {format_value(value)}"
-                     + (f" {unit}" if _shown(unit) else ""))
+                     + (f" {unit}" if _shown(unit) and value is not None else ""))
     return "\n".join(lines)
+
+
+def print_result(quiet, line, **results):
+    """The closing ``line`` of a command (its counts, its folder) on stdout; with ``quiet``
+    (--quiet) on stderr instead, and ``results`` (JSON values) as JSON alone on stdout."""
+    if quiet:
+        print(line, file=sys.stderr)
+        print(json.dumps(results, indent=2))
+    else:
+        print(line)
 
 
 def print_summary(summary, keys, quiet=False, columns=None):
     """Print the ``keys`` of a run's ``summary``: format_summary's lines, or with ``quiet``
     (--quiet, for scripts) the same keys as JSON, values unrounded."""
     if quiet:
-        print(json.dumps({key: summary[key] for key in keys if key in summary}, indent=2))
+        print(json.dumps({key: summary[key] for key in keys if key in summary}, indent=2,
+                         default=lambda value: value.tolist()))
     else:
         print(format_summary(summary, keys, columns))

@@ -26,7 +26,7 @@ from pendular.io.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, S
 #: File attributes written by write_history itself (not overridable by ``attributes``).
 RESERVED_ATTRIBUTES = ("pendular_version", "schema_version", "config")
 #: Coordinates of the ``record`` dimension in read_history's Dataset.
-RECORD_COORDINATES = ("axial_strain", "step", "time")
+RECORD_COORDINATES = ("axial_strain", "shear_strain", "step", "time")
 #: Files read_summary looks for in a folder, in this order.
 SUMMARY_FILES = ("summary.json", "campaign.json", "campaign.csv", "tension.json")
 
@@ -152,10 +152,12 @@ def read_history(path_or_dir, index="auto"):
     One variable per column, each with attributes ``units``, ``description`` (and
     ``equation``); dimensions: the records, ``axis`` and ``component`` (coordinates x, y, z),
     ``grip`` (z-, z+); coordinates ``axial_strain``, ``step`` and ``time`` on the records.
-    ``index`` names the records' dimension: "auto" (default) ``axial_strain`` when it rises or
-    falls strictly over the records (a shear: ``history.peak_q.plot()`` plots against the
-    strain, ``history.sel(axial_strain=0.01, method="nearest")`` picks a record), else
-    ``record``; or one of "record", "axial_strain", "step", "time". Dataset attributes:
+    ``index`` names the records' dimension: "auto" (default) the strain a test drives, when
+    it rises or falls strictly over the records: ``shear_strain`` gamma in a simple shear,
+    else ``axial_strain`` (a shear: ``history.peak_q.plot()`` plots against the strain,
+    ``history.sel(axial_strain=0.01, method="nearest")`` picks a record), else ``record`` (a
+    simple shear after a consolidation, whose gamma stays 0 there); or one of "record",
+    "axial_strain", "shear_strain", "step", "time". Dataset attributes:
     ``config`` (the run configuration as JSON text: ``json.loads(history.attrs["config"])``),
     ``pendular_version``, ``schema_version`` (0 for files written before the schema, whose
     attributes are filled from pendular.io.schema), the file's other attributes (run
@@ -197,9 +199,10 @@ def read_history(path_or_dir, index="auto"):
         "schema_version": int(file_attrs.get("schema_version", 0)),
         "source": path})
     if index == "auto":
-        strain = np.diff(dataset["axial_strain"].values) if "axial_strain" in dataset else []
+        driven = "shear_strain" if "shear_strain" in dataset else "axial_strain"
+        strain = np.diff(dataset[driven].values) if driven in dataset else []
         rises_or_falls = len(strain) > 0 and (np.all(strain > 0) or np.all(strain < 0))
-        index = "axial_strain" if rises_or_falls else "record"
+        index = driven if rises_or_falls else "record"
     if index != "record":
         if index not in dataset.coords:
             raise ValueError(f"history = {path!r} has no {index!r} to index its records by")

@@ -11,7 +11,7 @@ import numpy as np
 
 from pendular.utils.atomic import replacing
 from pendular.homogenize.invariants import (deviator_stress, lateral_stress, mean_stress,
-    stress_ratio)
+    shear_deviator)
 
 
 def pyplot():
@@ -46,7 +46,8 @@ def _diagonals(values):
 
 def run_label(parameters, initial_porosity=None):
     """One line of a run's parameters for figure titles: N, sigma_3 (an oedometer's start and
-    end stress, an isotropic path's stresses), s, the contact angle, porosity."""
+    end stress, an isotropic path's stresses, a shear's constant p), b, s, the contact angle,
+    ``initial_porosity`` (n0: the porosity the loading starts from, after any wetting)."""
     parts = [f"N = {parameters['particles']}"]
     if parameters.get("psd") is not None:
         parts[0] += " (graded)"
@@ -57,8 +58,12 @@ def run_label(parameters, initial_porosity=None):
                      f"{parameters['axial_stress'] / 1e3:g} kPa")
     elif "stresses" in parameters:           # isotropic stages [Pa]
         parts.append(f"p = {parameters['stresses']} Pa")
+    elif parameters.get("constant_p"):
+        parts.append(f"constant p = {parameters['confining'] / 1e3:g} kPa")
     else:
         parts.append(f"σ3 = {parameters['confining'] / 1e3:g} kPa")
+    if parameters.get("b") is not None:
+        parts.append(f"b = {parameters['b']:g}")
     if parameters.get("water_content_percent") is not None:
         parts.append(f"w = {parameters['water_content_percent']:g} %")
     else:
@@ -71,13 +76,19 @@ def run_label(parameters, initial_porosity=None):
     return ", ".join(parts)
 
 
+#: What q is, by whether the test holds an intermediate principal stress (b != 0).
+Q_WORDS = {False: "deviator stress", True: "von Mises stress"}
+#: Least span of a stress path's p axis, over the span of its q axis.
+MIN_P_SPAN = 0.5
 #: The sign of q = sigma_z - sigma_lateral at the failure of a shear, by direction.
 DIRECTION_SIGN = {"compression": 1.0, "extension": -1.0}
 
 
-def _peak(history, direction="compression"):
-    """Index of the peak of q (compression) or of -q (extension)."""
-    return int(np.argmax(DIRECTION_SIGN[direction] * deviator_stress(history["sigma_wall"])))
+def _peak(history, direction="compression", b=None):
+    """Index of the peak of q (compression) or of -q (extension); q of a test at ``b``
+    (invariants.shear_deviator)."""
+    return int(np.argmax(DIRECTION_SIGN[direction]
+                         * shear_deviator(history["sigma_wall"], b)))
 
 
 def _strain_axes(axes, label):
@@ -86,19 +97,19 @@ def _strain_axes(axes, label):
     axes.grid(alpha=0.3)
 
 
-def history_figure(history, title="", direction="compression"):
-    """The figure of plot_history: q [kPa] above the volumetric strain [%], both against the
-    axial strain [%], tick labels on both panels."""
+def history_figure(history, title="", direction="compression", b=None):
+    """The figure of plot_history: q [kPa] (von Mises at ``b`` != 0) above the volumetric
+    strain [%], both against the axial strain [%], tick labels on both panels."""
     strain = 100.0 * history["axial_strain"]
-    q = deviator_stress(history["sigma_wall"]) / 1e3
-    peak = _peak(history, direction)
+    q = shear_deviator(history["sigma_wall"], b) / 1e3
+    peak = _peak(history, direction, b)
     figure, (top, bottom) = pyplot().subplots(2, 1, figsize=(6, 7), sharex=True)
     top.plot(strain, q, color="C0", label="net stress")
     top.plot(strain[peak], q[peak], "o", color="C3",
              label=f"{'peak' if direction == 'compression' else 'least'} q = {q[peak]:.3g} kPa "
                    f"at εa = {strain[peak]:.2f} %")
     top.legend(fontsize=8)
-    _strain_axes(top, "deviator stress q [kPa]")
+    _strain_axes(top, f"{Q_WORDS[bool(b)]} q [kPa]")
     top.tick_params(labelbottom=True)          # sharex hides them on the upper panel
     bottom.plot(strain, 100.0 * history["volumetric_strain"], color="C2")
     bottom.axvline(strain[peak], color="C3", lw=0.8, ls=":")
@@ -107,22 +118,24 @@ def history_figure(history, title="", direction="compression"):
     return figure
 
 
-def plot_history(history, path, title="", direction="compression"):
+def plot_history(history, path, title="", direction="compression", b=None):
     """q [kPa] and volumetric strain [%] against axial strain [%] (thesis Fig. 5.3), the peak
-    of q marked (in extension the least q); ``title``: the run's parameters (run_label)."""
-    return save_figure(history_figure(history, title, direction), path)
+    of q marked (in extension the least q); ``title``: the run's parameters (run_label);
+    ``b``: the test's, q then the von Mises deviatoric stress."""
+    return save_figure(history_figure(history, title, direction, b), path)
 
 
-def write_plots(history, folder, title="", direction="compression"):
+def write_plots(history, folder, title="", direction="compression", b=None):
     """The plots of a triaxial run into ``folder``, each against axial strain [%] with the run's
     parameters in the title: q_p.png (q/p of the net stress and, wet, q'/p' of the effective
     stress of Eq. 3.43), volumetric_strain.png and, wet, saturation.png (Sr [%]) and
     capillary_stress.png (capillary_figure); undrained, excess_pore_pressure.png (Delta u
     [kPa]) and, wet, suction.png (s [kPa]); the peak of q (``direction`` 'extension': of -q)
-    marked, none for ``direction`` None (a path without a failure). Returns the paths."""
+    marked, none for ``direction`` None (a path without a failure); q von Mises at ``b`` != 0.
+    Returns the paths."""
     plt = pyplot()
     strain = 100.0 * history["axial_strain"]
-    peak = None if direction is None else _peak(history, direction)
+    peak = None if direction is None else _peak(history, direction, b)
     paths = []
 
     def single(name, heading, label, series):
@@ -136,13 +149,16 @@ def write_plots(history, folder, title="", direction="compression"):
         axes.set_title(f"{heading}\n{title}", fontsize=9)
         paths.append(save_figure(figure, os.path.join(folder, name)))
 
-    ratios = [("q/p, net stress", stress_ratio(history["sigma_wall"]))]
+    def ratio(sigma):
+        return shear_deviator(sigma, b) / mean_stress(sigma)
+
+    ratios = [("q/p, net stress", ratio(history["sigma_wall"]))]
     if "sigma_effective" in history:
         ratios.append(("q′/p′, effective stress (Eq. 3.43)",
-                       stress_ratio(_diagonals(history["sigma_effective"]))))
+                       ratio(_diagonals(history["sigma_effective"]))))
     if "sigma_effective_complete" in history:
         ratios.append(("q′/p′, complete effective stress (ψ + interface term)",
-                       stress_ratio(_diagonals(history["sigma_effective_complete"]))))
+                       ratio(_diagonals(history["sigma_effective_complete"]))))
     single("q_p.png", "Stress ratio", "stress ratio q/p [-]", ratios)
     single("volumetric_strain.png", "Volumetric strain",
            "volumetric strain εv [%]\n(contraction +)",
@@ -210,13 +226,14 @@ def _stage_ends(history):
     return np.flatnonzero(np.append(stage[1:] != stage[:-1], True))
 
 
-def stress_path_figure(history, title="", direction=None):
+def stress_path_figure(history, title="", direction=None, b=None):
     """The figure of plot_stress_path: q against p [kPa] of the net wall stress and, wet, q′
     against p′ of the effective stress (Eq. 3.43) and of the complete one (ψ + interface
     term) on the same axes, each path's start and (``direction`` of a shear) its peak of q
-    marked."""
+    marked; q von Mises at ``b`` != 0. The p axis spans at least half the q axis's span
+    (MIN_P_SPAN), so that a path at constant p is drawn upright, not spread over a sliver."""
     figure, axes = pyplot().subplots(figsize=(6, 5.5))
-    peak = None if direction is None else _peak(history, direction)
+    peak = None if direction is None else _peak(history, direction, b)
     paths = [("net stress: q–p", np.asarray(history["sigma_wall"]), "C0")]
     effective = _effective_diagonals(history)
     if effective is not None:
@@ -224,15 +241,23 @@ def stress_path_figure(history, title="", direction=None):
     if "sigma_effective_complete" in history:
         paths.append(("complete effective stress (ψ + interface term): q′–p′",
                       _diagonals(history["sigma_effective_complete"]), "C2"))
+    drawn_p, drawn_q = [], []
     for label, sigma, color in paths:
-        p, q = mean_stress(sigma) / 1e3, deviator_stress(sigma) / 1e3
+        p, q = mean_stress(sigma) / 1e3, shear_deviator(sigma, b) / 1e3
+        drawn_p.append(p)
+        drawn_q.append(q)
         axes.plot(p, q, color=color, label=label)
         axes.plot(p[0], q[0], "s", color=color, ms=4)
         if peak is not None:
             axes.plot(p[peak], q[peak], "o", color=color, mfc="none")
     wet = len(paths) > 1
+    p_low, p_high = min(map(np.nanmin, drawn_p)), max(map(np.nanmax, drawn_p))
+    span = MIN_P_SPAN * (max(map(np.nanmax, drawn_q)) - min(map(np.nanmin, drawn_q)))
+    if p_high - p_low < span:
+        middle = 0.5 * (p_low + p_high)
+        axes.set_xlim(middle - 0.5 * span, middle + 0.5 * span)
     axes.set_xlabel(f"mean stress {'p, p′' if wet else 'p'} [kPa]")
-    axes.set_ylabel(f"deviator stress {'q, q′' if wet else 'q'} [kPa]")
+    axes.set_ylabel(f"{Q_WORDS[bool(b)]} {'q, q′' if wet else 'q'} [kPa]")
     axes.grid(alpha=0.3)
     axes.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12),
                 title=("square: start, circle: peak of q" if peak is not None
@@ -241,11 +266,12 @@ def stress_path_figure(history, title="", direction=None):
     return figure
 
 
-def plot_stress_path(history, path, title="", direction=None):
+def plot_stress_path(history, path, title="", direction=None, b=None):
     """The stress path q [kPa] against p [kPa] of the net wall stress and, wet, q′ against p′
     of the effective stress (Eq. 3.43) beside it (stress_path_figure); q = sigma_z -
-    (sigma_x + sigma_y) / 2, negative in extension; ``direction`` of a shear marks its peak."""
-    return save_figure(stress_path_figure(history, title, direction), path)
+    (sigma_x + sigma_y) / 2, negative in extension (von Mises at ``b`` != 0); ``direction``
+    of a shear marks its peak."""
+    return save_figure(stress_path_figure(history, title, direction, b), path)
 
 
 def plot_compression(history, path, title="", stress="axial"):
@@ -395,35 +421,58 @@ def plot_path(history, path, title=""):
     return save_figure(figure, path)
 
 
-def plot_simple_shear(history, path, title=""):
+def plot_simple_shear(history, path, title="", summary=None):
     """A simple shear's records (pendular.procedures.simple_shear) against the shear strain
-    gamma [%]: the shear stress tau [kPa] with the peak of tau / sigma_n marked and its
-    friction angle, the normal stress sigma_n = sigma_zz [kPa] and the volumetric strain [%]
-    from the shear's start; ``title``: the run's parameters."""
+    gamma [%]: the shear stress tau [kPa] with its largest value marked, tau / sigma_n with
+    its peak and friction angle marked (each "peak" only where ``summary``, the
+    simple_shear_summary, says the test went past it; "largest" otherwise), the normal stress
+    sigma_n = sigma_zz [kPa]; drained, the volumetric strain [%] from the shear's start, at
+    constant volume (where it stays 0) the stress path tau against sigma_n instead;
+    ``title``: the run's parameters."""
+    summary = summary or {}
     gamma = 100.0 * np.asarray(history["shear_strain"])
     tau = np.asarray(history["shear_stress"]) / 1e3
     normal = np.asarray(history["normal_stress"]) / 1e3
     volume = 1.0 - np.asarray(history["volumetric_strain"])
+    volumetric = 100.0 * (1.0 - volume / volume[0])
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(normal > 0.0, tau / normal, np.nan)
-    figure, (top, middle, bottom) = pyplot().subplots(3, 1, figsize=(6, 9), sharex=True)
+    figure, (top, second, third, bottom) = pyplot().subplots(4, 1, figsize=(6, 11))
     top.plot(gamma, tau, color="C0")
+    largest = int(np.argmax(tau))
+    word = "peak" if summary.get("peak_shear_stress_reached") else "largest"
+    top.plot(gamma[largest], tau[largest], "o", color="C3",
+             label=f"{word} τ = {tau[largest]:.3g} kPa at γ = {gamma[largest]:.2f} %")
+    top.legend(fontsize=8)
+    top.set_ylabel("shear stress τ [kPa]")
+    second.plot(gamma, ratio, color="C4")
     if np.isfinite(ratio).any():
         peak = int(np.nanargmax(ratio))
-        top.plot(gamma[peak], tau[peak], "o", color="C3",
-                 label=f"peak τ/σn = {ratio[peak]:.3g} (φ = "
-                       f"{np.degrees(np.arctan(ratio[peak])):.1f}°) at γ = {gamma[peak]:.2f} %")
-        top.legend(fontsize=8)
-    top.set_ylabel("shear stress τ [kPa]")
-    middle.plot(gamma, normal, color="C1")
-    middle.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
-    middle.ticklabel_format(axis="y", useOffset=False)
-    middle.set_ylim(0.0, 1.1 * max(float(np.max(normal)), 0.0) or 1.0)   # held: a flat line
-    bottom.plot(gamma, 100.0 * (1.0 - volume / volume[0]), color="C2")
-    bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
-    bottom.set_xlabel("shear strain γ [%]")
-    for axes in (top, middle, bottom):
+        word = "peak" if summary.get("peak_reached") else "largest"
+        second.plot(gamma[peak], ratio[peak], "o", color="C3",
+                    label=f"{word} τ/σn = {ratio[peak]:.3g} (φ = "
+                          f"{np.degrees(np.arctan(ratio[peak])):.1f}°) at γ = "
+                          f"{gamma[peak]:.2f} %")
+        second.legend(fontsize=8)
+    second.set_ylabel("stress ratio τ/σn [-]")
+    third.plot(gamma, normal, color="C1")
+    third.set_ylabel("normal stress σn = σzz [kPa]\n(compression +)")
+    third.ticklabel_format(axis="y", useOffset=False)
+    third.set_ylim(0.0, 1.1 * max(float(np.max(normal)), 0.0) or 1.0)   # held: a flat line
+    for axes in (top, second, third):
+        axes.set_xlabel("shear strain γ [%]")
+    if np.ptp(volumetric) > 0.0:
+        bottom.plot(gamma, volumetric, color="C2")
+        bottom.set_ylabel("volumetric strain εv [%]\n(contraction +)")
+        bottom.set_xlabel("shear strain γ [%]")
+    else:                                    # constant volume: the stress path instead
+        bottom.plot(normal, tau, color="C0")
+        bottom.plot(normal[0], tau[0], "s", color="C0", ms=4, label="start")
+        bottom.legend(fontsize=8)
+        bottom.set_xlabel("normal stress σn [kPa]")
+        bottom.set_ylabel("shear stress τ [kPa]")
+    for axes in (top, second, third, bottom):
         axes.grid(alpha=0.3)
-        axes.tick_params(labelbottom=True)
     top.set_title(f"Simple shear (x with z, periodic cell)\n{title}", fontsize=9)
+    figure.tight_layout()
     return save_figure(figure, path)

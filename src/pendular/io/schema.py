@@ -6,30 +6,18 @@ column that is not, so a new column cannot be written without its units. Units a
 ``record`` (one row per record, always first), ``axis`` (x, y, z), ``component`` (x, y, z:
 the second index of a 3x3 tensor), ``grip`` (z-, z+: the grips of direct tension).
 
-Columns by test (pendular.procedures.loading.history_columns, pendular.procedures.tension):
-
-- triaxial, dry: step, time, axial_strain, volumetric_strain, sigma_wall, sigma_contact,
-  porosity, coordination, fabric, anisotropy, unbalanced_force;
-- triaxial, wet: the dry ones and saturation, suction, sigma_capillary, bridges,
-  pendular_overlaps, chi, B, psi, sigma_effective, fabric_bridges, anisotropy_bridges, a_psi
-  and, with exact bridges, psi_interface and sigma_effective_complete
-  (pendular.homogenize.on_the_fly.CapillaryHomogenization); at a water content (closed liquid)
-  liquid_bridges, liquid_film, liquid_lost;
-- oedometer and isotropic paths (pendular.procedures.triaxial.OedometerTest, IsotropicTest):
-  the triaxial's, and void_ratio; the oedometer k0; stage when the path has several stages;
-- cyclic triaxial (pendular.procedures.cyclic.CyclicTest): the oedometer's less k0, and cycle;
-- simple shear (pendular.procedures.simple_shear.SimpleShearTest): the loading path's,
-  shear_strain, shear_stress and normal_stress;
-- undrained triaxial (--drainage undrained): the triaxial's and excess_pore_pressure;
-- a path with water-content stages: water_content and liquid_total besides the liquid
-  columns;
-- direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
-  coordination, unbalanced_force, and wet: bridges, water_content, saturation.
+The commands that write each column: HISTORY_WRITERS (every loading path records
+pendular.procedures.loading.history_columns; wet, the capillary ones of
+pendular.homogenize.on_the_fly.CapillaryHomogenization; at a water content the closed
+liquid's; each test adds its own: an undrained triaxial excess_pore_pressure, a path with
+water-content stages water_content and liquid_total). Every summary key, with its units,
+meaning and the commands that write it: SUMMARY_KEYS (docs/outputs.md is generated from both;
+``undeclared_keys`` names what a summary holds beyond them).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -49,13 +37,15 @@ DIMENSIONS = ("record", *DIMENSION_LABELS)
 @dataclass(frozen=True)
 class Column:
     """One recorded quantity: units (SI, "1" dimensionless), description, the dimensions after
-    ``record`` (names of DIMENSION_LABELS), dtype of the stored values, thesis equation."""
+    ``record`` (names of DIMENSION_LABELS), dtype of the stored values, thesis equation, the
+    commands whose history.h5 holds it (HISTORY_WRITERS)."""
 
     units: str
     description: str
     dims: tuple = ()
     dtype: str = "float64"
     equation: str = ""
+    commands: tuple = ()
 
     @property
     def shape(self):
@@ -66,6 +56,33 @@ class Column:
     def is_integer(self):
         return np.dtype(self.dtype).kind in "iu"
 
+
+#: The laboratory tests (pendular.procedures.triaxial.LaboratoryTest): what every run writes.
+LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path")
+
+#: The commands whose history.h5 holds each column, by column: every loading path's
+#: (pendular.procedures.loading.history_columns) and the SWCC's; wet, the capillary ones; the
+#: closed liquid's; each test's own.
+HISTORY_WRITERS = {
+    **dict.fromkeys(("porosity", "volumetric_strain", "sigma_contact", "fabric", "anisotropy"),
+                    (*LABORATORY, "swcc")),
+    **dict.fromkeys(("step", "time", "axial_strain", "sigma_wall", "coordination",
+                     "unbalanced_force", "bridges", "saturation"),
+                    (*LABORATORY, "swcc", "tension")),
+    **dict.fromkeys(("suction", "sigma_capillary", "pendular_overlaps", "chi", "B", "psi",
+                     "sigma_effective", "psi_interface", "sigma_effective_complete",
+                     "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
+    **dict.fromkeys(("liquid_bridges", "liquid_film", "liquid_lost"), LABORATORY),
+    **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
+    "water_content": ("tension", "path"),
+    "liquid_total": ("path",),
+    "excess_pore_pressure": ("triaxial",),
+    "void_ratio": ("oedometer", "isotropic", "cyclic", "path"),
+    "k0": ("oedometer", "path"),
+    "stage": ("oedometer", "isotropic", "simple-shear", "cyclic", "path"),
+    "cycle": ("cyclic",),
+    **dict.fromkeys(("shear_strain", "shear_stress", "normal_stress"), ("simple-shear",)),
+}
 
 _VECTOR = ("axis",)
 _TENSOR = ("axis", "component")
@@ -155,6 +172,9 @@ HISTORY_COLUMNS = {
                                   "compression positive"),
 }
 
+HISTORY_COLUMNS = {name: replace(column, commands=HISTORY_WRITERS.get(name, ()))
+                   for name, column in HISTORY_COLUMNS.items()}
+
 #: Field data of the ParaView frames (pendular.io.vtk.VtkWriter: one number a .vtu file, the
 #: same in the four series). A series' time axis (the .pvd ``timestep``, ParaView's time
 #: slider) is one of these, named in a comment of its .pvd file.
@@ -177,68 +197,30 @@ VTK_FIELDS = {
                                      "positive"),
 }
 
-#: Units of a triaxial summary.json (pendular.procedures.triaxial.summarize and TriaxialTest).
-TRIAXIAL_SUMMARY_UNITS = {
-    "peak_axial_stress": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "lateral_stress": "Pa",
-    "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
-    "peak_q_effective_complete": "Pa", "p_effective_complete_at_peak": "Pa",
-    "suction_at_peak": "Pa", "liquid_balance_error": "1", "liquid_lost_fraction": "1",
-    "liquid_initial": "m^3", "water_content": "1", "formation_suction_pa": "Pa",
-    "axial_strain_at_peak": "1",
-    "peak_index": "1", "saturation_at_peak": "1", "initial_porosity": "1",
-    "initial_coordination": "1", "wall_time_s": "s", "preparation_time_s": "s",
-    "shear_time_s": "s", "wetting_time_s": "s", "steps": "1", "preparation_steps": "1",
-    "particle_steps_per_s": "1/s", "dt": "s", "strain_rate": "1/s", "inertial_number": "1",
-    "max_unbalanced_force": "1", "mean_unbalanced_force": "1", "threads": "1",
-    "initial_saturation": "1", "initial_bridges": "1", "wet_porosity": "1",
-    "wetting_steps": "1", "stress_balance_error": "1", "stress_balance_bound": "1",
-    "stress_balance_flagged": "record", "grading": GRADING_UNITS,
-    "min_axial_stress": "Pa", "phi_peak_deg": "deg", "phi_peak_effective_deg": "deg",
-    "mean_stress_deviation": "1", "b_deviation": "1",
-}
+@dataclass(frozen=True)
+class Key:
+    """One summary key: its units (SI, "1" dimensionless, "record" a list of history rows; a
+    dict for a nested record: the units of its fields), what it holds and the commands that
+    write it (names of pendular.cli.COMMANDS)."""
 
-#: Units of an oedometer summary.json (pendular.procedures.loading.oedometer_summary).
-OEDOMETER_SUMMARY_UNITS = {
-    "k0": "1", "k0_effective": "1", "k0_final": "1", "axial_stress_target": "Pa",
-    "axial_stress_at_load": "Pa", "lateral_stress_at_load": "Pa", "axial_strain_at_load": "1",
-    "initial_void_ratio": "1", "void_ratio_at_load": "1", "constrained_modulus": "Pa",
-    "constrained_modulus_tangent": "Pa", "constrained_modulus_unloading": "Pa",
-    "compression_index": "1", "compression_index_effective": "1", "unload_to": "Pa",
-    "axial_stress_final": "Pa", "axial_strain_final": "1", "void_ratio_final": "1",
-    "swelling_index": "1", "swelling_index_effective": "1",
-}
+    units: object
+    description: str
+    commands: tuple
 
-#: Units of an isotropic summary.json (pendular.procedures.loading.isotropic_summary) and of
-#: a path table's (pendular.procedures.path_table.path_summary): their ``stages`` rows hold
-#: the end state of each stage.
-ISOTROPIC_SUMMARY_UNITS = {
-    "stages": {"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa", "q_effective": "Pa",
-               "sigma_wall": "Pa", "void_ratio": "1", "axial_strain": "1",
-               "volumetric_strain": "1", "stage": "1", "step": "1", "row": "1",
-               "axial_strain_change": "1", "volumetric_strain_change": "1", "suction": "Pa",
-               "saturation": "1", "water_content": "1"},
-    "final_void_ratio": "1", "peak_stage": "1",
-    "water_stages": {"stage": "1", "axial_strain_change": "1",
-                     "volumetric_strain_change": "1",
-                     "suction_before": "Pa", "suction_after": "Pa",
-                     "water_content_before": "1", "water_content_after": "1"},
-    "collapse_strain": "1", "collapse_axial_strain": "1",
-}
 
-#: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
-TENSION_SUMMARY_UNITS = {
-    "void_ratio_target": "1", "void_ratio": "1", "void_ratio_box": "1", "void_ratio_wet": "1",
-    "prep_friction_deg": "deg", "water_content_target": "1", "formation_suction_pa": "Pa",
-    "water_content": "1", "saturation": "1", "bridges": "1", "coordination_wet": "1",
-    "unbalanced_force_wet": "1", "tensile_strength_pa": "Pa", "axial_extension_at_peak": "1",
-    "water_content_at_peak": "1", "bridges_at_peak": "1", "final_tensile_stress_pa": "Pa",
-    "final_axial_extension": "1", "kim_measured_pa": "Pa", "packing_state_pa": "Pa",
-    "relative_difference_to_kim": "1", "relative_difference_to_packing_state": "1",
-    "strain_rate": "1/s", "inertial_number": "1", "mean_unbalanced_force_to_peak": "1",
-    "unbalanced_force_at_peak": "1", "pull_steps": "1", "dt": "s", "wetting_time_s": "s",
-    "pull_time_s": "s",
-    "grading": GRADING_UNITS,
-}
+#: The tests whose summary holds a peak of q.
+SHEARS = ("triaxial", "path")
+_T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
+_E = ("envelope",)
+_COMPRESSION = ("oedometer", "isotropic", "path")
+_INDICES = ("oedometer", "isotropic")
+#: The fields of a row of the SWCC (swcc.json ``drying`` and ``wetting``,
+#: pendular.procedures.swcc).
+SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
+                    "bridges_across_gaps": "1", "porosity": "1", "volumetric_strain": "1",
+                    "chi": "1", "chi_tensor": "1", "psi": "Pa", "psi_interface": "Pa",
+                    "sigma_wall": "Pa", "coordination": "1", "pendular_overlaps": "1",
+                    "steps": "1"}
 
 #: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
@@ -257,72 +239,415 @@ OPTION_UNITS = {
     "record_strain": "1", "amplitude_q": "Pa", "amplitude_strain": "1", "unload_to": "Pa",
 }
 
-#: Units of a cyclic triaxial summary.json (pendular.procedures.cyclic.cyclic_summary); its
-#: ``cycles`` rows hold the measures of each cycle's loop.
-CYCLIC_SUMMARY_UNITS = {
-    "cycles": {"cycle": "1", "secant_modulus": "Pa", "damping_ratio": "1",
-               "secant_modulus_effective": "Pa", "damping_ratio_effective": "1",
-               "dissipated_energy": "Pa", "strain_energy": "Pa", "q_max": "Pa", "q_min": "Pa",
-               "axial_strain_max": "1", "axial_strain_min": "1",
-               "axial_strain_increment": "1", "axial_strain_accumulated": "1",
-               "volumetric_strain": "1", "volumetric_strain_increment": "1", "records": "1"},
-    "cycles_completed": "1", "secant_modulus_first": "Pa", "secant_modulus_last": "Pa",
-    "damping_ratio_first": "1", "damping_ratio_last": "1",
-    "secant_modulus_first_effective": "Pa", "secant_modulus_last_effective": "Pa",
-    "damping_ratio_first_effective": "1", "damping_ratio_last_effective": "1",
-    "axial_strain_accumulated": "1", "volumetric_strain_accumulated": "1",
-    "axial_strain_at_load": "1", "q_at_load": "Pa",
+#: Every summary key pendular writes (summary.json of the laboratory tests, tension.json
+#: ``cases``), declared once: docs/outputs.md is generated from it, a summary's ``units`` block
+#: is taken from it, and the tests refuse a written key that is not here. Keys that are text
+#: or flags have units "1". Stresses compression positive; strains compression positive.
+SUMMARY_KEYS = {
+    # -- the peak of a shear (pendular.procedures.triaxial.summarize; path_table.path_summary)
+    "peak_q": Key("Pa", "the peak of q: the largest in compression, the least (most "
+                        "negative) in extension; q = sigma_z - (sigma_x + sigma_y)/2, the von "
+                        "Mises deviatoric stress at b != 0; the '_at_peak' keys are of its "
+                        "record", SHEARS),
+    "peak_index": Key("1", "history row of the peak of q", SHEARS),
+    "peak_axial_stress": Key("Pa", "largest axial (z) wall stress of the shear (compression)",
+                             _T),
+    "min_axial_stress": Key("Pa", "least axial (z) wall stress of the shear (extension)", _T),
+    "axial_contact_lost": Key("1", "extension: whether the axial stress fell to 0, the axial "
+                                   "walls (which cannot pull) having left the sample; the "
+                                   "shear then ends there", _T),
+    "p_at_peak": Key("Pa", "mean stress p = (sigma_x + sigma_y + sigma_z)/3 at the peak of q",
+                     SHEARS),
+    "axial_strain_at_peak": Key("1", "axial strain at the peak of q (negative in extension)",
+                                SHEARS),
+    "principal_difference_at_peak": Key("Pa", "sigma_1 - sigma_3, largest less least wall "
+                                              "stress, at the peak of q", _T),
+    "lateral_stress": Key("Pa", "mean over the shear of (sigma_x + sigma_y)/2", _T),
+    "phi_peak_deg": Key("deg", "mobilised friction angle asin((sigma_1 - sigma_3)/(sigma_1 + "
+                               "sigma_3)) of the net stresses at the peak (simple shear: "
+                               "atan of the peak tau/sigma_n; cyclic: at a failure peak only); "
+                               "null with phi_peak_note when it cannot be measured",
+                        (*SHEARS, "simple-shear", "cyclic")),
+    "phi_peak_note": Key("1", "why phi_peak_deg is null (text)", _T),
+    "peak_reached": Key("1", "whether the maximum of q (simple shear: of tau/sigma_n) is a "
+                             "peak the test went past (pendular.io.schema.peak_reached); false "
+                             "when the test ended on its way up or lost axial contact",
+                        (*_T, *_S)),
+    "has_peak": Key("1", "path: whether a stage went past a peak of q", ("path",)),
+    "peak_stage": Key("1", "path: index of the stage holding the peak of q", ("path",)),
+    "saturation_at_peak": Key("1", "degree of saturation Sr at the peak of q", _T),
+    "suction_at_peak": Key("Pa", "matric suction at the peak of q", _T),
+    "peak_q_effective": Key("Pa", "q' of the effective stress (Eq. 3.43) at the peak of q",
+                            SHEARS),
+    "p_effective_at_peak": Key("Pa", "p' of the effective stress (Eq. 3.43) at the peak of q",
+                               SHEARS),
+    "phi_peak_effective_deg": Key("deg", "friction angle of the effective stress at the peak "
+                                         "of q (simple shear: of tau'/sigma_n'); null with "
+                                         "phi_peak_note when it cannot be measured",
+                                  (*SHEARS, *_S)),
+    "peak_q_effective_complete": Key("Pa", "q' of the complete effective stress (psi and the "
+                                           "liquid-gas interface term) at the peak of q", _T),
+    "p_effective_complete_at_peak": Key("Pa", "p' of the complete effective stress at the "
+                                              "peak of q", _T),
+    # -- the critical state (pendular.procedures.critical_state)
+    "phi_cs_deg": Key("deg", "friction angle at the critical state, of the mean net stresses "
+                             "over the last 5 % of axial strain; null when not reached "
+                             "(critical_state_note)", _T),
+    "M_cs": Key("1", "critical state stress ratio: mean |q| / mean p over that window; null "
+                     "when not reached", _T),
+    "void_ratio_cs": Key("1", "mean void ratio over that window; null when not reached", _T),
+    "critical_state_note": Key("1", "the critical state rule as judged on this test: reached, "
+                                    "or why not (q/p drift, |d eps_v / d eps_a| against their "
+                                    "tolerances)", _T),
+    "phi_cs_effective_deg": Key("deg", "phi_cs_deg of the effective stress (Eq. 3.43)", _T),
+    "M_cs_effective": Key("1", "M_cs of the effective stress (Eq. 3.43)", _T),
+    # -- how closely a shear held its path (loading.path_deviations)
+    "mean_stress_deviation": Key("1", "--constant-p: largest |p / confining - 1| over the "
+                                      "records", _T),
+    "b_deviation": Key("1", "--b: largest |b measured - b| over the records with sigma_z - "
+                            "sigma_x of at least a tenth of the confining stress; null "
+                            "without such records", _T),
+    "b_deviation_note": Key("1", "why b_deviation is null", _T),
+    # -- an undrained triaxial (loading.undrained_summary; history excess_pore_pressure)
+    "drainage": Key("1", "'undrained' when the shear held the volume (text)", _T),
+    "excess_pore_pressure_at_peak": Key("Pa", "undrained: excess pore pressure Delta u of a "
+                                              "saturated sample at the peak of q", _T),
+    "excess_pore_pressure_final": Key("Pa", "undrained: Delta u at the end of the shear", _T),
+    "excess_pore_pressure_max": Key("Pa", "undrained: the largest Delta u of the shear", _T),
+    "p_min": Key("Pa", "undrained: the least mean wall stress p (the effective stress of the "
+                       "saturated sample) over the shear", _T),
+    "axial_strain_at_p_min": Key("1", "undrained: axial strain at p_min, where a contracting "
+                                      "sample turns to dilating (phase transformation)", _T),
+    "suction_final": Key("Pa", "undrained, wet: suction at the end of the shear (it changes "
+                               "at a constant water content)", _T),
+    "saturation_final": Key("1", "undrained, wet: Sr at the end of the shear", _T),
+    "effective_stress_path": Key({"axial_strain": "1", "p": "Pa", "q": "Pa",
+                                  "excess_pore_pressure": "Pa", "p_effective": "Pa",
+                                  "suction": "Pa", "saturation": "1"},
+                                 "undrained: the stress path at points evenly spaced over "
+                                 "the history (loading.PATH_POINTS; each field a list): axial "
+                                 "strain, p and q of the wall stresses, Delta u and, wet, p' "
+                                 "of Eq. 3.43, the suction and Sr", _T),
+    # -- every laboratory run (TriaxialTest's run, pendular.procedures.triaxial)
+    "completed": Key("1", "whether the loading reached its end (false: interrupted or "
+                          "failed; error says why)", LABORATORY),
+    "phase": Key("1", "the phase a run stopped in: prepare, wet, shear, write", LABORATORY),
+    "error": Key("1", "what stopped the loading, when it failed", LABORATORY),
+    "stopped": Key("1", "why a loading ended before its last stage's end with its results "
+                        "(the axial walls left the sample)", _T),
+    "initial_porosity": Key("1", "porosity of the prepared (or loaded) sample, before any "
+                                 "wetting", LABORATORY),
+    "initial_coordination": Key("1", "coordination number of the prepared sample", LABORATORY),
+    "porosity_before_wetting": Key("1", "wet runs: porosity of the dry sample at the "
+                                        "confining stress", LABORATORY),
+    "porosity_after_wetting": Key("1", "wet runs: porosity once wetted and equilibrated, the "
+                                       "one the loading starts from", LABORATORY),
+    "void_ratio_before_wetting": Key("1", "wet runs: e = n/(1 - n) before wetting",
+                                     LABORATORY),
+    "void_ratio_after_wetting": Key("1", "wet runs: e after wetting", LABORATORY),
+    "wall_time_s": Key("s", "wall-clock time of the run", (*LABORATORY, "swcc", "tension")),
+    "preparation_time_s": Key("s", "wall-clock time of the preparation", LABORATORY),
+    "shear_time_s": Key("s", "wall-clock time of the loading", LABORATORY),
+    "steps": Key("1", "time steps of the loading", LABORATORY),
+    "preparation_steps": Key("1", "time steps of the preparation (by phase when a dict)",
+                             LABORATORY),
+    "particle_steps_per_s": Key("1/s", "particles times steps of the loading per second of "
+                                       "wall-clock time", LABORATORY),
+    "dt": Key("s", "time step", (*LABORATORY, *_TEN)),
+    "strain_rate": Key("1/s", "axial strain rate of the loading (tension: of the pull)",
+                       (*LABORATORY, *_TEN)),
+    "inertial_number": Key("1", "inertial number I = rate 2R sqrt(rho / p) at the reference "
+                                "stress (GDR MiDi 2004)", (*LABORATORY, *_TEN)),
+    "max_unbalanced_force": Key("1", "largest unbalanced force ratio over the records",
+                                LABORATORY),
+    "mean_unbalanced_force": Key("1", "mean unbalanced force ratio over the records",
+                                 LABORATORY),
+    "threads": Key("1", "Numba threads of the run", LABORATORY),
+    "device": Key("1", "where the run ran: cpu or gpu", LABORATORY),
+    "grading": Key(GRADING_UNITS, "the grading of the radii: D10, D30, D50, D60 [m], Cu, Cc, "
+                                  "radius_min, radius_max, radius_mean [m]",
+                   (*LABORATORY, *_TEN, "swcc")),
+    "stress_balance_error": Key("1", "largest per-record |sigma_wall - Love-Weber stress of "
+                                     "contacts and bridges| / p over the records: how far "
+                                     "from quasi-static equilibrium", LABORATORY),
+    "stress_balance_bound": Key("1", "the bound beyond which a record is flagged (0.05)",
+                                LABORATORY),
+    "stress_balance_flagged": Key("record", "history rows whose stress balance error exceeds "
+                                            "the bound", LABORATORY),
+    # -- the wetting (triaxial.wetting_report)
+    "wetting": Key("1", "laboratory tests: the wetting protocol (text: isotropic, "
+                        "at-shear, constant-volume, water-content); swcc: the rows of the "
+                        "wetting branch, their fields as drying's", (*LABORATORY, "swcc")),
+    "wetting_steps": Key("1", "time steps of the wetting's equilibria", LABORATORY),
+    "wetting_time_s": Key("s", "wall-clock time of the wetting", (*LABORATORY, *_TEN)),
+    "initial_saturation": Key("1", "degree of saturation Sr once wetted", LABORATORY),
+    "initial_bridges": Key("1", "liquid bridges once wetted", LABORATORY),
+    "wet_porosity": Key("1", "porosity once wetted (as porosity_after_wetting)", LABORATORY),
+    "sigma_wall_at_constant_volume": Key("Pa", "constant-volume wetting: the wall stresses "
+                                               "(x, y, z) the bridges made, walls fixed",
+                                         LABORATORY),
+    "wetting_attempts": Key({"formation_suction_pa": "Pa", "steps": "1",
+                             "water_volume": "m^3", "water_content": "1"},
+                            "water-content wetting: each try at a formation suction, its "
+                            "steps and the liquid its bridges held (tension: as a water "
+                            "content)", (*LABORATORY, *_TEN)),
+    "formation_suction_pa": Key("Pa", "water-content wetting: the suction the bridges formed "
+                                      "at", (*LABORATORY, *_TEN)),
+    "water_content": Key("1", "gravimetric water content w held by the bridges (tension: of "
+                              "the case after wetting)", (*LABORATORY, *_TEN)),
+    "liquid_initial": Key("m^3", "closed liquid: the liquid at the start of the loading",
+                          LABORATORY),
+    "liquid_balance_error": Key("1", "closed liquid: largest |bridges + film + lost - "
+                                     "initial| / initial over the records", LABORATORY),
+    "liquid_lost_fraction": Key("1", "closed liquid: the fraction of the liquid lost by the "
+                                     "end", LABORATORY),
+    # -- oedometer (loading.oedometer_summary)
+    "k0": Key("1", "K0 = sigma_lateral / sigma_axial of the wall stresses at the axial stress "
+                   "target", ("oedometer",)),
+    "k0_effective": Key("1", "K0 of the effective stress (Eq. 3.43) there", ("oedometer",)),
+    "k0_final": Key("1", "K0 at the end of the unloading", ("oedometer",)),
+    "axial_stress_target": Key("Pa", "--axial-stress, the loading's target", ("oedometer",)),
+    "axial_stress_at_load": Key("Pa", "axial stress at the end of the loading",
+                                ("oedometer",)),
+    "lateral_stress_at_load": Key("Pa", "lateral stress at the end of the loading",
+                                  ("oedometer",)),
+    "axial_strain_at_load": Key("1", "axial strain at the end of the (first) loading",
+                                ("oedometer", *_C)),
+    "initial_void_ratio": Key("1", "void ratio the loading starts from (after any wetting)",
+                              _COMPRESSION),
+    "void_ratio_at_load": Key("1", "void ratio at the end of the loading", ("oedometer",)),
+    "constrained_modulus": Key("Pa", "secant constrained modulus M = delta sigma_v / "
+                                     "delta eps_a over the loading", ("oedometer",)),
+    "constrained_modulus_tangent": Key("Pa", "tangent M over the last 20 % of the loading's "
+                                             "strain", ("oedometer",)),
+    "constrained_modulus_tangent_note": Key("1", "why constrained_modulus_tangent is null",
+                                            ("oedometer",)),
+    "constrained_modulus_unloading": Key("Pa", "secant M of the unloading", ("oedometer",)),
+    "compression_index": Key("1", "Cc = -delta e / delta log10 sigma over the loading "
+                                  "(isotropic: of p)", _INDICES),
+    "compression_index_effective": Key("1", "Cc against the effective stress", _INDICES),
+    "swelling_index": Key("1", "Cs = -delta e / delta log10 sigma over the unloading",
+                          _INDICES),
+    "swelling_index_effective": Key("1", "Cs against the effective stress", _INDICES),
+    "unload_to": Key("Pa", "--unload-to, the unloading's target", ("oedometer",)),
+    "axial_stress_final": Key("Pa", "axial stress at the end of the path", ("oedometer",)),
+    "axial_strain_final": Key("1", "axial strain at the end of the path", ("oedometer",)),
+    "void_ratio_final": Key("1", "void ratio at the end of the path", ("oedometer",)),
+    # -- isotropic and path tables (loading.isotropic_summary, path_table.path_summary)
+    "stages": Key({"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa",
+                   "q_effective": "Pa", "sigma_wall": "Pa", "void_ratio": "1",
+                   "axial_strain": "1", "volumetric_strain": "1", "stage": "1", "step": "1",
+                   "row": "1", "axial_strain_change": "1", "volumetric_strain_change": "1",
+                   "suction": "Pa", "saturation": "1", "water_content": "1"},
+                  "one row per stage, its end state: target stress, p, q (and p', q'), "
+                  "the wall stresses, e, the strains, the stage, step and history row; a "
+                  "path's also the strains' changes over the stage and, wet, the suction, Sr "
+                  "and water content at its end", ("isotropic", "path")),
+    "final_void_ratio": Key("1", "void ratio at the end of the path", ("isotropic", "path")),
+    "water_stages": Key({"stage": "1", "axial_strain_change": "1",
+                         "volumetric_strain_change": "1", "suction_before": "Pa",
+                         "suction_after": "Pa", "water_content_before": "1",
+                         "water_content_after": "1"},
+                        "path: one row per stage that changes the water "
+                        "(path_table.wetting_strains): its index, the suction or the water "
+                        "content (a fraction) before and after it, its axial and volumetric "
+                        "strain changes", ("path",)),
+    "collapse_strain": Key("1", "path: volumetric strain over the stages that wet the sample "
+                                "(suction lowered, water content raised): at a held stress, "
+                                "the collapse on wetting, compression positive", ("path",)),
+    "collapse_axial_strain": Key("1", "path: axial strain over the stages that wet the sample",
+                                 ("path",)),
+    # -- cyclic (cyclic.cyclic_summary)
+    "cycles": Key({"cycle": "1", "secant_modulus": "Pa", "damping_ratio": "1",
+                   "damping_ratio_measured": "1", "damping_ratio_resolution": "1",
+                   "damping_ratio_note": "1", "secant_modulus_effective": "Pa",
+                   "damping_ratio_effective": "1", "damping_ratio_effective_measured": "1",
+                   "damping_ratio_effective_resolution": "1",
+                   "damping_ratio_effective_note": "1",
+                   "dissipated_energy": "Pa", "strain_energy": "Pa", "q_max": "Pa",
+                   "q_min": "Pa", "axial_strain_max": "1", "axial_strain_min": "1",
+                   "axial_strain_increment": "1", "axial_strain_accumulated": "1",
+                   "volumetric_strain": "1", "volumetric_strain_increment": "1",
+                   "records": "1"},
+                  "one row per complete cycle: its loop's secant modulus E_sec and damping "
+                  "ratio D = W_D / (4 pi W_S) (null below its resolution, with the measured "
+                  "value, the resolution and a note), W_D, W_S, the extremes of q and "
+                  "strain, the strains' increments and accumulation, the rows of the loop", _C),
+    "cycles_completed": Key("1", "complete cycles", _C),
+    "secant_modulus_first": Key("Pa", "E_sec of the first cycle", _C),
+    "secant_modulus_last": Key("Pa", "E_sec of the last cycle", _C),
+    "damping_ratio_first": Key("1", "D of the first cycle (null below its resolution)", _C),
+    "damping_ratio_last": Key("1", "D of the last cycle (null below its resolution)", _C),
+    "damping_ratio_note": Key("1", "which cycles' D are below their resolution", _C),
+    "secant_modulus_first_effective": Key("Pa", "E_sec of the effective q', first cycle", _C),
+    "secant_modulus_last_effective": Key("Pa", "E_sec of the effective q', last cycle", _C),
+    "damping_ratio_first_effective": Key("1", "D of the effective q', first cycle", _C),
+    "damping_ratio_last_effective": Key("1", "D of the effective q', last cycle", _C),
+    "axial_strain_accumulated": Key("1", "axial strain accumulated over the cycles since the "
+                                         "first loading (ratcheting)", _C),
+    "volumetric_strain_accumulated": Key("1", "volumetric strain accumulated over the cycles",
+                                         _C),
+    "q_at_load": Key("Pa", "q at the end of the first loading", _C),
+    # -- simple shear (simple_shear.simple_shear_summary)
+    "peak_shear_stress": Key("Pa", "the largest shear stress tau; its companions end in "
+                                   "'_at_peak_stress'", _S),
+    "shear_strain_at_peak_stress": Key("1", "gamma at the largest tau", _S),
+    "normal_stress_at_peak_stress": Key("Pa", "sigma_n at the largest tau", _S),
+    "peak_shear_stress_reached": Key("1", "whether the largest tau is a peak the test went "
+                                          "past", _S),
+    "peak_stress_ratio": Key("1", "the peak of tau / sigma_n; its companions end in "
+                                  "'_at_peak'", _S),
+    "shear_strain_at_peak": Key("1", "gamma at the peak of tau / sigma_n", _S),
+    "normal_stress_at_peak": Key("Pa", "sigma_n at the peak of tau / sigma_n", _S),
+    "shear_stress_at_peak": Key("Pa", "tau at the peak of tau / sigma_n", _S),
+    "residual_stress_ratio": Key("1", "mean tau / sigma_n over the last fifth of the shear "
+                                      "strain", _S),
+    "phi_residual_deg": Key("deg", "atan of residual_stress_ratio", _S),
+    "phi_residual_note": Key("1", "why residual_stress_ratio and phi_residual_deg are null",
+                             _S),
+    "normal_stress_final": Key("Pa", "sigma_n at the end", _S),
+    "max_dilatancy": Key("1", "drained: the largest -d eps_v / d gamma over windows of a "
+                              "tenth of the shear strain range (dilation positive)", _S),
+    "dilatancy_angle_deg": Key("deg", "atan of max_dilatancy", _S),
+    "max_dilatancy_note": Key("1", "why max_dilatancy and dilatancy_angle_deg are null", _S),
+    "volumetric_strain_of_shear": Key("1", "drained: eps_v at the end, from the shear's start",
+                                      _S),
+    "max_volume_change": Key("1", "constant volume (simple shear --constant-volume, undrained "
+                                  "triaxial): the largest |V / V_start - 1|, the volume held "
+                                  "(round-off)", (*_T, *_S)),
+    "peak_stress_ratio_effective": Key("1", "wet: the peak of tau' / sigma_n'", _S),
+    "shear_strain_at_peak_effective": Key("1", "wet: gamma at the peak of tau' / sigma_n'", _S),
+    "phi_residual_effective_deg": Key("deg", "wet: the residual friction angle of tau' / "
+                                             "sigma_n'", _S),
+    # -- direct tension, one case of tension.json (pendular.procedures.tension)
+    "void_ratio_target": Key("1", "the case's void ratio target", _TEN),
+    "void_ratio": Key("1", "void ratio of the sample's core after preparation", _TEN),
+    "void_ratio_box": Key("1", "void ratio of the box inside the walls", _TEN),
+    "void_ratio_wet": Key("1", "void ratio of the core once wetted", _TEN),
+    "prep_friction_deg": Key("deg", "friction angle of the preparation that reached the void "
+                                    "ratio", _TEN),
+    "water_content_target": Key("1", "the case's water content target", _TEN),
+    "saturation": Key("1", "degree of saturation once wetted", _TEN),
+    "bridges": Key("1", "liquid bridges once wetted", _TEN),
+    "coordination_wet": Key("1", "coordination number once wetted", _TEN),
+    "unbalanced_force_wet": Key("1", "unbalanced force ratio once wetted", _TEN),
+    "tensile_strength_pa": Key("Pa", "the peak of the tensile stress", _TEN),
+    "axial_extension_at_peak": Key("1", "axial extension at the peak", _TEN),
+    "water_content_at_peak": Key("1", "water content at the peak", _TEN),
+    "bridges_at_peak": Key("1", "liquid bridges at the peak", _TEN),
+    "final_tensile_stress_pa": Key("Pa", "tensile stress at the end of the pull", _TEN),
+    "final_axial_extension": Key("1", "axial extension at the end of the pull", _TEN),
+    "ruptured": Key("1", "whether the stress fell below --residual of the strength", _TEN),
+    "kim_measured_pa": Key("Pa", "Kim's (2001) measured strength of the case, null outside "
+                                 "his cases", _TEN),
+    "packing_state_pa": Key("Pa", "the packing-state prediction of the strength", _TEN),
+    "packing_state_packing": Key("1", "the regular packing of that prediction (text)", _TEN),
+    "relative_difference_to_kim": Key("1", "strength / Kim's - 1", _TEN),
+    "relative_difference_to_packing_state": Key("1", "strength / prediction - 1", _TEN),
+    "mean_unbalanced_force_to_peak": Key("1", "mean unbalanced force ratio before the peak",
+                                         _TEN),
+    "unbalanced_force_at_peak": Key("1", "unbalanced force ratio at the peak", _TEN),
+    "pull_steps": Key("1", "time steps of the pull", _TEN),
+    "pull_time_s": Key("s", "wall-clock time of the pull", _TEN),
+    "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
+    "case": Key("1", "the case's name: e<void ratio>_w<water content %>", _TEN),
+    # -- the soil-water characteristic curve, swcc.json (pendular.procedures.swcc)
+    "drying": Key(SWCC_STAGE_UNITS, "one row per suction of the drying branch, each stage's "
+                               "equilibrium: suction, Sr, bridges (and across gaps), "
+                               "porosity, eps_v, chi (its trace / 3, and the tensor), psi, "
+                               "the interface term, the wall stresses, coordination, "
+                               "overlapping menisci, steps", ("swcc",)),
+    "hysteresis": Key({"suction": "Pa", "saturation_difference": "1",
+                       "bridges_difference": "1"},
+                      "per suction, drying less wetting: Sr and bridges", ("swcc",)),
+    "bridges_formed_across_gaps": Key("1", "bridges formed across gaps over the path",
+                                      ("swcc",)),
+    "regular_packings": Key("1", "chi of the regular packings (scp, bcc, fcp) at each "
+                                 "suction, null where their bridges merge (thesis Ch. 4)",
+                            ("swcc",)),
+    "thesis_fig_5_5": Key("1", "the thesis's Fig. 5.5 Sr read at its suctions [Pa] "
+                               "(reference values)", ("swcc",)),
+    "preparation": Key({"porosity": "1", "coordination": "1", "steps": "1"},
+                       "the prepared sample: porosity, coordination, steps by phase",
+                       ("swcc",)),
+    "config": Key("1", "the run's configuration (pendular.procedures.config.config_to_dict)",
+                  ("swcc",)),
+    # -- a strength envelope (pendular.studies.envelope): the Mohr–Coulomb line q = M p + q0,
+    # M = 6 sin(phi) / (3 - sin(phi)), q0 = c 6 cos(phi) / (3 - sin(phi)), fitted to the
+    # tests' peaks in net stresses and ('_effective') in the effective stresses of Eq. 3.43
+    **{name.format(suffix): Key(units, f"{text} ({stresses})", _E)
+       for suffix, stresses in (("", "net stresses"),
+                                ("_effective", "effective stresses, Eq. 3.43; dry: the net"))
+       for name, units, text in (
+           ("phi{}_deg", "deg", "friction angle phi of the Mohr–Coulomb line fitted to the "
+                                "tests' peaks"),
+           ("phi{}_error_deg", "deg", "standard error of phi (delta method; null with two "
+                                      "tests, fit_error_note)"),
+           ("phi{}_through_origin_deg", "deg", "phi of the line through the origin (c = 0)"),
+           ("cohesion{}", "Pa", "cohesion c of the fitted line"),
+           ("cohesion{}_error", "Pa", "standard error of c (null with two tests)"),
+           ("failure_line_slope{}", "1", "slope M of the failure line q = M p + q0"),
+           ("failure_line_slope{}_error", "1", "standard error of M (null with two tests)"),
+           ("failure_line_intercept{}", "Pa", "intercept q0 of the failure line"),
+           ("failure_line_intercept{}_error", "Pa", "standard error of q0 (null with two "
+                                                    "tests)"))},
+    "confining": Key("Pa", "envelope: the tests' confining stresses", _E),
+    "suction": Key("Pa", "envelope: the tests' suction (null at a water content, where each "
+                         "test's is an output)", _E),
+    "water_content_percent": Key("%", "envelope: the tests' water content (--water-content)",
+                                 _E),
+    "particles": Key("1", "envelope: particles of each test's sample", _E),
+    "fit_points": Key("1", "tests the lines are fitted to", _E),
+    "degrees_of_freedom": Key("1", "of the fit: fit_points - 2", _E),
+    "fit_error_note": Key("1", "why the standard errors are null (two tests: no scatter)", _E),
+    "effective_note": Key("1", "dry tests: the effective stress is the net stress", _E),
+    "peak_not_reached": Key("Pa", "confining stresses of the tests whose q still rose at "
+                                  "their end (peak_reached false)", _E),
+    "tests": Key({"run": "1", "reused": "1", "confining": "Pa", "peak_q": "Pa",
+                  "p_at_peak": "Pa", "peak_axial_stress": "Pa", "axial_strain_at_peak": "1",
+                  "phi_peak_deg": "deg", "peak_reached": "1", "saturation_at_peak": "1",
+                  "suction_at_peak": "Pa", "peak_q_effective": "Pa",
+                  "p_effective_at_peak": "Pa", "phi_peak_effective_deg": "deg",
+                  "sigma_1_at_peak": "Pa", "sigma_3_at_peak": "Pa",
+                  "sigma_1_effective_at_peak": "Pa", "sigma_3_effective_at_peak": "Pa"},
+                 "envelope: one row per triaxial, by confining stress: its run folder, "
+                 "whether an earlier run was reused, its peak (its summary.json's keys) and the "
+                 "principal stresses there, sigma_1 = p + 2q/3 and sigma_3 = p - q/3, net and "
+                 "effective", _E),
 }
 
-#: Units of a simple shear summary.json (pendular.procedures.simple_shear.simple_shear_summary)
-#: and of its options.
-SIMPLE_SHEAR_SUMMARY_UNITS = {
-    "peak_shear_stress": "Pa", "shear_strain_at_peak_stress": "1", "peak_stress_ratio": "1",
-    "shear_strain_at_peak": "1", "normal_stress_at_peak": "Pa", "residual_stress_ratio": "1",
-    "phi_residual_deg": "deg", "normal_stress_final": "Pa", "max_dilatancy": "1",
-    "peak_stress_ratio_effective": "1", "shear_strain_at_peak_effective": "1",
-    "phi_residual_effective_deg": "deg",
-    "dilatancy_angle_deg": "deg", "volumetric_strain_of_shear": "1", "max_volume_change": "1",
-    "normal_stress": "Pa",
-}
 
-#: Units of the keys an undrained triaxial adds to its summary.json
-#: (pendular.procedures.loading.undrained_summary).
-UNDRAINED_SUMMARY_UNITS = {
-    "excess_pore_pressure_at_peak": "Pa", "excess_pore_pressure_final": "Pa",
-    "excess_pore_pressure_max": "Pa", "p_min": "Pa", "axial_strain_at_p_min": "1",
-    "max_volume_change": "1", "suction_final": "Pa", "saturation_final": "1",
-    "effective_stress_path": {"axial_strain": "1", "p": "Pa", "q": "Pa",
-                              "excess_pore_pressure": "Pa", "p_effective": "Pa",
-                              "suction": "Pa", "saturation": "1"},
-}
+def summary_units(command):
+    """Units of the summary keys ``command`` writes (SUMMARY_KEYS)."""
+    return {name: key.units for name, key in SUMMARY_KEYS.items() if command in key.commands}
 
-#: Units of a strength envelope's summary.json (pendular.studies.envelope): the Mohr–Coulomb
-#: fits in net and effective stresses with their standard errors, and its ``tests`` rows (each
-#: triaxial's peak, the principal stresses there).
-ENVELOPE_SUMMARY_UNITS = {
-    **{key.format(suffix): unit for suffix in ("", "_effective") for key, unit in (
-        ("phi{}_deg", "deg"), ("phi{}_error_deg", "deg"), ("phi{}_through_origin_deg", "deg"),
-        ("cohesion{}", "Pa"), ("cohesion{}_error", "Pa"), ("failure_line_slope{}", "1"),
-        ("failure_line_slope{}_error", "1"), ("failure_line_intercept{}", "Pa"),
-        ("failure_line_intercept{}_error", "Pa"))},
-    "confining": "Pa", "suction": "Pa", "particles": "1", "fit_points": "1",
-    "degrees_of_freedom": "1", "peak_not_reached": "Pa", "water_content_percent": "%",
-    "tests": {"confining": "Pa", "peak_q": "Pa", "p_at_peak": "Pa", "peak_axial_stress": "Pa",
-              "axial_strain_at_peak": "1", "phi_peak_deg": "deg", "saturation_at_peak": "1",
-              "suction_at_peak": "Pa", "peak_q_effective": "Pa", "p_effective_at_peak": "Pa",
-              "phi_peak_effective_deg": "deg", "sigma_1_at_peak": "Pa",
-              "sigma_3_at_peak": "Pa", "sigma_1_effective_at_peak": "Pa",
-              "sigma_3_effective_at_peak": "Pa"},
-}
+
+def undeclared_keys(summary, command):
+    """The keys of ``summary`` (a summary.json's dict, or one tension.json case) that
+    SUMMARY_KEYS does not declare for ``command``, and ``key.field`` for the fields of a
+    nested record's rows that its units do not declare; its ``units`` block left out."""
+    found = []
+    for name, value in summary.items():
+        key = SUMMARY_KEYS.get(name)
+        if name == "units":
+            continue
+        if key is None or command not in key.commands:
+            found.append(name)
+            continue
+        rows = value if isinstance(value, list) else [value]
+        if isinstance(key.units, dict) and name != "grading":
+            found += [f"{name}.{field}" for row in rows if isinstance(row, dict)
+                      for field in row if field not in key.units]
+    return sorted(set(found))
+
+
+#: Units of a direct-tension case (tension.json ``cases``, pendular.procedures.tension).
+TENSION_SUMMARY_UNITS = summary_units("tension")
 
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
-#: rows); keys not listed are text, flags or nested records. A summary.json carries the units
-#: of its own keys in its ``units`` block.
-SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
-                 **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS, **UNDRAINED_SUMMARY_UNITS,
-                 **ENVELOPE_SUMMARY_UNITS}
+#: rows: the run options too); a summary.json carries the units of its own keys in its
+#: ``units`` block.
+SUMMARY_UNITS = {**OPTION_UNITS, **{name: key.units for name, key in SUMMARY_KEYS.items()}}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

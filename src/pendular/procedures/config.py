@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from pendular.dem.sample import load_sample
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
@@ -309,7 +310,9 @@ class LaboratoryConfig:
     sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its
     ``confining`` [Pa] is the isotropic stress the loading path starts from; at least
     MIN_SAMPLE_PARTICLES spheres); bridges: None for a dry test;
-    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one;
+    sample_path: start from this saved sample (pendular.dem.sample) instead of preparing one,
+    whose count and sizes the test takes where ``sample`` leaves them at their defaults
+    (``sized_as_sample``);
     wet_steps: most steps to equilibrate after wetting (or after loading a sample);
     vtk_frames: ParaView frames over the loading (0: none; a path whose length is not known
     before it runs writes one every VTK_RECORDS history rows); vtk_every: steps between frames
@@ -386,6 +389,32 @@ class LaboratoryConfig:
                              "rate (--strain-rate / --inertial-number) or the time step "
                              "(--timestep-safety) is too small to be represented")
         return per_step
+
+
+#: The fields of a PrepareConfig that a prepared sample fixes: its spheres' count and sizes
+#: (the seed draws a spread of radii).
+SAMPLE_FIELDS = ("particles", "radius", "radius_spread", "psd", "seed")
+
+
+def sized_as_sample(sample, path):
+    """``sample`` (a PrepareConfig) with the count and sizes (SAMPLE_FIELDS) of the prepared
+    sample at ``path`` for the fields at their defaults (not given), read from the
+    configuration the sample was prepared with, else from its spheres (count and mean
+    radius). A field given keeps its value, which pendular.dem.sample.load_sample then
+    refuses when the sample contradicts it. ValueError naming the path for an unreadable
+    sample."""
+    particles, _, _, stored = load_sample(path)
+    made = {"particles": len(particles), "radius": float(np.mean(particles.radius))}
+    if isinstance(stored.get("config"), dict):
+        try:
+            prepared = config_from_dict(stored["config"], f"sample = {path!r}").sample
+        except (AttributeError, TypeError, ValueError):
+            prepared = None            # written by another tool: its spheres say enough
+        if isinstance(prepared, PrepareConfig):
+            made = {name: getattr(prepared, name) for name in SAMPLE_FIELDS}
+    return dataclasses.replace(sample, **{
+        name: value for name, value in made.items()
+        if getattr(sample, name) == default_of(PrepareConfig, name)})
 
 
 @dataclass

@@ -9,7 +9,7 @@ reloading back. Stress control: q = sigma_z - (sigma_x + sigma_y) / 2 between +A
 from the start (``Strain`` ends). Stage 0 is the first loading, stages 2k - 1 and 2k the
 unloading and reloading of cycle k (1-based): the history's ``cycle`` is 0 on the first
 loading and k on cycle k. The axial walls cannot pull: a run whose axial stress falls to 0
-stops (``AxialStressGuard``, StageFailed).
+stops (pendular.procedures.guards.AxialStressGuard, StageFailed).
 
 The measures of a loop (``loop_measures``; Kramer 1996, "Geotechnical Earthquake
 Engineering", Ch. 6, the equivalent linear model, with q for tau and the axial strain for
@@ -26,12 +26,12 @@ import os
 
 import numpy as np
 
-from pendular.homogenize.invariants import deviator_stress
+from pendular.homogenize.invariants import deviator_stress, lateral_stress
 from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.config import CyclicConfig
-from pendular.procedures.loading import (LoadingPath, Stage, StageFailed, Strain, Stress,
-    friction_angle)
+from pendular.procedures.guards import AxialStressGuard
+from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress, friction_angle
 from pendular.procedures.triaxial import COMPRESSION_COLUMNS, LaboratoryTest, stress_balance
 
 #: Least history rows of a half-cycle under strain control: a loop's area needs its shape.
@@ -64,26 +64,6 @@ def cyclic_stages(confining, rate, cycles, *, amplitude_q=None, amplitude_strain
 def cycle_of(stage):
     """The cycle (1-based; 0: the first loading) of the stage of index ``stage``."""
     return (stage + 1) // 2
-
-
-class AxialStressGuard:
-    """A writer: StageFailed when the axial (z) stress is 0 or below after a step. The axial
-    walls cannot pull: at zero stress they have left the sample (in a periodic cell, the
-    sample is in tension), which a cyclic test does not measure. ``describe(sim)``: where the
-    path stands (text); ``remedy``: what to change (text)."""
-
-    stateless = True
-
-    def __init__(self, describe, remedy):
-        self.describe = describe
-        self.remedy = remedy
-
-    def apply(self, sim):
-        sigma = sim.walls.stress()[2]
-        if not sigma > 0.0:
-            raise StageFailed(f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa "
-                              f"at step {sim.step} and the axial walls cannot pull; "
-                              f"{self.remedy}")
 
 
 class CyclicPath(LoadingPath):
@@ -122,6 +102,41 @@ def loop_measures(strain, q):
     return modulus, damping, dissipated, stored
 
 
+def damping_resolution(strain, q, lateral, target, stored):
+    """The resolution [-] of a loop's damping ratio (loop_measures): the loop area that the
+    measurement itself can make, over 4 pi W_S (``stored`` [Pa]). Two parts, each an area
+    over the strain travelled sum |d eps| (``strain`` [-] in the order travelled): the
+    lateral stress's departure from its ``target`` [Pa] (the servo's lag),
+    sum |lateral - target| |d eps| (trapezoids), and the scatter of the records of ``q``
+    [Pa], its noise estimated from their second differences (median absolute deviation,
+    robust to the loop's turning points: s = median |q[i+1] - 2 q[i] + q[i-1]| /
+    (0.6745 sqrt 6)) times sum |d eps|. None where W_S is 0 or the loop has fewer than 3
+    records."""
+    strain = np.asarray(strain, dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    if not stored > 0.0 or len(q) < 3:
+        return None
+    travel = np.abs(np.diff(strain))
+    off = np.abs(np.asarray(lateral, dtype=np.float64) - target)
+    lag = float(np.sum(0.5 * (off[1:] + off[:-1]) * travel))
+    noise = float(np.median(np.abs(q[2:] - 2.0 * q[1:-1] + q[:-2]))) / (0.6745 * math.sqrt(6.0))
+    return (lag + noise * float(np.sum(travel))) / (4.0 * math.pi * stored)
+
+
+def _resolved(row, name, damping, resolution):
+    """Fill ``row`` with the damping ratio ``name`` measured against its ``resolution``: the
+    value, or None with a note when it does not exceed the resolution (a damping ratio is not
+    negative: a negative one is the measurement's own error)."""
+    row[name] = damping
+    row[f"{name}_measured"] = damping
+    row[f"{name}_resolution"] = resolution
+    if damping is not None and resolution is not None and damping <= resolution:
+        row[name] = None
+        row[f"{name}_note"] = (f"below resolution: {name} {damping:.2g} <= {resolution:.2g}, "
+                               "the loop area that the lateral servo's lag and the records' "
+                               "scatter can make")
+
+
 def _stage_end(stage, k):
     """Last row of stage ``k`` (stage index per row), None if it has none."""
     rows = np.flatnonzero(stage == k)
@@ -146,7 +161,7 @@ def _failure_peak(strain, q, stage):
     return found
 
 
-def cyclic_summary(history, cycles, complete=True):
+def cyclic_summary(history, cycles, complete=True, confining=None):
     """Results of a cyclic path's history (cyclic_stages with ``cycles`` cycles; columns
     ``sigma_wall``, ``axial_strain``, ``volumetric_strain``, ``stage``); ``complete``: whether
     the path reached its end (else the last cycle recorded, cut short, is left out).
@@ -161,7 +176,11 @@ def cyclic_summary(history, cycles, complete=True):
     Top level: ``secant_modulus_first`` / ``_last``, ``damping_ratio_first`` / ``_last``,
     ``axial_strain_accumulated``, ``volumetric_strain_accumulated`` after the last cycle,
     ``axial_strain_at_load`` and ``q_at_load`` at the end of the first loading,
-    ``cycles_completed``; ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
+    ``cycles_completed``. A damping ratio below its resolution (``damping_resolution``
+    about the lateral stress ``confining`` [Pa], default the first record's) is None, with
+    ``damping_ratio_measured``, ``damping_ratio_resolution`` and ``damping_ratio_note`` in its
+    row (``damping_ratio_effective_*`` of q') and ``damping_ratio_note`` at the top naming the
+    cycles. ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
     where a half-cycle has a failure peak (q falls after it by FAILURE_DROP or more). A wet
     history adds, per cycle and at the top, the modulus and damping ratio of the effective
     stress (Eq. 3.43; ``*_effective``)."""
@@ -173,6 +192,8 @@ def cyclic_summary(history, cycles, complete=True):
     effective = None
     if "sigma_effective" in history:
         effective = deviator_stress(np.diagonal(history["sigma_effective"], axis1=1, axis2=2))
+    lateral = lateral_stress(sigma)
+    target = lateral[0] if confining is None else confining
     loaded = _stage_end(stage, 0)
     rows = []
     start = loaded
@@ -183,8 +204,8 @@ def cyclic_summary(history, cycles, complete=True):
             break
         loop = slice(start, end + 1)
         modulus, damping, dissipated, stored = loop_measures(strain[loop], q[loop])
-        row = {"cycle": k, "secant_modulus": modulus, "damping_ratio": damping,
-               "dissipated_energy": dissipated, "strain_energy": stored,
+        resolution = damping_resolution(strain[loop], q[loop], lateral[loop], target, stored)
+        row = {"cycle": k, "secant_modulus": modulus, "dissipated_energy": dissipated, "strain_energy": stored,
                "q_max": float(q[loop].max()), "q_min": float(q[loop].min()),
                "axial_strain_max": float(strain[loop].max()),
                "axial_strain_min": float(strain[loop].min()),
@@ -193,10 +214,12 @@ def cyclic_summary(history, cycles, complete=True):
                "volumetric_strain": float(volumetric[end]),
                "volumetric_strain_increment": float(volumetric[end] - volumetric[start]),
                "records": end + 1 - start}
+        _resolved(row, "damping_ratio", damping, resolution)
         if effective is not None:
-            modulus, damping, _, _ = loop_measures(strain[loop], effective[loop])
-            row.update({"secant_modulus_effective": modulus,
-                        "damping_ratio_effective": damping})
+            modulus, damping, _, stored = loop_measures(strain[loop], effective[loop])
+            row["secant_modulus_effective"] = modulus
+            _resolved(row, "damping_ratio_effective", damping, damping_resolution(
+                strain[loop], effective[loop], lateral[loop], target, stored))
         rows.append(row)
         start = end
     summary = {"cycles": rows, "cycles_completed": len(rows),
@@ -206,6 +229,11 @@ def cyclic_summary(history, cycles, complete=True):
         for name in ("secant_modulus", "damping_ratio"):
             summary[f"{name}_first{suffix}"] = rows[0][name + suffix] if rows else None
             summary[f"{name}_last{suffix}"] = rows[-1][name + suffix] if rows else None
+    below = [row["cycle"] for row in rows if "damping_ratio_note" in row]
+    if below:
+        summary["damping_ratio_note"] = (
+            f"below resolution in cycle(s) {', '.join(map(str, below))}: the damping ratio is "
+            "null there, its measured value, resolution and note in the cycle's row")
     summary["axial_strain_accumulated"] = rows[-1]["axial_strain_accumulated"] if rows else None
     summary["volumetric_strain_accumulated"] = (float(volumetric[start] - volumetric[loaded])
                                                 if rows else None)
@@ -245,7 +273,8 @@ class CyclicTest(LaboratoryTest):
     def summarize(self, history):
         path = getattr(self, "path", None)
         complete = path is None or path.done
-        return {**cyclic_summary(history, self.config.cycles, complete),
+        return {**cyclic_summary(history, self.config.cycles, complete,
+                                 self.config.confining),
                 **stress_balance(history)}
 
     def plot(self, history, out, title):

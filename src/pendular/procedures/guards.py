@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from pendular.dem.measure import porosity
+from pendular.dem.mixed_stress import StageFailed
 from pendular.utils.validate import check_int, check_range
 
 #: Largest overlap of two spheres, or of a sphere and a wall, over the smaller radius [-]. The
@@ -37,6 +38,31 @@ SHEAR_REMEDY = ("lower --max-strain, or the strain rate (--strain-rate / --inert
 
 class SampleCrushed(ValueError):
     """A sample's state left the bounds of a packing (overlaps or porosity, SampleGuard)."""
+
+
+class AxialContactLost(StageFailed):
+    """The axial stress fell to 0: the axial walls, which cannot pull, left the sample
+    (AxialStressGuard)."""
+
+
+class AxialStressGuard:
+    """A writer: AxialContactLost when the axial (z) stress is 0 or below after a step. The
+    axial walls cannot pull: at zero stress they have left the sample (in a periodic cell, the
+    sample is in tension), whose response they then no longer measure. ``describe(sim)``:
+    where the path stands (text); ``remedy``: what to change (text)."""
+
+    stateless = True
+
+    def __init__(self, describe, remedy):
+        self.describe = describe
+        self.remedy = remedy
+
+    def apply(self, sim):
+        sigma = sim.walls.stress()[2]
+        if not sigma > 0.0:
+            raise AxialContactLost(
+                f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa at step "
+                f"{sim.step} and the axial walls cannot pull; {self.remedy}")
 
 
 class SampleGuard:

@@ -807,7 +807,8 @@ def path_deviations(history, shear, confining):
     """How closely a shear of ``shear`` (ShearConfig) held its mixed condition: with
     ``constant_p``, ``mean_stress_deviation`` max over the records of |p / confining - 1|;
     with ``b``, ``b_deviation`` max of |b measured - b| over the records with sigma_z - sigma_x
-    of at least B_MEASURE_FROM confining (measured_b). Both [-]; {} for neither."""
+    of at least B_MEASURE_FROM confining (measured_b), None with ``b_deviation_note`` without
+    such records. Both [-]; {} for neither."""
     sigma = history["sigma_wall"]
     found = {}
     if shear.constant_p:
@@ -817,6 +818,10 @@ def path_deviations(history, shear, confining):
         b = measured_b(sigma, confining)
         found["b_deviation"] = (float(np.nanmax(np.abs(b - shear.b)))
                                 if np.isfinite(b).any() else None)
+        if found["b_deviation"] is None:
+            found["b_deviation_note"] = (
+                f"not measured: no record has sigma_z - sigma_x of at least {B_MEASURE_FROM:g} "
+                "of the confining stress, where b is more than noise")
     return found
 
 
@@ -942,6 +947,10 @@ def oedometer_summary(history, axial_stress, unload_to=None):
                                                         axial[:loaded + 1]),
         "compression_index": _index(void[0], void[loaded], axial[loaded], axial[0]),
     }
+    if summary["constrained_modulus_tangent"] is None:
+        summary["constrained_modulus_tangent_note"] = (
+            "not measured: fewer than 3 records, or no strain, in the top fifth of the "
+            "loading's stress")
     effective = _effective(history)
     if effective is not None:
         summary["k0_effective"] = float(lateral_stress(effective[loaded])

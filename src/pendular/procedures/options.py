@@ -129,22 +129,49 @@ def rate_options(config):
 
 
 def output_options(frames):
-    """ParaView frames (--vtk-frames only when ``frames``: a path whose length is known before
-    it runs) and checkpoints of a laboratory test."""
+    """ParaView frames (--vtk-every or --vtk-frames; ``frames``: the loading's length is known
+    before it runs, else --vtk-frames takes its estimate, or 0 alone: ``framed``) and
+    checkpoints of a laboratory test."""
     every = dataclasses.replace(option_of(
         LaboratoryConfig, "vtk_every",
         help="steps between ParaView frames of the loading (default: " + (
             f"about {LaboratoryConfig.vtk_frames} frames" if frames else
-            "a frame every 10 history rows") + "; 0: no ParaView output)"),
-        least=0, group="frames" if frames else None)
+            f"about {LaboratoryConfig.vtk_frames} frames over a loading whose length is "
+            "estimated before it runs, else a frame every 10 history rows") + "; 0: no "
+            "ParaView output)"),
+        least=0, group="frames")
     count = dataclasses.replace(option_of(
         LaboratoryConfig, "vtk_frames", unset=True,
-        help="ParaView frames over the shear (0: none; at most one a step); instead of "
-             "--vtk-every"), least=0, group="frames")
+        help="ParaView frames over the loading (0: none; at most one a step; " + (
+            "" if frames else "a path whose stages end at a stress or at equilibrium takes "
+            "0 only; ") + "instead of --vtk-every"), least=0, group="frames")
     checkpoints = dataclasses.replace(option_of(
         LaboratoryConfig, "checkpoint_every",
         help="steps between checkpoints DIR/checkpoint.h5 (0: none)"), least=0)
-    return (every, count, checkpoints) if frames else (every, checkpoints)
+    return every, count, checkpoints
+
+
+def framed(build):
+    """The configuration builder ``build`` of a loading path with --vtk-frames: spread over
+    the loading's estimated length (estimated_steps: a simple shear, a strain-controlled
+    cyclic test), 0 for no frames; OptionError naming it for other frames on a path of
+    unknown length (its stages end at a stress or at equilibrium)."""
+    def build_framed(values, given):
+        config = build(values, given)
+        frames = values["vtk_frames"]
+        if frames is None:
+            return config
+        steps = config.estimated_steps()
+        if steps is None and frames > 0:
+            raise OptionError(lambda name: (
+                f"{name('vtk_frames')} {frames}: this path's length is not known before it "
+                "runs (its stages end at a stress or at equilibrium), so frames cannot be "
+                f"spread over it; give {name('vtk_every')} STEPS, or {name('vtk_frames')} 0 "
+                "for none"))
+        if steps is not None:
+            _steps_count("vtk_frames", frames, steps, "the loading")
+        return dataclasses.replace(config, vtk_frames=frames)
+    return build_framed
 
 
 def laboratory_fields(values, given, path):
@@ -401,13 +428,15 @@ def _laboratory(own, build, frames=False, first=(), sample=SAMPLE):
 
 COMMANDS = {
     "triaxial": _laboratory(SHEAR, triaxial_config, frames=True),
-    "oedometer": _laboratory(OEDOMETER_OWN, path_command(OedometerConfig, OEDOMETER_OWN)),
-    "isotropic": _laboratory(ISOTROPIC_OWN, path_command(IsotropicConfig, ISOTROPIC_OWN)),
-    "simple-shear": _laboratory(SIMPLE_SHEAR_OWN, simple_shear_config,
+    "oedometer": _laboratory(OEDOMETER_OWN, framed(path_command(OedometerConfig,
+                                                                OEDOMETER_OWN))),
+    "isotropic": _laboratory(ISOTROPIC_OWN, framed(path_command(IsotropicConfig,
+                                                                ISOTROPIC_OWN))),
+    "simple-shear": _laboratory(SIMPLE_SHEAR_OWN, framed(simple_shear_config),
                                 sample=SIMPLE_SHEAR_SAMPLE),
-    "cyclic": _laboratory(CYCLIC_OWN, path_command(CyclicConfig, CYCLIC_OWN,
-                                                   check=amplitude_given)),
-    "path": _laboratory(PATH_OWN, table_path_config, first=(PATH_TABLE,)),
+    "cyclic": _laboratory(CYCLIC_OWN, framed(path_command(CyclicConfig, CYCLIC_OWN,
+                                                          check=amplitude_given))),
+    "path": _laboratory(PATH_OWN, framed(table_path_config), first=(PATH_TABLE,)),
     "tension": CommandOptions(TENSION, tension_config),
     "swcc": CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL,
                            swcc_config),

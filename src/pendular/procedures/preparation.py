@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+from tqdm import tqdm
 
 from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
@@ -569,10 +570,14 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     start = servo.target
     stages = 20
     _enter(writers, "unload")
-    for stage in range(1, stages + 1):
-        servo.target = start + (config.confining - start) * stage / stages
-        sim.run(config.unload_steps // stages)
-    steps["unload"] = config.unload_steps // stages * stages
+    each = config.unload_steps // stages
+    # one bar over the stages, with its total and time left
+    with tqdm(total=each * stages, desc="unload", unit="step", mininterval=1.0,
+              disable=label is None) as bar:
+        for stage in range(1, stages + 1):
+            servo.target = start + (config.confining - start) * stage / stages
+            bar.update(sim.run(each))
+    steps["unload"] = each * stages
     _enter(writers, "equilibrate")
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
                                    progress=label and "equilibrate", status=status)

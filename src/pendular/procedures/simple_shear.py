@@ -90,11 +90,14 @@ def _friction_angle(ratio):
 
 
 def simple_shear_summary(history, constant_volume):
-    """Results of a simple shear's history (``shear_rows``): ``peak_shear_stress`` [Pa] and
-    the shear strain there; at the peak of tau / sigma_n (records with sigma_n above
-    MIN_NORMAL_FRACTION of its initial value) ``peak_stress_ratio``, ``phi_peak_deg`` =
-    atan(tau / sigma_n), ``shear_strain_at_peak``, ``normal_stress_at_peak``, ``peak_reached``
-    (pendular.io.schema.peak_reached); over the last RESIDUAL_FRACTION of the shear strain
+    """Results of a simple shear's history (``shear_rows``). Two peaks, each with the values
+    of its own record: the largest tau, ``peak_shear_stress`` [Pa], with
+    ``shear_strain_at_peak_stress`` and ``normal_stress_at_peak_stress`` and
+    ``peak_shear_stress_reached`` (pendular.io.schema.peak_reached of tau); the peak of tau /
+    sigma_n (records with sigma_n above MIN_NORMAL_FRACTION of its initial value),
+    ``peak_stress_ratio``, with ``phi_peak_deg`` = atan(tau / sigma_n),
+    ``shear_strain_at_peak``, ``normal_stress_at_peak``, ``shear_stress_at_peak`` and
+    ``peak_reached`` (peak_reached of tau / sigma_n); over the last RESIDUAL_FRACTION of the shear strain
     ``residual_stress_ratio`` (mean tau / sigma_n) and ``phi_residual_deg``;
     ``normal_stress_final``. Drained: ``max_dilatancy`` = max -d(eps_v)/d(gamma) over windows
     of DILATANCY_WINDOW of the shear strain (eps_v contraction positive, so dilation is
@@ -110,7 +113,9 @@ def simple_shear_summary(history, constant_volume):
     ratio = np.where(measured, tau / np.where(measured, normal, 1.0), np.nan)
     top = int(np.argmax(tau))
     summary = {"peak_shear_stress": float(tau[top]),
-               "shear_strain_at_peak_stress": float(gamma[top])}
+               "shear_strain_at_peak_stress": float(gamma[top]),
+               "normal_stress_at_peak_stress": float(normal[top]),
+               "peak_shear_stress_reached": peak_reached(gamma, tau)}
     if np.isfinite(ratio).any():
         peak = int(np.nanargmax(ratio))
         span = gamma[-1] - gamma[0]
@@ -121,9 +126,14 @@ def simple_shear_summary(history, constant_volume):
             "phi_peak_deg": _friction_angle(ratio[peak]),
             "shear_strain_at_peak": float(gamma[peak]),
             "normal_stress_at_peak": float(normal[peak]),
+            "shear_stress_at_peak": float(tau[peak]),
             "peak_reached": peak_reached(gamma[measured], ratio[measured]),
             "residual_stress_ratio": residual_ratio if np.isfinite(residual_ratio) else None,
             "phi_residual_deg": _friction_angle(residual_ratio)})
+        if summary["residual_stress_ratio"] is None:
+            summary["phi_residual_note"] = (
+                f"not measured: no record in the last {100 * RESIDUAL_FRACTION:g} % of the "
+                f"shear strain has sigma_n above {100 * MIN_NORMAL_FRACTION:g} % of its start")
     summary["normal_stress_final"] = float(normal[-1])
     if "psi" in history:
         summary.update(effective_friction(history, rows))
@@ -165,11 +175,14 @@ def dilatancy(gamma, volumetric):
     """``max_dilatancy`` = max over the shear of -d(eps_v)/d(gamma) [-], differences over
     windows of DILATANCY_WINDOW of the shear strain range (eps_v ``volumetric``, contraction
     positive, against ``gamma``, rising), ``dilatancy_angle_deg`` = atan of it and
-    ``volumetric_strain_of_shear`` (the last eps_v); None without a range of shear strain."""
+    ``volumetric_strain_of_shear`` (the last eps_v); None without a range of shear strain,
+    ``max_dilatancy_note`` saying so."""
     span = gamma[-1] - gamma[0]
     found = {"volumetric_strain_of_shear": float(volumetric[-1])}
     if not span > 0.0 or len(gamma) < 3:
-        return {**found, "max_dilatancy": None, "dilatancy_angle_deg": None}
+        return {**found, "max_dilatancy": None, "dilatancy_angle_deg": None,
+                "max_dilatancy_note": "not measured: the shear strain did not move, or fewer "
+                                      "than 3 records"}
     window = DILATANCY_WINDOW * span
     start = np.linspace(gamma[0], gamma[-1] - window, 200)
     slope = -(np.interp(start + window, gamma, volumetric)
@@ -208,4 +221,5 @@ class SimpleShearTest(LaboratoryTest):
                  if np.ndim(values) and len(values) == len(history["step"])}
         kind = "constant volume" if config.constant_volume else "drained"
         plot_simple_shear(shear, os.path.join(out, self.FIGURE),
-                          f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}")
+                          f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}",
+                          summary=simple_shear_summary(history, config.constant_volume))

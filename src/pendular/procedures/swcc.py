@@ -54,6 +54,7 @@ from pendular.homogenize.regular_packing import KINDS
 
 from pendular.procedures.config import SwccConfig, config_to_dict
 from pendular.io.history import write_history
+from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import FIG_5_5
@@ -63,11 +64,6 @@ from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, e
 
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
-#: Units of the stage rows of swcc.json.
-STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1", "bridges_across_gaps": "1",
-               "porosity": "1", "volumetric_strain": "1", "chi": "1", "chi_tensor": "1",
-               "psi": "Pa", "psi_interface": "Pa", "sigma_wall": "Pa", "coordination": "1",
-               "pendular_overlaps": "1", "steps": "1"}
 
 
 def path_bridges(config: SwccConfig, radii) -> CapillaryBridges:
@@ -157,7 +153,7 @@ class SwccTest:
             "regular_packings": regular_packing_curves(config, suctions),
             "thesis_fig_5_5": {str(int(s)): v for s, v in FIG_5_5.items()},
             "wall_time_s": time.perf_counter() - started,
-            "units": {**STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
+            "units": {**SWCC_STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
         }
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
@@ -182,7 +178,7 @@ class SwccTest:
 
     @staticmethod
     def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):
-        """The swcc.json row of a static stage (STAGE_UNITS)."""
+        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS)."""
         state = bridges.state(sim)
         chi = homogenization.chi(sim)
         return {"suction": suction,

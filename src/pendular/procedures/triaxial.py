@@ -25,6 +25,7 @@ positive, volumetric strain positive in contraction (docs/units.md).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -47,11 +48,14 @@ from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
 from pendular.utils.validate import check_int
 from pendular.dem.walls import ConstantStrainRate, StressServo
-from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
+from pendular.homogenize.invariants import (lateral_stress, mean_stress,
+    principal_difference, shear_deviator)
 
-from pendular.procedures.guards import SampleCrushed
+from pendular.procedures.critical_state import critical_state
+from pendular.procedures.guards import AxialContactLost, AxialStressGuard, SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
-    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number)
+    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number,
+    sized_as_sample)
 from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
     check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages,
     isotropic_summary, k0, oedometer_stages, oedometer_summary, path_deviations, shear_stage,
@@ -282,7 +286,7 @@ def frame_period(vtk_every, vtk_frames, steps, unknown_length_period=0):
     if not vtk_frames:
         return 0
     if steps is not None:
-        return max(1, steps // vtk_frames)
+        return max(1, int(steps // vtk_frames))
     return unknown_length_period
 
 
@@ -333,49 +337,71 @@ def shear_path(sim, shear, confining, rate, columns=None):
                        rate_on_current_length=shear.rate_on_current_length)
 
 
-def summarize(history, direction="compression"):
-    """Peak values of a triaxial history (dict of arrays): in compression the axial stress, q,
-    p, strain at the peak of q (and Sr there when recorded); in extension (``direction``) the
-    least axial stress and, at the peak of q = sigma_lateral - sigma_axial, q (positive), p
-    and the strain (negative), and ``axial_contact_lost``: whether the axial stress fell to 0
-    (the walls released a cohesive sample before it failed). ``phi_peak_deg``: the mobilised friction angle there
-    (loading.friction_angle of the net wall stresses). A wet history adds
-    ``peak_q_effective``, ``p_effective_at_peak`` and ``phi_peak_effective_deg``: q', p' and
-    the friction angle of the effective stress (Eq. 3.43) at the peak of q, and with the exact
-    bridge model ``peak_q_effective_complete`` and ``p_effective_complete_at_peak``: those of
-    the complete effective stress (psi plus the liquid-gas interface term,
-    pendular.homogenize.on_the_fly)."""
-    sigma = history["sigma_wall"]
+def summarize(history, direction="compression", b=None):
+    """Peak values of a triaxial history (dict of arrays). q is that of the test
+    (invariants.shear_deviator: sigma_z - sigma_lateral, negative in extension; the von Mises
+    q at ``b`` != 0), its peak the largest q in compression, the least (most negative) in
+    extension: ``peak_q``, ``p_at_peak``, ``axial_strain_at_peak`` (negative in extension),
+    ``principal_difference_at_peak`` (sigma_1 - sigma_3) and, recorded, Sr and the suction
+    there, all of that record; in compression ``peak_axial_stress`` (the largest axial
+    stress), in extension ``min_axial_stress`` and ``axial_contact_lost``: whether the axial
+    stress fell to 0 (the walls released a cohesive sample before it failed).
+    ``phi_peak_deg``: the mobilised friction angle at the peak (loading.friction_angle of the
+    net wall stresses), None with ``phi_peak_note`` when the axial contact was lost. A wet
+    history adds ``peak_q_effective``, ``p_effective_at_peak`` and
+    ``phi_peak_effective_deg``: q', p' and the friction angle of the effective stress (Eq.
+    3.43) at the peak of q, and with the exact bridge model ``peak_q_effective_complete`` and
+    ``p_effective_complete_at_peak``: those of the complete effective stress (psi plus the
+    liquid-gas interface term, pendular.homogenize.on_the_fly). The critical state
+    (pendular.procedures.critical_state): ``phi_cs_deg``, ``M_cs``, ``void_ratio_cs`` and
+    ``critical_state_note``, and wet ``phi_cs_effective_deg``, ``M_cs_effective``."""
+    sigma = np.asarray(history["sigma_wall"], dtype=np.float64)
     extension = direction == "extension"
-    q = -deviator_stress(sigma) if extension else deviator_stress(sigma)
-    peak = int(np.argmax(q))
+    q = shear_deviator(sigma, b)
+    peak = int(np.argmax(-q if extension else q))
+    contact_lost = extension and bool(sigma[:, 2].min() <= 0.0)
     summary = {"min_axial_stress": float(sigma[:, 2].min()),
                # the axial walls cannot pull: at zero stress they have left the sample, whose
                # strength in extension they then no longer measure (a cohesive wet sample)
-               "axial_contact_lost": bool(sigma[:, 2].min() <= 0.0)} if extension else {
+               "axial_contact_lost": contact_lost} if extension else {
         "peak_axial_stress": float(sigma[:, 2].max())}
     summary.update({
         "peak_q": float(q[peak]),
         "p_at_peak": float(mean_stress(sigma)[peak]),
         "axial_strain_at_peak": float(history["axial_strain"][peak]),
+        "principal_difference_at_peak": float(principal_difference(sigma[peak])),
         "lateral_stress": float(np.mean(lateral_stress(sigma))),
         "peak_index": peak,
-        "phi_peak_deg": float(friction_angle(sigma[peak])),
+        "phi_peak_deg": None if contact_lost else float(friction_angle(sigma[peak])),
     })
+    if contact_lost:
+        summary["phi_peak_note"] = (
+            "not measured: the axial stress fell to 0, the axial walls (which cannot pull) "
+            "left the sample before it failed in extension; the peak values are those of the "
+            "walls' release")
     if "saturation" in history:
         summary["saturation_at_peak"] = float(history["saturation"][peak])
     if "suction" in history:                      # not in a YADE history
         summary["suction_at_peak"] = float(history["suction"][peak])
-    sign = -1.0 if extension else 1.0
+    effective = None
     if "sigma_effective" in history:
-        effective = np.diagonal(history["sigma_effective"][peak])
-        summary["peak_q_effective"] = float(sign * deviator_stress(effective))
-        summary["p_effective_at_peak"] = float(effective.mean())
-        summary["phi_peak_effective_deg"] = float(friction_angle(effective))
+        effective = np.diagonal(history["sigma_effective"], axis1=1, axis2=2)
+        summary["peak_q_effective"] = float(shear_deviator(effective[peak], b))
+        summary["p_effective_at_peak"] = float(effective[peak].mean())
+        summary["phi_peak_effective_deg"] = (None if contact_lost else
+                                             float(friction_angle(effective[peak])))
     if "sigma_effective_complete" in history:
         complete = np.diagonal(history["sigma_effective_complete"][peak])
-        summary["peak_q_effective_complete"] = float(sign * deviator_stress(complete))
+        summary["peak_q_effective_complete"] = float(shear_deviator(complete, b))
         summary["p_effective_complete_at_peak"] = float(complete.mean())
+    if "porosity" in history and "volumetric_strain" in history:
+        strain, volumetric = history["axial_strain"], history["volumetric_strain"]
+        summary.update(critical_state(strain, volumetric, sigma, q, history["porosity"]))
+        if effective is not None:
+            found = critical_state(strain, volumetric, effective, shear_deviator(effective, b),
+                                   history["porosity"])
+            summary.update({"phi_cs_effective_deg": found["phi_cs_deg"],
+                            "M_cs_effective": found["M_cs"]})
     summary.update(stress_balance(history))
     return summary
 
@@ -508,11 +534,17 @@ class LaboratoryTest:
     FIGURE = "triaxial.png"
     #: Progress-bar label of the loading.
     PROGRESS = "shear"
+    #: Whether the loading ends, its results written, when the axial walls leave the sample
+    #: (guards.AxialContactLost), rather than failing.
+    ENDS_AT_CONTACT_LOSS = False
 
     def __init__(self, config, *, force=False):
         if not isinstance(config, self.CONFIG):
             raise TypeError(f"config must be a {self.CONFIG.__name__}, got "
                             f"{type(config).__name__}")
+        if config.sample_path is not None:      # the sample's count and sizes, unless given
+            config = dataclasses.replace(config, sample=sized_as_sample(config.sample,
+                                                                        config.sample_path))
         self.config = config
         check_feasible(config, force=force)
         if config.bridges is not None and config.bridges.suction is not None:
@@ -716,10 +748,17 @@ class TriaxialTest(LaboratoryTest):
     stress_path.png: q-p and, wet, q'-p' of the effective stress)."""
 
     CONFIG = TriaxialConfig
+    ENDS_AT_CONTACT_LOSS = True
 
     def loading(self, sim):
         config = self.config
-        return shear_path(sim, config.shear, config.confining, config.rate())
+        path = shear_path(sim, config.shear, config.confining, config.rate())
+        if config.shear.direction == "extension":
+            # the axial walls cannot pull: once they leave the sample the test is over
+            sim.writers.append(AxialStressGuard(
+                lambda s: f"extension at axial strain {path.axial.strain(s.walls):.3g}",
+                "the shear ends there (summary.json axial_contact_lost)"))
+        return path
 
     def stages(self):
         config = self.config
@@ -727,10 +766,12 @@ class TriaxialTest(LaboratoryTest):
 
     def summarize(self, history):
         shear = self.config.shear
-        summary = summarize(history, shear.direction)
-        sign = -1.0 if shear.direction == "extension" else 1.0     # summarize's q at failure
-        summary["peak_reached"] = peak_reached(history["axial_strain"],
-                                               sign * deviator_stress(history["sigma_wall"]))
+        summary = summarize(history, shear.direction, shear.b)
+        q = shear_deviator(history["sigma_wall"], shear.b)
+        summary["peak_reached"] = (not summary.get("axial_contact_lost", False)
+                                   and peak_reached(history["axial_strain"],
+                                                    -q if shear.direction == "extension"
+                                                    else q))
         summary.update(path_deviations(history, shear, self.config.confining))
         if self.config.undrained:
             summary.update(undrained_summary(history, summary["peak_index"]))
@@ -744,11 +785,13 @@ class TriaxialTest(LaboratoryTest):
         return history
 
     def plot(self, history, out, title):
-        direction = self.config.shear.direction
-        plot_history(history, os.path.join(out, self.FIGURE), title, direction)
-        write_plots(history, os.path.join(out, "plots"), title, direction)
-        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title,
-                         direction)
+        shear = self.config.shear
+        plot_history(history, os.path.join(out, self.FIGURE), title, shear.direction, shear.b)
+        drainage = "undrained" if self.config.undrained else "drained"
+        named = f"{drainage} triaxial {shear.direction}; {title}"    # the plots/ name the test
+        write_plots(history, os.path.join(out, "plots"), named, shear.direction, shear.b)
+        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), named,
+                         shear.direction, shear.b)
 
 
 #: History columns of the oedometric and isotropic paths beyond the triaxial's.
@@ -834,8 +877,11 @@ class _PathRun:
         self.steps = self.path.steps           # None: known only as the path runs
         self.start_step = sim.step
         self.shear_time = 0.0        # seconds spent loading by earlier (interrupted) runs
-        self.vtk_period = frame_period(config.vtk_every, config.vtk_frames, self.steps,
-                                       self.path.recorder.period * VTK_RECORDS)
+        # frames spread over the loading, or over its estimate when its stages end otherwise
+        self.vtk_period = frame_period(
+            config.vtk_every, config.vtk_frames,
+            self.steps if self.steps is not None else config.estimated_steps(),
+            self.path.recorder.period * VTK_RECORDS)
         field_data, time_axis = test.frame_fields(self.path)
         self.vtk = frames_writer(sim, out, self.vtk_period, field_data=field_data,
                                  time_axis=time_axis)
@@ -883,11 +929,16 @@ class _PathRun:
             path.run(sim, max_steps=None if budget == math.inf else budget, progress=label)
         except KeyboardInterrupt:
             pass
-        except (SampleCrushed, StageFailed) as error:
+        except AxialContactLost as error:
+            if not self.test.ENDS_AT_CONTACT_LOSS:
+                return self._failed(error)
+            path.recorder.record(sim)            # the record of the loss ends the history
             self.shear_time += time.perf_counter() - self._clock
-            if not self.folder.earlier_results:
-                self.write_outputs(completed=False, error=str(error))
-            raise
+            if self.vtk is not None:
+                self.vtk.close(sim)
+            return self.write_outputs(plots=plots, stopped=str(error))
+        except (SampleCrushed, StageFailed) as error:
+            return self._failed(error)
         self.shear_time += time.perf_counter() - self._clock
         if not path.done:
             if self.folder.earlier_results:
@@ -901,10 +952,19 @@ class _PathRun:
             self.vtk.close(sim)
         return self.write_outputs(plots=plots)
 
-    def write_outputs(self, completed=True, plots=True, error=None):
+    def _failed(self, error):
+        """Keep the history of a loading that ``error`` stopped (unless the folder holds the
+        finished results of an earlier run), then raise it."""
+        self.shear_time += time.perf_counter() - self._clock
+        if not self.folder.earlier_results:
+            self.write_outputs(completed=False, error=str(error))
+        raise error
+
+    def write_outputs(self, completed=True, plots=True, error=None, stopped=None):
         """history.h5, summary.json (``completed``: whether the loading reached its end;
-        ``error``: what stopped it, if not an interruption) and, for a completed run, the plots
-        unless ``plots`` is False."""
+        ``error``: what stopped it, if not an interruption; ``stopped``: why a completed
+        loading ended before its last stage's end) and, for a completed run, the plots unless
+        ``plots`` is False."""
         sim, config, out = self.sim, self.config, self.out
         sample = config.sample
         preparation = self.before_shear["preparation"]
@@ -934,6 +994,12 @@ class _PathRun:
             "grading": grading(sim.particles.radius),
             **self.before_shear["wetting"],
         })
+        wetting = self.before_shear["wetting"]
+        if "wet_porosity" in wetting:
+            before, after = preparation["porosity"], wetting["wet_porosity"]
+            summary.update({"porosity_before_wetting": before, "porosity_after_wetting": after,
+                            "void_ratio_before_wetting": before / (1.0 - before),
+                            "void_ratio_after_wetting": after / (1.0 - after)})
         if "liquid_bridges" in history:
             # the closed amount, which water-content stages change (path_table.liquid_total)
             initial = np.asarray(history.get("liquid_total",
@@ -943,6 +1009,7 @@ class _PathRun:
                 "liquid_balance_error": float(np.max(np.abs(total - initial) / initial)),
                 "liquid_lost_fraction": float(history["liquid_lost"][-1]
                                               / np.ravel(initial)[-1])})
+        summary = _plain(summary)              # NumPy scalars as plain floats and ints
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
@@ -951,6 +1018,8 @@ class _PathRun:
             summary["phase"] = "shear"
         if error is not None:
             summary["error"] = error
+        if stopped is not None:
+            summary["stopped"] = stopped
         self.folder.phase = "write"
         with deferred_interrupts():       # history and summary are written whole, or not at all
             write_history(os.path.join(out, "history.h5"), history,
@@ -969,12 +1038,13 @@ class _PathRun:
                   "there (summary.json stress_balance_flagged)", file=sys.stderr)
         if summary.get("axial_contact_lost"):
             print("warning: the axial stress fell to 0: the axial walls, which cannot pull, left "
-                  "the sample before it failed in extension, so the peak is that of the walls' "
-                  "release, not of the sample (summary.json axial_contact_lost); raise "
-                  "--confining, or read the effective stresses", file=sys.stderr)
+                  "the sample before it failed in extension, and the shear ended there; the "
+                  "peak is that of the walls' release, not of the sample, and phi_peak_deg is "
+                  "null (summary.json axial_contact_lost); raise --confining", file=sys.stderr)
         if not plots:
             return summary
-        self.test.plot(history, out, run_label(parameters(config), preparation["porosity"]))
+        self.test.plot(history, out, run_label(parameters(config),
+                                               float(history["porosity"][0])))
         return summary
 
 

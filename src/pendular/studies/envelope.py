@@ -11,8 +11,9 @@ freedom), carried to phi and c to first order (the delta method).
 one campaign (pendular.studies.campaign: local processes or a Dask cluster) and fits the
 envelope to their peaks in net stresses and in the effective stresses of Eq. 3.43 (the wet
 summaries' p' and q' at the peak of q; a dry test's effective stress is its net stress).
-It writes into ``out``: summary.json (ENVELOPE keys, pendular.io.schema), campaign.csv, the
-figures of pendular.studies.envelope_figures, and runs/confining<S>/ (each triaxial's outputs).
+It writes into ``out``: summary.json (its keys declared in pendular.io.schema.SUMMARY_KEYS),
+campaign.csv, the figures of pendular.studies.envelope_figures, and runs/confining<S>/ (each
+triaxial's outputs).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from typing import NamedTuple
 import numpy as np
 
 from pendular.io.outputs import OutputFolder
-from pendular.io.schema import ENVELOPE_SUMMARY_UNITS
+from pendular.io.schema import summary_units
 from pendular.procedures.options import config_from_options, options_of
 from pendular.procedures.preparation import PrepareConfig
 from pendular.studies.campaign import Campaign, Run, run_name, write_campaign_csv
@@ -218,7 +219,7 @@ def envelope_summary(rows, config):
     summary["peak_not_reached"] = [row["confining"] for row in rows
                                    if row.get("peak_reached") is False]
     summary["tests"] = rows
-    summary["units"] = {key: unit for key, unit in ENVELOPE_SUMMARY_UNITS.items()
+    summary["units"] = {key: unit for key, unit in summary_units("envelope").items()
                         if key in summary}
     return summary
 

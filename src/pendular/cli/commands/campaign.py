@@ -27,8 +27,13 @@ import os
 
 from pendular.studies.campaign import (Campaign, RunRefused, sweep_from_table,
                                        write_campaign_csv)
-from pendular.cli import UsageError, add_executor_options, start_executor_run
+from pendular.cli import UsageError, add_executor_options, print_result, start_executor_run
 from pendular.io.outputs import OutputFolder
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular campaign campaign.toml --out runs/campaign --jobs 2",
+           "every row of a table of any command's options, two at a time, collected in "
+           "campaign.csv (the table: the tutorial 'A campaign from a table')")
 
 
 def add_arguments(parser):
@@ -51,7 +56,9 @@ def run(args):
         except RunRefused as error:
             raise UsageError(f"table = {args.table!r}: {error}") from None
         write_campaign_csv(csv_path, result)
-    print(f"campaign: {len(runs)} {command} runs ({len(result.reused)} reused, "
-          f"{len(result.failed)} failed); outputs in {args.out} (campaign.csv, runs/)")
+    print_result(args.quiet, f"campaign: {len(runs)} {command} runs ({len(result.reused)} "
+                 f"reused, {len(result.failed)} failed); outputs in {args.out} (campaign.csv, "
+                 "runs/)", command=command, runs=len(runs), reused=len(result.reused),
+                 failed=len(result.failed), out=args.out)
     result.check()
     return 0

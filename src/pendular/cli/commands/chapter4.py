@@ -6,6 +6,10 @@ from pendular.utils.parameters import option_from
 
 from pendular.cli import add_declared_options, add_run_options, declared_values
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular chapter4 --out runs/chapter4",
+           "the regular packings' SWCC, chi, B and psi of thesis Chapter 4: tables and figures")
+
 #: States per curve of the figures, checked as the option is read.
 POINTS = option_from(POINTS_PARAMETER, 40, checked=True)
 

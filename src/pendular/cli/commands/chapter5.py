@@ -7,7 +7,13 @@ threads (one by default) and its own log.txt with its progress."""
 
 from pendular.studies.chapter5 import chapter5_campaign, grid_from_options, grid_options
 from pendular.cli import (add_declared_options, add_executor_options, declared_values,
-    start_executor_run)
+    print_result, start_executor_run)
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular chapter5 --particles 1000 --suctions 0,30000 --confining 250,750 "
+           "--max-strain 0.1 --out runs/chapter5",
+           "four triaxial tests of thesis Table 5.3 and their strength envelopes; campaign.json, "
+           "report.md, plots/")
 
 
 def add_arguments(parser):
@@ -24,7 +30,8 @@ def run(args):
                                          device=args.device,
                                          quiet=args.quiet)
     runs = len(campaign["runs"])
-    if reused:
-        print(f"chapter5: {reused} finished runs in {args.out} reused, {runs - reused} run")
-    print(f"chapter5: {runs} runs; outputs in {args.out} (campaign.json, report.md, plots/)")
+    print_result(args.quiet, (f"chapter5: {reused} finished runs in {args.out} reused, "
+                              f"{runs - reused} run\n" if reused else "")
+                 + f"chapter5: {runs} runs; outputs in {args.out} (campaign.json, report.md, "
+                   "plots/)", runs=runs, reused=reused, out=args.out)
     return 0

@@ -12,6 +12,8 @@ positive [Pa]. Needs ``yade`` on PATH; docs/yade_crosscheck.md lists the differe
 
 from __future__ import annotations
 
+import sys
+
 from pendular.cli import (UsageError, add_declared_options, add_device_option, declared_values,
     positive_int, print_summary, set_threads)
 from pendular.dem.simulation import check_device
@@ -19,6 +21,11 @@ from pendular.studies.crosscheck import (OPTIONS, SHOWN, check_mirrored, check_p
     crosscheck_from_options, run_crosscheck)
 from pendular.interop.yade.runner import find_yade
 from pendular.utils.parameters import OptionError, ParameterError
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular crosscheck --particles 1000 --suction 30000 --out runs/crosscheck",
+           "the same packing sheared by pendular and YADE (when installed) side by side; "
+           "crosscheck.json, crosscheck.png")
 
 
 def add_arguments(parser):
@@ -64,5 +71,7 @@ def run(args):
                             packing=args.packing, concurrent=args.concurrent,
                             threads=args.threads, progress=not args.quiet, device=args.device)
     print_summary(result, SHOWN, args.quiet)
-    print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)")
+    # with --quiet, stdout holds the JSON alone
+    print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)",
+          file=sys.stderr if args.quiet else sys.stdout)
     return 0

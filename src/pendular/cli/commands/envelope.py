@@ -19,6 +19,13 @@ from pendular.cli import (add_declared_options, add_executor_options, declared_v
     print_summary, start_executor_run)
 from pendular.studies.envelope import envelope, envelope_options, envelope_runs
 
+#: A worked example: (command line, what it gives).
+EXAMPLE = ("pendular envelope --confining 250,500,1000,2000 --particles 300 --suction 30000 "
+           "--out runs/envelope --jobs 2",
+           "four wet drained triaxial compressions, two at a time, and the Mohr–Coulomb line "
+           "fitted to their peaks: phi and c with their standard errors, net and effective, in "
+           "summary.json; mohr_circles.png, peaks_pq.png, campaign.csv")
+
 #: Summary keys printed at the end.
 SHOWN = ("phi_deg", "phi_error_deg", "cohesion", "cohesion_error", "phi_effective_deg",
          "phi_effective_error_deg", "cohesion_effective", "cohesion_effective_error",

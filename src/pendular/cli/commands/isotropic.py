@@ -17,6 +17,12 @@ from pendular.procedures.triaxial import IsotropicTest
 
 from pendular.cli.commands.triaxial import loading_command
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular isotropic --particles 1000 --stresses 1000,2000,4000,2000,1000 "
+           "--out runs/isotropic",
+           "e against log p at the end of each stage, with the compression and swelling indices; "
+           "isotropic.png")
+
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "compression_index",
          "swelling_index", "compression_index_effective", "swelling_index_effective",

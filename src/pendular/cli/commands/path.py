@@ -42,6 +42,11 @@ from pendular.procedures.path_table import PathTest
 
 from pendular.cli.commands.triaxial import loading_command
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular path examples/paths/oedometer_unload.toml --particles 1000 --out runs/path",
+           "the stages of a TOML table run in turn: each stage's end state in summary.json, the "
+           "stress path in plots/")
+
 #: Summary keys printed at the end.
 SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
          "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",

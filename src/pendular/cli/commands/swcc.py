@@ -19,6 +19,11 @@ from pendular.cli import (add_command_options, add_device_option, add_run_option
     command_config, print_summary, set_threads)
 from pendular.procedures.swcc import SwccTest
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular swcc --particles 1000 --suctions 3000,10000,30000,100000 --out runs/swcc",
+           "Sr and chi along drying then wetting at these suctions, with the hysteresis; "
+           "swcc.json, swcc.png")
+
 #: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
 SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
 
@@ -40,21 +45,14 @@ def run(args):
     set_threads(args.threads)
     result = SwccTest(config_from(args)).run(args.out, progress=not args.quiet,
                                             threads=args.threads, device=args.device)
-    if args.quiet:
-        print(f"{'branch':<8} {'suction [Pa]':>12} {'Sr [%]':>8} {'bridges':>8} "
-              f"{'porosity':>9} {'eps_v':>9} {'chi':>8}")
-        for branch in ("drying", "wetting"):
-            for row in result[branch]:
-                print(f"{branch:<8} {row['suction']:>12g} {100 * row['saturation']:>8.3f} "
-                      f"{row['bridges']:>8d} {row['porosity']:>9.4f} "
-                      f"{row['volumetric_strain']:>9.2e} {row['chi']:>8.4f}")
-    else:
-        print_summary(result, ("drying", "wetting"), columns=SHOWN_COLUMNS)
+    print_summary(result, ("drying", "wetting"), args.quiet, columns=SHOWN_COLUMNS)
     merged = sorted({row["suction"] for branch in ("drying", "wetting") for row in result[branch]
                      if row["pendular_overlaps"] > 0})
     if merged:
         print(f"warning: at suction(s) {', '.join(f'{s:g}' for s in merged)} Pa menisci merge on "
               "grains (pendular_overlaps > 0 in swcc.json): the sample is past the pendular "
               "regime that the bridges model there", file=sys.stderr)
-    print(f"done in {result['wall_time_s']:.0f} s; outputs in {args.out}")
+    # with --quiet, stdout holds the JSON alone
+    print(f"done in {result['wall_time_s']:.0f} s; outputs in {args.out}",
+          file=sys.stderr if args.quiet else sys.stdout)
     return 0

@@ -12,12 +12,18 @@ what the GPU does not run yet (docs/gpu.md).
 from __future__ import annotations
 
 import argparse
+import sys
 
 from pendular.cli import (add_command_options, add_device_option, add_run_options,
     command_config, print_summary, set_threads)
 from pendular.procedures.config import TensionConfig
 from pendular.dem.simulation import check_device
-from pendular.procedures.tension import TensionTest, report_lines
+from pendular.procedures.tension import TensionTest
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tension",
+           "the direct tensile strength of one of Kim's (2001) cases against his measurement and "
+           "the packing-state prediction; tension.json, report.md")
 
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
@@ -42,9 +48,8 @@ def run(args: argparse.Namespace) -> int:
     check_device(args.device)                   # before anything is made
     output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args),
                                      device=args.device)
-    if args.quiet:
-        print("\n".join(report_lines(output["cases"], config)))
-    else:
-        print_summary(output, ("cases",), columns=SHOWN_COLUMNS)
-    print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}")
+    print_summary(output, ("cases",), args.quiet, columns=SHOWN_COLUMNS)
+    # with --quiet, stdout holds the JSON alone
+    print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}",
+          file=sys.stderr if args.quiet else sys.stdout)
     return 0

@@ -15,6 +15,11 @@ from pendular.studies.tradeoff import (OPTIONS, SeedStudy, study_of, write_seed_
 
 from pendular.cli import add_declared_options, declared_values
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular tradeoff --quick --out runs/tradeoff",
+           "speed against accuracy of each numerical setting on a small sample; tradeoff.json, "
+           "tradeoff.md")
+
 
 def add_arguments(parser):
     parser.add_argument("--out", required=True, help="output folder")

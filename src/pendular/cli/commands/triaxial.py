@@ -32,15 +32,24 @@ from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_devi
 from pendular.dem.simulation import check_device
 from pendular.procedures.triaxial import Interrupted, TriaxialTest
 
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular triaxial --particles 1000 --suction 30000 --confining 750 --out runs/wet",
+           "a wet drained triaxial compression at 30 kPa suction and 750 Pa confining stress: "
+           "the peak of q and its friction angles (net and effective), the critical state when "
+           "reached, in summary.json; q and the volumetric strain in triaxial.png")
+
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
 #: Summary keys printed at the end.
 SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
-         "phi_peak_deg", "peak_q_effective", "p_effective_at_peak", "phi_peak_effective_deg",
-         "peak_q_effective_complete", "p_effective_complete_at_peak", "mean_stress_deviation",
-         "b_deviation", "axial_contact_lost", "initial_porosity", "saturation_at_peak",
-         "suction_at_peak", "excess_pore_pressure_at_peak", "excess_pore_pressure_final",
-         "p_min", "max_volume_change", "suction_final", "saturation_final",
+         "principal_difference_at_peak", "phi_peak_deg", "peak_q_effective",
+         "p_effective_at_peak", "phi_peak_effective_deg", "peak_q_effective_complete",
+         "p_effective_complete_at_peak", "phi_cs_deg", "M_cs", "void_ratio_cs",
+         "critical_state_note", "phi_peak_note",
+         "mean_stress_deviation", "b_deviation", "axial_contact_lost", "initial_porosity",
+         "porosity_after_wetting", "saturation_at_peak", "suction_at_peak",
+         "excess_pore_pressure_at_peak", "excess_pore_pressure_final", "p_min",
+         "max_volume_change", "suction_final", "saturation_final",
          "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
 
 
@@ -124,7 +133,8 @@ def run_test(args, test, config_from, shown, add_arguments):
         print("note: q still rises at the end of the test (peak_reached false in "
               "summary.json): the values 'at peak' are those of the highest record; a larger "
               "--max-strain reaches the peak")
-    print(f"outputs in {out}")
+    # with --quiet, stdout holds the JSON alone
+    print(f"outputs in {out}", file=sys.stderr if args.quiet else sys.stdout)
     return 0
 
 
