@@ -6,6 +6,7 @@ import pytest
 
 from conftest import assert_drawn, refused, run_in_process, summary_of
 
+from pendular.io.schema import undeclared_keys
 from pendular.studies.envelope import mohr_coulomb_envelope
 
 TINY = ["--particles", "60", "--max-strain", "0.01", "--inertial-number", "2e-3",
@@ -35,6 +36,7 @@ def test_an_envelope_of_three_tests_is_fitted_drawn_and_its_tests_reused(tmp_pat
     assert summary["cohesion_error"] == fit.cohesion_error > 0
     assert summary["phi_effective_deg"] == summary["phi_deg"] and "effective_note" in summary
     assert summary["degrees_of_freedom"] == 1 and summary["units"]["cohesion"] == "Pa"
+    assert not undeclared_keys(summary, "envelope")
     for name in ("mohr_circles.png", "peaks_pq.png"):
         assert_drawn(out / name)
     assert (out / "campaign.csv").read_text().count("confining") >= 4

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from pendular.homogenize.invariants import deviator_stress, mean_stress
+from pendular.io.schema import undeclared_keys
 
 from conftest import ROOT, history_of, refused, run_in_process, summary_of
 
@@ -37,6 +38,7 @@ def test_an_undrained_triaxial_holds_its_volume_and_gives_the_excess_pore_pressu
     path = summary["effective_stress_path"]
     assert path["p"][0] == pytest.approx(p[0]) and path["q"][-1] == pytest.approx(q[-1])
     assert summary["units"]["excess_pore_pressure_at_peak"] == "Pa"
+    assert not undeclared_keys(summary, "triaxial")
     if wet:     # the water held: closed liquid, its balance, suction and Sr recorded
         assert summary["liquid_balance_error"] < 1e-9
         assert {"suction", "saturation", "liquid_bridges"} <= set(history)
@@ -69,6 +71,7 @@ suction = 30000
     assert (first["suction_before"], first["suction_after"]) == (30000.0, 10000.0)
     assert summary["collapse_strain"] == first["volumetric_strain_change"]
     assert summary["stages"][0]["saturation"] > summary["stages"][1]["saturation"]
+    assert not undeclared_keys(summary, "path")
 
     table = tmp_path / "water.toml"
     table.write_text("""
@@ -91,6 +94,7 @@ until = {strain = 0.005}
     volume = history["volumetric_strain"][shear]
     assert np.abs(volume - volume[0]).max() < 1e-6
     assert summary["liquid_balance_error"] < 1e-9
+    assert not undeclared_keys(summary, "path")
 
 
 @pytest.mark.parametrize("stage, wetting, words", [

@@ -152,6 +152,7 @@ def test_a_summary_of_peaks_on_known_envelopes_gives_them_back_and_draws_them(tm
     stresses and both figures."""
     from conftest import assert_drawn
 
+    from pendular.io.schema import undeclared_keys
     from pendular.studies.envelope import envelope_summary, peak_row
     from pendular.studies.envelope_figures import plot_mohr_circles, plot_peaks
 
@@ -180,5 +181,6 @@ def test_a_summary_of_peaks_on_known_envelopes_gives_them_back_and_draws_them(tm
     assert test["sigma_1_at_peak"] - test["sigma_3_at_peak"] == pytest.approx(test["peak_q"])
     assert summary["units"]["tests"]["sigma_1_at_peak"] == "Pa"
     assert summary["units"]["phi_effective_error_deg"] == "deg"
+    assert not undeclared_keys(summary, "envelope")
     for draw, name in ((plot_mohr_circles, "mohr.png"), (plot_peaks, "pq.png")):
         assert_drawn(draw(str(tmp_path / name), summary))

@@ -14,7 +14,8 @@ from conftest import ROOT
 from pendular.io.schema import HISTORY_COLUMNS, SUMMARY_KEYS, SUMMARY_UNITS, undeclared_keys
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.cyclic import cyclic_summary
-from pendular.procedures.loading import isotropic_summary, oedometer_summary, path_deviations
+from pendular.procedures.loading import (Stage, Strain, excess_pore_pressure,
+    isotropic_summary, oedometer_summary, path_deviations, undrained_summary)
 from pendular.procedures.path_table import path_summary
 from pendular.procedures.simple_shear import simple_shear_summary
 from pendular.procedures.triaxial import stress_balance, summarize
@@ -104,6 +105,35 @@ def test_the_cyclic_and_simple_shear_summaries_write_declared_keys(wet):
         assert_declared(summary, "simple-shear")
         assert summary["shear_stress_at_peak"] == pytest.approx(
             summary["peak_stress_ratio"] * summary["normal_stress_at_peak"])
+
+
+@pytest.mark.parametrize("wet", [False, True])
+def test_the_undrained_summary_writes_declared_keys(wet):
+    found = shear(wet)
+    found["excess_pore_pressure"] = excess_pore_pressure(found["sigma_wall"])
+    summary = summarize(found, "compression")
+    summary.update(undrained_summary(found, summary["peak_index"]))
+    assert ("suction_final" in summary) == wet
+    assert_declared(summary, "triaxial")
+
+
+@pytest.mark.parametrize("water", ["suction", "water_content"])
+def test_a_path_changing_its_water_writes_declared_keys(water):
+    """A path held at 750 Pa, wetted (the suction lowered, or the water content raised: the
+    stage's in %, the history's a fraction), then sheared."""
+    held = {axis: 750.0 for axis in "xyz"}
+    before, after, given = (3e4, 1e4, 1e4) if water == "suction" else (0.05, 0.08, 8.0)
+    stages = [Stage(stress=held), Stage(stress=held, **{water: given}),
+              Stage(stress={"x": 750.0, "y": 750.0}, strain_rate={"z": 1.0},
+                    until=Strain(0.2))]
+    stage = np.repeat([0, 1, 2], [60, 60, 80])
+    path = shear(wet=True)
+    path.update(stage=stage, void_ratio=np.linspace(0.7, 0.6, ROWS),
+                **{water: np.where(stage == 0, before, after)})
+    summary = path_summary(path, len(stages), stages)
+    assert [row["stage"] for row in summary["water_stages"]] == [1]
+    assert "collapse_strain" in summary and "collapse_axial_strain" in summary
+    assert_declared(summary, "path")
 
 
 def test_an_undeclared_key_or_field_is_named():
