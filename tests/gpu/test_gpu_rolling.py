@@ -9,6 +9,8 @@ Measured (simulator, 27 spheres, 200 steps, 6 rebuilds, 49 touching pairs): larg
 differences from the CPU 1.3e-15 in positions, 1.0e-12 in angular velocities, 1.5e-12 in
 torques, 1.5e-13 in the rolling springs, 1.6e-13 in the twisting springs, 1.8e-13 in the
 pairs' moments (the simulator does not contract multiply-adds as the CPU's hot kernels do).
+In the cell (64 spheres, 100 steps, 185 touching pairs): 5.8e-16 in unwrapped positions,
+2.6e-13 in angular velocities, 7.3e-14 and 1.2e-13 in the rolling and twisting springs.
 """
 
 import json

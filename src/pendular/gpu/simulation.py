@@ -33,9 +33,9 @@ SuctionBridges at contact or across gaps (``persist``; a new suction between run
 CPU: GpuSimulation._follow_suction); controls StressServo, ConstantStrainRate, MixedStress
 (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip
 after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not)
-with ContactForces, RollingResistance and, wet, SuctionBridges at contact or across gaps or VolumeBridges, under
-StressServo, ConstantStrainRate, ConstantShearRate (simple shear, Lees–Edwards) and
-MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
+with ContactForces, RollingResistance and, wet, SuctionBridges at contact or across gaps or
+VolumeBridges, under StressServo, ConstantStrainRate, ConstantShearRate (simple shear,
+Lees–Edwards) and MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
 cell's faces at a rebuild (as far as the bridges' rupture range), reduces the cell's stress
 (with the face terms of the forces of bridges across gaps), runs its controls and a leapfrog
 carried by its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a
@@ -100,7 +100,7 @@ def check_scene(sim):
             raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
                              "(valid: ContactForces, WallForces, SuctionBridges, "
                              "VolumeBridges, RollingResistance, Gravity)")
-    _one(sim, Gravity, required=False)
+    _one(sim, Gravity, required=False)             # at most one of each
     resistance = _one(sim, RollingResistance, required=False)
     if resistance is not None and sim.forces.index(resistance) < sim.forces.index(
             _one(sim, ContactForces)):
