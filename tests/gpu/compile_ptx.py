@@ -1,5 +1,5 @@
 """Compile every kernel of a dry and a wet step (and a radius growth's, a periodic cell's
-dry and wet, a simple shear's, and the grips') for a real GPU (PTX,
+dry and wet, a simple shear's, the grips', the rolling resistance's and gravity's) for a real GPU (PTX,
 by default for compute capability 9.0, an H100) without one, as a script in its own process:
 the simulator runs kernels as Python and would not see code that the CUDA target cannot
 compile (a NumPy ufunc, a global it cannot type).
@@ -78,18 +78,21 @@ def compile_step_kernels(cuda, capability):
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
     # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene), those
     # of a dry and a wet step in a periodic cell (test_gpu_periodic.py's), of a simple shear
-    # (test_gpu_shear.py's), the grips' (test_gpu_grips.py's) and volume-controlled bridges'
-    # liquid exchange (test_gpu_volume.py's)
+    # (test_gpu_shear.py's), the grips' (test_gpu_grips.py's), volume-controlled bridges'
+    # liquid exchange (test_gpu_volume.py's), the rolling resistance and gravity
+    # (test_gpu_rolling.py's)
     from test_gpu_grips import scene as grips_scene
     from test_gpu_growth import scene as growth_scene
     from test_gpu_periodic import scene as periodic_scene
+    from test_gpu_rolling import scene as rolling_scene
     from test_gpu_shear import scene as shear_scene
     from test_gpu_volume import scene as volume_scene
 
     for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
                        (periodic_scene(wet=True), " periodic wet"),
                        (shear_scene(), " sheared"),
-                       (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume")):
+                       (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume"),
+                       (rolling_scene(), "")):
         gpu = GpuSimulation(sim)
         gpu._configure()
         for kernel, _, args in gpu._steps:

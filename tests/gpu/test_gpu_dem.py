@@ -95,8 +95,8 @@ def compile_ptx(*arguments):
 
 
 def test_every_kernel_compiles_for_a_gpu():
-    """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic
-    (tests/gpu/compile_ptx.py),
+    """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic, with
+    the rolling resistance and gravity (tests/gpu/compile_ptx.py),
     where a CUDA compiler is installed (the gpu extra installs one): the simulator would run
     code that the CUDA target rejects."""
     done = compile_ptx()
@@ -109,10 +109,11 @@ def test_every_kernel_compiles_for_a_gpu():
                "homogenize_partials", "sum_columns")
     growth = ("grow", "mark_rebuild", "grown_beyond")
     grips = ("grip_partials", "grip_hold")
+    resisting = ("pair_moments", "gather_moments", "add_weight")
     periodic = ("bin_periodic", "find_periodic_pairs", "cell_partials", "cell_controls",
                 "cell_leapfrog")
     assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth,
-                                        *grips,
+                                        *grips, *resisting,
                                         *(f"{name} periodic" for name in periodic),
                                         *(f"{name} periodic wet" for name in periodic),
                                         *(f"{name} sheared" for name in (*periodic,

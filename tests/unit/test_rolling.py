@@ -20,8 +20,7 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.gravity import Gravity
-from pendular.procedures.preparation import (PrepareConfig, check_engine, random_cloud,
-    servoed_simulation)
+from pendular.procedures.preparation import PrepareConfig, random_cloud, servoed_simulation
 
 OVERLAP = 1e-5                                  # [m], 0.01 R
 REDUCED = 0.5 * RADIUS                          # R* of two equal spheres [m]
@@ -250,15 +249,6 @@ def test_a_loaded_sample_gets_the_resistance_and_the_weight_and_a_plain_one_neit
         kinds[name] = [type(op) for op in sim.forces]
     assert kinds["plain"] == [ContactForces, WallForces]
     assert kinds["resisting"] == [ContactForces, WallForces, Gravity, RollingResistance]
-
-
-def test_the_gpu_engine_is_refused_the_forces_it_does_not_run_naming_them():
-    config = PrepareConfig(particles=30, rolling_friction=0.2, gravity=9.81)
-    with pytest.raises(ValueError, match="--device gpu does not run --rolling-friction, "
-                                         "--gravity"):
-        check_engine(config, "gpu")
-    check_engine(config, "cpu")
-    check_engine(PrepareConfig(particles=30), "gpu")
 
 
 def test_a_capillary_bridge_does_not_raise_the_limit_moment():

@@ -15,12 +15,19 @@ from pendular.utils.validate import check_range
 MAX_GRAVITY = 1000.0
 
 
+@numba.njit(cache=True, inline="always")
+def _add_particle_weight(p, force, mass, gravity):
+    """Subtract particle p's weight m g [N] from the z component of its ``force`` (N, 3)
+    (the body of add_weight and of the device's, pendular.gpu.gravity)."""
+    force[p, 2] -= mass[p] * gravity
+
+
 @numba.njit(cache=True)
 def add_weight(force, mass, gravity):
     """Subtract m g [N] from the z component of each particle's ``force`` (N, 3); ``mass``
     (N,) [kg], ``gravity`` [m/s^2]."""
     for p in range(len(mass)):
-        force[p, 2] -= mass[p] * gravity
+        _add_particle_weight(p, force, mass, gravity)
 
 
 class Gravity:

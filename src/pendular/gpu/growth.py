@@ -98,21 +98,24 @@ class DeviceGrowth:
             return None
         return cls(controls)
 
-    def grown_state(self, sim, skin, wet):
+    def grown_state(self, sim, skin, wet, resisting=False):
         """DeviceState of ``sim`` whose grid cells and rows hold the neighbours of the
         largest radii the growth may reach (growth_factor_bound), with the radii, masses and
-        inertias of now and the host's list (its per-pair state) in those rows."""
+        inertias of now and the host's list (its per-pair state) in those rows; ``wet``,
+        ``resisting`` as DeviceState's."""
         p = sim.particles
         bound = growth_factor_bound(p, sim.walls)
         grown = Particles(p.position, p.radius * bound, p.density, velocity=p.velocity,
                           angular_velocity=p.angular_velocity)
         state = DeviceState(types.SimpleNamespace(particles=grown, walls=sim.walls,
-                                                  contacts=None), skin, wet)
+                                                  contacts=None), skin, wet,
+                            resisting=resisting)
         for name in ("radius", "mass", "inertia"):
             setattr(state, name, cuda.to_device(np.ascontiguousarray(getattr(p, name))))
         if sim.contacts is not None and len(sim.contacts):
             rows = state._host_rows(sim.contacts, state.count)
-            for name in ("pair_count", "pair_j", "shear_force", "normal", "overlap", "bridges"):
+            for name in ("pair_count", "pair_j", "shear_force", "normal", "overlap", "bridges",
+                         "rolling"):
                 setattr(state, name, cuda.to_device(rows[name]))
         self.reference_radius = cuda.to_device(np.ascontiguousarray(p.radius))
         return state

@@ -126,13 +126,14 @@ def carry(old, new, source, k, fill):
 @cuda.jit
 def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_count,
                cell_members, cell_width, cell_of, width, pair_count, pair_j, new_count,
-               new_pair_j, lower_count, lower, shear_force, normal, overlap, bridges,
-               new_shear_force, new_normal, new_overlap, new_bridges, flags):
+               new_pair_j, lower_count, lower, shear_force, normal, overlap, bridges, rolling,
+               new_shear_force, new_normal, new_overlap, new_bridges, new_rolling, flags):
     """Particle p's neighbours within r_p + r_q + skin from the 27 cells around its own:
     those above p into its new row, those below into ``lower`` (both sorted); then the per-pair
     state of the new row from the same (p, j) pairs of the old one (the CPU's
     previous_pair_index and carry_pair_array): shear force, normal, overlap (-inf: never
-    touched) and the bridges' (K, C) values (state, volume, force, filling angles; zeros)."""
+    touched), the bridges' (K, C) values (state, volume, force, filling angles; zeros) and
+    the rolling resistance's springs (K, C) (pendular.gpu.rolling; zeros)."""
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -156,14 +157,14 @@ def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_
                         else:
                             below = insert_sorted(lower, p, n, below, width, q, flags)
     carry_rows(p, n, min(above, width), min(below, width), new_count, lower_count, pair_count,
-               pair_j, new_pair_j, shear_force, normal, overlap, bridges, new_shear_force,
-               new_normal, new_overlap, new_bridges)
+               pair_j, new_pair_j, shear_force, normal, overlap, bridges, rolling,
+               new_shear_force, new_normal, new_overlap, new_bridges, new_rolling)
 
 
 @device
 def carry_rows(p, n, above, below, new_count, lower_count, pair_count, pair_j, new_pair_j,
-               shear_force, normal, overlap, bridges, new_shear_force, new_normal, new_overlap,
-               new_bridges):
+               shear_force, normal, overlap, bridges, rolling, new_shear_force, new_normal,
+               new_overlap, new_bridges, new_rolling):
     """Close particle p's new rows: ``above`` pairs j > p and ``below`` j < p listed (counts
     within the rows' width), and the per-pair state of the new row from the same (p, j) pairs
     of its old one (find_pairs)."""
@@ -181,6 +182,8 @@ def carry_rows(p, n, above, below, new_count, lower_count, pair_count, pair_j, n
         new_overlap[k] = overlap[source] if source >= 0 else -math.inf
         if bridges.shape[0] == overlap.shape[0]:        # a wet scene
             carry(bridges, new_bridges, source, k, 0.0)
+        if rolling.shape[0] == overlap.shape[0]:        # a rolling resistance
+            carry(rolling, new_rolling, source, k, 0.0)
 
 
 @device
@@ -192,10 +195,10 @@ def copy_row(new, current, k):
 
 @cuda.jit
 def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shear_force,
-                   new_normal, new_overlap, new_bridges, pair_count, pair_j, second_count,
-                   second_pair, shear_force, normal, overlap, bridges, normal_force, force,
-                   reference_position, wall_position, reference_walls, cell_count, cell_of,
-                   flags, rebuilds):
+                   new_normal, new_overlap, new_bridges, new_rolling, pair_count, pair_j,
+                   second_count, second_pair, shear_force, normal, overlap, bridges, rolling,
+                   normal_force, force, reference_position, wall_position, reference_walls,
+                   cell_count, cell_of, flags, rebuilds):
     """Make the new rows the list: counts, neighbours and carried state (force and normal
     force zero, as a new CPU list's), the transposed index (for each q below p, the slot of p
     in q's row), the reference positions and walls of the displacement test; empty the cells
@@ -216,6 +219,8 @@ def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shea
         copy_row(new_normal, normal, k)
         if bridges.shape[0] == overlap.shape[0]:
             copy_row(new_bridges, bridges, k)
+        if rolling.shape[0] == overlap.shape[0]:
+            copy_row(new_rolling, rolling, k)
     second_count[p] = lower_count[p]
     for s in range(lower_count[p]):
         q = lower[s * n + p]
@@ -342,8 +347,8 @@ def insert_with_image(row, image, p, n, found, width, q, sx, sy, sz, flags):
 def find_periodic_pairs(position, radius, skin, cell_position, period, cell_size, max_dims,
                         cell_count, cell_members, cell_width, cell_of, width, pair_count,
                         pair_j, new_count, new_pair_j, image, lower_count, lower, shear_force,
-                        normal, overlap, bridges, new_shear_force, new_normal, new_overlap,
-                        new_bridges, flags):
+                        normal, overlap, bridges, rolling, new_shear_force, new_normal,
+                        new_overlap, new_bridges, new_rolling, flags):
     """find_pairs in a periodic cell: particle p's neighbours through the nearest image from
     the 27 cells around its own, wrapped across the faces (the CPU's _periodic_neighbors_of:
     in a sheared cell, ``period`` (4,), the rows through a z face around p's x less their
@@ -388,8 +393,8 @@ def find_periodic_pairs(position, radius, skin, cell_position, period, cell_size
                         else:
                             below = insert_sorted(lower, p, n, below, width, q, flags)
     carry_rows(p, n, min(above, width), min(below, width), new_count, lower_count, pair_count,
-               pair_j, new_pair_j, shear_force, normal, overlap, bridges, new_shear_force,
-               new_normal, new_overlap, new_bridges)
+               pair_j, new_pair_j, shear_force, normal, overlap, bridges, rolling,
+               new_shear_force, new_normal, new_overlap, new_bridges, new_rolling)
 
 
 @cuda.jit

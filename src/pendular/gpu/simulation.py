@@ -6,6 +6,8 @@ CPU pipeline (pendular.dem.simulation) on the device::
     bin_particles, find_pairs, finish_rebuild   neighbour list (only when a rebuild is due)
     pair_forces                                 contact law (+ bridges, wet)
     gather                                      forces and torques per particle (+ walls)
+    pair_moments, gather_moments                rolling resistance (its moments on torques)
+    add_weight                                  gravity
     wall_partials, wall_sums, wall_controls     walls' force, stiffness, moment; controls
     grip_partials, grip_hold                    grips: their pulls, members on their walls
     leapfrog                                    integrator (+ the rebuild test)
@@ -25,14 +27,15 @@ stresses, as the CPU does. When a target falls below zero the device records it 
 raises the CPU's StageFailed at its next check or, earlier, when anything reads the state
 (``copy_back``), so that no writer records a state past the failure.
 
-What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces and,
-wet, SuctionBridges at contact or across gaps (``persist``; a new suction between runs, as the
+What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces,
+RollingResistance (pendular.gpu.rolling), Gravity (pendular.gpu.gravity) and, wet,
+SuctionBridges at contact or across gaps (``persist``; a new suction between runs, as the
 CPU: GpuSimulation._follow_suction); controls StressServo, ConstantStrainRate, MixedStress
 (its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip
 after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not)
-with ContactForces and, wet, SuctionBridges at contact or across gaps or VolumeBridges, under
-StressServo, ConstantStrainRate, ConstantShearRate (simple shear, Lees–Edwards) and
-MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
+with ContactForces, RollingResistance and, wet, SuctionBridges at contact or across gaps or
+VolumeBridges, under StressServo, ConstantStrainRate, ConstantShearRate (simple shear,
+Lees–Edwards) and MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
 cell's faces at a rebuild (as far as the bridges' rupture range), reduces the cell's stress
 (with the face terms of the forces of bridges across gaps), runs its controls and a leapfrog
 carried by its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a
@@ -45,14 +48,17 @@ import numpy as np
 from pendular.capillary.bridges import CapillaryBridges, SuctionBridges, VolumeBridges
 from pendular.dem.cell import ConstantShearRate, PeriodicCell
 from pendular.dem.contact_law import ContactForces
+from pendular.dem.gravity import Gravity
 from pendular.dem.grips import Grip
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.mixed_stress import MixedStress
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
+from pendular.dem.rolling import RollingResistance
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
-from pendular.gpu import cell as device_cell, forces, integrate, neighbors, walls as device_walls
+from pendular.gpu import (cell as device_cell, forces, gravity as device_gravity, integrate,
+    neighbors, rolling as device_rolling, walls as device_walls)
 from pendular.gpu.cuda import configured, cuda, simulated
 from pendular.gpu.grips import DeviceGrips, check_grips
 from pendular.gpu.growth import DeviceGrowth
@@ -89,10 +95,17 @@ def check_scene(sim):
     if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
-        if type(op) not in (ContactForces, WallForces, SuctionBridges, VolumeBridges):
+        if type(op) not in (ContactForces, WallForces, SuctionBridges, VolumeBridges,
+                            RollingResistance, Gravity):
             raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
                              "(valid: ContactForces, WallForces, SuctionBridges, "
-                             "VolumeBridges)")
+                             "VolumeBridges, RollingResistance, Gravity)")
+    _one(sim, Gravity, required=False)             # at most one of each
+    resistance = _one(sim, RollingResistance, required=False)
+    if resistance is not None and sim.forces.index(resistance) < sim.forces.index(
+            _one(sim, ContactForces)):
+        raise ValueError("device='gpu' runs a RollingResistance listed after the contact law "
+                         "only (it reads the contact law's pairs of the same step)")
     bridges = _bridges_of(sim)
     if bridges is not None and bridges.persist:
         _check_persist(sim, bridges)
@@ -143,9 +156,9 @@ def _check_periodic(sim, cell):
     cell, ConstantShearRate, MixedStress and a radius growth in a fixed cell run:
     pendular.gpu.cell)."""
     for op in sim.forces:
-        if type(op) is WallForces:
-            raise ValueError("device='gpu' runs a periodic cell without WallForces (it has no "
-                             "walls)")
+        if type(op) in (WallForces, Gravity):
+            raise ValueError(f"device='gpu' runs a periodic cell without {type(op).__name__} "
+                             "(it has no walls)")
     controls = sim.peek("controls")
     for op in controls:
         if type(op) not in (StressServo, ConstantStrainRate, ConstantShearRate, RadiusGrowth) \
@@ -202,10 +215,13 @@ class GpuSimulation:
                     else np.zeros(count))
         self._growth = DeviceGrowth.of(tuple(sim.controls))
         persist = bridges is not None and bridges.persist
+        self._resistance = _one(sim, RollingResistance, required=False)
+        resisting = self._resistance is not None
         self.state = (DeviceState(sim, sim.neighbors.skin, bridges is not None, reach, persist,
-                                  film)
+                                  film, resisting)
                       if self._growth is None else
-                      self._growth.grown_state(sim, sim.neighbors.skin, bridges is not None))
+                      self._growth.grown_state(sim, sim.neighbors.skin, bridges is not None,
+                                               resisting))
         self._controls = tuple(sim.controls)
         self._mixed = tuple(c for c, op in enumerate(self._controls)
                             if isinstance(op, MixedStress))
@@ -382,7 +398,8 @@ class GpuSimulation:
     def _force_steps(self, image, period, affine_rate, walls_first, wall_young):
         """(kernel, items, arguments) of the pair forces and their gather (walls' springs of
         stiffness ``wall_young`` [Pa] E R, 0: none; images ``image``, ``period`` and
-        stretching ``affine_rate``: pendular.gpu.forces.pair_forces)."""
+        stretching ``affine_rate``: pendular.gpu.forces.pair_forces), then the rolling
+        resistance and the weight, if the scene has them."""
         sim = self.sim
         s = self.state
         n = s.count
@@ -394,6 +411,7 @@ class GpuSimulation:
         bridges = self._bridges
         volume = self._volume_control
         liquid = (bridges.roughness, bridges.closed) if volume else (0.0, False)
+        gravity = _one(sim, Gravity, required=False)
         return [
             (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
                                      s.pair_count, s.pair_i, s.pair_j, image, period,
@@ -410,6 +428,9 @@ class GpuSimulation:
                                 s.second_pair, s.pair_force, s.normal, s.overlap, joined,
                                 columns[2], walls_first, s.wall_position, wall_young,
                                 s.persist, s.bridge_pair_force, s.force, s.torque)),
+            *(device_rolling.launches(self._resistance, s, sim.dt)
+              if self._resistance is not None else ()),
+            *(device_gravity.launches(gravity, s) if gravity is not None else ()),
         ]
 
     def _exchange_step(self):
@@ -428,9 +449,10 @@ class GpuSimulation:
         s = self.state
         return (neighbors.finish_rebuild, s.count,
                 (s.position, s.new_count, s.new_pair_j, s.lower_count, s.lower,
-                 s.new_shear_force, s.new_normal, s.new_overlap, s.new_bridges, s.pair_count,
-                 s.pair_j, s.second_count, s.second_pair, s.shear_force, s.normal, s.overlap,
-                 s.bridges, s.normal_force, s.pair_force, s.reference_position,
+                 s.new_shear_force, s.new_normal, s.new_overlap, s.new_bridges, s.new_rolling,
+                 s.pair_count, s.pair_j, s.second_count, s.second_pair, s.shear_force,
+                 s.normal, s.overlap, s.bridges, s.rolling, s.normal_force, s.pair_force,
+                 s.reference_position,
                  s.wall_position, s.reference_walls, s.cell_count, s.cell_of, s.flags,
                  s.rebuilds))
 
@@ -456,8 +478,9 @@ class GpuSimulation:
              (s.position, s.radius, s.skin + s.reach, s.wall_position, s.period, s.cell_size,
               s.max_dims, s.cell_count, s.cell_members, s.cell_width, s.cell_of, s.width,
               s.pair_count, s.pair_j, s.new_count, s.new_pair_j, s.image, s.lower_count,
-              s.lower, s.shear_force, s.normal, s.overlap, bridges, s.new_shear_force,
-              s.new_normal, s.new_overlap, s.new_bridges, s.flags)),
+              s.lower, s.shear_force, s.normal, s.overlap, bridges, s.rolling,
+              s.new_shear_force, s.new_normal, s.new_overlap, s.new_bridges, s.new_rolling,
+              s.flags)),
             self._finish_step(),
             *([(neighbors.shear_rebuilt, 1, (s.period, s.shear, s.flags))] if sheared else []),
             *self._force_steps(s.image, s.period, s.affine_rate, False, 0.0),
@@ -499,8 +522,9 @@ class GpuSimulation:
                                        s.cell_members, s.cell_width, s.cell_of, s.width,
                                        s.pair_count, s.pair_j, s.new_count, s.new_pair_j,
                                        s.lower_count, s.lower, s.shear_force, s.normal,
-                                       s.overlap, bridges, s.new_shear_force, s.new_normal,
-                                       s.new_overlap, s.new_bridges, s.flags)),
+                                       s.overlap, bridges, s.rolling, s.new_shear_force,
+                                       s.new_normal, s.new_overlap, s.new_bridges,
+                                       s.new_rolling, s.flags)),
             self._finish_step(),
             *self._force_steps(s.no_image, s.no_period, s.no_period, walls_first,
                                wall_law.young),
@@ -637,6 +661,8 @@ class GpuSimulation:
                                     sim.contacts.pair_j)
         sim.contacts.force = carry_pair_array(listed.force, index)
         sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
+        if self._resistance is not None:
+            self._resistance.moment = carry_pair_array(self.state.pair_moments(), index)
         if self.state.persist:
             self._persisting_to_host(sim, index)
         if self._growth is not None:

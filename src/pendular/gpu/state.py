@@ -14,7 +14,9 @@ skin (their rupture range, the CPU's interaction_range). Volume control's liquid
 (pendular.capillary.bridge_kernels.LiquidExchange): ``film`` (N,) [m^3] on each grain, per
 pair ``released`` [m^3] and ``events`` (int8, cleared by each step's exchange: not carried
 across rebuilds, as the CPU's fresh arrays after one), ``marked`` (1,) the events of the step,
-``liquid_lost`` (1,) [m^3].
+``liquid_lost`` (1,) [m^3]. A rolling resistance's springs (``rolling``: the per-pair state
+of pendular.dem.rolling, carried as the bridges' columns) and its pair moments
+(pendular.gpu.rolling).
 """
 
 import math
@@ -25,6 +27,7 @@ from pendular.capillary.bridge_state import FIELDS, OWNER
 from pendular.dem.neighbors import Contacts, build_pairs, build_periodic_pairs, second_index
 from pendular.dem.protocols import pair_key
 from pendular.gpu.cell import CELL_SUMS
+from pendular.gpu import rolling as device_rolling
 from pendular.gpu.cuda import cuda
 from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS
 
@@ -75,15 +78,16 @@ class DeviceState:
     """Device arrays of a scene (attributes named as on the host; a periodic cell's faces in
     ``wall_position``, its other state in the ``cell_`` arrays, ``period``, ``affine_rate``,
     ``wraps`` and the pairs' ``image``: pendular.gpu.cell). ``to_host`` writes them back into
-    the Simulation."""
+    the Simulation. ``resisting``: whether the pairs keep a rolling resistance's springs."""
 
-    def __init__(self, sim, skin, wet, reach=0.0, persist=False, film=None):
+    def __init__(self, sim, skin, wet, reach=0.0, persist=False, film=None, resisting=False):
         p = sim.particles
         walls = sim.walls
         count = len(p)
         self.count = count
         self.skin = skin
         self.wet = wet
+        self.resisting = resisting
         self.persist = persist
         self.reach = reach
         self.periodic = walls.periodic
@@ -124,6 +128,7 @@ class DeviceState:
         self.normal = to(rows["normal"])
         self.overlap = to(rows["overlap"])
         self.bridges = to(rows["bridges"])
+        self.rolling = to(rows["rolling"])
         self.image = to(rows["image"])
         # each slot's first member (k = s * N + p: p), which the CPU's bridge law reads as
         # pair_i when a bridge forms (pendular.gpu.forces.pair_forces); wet scenes only
@@ -143,6 +148,7 @@ class DeviceState:
         self.liquid_lost = to(np.zeros(1))
         self.normal_force = to(np.zeros(pairs))
         self.pair_force = to(np.zeros((pairs, 3)))
+        self.pair_moment = to(np.zeros((pairs if resisting else 1, 3)))
         self.second_count = to(np.zeros(count, np.int32))
         self.second_pair = to(np.zeros(pairs, np.int32))
         # the list being built at a rebuild
@@ -154,6 +160,7 @@ class DeviceState:
         self.new_normal = to(np.zeros((pairs, 3)))
         self.new_overlap = to(np.zeros(pairs))
         self.new_bridges = to(np.zeros(rows["bridges"].shape))
+        self.new_rolling = to(np.zeros(rows["rolling"].shape))
         self.flags = to(np.array([1, 0, 0], np.int32))
         self.rebuilds = to(np.zeros(1, np.int64))
 
@@ -177,6 +184,7 @@ class DeviceState:
         """The host's list (or none) as device rows: counts, neighbours and per-pair state."""
         width = self.width
         bridge_rows = width * count if self.wet else 1
+        rolling = np.zeros((width * count if self.resisting else 1, device_rolling.COLUMNS))
         if contacts is None or len(contacts) == 0:
             return {"pair_count": np.zeros(count, np.int32),
                     "pair_j": np.zeros(width * count, np.int32),
@@ -184,6 +192,7 @@ class DeviceState:
                     "normal": np.zeros((width * count, 3)),
                     "overlap": np.full(width * count, -np.inf),
                     "bridges": np.zeros((bridge_rows, len(BRIDGE_COLUMNS))),
+                    "rolling": rolling,
                     "image": np.zeros((width * count if self.periodic else 1, 3), np.int8)}
         counts = np.diff(contacts.row_start)
         slots = (np.arange(len(contacts)) - contacts.row_start[contacts.pair_i]) * count \
@@ -193,12 +202,15 @@ class DeviceState:
             columns = np.stack([contacts.extra[pair_key(OWNER, field)].astype(np.float64)
                                 for field in FIELDS], axis=1)
             bridges = _to_ell(columns, slots, count, width, 0.0)
+        if self.resisting:
+            rolling = _to_ell(device_rolling.host_columns(contacts), slots, count, width, 0.0)
         return {"pair_count": counts.astype(np.int32),
                 "pair_j": _to_ell(contacts.pair_j.astype(np.int32), slots, count, width, 0),
                 "shear_force": _to_ell(contacts.shear_force, slots, count, width, 0.0),
                 "normal": _to_ell(contacts.normal, slots, count, width, 0.0),
                 "overlap": _to_ell(contacts.overlap, slots, count, width, -np.inf),
                 "bridges": bridges,
+                "rolling": rolling,
                 "image": (_to_ell(contacts.image, slots, count, width, 0) if self.periodic
                           else np.zeros((1, 3), np.int8))}
 
@@ -220,6 +232,11 @@ class DeviceState:
         order of ``contacts()``."""
         return self.bridge_pair_force.copy_to_host()[self._slots()[2]]
 
+    def pair_moments(self):
+        """The rolling resistance's pair moments (K, 3) [N m] of the device's list, in the
+        order of ``contacts()``."""
+        return self.pair_moment.copy_to_host()[self._slots()[2]]
+
     def contacts(self):
         """The device's neighbour list and per-pair state as a host Contacts (CSR order)."""
         count = self.count
@@ -231,6 +248,8 @@ class DeviceState:
             bridges = self.bridges.copy_to_host()[slots]
             for column, field in enumerate(FIELDS):
                 extra[pair_key(OWNER, field)] = bridges[:, column].astype(field.dtype)
+        if self.resisting:
+            extra.update(device_rolling.host_fields(self.rolling.copy_to_host()[slots]))
         return Contacts(pair_i=pair_i, pair_j=pair_j, row_start=row_start,
                         second_start=second_start, second_pair=second_pair,
                         shear_force=self.shear_force.copy_to_host()[slots],

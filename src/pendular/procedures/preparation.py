@@ -450,20 +450,6 @@ def resisting(config):
     return []
 
 
-#: The sample's forces that the CPU engine alone runs, by PrepareConfig field.
-CPU_ONLY = ("rolling_friction", "twisting_friction", "gravity")
-
-
-def check_engine(config, device):
-    """ValueError naming --device and the options when ``device`` is not "cpu" and
-    ``config`` (a PrepareConfig) asks for a force that only the CPU engine runs (CPU_ONLY
-    above 0), before anything runs."""
-    asked = [spec_of(config, name).flag for name in CPU_ONLY if getattr(config, name) > 0.0]
-    if device != "cpu" and asked:
-        raise ValueError(f"--device {device} does not run {', '.join(asked)} yet (the CPU "
-                         f"engine alone has them): leave them at 0 or run on --device cpu")
-
-
 def servoed_simulation(particles, walls, config, target, threads=None):
     """A static sample's simulation: dry scene at the test friction, six walls servoed at
     ``target`` [Pa]. Used to continue from a saved sample."""

@@ -42,7 +42,7 @@ from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
 from pendular.utils.parameters import fail, flat_options
 from pendular.dem.measure import coordination, porosity, unbalanced_force
-from pendular.procedures.preparation import (PREPARATION_PHASES, check_engine, prepare_sample,
+from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
     pwave_step, servoed_simulation, static, timestep, timestep_description)
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
@@ -607,7 +607,6 @@ class LaboratoryTest:
         the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
         the configuration."""
         check_device(device)
-        check_engine(self.config.sample, device)
         check_stages_device(self.stages(), device)
         if vtk_prep is not True and vtk_prep is not False:
             vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
@@ -679,7 +678,6 @@ class LaboratoryTest:
                 raise ValueError(f"resume = {out!r} holds a run of another test "
                                  f"({type(config).__name__}), not of pendular {cls.NAME}")
             check_device(device)
-            check_engine(config.sample, device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
