@@ -57,6 +57,8 @@ class PoreUnits:
     throat_radius: (M, 4) [m] of the face opposite each vertex.
     throat_units: (T, 2) the two units of each throat (the second -1 on the hull), first < second.
     throat_of: (M, 4) the throat across the face opposite each vertex.
+    throat_shift: (T, 3) int, the periods between the throat's face as the second unit sees it
+    and as the first does (zero without a period; zero on the hull).
     period: (3,) [m] the periodic cell's lengths, or None (walls: the hull of the centres).
     """
 
@@ -71,6 +73,7 @@ class PoreUnits:
     throat_radius: np.ndarray
     throat_units: np.ndarray
     throat_of: np.ndarray
+    throat_shift: np.ndarray
     period: np.ndarray | None
 
     @property
@@ -215,6 +218,22 @@ def _throats(neighbours):
     return throat_units, number.reshape(-1, 4)
 
 
+def _throat_shift(vertices, throat_units, throat_of, period):
+    """(T, 3) int periods from the first unit's copy of each throat's face to the second's."""
+    shift = np.zeros((len(throat_units), 3), np.int64)
+    if period is None:
+        return shift
+    face_centre = vertices[:, FACES].mean(axis=2)  # (M, 4, 3)
+    unit, face = np.divmod(np.arange(throat_of.size), 4)
+    throat = throat_of.ravel()
+    second = throat_units[throat, 1] == unit
+    first_centre = np.empty((len(throat_units), 3))
+    first_centre[throat[~second]] = face_centre[unit[~second], face[~second]]
+    shift[throat[second]] = np.rint((face_centre[unit[second], face[second]]
+                                     - first_centre[throat[second]]) / period).astype(np.int64)
+    return shift
+
+
 def decompose(position, radius, period=None):
     """Pore units of spheres at ``position`` (N, 3) [m] with ``radius`` (N,) [m].
 
@@ -238,10 +257,11 @@ def decompose(position, radius, period=None):
         grains, vertices, neighbours = _periodic_units(position, radius, period_array)
     volume, omega, pore, area, protrudes, throat = _unit_geometry(vertices, radius[grains])
     throat_units, throat_of = _throats(neighbours)
+    shift = _throat_shift(vertices, throat_units, throat_of, period_array)
     return PoreUnits(grains=grains, vertices=vertices, neighbours=neighbours, volume=volume,
                      pore_volume=pore, solid_angle=omega, grain_area=area, protrudes=protrudes,
                      throat_radius=throat, throat_units=throat_units, throat_of=throat_of,
-                     period=period_array)
+                     throat_shift=shift, period=period_array)
 
 
 def _delaunay(points):
