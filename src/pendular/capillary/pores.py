@@ -348,5 +348,9 @@ def _circumspheres(corners):
     corners, its neighbours' circumsphere being the one that bounds it."""
     edges = corners[:, 1:] - corners[:, :1]
     rhs = 0.5 * np.sum(edges * edges, axis=2)
-    centre = (np.linalg.pinv(edges) @ rhs[..., None])[..., 0]
+    scale = np.sum(edges * edges, axis=(1, 2)) ** 1.5
+    flat = np.abs(np.linalg.det(edges)) <= 1e-10 * scale
+    centre = np.empty((len(corners), 3))
+    centre[~flat] = np.linalg.solve(edges[~flat], rhs[~flat][..., None])[..., 0]
+    centre[flat] = (np.linalg.pinv(edges[flat]) @ rhs[flat][..., None])[..., 0]
     return corners[:, 0] + centre, np.linalg.norm(centre, axis=1)
