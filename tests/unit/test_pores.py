@@ -227,3 +227,58 @@ def test_bad_input_is_refused_by_name():
         pores.decompose(np.vstack([centres, centres[:1]]), np.full(5, RADIUS))
     with pytest.raises(ValueError, match="periodic cell"):
         pores.decompose(centres, np.full(4, RADIUS), period=np.full(3, 10 * RADIUS))
+
+
+def test_beyond_face_volume_is_the_cap_when_the_triangle_holds_its_disk():
+    triangle = np.array([[[-10, -10, 0], [10, -10, 0], [0, 10, 0]]], float) * RADIUS
+    for h in (0.05, 0.5, 0.95):
+        apex = np.array([[0.3, -1.0, h]]) * RADIUS
+        cap = math.pi * (RADIUS - h * RADIUS) ** 2 * (2 * RADIUS + h * RADIUS) / 3
+        assert pores.beyond_face_volume(apex, np.array([RADIUS]), triangle)[0] == \
+            pytest.approx(cap, rel=1e-12)
+    far = np.array([[0.0, 0.0, 1.2 * RADIUS]])
+    assert pores.beyond_face_volume(far, np.array([RADIUS]), triangle)[0] == 0.0
+
+
+def test_ball_tetrahedron_volume_against_closed_forms_and_monte_carlo():
+    tetrahedron = regular_tetrahedron(6 * RADIUS)[None]
+    inscribed = 6 * RADIUS / math.sqrt(24)       # inradius of a regular tetrahedron
+    volume = pores.ball_tetrahedron_volume
+    # a ball inside, a ball outside, a ball holding the tetrahedron
+    assert volume(np.zeros((1, 3)), np.array([0.9 * inscribed]), tetrahedron)[0] == \
+        pytest.approx(4 / 3 * math.pi * (0.9 * inscribed) ** 3, rel=1e-12)
+    assert volume(np.array([[20 * RADIUS, 0, 0]]), np.array([RADIUS]), tetrahedron)[0] == \
+        pytest.approx(0.0, abs=1e-12 * RADIUS ** 3)
+    assert volume(np.zeros((1, 3)), np.array([10 * RADIUS]), tetrahedron)[0] == \
+        pytest.approx(pores.tetrahedron_volume(tetrahedron)[0], rel=1e-12)
+    # balls across faces, edges and corners, inside and outside the tetrahedron
+    rng = np.random.default_rng(17)
+    centres = rng.uniform(-3 * RADIUS, 3 * RADIUS, (6, 3))
+    radii = rng.uniform(1.0, 2.5, 6) * RADIUS
+    exact = volume(centres, radii, np.repeat(tetrahedron, 6, axis=0))
+    count = 200_000
+    points = sample_in_tetrahedron(tetrahedron[0], count, rng)
+    tet_volume = pores.tetrahedron_volume(tetrahedron)[0]
+    for centre, radius, value in zip(centres, radii, exact):
+        fraction = (np.linalg.norm(points - centre, axis=1) < radius).mean()
+        assert value == pytest.approx(fraction * tet_volume,
+                                      abs=mc_tolerance(fraction, count, tet_volume) + 1e-15)
+
+
+def test_each_unit_holds_its_own_void_even_where_grains_cross_its_faces():
+    """Flat units of a random packing, where grains cross the face opposite them and grains of
+    neighbouring units reach in, against a Monte Carlo count of the void in each tetrahedron."""
+    box = np.full(3, 11 * RADIUS)
+    centres, radii = random_spheres(110, box, (0.8 * RADIUS, 1.2 * RADIUS), 0.0, seed=23)
+    units = pores.decompose(centres, radii)
+    flat = np.flatnonzero(units.protrudes)
+    assert len(flat) >= 10
+    rng = np.random.default_rng(29)
+    count = 20_000
+    tree = cKDTree(centres)
+    for unit in flat[:10]:
+        points = sample_in_tetrahedron(units.vertices[unit], count, rng)
+        distance, index = tree.query(points, k=8)
+        void = 1.0 - (distance < radii[index]).any(axis=1).mean()
+        assert units.pore_volume[unit] == pytest.approx(
+            void * units.volume[unit], abs=mc_tolerance(void, count, units.volume[unit]))

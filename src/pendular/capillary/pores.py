@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import Delaunay
+from scipy.spatial import Delaunay, cKDTree
 
 from pendular.utils.validate import check_array, check_range
 
@@ -41,6 +41,8 @@ EDGES = np.array([[0, 1, 2, 3], [0, 2, 1, 3], [0, 3, 1, 2],
                   [1, 2, 0, 3], [1, 3, 0, 2], [2, 3, 0, 1]])
 #: Size of the tie-breaking perturbation of a periodic triangulation, per mean grain spacing.
 PERTURBATION = 1e-9
+#: Gauss–Legendre nodes and weights on [-1, 1] of each panel of ``beyond_face_volume``.
+_GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(16)
 #: The face opposite vertex k, as its three vertices.
 FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 
@@ -94,20 +96,22 @@ def tetrahedron_volume(vertices):
     return np.abs(np.einsum("ij,ij->i", a, np.cross(b, c))) / 6.0
 
 
+def triangle_solid_angle(point, triangle):
+    """(P,) [sr] the solid angle of ``triangle`` (P, 3, 3) [m] seen from ``point`` (P, 3) [m]
+    (Van Oosterom & Strackee 1983: tan(Omega/2) = |a . b x c| / (abc + (a.b)c + (a.c)b +
+    (b.c)a), a, b, c the vectors from the point to the corners); 0 from a corner."""
+    a, b, c = (triangle[:, i] - point for i in range(3))
+    la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
+    triple = np.abs(np.einsum("ij,ij->i", a, np.cross(b, c)))
+    denominator = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc
+                   + np.einsum("ij,ij->i", a, c) * lb + np.einsum("ij,ij->i", b, c) * la)
+    return 2.0 * np.arctan2(triple, denominator)
+
+
 def solid_angles(vertices):
-    """(M, 4) [sr] the solid angle of each tetrahedron at each vertex (Van Oosterom & Strackee
-    1983: tan(Omega/2) = |a . b x c| / (abc + (a.b)c + (a.c)b + (b.c)a), a, b, c the edges
-    from the vertex)."""
-    omega = np.empty(vertices.shape[:2])
-    for k in range(4):
-        others = vertices[:, FACES[k]] - vertices[:, k:k + 1]
-        a, b, c = others[:, 0], others[:, 1], others[:, 2]
-        la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
-        triple = np.abs(np.einsum("ij,ij->i", a, np.cross(b, c)))
-        dot = lambda u, v: np.einsum("ij,ij->i", u, v)  # noqa: E731
-        denominator = la * lb * lc + dot(a, b) * lc + dot(a, c) * lb + dot(b, c) * la
-        omega[:, k] = 2.0 * np.arctan2(triple, denominator)
-    return omega
+    """(M, 4) [sr] the solid angle of each tetrahedron at each vertex."""
+    return np.stack([triangle_solid_angle(vertices[:, k], vertices[:, FACES[k]])
+                     for k in range(4)], axis=1)
 
 
 def dihedral_angles(vertices):
@@ -184,6 +188,128 @@ def entry_suction(throat_radius, surface_tension, contact_angle=0.0):
         return np.where(r > 0, 2.0 * gamma * math.cos(math.radians(theta)) / r, np.inf)
 
 
+def beyond_face_volume(apex, radius, triangle):
+    """(P,) [m^3] volume of the ball of ``radius`` (P,) [m] about ``apex`` (P, 3) [m] that lies
+    beyond the plane of ``triangle`` (P, 3, 3) [m] inside the cone from the apex through the
+    triangle: what a sector over-counts where a grain crosses the face opposite it.
+
+    In polar coordinates about the apex, with h its height above the plane and rho the distance
+    to a point of the plane, the volume is (h/3) times the integral over the triangle of
+    (R^3/rho^3 - 1) where rho < R. The integrand is radial about the foot F of the apex, so the
+    triangle splits into the signed triangles (F, P_i, P_j) of its edges; over each, at angle
+    phi from the perpendicular to the edge (at distance d from F), the radial integral is
+    G(min(a, d / cos phi)) - G(0), G(r) = -R^3/sqrt(h^2 + r^2) - r^2/2, a = sqrt(R^2 - h^2),
+    integrated in phi by Gauss–Legendre on the panels between its kinks at +-arccos(d/a)."""
+    p0, p1, p2 = triangle[:, 0], triangle[:, 1], triangle[:, 2]
+    normal = np.cross(p1 - p0, p2 - p0)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    offset = np.sum((apex - p0) * normal, axis=1)
+    h = np.abs(offset)
+    foot = apex - offset[:, None] * normal
+    a = np.sqrt(np.maximum(radius ** 2 - h ** 2, 0.0))
+    r3 = radius ** 3
+    total = np.zeros(len(apex))
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        pi, pj = triangle[:, i], triangle[:, j]
+        along = (pj - pi) / np.linalg.norm(pj - pi, axis=1, keepdims=True)
+        t_i = np.sum((pi - foot) * along, axis=1)
+        t_j = np.sum((pj - foot) * along, axis=1)
+        perpendicular = (pi - foot) - t_i[:, None] * along
+        d = np.linalg.norm(perpendicular, axis=1)
+        sign = np.sign(np.sum(np.cross(pi - foot, pj - foot) * normal, axis=1))
+        phi_i, phi_j = np.arctan2(t_i, d), np.arctan2(t_j, d)
+        kink = np.arccos(np.minimum(d / np.where(a > 0, a, 1.0), 1.0))
+        lo, hi = np.clip(-kink, phi_i, phi_j), np.clip(kink, phi_i, phi_j)
+        # outside the kinks the edge is beyond the disk of radius a: the integrand is constant
+        outside = (lo - phi_i) + (phi_j - hi)
+        full = -r3 / radius - 0.5 * a ** 2 + r3 / np.maximum(h, 1e-300)
+        phi = 0.5 * (hi - lo)[:, None] * (_GAUSS_NODES + 1.0) + lo[:, None]
+        cos = np.cos(phi)
+        reach = np.minimum(a[:, None], d[:, None] / np.maximum(cos, 1e-300))
+        g = (-r3[:, None] / np.sqrt(h[:, None] ** 2 + reach ** 2) - 0.5 * reach ** 2
+             + r3[:, None] / np.maximum(h[:, None], 1e-300))
+        total += sign * (outside * full + 0.5 * (hi - lo) * (g @ _GAUSS_WEIGHTS))
+    return np.where(a > 0, h / 3.0 * total, 0.0)
+
+
+def ball_tetrahedron_volume(centre, radius, vertices):
+    """(P,) [m^3] volume of the intersection of the balls ``centre`` (P, 3), ``radius`` (P,)
+    [m] with the tetrahedra ``vertices`` (P, 4, 3) [m], anywhere.
+
+    The tetrahedron is the signed sum of the pyramids from the ball's centre over its four
+    faces (+ where the centre is on the tetrahedron's side of the face, - otherwise); the ball
+    meets a pyramid in its sector Omega R^3 / 3 (Omega the face's solid angle from the centre)
+    less what lies beyond the face (``beyond_face_volume``)."""
+    total = np.zeros(len(centre))
+    for k in range(4):
+        face = vertices[:, FACES[k]]
+        normal = np.cross(face[:, 1] - face[:, 0], face[:, 2] - face[:, 0])
+        side = np.sign(np.sum((centre - face[:, 0]) * normal, axis=1)) \
+            * np.sign(np.sum((vertices[:, k] - face[:, 0]) * normal, axis=1))
+        total += side * triangle_solid_angle(centre, face) * radius ** 3 / 3
+        height = np.abs(np.sum((centre - face[:, 0]) * normal, axis=1)) \
+            / np.linalg.norm(normal, axis=1)
+        crossing = (side != 0) & (height < radius)
+        total[crossing] -= side[crossing] * beyond_face_volume(centre[crossing],
+                                                               radius[crossing], face[crossing])
+    return total
+
+
+def _intruding_volume(vertices, grains, position, radius, period):
+    """(M,) [m^3] the volume of the balls of other grains than a unit's four inside it (in a
+    periodic cell, of their images nearest the unit). Candidates: the grains within their radius
+    of the unit's bounding sphere (about its centroid) and of each face's plane on its side."""
+    centroid = vertices.mean(axis=1)
+    reach = np.linalg.norm(vertices - centroid[:, None], axis=2).max(axis=1)
+    if period is None:
+        grains_tree = cKDTree(position)
+    else:
+        centroid_in_cell = np.mod(centroid, period)
+        centroid_in_cell = np.where(centroid_in_cell < period, centroid_in_cell, 0.0)
+        grains_tree = cKDTree(position, boxsize=period)
+    # the few flat units with a long reach are searched apart, so that the bulk's search stays short
+    long_reach = reach > 2.0 * np.median(reach)
+    found = []
+    for group in (np.flatnonzero(~long_reach), np.flatnonzero(long_reach)):
+        if len(group) == 0:
+            continue
+        points = centroid[group] if period is None else centroid_in_cell[group]
+        tree = cKDTree(points) if period is None else cKDTree(points, boxsize=period)
+        pairs = tree.sparse_distance_matrix(grains_tree, reach[group].max() + radius.max(),
+                                            output_type="ndarray")
+        unit, grain = group[pairs["i"]], pairs["j"].astype(np.int64)
+        near = pairs["v"] < reach[unit] + radius[grain]
+        found.append((unit[near], grain[near]))
+    unit = np.concatenate([f[0] for f in found])
+    grain = np.concatenate([f[1] for f in found])
+    other = np.all(grains[unit] != grain[:, None], axis=1)
+    unit, grain = unit[other], grain[other]
+    centre = position[grain]
+    if period is not None:
+        centre = centre + period * np.rint((centroid[unit] - centre) / period)
+    for k in range(4):
+        face = vertices[unit[:, None], FACES[k]]
+        normal = np.cross(face[:, 1] - face[:, 0], face[:, 2] - face[:, 0])
+        normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+        normal *= np.sign(np.sum((vertices[unit, k] - face[:, 0]) * normal, axis=1))[:, None]
+        keep = np.sum((centre - face[:, 0]) * normal, axis=1) > -radius[grain]
+        unit, grain, centre = unit[keep], grain[keep], centre[keep]
+    inside = ball_tetrahedron_volume(centre, radius[grain], vertices[unit])
+    return np.bincount(unit, inside, minlength=len(vertices))
+
+
+def _heights(vertices):
+    """(M, 4) [m] height of each vertex above the plane of the face opposite it."""
+    volume = tetrahedron_volume(vertices)
+    face_area = np.empty((len(vertices), 4))
+    for k in range(4):
+        f = vertices[:, FACES[k]]
+        face_area[:, k] = 0.5 * np.linalg.norm(np.cross(f[:, 1] - f[:, 0], f[:, 2] - f[:, 0]),
+                                               axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(face_area > 0, 3.0 * volume[:, None] / face_area, np.inf)
+
+
 def _unit_geometry(vertices, radius):
     """Per-unit geometry of tetrahedra ``vertices`` (M, 4, 3) with grain radii ``radius`` (M, 4)."""
     volume = tetrahedron_volume(vertices)
@@ -193,14 +319,15 @@ def _unit_geometry(vertices, radius):
     lens = lens_volume(edge_length, radius[:, EDGES[:, 0]], radius[:, EDGES[:, 1]])
     pore = (volume - np.sum(omega * radius ** 3, axis=1) / 3.0
             + np.sum(lens * dihedral, axis=1) / (2.0 * np.pi))
-    face_area = np.empty((len(vertices), 4))
-    for k in range(4):
-        f = vertices[:, FACES[k]]
-        face_area[:, k] = 0.5 * np.linalg.norm(np.cross(f[:, 1] - f[:, 0], f[:, 2] - f[:, 0]),
-                                               axis=1)
-    height = 3.0 * volume[:, None] / face_area
+    # a grain crossing the face opposite it: its sector reaches past the unit
+    unit, k = np.nonzero(_heights(vertices) < radius)
+    beyond = beyond_face_volume(vertices[unit, k], radius[unit, k],
+                                vertices[unit[:, None], FACES[k]])
+    pore += np.bincount(unit, beyond, minlength=len(vertices))
     throat = throat_radius(vertices[:, FACES], radius[:, FACES])
-    return volume, omega, pore, omega * radius ** 2, np.any(height < radius, axis=1), throat
+    protrudes = np.zeros(len(vertices), bool)
+    protrudes[unit] = True
+    return volume, omega, pore, omega * radius ** 2, protrudes, throat
 
 
 def _throats(neighbours):
@@ -256,6 +383,7 @@ def decompose(position, radius, period=None):
             raise ValueError("position must lie in the periodic cell [0, period); wrap it first")
         grains, vertices, neighbours = _periodic_units(position, radius, period_array)
     volume, omega, pore, area, protrudes, throat = _unit_geometry(vertices, radius[grains])
+    pore -= _intruding_volume(vertices, grains, position, radius, period_array)
     throat_units, throat_of = _throats(neighbours)
     shift = _throat_shift(vertices, throat_units, throat_of, period_array)
     return PoreUnits(grains=grains, vertices=vertices, neighbours=neighbours, volume=volume,
