@@ -8,7 +8,7 @@ The sample is the thesis-default one of ``particles`` spheres (Ch. 5.2.2 at 750 
 under .cache/, as benchmarks/bench_grading.py). ``decompose`` is timed on it between walls and,
 for the cost alone, on its positions taken as a periodic cell of the walls' box. For ``units``
 units drawn at random, ``points`` uniform points in the tetrahedron give its void, which the
-unit's pore volume (sectors and lenses, pendular.capillary.pores) is compared with: the error
+unit's pore volume (pendular.capillary.pores) is compared with: the error
 shown relative to the mean pore volume of a unit, apart for the units where a grain crosses
 the opposite face (``protrudes``).
 """

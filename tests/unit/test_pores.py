@@ -84,15 +84,15 @@ def test_lens_volume_closed_forms():
     assert pores.lens_volume(0.0, r, r) == pytest.approx(4 / 3 * math.pi * r ** 3)
     # two equal balls at distance d: pi (4 r + d)(2 r - d)^2 / 12
     d = 1.3 * r
-    assert pores.lens_volume(d, r, r) == pytest.approx(math.pi * (4 * r + d) * (2 * r - d) ** 2 / 12,
-                                                       rel=1e-13)
+    lens = math.pi * (4 * r + d) * (2 * r - d) ** 2 / 12
+    assert pores.lens_volume(d, r, r) == pytest.approx(lens, rel=1e-13)
     assert pores.lens_volume(0.5 * r, r, 3 * r) == pytest.approx(4 / 3 * math.pi * r ** 3)
 
 
-@pytest.mark.parametrize("radii, expected", [
-    # three mutually touching circles: Descartes, k4 = k1 + k2 + k3 + 2 sqrt(k1 k2 + k2 k3 + k3 k1)
-    ((1.0, 1.0, 1.0), None), ((1.0, 2.0, 3.0), None), ((0.5, 1.0, 2.5), None)])
-def test_throat_radius_of_touching_spheres_follows_descartes(radii, expected):
+@pytest.mark.parametrize("radii", [(1.0, 1.0, 1.0), (1.0, 2.0, 3.0), (0.5, 1.0, 2.5)])
+def test_throat_radius_of_touching_spheres_follows_descartes(radii):
+    """Three mutually touching circles: Descartes, k4 = k1 + k2 + k3 + 2 sqrt(k1 k2 + k2 k3 +
+    k3 k1)."""
     r1, r2, r3 = (RADIUS * x for x in radii)
     # triangle of the centres from its sides r1 + r2, r1 + r3, r2 + r3
     a, b = r1 + r2, r1 + r3

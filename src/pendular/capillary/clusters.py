@@ -43,7 +43,8 @@ class Clusters:
 
 
 def find_clusters(pore_units, filled):
-    """Clusters of the ``filled`` (M,) bool units of ``pore_units`` (pendular.capillary.pores.PoreUnits)."""
+    """Clusters of the ``filled`` (M,) bool units of ``pore_units`` (a
+    pendular.capillary.pores.PoreUnits)."""
     filled = np.asarray(filled)
     if filled.shape != (pore_units.count,) or filled.dtype != bool:
         raise ValueError(f"filled must be a bool array of shape ({pore_units.count},), one per "

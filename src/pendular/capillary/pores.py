@@ -8,17 +8,17 @@ it. Per unit, in SI units (positions and radii in m):
 - ``volume`` [m^3]: the tetrahedron;
 - ``solid_angle`` [sr]: the solid angle of the tetrahedron at each of its four grains
   (Van Oosterom & Strackee 1983);
-- ``pore_volume`` [m^3]: the tetrahedron less the four sphere sectors Omega_k R_k^3 / 3, plus
-  the share phi/(2 pi) of each lens where two of its grains overlap (phi the dihedral angle at
-  their edge), since the lens is counted in both sectors. The sectors of one grain over all the
-  units around it partition its ball, and the dihedral angles around an edge sum to 2 pi, so
-  the pore volumes sum exactly to the volume covered less the solid in it. A unit's own pore
-  volume is exact while each of its balls lies in its own cone inside the unit and meets no
-  third ball in a lens (no triple overlaps); ``protrudes`` marks the units where a grain crosses
-  the opposite face (flat "sliver" tetrahedra), whose pore volume may even be negative, the
-  neighbours holding the difference;
-- ``grain_area`` [m^2]: the area Omega_k R_k^2 of each grain's surface inside the unit (the
-  wetted area of a filled unit, lenses neglected);
+- ``pore_volume`` [m^3]: the tetrahedron less the solid inside it. Each of its four grains
+  fills its sector Omega_k R_k^3 / 3 less the part of it beyond the opposite face, where the
+  grain crosses that face (flat tetrahedra, ``protrudes``); every other grain whose ball
+  reaches into the unit fills its exact intersection with the tetrahedron
+  (``ball_tetrahedron_volume``). Where two of the unit's grains overlap, the share phi/(2 pi)
+  of their lens (phi the dihedral angle at their edge) is added back, since both sectors count
+  it. Neglected: the part of such a lens outside the unit, overlaps with an intruding grain,
+  and triple overlaps, all of the order of the square of the overlaps of DEM contacts. The pore
+  volumes then sum to the volume covered less the solid in it;
+- ``grain_area`` [m^2]: the area Omega_k R_k^2 of each grain's surface in its cone (the
+  wetted area of a filled unit; lenses and the surface beyond the opposite face neglected);
 - ``throat_radius`` [m] (across the face opposite each grain): the radius of the circle in the
   face's plane tangent to the three grains' great circles (Apollonius' problem; the throat's
   inscribed circle), negative where the three grains close the throat.
@@ -55,7 +55,8 @@ class PoreUnits:
     vertices: (M, 4, 3) [m] their centres as the unit sees them (a periodic image's, unwrapped).
     neighbours: (M, 4) the unit across the face opposite each vertex, -1 on the hull.
     volume: (M,) [m^3] the tetrahedron. pore_volume: (M,) [m^3] its void (module docstring).
-    solid_angle: (M, 4) [sr]. grain_area: (M, 4) [m^2]. protrudes: (M,) bool.
+    solid_angle: (M, 4) [sr]. grain_area: (M, 4) [m^2].
+    protrudes: (M,) bool, a grain crosses the face opposite it (a flat unit).
     throat_radius: (M, 4) [m] of the face opposite each vertex.
     throat_units: (T, 2) the two units of each throat (the second -1 on the hull), first < second.
     throat_of: (M, 4) the throat across the face opposite each vertex.
@@ -461,7 +462,8 @@ def _image_code(shift):
 
 
 def _search_rows(sorted_rows, rows):
-    """Index in ``sorted_rows`` (lexicographically sorted, unique) of each of ``rows``; -1 if absent."""
+    """Index in ``sorted_rows`` (lexicographically sorted, unique) of each of ``rows``; -1 if
+    absent."""
     dtype = np.dtype([(f"f{i}", sorted_rows.dtype) for i in range(sorted_rows.shape[1])])
     table = np.ascontiguousarray(sorted_rows).view(dtype).ravel()
     query = np.ascontiguousarray(rows).view(dtype).ravel()
