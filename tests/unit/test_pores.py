@@ -269,7 +269,7 @@ def test_each_unit_holds_its_own_void_even_where_grains_cross_its_faces():
     """Flat units of a random packing, where grains cross the face opposite them and grains of
     neighbouring units reach in, against a Monte Carlo count of the void in each tetrahedron."""
     box = np.full(3, 11 * RADIUS)
-    centres, radii = random_spheres(110, box, (0.8 * RADIUS, 1.2 * RADIUS), 0.0, seed=23)
+    centres, radii = random_spheres(80, box, (0.8 * RADIUS, 1.2 * RADIUS), 0.0, seed=23)
     units = pores.decompose(centres, radii)
     flat = np.flatnonzero(units.protrudes)
     assert len(flat) >= 10
