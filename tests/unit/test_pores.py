@@ -282,3 +282,15 @@ def test_each_unit_holds_its_own_void_even_where_grains_cross_its_faces():
         void = 1.0 - (distance < radii[index]).any(axis=1).mean()
         assert units.pore_volume[unit] == pytest.approx(
             void * units.volume[unit], abs=mc_tolerance(void, count, units.volume[unit]))
+
+
+def test_periodic_pore_volumes_of_separate_grains_sum_exactly():
+    """Without overlaps, the units' pore volumes sum to the cell less the grains, to round-off:
+    every part of every ball is counted once, in the unit it lies in."""
+    box = np.full(3, 11 * RADIUS)
+    centres, radii = random_spheres(80, box, (0.8 * RADIUS, 1.2 * RADIUS), 0.0, seed=31)
+    centres = np.mod(centres + 0.5 * box, box)
+    units = pores.decompose(centres, radii, period=box)
+    assert units.protrudes.any()
+    solid = np.sum(4 / 3 * math.pi * radii ** 3)
+    assert units.pore_volume.sum() == pytest.approx(np.prod(box) - solid, rel=1e-12)
