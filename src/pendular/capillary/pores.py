@@ -380,8 +380,12 @@ def decompose(position, radius, period=None):
         period_array = None
     else:
         period_array = check_array("period", period, positive=True, length=3)
-        if ((position < 0) | (position >= period_array)).any():
-            raise ValueError("position must lie in the periodic cell [0, period); wrap it first")
+        outside = (position < 0) | (position >= period_array)
+        if outside.any():
+            i, axis = (int(x) for x in np.argwhere(outside)[0])
+            raise ValueError(f"position[{i}, {axis}] = {position[i, axis]:g} m is outside the "
+                             f"periodic cell's valid range [0, {period_array[axis]:g}) m; wrap "
+                             "the positions into the cell first")
         grains, vertices, neighbours = _periodic_units(position, radius, period_array)
     volume, omega, pore, area, protrudes, throat = _unit_geometry(vertices, radius[grains])
     pore -= _intruding_volume(vertices, grains, position, radius, period_array)
