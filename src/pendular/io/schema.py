@@ -21,7 +21,9 @@ Columns by test (pendular.procedures.loading.history_columns, pendular.procedure
 - simple shear (pendular.procedures.simple_shear.SimpleShearTest): the loading path's,
   shear_strain, shear_stress and normal_stress;
 - direct tension: step, time, axial_strain, tensile_stress, grip_pull, sigma_wall,
-  coordination, unbalanced_force, and wet: bridges, water_content, saturation.
+  coordination, unbalanced_force, and wet: bridges, water_content, saturation;
+- impact (pendular.procedures.impact): time, overlap, normal_force, tangential_force,
+  angular_velocity.
 """
 
 from __future__ import annotations
@@ -142,6 +144,14 @@ HISTORY_COLUMNS = {
                                  "positive resisting a positive shear", equation="Eq. 3.41"),
     "normal_stress": Column("Pa", "simple shear: normal stress sigma_zz of the cell, "
                                   "compression positive"),
+    "overlap": Column("m", "impact: overlap of the sphere with its target"),
+    "normal_force": Column("N", "impact: contact force on the sphere along the normal from "
+                                "its target, repulsion positive"),
+    "tangential_force": Column("N", "impact: contact force on the sphere along the incident "
+                                    "tangent (in the plane of incidence)"),
+    "angular_velocity": Column("rad/s", "impact: the sphere's angular velocity about the axis "
+                                        "normal to the plane of incidence, positive rolling "
+                                        "forward"),
 }
 
 #: Field data of the ParaView frames (pendular.io.vtk.VtkWriter: one number a .vtu file, the
@@ -267,12 +277,19 @@ SIMPLE_SHEAR_SUMMARY_UNITS = {
     "normal_stress": "Pa",
 }
 
+#: Units of an impact's summary.json (pendular.procedures.impact.impact_summary).
+IMPACT_SUMMARY_UNITS = {
+    "max_normal_force": "N", "max_overlap": "m", "contact_duration": "s",
+    "normal_restitution": "1", "tangential_restitution": "1", "rebound_angular_velocity": "rad/s",
+    "rebound_angle_deg": "deg", "dt": "s", "rayleigh_timestep": "s",
+}
+
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
                  **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS}
+                 **SIMPLE_SHEAR_SUMMARY_UNITS, **IMPACT_SUMMARY_UNITS}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

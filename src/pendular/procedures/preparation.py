@@ -27,6 +27,7 @@ from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
+from pendular.dem.hertz_mindlin import CONTACT_LAWS, POISSON_RANGE
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
@@ -271,6 +272,17 @@ class PrepareConfig:
                              help="YADE young E, kn = E R")
     shear_ratio: float = parameter(0.3, low=0.0, high=10.0, help="contact stiffness ratio "
                                    "ks / kn")
+    contact: str = parameter("linear", kind=str, choices=CONTACT_LAWS, flag="--contact",
+                             help="contact law: linear springs (kn = E R, ks = 0.3 kn), or "
+                                  "Hertz-Mindlin from the grains' E and --poisson, its time "
+                                  "step the Rayleigh-wave rule (docs/physics.md)")
+    poisson: float = parameter(0.3, low=POISSON_RANGE[0], high=POISSON_RANGE[1],
+                               low_inclusive=False, high_inclusive=False, flag="--poisson",
+                               help="Poisson ratio of the grains (Hertz-Mindlin)")
+    restitution: float = parameter(1.0, low=0.0, high=1.0, low_inclusive=False,
+                                   flag="--restitution",
+                                   help="coefficient of restitution of a contact, normal and "
+                                        "tangential: viscous damping, 1 none")
     friction_deg: float = parameter(18.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
                                     flag="--friction", help="contact friction")
     prep_friction_deg: float = parameter(
