@@ -48,7 +48,7 @@ OUTPUTS = ("summary.json", "history.h5", "impact.png")
 OPTIONS = (
     Option("target", "what the sphere hits: an identical sphere coming the other way, or a "
                      "rigid flat wall", default="wall", kind=str, choices=("sphere", "wall")),
-    option_of(PrepareConfig, "radius", default=0.01, checked=True),
+    option_of(PrepareConfig, "radius", default=0.01, checked=True, help="sphere radius"),
     option_of(PrepareConfig, "young", default=2e11, checked=True,
               help="Young's modulus E of the spheres (linear: kn = E R)"),
     option_of(PrepareConfig, "poisson", checked=True),
