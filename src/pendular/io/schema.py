@@ -236,6 +236,7 @@ TENSION_SUMMARY_UNITS = {
 #: of the columns a Chapter 5 campaign.json adds.
 OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
+    "poisson": "1", "restitution": "1",
     "friction": "deg", "prep_friction": "deg", "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
