@@ -262,3 +262,42 @@ def test_the_impact_command_refuses_bad_input_in_one_line(argv, words, tmp_path,
     status, err = run_in_process("impact", [*argv, "--out", tmp_path / "run"], capsys)
     refused(status, err, *words)
     assert not (tmp_path / "run").exists()
+
+
+def test_an_oblique_impact_resumes_from_a_checkpoint_bit_for_bit(tmp_path):
+    """The wall's springs and the pairs' go through a checkpoint: a resumed impact is the
+    uninterrupted one."""
+    from pendular.dem.checkpoint import load_checkpoint, save_checkpoint
+
+    values, _ = option_values(impact.OPTIONS, {**STEEL, "contact": "hertz-mindlin",
+                                               "angle": 20.0, "restitution": 0.7})
+    saved, _ = impact.impact_scene(values)
+    saved.run(600)
+    assert np.any(saved.operation(ViscoelasticWallForces).wall_shear != 0.0)
+    save_checkpoint(tmp_path / "impact.h5", saved)
+    resumed, _ = impact.impact_scene(values)
+    load_checkpoint(tmp_path / "impact.h5", resumed)
+    for sim in (saved, resumed):
+        sim.run(600)
+    assert np.array_equal(resumed.particles.velocity, saved.particles.velocity)
+    assert np.array_equal(resumed.particles.angular_velocity, saved.particles.angular_velocity)
+
+
+def test_a_laboratory_scene_takes_the_law_its_configuration_names():
+    from pendular.dem.contact_law import ContactForces
+    from pendular.dem.state import Particles, Walls
+    from pendular.dem.walls import WallForces
+    from pendular.procedures.preparation import (RAYLEIGH_SHARE, PrepareConfig, dry_simulation,
+        pwave_step)
+
+    particles = Particles(np.array([[0.5, 0.5, 0.5]]), np.array([0.1]), 2650.0)
+    walls = Walls.box((0, 0, 0), (1, 1, 1))
+    for settings, kinds in (({}, (ContactForces, WallForces)),
+                            ({"restitution": 0.5}, (DampedLinearForces, ViscoelasticWallForces)),
+                            ({"contact": "hertz-mindlin", "young": 7e10, "poisson": 0.22},
+                             (HertzMindlinForces, ViscoelasticWallForces))):
+        config = PrepareConfig(**settings)
+        sim = dry_simulation(particles, walls, config, 1e-6, 0.01, 18.0, [])
+        assert tuple(type(op) for op in sim.forces) == kinds
+    assert pwave_step([1e-3], config) == pytest.approx(
+        config.timestep_safety * RAYLEIGH_SHARE * rayleigh_timestep(1e-3, 7e10, 0.22, 2650.0))

@@ -24,6 +24,7 @@ from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
     ViscoelasticWallForces, effective_modulus)
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
+from pendular.dem.protocols import state_array
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import rayleigh_timestep
@@ -95,11 +96,15 @@ class ImpactRecorder:
         self.touched = False
 
     def state_dict(self):
-        return {"rows": [list(row) for row in self.rows], "touched": self.touched}
+        """The ``rows`` recorded (R, 5): time [s], overlap [m], normal and tangential force [N],
+        angular velocity [rad/s]; ``touched``: whether the contact has begun."""
+        return {"rows": np.array(self.rows, dtype=np.float64).reshape(-1, 5),
+                "touched": self.touched}
 
     def load_state(self, state):
-        self.rows = [tuple(row) for row in state["rows"]]
+        rows = state_array(state, "rows", np.float64, (None, 5))
         self.touched = bool(state["touched"])
+        self.rows = [tuple(row) for row in rows.tolist()]
 
     def apply(self, sim):
         p = sim.particles
