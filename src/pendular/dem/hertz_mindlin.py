@@ -10,8 +10,11 @@ a = sqrt(R* delta), effective mass 1/m* = 1/m1 + 1/m2:
   linear law's (pendular.dem.contact_law._turned_contact), capped by Coulomb; the
   microslip of Mindlin & Deresiewicz (1953) inside the contact is left out, as in YADE's
   Law2_ScGeom_MindlinPhys_Mindlin and LIGGGHTS's ``tangential history``;
-- damping: viscous, 2 gamma sqrt(m* k) times the normal and tangential relative velocities
-  (k = kn, kt), gamma from the coefficient of restitution (pendular.dem.restitution), no
+- damping: viscous, 2 gamma sqrt(m* kn) times the normal relative velocity and
+  2 gamma sqrt((2/7) m* kt) times the tangential one ((2/7) m*: the mass with which the
+  spheres' translations and rotations move the contact point tangentially; with m* the
+  dashpots of a dense packing's many contacts on one grain's rotation are too stiff for the
+  step), gamma from the coefficient of restitution (pendular.dem.restitution), no
   tension: the normal force, damping included, is at least 0; the Coulomb cap holds the
   spring and the dashpot together, and a sliding contact keeps its force on the cap as its
   spring.
@@ -42,6 +45,9 @@ from pendular.dem.protocols import state_array
 from pendular.dem.restitution import damping_ratio
 from pendular.utils.validate import check_positive, check_range
 
+#: The effective mass of a contact point's tangential motion over m*: a sphere's translation
+#: and rotation (I = 2/5 m R^2) together move it as a mass of 2/7 of its own.
+TANGENTIAL_MASS = 2.0 / 7.0
 #: The contact laws a scene may use: linear springs (the default), Hertz–Mindlin.
 CONTACT_LAWS = ("linear", "hertz-mindlin")
 #: The valid Poisson ratios: (-1, 0.5), open at both ends (an incompressible 0.5 has no shear
@@ -99,7 +105,7 @@ def _damped_forces(fe, kn, kt, mass_star, damping, un, t0, t1, t2, s0, s1, s2, t
     s0 -= kt * t0 * dt
     s1 -= kt * t1 * dt
     s2 -= kt * t2 * dt
-    dashpot = 2.0 * damping * math.sqrt(mass_star * kt)
+    dashpot = 2.0 * damping * math.sqrt(TANGENTIAL_MASS * mass_star * kt)
     f0 = s0 - dashpot * t0
     f1 = s1 - dashpot * t1
     f2 = s2 - dashpot * t2
