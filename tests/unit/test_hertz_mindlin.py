@@ -257,6 +257,7 @@ def test_the_law_refuses_a_material_outside_its_range(given, words):
     (["--angle", "90"], ("--angle", "[0, 90)")),
     (["--velocity", "-1"], ("--velocity",)),
     (["--target", "floor"], ("--target",)),
+    (["--young", "1e3", "--velocity", "10"], ("--velocity", "--young", "at most 0.1")),
 ])
 def test_the_impact_command_refuses_bad_input_in_one_line(argv, words, tmp_path, capsys):
     status, err = run_in_process("impact", [*argv, "--out", tmp_path / "run"], capsys)

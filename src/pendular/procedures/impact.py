@@ -7,7 +7,8 @@ other way (the scene is symmetric through the contact point), with "wall" a rigi
 the limit of an infinitely stiff wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R, m* = m
 (pendular.dem.hertz_mindlin.ViscoelasticWallForces; linear: kn = E R). The engine's own
 Simulation runs it with the chosen contact law, without local damping or gravity, at a step of
-1/STEPS_PER_CONTACT of the contact's closed-form duration (Hertz's, or pi sqrt(m* / kn)).
+1/STEPS_PER_CONTACT of the contact's closed-form duration (Hertz's, or pi sqrt(m* / kn)); an
+impact whose closed-form peak overlap exceeds MAX_OVERLAP of the radius is refused.
 
 The summary holds the peak normal force and overlap, the contact's duration (while the normal
 force is positive), the restitution of the sphere's centre velocity along the initial normal
@@ -34,13 +35,15 @@ from pendular.io.plots import pyplot, save_figure
 from pendular.io.schema import IMPACT_SUMMARY_UNITS
 from pendular.procedures.preparation import PrepareConfig
 from pendular.utils.atomic import write_json
-from pendular.utils.parameters import Option, Parameter, option_from, option_of
+from pendular.utils.parameters import Option, OptionError, Parameter, option_from, option_of
 
 #: Steps in the closed-form duration of the contact: the peak force sampled within 1e-6 of
 #: its value, the duration within 1/STEPS_PER_CONTACT.
 STEPS_PER_CONTACT = 2000
 #: Most steps of a run, in contact durations (a damped contact ends sooner than an elastic one).
 MAX_CONTACT_DURATIONS = 20
+#: The largest peak overlap / radius of an impact (closed form, elastic_impact).
+MAX_OVERLAP = 0.1
 #: Files the impact writes in its folder.
 OUTPUTS = ("summary.json", "history.h5", "impact.png")
 
@@ -68,20 +71,38 @@ OPTIONS = (
 )
 
 
-def contact_duration_estimate(contact, radius, young, poisson, density, velocity, target):
-    """The closed-form duration [s] of an elastic normal impact at ``velocity`` [m/s]
-    (each sphere's with target "sphere"): Hertz's 2.868 (m*^2 / (R* E*^2 v))^(1/5)
-    (Johnson 1985, Eq. 11.24), v the approach speed, or a linear spring's pi sqrt(m* / kn)."""
-    mass = density * 4.0 / 3.0 * math.pi * radius ** 3
-    pair = target == "sphere"
+def elastic_impact(values):
+    """(duration [s], peak overlap [m]) of the elastic normal impact of ``values`` (OPTIONS,
+    read; each sphere at ``velocity`` with target "sphere"), in closed form: Hertz's
+    2.868 (m*^2 / (R* E*^2 v))^(1/5) and (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) (Johnson 1985,
+    Eqs. 11.23-11.24), v the approach speed, or a linear spring's pi sqrt(m* / kn) and
+    v sqrt(m* / kn)."""
+    radius, young, poisson = values["radius"], values["young"], values["poisson"]
+    mass = values["density"] * 4.0 / 3.0 * math.pi * radius ** 3
+    pair = values["target"] == "sphere"
     mass_star = mass / 2.0 if pair else mass
-    if contact == "linear":
-        return math.pi * math.sqrt(mass_star / (young * radius))
+    approach = 2.0 * values["velocity"] if pair else values["velocity"]
+    if values["contact"] == "linear":
+        period = math.sqrt(mass_star / (young * radius))
+        return math.pi * period, approach * period
     modulus = (effective_modulus(young, poisson, young, poisson) if pair
                else effective_modulus(young, poisson))
     radius_star = radius / 2.0 if pair else radius
-    approach = 2.0 * velocity if pair else velocity
-    return 2.868 * (mass_star ** 2 / (radius_star * modulus ** 2 * approach)) ** 0.2
+    return (2.868 * (mass_star ** 2 / (radius_star * modulus ** 2 * approach)) ** 0.2,
+            (15.0 * mass_star * approach ** 2 / (16.0 * modulus * math.sqrt(radius_star)))
+            ** 0.4)
+
+
+def check_impact(values):
+    """OptionError naming --velocity and --young when the impact of ``values`` would overlap
+    the spheres by more than MAX_OVERLAP of their radius (elastic_impact)."""
+    overlap = elastic_impact(values)[1] / values["radius"]
+    if overlap > MAX_OVERLAP:
+        raise OptionError(lambda name: (
+            f"{name('velocity')} = {values['velocity']:g} m/s with {name('young')} = "
+            f"{values['young']:g} Pa overlaps the spheres by {overlap:.3g} of their radius at "
+            f"the peak; valid: at most {MAX_OVERLAP:g} (the contact laws hold for small "
+            f"overlaps): lower {name('velocity')} or raise {name('young')}"))
 
 
 class ImpactRecorder:
@@ -164,9 +185,7 @@ def impact_scene(values):
     forces = [contact]
     if wall:
         forces.append(ViscoelasticWallForces(contact, values["friction"]))
-    duration = contact_duration_estimate(values["contact"], radius, values["young"],
-                                         values["poisson"], values["density"], speed,
-                                         values["target"])
+    duration = elastic_impact(values)[0]
     recorder = ImpactRecorder(values["target"])
     sim = Simulation(particles, walls, duration / STEPS_PER_CONTACT,
                      neighbors=NeighborList(0.1 * radius), forces=forces,
@@ -202,6 +221,7 @@ def impact_summary(sim, recorder, values):
 
 def run_impact(values):
     """Run the impact of ``values`` (OPTIONS, read); (summary, history columns)."""
+    check_impact(values)
     sim, recorder = impact_scene(values)
     sim.run(MAX_CONTACT_DURATIONS * STEPS_PER_CONTACT, until=recorder.ended, check_every=1)
     if not recorder.ended(sim):
@@ -231,6 +251,7 @@ def impact_figure(history, contact):
 def write_impact(values, out):
     """Run the impact of ``values`` into the folder ``out`` (summary.json, history.h5,
     impact.png); return the summary."""
+    check_impact(values)            # before the folder is made
     with OutputFolder(os.path.abspath(out), "impact") as folder:
         paths = {name: folder.claim(name) for name in OUTPUTS}
         summary, history = run_impact(values)
