@@ -34,7 +34,8 @@ BOUNDS = [
 #: The options of ``pendular triaxial`` made from their fields' metadata.
 GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spread",
              "porosity", "friction", "prep_friction", "rolling_friction", "twisting_friction",
-             "gravity", "young", "damping", "timestep_safety",
+             "gravity", "young", "contact", "poisson", "restitution", "damping",
+             "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
              "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",

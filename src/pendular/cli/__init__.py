@@ -33,6 +33,7 @@ COMMANDS = {
     "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
     "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),
     "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),
+    "impact": ("impact", "one collision of a sphere with a sphere or a wall: the contact law"),
 }
 
 #: Exit status of a run stopped by Ctrl-C or --stop-after.

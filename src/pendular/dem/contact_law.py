@@ -62,19 +62,16 @@ def _stretched(affine_rate):
 
 
 @numba.njit(cache=True, inline="always")
-def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, image, period,
-                   periodic, affine_rate, stretched, shear_force, normal, overlap, normal_force,
-                   force, young, shear_ratio, tan_friction, dt):
-    """Evaluate pair k of first member ``first`` (_first_member) and second member j
-    (pair_forces), fill its per-pair arrays; (touching, the force on j from i [N], the normal,
-    the overlap [m]), force and normal (0, 0, 0) for a pair apart. ``periodic``,
-    ``stretched``: whether the scene has images, stretching (pair_forces); a sheared cell's
-    ``period`` and ``affine_rate`` hold a fourth entry (the tests of their lengths are on
-    the arrays' shapes, hoisted out of the loops)."""
-    xi0, xi1, xi2, ui0, ui1, ui2, wi0, wi1, wi2, ri = first
-    d0 = position[j, 0] - xi0
-    d1 = position[j, 1] - xi1
-    d2 = position[j, 2] - xi2
+def _contact_gap(k, first, j, position, radius, image, period, periodic, overlap, shear_force,
+                 normal_force, force):
+    """The branch vector d [m] of pair k of first member ``first`` (_first_member) and second
+    member j, its length [m] and the pair's overlap [m] (stored; negative: a gap), the force
+    arrays of a pair that has just separated zeroed. ``periodic``, ``period``: as
+    _evaluate_pair's. The first part of every contact law's pair (this module's,
+    pendular.dem.hertz_mindlin), then _turned_contact for a touching pair."""
+    d0 = position[j, 0] - first[0]
+    d1 = position[j, 1] - first[1]
+    d2 = position[j, 2] - first[2]
     if periodic:        # as pendular.dem.neighbors.branch_vector, skipped for most pairs
         m0 = image[k, 0]
         m1 = image[k, 1]
@@ -86,22 +83,33 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
             if len(period) > 3:     # Lees–Edwards: the images above in z offset along x
                 d0 += m2 * period[3]
     distance = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-    rj = radius[j]
-    gap_overlap = ri + rj - distance
+    gap_overlap = first[9] + radius[j] - distance
     was_touching = overlap[k] > 0.0
     overlap[k] = gap_overlap
-    if gap_overlap <= 0.0:
-        if was_touching:    # else the pair's arrays are still zero from when it separated
-            normal_force[k] = 0.0
-            for c in range(3):
-                shear_force[k, c] = 0.0
-                force[k, c] = 0.0
-        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, gap_overlap
+    if gap_overlap <= 0.0 and was_touching:   # else still zero from when it separated
+        normal_force[k] = 0.0
+        for c in range(3):
+            shear_force[k, c] = 0.0
+            force[k, c] = 0.0
+    return d0, d1, d2, distance, gap_overlap
+
+
+@numba.njit(cache=True, inline="always")
+def _turned_contact(k, first, j, d0, d1, d2, distance, velocity, angular_velocity, radius,
+                    affine_rate, stretched, shear_force, normal, dt):
+    """A touching pair k's normal n (i to j), its stored shear force turned with the contact
+    [N] and the relative velocity of j with respect to i at the contact [m/s], from its
+    branch vector d and length (_contact_gap); ``stretched``, ``affine_rate``: as
+    _evaluate_pair's.
+
+    The shear force turns as in YADE's Law2_ScGeom_FrictPhys_CundallStrack: tilt of the
+    normal (axis n_old x n), then twist by the mean spin about n; the relative velocity takes
+    the radii as lever arms (YADE's avoidGranularRatcheting)."""
+    xi0, xi1, xi2, ui0, ui1, ui2, wi0, wi1, wi2, ri = first
+    rj = radius[j]
     n0 = d0 / distance
     n1 = d1 / distance
     n2 = d2 / distance
-    kn = normal_stiffness(young, ri, rj)
-    ks = shear_ratio * kn
     fs0 = shear_force[k, 0]
     fs1 = shear_force[k, 1]
     fs2 = shear_force[k, 2]
@@ -133,19 +141,13 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
         v2 += affine_rate[2] * d2
         if len(affine_rate) > 3:    # simple shear: the velocity gamma_dot * z along x
             v0 += affine_rate[3] * d2
-    vn = v0 * n0 + v1 * n1 + v2 * n2
-    fs0 -= ks * (v0 - vn * n0) * dt
-    fs1 -= ks * (v1 - vn * n1) * dt
-    fs2 -= ks * (v2 - vn * n2) * dt
-    fn = kn * gap_overlap
-    cap = fn * tan_friction
-    magnitude = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
-    # a select, not a branch: whether a contact slides is unpredictable pair to pair (a fifth
-    # of a dry shear's contacts slide); x * 1.0 == x, so a sticking contact is unchanged
-    scale = cap / magnitude if magnitude > cap else 1.0
-    fs0 *= scale
-    fs1 *= scale
-    fs2 *= scale
+    return n0, n1, n2, fs0, fs1, fs2, v0, v1, v2
+
+
+@numba.njit(cache=True, inline="always")
+def _store_contact(k, fn, fs0, fs1, fs2, n0, n1, n2, shear_force, normal, normal_force, force):
+    """Store pair k's shear force ``fs`` [N] (the spring the next step turns and increments),
+    normal n and normal force ``fn`` [N]; return its force on j from i, fn n + fs [N]."""
     shear_force[k, 0] = fs0
     shear_force[k, 1] = fs1
     shear_force[k, 2] = fs2
@@ -159,6 +161,44 @@ def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, im
     force[k, 0] = f0
     force[k, 1] = f1
     force[k, 2] = f2
+    return f0, f1, f2
+
+
+@numba.njit(cache=True, inline="always")
+def _evaluate_pair(k, first, j, position, velocity, angular_velocity, radius, image, period,
+                   periodic, affine_rate, stretched, shear_force, normal, overlap, normal_force,
+                   force, young, shear_ratio, tan_friction, dt):
+    """Evaluate pair k of first member ``first`` (_first_member) and second member j
+    (pair_forces), fill its per-pair arrays; (touching, the force on j from i [N], the normal,
+    the overlap [m]), force and normal (0, 0, 0) for a pair apart. ``periodic``,
+    ``stretched``: whether the scene has images, stretching (pair_forces); a sheared cell's
+    ``period`` and ``affine_rate`` hold a fourth entry (the tests of their lengths are on
+    the arrays' shapes, hoisted out of the loops)."""
+    d0, d1, d2, distance, gap_overlap = _contact_gap(k, first, j, position, radius, image,
+                                                     period, periodic, overlap, shear_force,
+                                                     normal_force, force)
+    if gap_overlap <= 0.0:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, gap_overlap
+    kn = normal_stiffness(young, first[9], radius[j])
+    ks = shear_ratio * kn
+    n0, n1, n2, fs0, fs1, fs2, v0, v1, v2 = _turned_contact(
+        k, first, j, d0, d1, d2, distance, velocity, angular_velocity, radius, affine_rate,
+        stretched, shear_force, normal, dt)
+    vn = v0 * n0 + v1 * n1 + v2 * n2
+    fs0 -= ks * (v0 - vn * n0) * dt
+    fs1 -= ks * (v1 - vn * n1) * dt
+    fs2 -= ks * (v2 - vn * n2) * dt
+    fn = kn * gap_overlap
+    cap = fn * tan_friction
+    magnitude = math.sqrt(fs0 * fs0 + fs1 * fs1 + fs2 * fs2)
+    # a select, not a branch: whether a contact slides is unpredictable pair to pair (a fifth
+    # of a dry shear's contacts slide); x * 1.0 == x, so a sticking contact is unchanged
+    scale = cap / magnitude if magnitude > cap else 1.0
+    fs0 *= scale
+    fs1 *= scale
+    fs2 *= scale
+    f0, f1, f2 = _store_contact(k, fn, fs0, fs1, fs2, n0, n1, n2, shear_force, normal,
+                                normal_force, force)
     return True, f0, f1, f2, n0, n1, n2, gap_overlap
 
 

@@ -44,6 +44,23 @@ def pwave_timestep(radius, young, density):
     return float(np.min(radius) / np.sqrt(young / density))
 
 
+def rayleigh_timestep(radius, young, poisson, density):
+    """The Rayleigh-wave step pi R_min sqrt(rho / G) / (0.1631 nu + 0.8766) [s] of spheres of
+    ``radius`` [m], Young's modulus [Pa], Poisson ratio and density [kg/m^3], G = E / (2 (1 +
+    nu)) (to be multiplied by a safety factor): the time a Rayleigh wave takes to cross half a
+    sphere's circumference (Li, Xu & Thornton 2005; Thornton 2015), the step of Hertz–Mindlin
+    scenes. It depends on the material alone, not on the overlaps: the Hertz stiffness
+    2 E* sqrt(R* delta) grows with the load, so a step from the contacts' stiffness would have
+    to guess the largest overlap to come, while the energy of the contacts travels at the
+    Rayleigh speed whatever the load (docs/physics.md 'Hertz–Mindlin contacts')."""
+    radius = check_array("radius", np.atleast_1d(radius), positive=True)
+    young = check_positive("young", young, "Pa")
+    density = check_positive("density", density, "kg/m^3")
+    shear = young / (2.0 * (1.0 + poisson))
+    return float(np.pi * np.min(radius) * np.sqrt(density / shear)
+                 / (0.1631 * poisson + 0.8766))
+
+
 @numba.njit(cache=True)
 def stiffness_product(vector, position, radius, scale_u, scale_r, pair_i, pair_j, image, period,
                       wall_position, young, shear_ratio):

@@ -19,11 +19,13 @@ from pendular.capillary.bridge_kernels import (FORMS_FROM_FILMS, RUPTURED,
 from pendular.capillary.bridge_state import AT_CONTACT
 from pendular.dem.contact_law import (_evaluate_pair, _first_member, _store_row_sums,
     _stretched, _sum_pair_terms, wall_contact_stiffness)
+from pendular.dem.hertz_mindlin import _evaluate_damped_pair
 from pendular.dem.neighbors import _sum_pair_forces
 from pendular.gpu.cuda import cuda, device, device_twin
 
 first_member = device_twin(_first_member)
 evaluate_pair = device_twin(_evaluate_pair)
+evaluate_damped_pair = device_twin(_evaluate_damped_pair)
 is_stretched = device_twin(_stretched)
 follow_contact = device_twin(_follow_contact)
 follow_across_gap = device_twin(_follow_across_gap)
@@ -40,14 +42,18 @@ wall_stiffness = device_twin(wall_contact_stiffness)
 @cuda.jit
 def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i, pair_j,
                 image, period, affine_rate, shear_force, normal, overlap, normal_force, force,
-                young, shear_ratio, tan_friction, dt, flags, wet, persist, volume_control,
+                young, shear_ratio, tan_friction, dt, mass, damped, hertz, damping, flags, wet,
+                persist, volume_control,
                 state, volume, bridge_force, filling_i, filling_j, bridge_suction,
                 bridge_pair_force, suction, surface_tension, radius_ratios, suction_axis,
                 distance_low, log_distance_rupture, log_values, roughness, closed, film,
                 released, events, marked, volume_ratios, volume_axes, volume_distance_low,
                 volume_log_rupture, grid):
     """Every pair of particle p's row (one thread per particle): the CPU's contact law
-    (_evaluate_pair, with its tests as the CPU's pair_forces: images where ``period`` (3,)
+    (_evaluate_pair; with ``damped``, the damped law of pendular.dem.hertz_mindlin,
+    _evaluate_damped_pair, of ``mass`` (N,) [kg], ``hertz``, ``damping`` and ``young``,
+    ``shear_ratio`` standing for its modulus and tangential stiffness; with its tests as the
+    CPU's pair_forces: images where ``period`` (3,)
     [m] is not zero, each pair's in ``image`` (K, 3) int8, and stretching where
     ``affine_rate`` (3,) [1/s] is not; inside walls (1, 3) and (3,) zeros stand for the
     arrays it then does not read), then (``wet``) its suction-controlled bridge at contact
@@ -74,9 +80,16 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
     events_marked = 0
     for s in range(pair_count[p]):
         k = s * n + p
-        evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
-                      image, period, periodic, affine_rate, stretched, shear_force, normal,
-                      overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
+        if damped:
+            evaluate_damped_pair(k, first, mass[p], pair_j[k], position, velocity,
+                                 angular_velocity, radius, mass, image, period, periodic,
+                                 affine_rate, stretched, shear_force, normal, overlap,
+                                 normal_force, force, hertz, young, shear_ratio, damping,
+                                 tan_friction, dt)
+        else:
+            evaluate_pair(k, first, pair_j[k], position, velocity, angular_velocity, radius,
+                          image, period, periodic, affine_rate, stretched, shear_force, normal,
+                          overlap, normal_force, force, young, shear_ratio, tan_friction, dt)
         if wet and volume_control:
             events_marked += follow_volume(
                 k, position, radius, pair_i, pair_j, image, period, overlap, normal, state,

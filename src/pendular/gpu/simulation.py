@@ -27,15 +27,17 @@ stresses, as the CPU does. When a target falls below zero the device records it 
 raises the CPU's StageFailed at its next check or, earlier, when anything reads the state
 (``copy_back``), so that no writer records a state past the failure.
 
-What runs on the device so far: walled scenes (``Walls``) with ContactForces, WallForces,
-RollingResistance (pendular.gpu.rolling), Gravity (pendular.gpu.gravity) and, wet,
-SuctionBridges at contact or across gaps (``persist``; a new suction between runs, as the
-CPU: GpuSimulation._follow_suction); controls StressServo, ConstantStrainRate, MixedStress
-(its servos among the controls), RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip
-after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not)
-with ContactForces, RollingResistance and, wet, SuctionBridges at contact or across gaps or
-VolumeBridges, under StressServo, ConstantStrainRate, ConstantShearRate (simple shear,
-Lees–Edwards) and MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
+What runs on the device so far: walled scenes (``Walls``) with ContactForces (or the damped
+and Hertz–Mindlin laws of pendular.dem.hertz_mindlin, whose walls the device does not run:
+ViscoelasticWallForces is refused), WallForces, RollingResistance (pendular.gpu.rolling),
+Gravity (pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps
+(``persist``; a new suction between runs, as the CPU: GpuSimulation._follow_suction);
+controls StressServo, ConstantStrainRate, MixedStress (its servos among the controls),
+RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips);
+the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
+damped or Hertz–Mindlin law), RollingResistance and, wet, SuctionBridges at contact or across
+gaps or VolumeBridges, under StressServo, ConstantStrainRate, ConstantShearRate (simple
+shear, Lees–Edwards) and MixedStress (pendular.gpu.cell): its step wraps the particles and finds the pairs through the
 cell's faces at a rebuild (as far as the bridges' rupture range), reduces the cell's stress
 (with the face terms of the forces of bridges across gaps), runs its controls and a leapfrog
 carried by its stretching and shear, or grows the radii (RadiusGrowth, GrowthTimeStep) in a
@@ -49,6 +51,7 @@ from pendular.capillary.bridges import CapillaryBridges, SuctionBridges, VolumeB
 from pendular.dem.cell import ConstantShearRate, PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.gravity import Gravity
+from pendular.dem.hertz_mindlin import DampedLinearForces, HertzMindlinForces
 from pendular.dem.grips import Grip
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
@@ -83,6 +86,16 @@ def _one(sim, kind, required=True):
     return found[0] if found else None
 
 
+def _contact_law(sim):
+    """The one contact law among sim's forces: a ContactForces, or a damped or Hertz–Mindlin
+    law (pendular.dem.hertz_mindlin), which the device runs with the same gather."""
+    found = [op for op in sim.forces if isinstance(op, ContactForces)]
+    if len(found) != 1:
+        raise ValueError(f"device='gpu' needs one contact law among the forces; found "
+                         f"{len(found)}")
+    return found[0]
+
+
 def check_scene(sim):
     """ValueError naming what of ``sim`` the GPU path does not run yet (module docstring).
     Reads what the scene is made of, not its state (Simulation.peek)."""
@@ -95,15 +108,16 @@ def check_scene(sim):
     if type(sim.neighbors) is not NeighborList or type(sim.integrator) is not Integrator:
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
-        if type(op) not in (ContactForces, WallForces, SuctionBridges, VolumeBridges,
-                            RollingResistance, Gravity):
+        if type(op) not in (ContactForces, HertzMindlinForces, DampedLinearForces, WallForces,
+                            SuctionBridges, VolumeBridges, RollingResistance, Gravity):
             raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
-                             "(valid: ContactForces, WallForces, SuctionBridges, "
-                             "VolumeBridges, RollingResistance, Gravity)")
+                             "(valid: ContactForces, HertzMindlinForces, DampedLinearForces, "
+                             "WallForces, SuctionBridges, VolumeBridges, RollingResistance, "
+                             "Gravity)")
     _one(sim, Gravity, required=False)             # at most one of each
     resistance = _one(sim, RollingResistance, required=False)
     if resistance is not None and sim.forces.index(resistance) < sim.forces.index(
-            _one(sim, ContactForces)):
+            _contact_law(sim)):
         raise ValueError("device='gpu' runs a RollingResistance listed after the contact law "
                          "only (it reads the contact law's pairs of the same step)")
     bridges = _bridges_of(sim)
@@ -403,8 +417,11 @@ class GpuSimulation:
         sim = self.sim
         s = self.state
         n = s.count
-        contact = _one(sim, ContactForces)
+        contact = _contact_law(sim)
         tan_friction = float(np.tan(np.radians(contact.friction_deg)))
+        damped = type(contact) is not ContactForces
+        stiffness = (contact.modulus, contact.tangential) if damped else (contact.young,
+                                                                           contact.shear_ratio)
         columns = self._bridge_columns()
         # bridges at contact join the contact law's gather; persisting ones are added last
         joined = s.wet and not s.persist
@@ -416,8 +433,10 @@ class GpuSimulation:
             (forces.pair_forces, n, (s.position, s.velocity, s.angular_velocity, s.radius,
                                      s.pair_count, s.pair_i, s.pair_j, image, period,
                                      affine_rate, s.shear_force, s.normal,
-                                     s.overlap, s.normal_force, s.pair_force, contact.young,
-                                     contact.shear_ratio, tan_friction, sim.dt, s.flags,
+                                     s.overlap, s.normal_force, s.pair_force, *stiffness,
+                                     tan_friction, sim.dt, s.mass, damped,
+                                     damped and contact.hertz,
+                                     contact.damping if damped else 0.0, s.flags,
                                      s.wet, s.persist, volume, *columns,
                                      s.bridge_pair_force, self._suction,
                                      bridges.surface_tension if s.wet else 1.0,
@@ -509,8 +528,9 @@ class GpuSimulation:
         s = self.state
         n = s.count
         order = [type(op) for op in sim.forces]
-        gathered_by = SuctionBridges if s.wet and not s.persist else ContactForces
-        walls_first = order.index(WallForces) < order.index(gathered_by)
+        gatherer = (order.index(SuctionBridges) if s.wet and not s.persist
+                    else sim.forces.index(_contact_law(sim)))
+        walls_first = order.index(WallForces) < gatherer
         limit = 0.5 * s.skin
         bridges = s.bridges
         return [

@@ -10,8 +10,9 @@ The commands that write each column: HISTORY_WRITERS (every loading path records
 pendular.procedures.loading.history_columns; wet, the capillary ones of
 pendular.homogenize.on_the_fly.CapillaryHomogenization; at a water content the closed
 liquid's; each test adds its own: an undrained triaxial excess_pore_pressure, a path with
-water-content stages water_content and liquid_total). Every summary key, with its units,
-meaning and the commands that write it: SUMMARY_KEYS (docs/outputs.md is generated from both;
+water-content stages water_content and liquid_total; an impact records every step of its
+collision, pendular.procedures.impact). Every summary key, with its units, meaning and the
+commands that write it: SUMMARY_KEYS (docs/outputs.md is generated from both;
 ``undeclared_keys`` names what a summary holds beyond them).
 """
 
@@ -66,9 +67,9 @@ LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "p
 HISTORY_WRITERS = {
     **dict.fromkeys(("porosity", "volumetric_strain", "sigma_contact", "fabric", "anisotropy"),
                     (*LABORATORY, "swcc")),
-    **dict.fromkeys(("step", "time", "axial_strain", "sigma_wall", "coordination",
-                     "unbalanced_force", "bridges", "saturation"),
-                    (*LABORATORY, "swcc", "tension")),
+    **dict.fromkeys(("step", "axial_strain", "sigma_wall", "coordination", "unbalanced_force",
+                     "bridges", "saturation"), (*LABORATORY, "swcc", "tension")),
+    "time": (*LABORATORY, "swcc", "tension", "impact"),
     **dict.fromkeys(("suction", "sigma_capillary", "pendular_overlaps", "chi", "B", "psi",
                      "sigma_effective", "psi_interface", "sigma_effective_complete",
                      "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
@@ -82,12 +83,14 @@ HISTORY_WRITERS = {
     "stage": ("oedometer", "isotropic", "simple-shear", "cyclic", "path"),
     "cycle": ("cyclic",),
     **dict.fromkeys(("shear_strain", "shear_stress", "normal_stress"), ("simple-shear",)),
+    **dict.fromkeys(("overlap", "normal_force", "tangential_force", "angular_velocity"),
+                    ("impact",)),
 }
 
 _VECTOR = ("axis",)
 _TENSOR = ("axis", "component")
 
-#: Every history column pendular writes (triaxial dry and wet, direct tension).
+#: Every history column pendular writes (triaxial dry and wet, direct tension, impact).
 HISTORY_COLUMNS = {
     "step": Column("1", "time step number", dtype="int64"),
     "time": Column("s", "simulated time"),
@@ -170,6 +173,14 @@ HISTORY_COLUMNS = {
                                  "positive resisting a positive shear", equation="Eq. 3.41"),
     "normal_stress": Column("Pa", "simple shear: normal stress sigma_zz of the cell, "
                                   "compression positive"),
+    "overlap": Column("m", "impact: overlap of the sphere with its target"),
+    "normal_force": Column("N", "impact: contact force on the sphere along the normal from "
+                                "its target, repulsion positive"),
+    "tangential_force": Column("N", "impact: contact force on the sphere along the incident "
+                                    "tangent (in the plane of incidence)"),
+    "angular_velocity": Column("rad/s", "impact: the sphere's angular velocity about the axis "
+                                        "normal to the plane of incidence, positive rolling "
+                                        "forward"),
 }
 
 HISTORY_COLUMNS = {name: replace(column, commands=HISTORY_WRITERS.get(name, ()))
@@ -211,7 +222,7 @@ class Key:
 #: The tests whose summary holds a peak of q.
 SHEARS = ("triaxial", "path")
 _T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
-_E = ("envelope",)
+_E, _I = ("envelope",), ("impact",)
 _COMPRESSION = ("oedometer", "isotropic", "path")
 _INDICES = ("oedometer", "isotropic")
 #: The fields of a row of the SWCC (swcc.json ``drying`` and ``wetting``,
@@ -227,7 +238,8 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
 OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
     "friction": "deg", "prep_friction": "deg", "rolling_friction": "1",
-    "twisting_friction": "1", "gravity": "m/s^2", "density": "kg/m^3", "damping": "1",
+    "twisting_friction": "1", "gravity": "m/s^2", "contact": "1", "poisson": "1",
+    "restitution": "1", "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
@@ -614,6 +626,25 @@ SUMMARY_KEYS = {
                  "whether an earlier run was reused, its peak (its summary.json's keys) and the "
                  "principal stresses there, sigma_1 = p + 2q/3 and sigma_3 = p - q/3, net and "
                  "effective", _E),
+    # -- one collision, summary.json of ``pendular impact`` (pendular.procedures.impact)
+    "max_normal_force": Key("N", "impact: the peak normal contact force on the sphere", _I),
+    "max_overlap": Key("m", "impact: the peak overlap of the sphere with its target", _I),
+    "contact_duration": Key("s", "impact: how long the normal force was positive", _I),
+    "normal_restitution": Key("1", "impact: -(rebound / incident) velocity of the sphere's "
+                                   "centre along the initial normal", _I),
+    "tangential_restitution": Key("1", "impact: rebound / incident velocity of the sphere's "
+                                       "centre along the incident tangent (signed); null at "
+                                       "normal incidence", _I),
+    "rebound_angular_velocity": Key("rad/s", "impact: the sphere's angular velocity after the "
+                                             "contact, about the axis normal to the plane of "
+                                             "incidence (positive: rolling forward)", _I),
+    "rebound_angle_deg": Key("deg", "impact: angle of the rebound velocity from the normal",
+                             _I),
+    "dt": Key("s", "impact: the time step, 1/STEPS_PER_CONTACT of the contact's closed-form "
+                   "duration", _I),
+    "rayleigh_timestep": Key("s", "impact: the Rayleigh-wave time step of the sphere "
+                                  "(pendular.dem.timestep.rayleigh_timestep), for comparison",
+                             _I),
 }
 
 

@@ -70,8 +70,8 @@ _SAMPLE_CELL = ((option_of(PrepareConfig, "particles", low=MIN_SAMPLE_PARTICLES)
                 + _options(PrepareConfig, ("confining", "seed", "periodic")))
 _MATERIAL = _options(PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg",
                                      "rolling_friction", "twisting_friction", "gravity",
-                                     "young", "damping", "timestep_safety", "timestep_rule",
-                                     "skin_factor"))
+                                     "young", "contact", "poisson", "restitution", "damping",
+                                     "timestep_safety", "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL
 #: A laboratory test's sample: its preparation, sizes and material, or a prepared --sample.

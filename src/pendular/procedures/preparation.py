@@ -32,6 +32,8 @@ from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.gravity import MAX_GRAVITY, Gravity
+from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinearForces,
+    HertzMindlinForces, ViscoelasticWallForces)
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
@@ -39,7 +41,8 @@ from pendular.dem.neighbors import NeighborList, spatial_order
 from pendular.dem.rolling import MAX_RESISTANCE, RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
-from pendular.dem.timestep import TIMESTEP_RULES, critical_timestep, pwave_timestep
+from pendular.dem.timestep import (TIMESTEP_RULES, critical_timestep, pwave_timestep,
+    rayleigh_timestep)
 from pendular.utils.parameters import fail, parameter, spec_of, validate
 from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
@@ -281,6 +284,17 @@ class PrepareConfig:
                              help="YADE young E, kn = E R")
     shear_ratio: float = parameter(0.3, low=0.0, high=10.0, help="contact stiffness ratio "
                                    "ks / kn")
+    contact: str = parameter("linear", kind=str, choices=CONTACT_LAWS, flag="--contact",
+                             help="contact law: linear springs (kn = E R, ks = 0.3 kn), or "
+                                  "Hertz-Mindlin from the grains' E and --poisson, its time "
+                                  "step the Rayleigh-wave rule (docs/physics.md)")
+    poisson: float = parameter(0.3, low=POISSON_RANGE[0], high=POISSON_RANGE[1],
+                               low_inclusive=False, high_inclusive=False, flag="--poisson",
+                               help="Poisson ratio of the grains (Hertz-Mindlin)")
+    restitution: float = parameter(1.0, low=0.0, high=1.0, low_inclusive=False,
+                                   flag="--restitution",
+                                   help="coefficient of restitution of a contact, normal and "
+                                        "tangential: viscous damping, 1 none")
     friction_deg: float = parameter(18.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
                                     flag="--friction", help="contact friction")
     prep_friction_deg: float = parameter(
@@ -366,17 +380,29 @@ class PrepareConfig:
                             self.seed)
 
 
+#: The share of the Rayleigh-wave step a Hertz–Mindlin scene runs at (times
+#: timestep_safety): the Rayleigh step is one contact's, and a packing's grains touch several
+#: others, so 20-40 % of it is the usual choice (Thornton 2015); 0.3 x 0.7 = 0.21.
+RAYLEIGH_SHARE = 0.3
+
+
 def pwave_step(radius, config):
     """timestep_safety times the P-wave estimate (YADE's PWaveTimeStep) of the spheres of
-    ``radius`` [m] with ``config``'s material [s]."""
+    ``radius`` [m] with ``config``'s material [s]; with Hertz–Mindlin contacts, times
+    RAYLEIGH_SHARE of their Rayleigh-wave step (pendular.dem.timestep.rayleigh_timestep),
+    whatever the rule."""
+    if config.contact == "hertz-mindlin":
+        return config.timestep_safety * RAYLEIGH_SHARE * rayleigh_timestep(
+            radius, config.young, config.poisson, config.density)
     return config.timestep_safety * pwave_timestep(radius, config.young, config.density)
 
 
 def timestep(sim, config):
     """dt [s] = timestep_safety times the estimate of ``config.timestep_rule``: the P-wave
     estimate of the current radii, or the critical step of the contacts of ``sim``
-    (pendular.dem.timestep.critical_timestep; the P-wave estimate while nothing touches)."""
-    if config.timestep_rule == "stiffness":
+    (pendular.dem.timestep.critical_timestep; the P-wave estimate while nothing touches);
+    with Hertz–Mindlin contacts the Rayleigh-wave step (pwave_step)."""
+    if config.timestep_rule == "stiffness" and config.contact == "linear":
         critical = critical_timestep(sim, config.young, config.shear_ratio)
         if np.isfinite(critical):
             return config.timestep_safety * critical
@@ -419,17 +445,32 @@ def equilibrated(config):
     return static(config.equilibrium_unbalanced, config.stress_tolerance)
 
 
+def contact_forces(config, friction_deg):
+    """The contact law of ``config`` at ``friction_deg`` [deg]: the linear law
+    (ContactForces), damped where its ``restitution`` is below 1 (DampedLinearForces), or
+    Hertz–Mindlin (pendular.dem.hertz_mindlin)."""
+    if config.contact == "hertz-mindlin":
+        return HertzMindlinForces(config.young, config.poisson, config.restitution,
+                                  friction_deg)
+    if config.restitution < 1.0:
+        return DampedLinearForces(config.young, config.shear_ratio, config.restitution,
+                                  friction_deg)
+    return ContactForces(config.young, config.shear_ratio, friction_deg)
+
+
 def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None,
                    device="cpu", resistance=True):
-    """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m], linear
-    contacts at ``friction_deg`` [deg], wall springs (none in a periodic cell), the weight
-    (``config.gravity`` > 0), the rolling and twisting resistance (``resistance`` and one of
-    ``config``'s coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its
-    runs on ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity
-    and resistance it holds the contacts and the walls alone."""
-    forces = [ContactForces(config.young, config.shear_ratio, friction_deg)]
+    """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m],
+    contacts of ``config``'s law at ``friction_deg`` [deg] (contact_forces), frictionless
+    wall contacts of the same law (none in a periodic cell), the weight (``config.gravity``
+    > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
+    coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its runs on
+    ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
+    resistance it holds the contacts and the walls alone."""
+    forces = [contact_forces(config, friction_deg)]
     if not walls.periodic:
-        forces.append(WallForces(config.young))
+        forces.append(WallForces(config.young) if type(forces[0]) is ContactForces
+                      else ViscoelasticWallForces(forces[0]))
     if config.gravity > 0.0:
         forces.append(Gravity(config.gravity))
     if resistance:
@@ -518,7 +559,7 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     particles = Particles(position[order], cloud_radius[order], config.density)
     walls = (PeriodicCell if config.periodic else Walls).box(lo, hi)
     growth = [RadiusGrowth(config.prep_stress, max_rate=1e-4)]
-    if config.timestep_rule == "stiffness":
+    if config.timestep_rule == "stiffness" and config.contact == "linear":
         growth.append(GrowthTimeStep(config))
     sim = dry_simulation(particles, walls, config, pwave_step(particles.radius, config),
                          GROWTH_SKIN_FACTOR * config.radius,
@@ -587,6 +628,9 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
 
 def timestep_description(config):
     """How ``config`` sets the time step, in words (reports)."""
+    if config.contact == "hertz-mindlin":
+        return (f"{config.timestep_safety} x {RAYLEIGH_SHARE} x Rayleigh-wave time step "
+                "pi R_min sqrt(rho / G) / (0.1631 nu + 0.8766)")
     if config.timestep_rule == "stiffness":
         return (f"{config.timestep_safety} x the critical time step of the contacts "
                 "(pendular.dem.timestep; radius growth: P-wave estimate of the current radii)")
