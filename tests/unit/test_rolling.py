@@ -261,3 +261,32 @@ def test_a_capillary_bridge_does_not_raise_the_limit_moment():
     assert sim.particles.force[0, 0] != pytest.approx(-NORMAL_FORCE, rel=1e-3)   # attracted
     assert sim.particles.torque[0] == pytest.approx([0, 0, -0.2 * REDUCED * NORMAL_FORCE],
                                                     rel=1e-12)
+
+
+@pytest.mark.parametrize("contact", ["hertz-mindlin", "linear"])
+def test_spheres_rolling_on_each_other_in_an_impact_lose_the_limit_moments_impulse(contact):
+    """``pendular impact --target sphere --spin W --rolling-friction MU_R``: at normal incidence
+    the two spheres, spinning opposite ways, roll on each other without sliding, and a spring
+    that loads faster than its limit grows (2.25 k_n mu_r^2 R*^2 2W against mu_r R* dFn/dt)
+    stays on it: the moment mu_r R* Fn takes mu_r R* J / I off the spin, J = m v (1 + e_n) the
+    normal impulse; without resistance the spin is kept."""
+    from pendular.procedures import impact
+    from pendular.utils.parameters import option_values
+
+    radius, density, speed, spin, mu_r = 0.01, 7800.0, 1.0, 2000.0, 0.2
+    given = {"target": "sphere", "contact": contact, "radius": radius, "young": 2e11,
+             "density": density, "velocity": speed, "spin": spin, "restitution": 0.8}
+    rolled, _ = impact.run_impact(option_values(impact.OPTIONS,
+                                                {**given, "rolling_friction": mu_r})[0])
+    free, _ = impact.run_impact(option_values(impact.OPTIONS, given)[0])
+    mass = density * 4.0 / 3.0 * np.pi * radius ** 3
+    impulse = mass * speed * (1.0 + rolled["normal_restitution"])
+    loss = mu_r * 0.5 * radius * impulse / (0.4 * mass * radius ** 2)
+    assert spin - rolled["rebound_angular_velocity"] == pytest.approx(loss, rel=1e-6)
+    assert free["rebound_angular_velocity"] == pytest.approx(spin, rel=1e-12)
+    assert rolled["normal_restitution"] == pytest.approx(free["normal_restitution"], rel=1e-9)
+
+
+def test_rolling_friction_with_a_wall_target_is_refused_naming_the_option(capsys):
+    refused(*run_in_process("impact", ["--target", "wall", "--rolling-friction", "0.2"],
+                            capsys), "--rolling-friction", "--target")

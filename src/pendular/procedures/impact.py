@@ -3,7 +3,10 @@
 A sphere of ``radius``, ``young``, ``poisson``, ``density`` hits a target at ``velocity``,
 ``angle`` degrees from the normal, spinning at ``spin`` about the axis normal to the plane of
 incidence (positive: rolling forward); with target "sphere" an identical sphere comes the
-other way (the scene is symmetric through the contact point), with "wall" a rigid flat wall:
+other way (its position and velocity the mirror image through the contact point) spinning the
+other way (-spin: at normal incidence the two roll on each other without sliding, their
+relative rotation the rolling resistance's, ``rolling_friction`` and ``twisting_friction``,
+pendular.dem.rolling), with "wall" a rigid flat wall:
 the limit of an infinitely stiff wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R, m* = m
 (pendular.dem.hertz_mindlin.ViscoelasticWallForces; linear: kn = E R). The engine's own
 Simulation runs it with the chosen contact law, without local damping or gravity, at a step of
@@ -26,6 +29,7 @@ from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
 from pendular.dem.protocols import state_array
+from pendular.dem.rolling import RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import rayleigh_timestep
@@ -68,6 +72,12 @@ OPTIONS = (
                                    "(positive: rolling forward)", flag="--spin"),
                 0.0, checked=True),
     option_of(PrepareConfig, "contact", checked=True),
+    option_of(PrepareConfig, "rolling_friction", checked=True,
+              help="rolling resistance coefficient mu_r between the spheres (target sphere): "
+                   "limit moment mu_r R* Fn (pendular.dem.rolling; 0: none)"),
+    option_of(PrepareConfig, "twisting_friction", checked=True,
+              help="twisting resistance coefficient mu_t between the spheres (target sphere): "
+                   "limit moment mu_t R* Fn about the normal (0: none)"),
 )
 
 
@@ -95,7 +105,16 @@ def elastic_impact(values):
 
 def check_impact(values):
     """OptionError naming --velocity and --young when the impact of ``values`` would overlap
-    the spheres by more than MAX_OVERLAP of their radius (elastic_impact)."""
+    the spheres by more than MAX_OVERLAP of their radius (elastic_impact), and naming
+    --rolling-friction or --twisting-friction above 0 with a wall target (sphere–wall contacts
+    carry no rolling or twisting moment: pendular.dem.rolling)."""
+    for option in ("rolling_friction", "twisting_friction"):
+        if values[option] > 0.0 and values["target"] == "wall":
+            raise OptionError(lambda name, option=option: (
+                f"{name(option)} = {values[option]:g} acts between spheres only (a wall "
+                f"carries no rolling or twisting moment); valid: 0 with {name('target')} "
+                f"wall, or "
+                f"{name('target')} sphere"))
     overlap = elastic_impact(values)[1] / values["radius"]
     if overlap > MAX_OVERLAP:
         raise OptionError(lambda name: (
@@ -168,10 +187,10 @@ def impact_scene(values):
     position = np.array([[0.0, 0.0, radius]])
     spin = np.array([[0.0, values["spin"], 0.0]])
     wall = values["target"] == "wall"
-    if not wall:        # the mirror image through the contact point
+    if not wall:        # the mirror image through the contact point, spinning the other way
         velocity = np.vstack((velocity, -velocity))
         position = np.vstack((position, -position))
-        spin = np.vstack((spin, spin))
+        spin = np.vstack((spin, -spin))
     particles = Particles(position, np.full(len(position), radius), values["density"],
                           velocity=velocity, angular_velocity=spin)
     reach = 40.0 * radius
@@ -185,6 +204,9 @@ def impact_scene(values):
     forces = [contact]
     if wall:
         forces.append(ViscoelasticWallForces(contact, values["friction"]))
+    elif values["rolling_friction"] > 0.0 or values["twisting_friction"] > 0.0:
+        forces.append(RollingResistance(values["rolling_friction"],
+                                        values["twisting_friction"]))
     duration = elastic_impact(values)[0]
     recorder = ImpactRecorder(values["target"])
     sim = Simulation(particles, walls, duration / STEPS_PER_CONTACT,

@@ -6,8 +6,10 @@ With --target sphere two identical spheres approach each other, each at --veloci
 --target wall one sphere hits a rigid flat wall at --velocity: the limit of an infinitely
 stiff wall (Hertz: E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R; linear: kn = E R).
 --angle tilts the velocity from the normal, --spin turns the sphere about the axis normal to
-the plane of incidence. The engine's own simulation runs it with the chosen --contact law, at
-2,000 steps per closed-form contact duration. Writes DIR/summary.json, DIR/history.h5 (time,
+the plane of incidence (a target sphere the other way); --rolling-friction and
+--twisting-friction resist the spheres' relative rotation (target sphere only). The engine's
+own simulation runs it with the chosen --contact law, at 2,000 steps per closed-form contact
+duration. Writes DIR/summary.json, DIR/history.h5 (time,
 overlap, normal_force, tangential_force, angular_velocity) and DIR/impact.png (force against
 time and against overlap).
 """
