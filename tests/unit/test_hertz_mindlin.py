@@ -302,3 +302,30 @@ def test_a_laboratory_scene_takes_the_law_its_configuration_names():
         assert tuple(type(op) for op in sim.forces) == kinds
     assert pwave_step([1e-3], config) == pytest.approx(
         config.timestep_safety * RAYLEIGH_SHARE * rayleigh_timestep(1e-3, 7e10, 0.22, 2650.0))
+
+
+@pytest.mark.parametrize("law", [HertzMindlinForces(2e11, 0.3, 0.3),
+                                 DampedLinearForces(2e11, 0.3, 0.3)])
+def test_the_per_pair_normal_force_is_the_springs_whatever_the_damping(law):
+    """A damped pair closing or opening: its force on the particles carries the dashpot, its
+    per-pair normal force the spring's alone, so that the rolling resistance's k_n = F_n /
+    delta (pendular.dem.rolling) is the secant stiffness, 4/3 E* sqrt(R* delta) or the
+    linear kn, and not one that swings with the normal velocity."""
+    from pendular.dem.contact_law import normal_stiffness
+
+    overlap, radius = 1e-6, STEEL["radius"]
+    position, radii, contacts = pressed_pair(overlap)
+    mass = np.full(2, STEEL["density"] * 4.0 / 3.0 * math.pi * radius ** 3)
+    stiffness = (4.0 / 3.0 * law.modulus * math.sqrt(0.5 * radius * overlap) if law.hertz
+                 else normal_stiffness(law.modulus, radius, radius))
+    for speed in (-0.1, 0.1):                   # closing, then opening
+        velocity = np.array([[0.0, 0.0, 0.0], [speed, 0.0, 0.0]])
+        arrays = [np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(1), np.zeros(1),
+                  np.zeros((1, 3))]
+        viscoelastic_pair_forces(position, velocity, np.zeros((2, 3)), radii, mass,
+                                 contacts.pair_i, contacts.pair_j, contacts.image,
+                                 np.zeros(3), np.zeros(3), *arrays, law.hertz, law.modulus,
+                                 law.tangential, law.damping, law._tan_friction, 1e-9)
+        _, _, overlaps, normal_force, force = arrays
+        assert normal_force[0] / overlaps[0] == pytest.approx(stiffness, rel=1e-9)
+        assert (force[0, 0] > normal_force[0]) == (speed < 0.0)     # the dashpot's sign

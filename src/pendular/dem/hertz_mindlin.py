@@ -29,8 +29,13 @@ virtual sphere of the same radius, kn = E R); its tangential spring lies in the 
 plane, capped at Fn tan(wall friction): frictionless walls by default.
 
 The per-pair arrays are the contacts' (shear_force: the spring, normal, overlap,
-normal_force: F with damping, force: on j from i), and the forces reach the particles through
-the linear law's gather (ContactForces.gather).
+normal_force: the elastic spring's force, without the dashpot, as pendular.dem.neighbors.Contacts
+declares it, force: on j from i, damping included), and the forces reach the particles through
+the linear law's gather (ContactForces.gather). Readers of normal_force / overlap (the rolling
+resistance's k_n, pendular.dem.rolling; a periodic cell's servo stiffness) thus get the
+spring's secant stiffness, 2/3 of Hertz's tangent kn or the linear kn, at any damping, not a
+stiffness that swings with the normal velocity (above kn while the contact closes, 0 where
+the dashpot cancels the spring).
 """
 
 import math
@@ -151,7 +156,7 @@ def _evaluate_damped_pair(k, first, mass_i, j, position, velocity, angular_veloc
     normal[k, 0] = n0
     normal[k, 1] = n1
     normal[k, 2] = n2
-    normal_force[k] = fn
+    normal_force[k] = fe            # the spring's: F_n / delta is its secant stiffness
     force[k, 0] = fn * n0 + f0
     force[k, 1] = fn * n1 + f1
     force[k, 2] = fn * n2 + f2

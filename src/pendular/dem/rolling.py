@@ -21,8 +21,9 @@ and a twisting moment M_t n, both on i (j gets their opposite):
 k_n is the pair's secant stiffness F_n / δ, read from the per-pair arrays that every contact law
 fills (``Contacts.normal_force``, ``overlap``, ``normal``): the linear law's k_n itself, and for
 a Hertz law 4/3 E* sqrt(R* δ), the k_n LIGGGHTS's ``rolling_friction epsd`` takes from its
-Hertz law. F_n is the contact law's mechanical force alone: a capillary bridge's attraction
-does not raise the limit, as it does not raise the Coulomb cap. Sphere–wall contacts are
+Hertz law. F_n is the contact law's elastic spring force alone: a capillary bridge's attraction
+does not raise the limit, as it does not raise the Coulomb cap, and a damped law's dashpot
+(pendular.dem.hertz_mindlin) is left out of both k_n and the limit. Sphere–wall contacts are
 frictionless and carry no moment.
 """
 
