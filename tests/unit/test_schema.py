@@ -310,3 +310,18 @@ def test_a_simple_shear_history_is_indexed_by_its_shear_strain(tmp_path):
     write_history(tmp_path / "history.h5", columns, CONFIG)
     assert read_history(tmp_path).sigma_wall.dims == ("record", "axis")
     assert read_history(tmp_path, index="shear_strain").shear_strain.dims == ("shear_strain",)
+
+
+def test_no_key_is_declared_twice():
+    """A dict literal keeps the last of two equal keys silently: a second declaration of a
+    summary key or column would take the first one's commands away."""
+    import ast
+
+    import pendular.io.schema as schema
+
+    with open(schema.__file__, encoding="utf-8") as handle:
+        tree = ast.parse(handle.read())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):
+            keys = [key.value for key in node.keys if isinstance(key, ast.Constant)]
+            assert len(keys) == len(set(keys)), sorted({k for k in keys if keys.count(k) > 1})

@@ -365,7 +365,8 @@ SUMMARY_KEYS = {
                              LABORATORY),
     "particle_steps_per_s": Key("1/s", "particles times steps of the loading per second of "
                                        "wall-clock time", LABORATORY),
-    "dt": Key("s", "time step", (*LABORATORY, *_TEN)),
+    "dt": Key("s", "time step (impact: 1/STEPS_PER_CONTACT of the contact's closed-form "
+                   "duration)", (*LABORATORY, *_TEN, *_I)),
     "strain_rate": Key("1/s", "axial strain rate of the loading (tension: of the pull)",
                        (*LABORATORY, *_TEN)),
     "inertial_number": Key("1", "inertial number I = rate 2R sqrt(rho / p) at the reference "
@@ -640,8 +641,6 @@ SUMMARY_KEYS = {
                                              "incidence (positive: rolling forward)", _I),
     "rebound_angle_deg": Key("deg", "impact: angle of the rebound velocity from the normal",
                              _I),
-    "dt": Key("s", "impact: the time step, 1/STEPS_PER_CONTACT of the contact's closed-form "
-                   "duration", _I),
     "rayleigh_timestep": Key("s", "impact: the Rayleigh-wave time step of the sphere "
                                   "(pendular.dem.timestep.rayleigh_timestep), for comparison",
                              _I),
