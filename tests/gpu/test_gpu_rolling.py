@@ -11,6 +11,9 @@ torques, 1.5e-13 in the rolling springs, 1.6e-13 in the twisting springs, 1.8e-1
 pairs' moments (the simulator does not contract multiply-adds as the CPU's hot kernels do).
 In the cell (64 spheres, 100 steps, 185 touching pairs): 5.8e-16 in unwrapped positions,
 2.6e-13 in angular velocities, 7.3e-14 and 1.2e-13 in the rolling and twisting springs.
+In the cell with Hertz–Mindlin contacts damped to e = 0.5 (40 steps, 182 touching pairs, 1 on
+its rolling limit): 1.2e-15 in positions, 3.4e-14 in angular velocities, 1.2e-14 and 3.0e-15
+in the rolling and twisting springs.
 """
 
 import json
@@ -81,21 +84,33 @@ def test_the_rolling_resistance_in_a_periodic_cell_agrees_with_the_cpu(resisting
         assert periodic[name] < 1e-10, name
 
 
+def test_the_rolling_resistance_on_damped_hertz_mindlin_contacts_agrees_with_the_cpu(resisting):
+    """The moments read the damped law's per-pair normal force (its spring's) on the device as
+    on the CPU; over HERTZ_STEPS, before the damped scene's round-off grows."""
+    hertz = resisting["periodic_hertz"]
+    assert hertz["touching_cpu"] == hertz["touching_gpu"] == hertz["touching_both"] > 100
+    assert hertz["position"] < 1e-13 and hertz["cell"] < 1e-13
+    for name in ("angular_velocity", "torque", "rolling_moment", "twisting_moment", "moment"):
+        assert hertz[name] < 1e-10, name
+    assert resisting["hertz_on_limit"][0] > 0
+
+
 def test_a_rolling_resistance_before_the_contact_law_is_refused(resisting):
     assert "RollingResistance listed after the contact law only" in resisting["refusal"]
 
 
 # ---------------------------------------------------------------- the script, in the simulator
 
-def scene(moments=True, weight=True, periodic=False):
+def scene(moments=True, weight=True, periodic=False, hertz=False):
     """simulated.py's scene with the rolling resistance and the weight (module docstring), or
-    test_gpu_periodic.py's cell with the rolling resistance (``periodic``: no weight)."""
+    test_gpu_periodic.py's cell with the rolling resistance (``periodic``: no weight), its
+    contacts Hertz–Mindlin's damped to e = 0.5 with ``hertz`` (test_gpu_periodic.hertz_scene)."""
     from pendular.dem.gravity import Gravity
     from pendular.dem.rolling import RollingResistance
     from simulated import scene as plain
-    from test_gpu_periodic import scene as cell
+    from test_gpu_periodic import hertz_scene, scene as cell
 
-    sim = cell() if periodic else plain()
+    sim = (hertz_scene() if hertz else cell()) if periodic else plain()
     weight = weight and not periodic
     if weight:
         sim.forces.append(Gravity(9.81))
@@ -202,6 +217,12 @@ def main():
     gpu_cell = GpuSimulation(scene(periodic=True))
     gpu_cell.run(PERIODIC_STEPS)
     gpu_cell.to_host()
+    from test_gpu_periodic import HERTZ_STEPS
+    cpu_hertz = scene(periodic=True, hertz=True)
+    cpu_hertz.run(HERTZ_STEPS)
+    gpu_hertz = GpuSimulation(scene(periodic=True, hertz=True))
+    gpu_hertz.run(HERTZ_STEPS)
+    gpu_hertz.to_host()
     misplaced = scene()
     misplaced.forces.insert(0, misplaced.forces.pop())
     try:
@@ -216,7 +237,9 @@ def main():
         "forced_equals_plain": identical(snapshot(gpu.sim), snapshot(forced.sim)),
         "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim)),
         "rolling_on_limit": on_limit(cpu), "without": without,
-        "periodic": compare(snapshot(cpu_cell), snapshot(gpu_cell.sim)), "refusal": refusal}))
+        "periodic": compare(snapshot(cpu_cell), snapshot(gpu_cell.sim)),
+        "periodic_hertz": compare(snapshot(cpu_hertz), snapshot(gpu_hertz.sim)),
+        "hertz_on_limit": on_limit(cpu_hertz), "refusal": refusal}))
 
 
 if __name__ == "__main__":
