@@ -173,16 +173,16 @@ def figure(cases, path, title):
 
 
 def substitutions(numbers):
-    """Every measure as text, three significant digits (strains and Sr in %), named
-    dilatancy_<run>_<code>_<measure>."""
+    """Every measure as text (strains and Sr in %; three significant digits, whole numbers
+    from 100 on), named dilatancy_<run>_<code>_<measure>."""
     text = {}
     for run, codes in numbers.items():
         for code, values in codes.items():
             for key, value in values.items():
-                percent = key.startswith(("volumetric", "largest", "axial", "saturation"))
+                if key.startswith(("volumetric", "largest", "axial", "saturation")):
+                    value = 100.0 * value
                 text[f"dilatancy_{run}_{code}_{key}"] = (
-                    f"{value:,}" if isinstance(value, int)
-                    else f"{100 * value:.3g}" if percent else f"{value:.3g}")
+                    f"{value:,.0f}" if abs(value) >= 100.0 else f"{value:#.3g}")
     return text
 
 
