@@ -130,6 +130,7 @@ def run_case(young, sigma, prep_stress, seed, particles, max_strain, out, reuse)
             "mean_overlap_over_radius": float(overlaps.mean()),
             "max_overlap_over_radius": float(overlaps.max()),
             "mean_overlap_over_sigma_over_young": float(overlaps.mean() * young / sigma),
+            "max_overlap_over_mean": float(overlaps.max() / overlaps.mean()),
             "porosity": porosity, "coordination": coordination,
             "phi_peak_deg": triaxial["phi_peak_deg"], "peak_q": triaxial["peak_q"],
             "axial_strain_at_peak": triaxial["axial_strain_at_peak"],
@@ -141,15 +142,36 @@ def run_case(young, sigma, prep_stress, seed, particles, max_strain, out, reuse)
             "triaxial_wall_s": triaxial_s, "oedometer_wall_s": oedometer_s}
 
 
-UNITS = {"young": "Pa", "confining": "Pa", "sigma_over_young": "1", "prep_stress": "Pa",
-         "seed": "1",
+UNITS = {"case": "E:sigma[:growth[:seed]]", "young": "Pa", "confining": "Pa",
+         "sigma_over_young": "1", "prep_stress": "Pa", "seed": "1",
          "mean_overlap_over_radius": "1", "max_overlap_over_radius": "1",
-         "mean_overlap_over_sigma_over_young": "1", "porosity": "1", "coordination": "1",
+         "mean_overlap_over_sigma_over_young": "1", "max_overlap_over_mean": "1",
+         "porosity": "1", "coordination": "1",
          "phi_peak_deg": "deg", "peak_q": "Pa", "axial_strain_at_peak": "1", "e50": "Pa",
          "e50_over_sigma": "1", "e_small": "Pa", "e_small_over_sigma": "1", "k0": "1",
          "compression_index": "1",
          "constrained_modulus": "Pa", "dt": "s", "shear_steps": "1", "triaxial_wall_s": "s",
          "oedometer_wall_s": "s"}
+
+
+#: Columns quoted one by one by docs/material_stiffness.md.
+QUOTED = ("mean_overlap_over_sigma_over_young", "max_overlap_over_mean", "coordination",
+          "phi_peak_deg", "e_small_over_sigma", "e50_over_sigma", "k0", "compression_index",
+          "shear_steps")
+
+
+def substitutions(rows):
+    """The table as Markdown (``stiffness_table``) and each quoted value as text (three
+    significant digits, whole numbers from 100 on), named stiffness_<case>_<column> with the
+    case written E_sigma[_growth[_seed]] as on the command line, ':' as '_'."""
+    text = {"stiffness_table": markdown(rows)}
+    for row in rows:
+        label = row["case"].replace(":", "_").replace(".", "p").replace("+", "")
+        for key in QUOTED:
+            value = row[key]
+            text[f"stiffness_{label}_{key}"] = (f"{value:,.0f}" if abs(value) >= 100.0
+                                                else f"{value:#.3g}")
+    return text
 
 
 def markdown(rows):
@@ -187,9 +209,10 @@ def main(argv=None):
     rows = []
     for case in args.cases.split(","):
         young, sigma, prep, seed = (case.split(":") + ["", ""])[:4]
-        rows.append(run_case(float(young), float(sigma), float(prep) if prep else None,
-                             int(seed or 0), args.particles, args.max_strain, args.out,
-                             args.reuse))
+        rows.append({"case": case, **run_case(float(young), float(sigma),
+                                               float(prep) if prep else None, int(seed or 0),
+                                               args.particles, args.max_strain, args.out,
+                                               args.reuse)})
         print(markdown(rows[-1:]).splitlines()[-1], file=sys.stderr, flush=True)
     if args.json:
         with open(args.json, "w") as handle:
@@ -200,7 +223,7 @@ def main(argv=None):
                        "machine": args.machine,
                        "date": time.strftime("%Y-%m-%d", time.gmtime()),
                        "units": UNITS, "cases": rows,
-                       "substitutions": {"stiffness_table": markdown(rows)}},
+                       "substitutions": substitutions(rows)},
                       handle, indent=1)
     print(markdown(rows))
 

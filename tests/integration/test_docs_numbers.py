@@ -13,9 +13,9 @@ DOCS = os.path.join(ROOT, "docs")
 FIGURES = os.path.join(DOCS, "figures")
 
 
-def load_script(name):
-    """A script of docs/figures as a module (they are not a package)."""
-    spec = importlib.util.spec_from_file_location(name, os.path.join(FIGURES, f"{name}.py"))
+def load_script(name, folder=FIGURES):
+    """A script of docs/figures (or ``folder``) as a module (they are not a package)."""
+    spec = importlib.util.spec_from_file_location(name, os.path.join(folder, f"{name}.py"))
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -59,3 +59,10 @@ def test_the_dilatancy_numbers_are_those_of_its_measures():
         record = json.load(handle)
     expected = script.substitutions(record["measures"])
     assert {k: record["substitutions"][k] for k in expected} == expected
+
+
+def test_the_stiffness_numbers_are_those_of_its_cases():
+    script = load_script("bench_stiffness", os.path.join(ROOT, "benchmarks"))
+    with open(os.path.join(FIGURES, "material_stiffness.json"), encoding="utf-8") as handle:
+        record = json.load(handle)
+    assert record["substitutions"] == script.substitutions(record["cases"])
