@@ -10,6 +10,7 @@ come from the code as it is; the outputs reference, the command help and the API
 generated from the code (docs/_ext/pendular_docs.py).
 """
 
+import json
 import os
 import re
 import sys
@@ -41,8 +42,15 @@ exclude_patterns = ["_build", "**/GALLERY_HEADER.rst", "tutorials/runs", "Thumbs
                     ".DS_Store", "_generated/outputs_tables.md", "_generated/commands.md"]
 
 # MyST: headings get anchors (links such as yade_crosscheck.md#periodic-cell), ::: fences
-myst_enable_extensions = ["colon_fence", "deflist"]
+myst_enable_extensions = ["colon_fence", "deflist", "substitution"]
 myst_heading_anchors = 3
+# numbers measured by the scripts of docs/figures (make_*.py), each written with its figures
+# into a JSON beside them: a page quotes {{ readme_peak_q_kpa }}, never a copy of the number
+myst_substitutions = {}
+for _name in sorted(os.listdir(os.path.join(HERE, "figures"))):
+    if _name.endswith(".json"):
+        with open(os.path.join(HERE, "figures", _name), encoding="utf-8") as _numbers:
+            myst_substitutions.update(json.load(_numbers).get("substitutions", {}))
 
 # autodoc: the docstrings are short plain text with units, not numpydoc or Google sections, so
 # napoleon is left out (it would read "name: text" lines of attribute docs as types); members in
