@@ -1,6 +1,7 @@
-"""An SWCC run stopped mid-path (deterministically, --stop-after) and continued with --resume
-writes the uninterrupted run's files bit for bit (timings aside); a damaged or forged
-checkpoint, and a resume that would change the run's configuration, are refused in one line."""
+"""An SWCC run stopped mid-path and a direct tension stopped mid-pull (deterministically,
+--stop-after) and continued with --resume write the uninterrupted run's files bit for bit
+(timings aside); a damaged or forged checkpoint, and a resume that would change the run's
+configuration, are refused in one line naming the file or the option."""
 
 import json
 import os
@@ -22,8 +23,8 @@ RUN = ["--particles", "50", "--confining", "750", "--suctions", "3000,30000", "-
 #: Checkpoints every 70 steps, stopped after 350 steps of the path: the last checkpoint falls
 #: inside a stage, away from its equilibrium checks (every 200 steps of the stage).
 STOP = ["--checkpoint-every", "70", "--stop-after", "350"]
-#: Timings, which differ between runs.
-TIMINGS = {"wall_time_s"}
+#: Timings, which differ between runs (summaries, a tension's cases, history attributes).
+TIMINGS = {"wall_time_s", "wetting_time_s", "pull_time_s"}
 #: HDF5 attributes that hold object references (dimension scales), compared by their targets.
 REFERENCES = {"DIMENSION_LIST", "REFERENCE_LIST"}
 
@@ -45,17 +46,28 @@ def runs(tmp_path_factory):
 def contents(path):
     """{object name: (data or None, attributes)} of an HDF5 file, references left out."""
     with h5py.File(path) as handle:
-        found = {"/": (None, dict(handle.attrs))}
+        found = {}
 
         def visit(name, item):
             data = item[()] if isinstance(item, h5py.Dataset) else None
-            found[name] = (data, {k: v for k, v in item.attrs.items() if k not in REFERENCES})
+            found[name] = (data, {k: v for k, v in item.attrs.items()
+                                  if k not in REFERENCES and k not in TIMINGS})
         handle.visititems(visit)
+        found["/"] = (None, {k: v for k, v in handle.attrs.items() if k not in TIMINGS})
     return found
 
 
-def assert_same_files(first, second):
-    for name in ("history.h5", "sample.h5"):
+def without_timings(data):
+    """A JSON value with the TIMINGS keys left out at every depth."""
+    if isinstance(data, dict):
+        return {k: without_timings(v) for k, v in data.items() if k not in TIMINGS}
+    if isinstance(data, list):
+        return [without_timings(v) for v in data]
+    return data
+
+
+def assert_same_files(first, second, files=("history.h5", "sample.h5"), summary="swcc.json"):
+    for name in files:
         a, b = contents(first / name), contents(second / name)
         assert a.keys() == b.keys(), name
         for key, (data, attributes) in a.items():
@@ -65,10 +77,8 @@ def assert_same_files(first, second):
             assert attributes.keys() == other_attributes.keys(), (name, key)
             for attribute, value in attributes.items():
                 assert np.array_equal(value, other_attributes[attribute]), (name, key, attribute)
-    a, b = (json.loads((folder / "swcc.json").read_text()) for folder in (first, second))
-    for key in TIMINGS:
-        a.pop(key), b.pop(key)
-    assert a == b
+    a, b = (json.loads((folder / summary).read_text()) for folder in (first, second))
+    assert without_timings(a) == without_timings(b)
 
 
 def test_a_stopped_swcc_resumes_bit_for_bit(runs, tmp_path, capsys):
@@ -128,3 +138,74 @@ def test_a_resume_that_changes_the_configuration_is_refused(runs, tmp_path, caps
     shutil.copytree(runs[1], run)
     refused(*swcc(["--resume", str(run), "--suctions", "3000,300000", "--quiet"], capsys),
             "--suctions", "cannot be changed")
+
+
+# ---------------------------------------------------------------- direct tension
+
+#: One void ratio, two water contents: the second case pulled from the sample of the first.
+TENSION = ["--particles", "100", "--void-ratio", "0.72", "--water-content", "1,2",
+           "--max-strain", "0.01", "--vtk-frames", "0", "--threads", "1", "--quiet"]
+#: Stopped in the second case's pull (each pulls about 1,900 steps), checkpoints every 150.
+TENSION_STOP = ["--checkpoint-every", "150", "--stop-after", "2500"]
+CASES = ("e0.72_w1.00", "e0.72_w2.00")
+
+
+@pytest.fixture(scope="module")
+def tension_runs(tmp_path_factory):
+    """(folder holding the uninterrupted run ``run``, folder holding the stopped one): the
+    same --out, which tension.json records."""
+    whole, stopped = (tmp_path_factory.mktemp(name) for name in ("whole", "stopped"))
+    here = os.getcwd()
+    try:
+        os.chdir(whole)
+        assert run_command("tension", TENSION + ["--out", "run"]) == 0
+        os.chdir(stopped)
+        assert run_command("tension", TENSION + TENSION_STOP + ["--out", "run"]) == 130
+    finally:
+        os.chdir(here)
+    return whole, stopped
+
+
+def tension(argv, capsys):
+    return run_in_process("tension", argv, capsys)
+
+
+def test_a_stopped_tension_resumes_bit_for_bit(tension_runs, tmp_path, capsys, monkeypatch):
+    whole, stopped = tension_runs
+    shutil.copytree(stopped / "run", tmp_path / "run")
+    monkeypatch.chdir(tmp_path)
+    assert not (tmp_path / "run" / "tension.json").exists()
+    status, err = tension(["--resume", "run", "--threads", "1", "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole / "run", tmp_path / "run",
+                      files=[f"cases/{case}/history.h5" for case in CASES],
+                      summary="tension.json")
+    assert ((whole / "run" / "report.md").read_bytes()
+            == (tmp_path / "run" / "report.md").read_bytes())
+
+
+TENSION_FAULTS = {
+    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position", 32), ["checksum mismatch"]),
+    "case forged": (lambda p: forge(p, edit_extra("case", 0)), ["finished cases"]),
+    "pull start forged": (lambda p: forge(p, edit_extra("pull_start", 5)), ["pull_start = 5"]),
+    "missing": (os.remove, ["checkpoint.h5 is missing"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TENSION_FAULTS))
+def test_a_damaged_tension_checkpoint_is_refused_naming_it(name, tension_runs, tmp_path,
+                                                           capsys):
+    run = tmp_path / "run"
+    shutil.copytree(tension_runs[1] / "run", run)
+    damage, words = TENSION_FAULTS[name]
+    damage(str(run / "checkpoint.h5"))
+    refused(*tension(["--resume", str(run), "--quiet"], capsys), "checkpoint.h5", *words)
+    assert not (run / "tension.json").exists()
+
+
+def test_a_tension_resume_that_changes_the_configuration_is_refused(tension_runs, tmp_path,
+                                                                    capsys):
+    run = tmp_path / "run"
+    shutil.copytree(tension_runs[1] / "run", run)
+    refused(*tension(["--resume", str(run), "--water-content", "3", "--quiet"], capsys),
+            "--water-content", "cannot be changed")
