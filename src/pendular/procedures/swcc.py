@@ -25,7 +25,9 @@ saturation, bridges, porosity, volumetric_strain (contraction positive, from the
 chi (tr chi / 3, Eq. 3.44), pendular_overlaps (pairs of menisci merging on a grain: beyond the
 pendular regime where many), ...}), swcc.png (Sr against log suction, both branches, with
 thesis Fig. 5.5's points and the regular packings' SWCCs of Chapter 4), history.h5 (the wet
-triaxial's columns, pendular.io.schema, recorded through the whole path) and sample.h5.
+triaxial's columns, pendular.io.schema, recorded through the whole path) and sample.h5; with
+``run(out, checkpoint_every=N)`` checkpoint.h5 (SwccPath), from which ``SwccTest.resume(out)``
+continues an interrupted path bit for bit.
 
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the

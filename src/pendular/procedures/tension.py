@@ -41,7 +41,9 @@ strength against w beside Kim and the prediction), and per case cases/<case>/his
 (group ``history``: step, time, axial_strain (compression positive, so negative here),
 tensile_stress [Pa], grip_pull (2) [N] (z-, z+ grips), sigma_wall (3) [Pa], coordination,
 bridges, water_content, saturation, unbalanced_force) and the ParaView series
-``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull).
+``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull); with
+``run(out, checkpoint_every=N)`` checkpoint.h5 (TensionRun), from which
+``TensionTest.resume(out)`` continues an interrupted run bit for bit.
 """
 
 from __future__ import annotations
