@@ -704,6 +704,23 @@ def load_checkpoint(path, sim, expected_identity=None):
     return extra_state
 
 
+def checkpoint_extra_state(path, expected_identity=None):
+    """The ``extra_state`` of the checkpoint ``path``, its checksum (and identity) verified
+    first, without a simulation to load it into (a run that reads its configuration from
+    it); ValueError naming the path otherwise."""
+    path = os.fspath(path)
+    verify(path, expected_identity, kind="checkpoint")
+    with reading(path, "pendular checkpoint"), h5py.File(path, "r") as handle:
+        if handle.attrs.get("format") != FORMAT:
+            raise ValueError(f"{path!r} is not a pendular checkpoint")
+        extra_json = handle.attrs.get("extra_state")
+    try:
+        return json.loads(extra_json)
+    except (TypeError, json.JSONDecodeError) as error:
+        raise ValueError(f"checkpoint {path!r}: its extra_state attribute is not JSON "
+                         f"({error})") from None
+
+
 class CheckpointWriter:
     """Writer saving a checkpoint to ``path`` every ``period`` steps (``sim.step % period == 0``).
 

@@ -37,6 +37,17 @@ class Grip:
             raise ValueError(f"grip of wall {wall} has no particles: increase the grip depth")
         self.pull = 0.0
 
+    def state_dict(self):
+        """``pull`` [N], that of the last step (the members are the scene's: chosen from the
+        state the pull starts from)."""
+        return {"pull": self.pull}
+
+    def load_state(self, state):
+        pull = float(state["pull"])
+        if not np.isfinite(pull):
+            raise ValueError(f"pull = {pull!r} N is not finite")
+        self.pull = pull
+
     def apply(self, sim):
         p = sim.particles
         resultant = float(np.sum(p.force[self.members, self.axis]))

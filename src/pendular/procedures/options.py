@@ -128,6 +128,13 @@ def rate_options(config):
     return _options(config, ("inertial_number", "strain_rate"))
 
 
+#: Steps between checkpoints of a run (every command that resumes: the laboratory tests,
+#: swcc).
+CHECKPOINT_EVERY = dataclasses.replace(option_of(
+    LaboratoryConfig, "checkpoint_every",
+    help="steps between checkpoints DIR/checkpoint.h5 (0: none)"), least=0)
+
+
 def output_options(frames):
     """ParaView frames (--vtk-every or --vtk-frames; ``frames``: the loading's length is known
     before it runs, else --vtk-frames takes its estimate, or 0 alone: ``framed``) and
@@ -145,10 +152,7 @@ def output_options(frames):
         help="ParaView frames over the loading (0: none; at most one a step; " + (
             "" if frames else "a path whose stages end at a stress or at equilibrium takes "
             "0 only; ") + "instead of --vtk-every"), least=0, group="frames")
-    checkpoints = dataclasses.replace(option_of(
-        LaboratoryConfig, "checkpoint_every",
-        help="steps between checkpoints DIR/checkpoint.h5 (0: none)"), least=0)
-    return every, count, checkpoints
+    return every, count, CHECKPOINT_EVERY
 
 
 def framed(build):

@@ -25,7 +25,9 @@ saturation, bridges, porosity, volumetric_strain (contraction positive, from the
 chi (tr chi / 3, Eq. 3.44), pendular_overlaps (pairs of menisci merging on a grain: beyond the
 pendular regime where many), ...}), swcc.png (Sr against log suction, both branches, with
 thesis Fig. 5.5's points and the regular packings' SWCCs of Chapter 4), history.h5 (the wet
-triaxial's columns, pendular.io.schema, recorded through the whole path) and sample.h5.
+triaxial's columns, pendular.io.schema, recorded through the whole path) and sample.h5; with
+``run(out, checkpoint_every=N)`` checkpoint.h5 (SwccPath), from which ``SwccTest.resume(out)``
+continues an interrupted path bit for bit.
 
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
@@ -34,6 +36,7 @@ wetting across gaps and the rows of swcc.json are computed on the host between t
 
 from __future__ import annotations
 
+import math
 import os
 import time
 
@@ -43,27 +46,29 @@ from pendular.capillary import CapillaryBridges, sample_radius_ratios
 from pendular.utils.atomic import write_json
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
-from pendular.procedures.preparation import prepare_sample
+from pendular.procedures.preparation import prepare_sample, servoed_simulation, static
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.sample import save_sample
+from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
+from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
+from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
 
-from pendular.procedures.config import SwccConfig, config_to_dict
+from pendular.procedures.config import SwccConfig, config_from_dict, config_to_dict
 from pendular.io.history import write_history
 from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import FIG_5_5
 from pendular.procedures.loading import history_columns
-from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, NotStatic, equilibrate,
-    equilibrium_status, watched)
+from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, Interrupted, NotStatic,
+    equilibrium_status, plain, run_identity)
 
 #: Files a SWCC run owns in its output folder.
-OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5")
+OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5", "checkpoint.h5")
 
 
 def path_bridges(config: SwccConfig, radii) -> CapillaryBridges:
@@ -97,84 +102,79 @@ class SwccTest:
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
 
-    def run(self, out, *, progress=True, threads=None, device="cpu"):
+    def run(self, out, *, progress=True, threads=None, device="cpu", checkpoint_every=0,
+            stop_after=None):
         """Run the path into ``out``; ``device``: where the preparation and the stages run,
-        "cpu" or "gpu" (``check_device``, before anything is made)."""
+        "cpu" or "gpu" (``check_device``, before anything is made); ``checkpoint_every``:
+        steps between checkpoints ``out``/checkpoint.h5 of the path (0: none), from which
+        ``resume`` continues; ``stop_after``: stop the path after this many steps as an
+        interruption would (raises Interrupted)."""
         check_device(device)
+        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, device)
+            return self._run(out, progress, threads, device, checkpoint_every, stop_after)
 
-    def _run(self, out, progress, threads, device):
+    def _run(self, out, progress, threads, device, checkpoint_every, stop_after):
         config = self.config
         started = time.perf_counter()
         sim, preparation = prepare_sample(config.sample, progress=progress, threads=threads,
                                           device=device)
-        save_sample(os.path.join(out, "sample.h5"), sim, preparation,
+        sample_file = os.path.join(out, "sample.h5")
+        save_sample(sample_file, sim, preparation,
                     {"config": config_to_dict(config)}, identity={"seed": config.sample.seed})
-        dry_volume = sim.walls.volume()
         bridges = path_bridges(config, sim.particles.radius)
-        sim.forces.append(bridges)
+        path = SwccPath(self, sim, bridges, out, preparation, checkpoint_every,
+                        run_identity(config, sample_file), time.perf_counter() - started)
         sim.evaluate_forces()                     # the neighbour list at the bridges' reach
-        formed = 0
         if config.form_gap > 0.0:
-            formed = bridges.form_across_gaps(sim, config.form_gap * config.sample.radius)
-        axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
-        recorder = HistoryRecorder(config.record_every,
-                                   history_columns(sim, axial, dry_volume, bridges),
-                                   origin=sim.step)
-        homogenization = CapillaryHomogenization(bridges)
+            path.formed = bridges.form_across_gaps(sim, config.form_gap * config.sample.radius)
         sim.device = device
-        stages = {"drying": [], "wetting": []}
-        suctions = list(config.suctions)
-        path = [("drying", s) for s in suctions] + [("wetting", s) for s in suctions[::-1]]
-        with watched(sim, [recorder], "path"):
-            for index, (branch, suction) in enumerate(path):
-                if index == len(suctions):        # the turning point: drying's last state
-                    stages[branch].append(dict(stages["drying"][-1], steps=0))
-                    continue
-                bridges.set_suction(suction)
-                steps = self.stage(sim, suction, branch, progress)
-                recorder.record(sim)
-                stages[branch].append(self.stage_row(sim, bridges, homogenization, suction,
-                                                     dry_volume, steps))
-        history = recorder.arrays()
-        write_history(os.path.join(out, "history.h5"), history, config_to_dict(config),
-                      attributes={"test": "swcc", "dt": sim.dt})
-        result = {
-            "config": config_to_dict(config),
-            "drying": stages["drying"],
-            "wetting": stages["wetting"],
-            "bridges_formed_across_gaps": formed,
-            "hysteresis": hysteresis(stages),
-            "preparation": {k: preparation[k] for k in ("porosity", "coordination", "steps")},
-            "grading": grading(sim.particles.radius),
-            "regular_packings": regular_packing_curves(config, suctions),
-            "thesis_fig_5_5": {str(int(s)): v for s, v in FIG_5_5.items()},
-            "wall_time_s": time.perf_counter() - started,
-            "units": {**SWCC_STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
-        }
-        write_json(os.path.join(out, "swcc.json"), result)
-        plot_swcc(os.path.join(out, "swcc.png"), result)
-        return result
+        return path.finish(progress, stop_after)
 
-    def stage(self, sim, suction, branch, progress):
-        """Run one stage of the path to equilibrium; its steps. NotStatic naming --stage-steps
-        when the stage ends at that limit first."""
+    @classmethod
+    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
+        """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
+        configuration stored in its sample.h5, its path on ``device``; returns the swcc.json
+        content."""
+        sample_file = os.path.join(out, "sample.h5")
+        checkpoint = os.path.join(out, "checkpoint.h5")
+        for path in (sample_file, checkpoint):
+            if not os.path.exists(path):
+                raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
+                                 "with checkpoint_every > 0?)")
+        with OutputFolder(out, "swcc --resume", keep=True) as folder:
+            for name in OUTPUTS:
+                folder.claim(name)
+            particles, walls, preparation, stored = load_sample(sample_file)
+            config = config_from_dict(stored.get("config"), sample_file)
+            if not isinstance(config, SwccConfig):
+                raise ValueError(f"resume = {out!r} holds a run of another test "
+                                 f"({type(config).__name__}), not of pendular swcc")
+            check_device(device)
+            sim = servoed_simulation(particles, walls, config.sample, config.sample.confining,
+                                     threads=threads)
+            test = cls.__new__(cls)          # the stored run, checked when it started
+            test.config = config
+            identity = run_identity(config, sample_file)
+            path = SwccPath(test, sim, path_bridges(config, particles.radius), out,
+                            preparation, 1, identity, 0.0)
+            state = path.load(checkpoint)
+            path.resumed(state, checkpoint)
+            sim.device = device
+            return path.finish(progress, stop_after)
+
+    def stage_failed(self, sim, suction, branch):
+        """NotStatic naming --stage-steps: the stage at ``suction`` [Pa] of ``branch`` ended
+        at that limit before its equilibrium."""
         sample = self.config.sample
-        limit = self.config.stage_steps
-        try:
-            return equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
-                               tolerance=sample.stress_tolerance, max_steps=limit,
-                               progress=(f"{branch} {suction:g} Pa" if progress else None))
-        except NotStatic:
-            reached = equilibrium_status(sample.equilibrium_unbalanced)(sim)
-            raise NotStatic(
-                f"--stage-steps = {limit}: the equilibrium at suction {suction:g} Pa ({branch}) "
-                "was not reached within this many steps ("
-                + ", ".join(f"{k} {v}" for k, v in reached.items())
-                + "): raise --stage-steps or check the settings") from None
+        reached = equilibrium_status(sample.equilibrium_unbalanced)(sim)
+        return NotStatic(
+            f"--stage-steps = {self.config.stage_steps}: the equilibrium at suction "
+            f"{suction:g} Pa ({branch}) was not reached within this many steps ("
+            + ", ".join(f"{k} {v}" for k, v in reached.items())
+            + "): raise --stage-steps or check the settings")
 
     @staticmethod
     def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):
@@ -195,6 +195,172 @@ class SwccTest:
                 "coordination": coordination(sim.contacts, len(sim.particles)),
                 "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
+
+
+class SwccPath:
+    """The drying and wetting path of a SwccTest's prepared sample ``sim`` with its persisting
+    ``bridges`` (appended to its forces): the stages run to equilibrium in turn, the history
+    recorded, and with ``checkpoint_every`` > 0 a checkpoint (pendular.dem.checkpoint) every
+    that many steps holding where the path stands (stage, its first step, the rows so far),
+    so that ``resume`` continues it bit for bit. ``finish`` runs the rest of the path and
+    writes the outputs."""
+
+    #: Steps between the equilibrium checks of a stage.
+    CHECK_EVERY = 200
+
+    def __init__(self, test, sim, bridges, out, preparation, checkpoint_every, identity,
+                 preparation_time):
+        config = test.config
+        self.test, self.sim, self.bridges, self.out = test, sim, bridges, out
+        self.preparation, self.preparation_time = preparation, preparation_time
+        self.dry_volume = sim.walls.volume()
+        sim.forces.append(bridges)
+        axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
+        self.recorder = HistoryRecorder(config.record_every,
+                                        history_columns(sim, axial, self.dry_volume, bridges),
+                                        origin=sim.step)
+        self.homogenization = CapillaryHomogenization(bridges)
+        suctions = list(config.suctions)
+        self.path = [("drying", s) for s in suctions] + [("wetting", s) for s in suctions[::-1]]
+        self.index, self.stage_start = 0, None
+        self.stages = {"drying": [], "wetting": []}
+        self.formed = 0
+        self.path_time = 0.0         # seconds spent on the path by earlier (interrupted) runs
+        self._static = static(config.sample.equilibrium_unbalanced,
+                              config.sample.stress_tolerance)
+        sim.writers.append(self.recorder)
+        self.checkpoint = None
+        if checkpoint_every > 0:
+            self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),
+                                               checkpoint_every, self.extra_state, identity)
+            sim.writers.append(self.checkpoint)
+        self._clock = time.perf_counter()
+
+    def extra_state(self, sim):
+        """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
+        return {"phase": "path", "stage": self.index, "stage_start": self.stage_start,
+                "stages": plain(self.stages), "formed": self.formed,
+                "checkpoint_every": self.checkpoint.period,
+                "preparation_time_s": self.preparation_time,
+                "path_time_s": self.path_time + time.perf_counter() - self._clock}
+
+    def load(self, path):
+        """Load the checkpoint ``path`` into the simulation; its extra state (ValueError naming
+        the file for one that does not belong to this run)."""
+        return load_checkpoint(path, self.sim, expected_identity=self.checkpoint.identity)
+
+    def resumed(self, state, path):
+        """Take the progress of the checkpoint ``path`` loaded into the simulation (its extra
+        ``state``); ValueError naming the file when it does not say where the path stood."""
+        try:
+            if state["phase"] != "path":
+                raise ValueError
+            index = check_int("stage", state["stage"], low=0, high=len(self.path) - 1)
+            start = check_int("stage_start", state["stage_start"], high=self.sim.step)
+            stages = {branch: list(state["stages"][branch]) for branch in self.stages}
+            done = len(stages["drying"]) + len(stages["wetting"])
+            self.checkpoint.period = check_int("checkpoint_every", state["checkpoint_every"],
+                                               low=1)
+            self.formed = check_int("formed", state["formed"], low=0)
+            times = (float(state["preparation_time_s"]), float(state["path_time_s"]))
+        except (KeyError, TypeError, ValueError):
+            raise ValueError(f"{path} does not belong to this run's suction path") from None
+        if done != index or not all(isinstance(row, dict) for rows in stages.values()
+                                    for row in rows):
+            raise ValueError(f"{path}: its {done} stage rows do not match its stage = {index} "
+                             "(an edited checkpoint)")
+        self.index, self.stage_start, self.stages = index, start, stages
+        self.preparation_time, self.path_time = times
+        self._clock = time.perf_counter()
+
+    def finish(self, progress, stop_after):
+        """Run the rest of the path (raising Interrupted at ``stop_after`` steps or on Ctrl-C,
+        the checkpoint kept) and write the outputs; returns the swcc.json content."""
+        sim, bridges = self.sim, self.bridges
+        budget = math.inf if stop_after is None else check_int("stop_after", stop_after, low=1)
+        turning = len(self.path) // 2
+        self._clock = time.perf_counter()
+        try:
+            while self.index < len(self.path):
+                branch, suction = self.path[self.index]
+                if self.index == turning:         # the turning point: drying's last state
+                    self.stages[branch].append(dict(self.stages["drying"][-1], steps=0))
+                    self.index += 1
+                    continue
+                if self.stage_start is None:
+                    bridges.set_suction(suction)
+                    self.stage_start = sim.step
+                budget -= self.run_stage(budget, f"{branch} {suction:g} Pa" if progress
+                                         else None)
+                if not self._ended(sim):
+                    break
+                self.recorder.record(sim)
+                self.stages[branch].append(self.test.stage_row(
+                    sim, bridges, self.homogenization, suction, self.dry_volume,
+                    sim.step - self.stage_start))
+                self.index, self.stage_start = self.index + 1, None
+        except KeyboardInterrupt:
+            pass
+        self.path_time += time.perf_counter() - self._clock
+        if self.index < len(self.path):
+            raise Interrupted(f"interrupted at step {sim.step}"
+                              + (f"; continue with --resume {self.out}"
+                                 if self.checkpoint is not None else ""))
+        return self.write_outputs()
+
+    def _ended(self, sim):
+        """Whether the running stage is static at one of its checks (every CHECK_EVERY steps
+        of the stage and at its step limit), where an uninterrupted run checks it."""
+        taken = sim.step - self.stage_start
+        return (taken > 0 and (taken % self.CHECK_EVERY == 0
+                               or taken == self.test.config.stage_steps)
+                and self._static(sim))
+
+    def run_stage(self, budget, label):
+        """Run the stage in progress until static, at most ``budget`` steps; the steps taken.
+        NotStatic (SwccTest.stage_failed) at its --stage-steps limit."""
+        sim, limit = self.sim, self.test.config.stage_steps
+        status = equilibrium_status(self.test.config.sample.equilibrium_unbalanced)
+        taken = 0
+        while not self._ended(sim):
+            done = sim.step - self.stage_start
+            if done >= limit:
+                branch, suction = self.path[self.index]
+                raise self.test.stage_failed(sim, suction, branch)
+            if taken >= budget:
+                break
+            steps = int(min(limit - done, budget - taken))
+            offset = done % self.CHECK_EVERY
+            if offset:              # a resumed stage: its checks fall where they fell before
+                taken += sim.run(min(self.CHECK_EVERY - offset, steps), progress=label,
+                                 status=status)
+                continue
+            taken += sim.run(steps, until=self._ended, check_every=self.CHECK_EVERY,
+                             progress=label, status=status)
+        return taken
+
+    def write_outputs(self):
+        """history.h5, swcc.json and swcc.png; returns the swcc.json content."""
+        sim, config, out = self.sim, self.test.config, self.out
+        write_history(os.path.join(out, "history.h5"), self.recorder.arrays(),
+                      config_to_dict(config), attributes={"test": "swcc", "dt": sim.dt})
+        result = {
+            "config": config_to_dict(config),
+            "drying": self.stages["drying"],
+            "wetting": self.stages["wetting"],
+            "bridges_formed_across_gaps": self.formed,
+            "hysteresis": hysteresis(self.stages),
+            "preparation": {k: self.preparation[k]
+                            for k in ("porosity", "coordination", "steps")},
+            "grading": grading(sim.particles.radius),
+            "regular_packings": regular_packing_curves(config, list(config.suctions)),
+            "thesis_fig_5_5": {str(int(s)): v for s, v in FIG_5_5.items()},
+            "wall_time_s": self.preparation_time + self.path_time,
+            "units": {**SWCC_STAGE_UNITS, "wall_time_s": "s", "grading": GRADING_UNITS},
+        }
+        write_json(os.path.join(out, "swcc.json"), result)
+        plot_swcc(os.path.join(out, "swcc.png"), result)
+        return result
 
 
 def hysteresis(stages):

@@ -41,16 +41,20 @@ strength against w beside Kim and the prediction), and per case cases/<case>/his
 (group ``history``: step, time, axial_strain (compression positive, so negative here),
 tensile_stress [Pa], grip_pull (2) [N] (z-, z+ grips), sigma_wall (3) [Pa], coordination,
 bridges, water_content, saturation, unbalanced_force) and the ParaView series
-``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull).
+``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull); with
+``run(out, checkpoint_every=N)`` checkpoint.h5 (TensionRun), from which
+``TensionTest.resume(out)`` continues an interrupted run bit for bit.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import time
 from dataclasses import replace
 
+import h5py
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -68,15 +72,19 @@ from pendular.procedures.grips import core_void_ratio, grip_members, tensile_str
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize import packing_state, regular_packing
 
-from pendular.procedures.config import TensionConfig, case_name, config_to_dict, inertial_number
+from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
+from pendular.procedures.config import (TensionConfig, case_name, config_from_dict,
+    config_to_dict, inertial_number)
 from pendular.procedures.loading import measured
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION,
     comparison_packing)
-from pendular.procedures.triaxial import frame_period, frames_writer
+from pendular.procedures.triaxial import Interrupted, frame_period, frames_writer
 from pendular.io.schema import TENSION_SUMMARY_UNITS
+from pendular.utils.integrity import config_hash
+from pendular.utils.validate import check_int
 from pendular.procedures.water_content import wet_to_water_volume
 
 #: Surface tension [N/m] of the Chapter 4 comparison (docs/physics.md 'Errata').
@@ -92,6 +100,8 @@ CHECK_EVERY = 200
 POST_PEAK_STRAIN = 0.01
 #: History rows over --max-strain.
 RECORDS = 400
+#: Files and folders a tension run owns in its output folder.
+OUTPUTS = ("tension.json", "report.md", "plots", "cases", "checkpoint.h5")
 
 
 def cases_of(void_ratios: list[float] | None = None,
@@ -306,6 +316,7 @@ class Pull:
                 "water_content": lambda s: gravimetric_water_content(
                     water_volume(s), solid, config.specific_gravity),
                 "saturation": saturation})
+        self.start = sim.step
         self.recorder = HistoryRecorder(period, columns, origin=sim.step)
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
@@ -335,16 +346,42 @@ class Pull:
         return (stress[peak] > 0.0 and stress[-1] < self.config.residual * stress[peak]
                 and strain[peak] - strain[-1] >= POST_PEAK_STRAIN)
 
-    def run(self, label: str | None) -> tuple[int, dict]:
+    def _ended(self, sim: Simulation) -> bool:
+        """Whether the pull has ended: at its last step, or ruptured at one of its checks
+        (every recorder period of the pull, where an uninterrupted pull checks)."""
+        taken = sim.step - self.start
+        return taken >= self.steps or (taken > 0 and taken % self.recorder.period == 0
+                                       and self.ruptured(sim))
+
+    def advance(self, label: str | None, budget: float = math.inf) -> bool:
+        """Pull on from where the pull stands (a resumed one too: its checks fall where they
+        fell before) to rupture or --max-strain, at most ``budget`` steps; whether it ended."""
         def status(s):
             return {"ext": f"{-self.extension.strain(s.walls):.4f}",
                     "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
 
-        steps = self.sim.run(self.steps, until=self.ruptured, check_every=self.recorder.period,
-                             progress=label if self.progress else None, status=status)
+        sim, period = self.sim, self.recorder.period
+        label = label if self.progress else None
+        taken = 0
+        while not self._ended(sim):
+            if taken >= budget:
+                return False
+            done = sim.step - self.start
+            steps = int(min(self.steps - done, budget - taken))
+            offset = done % period
+            if offset:
+                taken += sim.run(min(period - offset, steps), progress=label, status=status)
+                continue
+            taken += sim.run(steps, until=self._ended, check_every=period, progress=label,
+                             status=status)
         if self.vtk is not None:
-            self.vtk.close(self.sim)
-        return steps, self.recorder.arrays()
+            self.vtk.close(sim)
+        return True
+
+    def run(self, label: str | None) -> tuple[int, dict]:
+        """Pull to rupture; (steps, history)."""
+        self.advance(label)
+        return self.sim.step - self.start, self.recorder.arrays()
 
 
 def prediction(config: TensionConfig, void_ratio: float,
@@ -370,10 +407,11 @@ def kim_measured(void_ratio: float, water_content: float) -> float | None:
 
 def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_ratio: float,
              water_content: float, out: str, progress: bool,
-             arguments: dict | None = None) -> tuple[dict, dict]:
+             arguments: dict | None = None, run: TensionRun | None = None) -> tuple[dict, dict]:
     """Wet, pull and summarise one case into ``out``/cases/<case>: history.h5 (and vtk/);
     returns (summary, history). ``arguments``: history file attributes (default the
-    configuration's options, TensionConfig.options)."""
+    configuration's options, TensionConfig.options); ``run``: the TensionRun whose
+    checkpoints and interruptions watch the pull (None: pulled to its end)."""
     name = case_name(void_ratio, water_content)
     folder = os.path.join(out, "cases", name)
     os.makedirs(folder, exist_ok=True)
@@ -381,7 +419,12 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
     sim, bridges, wetting = wet(dry, config, water_content, progress)
     wetted = time.perf_counter()
     pull = Pull(sim, bridges, config, folder, progress)
-    steps, history = pull.run(f"pull {name}")
+    earlier = 0.0
+    if run is None:
+        pull.advance(f"pull {name}")
+    else:
+        earlier = run.pull(pull, f"pull {name}")
+    steps, history = sim.step - pull.start, pull.recorder.arrays()
     stress = history["tensile_stress"]
     peak = int(np.argmax(stress))
     strength = float(stress[peak])
@@ -418,7 +461,7 @@ def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_rat
         "pull_steps": steps,
         "dt": sim.dt,
         "wetting_time_s": wetted - started,
-        "pull_time_s": time.perf_counter() - wetted,
+        "pull_time_s": earlier + time.perf_counter() - wetted,
     }
     attributes = dict(arguments if arguments is not None else config.options())
     attributes.update({key: value for key, value in summary.items()
@@ -552,47 +595,180 @@ class TensionTest:
         self.config = config
 
     def run(self, out: str, *, progress: bool = True, arguments: dict | None = None,
-            device: str = "cpu") -> dict:
+            device: str = "cpu", checkpoint_every: int = 0, stop_after: int | None = None
+            ) -> dict:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
         the tension.json content. ``arguments``: what tension.json records under 'arguments'
         and the histories as attributes (the command: its options; default: the
         configuration's, TensionConfig.options); the configuration itself is under 'config'.
         ``device``: where the preparations, wettings and pulls run, "cpu" or "gpu"
         (``check_device``, before anything is made); a run option, not part of the
-        configuration."""
+        configuration. ``checkpoint_every``: steps between checkpoints ``out``/checkpoint.h5
+        of the pulls (0: none), from which ``resume`` continues; ``stop_after``: stop after
+        this many steps of the pulls as an interruption would (raises Interrupted)."""
         check_device(device)
+        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
+        arguments = self.config.options() if arguments is None else dict(arguments)
         with OutputFolder(out, "tension") as folder:
-            for name in ("tension.json", "report.md", "plots", "cases"):
+            for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, self.config.options() if arguments is None
-                             else dict(arguments), device)
+            run = TensionRun(out, self.config, arguments, checkpoint_every, stop_after)
+            return self._run(out, progress, device, run)
 
-    def _run(self, out, progress, arguments, device):
-        config = self.config
+    @classmethod
+    def resume(cls, out: str, *, progress: bool = True, stop_after: int | None = None,
+               device: str = "cpu") -> dict:
+        """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
+        configuration and arguments stored there: the cases finished are kept, the sample
+        of the case being pulled is prepared and wetted again (the engine is deterministic:
+        the same state), and its pull goes on from the checkpoint; returns the tension.json
+        content, bit for bit that of an uninterrupted run (timings aside)."""
+        path = os.path.join(out, "checkpoint.h5")
+        if not os.path.exists(path):
+            raise ValueError(f"resume = {out!r}: {path} is missing (was the run started with "
+                             "checkpoint_every > 0?)")
+        with OutputFolder(out, "tension --resume", keep=True) as folder:
+            for name in OUTPUTS:
+                folder.claim(name)
+            state = checkpoint_extra_state(path)
+            config = config_from_dict(state.get("config") if isinstance(state, dict)
+                                      else None, path)
+            if not isinstance(config, TensionConfig):
+                raise ValueError(f"resume = {out!r} holds a run of another test "
+                                 f"({type(config).__name__}), not of pendular tension")
+            check_device(device)
+            run = TensionRun(out, config, state.get("arguments"), 1, stop_after, state)
+            return cls(config)._run(out, progress, device, run)
+
+    def _run(self, out, progress, device, run):
+        config, arguments = self.config, run.arguments
         started = time.perf_counter()
-        summaries, histories, samples = [], {}, {}
+        summaries, histories, samples = run.summaries, {}, run.samples
+        index = 0
         for void_ratio in dict.fromkeys(e for e, _ in config.cases):
+            waters = [w for e, w in config.cases if e == void_ratio]
+            if index + len(waters) <= len(summaries):          # finished before a resume
+                for summary in summaries[index:index + len(waters)]:
+                    histories[summary["case"]] = case_history(out, summary["case"])
+                index += len(waters)
+                continue
             if progress:
                 print(f"sample e = {void_ratio}: tuning the growth friction", flush=True)
             dry, preparation = prepare_void_ratio(config, void_ratio, progress, device)
-            samples[void_ratio] = preparation
-            for e, water_content in config.cases:
-                if e != void_ratio:
+            samples[str(void_ratio)] = preparation
+            for water_content in waters:
+                if index < len(summaries):
+                    name = summaries[index]["case"]
+                    histories[name] = case_history(out, name)
+                    index += 1
                     continue
-                summary, history = run_case(dry, preparation, config, e, water_content, out,
-                                            progress, arguments)
+                summary, history = run_case(dry, preparation, config, void_ratio,
+                                            water_content, out, progress, arguments, run)
                 summaries.append(summary)
                 histories[summary["case"]] = history
+                index += 1
                 if progress:
                     print(case_line(summary), flush=True)
         output = {"arguments": arguments,
                   "cases_requested": [list(case) for case in config.cases],
                   "config": config_to_dict(config),
-                  "samples": {str(e): {k: v for k, v in r.items() if k != "sigma_wall"}
+                  "samples": {e: {k: v for k, v in r.items() if k != "sigma_wall"}
                               for e, r in samples.items()},
-                  "cases": summaries, "wall_time_s": time.perf_counter() - started}
+                  "cases": summaries,
+                  "wall_time_s": run.earlier_time + time.perf_counter() - started}
         write_json(os.path.join(out, "tension.json"), output, default=float)
         plot_curves(summaries, histories, os.path.join(out, "plots"), config)
         plot_strength(summaries, config, os.path.join(out, "plots", "strength_vs_water.png"))
         write_report(summaries, config, os.path.join(out, "report.md"))
         return output
+
+
+def case_history(out: str, name: str) -> dict:
+    """The history of the finished case ``name`` of run folder ``out`` (its history.h5), as
+    Pull.run returns it: {column: array}."""
+    with h5py.File(os.path.join(out, "cases", name, "history.h5"), "r") as handle:
+        return {key: value[()] for key, value in handle["history"].items()
+                if isinstance(value, h5py.Dataset)}
+
+
+def _as_written(data):
+    """``data`` as tension.json holds it (NumPy numbers as JSON numbers, write_json's
+    default=float): what a checkpoint keeps of the cases finished."""
+    return json.loads(json.dumps(data, default=float))
+
+
+class TensionRun:
+    """The checkpoints and interruptions of a TensionTest run into ``out``: with
+    ``checkpoint_every`` > 0 a checkpoint (pendular.dem.checkpoint) every that many steps of a
+    pull holding where the run stands (the case pulled, the step its pull started at, the
+    cases finished, their samples, the configuration and ``arguments``); ``stop_after``: the
+    steps of the pulls after which the run stops as an interruption would; ``state``: the
+    extra state of the checkpoint a resumed run continues from."""
+
+    def __init__(self, out, config, arguments, checkpoint_every, stop_after, state=None):
+        self.out, self.config = out, config
+        self.path = os.path.join(out, "checkpoint.h5")
+        self.every = checkpoint_every
+        self.budget = math.inf if stop_after is None else check_int("stop_after", stop_after,
+                                                                     low=1)
+        self.identity = {"config_hash": config_hash(config_to_dict(config)),
+                         "seed": config.sample.seed}
+        self.state, self.summaries, self.samples = state, [], {}
+        self.arguments, self.earlier_time = arguments, 0.0
+        self._pull, self._clock = None, time.perf_counter()
+        if state is not None:
+            try:
+                if state["phase"] != "pull" or not isinstance(state["arguments"], dict):
+                    raise ValueError
+                self.every = check_int("checkpoint_every", state["checkpoint_every"], low=1)
+                self.summaries = list(state["summaries"])
+                self.samples = dict(state["samples"])
+                self.earlier_time = float(state["wall_time_s"])
+                check_int("case", state["case"], low=0, high=len(config.cases) - 1)
+                check_int("pull_start", state["pull_start"], low=0)
+                float(state["pull_time_s"])
+            except (KeyError, TypeError, ValueError):
+                raise ValueError(f"{self.path} does not belong to this run's pulls") from None
+            if (state["case"] != len(self.summaries)
+                    or not all(isinstance(s, dict) for s in self.summaries)):
+                raise ValueError(f"{self.path}: its {len(self.summaries)} finished cases do not "
+                                 f"match its case = {state['case']} (an edited checkpoint)")
+
+    def extra_state(self, sim):
+        """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
+        return {"phase": "pull", "config": config_to_dict(self.config),
+                "arguments": _as_written(self.arguments), "checkpoint_every": self.every,
+                "summaries": _as_written(self.summaries), "samples": _as_written(self.samples),
+                "case": len(self.summaries), "pull_start": self._pull.start,
+                "pull_time_s": self._pull_time + time.perf_counter() - self._pull_clock,
+                "wall_time_s": self.earlier_time + time.perf_counter() - self._clock}
+
+    def pull(self, pull, label):
+        """Run ``pull`` (Pull) to its end under the run's checkpoints, from the checkpoint
+        when the run resumes; Interrupted (the checkpoint kept) at ``stop_after`` steps or
+        on Ctrl-C. Returns the seconds its earlier (interrupted) runs spent pulling."""
+        sim = pull.sim
+        self._pull, self._pull_time, self._pull_clock = pull, 0.0, time.perf_counter()
+        writer = None
+        if self.every > 0:
+            writer = CheckpointWriter(self.path, self.every, self.extra_state, self.identity)
+            sim.writers.append(writer)
+        if self.state is not None:               # the case the checkpoint was written in
+            state, self.state = self.state, None
+            if state["pull_start"] != pull.start:
+                raise ValueError(f"{self.path}: pull_start = {state['pull_start']} is not the "
+                                 f"step {pull.start} its case's pull starts at (an edited "
+                                 "checkpoint)")
+            load_checkpoint(self.path, sim, expected_identity=self.identity)
+            self._pull_time = float(state["pull_time_s"])
+        before = sim.step
+        try:
+            ended = pull.advance(label, self.budget)
+        except KeyboardInterrupt:
+            ended = False
+        self.budget -= sim.step - before
+        if not ended:
+            raise Interrupted(f"interrupted at step {sim.step}"
+                              + (f"; continue with --resume {self.out}"
+                                 if writer is not None else ""))
+        return self._pull_time

@@ -649,7 +649,7 @@ class LaboratoryTest:
         if frames is not None:
             frames.close(sim)           # the state the shear starts from
         folder.phase = "shear"
-        before_shear = _plain({"config": config_to_dict(config), "preparation": preparation,
+        before_shear = plain({"config": config_to_dict(config), "preparation": preparation,
                                "wetting": wetting, "preparation_time_s": prepared - started,
                                "pre_shear_time_s": time.perf_counter() - started})
         sample_file = os.path.join(out, "sample.h5")
@@ -1007,7 +1007,7 @@ class _PathRun:
                 "liquid_balance_error": float(np.max(np.abs(total - initial) / initial)),
                 "liquid_lost_fraction": float(history["liquid_lost"][-1]
                                               / np.ravel(initial)[-1])})
-        summary = _plain(summary)              # NumPy scalars as plain floats and ints
+        summary = plain(summary)              # NumPy scalars as plain floats and ints
         summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
         attributes = {k: v for k, v in parameters(config).items() if v is not None}
         attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
@@ -1046,7 +1046,7 @@ class _PathRun:
         return summary
 
 
-def _plain(data):
+def plain(data):
     """``data`` with NumPy scalars and arrays as JSON values."""
     return json.loads(json.dumps(data, default=lambda v: v.tolist() if hasattr(v, "tolist")
                                  else str(v)))

@@ -7,7 +7,8 @@ Bridges persist across gaps up to their rupture distance and form again only at 
 the branches differ where bridges across gaps broke (pendular.procedures.swcc). Writes into --out:
 swcc.json (drying and wetting rows: suction, saturation, bridges, porosity, volumetric strain,
 chi), swcc.png (Sr against log suction with thesis Fig. 5.5 and the Chapter 4 packings),
-history.h5 and sample.h5. --device gpu runs the preparation and the path on the GPU
+history.h5 and sample.h5, with --checkpoint-every N checkpoint.h5; --resume DIR continues an
+interrupted run bit for bit. --device gpu runs the preparation and the path on the GPU
 (docs/gpu.md).
 """
 
@@ -15,9 +16,13 @@ from __future__ import annotations
 
 import sys
 
-from pendular.cli import (add_command_options, add_device_option, add_run_options,
-    command_config, print_summary, set_threads)
+from pendular.cli import (INTERRUPTED, add_command_options, add_declared_options,
+    add_device_option, add_run_options, command_config, declared_values, print_summary,
+    set_threads)
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
+from pendular.procedures.options import CHECKPOINT_EVERY
 from pendular.procedures.swcc import SwccTest
+from pendular.procedures.triaxial import Interrupted
 
 #: A worked example: the command line, and what it gives (--help and docs/commands.md).
 EXAMPLE = ("pendular swcc --particles 1000 --suctions 3000,10000,30000,100000 --out runs/swcc",
@@ -34,6 +39,8 @@ def add_arguments(parser):
     add_run_options(parser)
     add_device_option(parser, "the preparation and the path (the wetting across gaps stays on "
                               "the CPU)")
+    add_declared_options(parser, (CHECKPOINT_EVERY,))
+    add_resume_options(parser)
 
 
 def config_from(args):
@@ -43,8 +50,21 @@ def config_from(args):
 
 def run(args):
     set_threads(args.threads)
-    result = SwccTest(config_from(args)).run(args.out, progress=not args.quiet,
-                                            threads=args.threads, device=args.device)
+    progress = not args.quiet
+    try:
+        if args.resume is not None:
+            check_resume_options(args, add_arguments)
+            result = SwccTest.resume(args.resume, progress=progress, threads=args.threads,
+                                     stop_after=args.stop_after, device=args.device)
+            args.out = args.resume
+        else:
+            every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
+            result = SwccTest(config_from(args)).run(
+                args.out, progress=progress, threads=args.threads, device=args.device,
+                checkpoint_every=every, stop_after=args.stop_after)
+    except Interrupted as stop:
+        print(f"{stop}", file=sys.stderr)
+        return INTERRUPTED
     print_summary(result, ("drying", "wetting"), args.quiet, columns=SHOWN_COLUMNS)
     merged = sorted({row["suction"] for branch in ("drying", "wetting") for row in result[branch]
                      if row["pendular_overlaps"] > 0})

@@ -4,7 +4,8 @@ Without --void-ratio / --water-content it runs Kim's six cases (F-75 sand, R = 0
 e = 0.72 and 0.58, three water contents each): a sample per void ratio (core void ratio reached
 by tuning the growth friction), wetted with volume-controlled bridges to the gravimetric water
 content, pulled apart by grips at its z walls. Writes tension.json, report.md, plots/ and
-cases/<case>/history.h5 and vtk/ (pendular.procedures.tension). --device gpu runs the
+cases/<case>/history.h5 and vtk/ (pendular.procedures.tension), with --checkpoint-every N
+checkpoint.h5; --resume DIR continues an interrupted run bit for bit. --device gpu runs the
 preparations, wettings and pulls on the GPU, or refuses in one line, before anything is made,
 what the GPU does not run yet (docs/gpu.md).
 """
@@ -14,11 +15,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-from pendular.cli import (add_command_options, add_device_option, add_run_options,
-    command_config, print_summary, set_threads)
+from pendular.cli import (INTERRUPTED, add_command_options, add_declared_options,
+    add_device_option, add_run_options, command_config, declared_values, print_summary,
+    set_threads)
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
 from pendular.procedures.config import TensionConfig
+from pendular.procedures.options import CHECKPOINT_EVERY
 from pendular.dem.simulation import check_device
 from pendular.procedures.tension import TensionTest
+from pendular.procedures.triaxial import Interrupted
 
 #: A worked example: the command line, and what it gives (--help and docs/commands.md).
 EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tension",
@@ -26,6 +31,9 @@ EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tens
            "the packing-state prediction; tension.json, report.md")
 
 #: Columns of the cases' table printed at the end (--quiet: report.md's table).
+#: Options that watch a run rather than make it: not recorded in tension.json's arguments.
+WATCHING = ("checkpoint_every", "resume", "stop_after")
+
 SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
                  "tensile_strength_pa", "kim_measured_pa", "packing_state_pa")
 
@@ -35,6 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", default="runs/direct_tension", help="output folder")
     add_run_options(parser, threads_default=1)
     add_device_option(parser, "the preparations, the wettings and the pulls")
+    add_declared_options(parser, (CHECKPOINT_EVERY,))
+    add_resume_options(parser)
 
 
 def config_from(args: argparse.Namespace) -> TensionConfig:
@@ -44,10 +54,24 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
 
 def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
-    config = config_from(args)
-    check_device(args.device)                   # before anything is made
-    output = TensionTest(config).run(args.out, progress=not args.quiet, arguments=vars(args),
-                                     device=args.device)
+    progress = not args.quiet
+    try:
+        if args.resume is not None:
+            check_resume_options(args, add_arguments)
+            output = TensionTest.resume(args.resume, progress=progress,
+                                        stop_after=args.stop_after, device=args.device)
+            args.out = args.resume
+        else:
+            config = config_from(args)
+            check_device(args.device)                   # before anything is made
+            every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
+            arguments = {k: v for k, v in vars(args).items() if k not in WATCHING}
+            output = TensionTest(config).run(args.out, progress=progress, arguments=arguments,
+                                             device=args.device, checkpoint_every=every,
+                                             stop_after=args.stop_after)
+    except Interrupted as stop:
+        print(f"{stop}", file=sys.stderr)
+        return INTERRUPTED
     print_summary(output, ("cases",), args.quiet, columns=SHOWN_COLUMNS)
     # with --quiet, stdout holds the JSON alone
     print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}",

@@ -86,13 +86,32 @@ def add_output_options(parser, out):
                              "DIR/vtk_prep/ (field data 'phase': 0 growth, 1 friction, 2 "
                              "unload, 3 equilibrate, 4 sample, 5 wetting), every N steps "
                              "(default: unload_steps / 20 = 500, a few tens of frames)")
+    add_resume_options(parser)
+
+
+def add_resume_options(parser):
+    """--resume DIR and, for the tests, --stop-after N (stop the loading after N steps as an
+    interruption would, exit status 130)."""
     parser.add_argument("--resume", metavar="DIR", default=None,
                         help="continue the interrupted run of DIR from its checkpoint, with the "
                              "configuration stored there (only --quiet, --threads and --device "
                              "may be added)")
-    # tests: stop the loading after this many steps as an interruption would (exit status 130)
     parser.add_argument("--stop-after", type=positive_int("--stop-after", low=1), default=None,
                         help=argparse.SUPPRESS)
+
+
+def check_resume_options(args, add_arguments):
+    """UsageError naming the options of ``args`` given beside --resume that would change the
+    stored run (any but RESUME_OPTIONS away from its default; ``add_arguments``: the
+    command's options, for their defaults)."""
+    defaults = vars(_defaults(add_arguments))
+    given = [name for name, value in vars(args).items()
+             if name not in RESUME_OPTIONS and value != defaults.get(name)]
+    if given:
+        raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
+                         f"{', '.join('--' + n.replace('_', '-') for n in given)} "
+                         "cannot be changed (only --quiet, --threads and --device may be "
+                         "added)")
 
 
 add_arguments, config_from, run = loading_command("triaxial", TriaxialTest, SHOWN)
@@ -107,14 +126,7 @@ def run_test(args, test, config_from, shown, add_arguments):
     progress = not args.quiet
     try:
         if args.resume is not None:
-            defaults = vars(_defaults(add_arguments))
-            given = [name for name, value in vars(args).items()
-                     if name not in RESUME_OPTIONS and value != defaults.get(name)]
-            if given:
-                raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
-                                 f"{', '.join('--' + n.replace('_', '-') for n in given)} "
-                                 "cannot be changed (only --quiet, --threads and --device may be "
-                                 "added)")
+            check_resume_options(args, add_arguments)
             summary = test.resume(args.resume, progress=progress, threads=args.threads,
                                   stop_after=args.stop_after, device=args.device)
             out = args.resume

@@ -1,0 +1,211 @@
+"""An SWCC run stopped mid-path and a direct tension stopped mid-pull (deterministically,
+--stop-after) and continued with --resume write the uninterrupted run's files bit for bit
+(timings aside); a damaged or forged checkpoint, and a resume that would change the run's
+configuration, are refused in one line naming the file or the option."""
+
+import json
+import os
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+
+from conftest import refused, run_in_process, zero_bytes
+from pendular.cli import run_command
+from pendular.utils.integrity import stamp, verify
+
+pytestmark = pytest.mark.slow
+
+# 50 spheres, two suctions: each stage of the path takes a few hundred steps
+RUN = ["--particles", "50", "--confining", "750", "--suctions", "3000,30000", "--threads", "1",
+       "--quiet"]
+#: Checkpoints every 70 steps, stopped after 350 steps of the path: the last checkpoint falls
+#: inside a stage, away from its equilibrium checks (every 200 steps of the stage).
+STOP = ["--checkpoint-every", "70", "--stop-after", "350"]
+#: Timings, which differ between runs (summaries, a tension's cases, history attributes).
+TIMINGS = {"wall_time_s", "wetting_time_s", "pull_time_s"}
+#: HDF5 attributes that hold object references (dimension scales), compared by their targets.
+REFERENCES = {"DIMENSION_LIST", "REFERENCE_LIST"}
+
+
+def swcc(argv, capsys):
+    return run_in_process("swcc", argv, capsys)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """(uninterrupted run folder, interrupted run folder before its resume)."""
+    root = tmp_path_factory.mktemp("swcc_resume")
+    whole, stopped = root / "whole", root / "stopped"
+    assert run_command("swcc", RUN + ["--out", str(whole)]) == 0
+    assert run_command("swcc", RUN + STOP + ["--out", str(stopped)]) == 130
+    return whole, stopped
+
+
+def contents(path):
+    """{object name: (data or None, attributes)} of an HDF5 file, references left out."""
+    with h5py.File(path) as handle:
+        found = {}
+
+        def visit(name, item):
+            data = item[()] if isinstance(item, h5py.Dataset) else None
+            found[name] = (data, {k: v for k, v in item.attrs.items()
+                                  if k not in REFERENCES and k not in TIMINGS})
+        handle.visititems(visit)
+        found["/"] = (None, {k: v for k, v in handle.attrs.items() if k not in TIMINGS})
+    return found
+
+
+def without_timings(data):
+    """A JSON value with the TIMINGS keys left out at every depth."""
+    if isinstance(data, dict):
+        return {k: without_timings(v) for k, v in data.items() if k not in TIMINGS}
+    if isinstance(data, list):
+        return [without_timings(v) for v in data]
+    return data
+
+
+def assert_same_files(first, second, files=("history.h5", "sample.h5"), summary="swcc.json"):
+    for name in files:
+        a, b = contents(first / name), contents(second / name)
+        assert a.keys() == b.keys(), name
+        for key, (data, attributes) in a.items():
+            other, other_attributes = b[key]
+            if data is not None:
+                assert data.dtype == other.dtype and np.array_equal(data, other), (name, key)
+            assert attributes.keys() == other_attributes.keys(), (name, key)
+            for attribute, value in attributes.items():
+                assert np.array_equal(value, other_attributes[attribute]), (name, key, attribute)
+    a, b = (json.loads((folder / summary).read_text()) for folder in (first, second))
+    assert without_timings(a) == without_timings(b)
+
+
+def test_a_stopped_swcc_resumes_bit_for_bit(runs, tmp_path, capsys):
+    whole, stopped = runs
+    run = tmp_path / "run"
+    shutil.copytree(stopped, run)
+    assert not (run / "swcc.json").exists() and (run / "checkpoint.h5").exists()
+    status, err = swcc(["--resume", str(run), "--threads", "1", "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole, run)
+    # stopped again after its resume, and resumed once more: still the same files
+    again = tmp_path / "again"
+    shutil.copytree(stopped, again)
+    status, err = swcc(["--resume", str(again), "--stop-after", "150", "--quiet"], capsys)
+    assert status == 130 and f"--resume {again}" in err, err
+    assert swcc(["--resume", str(again), "--quiet"], capsys)[0] == 0
+    assert_same_files(whole, again)
+
+
+def forge(path, change):
+    """Edit the checkpoint and stamp it again (a valid checksum over a wrong content)."""
+    stored = verify(path, kind="file")
+    with h5py.File(path, "r+") as handle:
+        change(handle)
+    stamp(path, stored)
+
+
+def edit_extra(key, value):
+    def change(handle):
+        extra = json.loads(handle.attrs["extra_state"])
+        extra[key] = value
+        handle.attrs["extra_state"] = json.dumps(extra)
+    return change
+
+
+FAULTS = {
+    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position", 32), ["checksum mismatch"]),
+    "stage forged": (lambda p: forge(p, edit_extra("stage", 3)), ["stage rows"]),
+    "path state forged": (lambda p: forge(p, edit_extra("stages", "none")),
+                          ["does not belong"]),
+    "missing": (os.remove, ["checkpoint.h5 is missing"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(FAULTS))
+def test_a_damaged_swcc_checkpoint_is_refused_naming_it(name, runs, tmp_path, capsys):
+    run = tmp_path / "run"
+    shutil.copytree(runs[1], run)
+    damage, words = FAULTS[name]
+    damage(str(run / "checkpoint.h5"))
+    refused(*swcc(["--resume", str(run), "--quiet"], capsys), "checkpoint.h5", *words)
+    assert not (run / "swcc.json").exists()
+
+
+def test_a_resume_that_changes_the_configuration_is_refused(runs, tmp_path, capsys):
+    run = tmp_path / "run"
+    shutil.copytree(runs[1], run)
+    refused(*swcc(["--resume", str(run), "--suctions", "3000,300000", "--quiet"], capsys),
+            "--suctions", "cannot be changed")
+
+
+# ---------------------------------------------------------------- direct tension
+
+#: One void ratio, two water contents: the second case pulled from the sample of the first.
+TENSION = ["--particles", "100", "--void-ratio", "0.72", "--water-content", "1,2",
+           "--max-strain", "0.01", "--vtk-frames", "0", "--threads", "1", "--quiet"]
+#: Stopped in the second case's pull (each pulls about 1,900 steps), checkpoints every 150.
+TENSION_STOP = ["--checkpoint-every", "150", "--stop-after", "2500"]
+CASES = ("e0.72_w1.00", "e0.72_w2.00")
+
+
+@pytest.fixture(scope="module")
+def tension_runs(tmp_path_factory):
+    """(folder holding the uninterrupted run ``run``, folder holding the stopped one): the
+    same --out, which tension.json records."""
+    whole, stopped = (tmp_path_factory.mktemp(name) for name in ("whole", "stopped"))
+    here = os.getcwd()
+    try:
+        os.chdir(whole)
+        assert run_command("tension", TENSION + ["--out", "run"]) == 0
+        os.chdir(stopped)
+        assert run_command("tension", TENSION + TENSION_STOP + ["--out", "run"]) == 130
+    finally:
+        os.chdir(here)
+    return whole, stopped
+
+
+def tension(argv, capsys):
+    return run_in_process("tension", argv, capsys)
+
+
+def test_a_stopped_tension_resumes_bit_for_bit(tension_runs, tmp_path, capsys, monkeypatch):
+    whole, stopped = tension_runs
+    shutil.copytree(stopped / "run", tmp_path / "run")
+    monkeypatch.chdir(tmp_path)
+    assert not (tmp_path / "run" / "tension.json").exists()
+    status, err = tension(["--resume", "run", "--threads", "1", "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole / "run", tmp_path / "run",
+                      files=[f"cases/{case}/history.h5" for case in CASES],
+                      summary="tension.json")
+    assert ((whole / "run" / "report.md").read_bytes()
+            == (tmp_path / "run" / "report.md").read_bytes())
+
+
+TENSION_FAULTS = {
+    "zeroed bytes": (lambda p: zero_bytes(p, "particles/position", 32), ["checksum mismatch"]),
+    "case forged": (lambda p: forge(p, edit_extra("case", 0)), ["finished cases"]),
+    "pull start forged": (lambda p: forge(p, edit_extra("pull_start", 5)), ["pull_start = 5"]),
+    "missing": (os.remove, ["checkpoint.h5 is missing"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(TENSION_FAULTS))
+def test_a_damaged_tension_checkpoint_is_refused_naming_it(name, tension_runs, tmp_path,
+                                                           capsys):
+    run = tmp_path / "run"
+    shutil.copytree(tension_runs[1] / "run", run)
+    damage, words = TENSION_FAULTS[name]
+    damage(str(run / "checkpoint.h5"))
+    refused(*tension(["--resume", str(run), "--quiet"], capsys), "checkpoint.h5", *words)
+    assert not (run / "tension.json").exists()
+
+
+def test_a_tension_resume_that_changes_the_configuration_is_refused(tension_runs, tmp_path,
+                                                                    capsys):
+    run = tmp_path / "run"
+    shutil.copytree(tension_runs[1] / "run", run)
+    refused(*tension(["--resume", str(run), "--water-content", "3", "--quiet"], capsys),
+            "--water-content", "cannot be changed")
