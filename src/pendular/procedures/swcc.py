@@ -44,10 +44,12 @@ from pendular.utils.atomic import write_json
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
 from pendular.procedures.preparation import prepare_sample
+from pendular.procedures.progress import swcc_plan
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import save_sample
 from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
+from pendular.utils.progress import whole_run
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
@@ -104,7 +106,8 @@ class SwccTest:
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, device)
+            with whole_run(swcc_plan(self.config), enabled=progress):
+                return self._run(out, progress, threads, device)
 
     def _run(self, out, progress, threads, device):
         config = self.config

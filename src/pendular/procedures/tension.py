@@ -70,6 +70,8 @@ from pendular.homogenize import packing_state, regular_packing
 
 from pendular.procedures.config import TensionConfig, case_name, config_to_dict, inertial_number
 from pendular.procedures.loading import measured
+from pendular.procedures.progress import equilibrium_bar, tension_plan
+from pendular.utils.progress import whole_run
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -139,7 +141,7 @@ def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
     tried = {}
 
     def prepared(friction):
-        sim, report = prepare_sample(prepare_config(config, friction), progress=False,
+        sim, report = prepare_sample(prepare_config(config, friction), progress=progress,
                                      device=device)
         sim.device = device
         report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
@@ -227,7 +229,8 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
 
     def settle(sim):
         return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
-                       progress="wet" if progress else None)
+                       progress=equilibrium_bar("wet" if progress else None,
+                                                config.sample.equilibrium_unbalanced))
 
     sim, bridges, tries = wet_to_water_volume(
         dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,
@@ -564,8 +567,9 @@ class TensionTest:
         with OutputFolder(out, "tension") as folder:
             for name in ("tension.json", "report.md", "plots", "cases"):
                 folder.claim(name)
-            return self._run(out, progress, self.config.options() if arguments is None
-                             else dict(arguments), device)
+            with whole_run(tension_plan(self.config), enabled=progress):
+                return self._run(out, progress, self.config.options() if arguments is None
+                                 else dict(arguments), device)
 
     def _run(self, out, progress, arguments, device):
         config = self.config
