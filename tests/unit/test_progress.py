@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
-from pendular.procedures.progress import laboratory_plan, preparation_plan
+from pendular.procedures.config import SwccConfig, TensionConfig, TriaxialConfig
+from pendular.procedures.progress import (OPEN_ENDED_STEPS, laboratory_plan, preparation_plan,
+                                          swcc_plan, tension_plan)
 from pendular.utils import progress
 from pendular.utils.progress import Approach, Decades, Phase, PhaseBar, whole_run
 
@@ -87,7 +89,30 @@ def test_the_plans_follow_the_configuration():
     assert [p for p, _ in preparation_plan(sample)] == ["grow radii", "set friction", "unload",
                                                         "equilibrate"]
     assert dict(preparation_plan(sample))["unload"] == 400
-    assert preparation_plan(sample, loaded=True) == [("equilibrate", pytest.approx(5000))]
+    assert preparation_plan(sample, loaded=True) == [("equilibrate", OPEN_ENDED_STEPS)]
+    triaxial = TriaxialConfig(sample=sample)
+    assert laboratory_plan(triaxial, "shear")[-1] == ("shear", triaxial.estimated_steps())
+    suctions = SwccConfig(sample=sample, suctions=[1e3, 1e4, 1e5])
+    assert swcc_plan(suctions)[-2:] == [("drying", 3 * OPEN_ENDED_STEPS),
+                                        ("wetting", 2 * OPEN_ENDED_STEPS)]
+    tension = TensionConfig(sample=sample, cases=[(0.7, 0.01), (0.7, 0.02), (0.6, 0.01)])
+    plan = tension_plan(tension)
+    assert [p if isinstance(p, str) else "tune" for p, _ in plan] == [
+        "tune", "wet", "pull", "wet", "pull", "tune", "wet", "pull"]
+    assert dict(plan)["pull"] == tension.pull_steps()
+
+
+def test_a_tuple_of_prefixes_holds_every_repeated_preparation():
+    with whole_run([(("grow", "unload"), 100), ("pull", 100)]):
+        for label in ("grow radii", "unload", "grow radii", "unload", "grow radii"):
+            bar = PhaseBar(label, 30)
+            bar.update(None, 30)
+            bar.close()                   # 150 steps: more than the 100 planned
+        assert run_fraction() == pytest.approx(100 * 150 / 250, abs=0.05)
+        bar = PhaseBar("pull e0.7", 100)
+        bar.update(None, 50)
+        assert run_fraction() == pytest.approx(100 * 200 / 250, abs=0.05)
+        bar.close()
 
 
 def test_a_preparation_shows_bars_with_totals_and_changes_no_result(capsys):

@@ -91,11 +91,15 @@ def swcc_plan(config):
 
 
 def tension_plan(config):
-    """The plan of a TensionConfig's run: per void ratio TUNING_PREPARATIONS preparations,
-    then per case its wetting and its pull (TensionConfig.pull_steps)."""
+    """The plan of a TensionConfig's run: per void ratio the preparations of its tuning (one
+    entry for all of them, TUNING_PREPARATIONS estimated), then per case its wetting and its
+    pull (TensionConfig.pull_steps)."""
+    preparation = preparation_plan(config.sample)
+    tuning = (tuple(prefix for prefix, _ in preparation),
+              TUNING_PREPARATIONS * sum(steps for _, steps in preparation))
     plan = []
     for void_ratio in dict.fromkeys(e for e, _ in config.cases):
-        plan.extend(preparation_plan(sample) * TUNING_PREPARATIONS)
+        plan.append(tuning)
         for _ in (w for e, w in config.cases if e == void_ratio):
             plan.extend([("wet", OPEN_ENDED_STEPS), ("pull", config.pull_steps())])
     return plan

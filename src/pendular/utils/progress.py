@@ -20,9 +20,10 @@ READ_INTERVAL seconds, from quantities that the phase's end test reads anyway (a
 brings back what its status fields bring back); reading it changes no result.
 
 ``whole_run(plan)``: while it is open, one more bar (above the phases') shows the run's
-percentage and its time left. ``plan`` lists the phases expected, in order, as (label prefix,
-estimated steps); a phase bar whose label starts with a prefix belongs to that entry (several
-phases may: the stages of a path), and a prefix passed over is a phase that did not run. The
+percentage and its time left. ``plan`` lists the phases expected, in order, as (label prefix
+or a tuple of them, estimated steps); a phase bar whose label starts with a prefix belongs to
+that entry (several phases may: the stages of a path, the repeated preparations of a tuning),
+and an entry passed over is a phase that did not run. The
 run counts steps: those the ended phases took, the running phase's against its estimate (its
 length, or from its gauge: steps so far over the fraction of the total reached, once that is
 5 % or more) and the plan's estimates of the phases to come, an entry never taking fewer than
@@ -138,8 +139,8 @@ class PhaseBar:
             position = self.gauge.read(sim)
             total = self.gauge.total
             if self.bar.total is None:
-                self.bar.total = round(total, 3)
-            self.bar.update(round(position, 3) - self.bar.n)
+                self.bar.total = _shown(total)
+            self.bar.update(_shown(position) - self.bar.n)
             # the steps this phase will take, once its gauge has moved enough to tell
             estimate = self.taken * total / position if position >= 0.05 * total else None
         if self.planned:
@@ -152,6 +153,11 @@ class PhaseBar:
         if self.planned:
             _RUN.finish(self.taken)
         self.bar.close()
+
+
+def _shown(value):
+    """``value`` to 4 significant digits, as a bar shows it."""
+    return float(f"{value:.4g}")
 
 
 class _Run:
@@ -200,7 +206,7 @@ _RUN = _Run()
 @contextlib.contextmanager
 def whole_run(plan, *, enabled=True, label="run"):
     """Show one bar for the whole run while the block runs (module docstring): ``plan`` a list
-    of (label prefix, estimated steps); nothing shown when not ``enabled`` or when a run is
+    of (label prefix or a tuple of them, estimated steps); nothing shown when not ``enabled`` or when a run is
     open already."""
     if not enabled or not plan or _RUN.bar is not None:
         yield
