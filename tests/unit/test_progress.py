@@ -7,10 +7,10 @@ import re
 import numpy as np
 import pytest
 
-from pendular.procedures.preparation import PrepareConfig, prepare_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample, static
 from pendular.procedures.config import SwccConfig, TensionConfig, TriaxialConfig
-from pendular.procedures.progress import (OPEN_ENDED_STEPS, laboratory_plan, preparation_plan,
-                                          swcc_plan, tension_plan)
+from pendular.procedures.progress import (OPEN_ENDED_STEPS, laboratory_plan, off_equilibrium,
+                                          preparation_plan, swcc_plan, tension_plan)
 from pendular.utils import progress
 from pendular.utils.progress import Approach, Decades, Phase, PhaseBar, whole_run
 
@@ -132,3 +132,8 @@ def test_a_preparation_shows_bars_with_totals_and_changes_no_result(capsys):
     assert re.search(r"run: 100%\|", err)
     assert math.isclose(float(re.findall(r"unload: +\d+%\|[^|]*\| [\d.]+/([\d.]+)", err)[-1]),
                         400)
+    # the equilibrium's gauge falls to 1 where the equilibrium's own test is met
+    for unbalanced in (1e-5, 1e-3, 1e-1):
+        for tolerance in (1e-5, 1e-3, 1e-1):
+            ratio = off_equilibrium(unbalanced, tolerance)(shown)
+            assert static(unbalanced, tolerance)(shown) == (ratio <= 1.0)

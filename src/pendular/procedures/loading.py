@@ -698,7 +698,7 @@ class LoadingPath:
         target, a Static one the unbalanced force's decades (pendular.procedures.progress)."""
         if isinstance(until, Stress):
             return stress_bar(label, AXES[until.axis], until.value)
-        return equilibrium_bar(label, until.unbalanced)
+        return equilibrium_bar(label, until.unbalanced, until.tolerance)
 
     def steps_left(self, sim):
         """Steps left to the running stage's end (Strain, ShearStrain) or limit (Stress,

@@ -553,7 +553,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=equilibrium_bar(label and "set friction",
-                                                         config.equilibrium_unbalanced),
+                                                         config.equilibrium_unbalanced,
+                                                         config.stress_tolerance),
                                 status=status)
     _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim),
              config)
@@ -572,7 +573,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     _enter(writers, "equilibrate")
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
                                    progress=equilibrium_bar(label and "equilibrate",
-                                                            config.equilibrium_unbalanced),
+                                                            config.equilibrium_unbalanced,
+                                                            config.stress_tolerance),
                                    status=status)
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)

@@ -6,8 +6,8 @@ Each open-ended phase is measured by the quantity that ends it (pendular.utils.p
   stress approaching its target [Pa];
 - an equilibrium (preparation's friction and final equilibria, wetting, a loaded sample's
   settling, a suction step of the SWCC, a Static loading stage): ``equilibrium_bar``, the decades
-  the unbalanced force [-] has fallen toward its threshold (the servo's stress tolerance,
-  usually met first, is not counted);
+  by which the distance to equilibrium has fallen toward 1 (``off_equilibrium``: the larger of
+  the unbalanced force over its threshold and the servos' stress errors over their tolerance);
 - a loading stage until a stress: ``stress_bar``, that wall stress approaching its target
   [Pa].
 
@@ -21,7 +21,10 @@ radius growth GROWTH_STEPS. These are rough; the run's bar refines them as its p
 end.
 """
 
+import numpy as np
+
 from pendular.dem.measure import unbalanced_force
+from pendular.dem.walls import StressServo
 from pendular.utils.progress import Approach, Decades, Phase
 
 #: Estimated steps of an equilibrium (the run bar's share of it) [-].
@@ -41,6 +44,22 @@ def unbalanced_now(sim):
     return device["unbalanced_force"]
 
 
+def off_equilibrium(unbalanced, tolerance):
+    """How far ``sim`` is from the equilibrium of pendular.procedures.preparation.static, as a
+    function of sim: the larger of the unbalanced force over ``unbalanced`` and each
+    StressServo's largest stress error over ``tolerance`` times its target [-]; at most 1 at
+    equilibrium."""
+
+    def ratio(sim):
+        worst = unbalanced_now(sim) / unbalanced
+        for servo in (op for op in sim.peek("controls") if isinstance(op, StressServo)):
+            error = np.max(np.abs(sim.walls.stress()[list(servo.axes)] - servo.target))
+            worst = max(worst, error / (tolerance * max(servo.target, 1e-12)))
+        return worst
+
+    return ratio
+
+
 def mean_wall_stress(sim):
     """The walls' mean stress [Pa]."""
     return float(sim.walls.stress().mean())
@@ -52,10 +71,11 @@ def growth_bar(label, target):
     return label and Phase(label, Approach(mean_wall_stress, target, "Pa"))
 
 
-def equilibrium_bar(label, unbalanced):
-    """The bar of an equilibrium until the unbalanced force is at most ``unbalanced`` [-];
-    None without ``label``."""
-    return label and Phase(label, Decades(unbalanced_now, unbalanced))
+def equilibrium_bar(label, unbalanced, tolerance):
+    """The bar of an equilibrium until the unbalanced force is at most ``unbalanced`` [-] and
+    the servos' stresses within ``tolerance`` (relative) of their targets: the decades by which
+    ``off_equilibrium`` falls to 1; None without ``label``."""
+    return label and Phase(label, Decades(off_equilibrium(unbalanced, tolerance), 1.0))
 
 
 def stress_bar(label, axis, target):

@@ -230,7 +230,8 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
     def settle(sim):
         return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
                        progress=equilibrium_bar("wet" if progress else None,
-                                                config.sample.equilibrium_unbalanced))
+                                                config.sample.equilibrium_unbalanced,
+                                                config.sample.stress_tolerance))
 
     sim, bridges, tries = wet_to_water_volume(
         dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,

@@ -117,7 +117,7 @@ def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check
     reached) when the limit is hit first."""
     done = static(unbalanced, tolerance)
     steps = sim.run(max_steps, until=done, check_every=check_every,
-                    progress=equilibrium_bar(progress, unbalanced),
+                    progress=equilibrium_bar(progress, unbalanced, tolerance),
                     status=equilibrium_status(unbalanced))
     if not done(sim):
         reached = equilibrium_status(unbalanced)(sim)
