@@ -46,6 +46,13 @@ def test_decades_of_a_force_already_small_is_a_bar_full_at_once():
     assert gauge.read(None) == gauge.total > 0.0
 
 
+def test_a_gauge_waits_for_a_finite_reading():
+    gauge = Decades(readings([math.inf, 1.0, 0.1]), 0.01)
+    assert gauge.read(None) == 0.0 and gauge.total is None
+    assert [gauge.read(None) for _ in range(2)] == pytest.approx([0.0, 1.0])
+    assert gauge.total == pytest.approx(2.0)
+
+
 def run_fraction():
     return progress._RUN.bar.n
 

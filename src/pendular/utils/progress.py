@@ -57,6 +57,8 @@ class Approach:
     def read(self, sim):
         """Read the quantity; returns the position [unit], never lower than before."""
         value = float(self.quantity(sim))
+        if not math.isfinite(value):          # nothing to measure yet (no contact)
+            return self.position
         if self.start is None:
             self.start = value
         span = self.target - self.start
@@ -86,6 +88,8 @@ class Decades:
     def read(self, sim):
         """Read the quantity; returns the position [decade], never lower than before."""
         value = float(self.quantity(sim))
+        if not math.isfinite(value):          # nothing to measure yet (no contact)
+            return self.position
         if self.first is None:
             self.first = max(value, self.threshold)
         if value > 0.0:
@@ -138,6 +142,8 @@ class PhaseBar:
             self.read_at = now
             position = self.gauge.read(sim)
             total = self.gauge.total
+            if total is None:
+                return
             if self.bar.total is None:
                 self.bar.total = _shown(total)
             self.bar.update(_shown(position) - self.bar.n)
@@ -206,8 +212,8 @@ _RUN = _Run()
 @contextlib.contextmanager
 def whole_run(plan, *, enabled=True, label="run"):
     """Show one bar for the whole run while the block runs (module docstring): ``plan`` a list
-    of (label prefix or a tuple of them, estimated steps); nothing shown when not ``enabled`` or when a run is
-    open already."""
+    of (label prefix or a tuple of them, estimated steps); nothing shown when not ``enabled``
+    or when a run is open already."""
     if not enabled or not plan or _RUN.bar is not None:
         yield
         return
