@@ -695,7 +695,8 @@ class LoadingPath:
     @staticmethod
     def _bar(label, until):
         """The bar of an open-ended stage: a Stress stage counts its wall's stress toward the
-        target, a Static one the unbalanced force's decades (pendular.procedures.progress)."""
+        target, a Static one the decades of its distance to equilibrium
+        (pendular.procedures.progress)."""
         if isinstance(until, Stress):
             return stress_bar(label, AXES[until.axis], until.value)
         return equilibrium_bar(label, until.unbalanced, until.tolerance)
