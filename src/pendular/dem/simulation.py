@@ -31,10 +31,10 @@ import importlib
 import time
 
 import numba
-from tqdm import tqdm
 
 from pendular.dem.protocols import Operation
 from pendular.dem.state import Box, Particles
+from pendular.utils.progress import PhaseBar
 from pendular.utils.validate import check_int, check_positive
 from pendular.utils.threads import configure as configure_threading
 
@@ -229,9 +229,10 @@ class Simulation:
 
     def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
         """Advance ``steps`` steps, or fewer if ``until(sim)`` becomes true (checked every
-        ``check_every`` steps). ``progress`` is a label for a progress bar; ``status(sim)``
-        returns a dict shown beside it (an open-ended run, with ``until``, shows the steps
-        taken and its status, not a fraction of the step limit). Returns the steps taken.
+        ``check_every`` steps). ``progress`` is a label for a progress bar counting steps, or
+        for an open-ended run (with ``until``) a ``pendular.utils.progress.Phase``, whose
+        gauge counts the quantity that ends it; ``status(sim)`` returns a dict shown beside
+        it. Returns the steps taken.
         On another ``device`` the steps run there, the writers, ``until`` and ``status``
         reading the state brought back (module docstring)."""
         steps = check_int("steps", steps)
@@ -258,8 +259,7 @@ class Simulation:
         (a device's own checks, which raise; None: none), the progress bar and ``status``,
         then ``until``. Arguments otherwise as ``run``, which checks them; returns the steps
         taken."""
-        bar = tqdm(total=None if until is not None else steps, desc=progress, unit="step",
-                   mininterval=1.0, smoothing=0.05, disable=progress is None)
+        bar = PhaseBar(progress, steps)
         taken = 0
         started = time.perf_counter()
         try:
@@ -268,13 +268,14 @@ class Simulation:
                 for _ in range(chunk):
                     advance()
                 taken += chunk
-                bar.update(chunk)
                 if check is not None:
                     check()
+                bar.update(self, chunk)
                 if status is not None and time.perf_counter() - started > 1.0:
-                    bar.set_postfix(status(self), refresh=False)
+                    bar.set_postfix(status(self))
                 if until is not None and until(self):
                     break
+            bar.update(self, 0, last=True)
         finally:
             bar.close()
         return taken

@@ -57,6 +57,7 @@ from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.hydraulic import SuctionChange, WaterContentChange
 from pendular.procedures.preparation import servo_speed, static
+from pendular.procedures.progress import equilibrium_bar, stress_bar
 from pendular.utils.validate import check_int, check_positive, check_range
 
 #: The axes by name, in order (x, y lateral; z axial).
@@ -685,11 +686,20 @@ class LoadingPath:
             if offset:              # a resumed stage: its checks fall where they fell before
                 taken += sim.run(min(every - offset, steps), progress=label, status=status)
                 continue
-            taken += sim.run(steps, until=self._reached, check_every=every, progress=label,
-                             status=status)
+            taken += sim.run(steps, until=self._reached, check_every=every,
+                             progress=self._bar(label, until), status=status)
             if not self._reached(sim) and sim.step >= self.stage_start + self.stage_steps:
                 raise StageFailed(self._failure(sim))
         return taken
+
+    @staticmethod
+    def _bar(label, until):
+        """The bar of an open-ended stage: a Stress stage counts its wall's stress toward the
+        target, a Static one the decades of its distance to equilibrium
+        (pendular.procedures.progress)."""
+        if isinstance(until, Stress):
+            return stress_bar(label, AXES[until.axis], until.value)
+        return equilibrium_bar(label, until.unbalanced, until.tolerance)
 
     def steps_left(self, sim):
         """Steps left to the running stage's end (Strain, ShearStrain) or limit (Stress,

@@ -25,7 +25,6 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from tqdm import tqdm
 
 from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
@@ -44,6 +43,8 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import (TIMESTEP_RULES, critical_timestep, pwave_timestep,
     rayleigh_timestep)
 from pendular.utils.parameters import fail, parameter, spec_of, validate
+from pendular.utils.progress import PhaseBar
+from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
 
@@ -579,8 +580,9 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
                          f"/{config.equilibrium_unbalanced:g}"}
 
     _enter(writers, "growth")
-    steps = {"growth": sim.run(max_steps, until=grown, check_every=200, progress=label and
-                               "grow radii", status=status)}
+    steps = {"growth": sim.run(max_steps, until=grown, check_every=200,
+                               progress=growth_bar(label and "grow radii", config.prep_stress),
+                               status=status)}
     _require(grown(sim), "radius growth", steps["growth"], status(sim), config)
     rescale(sim, config.radius / float(np.mean(sim.particles.radius)))
     sim.neighbors.skin = config.skin_factor * config.radius
@@ -591,23 +593,30 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     sim.forces.extend(resisting(config))        # with the test friction, as in a loaded sample
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
-                                progress=label and "set friction", status=status)
+                                progress=equilibrium_bar(label and "set friction",
+                                                         config.equilibrium_unbalanced,
+                                                         config.stress_tolerance),
+                                status=status)
     _require(done(sim), "equilibrium at the test friction", steps["friction"], status(sim),
              config)
     start = servo.target
     stages = 20
     _enter(writers, "unload")
     each = config.unload_steps // stages
-    # one bar over the stages, with its total and time left
-    with tqdm(total=each * stages, desc="unload", unit="step", mininterval=1.0,
-              disable=label is None) as bar:
+    bar = PhaseBar(label and "unload", each * stages)      # one bar over the stages
+    try:
         for stage in range(1, stages + 1):
             servo.target = start + (config.confining - start) * stage / stages
-            bar.update(sim.run(each))
+            bar.update(sim, sim.run(each))
+    finally:
+        bar.close()
     steps["unload"] = each * stages
     _enter(writers, "equilibrate")
     steps["equilibrate"] = sim.run(max_steps, until=done, check_every=200,
-                                   progress=label and "equilibrate", status=status)
+                                   progress=equilibrium_bar(label and "equilibrate",
+                                                            config.equilibrium_unbalanced,
+                                                            config.stress_tolerance),
+                                   status=status)
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)
     sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]

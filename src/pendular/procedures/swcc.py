@@ -47,11 +47,13 @@ from pendular.utils.atomic import write_json
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
 from pendular.procedures.preparation import prepare_sample, servoed_simulation, static
+from pendular.procedures.progress import swcc_plan
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
+from pendular.utils.progress import whole_run
 from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
@@ -114,7 +116,8 @@ class SwccTest:
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
-            return self._run(out, progress, threads, device, checkpoint_every, stop_after)
+            with whole_run(swcc_plan(self.config), enabled=progress):
+                return self._run(out, progress, threads, device, checkpoint_every, stop_after)
 
     def _run(self, out, progress, threads, device, checkpoint_every, stop_after):
         config = self.config

@@ -76,6 +76,8 @@ from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, lo
 from pendular.procedures.config import (TensionConfig, case_name, config_from_dict,
     config_to_dict, inertial_number)
 from pendular.procedures.loading import measured
+from pendular.procedures.progress import equilibrium_bar, tension_plan
+from pendular.utils.progress import whole_run
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -149,7 +151,7 @@ def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
     tried = {}
 
     def prepared(friction):
-        sim, report = prepare_sample(prepare_config(config, friction), progress=False,
+        sim, report = prepare_sample(prepare_config(config, friction), progress=progress,
                                      device=device)
         sim.device = device
         report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
@@ -237,7 +239,9 @@ def wet(dry: Simulation, config: TensionConfig, water_content: float,
 
     def settle(sim):
         return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
-                       progress="wet" if progress else None)
+                       progress=equilibrium_bar("wet" if progress else None,
+                                                config.sample.equilibrium_unbalanced,
+                                                config.sample.stress_tolerance))
 
     sim, bridges, tries = wet_to_water_volume(
         dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,
@@ -613,7 +617,8 @@ class TensionTest:
             for name in OUTPUTS:
                 folder.claim(name)
             run = TensionRun(out, self.config, arguments, checkpoint_every, stop_after)
-            return self._run(out, progress, device, run)
+            with whole_run(tension_plan(self.config), enabled=progress):
+                return self._run(out, progress, device, run)
 
     @classmethod
     def resume(cls, out: str, *, progress: bool = True, stop_after: int | None = None,

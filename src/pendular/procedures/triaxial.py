@@ -40,6 +40,7 @@ from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
+from pendular.utils.progress import whole_run
 from pendular.utils.parameters import fail, flat_options
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
@@ -52,6 +53,7 @@ from pendular.homogenize.invariants import (lateral_stress, mean_stress,
     principal_difference, shear_deviator)
 
 from pendular.procedures.critical_state import critical_state
+from pendular.procedures.progress import equilibrium_bar, laboratory_plan
 from pendular.procedures.guards import AxialContactLost, AxialStressGuard, SampleCrushed
 from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
     WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number,
@@ -110,10 +112,12 @@ def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check
                 progress=None, phase="equilibrium"):
     """Run ``sim`` until static: unbalanced force below ``unbalanced`` and, if a StressServo
     controls walls, their stresses within ``tolerance`` (relative) of its target; at most
-    ``max_steps`` steps. Returns the steps taken; NotStatic (naming ``phase`` and what it
+    ``max_steps`` steps; ``progress``: the label of its bar (procedures.progress
+    .equilibrium_bar). Returns the steps taken; NotStatic (naming ``phase`` and what it
     reached) when the limit is hit first."""
     done = static(unbalanced, tolerance)
-    steps = sim.run(max_steps, until=done, check_every=check_every, progress=progress,
+    steps = sim.run(max_steps, until=done, check_every=check_every,
+                    progress=equilibrium_bar(progress, unbalanced, tolerance),
                     status=equilibrium_status(unbalanced))
     if not done(sim):
         reached = equilibrium_status(unbalanced)(sim)
@@ -615,7 +619,8 @@ class LaboratoryTest:
         with OutputFolder(out, self.NAME) as folder:
             for name in self.outputs():
                 folder.claim(name)
-            return self._run(folder, progress, threads, stop_after, vtk_prep, plots, device)
+            with whole_run(laboratory_plan(self.config, self.PROGRESS), enabled=progress):
+                return self._run(folder, progress, threads, stop_after, vtk_prep, plots, device)
 
     def prep_writer(self, out, vtk_prep):
         """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
