@@ -29,6 +29,7 @@ COMMANDS = {
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
     "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
     "campaign": ("campaign", "sweep of any command's options from a TOML parameter table"),
+    "calibrate": ("calibrate", "Bayesian calibration of a test's parameters to a measured curve"),
     "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
     "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),
     "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),
