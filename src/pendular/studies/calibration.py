@@ -74,12 +74,16 @@ CALIBRATE_SETS = ("vtk_every", "vtk_frames", "checkpoint_every")
 class CurveKind:
     """The columns of a test's measured curve: its ``control`` (rising through the file), the
     ``observed`` columns (each required), ``optional`` ones; ``units`` of each; ``read``:
-    the same columns of a finished run's folder along its loading branch (a dict of arrays)."""
+    the same columns of a finished run's folder along its loading branch (a dict of arrays);
+    ``reach(config)``: (the option that sets how far the test goes, that value) in the
+    control's units, so that a test stopping before the data's end is refused before it
+    runs."""
 
     control: str
     observed: tuple
     units: dict
     read: Callable
+    reach: Callable
     optional: tuple = ()
 
     @property
@@ -94,20 +98,60 @@ def _loading_branch(columns, control):
     return {name: np.asarray(values, dtype=float)[:end] for name, values in columns.items()}
 
 
+def _history(folder):
+    return read_history(folder, index="record")
+
+
 def _triaxial_curve(folder):
-    history = read_history(folder, index="record")
+    history = _history(folder)
     return _loading_branch({"axial_strain": history["axial_strain"].values,
                             "q": deviator_stress(history["sigma_wall"].values),
                             "volumetric_strain": history["volumetric_strain"].values},
                            "axial_strain")
 
 
-#: The measured curve of each test calibrate compares (compression positive, SI, strains as
-#: fractions).
+def _oedometer_curve(folder):
+    history = _history(folder)
+    return _loading_branch({"axial_stress": history["sigma_wall"].values[:, 2],
+                            "void_ratio": history["void_ratio"].values}, "axial_stress")
+
+
+def _isotropic_curve(folder):
+    history = _history(folder)
+    return _loading_branch({"mean_stress": mean_stress(history["sigma_wall"].values),
+                            "void_ratio": history["void_ratio"].values}, "mean_stress")
+
+
+def _simple_shear_curve(folder):
+    history = _history(folder)
+    return _loading_branch({"shear_strain": history["shear_strain"].values,
+                            "shear_stress": history["shear_stress"].values}, "shear_strain")
+
+
+def _swcc_curve(folder):
+    with open(os.path.join(folder, "swcc.json"), encoding="utf-8") as handle:
+        drying = json.load(handle)["drying"]
+    return {name: np.array([row[name] for row in drying], dtype=float)
+            for name in ("suction", "saturation")}
+
+
+#: The measured curve of each test (compression positive, SI, strains as fractions).
 DATA_COLUMNS = {
     "triaxial": CurveKind("axial_strain", ("q",), {"axial_strain": "1", "q": "Pa",
                                                    "volumetric_strain": "1"},
-                          _triaxial_curve, optional=("volumetric_strain",)),
+                          _triaxial_curve, lambda c: ("max_strain", c.shear.max_strain),
+                          optional=("volumetric_strain",)),
+    "oedometer": CurveKind("axial_stress", ("void_ratio",),
+                           {"axial_stress": "Pa", "void_ratio": "1"}, _oedometer_curve,
+                           lambda c: ("axial_stress", c.axial_stress)),
+    "isotropic": CurveKind("mean_stress", ("void_ratio",),
+                           {"mean_stress": "Pa", "void_ratio": "1"}, _isotropic_curve,
+                           lambda c: ("stresses", max(c.stresses))),
+    "simple-shear": CurveKind("shear_strain", ("shear_stress",),
+                              {"shear_strain": "1", "shear_stress": "Pa"}, _simple_shear_curve,
+                              lambda c: ("max_strain", c.max_strain)),
+    "swcc": CurveKind("suction", ("saturation",), {"suction": "Pa", "saturation": "1"},
+                      _swcc_curve, lambda c: ("suctions", max(c.suctions))),
 }
 
 
@@ -314,7 +358,10 @@ class Calibration:
                     text = error.on_command_line() if hasattr(error, "on_command_line") else error
                     raise ValueError(f"--fit {fit.name}={fit.low:g}:{fit.high:g}: {text}") \
                         from None
-        self.config({})
+        try:        # each iteration is a campaign: one of the configurations a Run takes
+            Run(_sample_name(0, 0), self.config({}))
+        except TypeError as error:
+            raise ValueError(f"--test {test}: a campaign cannot run it ({error})") from None
         self.check_reach()
 
     def config(self, values):
@@ -322,14 +369,16 @@ class Calibration:
         return config_from_options(self.test, {**self.options, **values})
 
     def check_reach(self):
-        """ValueError when the test stops before the data's last control point."""
+        """ValueError when the test stops before the data's last control point (at the
+        prior's ends too, where a fitted option sets how far it goes)."""
         last = float(self.curve.control[-1])
-        if self.test == "triaxial":
-            strain = self.config({}).shear.max_strain
-            if strain < last:
-                raise ValueError(f"--max-strain {strain:g} is below the data's last "
-                                 f"axial_strain {last:g} ({self.curve.path}): give "
-                                 f"--max-strain {last:g} or more")
+        for values in ({}, *({fit.key: fit.value(end)} for fit in self.fits
+                             for end in (fit.low, fit.high))):
+            key, reach = self.curve.kind.reach(self.config(values))
+            if reach < last * (1.0 - 1e-9):
+                raise ValueError(f"--{key.replace('_', '-')} {reach:g} is below the data's "
+                                 f"last {self.curve.kind.control} {last:g} "
+                                 f"({self.curve.path}): the test must reach it")
 
     def sample_values(self, sample):
         return {fit.key: fit.value(value) for fit, value in zip(self.fits, sample)}
