@@ -267,12 +267,27 @@ SIMPLE_SHEAR_SUMMARY_UNITS = {
     "normal_stress": "Pa",
 }
 
+#: Units of a calibration's summary.json (pendular.studies.calibration): errors and the
+#: filter's uncertainty are RMS differences and variances in units of each data column's
+#: range; each fitted parameter's mean, std, best, low, high and prior_std are in its own
+#: ``unit``, given beside them.
+CALIBRATION_SUMMARY_UNITS = {
+    "best_error": "1", "seed_noise": "1", "runs": "1",
+    "iterations": {"iteration": "1", "runs": "1", "sigma": "1", "best_error": "1",
+                   "weighted_error": "1"},
+}
+
+#: Units of the columns of a calibration's posterior.csv beside the fitted options (in their
+#: own units, OPTION_UNITS): the posterior weight of the sample in its iteration, and its RMS
+#: error to the data in units of each data column's range.
+POSTERIOR_UNITS = {"iteration": "1", "sample": "1", "weight": "1", "error": "1"}
+
 #: Units of every summary key pendular writes (summary.json, tension.json cases, campaign
 #: rows); keys not listed are text, flags or nested records. A summary.json carries the units
 #: of its own keys in its ``units`` block.
 SUMMARY_UNITS = {**OPTION_UNITS, **TENSION_SUMMARY_UNITS, **TRIAXIAL_SUMMARY_UNITS,
                  **OEDOMETER_SUMMARY_UNITS, **ISOTROPIC_SUMMARY_UNITS, **CYCLIC_SUMMARY_UNITS,
-                 **SIMPLE_SHEAR_SUMMARY_UNITS}
+                 **SIMPLE_SHEAR_SUMMARY_UNITS, **CALIBRATION_SUMMARY_UNITS}
 
 
 def still_rising(axial_strain, stress, window=0.2, min_records=5):

@@ -43,6 +43,7 @@ import numpy as np
 
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.history import read_history
+from pendular.io.schema import CALIBRATION_SUMMARY_UNITS, POSTERIOR_UNITS
 from pendular.procedures.options import config_from_options, options_of
 from pendular.studies.campaign import Campaign, Run
 from pendular.utils.atomic import replacing, write_json
@@ -386,11 +387,14 @@ class Calibration:
     # ------------------------------------------------------------ simulated curves
 
     def simulated(self, folder):
-        """The run's curve at the data's control points: (columns, points) in units of each
-        column's range in the data, or None when its history stops before the last point."""
+        """The run's curve at the data's control points: (columns, points), each column
+        scaled as the data's (MeasuredCurve.scaled), or None when its history does not span
+        them (a path starting above the data's first stress, stopping before its last)."""
         columns = self.curve.kind.read(folder)
         control = columns[self.curve.kind.control]
-        if control[-1] < self.curve.control[-1] * (1.0 - 1e-9):
+        span = np.ptp(self.curve.control)
+        if (control.min() > self.curve.control[0] + 1e-9 * span
+                or control.max() < self.curve.control[-1] - 1e-9 * span):
             return None
         order = np.argsort(control, kind="stable")
         return np.array([self.curve.scaled(name, np.interp(self.curve.control, control[order],
@@ -445,7 +449,8 @@ class Calibration:
                     if curve is not None:
                         curves[run.name] = curve
                     else:
-                        result.failed[run.name] = "its history stops before the data's end"
+                        result.failed[run.name] = ("its history does not span the data's "
+                                                               f"{self.curve.kind.control}")
             if iteration == 0:
                 noise = self.seed_noise([curves[run.name] for run in runs
                                          if run.name in curves and (run.name.startswith(
@@ -553,9 +558,11 @@ def write_posterior(path, rows, fits):
         writer.writerows({key: row[key] for key in columns} for row in rows)
 
 
-def write_summary(path, summary):
-    """summary.json: the summary without its rows (posterior.csv holds them), with units."""
+def write_summary(path, summary, fits):
+    """summary.json: the summary without its rows (posterior.csv holds them), with the units
+    of its keys and of posterior.csv's columns (``units["posterior"]``)."""
     data = {key: value for key, value in summary.items() if key != "rows"}
-    data["units"] = {"best_error": "1", "seed_noise": "1"}
+    data["units"] = {**CALIBRATION_SUMMARY_UNITS,
+                     "posterior": {**POSTERIOR_UNITS, **{fit.key: fit.unit for fit in fits}}}
     write_json(path, data)
     return data

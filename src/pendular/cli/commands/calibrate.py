@@ -104,7 +104,7 @@ def run(args):
                                   device=args.device, quiet=args.quiet, log=_log)
         write_posterior(paths["posterior.csv"], summary["rows"], fits)
         write_figures(calibration, summary, os.path.abspath(args.out), paths)
-        data = write_summary(paths["summary.json"], summary)
+        data = write_summary(paths["summary.json"], summary, fits)
     for name, values in data["parameters"].items():
         note = "" if values["constrained"] else " (unconstrained: the data do not pin it)"
         print(f"  {name}  {values['mean']:.4g} ± {values['std']:.2g} {values['unit']}, best "
