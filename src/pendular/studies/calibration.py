@@ -16,14 +16,18 @@ Honest uncertainty:
   the data and in units of its range there (0 to 1 over the data: the filter's covariance,
   scaled by each column's largest value, is then ``sigma`` itself, a variance in units of that
   range squared);
-- the first iteration also runs the prior's centre with SEED_REPLICATES seeds: the scatter
-  between samples of different seeds at equal parameters. ``sigma`` is held at or above this
-  seed noise (the library's lower bound), counted once per curve, not once per point, since
-  the scatter of neighbouring points is correlated; a curve fitted closer than the seeds
-  repeat themselves gives no narrower posterior;
+- the first iteration also runs the prior's centre with SEED_REPLICATES other seeds: the
+  scatter between samples of different seeds at equal parameters. The data are one sample and
+  each run another, so their curves differ by twice that variance at equal parameters. The
+  filter's ``sigma`` is held at or above this seed noise (the library's lower bound), counted
+  once per curve, not once per point, since the scatter of neighbouring points is correlated:
+  a curve fitted closer than two samples repeat each other gives no narrower posterior. Every
+  run uses the same sample seed (the test's --seed), so the runs differ by their parameters
+  alone; the seed noise says how far that sample may stand from the data's;
 - each iteration's weights are corrected by the density its samples were drawn from (the
-  library's ``proposal``), so the posterior stays the prior times the likelihood however many
-  iterations ran;
+  library's ``proposal``), so that each estimates the same posterior, the prior times the
+  likelihood, however many iterations ran; the reported moments pool every iteration's
+  weighted ensemble (Calibration.pooled);
 - a parameter whose posterior standard deviation is above UNCONSTRAINED_FRACTION of the
   prior's is reported ``constrained`` false: the data do not pin it.
 """
@@ -62,6 +66,8 @@ MIXTURE_COMPONENTS = 2
 SAMPLING_SEED = 0
 #: A posterior standard deviation above this fraction of the prior's: unconstrained.
 UNCONSTRAINED_FRACTION = 0.7
+#: How far above the seed noise the filter's upper bound stays (a bounded search needs room).
+NOISE_MARGIN = 1e-3
 #: The smallest seed noise [variance, in units of the data's range squared]: the filter needs a
 #: positive lower bound where the seeds give identical curves (a prepared --sample).
 MIN_NOISE = 1e-8
@@ -468,7 +474,10 @@ class Calibration:
             system.set_sim_data(simulated)
             system.sigma_lower_bound = noise
             system.sigma_tol = noise
-            system.sigma_max = max(system.sigma_max, 2.0 * noise)
+            # the library anneals its upper bound from one iteration to the next: never
+            # below the seed noise
+            system.sigma_max = max(float(np.atleast_1d(system.sigma_max)[0]),
+                                   noise * (1.0 + NOISE_MARGIN))
             ibf.proposal = self.proposal_density(sampling, samples[kept], iteration)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -486,7 +495,7 @@ class Calibration:
             log(f"iteration {iteration + 1}: best error {errors.min():.3g}, "
                 + ", ".join(f"{fit.name} {m:.4g} ± {s:.2g}" for fit, (m, s) in
                             zip(self.fits, self.moments(samples[kept], weights))))
-        return self.summary(rows, history, noise, samples[kept], weights)
+        return self.summary(rows, history, noise)
 
     def centre_name(self):
         return _seed_name(0)
@@ -500,12 +509,14 @@ class Calibration:
                 for offset in range(SEED_REPLICATES + 1)]
 
     def seed_noise(self, curves):
-        """The filter's least uncertainty: the variance between the seeds' curves (units of
-        the data's range squared), averaged over the points and counted once per curve
-        (times the points: neighbouring points scatter together)."""
+        """The filter's least uncertainty: the variance of the difference between two
+        samples' curves (twice the variance between the seeds' curves: the data are one
+        sample, a run another), in units of the data's range squared, averaged over the
+        points and counted once per curve (times the points: neighbouring points scatter
+        together)."""
         if len(curves) < 2:
             return MIN_NOISE
-        spread = np.var(np.array(curves), axis=0, ddof=1)
+        spread = 2.0 * np.var(np.array(curves), axis=0, ddof=1)
         return max(float(np.mean(spread)) * spread.shape[-1], MIN_NOISE)
 
     def proposal_density(self, sampling, samples, iteration):
@@ -518,15 +529,27 @@ class Calibration:
 
     @staticmethod
     def moments(samples, weights):
+        """[(mean, standard deviation)] of each column of ``samples`` under ``weights``."""
         mean = weights @ samples
         std = np.sqrt(weights @ (samples - mean) ** 2)
         return list(zip(mean, std))
 
-    def summary(self, rows, history, noise, samples, weights):
+    def pooled(self, rows):
+        """(samples, weights) of every iteration together: each iteration's weights (an
+        estimate of the same posterior, its proposal divided out) times its share of the
+        effective sample sizes (1 / sum w^2)."""
+        samples = np.array([[row[fit.key] for fit in self.fits] for row in rows], dtype=float)
+        weights = np.array([row["weight"] for row in rows], dtype=float)
+        iterations = np.array([row["iteration"] for row in rows])
+        for iteration in np.unique(iterations):
+            mine = iterations == iteration
+            weights[mine] *= 1.0 / np.sum(weights[mine] ** 2)
+        return samples, weights / weights.sum()
+
+    def summary(self, rows, history, noise):
         best = min(rows, key=lambda row: row["error"])
         parameters = {}
-        for column, (fit, (mean, std)) in enumerate(zip(self.fits,
-                                                         self.moments(samples, weights))):
+        for fit, (mean, std) in zip(self.fits, self.moments(*self.pooled(rows))):
             prior_std = (fit.high - fit.low) / math.sqrt(12.0)
             parameters[fit.name] = {"mean": float(mean), "std": float(std),
                                     "best": best[fit.key], "unit": fit.unit,

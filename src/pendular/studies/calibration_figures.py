@@ -54,23 +54,19 @@ def curves_figure(calibration, summary, out):
 
 
 def posterior_figure(calibration, summary):
-    """Each parameter's weighted histogram over the last iteration (and its samples of every
-    iteration as ticks) on its prior range; below the diagonal the pairs, the samples sized by
-    weight."""
+    """Each parameter's posterior on its prior range: the weighted histogram of every
+    iteration's samples pooled (Calibration.pooled), each sample a tick; below the diagonal
+    the pairs, each sample sized by its weight."""
     fits = calibration.fits
-    last = max(row["iteration"] for row in summary["rows"])
-    rows = [row for row in summary["rows"] if row["iteration"] == last]
-    weights = np.array([row["weight"] for row in rows])
+    samples, weights = calibration.pooled(summary["rows"])
     size = len(fits)
     figure, axes = pyplot().subplots(size, size, figsize=(3.2 * size + 1, 3.0 * size + 0.5),
                                      squeeze=False)
     for i, fit in enumerate(fits):
-        values = np.array([row[fit.key] for row in rows])
         axis = axes[i, i]
-        axis.hist(values, bins=np.linspace(fit.low, fit.high, 21), weights=weights,
+        axis.hist(samples[:, i], bins=np.linspace(fit.low, fit.high, 21), weights=weights,
                   color="C0", alpha=0.7)
-        every = [row[fit.key] for row in summary["rows"]]
-        axis.plot(every, np.zeros(len(every)), "|", color="k", ms=8)
+        axis.plot(samples[:, i], np.zeros(len(samples)), "|", color="k", ms=8)
         posterior = summary["parameters"][fit.name]
         axis.axvline(posterior["mean"], color="C3", lw=1)
         axis.set_xlim(fit.low, fit.high)
@@ -82,12 +78,9 @@ def posterior_figure(calibration, summary):
             if j > i:
                 axes[i, j].axis("off")
             elif j < i:
-                other = fits[j]
-                pair = axes[i, j]
-                pair.scatter([row[other.key] for row in summary["rows"]],
-                             [row[fit.key] for row in summary["rows"]], s=6, color="0.6")
-                pair.scatter([row[other.key] for row in rows], values, s=5 + 200 * weights,
-                             color="C0", alpha=0.7)
+                other, pair = fits[j], axes[i, j]
+                pair.scatter(samples[:, j], samples[:, i], s=3 + 300 * weights, color="C0",
+                             alpha=0.6)
                 pair.set_xlim(other.low, other.high)
                 pair.set_ylim(fit.low, fit.high)
                 pair.set_xlabel(f"{other.name} [{other.unit}]")
