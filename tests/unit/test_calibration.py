@@ -2,6 +2,8 @@
 refusals (file, line, column), the --fit specifications, and `pendular calibrate` refusing bad
 input in one error line before anything runs."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -156,3 +158,51 @@ def test_calibrate_refuses_a_curve_of_another_test(tmp_path, capsys):
                                           "friction=5:40", "--out", out], capsys),
             str(data), "curve of oedometer, not of triaxial")
     assert not out.exists()
+
+
+def test_the_inference_recovers_a_parameter_and_reports_one_it_cannot_see(tmp_path, monkeypatch):
+    """A stand-in for the runs (a closed-form curve of the contact friction, in which Young's
+    modulus plays no part, with a scatter of 2 % between seeds) in place of the campaign: the
+    friction is recovered within its reported std, Young's modulus reported unconstrained."""
+    pytest.importorskip("grainlearning")
+    import pendular.studies.calibration as calibration_module
+    from pendular.studies.calibration import CurveKind, MeasuredCurve
+    from pendular.studies.campaign import CampaignResult
+
+    strain = np.linspace(0.0, 0.05, 101)
+
+    def curve(friction, seed):
+        scatter = 1.0 + 0.02 * np.random.default_rng(seed).standard_normal()
+        return (1e3 * np.tan(np.radians(friction)) * (1.0 - np.exp(-strain / 0.01))
+                * scatter)
+
+    configs = {}
+
+    class StandIn:
+        def __init__(self, runs):
+            self.runs = runs
+
+        def run(self, out, **settings):
+            for run in self.runs:
+                configs[os.path.join(out, "runs", run.name)] = run.config
+            return CampaignResult(self.runs, summaries={run.name: {} for run in self.runs})
+
+    def read(folder):
+        sample = configs[folder].sample
+        return {"axial_strain": strain, "q": curve(sample.friction_deg, sample.seed)}
+
+    monkeypatch.setattr(calibration_module, "Campaign", StandIn)
+    kind = CurveKind("axial_strain", ("q",), {}, read, lambda config: ("max_strain", 0.05))
+    control = np.linspace(0.005, 0.05, 10)
+    data = MeasuredCurve("stand-in", kind, control,
+                         {"q": np.interp(control, strain, curve(20.0, 7))})
+    fits = [parse_fit("friction=5:40", "triaxial"), parse_fit("young=5e5:5e6", "triaxial")]
+    calibration = Calibration("triaxial", {"particles": 60, "max_strain": 0.05}, fits, data,
+                              iterations=3, samples=16)
+    summary = calibration.run(str(tmp_path), log=lambda message: None)
+    friction, young = summary["parameters"]["friction"], summary["parameters"]["young"]
+    assert abs(friction["mean"] - 20.0) < max(2.0 * friction["std"], 0.5), friction
+    assert friction["constrained"] and friction["std"] < 0.3 * friction["prior_std"]
+    assert not young["constrained"], young
+    assert summary["seed_noise"] > 0.0
+    assert len(summary["rows"]) == 3 * 16
