@@ -127,7 +127,8 @@ def test_the_seed_noise_is_counted_once_per_curve(tmp_path):
                               [parse_fit("friction=5:40", "triaxial")], curve)
     base = np.zeros((2, 3))
     curves = [base + 0.1, base - 0.1]          # variance 0.02 at each of 3 points
-    assert calibration.seed_noise(curves) == pytest.approx(0.02 * 3)
+    # the data and a run: two samples, whose difference has twice that variance
+    assert calibration.seed_noise(curves) == pytest.approx(2 * 0.02 * 3)
     assert calibration.seed_noise([base, base]) > 0.0       # a positive bound for the filter
 
 

@@ -437,36 +437,23 @@ class Calibration:
         ibf.initialize(system)
         rows, history, noise = [], [], None
         for iteration in range(self.iterations):
-            samples = np.asarray(ibf.param_data_list[-1], dtype=float)
-            if self.fits and any(fit.integer for fit in self.fits):
-                samples = np.array([[fit.value(v) for fit, v in zip(self.fits, sample)]
-                                    for sample in samples], dtype=float)
+            # an integer option's samples run, and are weighed, at their rounded values
+            samples = np.array([[fit.value(v) for fit, v in zip(self.fits, sample)]
+                                for sample in ibf.param_data_list[-1]], dtype=float)
             runs = [Run(_sample_name(iteration, index), self.config(self.sample_values(sample)))
                     for index, sample in enumerate(samples)]
+            seeds = self.seed_runs() if iteration == 0 else []
+            log(f"iteration {iteration + 1} of {self.iterations}: {len(runs + seeds)} runs")
+            curves = self.campaign_curves(runs + seeds, out, log, jobs=jobs,
+                                          scheduler=scheduler, threads=threads, device=device,
+                                          quiet=quiet)
             if iteration == 0:
-                runs += self.seed_runs()
-            log(f"iteration {iteration + 1} of {self.iterations}: {len(runs)} runs")
-            result = Campaign(runs).run(out, jobs=jobs, scheduler=scheduler, threads=threads,
-                                        device=device, quiet=quiet)
-            curves = {}
-            for run in runs:
-                if run.name in result.summaries:
-                    curve = self.simulated(os.path.join(out, "runs", run.name))
-                    if curve is not None:
-                        curves[run.name] = curve
-                    else:
-                        result.failed[run.name] = ("its history does not span the data's "
-                                                               f"{self.curve.kind.control}")
-            if iteration == 0:
-                noise = self.seed_noise([curves[run.name] for run in runs
-                                         if run.name in curves and (run.name.startswith(
-                                             "iter0_seed") or run.name == self.centre_name())])
+                noise = self.seed_noise([curves[run.name] for run in seeds
+                                         if run.name in curves])
             kept = [i for i in range(len(samples)) if _sample_name(iteration, i) in curves]
             if len(kept) < 2:
-                result.check()
-                raise ValueError(f"iteration {iteration + 1}: fewer than two runs finished")
-            for name, error in result.failed.items():
-                log(f"run {name} left out: {error}")
+                raise ValueError(f"iteration {iteration + 1}: fewer than two of its runs "
+                                 "finished (their errors are in their log.txt)")
             simulated = np.array([curves[_sample_name(iteration, i)] for i in kept])
             errors = np.sqrt(np.mean((simulated - observed[None]) ** 2, axis=(1, 2)))
             system.param_data = samples[kept]
@@ -497,8 +484,23 @@ class Calibration:
                             zip(self.fits, self.moments(samples[kept], weights))))
         return self.summary(rows, history, noise)
 
-    def centre_name(self):
-        return _seed_name(0)
+    def campaign_curves(self, runs, out, log, **settings):
+        """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out``
+        (Campaign.run's ``settings``); a run that failed or whose history does not span the
+        data is left out, and said so through ``log``."""
+        result = Campaign(runs).run(out, **settings)
+        curves = {}
+        for run in runs:
+            if run.name not in result.summaries:
+                log(f"run {run.name} left out: {result.failed.get(run.name)}")
+                continue
+            curve = self.simulated(os.path.join(out, "runs", run.name))
+            if curve is None:
+                log(f"run {run.name} left out: its history does not span the data's "
+                    f"{self.curve.kind.control}")
+            else:
+                curves[run.name] = curve
+        return curves
 
     def seed_runs(self):
         """Runs of the prior's centre at its own seed and SEED_REPLICATES others."""
