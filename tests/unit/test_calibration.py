@@ -2,6 +2,7 @@
 refusals (file, line, column), the --fit specifications, and `pendular calibrate` refusing bad
 input in one error line before anything runs."""
 
+import json
 import os
 
 import numpy as np
@@ -207,3 +208,38 @@ def test_the_inference_recovers_a_parameter_and_reports_one_it_cannot_see(tmp_pa
     assert not young["constrained"], young
     assert summary["seed_noise"] > 0.0
     assert len(summary["rows"]) == 3 * 16
+
+
+def test_a_tension_curve_runs_one_specimen_per_water_content_of_the_data(tmp_path):
+    data = write(tmp_path, "water_content,tensile_strength\n0.005,400\n0.01,600\n0.02,700\n")
+    curve = read_curve(data, "tension")
+    fits = [parse_fit("contact-angle=0:30", "tension")]
+    calibration = Calibration("tension", {"particles": 100, "void_ratio": 0.7}, fits, curve)
+    config = calibration.config({"contact_angle": 10.0})
+    np.testing.assert_allclose(config.cases, [(0.7, 0.005), (0.7, 0.01), (0.7, 0.02)])
+    with pytest.raises(ValueError, match="--water-content: set by calibrate from the data's "
+                                         "water_content column"):
+        Calibration("tension", {"particles": 100, "void_ratio": 0.7, "water_content": 1.0},
+                    fits, curve)
+    with pytest.raises(ValueError, match="--void-ratio 0.58,0.72: give one void ratio"):
+        Calibration("tension", {"particles": 100}, fits, curve)
+    # the run's tension.json read back as the data's columns, by water content
+    (tmp_path / "tension.json").write_text(json.dumps({"cases": [
+        {"water_content_target": 0.01, "tensile_strength_pa": 610.0},
+        {"water_content_target": 0.005, "tensile_strength_pa": 390.0},
+        {"water_content_target": 0.02, "tensile_strength_pa": 720.0}]}))
+    run = curve.kind.read(str(tmp_path))
+    np.testing.assert_array_equal(run["water_content"], [0.005, 0.01, 0.02])
+    np.testing.assert_array_equal(run["tensile_strength"], [390.0, 610.0, 720.0])
+
+
+def test_an_swcc_curve_is_its_drying_branch(tmp_path):
+    (tmp_path / "swcc.json").write_text(json.dumps({
+        "drying": [{"suction": 5000.0, "saturation": 0.1}, {"suction": 10000.0,
+                                                             "saturation": 0.05}],
+        "wetting": [{"suction": 10000.0, "saturation": 0.05}, {"suction": 5000.0,
+                                                               "saturation": 0.07}]}))
+    run = read_curve(write(tmp_path, "suction,saturation\n5000,0.1\n7000,0.08\n10000,0.05\n"),
+                     "swcc").kind.read(str(tmp_path))
+    np.testing.assert_array_equal(run["suction"], [5000.0, 10000.0])
+    np.testing.assert_array_equal(run["saturation"], [0.1, 0.05])

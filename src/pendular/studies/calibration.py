@@ -84,7 +84,8 @@ class CurveKind:
     the same columns of a finished run's folder along its loading branch (a dict of arrays);
     ``reach(config)``: (the option that sets how far the test goes, that value) in the
     control's units, so that a test stopping before the data's end is refused before it
-    runs."""
+    runs (ValueError for a configuration whose curve is not one); ``from_data(control)``:
+    the options calibrate sets from the data's control values (a test run at each point)."""
 
     control: str
     observed: tuple
@@ -92,6 +93,7 @@ class CurveKind:
     read: Callable
     reach: Callable
     optional: tuple = ()
+    from_data: Callable | None = None
 
     @property
     def columns(self):
@@ -142,6 +144,21 @@ def _swcc_curve(folder):
             for name in ("suction", "saturation")}
 
 
+def _tension_curve(folder):
+    with open(os.path.join(folder, "tension.json"), encoding="utf-8") as handle:
+        cases = sorted(json.load(handle)["cases"], key=lambda case: case["water_content_target"])
+    return {"water_content": np.array([case["water_content_target"] for case in cases]),
+            "tensile_strength": np.array([case["tensile_strength_pa"] for case in cases])}
+
+
+def _tension_reach(config):
+    void_ratios = sorted({e for e, _ in config.cases})
+    if len(void_ratios) > 1:
+        raise ValueError(f"--void-ratio {','.join(f'{e:g}' for e in void_ratios)}: give one "
+                         "void ratio, that of the measured specimens")
+    return "water_content", max(w for _, w in config.cases)
+
+
 #: The measured curve of each test (compression positive, SI, strains as fractions).
 DATA_COLUMNS = {
     "triaxial": CurveKind("axial_strain", ("q",), {"axial_strain": "1", "q": "Pa",
@@ -159,6 +176,11 @@ DATA_COLUMNS = {
                               lambda c: ("max_strain", c.max_strain)),
     "swcc": CurveKind("suction", ("saturation",), {"suction": "Pa", "saturation": "1"},
                       _swcc_curve, lambda c: ("suctions", max(c.suctions))),
+    # one specimen per water content of the data [%], at one void ratio
+    "tension": CurveKind("water_content", ("tensile_strength",),
+                         {"water_content": "1", "tensile_strength": "Pa"}, _tension_curve,
+                         _tension_reach,
+                         from_data=lambda control: {"water_content": list(100.0 * control)}),
 }
 
 
@@ -349,7 +371,16 @@ class Calibration:
             if key in keys:
                 raise ValueError(f"--{key.replace('_', '-')}: fitted (--fit), so it cannot be "
                                  "fixed too")
-        self.options.update(vtk_every=0, checkpoint_every=0)
+        from_data = curve.kind.from_data(curve.control) if curve.kind.from_data else {}
+        for key in from_data:
+            if key in self.options or key in keys:
+                raise ValueError(f"--{key.replace('_', '-')}: set by calibrate from the data's "
+                                 f"{curve.kind.control} column; leave it out")
+        self.options.update(from_data)
+        # no ParaView frames nor checkpoints in the runs (where the test writes them)
+        declared = {option.key for option in options_of(test)}
+        self.options.update({key: 0 for key in ("vtk_every", "checkpoint_every")
+                             if key in declared})
         self.iterations = int(iterations)
         self.samples = int(samples)
         if self.iterations < 1:

@@ -7,8 +7,10 @@
 --test names the laboratory command; its own options (those of 'pendular TEST --help') fix
 what is not fitted; each --fit NAME=LOW:HIGH names one of its numeric options, in that
 option's units, with its prior range. CURVE.csv has a header naming its columns (compression
-positive, SI units, strains as fractions): triaxial axial_strain,q[,volumetric_strain]. Each
-run is compared with the data at the data's control points. GrainLearning's iterative Bayesian
+positive, SI units, strains as fractions): triaxial axial_strain,q[,volumetric_strain];
+oedometer axial_stress,void_ratio; isotropic mean_stress,void_ratio; simple-shear
+shear_strain,shear_stress; swcc suction,saturation; tension water_content,tensile_strength.
+Each run is compared with the data at the data's control points. GrainLearning's iterative Bayesian
 filter draws --samples runs per iteration (pip install 'pendular[calibrate]'); each
 iteration's runs are one campaign in --jobs local processes or on the Dask cluster of
 --scheduler, so a calibration started again reuses its finished runs.
