@@ -388,6 +388,7 @@ class Calibration:
         if self.samples < 2 * len(self.fits) + 2:
             raise ValueError(f"--samples {samples}: valid range [{2 * len(self.fits) + 2}, inf) "
                              f"for {len(self.fits)} fitted parameter(s)")
+        fixed = self.config({})         # the fixed options' errors name them alone
         for fit in self.fits:           # the prior's ends are configurations the test takes
             for end in (fit.low, fit.high):
                 try:
@@ -397,7 +398,7 @@ class Calibration:
                     raise ValueError(f"--fit {fit.name}={fit.low:g}:{fit.high:g}: {text}") \
                         from None
         try:        # each iteration is a campaign: one of the configurations a Run takes
-            Run(_sample_name(0, 0), self.config({}))
+            Run(_sample_name(0, 0), fixed)
         except TypeError as error:
             raise ValueError(f"--test {test}: a campaign cannot run it ({error})") from None
         self.check_reach()

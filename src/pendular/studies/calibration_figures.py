@@ -98,7 +98,7 @@ def errors_figure(summary):
     axis.plot([s["iteration"] + 1 for s in steps], [s["best_error"] for s in steps], "-o",
               color="C3", label="best")
     axis.plot([s["iteration"] + 1 for s in steps], [s["weighted_error"] for s in steps], "-s",
-              color="C0", label="posterior mean")
+              color="C0", label="mean under the posterior weights")
     axis.set_yscale("log")
     axis.set_xlabel("iteration")
     axis.set_ylabel("RMS error (fraction of the data's range)")
