@@ -77,6 +77,7 @@ def test_fit_names_a_numeric_option_of_the_test_in_its_units():
     ("frictio=10:50", ["'frictio' is not a numeric option of triaxial", "friction"]),
     ("periodic=0:1", ["'periodic' is not a numeric option"]),          # a flag
     ("vtk-every=0:10", ["not a numeric option"]),                      # set by calibrate
+    ("seed=0:10", ["not a numeric option"]),                           # varied by calibrate
     ("friction=50:10", ["range [50, 10] is empty", "LOW < HIGH"]),
     ("friction=10:10", ["is empty"]),
     ("friction=10", ["NAME=LOW:HIGH"]),

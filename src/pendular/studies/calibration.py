@@ -35,7 +35,6 @@ Honest uncertainty:
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
 import math
 import os
@@ -71,8 +70,9 @@ NOISE_MARGIN = 1e-3
 #: The smallest seed noise [variance, in units of the data's range squared]: the filter needs a
 #: positive lower bound where the seeds give identical curves (a prepared --sample).
 MIN_NOISE = 1e-8
-#: Options calibrate sets itself (the runs' outputs), refused as fitted or fixed.
-CALIBRATE_SETS = ("vtk_every", "vtk_frames", "checkpoint_every")
+#: Options --fit cannot name: the runs' outputs, which calibrate turns off, and the sample's
+#: seed, which is no property of the material (the seed runs vary it).
+CALIBRATE_SETS = ("vtk_every", "vtk_frames", "checkpoint_every", "seed")
 
 
 # ---------------------------------------------------------------- the data
@@ -440,7 +440,8 @@ class Calibration:
                          for name in self.curve.columns])
 
     def observed(self):
-        """The data's columns (columns, points), each 0 to 1 over its range (MeasuredCurve.scaled)."""
+        """The data's columns (columns, points), each 0 to 1 over its range
+        (MeasuredCurve.scaled)."""
         return np.array([self.curve.scaled(name, self.curve.observed[name])
                          for name in self.curve.columns])
 
@@ -606,7 +607,7 @@ def _seed_of(config):
 
 def write_posterior(path, rows, fits):
     """posterior.csv: one row per sample of every iteration: iteration, sample, run, the fitted
-    options (their units in the header), weight, error."""
+    options, weight, error (their units: summary.json's ``units["posterior"]``)."""
     columns = ["iteration", "sample", "run", *(fit.key for fit in fits), "weight", "error"]
     with replacing(path) as temporary, open(temporary, "w", newline="",
                                             encoding="utf-8") as handle:
