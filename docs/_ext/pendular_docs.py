@@ -85,6 +85,12 @@ def outputs_tables():
         lines += ["", f"Fields of `{name}`: "
                   + ", ".join(f"`{field}` [{_units(unit)}]" for field, unit in units.items())
                   + "."]
+    lines += ["", "## Calibration posterior (`posterior.csv` of `pendular calibrate`)", "",
+              "One row per sample of every iteration; the fitted options, between `run` and "
+              "`weight`, in their own units (Run options, below).", "",
+              "| column | units | meaning |", "|---|---|---|"]
+    lines += [f"| `{name}` | {_units(column.units)} | {_cell(column.description)} |"
+              for name, column in schema.POSTERIOR_COLUMNS.items()]
     lines += ["", "## Run options (campaign rows, `history.h5` attributes)", "",
               "The options of a run as its command names them (underscores for dashes; "
               "`pendular <command> --help` explains each):", "",

@@ -30,6 +30,7 @@ COMMANDS = {
     "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
     "campaign": ("campaign", "sweep of a laboratory command's options from a TOML table"),
     "envelope": ("envelope", "Mohr–Coulomb strength envelope of triaxials at several stresses"),
+    "calibrate": ("calibrate", "Bayesian calibration of a test's parameters to a measured curve"),
     "tradeoff": ("tradeoff", "speed against accuracy of the numerical settings"),
     "extremes": ("extremes", "grid of extreme settings: each runs or is refused clearly"),
     "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),

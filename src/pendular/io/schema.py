@@ -222,7 +222,7 @@ class Key:
 #: The tests whose summary holds a peak of q.
 SHEARS = ("triaxial", "path")
 _T, _S, _C, _TEN = ("triaxial",), ("simple-shear",), ("cyclic",), ("tension",)
-_E, _I = ("envelope",), ("impact",)
+_E, _I, _CAL = ("envelope",), ("impact",), ("calibrate",)
 _COMPRESSION = ("oedometer", "isotropic", "path")
 _INDICES = ("oedometer", "isotropic")
 #: The fields of a row of the SWCC (swcc.json ``drying`` and ``wetting``,
@@ -644,6 +644,44 @@ SUMMARY_KEYS = {
     "rayleigh_timestep": Key("s", "impact: the Rayleigh-wave time step of the sphere "
                                   "(pendular.dem.timestep.rayleigh_timestep), for comparison",
                              _I),
+    # -- a calibration, summary.json of ``pendular calibrate`` (pendular.studies.calibration):
+    # errors and the filter's uncertainty are RMS differences and variances in units of each
+    # data column's range
+    "test": Key("1", "calibrate: the laboratory command calibrated (text)", _CAL),
+    "data": Key("1", "calibrate: the measured curve's CSV (absolute path)", _CAL),
+    "columns": Key("1", "calibrate: the data's columns compared, the control first", _CAL),
+    "parameters": Key("1", "calibrate: per fitted option, its posterior mean and std (pooled "
+                           "over the iterations), the best run's value, the prior's low, "
+                           "high and std, all in the option's own unit (its field 'unit'), "
+                           "and 'constrained': whether the std is at most 0.7 of the prior's "
+                           "(calibration.UNCONSTRAINED_FRACTION)",
+                      _CAL),
+    "best_run": Key("1", "calibrate: folder of the run closest to the data (runs/<name>)",
+                    _CAL),
+    "best_error": Key("1", "calibrate: RMS difference of the best run's curve from the data, "
+                           "in units of each data column's range", _CAL),
+    "seed_noise": Key("1", "calibrate: the filter's least variance, the scatter between "
+                           "samples of different seeds at the prior's centre (each column's "
+                           "range squared)", _CAL),
+    "iterations": Key({"iteration": "1", "runs": "1", "sigma": "1", "best_error": "1",
+                       "weighted_error": "1"},
+                      "calibrate: one row per iteration of the filter: its index, the runs "
+                      "that finished, the filter's sigma, the least and the posterior-weighted "
+                      "RMS error", _CAL),
+    "runs": Key("1", "calibrate: runs of every iteration together, the seed runs included",
+                _CAL),
+}
+
+#: Units of the columns of a calibration's posterior.csv (pendular.studies.calibration), one row
+#: per sample of every iteration; the fitted options, between ``run`` and ``weight``, are in
+#: their own units (OPTION_UNITS), given in summary.json's ``units["posterior"]``.
+POSTERIOR_COLUMNS = {
+    "iteration": Key("1", "the filter's iteration, from 0", _CAL),
+    "sample": Key("1", "the sample's index in its iteration", _CAL),
+    "run": Key("1", "its run folder under runs/ (text)", _CAL),
+    "weight": Key("1", "its posterior weight in its iteration", _CAL),
+    "error": Key("1", "RMS difference of its curve from the data, in units of each data "
+                      "column's range", _CAL),
 }
 
 

@@ -1,0 +1,61 @@
+"""`pendular calibrate` end to end on a tiny triaxial (50 spheres to 0.6 % strain, two
+iterations of four samples): its outputs, and a calibration started again after a lost run
+reusing every other finished run and giving the same posterior."""
+
+import csv
+import json
+import os
+import shutil
+
+import pytest
+
+from conftest import assert_drawn, run_in_process
+
+from pendular.studies.calibration import SEED_REPLICATES
+
+pytest.importorskip("grainlearning")
+
+CURVE = "axial_strain,q,volumetric_strain\n0.002,450,0.0008\n0.004,650,0.0010\n0.006,700,0.0007\n"
+
+
+def test_calibrate_writes_its_posterior_and_resumes(tmp_path, capsys):
+    data = tmp_path / "curve.csv"
+    data.write_text(CURVE)
+    out = tmp_path / "calibration"
+    argv = ["--data", data, "--test", "triaxial", "--particles", "50", "--max-strain", "0.006",
+            "--inertial-number", "0.003", "--records", "60", "--fit", "friction=5:40",
+            "--iterations", "2", "--samples", "4", "--quiet", "--out", out]
+    status, err = run_in_process("calibrate", argv, capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    friction = summary["parameters"]["friction"]
+    assert set(friction) >= {"mean", "std", "best", "unit"} and friction["unit"] == "deg"
+    assert 5.0 <= friction["mean"] <= 40.0 and 0.0 < friction["std"] < 35.0 / 2
+    with open(out / "posterior.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [row["iteration"] for row in rows] == ["0"] * 4 + ["1"] * 4
+    assert set(rows[0]) == {"iteration", "sample", "run", "friction", "weight", "error"}
+    for iteration in ("0", "1"):        # each iteration's weights: a distribution
+        weights = [float(row["weight"]) for row in rows if row["iteration"] == iteration]
+        assert sum(weights) == pytest.approx(1.0)
+    best = min(rows, key=lambda row: float(row["error"]))
+    assert summary["best_run"] == os.path.join("runs", best["run"])
+    assert summary["best_error"] == pytest.approx(float(best["error"]))
+    assert friction["best"] == pytest.approx(float(best["friction"]))
+    assert (out / summary["best_run"] / "history.h5").is_file()
+    runs = sorted(os.listdir(out / "runs"))
+    assert len(runs) == 8 + SEED_REPLICATES + 1 == summary["runs"]
+    for name in ("calibration.png", "posterior.png", "errors.png"):
+        assert_drawn(out / name)
+
+    # a run lost (as when a calibration is interrupted): started again, the calibration
+    # draws the same samples, runs that one again and reuses the others
+    lost = out / "runs" / rows[-1]["run"]
+    shutil.rmtree(lost)
+    kept = {name: os.path.getmtime(out / "runs" / name / "history.h5") for name in runs
+            if name != rows[-1]["run"]}
+    status, err = run_in_process("calibrate", argv, capsys)
+    assert status == 0, err
+    assert json.loads((out / "summary.json").read_text())["parameters"] == summary["parameters"]
+    assert (lost / "history.h5").is_file()
+    assert kept == {name: os.path.getmtime(out / "runs" / name / "history.h5") for name in kept}
