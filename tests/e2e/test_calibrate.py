@@ -1,17 +1,20 @@
 """`pendular calibrate` end to end on a tiny triaxial (50 spheres to 0.6 % strain, two
 iterations of four samples): its outputs, and a calibration started again after a lost run
-reusing every other finished run and giving the same posterior."""
+reusing every other finished run and giving the same posterior; on a tiny oedometer, the curve
+of a run of its own recovered exactly."""
 
 import csv
 import json
 import os
 import shutil
 
+import numpy as np
 import pytest
 
 from conftest import assert_drawn, run_in_process
 
-from pendular.studies.calibration import SEED_REPLICATES
+from pendular.io.schema import undeclared_keys
+from pendular.studies.calibration import DATA_COLUMNS, SEED_REPLICATES
 
 pytest.importorskip("grainlearning")
 
@@ -42,6 +45,7 @@ def test_calibrate_writes_its_posterior_and_resumes(tmp_path, capsys):
     assert summary["best_run"] == os.path.join("runs", best["run"])
     assert summary["best_error"] == pytest.approx(float(best["error"]))
     assert friction["best"] == pytest.approx(float(best["friction"]))
+    assert not undeclared_keys(summary, "calibrate")
     assert (out / summary["best_run"] / "history.h5").is_file()
     runs = sorted(os.listdir(out / "runs"))
     assert len(runs) == 8 + SEED_REPLICATES + 1 == summary["runs"]
@@ -59,3 +63,34 @@ def test_calibrate_writes_its_posterior_and_resumes(tmp_path, capsys):
     assert json.loads((out / "summary.json").read_text())["parameters"] == summary["parameters"]
     assert (lost / "history.h5").is_file()
     assert kept == {name: os.path.getmtime(out / "runs" / name / "history.h5") for name in kept}
+
+
+def test_calibrate_fits_an_oedometer_to_a_curve_of_its_own(tmp_path, capsys):
+    """An oedometer's curve (axial stress, void ratio) made by a run at friction 22.5 deg: the
+    calibration's sample at 22.5 deg, the same sample seed, reproduces it exactly."""
+    test = ["--particles", "50", "--confining", "500", "--axial-stress", "2000",
+            "--inertial-number", "0.003", "--quiet"]
+    status, err = run_in_process("oedometer", [*test, "--friction", "22.5",
+                                               "--out", tmp_path / "data"], capsys)
+    assert status == 0, err
+    branch = DATA_COLUMNS["oedometer"].read(tmp_path / "data")
+    order = np.argsort(branch["axial_stress"], kind="stable")     # as calibrate reads a run
+    stress = np.linspace(700.0, 1900.0, 4)
+    void = np.interp(stress, branch["axial_stress"][order], branch["void_ratio"][order])
+    data = tmp_path / "curve.csv"
+    data.write_text("axial_stress,void_ratio\n"
+                    + "".join(f"{s!r},{e!r}\n" for s, e in zip(stress.tolist(),
+                                                                 void.tolist())))
+    out = tmp_path / "calibration"
+    status, err = run_in_process("calibrate", ["--data", data, "--test", "oedometer", *test,
+                                               "--fit", "friction=5:40", "--iterations", "1",
+                                               "--samples", "4", "--out", out], capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert not undeclared_keys(summary, "calibrate")
+    assert summary["columns"] == ["void_ratio"]
+    with open(out / "posterior.csv", newline="") as handle:
+        rows = {float(row["friction"]): float(row["error"]) for row in csv.DictReader(handle)}
+    assert rows[22.5] == pytest.approx(0.0, abs=1e-12)
+    assert min(error for friction, error in rows.items() if friction != 22.5) > 0.01
+    assert summary["best_error"] == pytest.approx(0.0, abs=1e-12)

@@ -73,6 +73,25 @@ def test_fit_names_a_numeric_option_of_the_test_in_its_units():
     assert parse_fit("particles=100:200", "triaxial").value(149.6) == 150
 
 
+def test_the_contact_laws_numbers_are_fitted_and_their_choices_fixed(tmp_path):
+    """Hertz–Mindlin's Poisson ratio and restitution, rolling resistance and gravity are
+    numbers --fit names; --contact and --drainage, choices, are fixed options of the runs."""
+    fits = [parse_fit(text, "triaxial") for text in
+            ("poisson=0.1:0.4", "restitution=0.3:0.9", "rolling-friction=0:0.2",
+             "gravity=0:9.81")]
+    assert [fit.unit for fit in fits] == ["1", "1", "1", "m/s^2"]
+    for text in ("contact=0:1", "drainage=0:1"):
+        with pytest.raises(ValueError, match="not a numeric option"):
+            parse_fit(text, "triaxial")
+    calibration = Calibration("triaxial", {"particles": 60, "max_strain": 0.05,
+                                           "contact": "hertz-mindlin", "drainage": "undrained"},
+                              fits, read_curve(write(tmp_path, TRIAXIAL), "triaxial"))
+    config = calibration.config(calibration.sample_values([0.25, 0.6, 0.1, 9.81]))
+    assert (config.sample.contact, config.shear.drainage) == ("hertz-mindlin", "undrained")
+    assert (config.sample.poisson, config.sample.restitution, config.sample.rolling_friction,
+            config.sample.gravity) == (0.25, 0.6, 0.1, 9.81)
+
+
 @pytest.mark.parametrize("text, words", [
     ("frictio=10:50", ["'frictio' is not a numeric option of triaxial", "friction"]),
     ("periodic=0:1", ["'periodic' is not a numeric option"]),          # a flag
