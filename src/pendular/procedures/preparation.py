@@ -216,7 +216,7 @@ def random_cloud(count, radius, lo, hi, seed):
 MAX_STRESS_OVER_YOUNG = 0.02
 
 #: Largest sample: about 1 kB of state per sphere and hours per 1e-3 of strain at 1e6 spheres
-#: on a few cores; beyond, memory and run time are out of reach (issue 12).
+#: on a few cores; beyond, memory and run time are out of reach.
 MAX_PARTICLES = 10_000_000
 #: Sphere radii a run accepts [m]: grains of a micron to a metre. Outside, the strain rate of
 #: an inertial number, the box and the masses leave the floating-point range a run needs.

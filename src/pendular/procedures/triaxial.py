@@ -552,7 +552,7 @@ class LaboratoryTest:
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
         shear after this many steps as an interruption would (raises Interrupted); ``plots``:
         False leaves out triaxial.png and plots/ (a run timed for its physics, as the
-        trade-off study's: the figures cost about 2 s a run).
+        trade-off study's: the figures' cost is not the physics').
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same.
@@ -818,7 +818,7 @@ class _PathRun:
         self.shear_time = state["shear_time_s"]
         where = state.get("path")
         if where is None and self.steps is not None:
-            # written before paths had stages: the one stage of a shear
+            # a checkpoint that holds no path: a shear's one stage
             where = {"stage": 0, "stage_start": self.start_step, "stage_steps": self.steps}
         if not isinstance(where, dict):
             raise ValueError("the checkpoint does not say where its loading path stood")

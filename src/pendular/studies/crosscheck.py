@@ -1,4 +1,4 @@
-"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing (issue 5).
+"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing.
 
 ``run_crosscheck(crosscheck_config(...), out)``; command ``pendular crosscheck``. Needs
 ``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md lists the differences by design.
