@@ -298,7 +298,8 @@ class LaboratoryConfig:
     vtk_frames: ParaView frames over the loading (0: none; a path whose length is not known
     before it runs writes one every VTK_RECORDS history rows); vtk_every: steps between frames
     instead (None: from vtk_frames);
-    checkpoint_every: steps between checkpoints of the loading (0: none);
+    checkpoint_every: steps between checkpoints of the loading (0: none); both at most
+    MAX_STAGE_STEPS;
     wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.triaxial.wet_sample):
     'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
     (switched on at the first loading step), 'constant-volume' (added with the walls fixed,
@@ -314,10 +315,11 @@ class LaboratoryConfig:
                                help="most steps to equilibrate the wetted (or loaded) sample")
     vtk_frames: int = parameter(50, kind=int, low=0, flag="--vtk-frames",
                                 help="ParaView frames over the loading")
-    vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
+    vtk_every: int | None = parameter(None, kind=int, low=0, high=MAX_STAGE_STEPS,
+                                      flag="--vtk-every",
                                       help="steps between ParaView frames of the loading")
-    checkpoint_every: int = parameter(0, kind=int, low=0, flag="--checkpoint-every",
-                                      help="steps between checkpoints")
+    checkpoint_every: int = parameter(0, kind=int, low=0, high=MAX_STAGE_STEPS,
+                                      flag="--checkpoint-every", help="steps between checkpoints")
     wetting: str = parameter("isotropic", kind=str, choices=WETTING_PROTOCOLS, flag="--wetting",
                              help="when bridges appear (--suction): added to the static sample "
                                   "and re-equilibrated (isotropic), switched on at the first "
