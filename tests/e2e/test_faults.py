@@ -55,7 +55,7 @@ EXTREMES = {
     "young huge": (["--young", "1e300"], ["steps"]),
     "young 1e12": (["--young", "1e12"], ["young"]),
     "young 1e8 (growth cannot settle)": (["--young", "1e8"], ["young", "prep_stress"]),
-    "strain rate huge": (["--strain-rate", "1e300"], ["inertial number"]),
+    "strain rate huge": (["--strain-rate", "1e300"], ["--strain-rate", "(0, 1e+06] 1/s"]),
     "strain rate 1e6": (["--strain-rate", "1e6"], ["inertial number", "--force"]),
     "strain rate 1e-12": (["--strain-rate", "1e-12"], ["steps", "h here"]),
     "inertial number 1": (["--inertial-number", "1"], ["inertial number"]),

@@ -231,7 +231,7 @@ REFUSED = [
      "cycles", "= 0 is outside the valid range [1, 10000]"),
     ("simple-shear", "--shear-rate", "-1", lambda: SimpleShearConfig(
         sample=PrepareConfig(particles=100, periodic=True), strain_rate=-1.0),
-     "strain_rate", "= -1.0 1/s is outside the valid range (0, inf] 1/s"),
+     "strain_rate", "= -1.0 1/s is outside the valid range (0, 1e+06] 1/s"),
     ("tension", "--residual", "1", lambda: TensionConfig(residual=1.0),
      "residual", "= 1.0 is outside the valid range (0, 1)"),
     ("tension", "--specific-gravity", "0.5", lambda: TensionConfig(

@@ -37,3 +37,72 @@ def test_an_output_period_beyond_any_run_is_refused_naming_it(command, option, t
     table = [OEDOMETER_TABLE] if command == "path" else []
     refused_here(capsys, tmp_path, command, [*table, *SMALL, option, HUGE],
                  f"{option} = {HUGE}", "valid range [0, ")
+
+
+# ---------------------------------------------------------------- loading rates and lengths
+def table(tmp_path, *stages):
+    """A path table of ``stages`` (TOML text of each [[stage]]) in ``tmp_path``; its path."""
+    path = tmp_path / "path.toml"
+    path.write_text("".join(f"[[stage]]\n{stage}\n" for stage in stages))
+    return str(path)
+
+
+LATERAL = 'stress = {x = "confining", y = "confining"}\n'
+
+
+def test_a_table_stage_at_a_strain_rate_that_never_ends_is_refused_naming_it(tmp_path, capsys):
+    path = table(tmp_path, LATERAL + 'strain_rate = {z = 1e-30}\n'
+                                     'until = {strain = 0.01, axis = "z"}')
+    line = refused_here(capsys, tmp_path, "path", [path, *SMALL],
+                        f"{path}: stage 1 would take", "steps", "raise its strain rate",
+                        "--force")
+    assert "--strain-rate" not in line
+
+
+def test_a_later_stage_counts_its_strain_from_where_the_earlier_one_ended(tmp_path):
+    from pendular.procedures.options import config_from_options
+
+    quick = LATERAL + 'strain_rate = {z = 1.0}\nuntil = {strain = 0.01, axis = "z"}'
+    slow = LATERAL + 'strain_rate = {z = 1e-3}\nuntil = {strain = 0.012, axis = "z"}'
+    held = 'strain_rate = {x = 0, y = 0, z = 0}\nuntil = "static"'
+    servoed = 'stress = {x = 500, y = 500, z = 500}\nuntil = "static"'
+    config = config_from_options("path", {"table": table(tmp_path, quick, held, slow, servoed,
+                                                         slow), "particles": 60})
+    per_step = config.strain_per_step(1.0)
+    (_, r1, s1), (_, r3, s3), (_, r5, s5) = config.stage_rates()     # the held ones move none
+    assert (r1, r3, r5) == (1.0, 1e-3, 1e-3)
+    assert s1 == pytest.approx(0.01 / per_step)
+    assert s3 == pytest.approx(0.002 / (1e-3 * per_step))     # from 0.01, held since
+    assert s5 is None                                          # z servoed since: unknown
+
+
+def test_a_table_stage_too_fast_to_be_quasi_static_is_refused_as_the_option_is(tmp_path, capsys):
+    path = table(tmp_path, LATERAL + 'strain_rate = {z = 1000}\n'
+                                     'until = {strain = 0.01, axis = "z"}')
+    refused_here(capsys, tmp_path, "path", [path, *SMALL], f"{path}: stage 1", "strain rate 1e+03",
+                 "inertial number", "--force")
+    refused_here(capsys, tmp_path, "triaxial", [*SMALL, "--strain-rate", "1e3"], "--strain-rate",
+                 "inertial number", "--force")
+
+
+@pytest.mark.parametrize("command, argv, flag", [
+    ("path", [OEDOMETER_TABLE, "--strain-rate"], "--strain-rate"),
+    ("oedometer", ["--strain-rate"], "--strain-rate"),
+    ("simple-shear", ["--shear-rate"], "--shear-rate"),
+])
+def test_a_rate_beyond_any_loading_names_the_option_typed(command, argv, flag, tmp_path, capsys):
+    line = refused_here(capsys, tmp_path, command, [*SMALL, *argv, "1e300"],
+                        f"{flag} = 1e+300", "(0, 1e+06] 1/s")
+    assert "stage" not in line
+
+
+def test_a_simple_shear_too_fast_names_its_shear_rate(tmp_path, capsys):
+    line = refused_here(capsys, tmp_path, "simple-shear", [*SMALL, "--shear-rate", "1e3"],
+                        "shear rate 1e+03 1/s", "inertial number", "lower --shear-rate")
+    assert "--strain-rate" not in line
+
+
+def test_the_longest_cyclic_test_of_a_large_sample_is_refused_as_too_long(tmp_path, capsys):
+    refused_here(capsys, tmp_path, "cyclic", ["--amplitude-strain", "0.001", "--cycles", "10000",
+                                              "--quiet"],
+                 "would take", "at 10000 spheres", "--cycles", "--particles", "--force")

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
 from pendular.utils.parameters import (Parameter, ParameterError, default_of, fail, parameter,
@@ -59,6 +60,8 @@ AXIAL_STRAIN_LIMIT = ("a triaxial test ends by 20-30 % axial strain (the thesis'
 #: Most steps of a stage run to equilibrium (wetting, an isotropic or SWCC stage, a
 #: consolidation): beyond, a stage that has not settled will not.
 MAX_STAGE_STEPS = 100_000_000
+#: Largest strain rate a loading may name [1/s] (ConstantStrainRate's bound).
+MAX_STRAIN_RATE = ConstantStrainRate.MAX_RATE
 #: Most history rows of a shear (each a few hundred bytes; one a step at most).
 MAX_RECORDS = 10_000_000
 #: Fewest spheres of a triaxial test or an SWCC: their stresses and saturation are averages
@@ -92,8 +95,8 @@ def stage_steps_parameter(default, help):
 
 def strain_rate_parameter():
     """The field of a loading's strain rate [1/s], None for the inertial number's."""
-    return parameter(None, unit="1/s", low=0.0, low_inclusive=False, flag="--strain-rate",
-                     help="axial strain rate (overrides --inertial-number)")
+    return parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE, low_inclusive=False,
+                     flag="--strain-rate", help="axial strain rate (overrides --inertial-number)")
 
 
 @dataclass
@@ -328,6 +331,8 @@ class LaboratoryConfig:
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
+    #: The options that set the loading's estimated length (``estimated_steps``).
+    LENGTH = ()
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -346,6 +351,11 @@ class LaboratoryConfig:
                                             or self.bridges.water_content is not None):
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
+
+    def stage_rates(self):
+        """[(where, strain rate [1/s], steps or None)] of the loading's stages that name their
+        own rate (a path table's, TablePathConfig); none here: the test's rate is ``rate``."""
+        return []
 
     @property
     def confining(self):
@@ -381,6 +391,7 @@ class TriaxialConfig(LaboratoryConfig):
     shear: ShearConfig = field(default_factory=ShearConfig)
 
     TEST = "a triaxial test"
+    LENGTH = ("--max-strain",)
 
     def __post_init__(self):
         if not isinstance(self.shear, ShearConfig):
@@ -863,6 +874,7 @@ class CyclicConfig(PathConfig):
                             help="cycles after the first loading")
 
     TEST = "a cyclic triaxial test"
+    LENGTH = ("--cycles", "--amplitude-strain")
 
     def __post_init__(self):
         super().__post_init__()
@@ -952,6 +964,40 @@ class TablePathConfig(PathConfig):
         return build_stages(self.stages, self.source, confining=self.sample.confining,
                             rate=self.rate(), young=self.sample.young)
 
+    def stage_rates(self):
+        """[(where, rate, steps)] of each stage of the table that moves an axis: 'FILE: stage
+        N', its fastest |strain rate| or |shear rate| [1/s] and, when it ends at a strain
+        whose start is known (the path's start, or the end of an earlier stage at a strain
+        of that axis, not moved since), its steps estimated before anything runs (the strain
+        to go over the strain of a step, ``strain_per_step``), else None."""
+        from pendular.procedures.loading import ShearStrain, Strain
+        from pendular.procedures.path_table import labelled_stages
+
+        start = {"x": 0.0, "y": 0.0, "z": 0.0, "shear": 0.0}      # None: not known
+        found = []
+        for label, stage in labelled_stages(self.stages, self.source,
+                                            confining=self.sample.confining, rate=self.rate()):
+            rates = {**stage.strain_rate, "shear": stage.shear_rate}
+            until = stage.until
+            ends = isinstance(until, (Strain, ShearStrain))
+            axis = "shear" if isinstance(until, ShearStrain) else getattr(until, "axis", None)
+            steps = None
+            if ends and start[axis] is not None:
+                try:
+                    steps = (abs(until.value - start[axis])
+                             / self.strain_per_step(abs(rates[axis])))
+                except ValueError:              # a strain per step that underflows
+                    steps = math.inf
+            for name in start:
+                if ends and name == axis:
+                    start[name] = until.value
+                elif rates.get(name, 0.0) != 0.0 or name in stage.stress or name in stage.free:
+                    start[name] = None
+            fastest = max(abs(value) for value in rates.values())
+            if fastest > 0.0:
+                found.append((f"{self.source}: {label}", fastest, steps))
+        return found
+
     def reference_pressure(self):
         """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining
         stress or a lower target of a stage."""
@@ -987,8 +1033,8 @@ class SimpleShearConfig(PathConfig):
     stress. The sample must be periodic (walls cannot shear it)."""
 
     # the shear rate gamma_dot [1/s]: PathConfig's strain rate, under the command's name
-    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, low_inclusive=False,
-                                          flag="--shear-rate",
+    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE,
+                                          low_inclusive=False, flag="--shear-rate",
                                           help="shear rate gamma_dot (overrides "
                                                "--inertial-number)")
     record_strain: float = parameter(4e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
@@ -1008,6 +1054,7 @@ class SimpleShearConfig(PathConfig):
         2_000_000, "most steps of the consolidation to --normal-stress")
 
     TEST = "a simple shear test"
+    LENGTH = ("--max-strain",)
 
     def __post_init__(self):
         super().__post_init__()

@@ -48,15 +48,13 @@ from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
-from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN
+from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.preparation import servo_speed, static
 from pendular.utils.validate import check_int, check_positive, check_range
 
 #: The axes by name, in order (x, y lateral; z axial).
 AXIS_NAMES = tuple(AXES)
-#: Largest strain rate a stage may name [1/s] (ConstantStrainRate's bound).
-MAX_STRAIN_RATE = 1e6
 #: A path of unknown length writes a ParaView frame every this many history rows.
 VTK_RECORDS = 10
 #: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b

@@ -235,6 +235,12 @@ def build_stages(entries, source, *, confining, rate, young=None):
     ``confining`` [Pa] and ``rate`` [1/s] are the values of the names 'confining' and
     'quasi-static'; with ``young`` [Pa], every stress is checked against it
     (preparation.check_soft_contacts). ValueError naming ``source`` and the entry."""
+    return [stage for _, stage in labelled_stages(entries, source, confining=confining,
+                                                  rate=rate, young=young)]
+
+
+def labelled_stages(entries, source, *, confining, rate, young=None):
+    """[(label, loading.Stage)] of build_stages, each with its entry's label ('stage 3.1')."""
     values = {"confining": confining, "quasi-static": rate, "-quasi-static": -rate}
     stages = []
     for label, entry in parse_entries(entries, source):
@@ -244,7 +250,7 @@ def build_stages(entries, source, *, confining, rate, young=None):
                 check_soft_contacts(name, value, young)
         except (ValueError, TypeError) as error:
             raise ValueError(f"{source}: {label}: {error}") from None
-        stages.append(stage)
+        stages.append((label, stage))
     return stages
 
 

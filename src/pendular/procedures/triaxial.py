@@ -39,7 +39,7 @@ from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
-from pendular.utils.parameters import fail, flat_options
+from pendular.utils.parameters import fail, flat_options, spec_of
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
     servoed_simulation, static, timestep, timestep_description)
@@ -68,6 +68,9 @@ from pendular.procedures.water_content import wet_to_water_volume
 MAX_INERTIAL_NUMBER = 1e-2
 #: Most shear steps a run may ask for without --force (about 1 h at 1,000 spheres here).
 MAX_SHEAR_STEPS = 20_000_000
+#: Most particle-steps (spheres x steps) of a loading without --force: about 7 h at
+#: ESTIMATE_RATE, a night's run; MAX_SHEAR_STEPS bounds the steps of smaller samples.
+MAX_PARTICLE_STEPS = 1e11
 #: Smallest prep_stress / young of a preparation: the radius growth (1e-4 R per step) settles
 #: only when the overlaps at the target stress (about 8 prep_stress / young R) are well above
 #: its step (60 spheres: 1.7e-4 settles in 7,400 steps, 5e-5 not in 2,000,000).
@@ -390,33 +393,63 @@ def stress_balance_error(history):
 
 # ---------------------------------------------------------------- the whole test
 
+def quasi_static_number(rate, sample, pressure):
+    """The inertial number [-] of the strain rate ``rate`` [1/s] for the grains of ``sample``
+    (a PrepareConfig) at the stress ``pressure`` [Pa]."""
+    return inertial_number(rate, sample.radius, sample.density, pressure)
+
+
 def check_feasible(config, force=False):
     """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
     MAX_INERTIAL_NUMBER at the lowest stress of its path) or would not finish in reasonable
     time (more than MAX_SHEAR_STEPS steps of a path whose length is known), with the estimate,
     or whose equilibrium phases cannot settle (a stress of the path below
     MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
-    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. Output periods
-    must fit the loading. ValueError naming the setting."""
+    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. A path
+    table's stages that name their own rates are held to the same bounds, each named by its
+    file and stage. Output periods must fit the loading. ValueError naming the setting."""
     sample = config.sample
     rate = config.rate()
+    # the option setting the rate: --strain-rate, or a simple shear's --shear-rate
+    flag = spec_of(config.shear if isinstance(config, TriaxialConfig) else config,
+                   "strain_rate").flag
+    rate_name = f"{flag[2:].replace('-', ' ')} {rate:.3g} 1/s"
     pressure = config.reference_pressure()
-    number = inertial_number(rate, sample.radius, sample.density, pressure)
+    number = quasi_static_number(rate, sample, pressure)
     dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
     steps = config.estimated_steps()
     where = (f"confining = {pressure:g} Pa" if pressure == sample.confining
              else f"{pressure:g} Pa, the lowest stress of the path")
+    # the most steps of a loading: MAX_SHEAR_STEPS, fewer for a large sample
+    most = min(MAX_SHEAR_STEPS, MAX_PARTICLE_STEPS / sample.particles)
+    large = ("--particles",) if most < MAX_SHEAR_STEPS else ()
+
+    def too_long(what, steps, rate_name, remedy):
+        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
+        return ValueError(
+            f"{what} would take {steps:.3g} steps (dt = {dt:.3g} s, {rate_name}; about "
+            f"{hours:.3g} h here at {sample.particles} spheres), outside the valid range "
+            f"[1, {most:.3g}]: {remedy} (or --force)")
+
     if not force and number > MAX_INERTIAL_NUMBER:
         raise ValueError(
-            f"strain rate {rate:.3g} 1/s gives the inertial number I = {number:.3g}, outside "
-            f"the quasi-static range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower "
-            "--strain-rate / --inertial-number (or --force)")
-    if not force and steps is not None and steps > MAX_SHEAR_STEPS:
-        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
-        raise ValueError(
-            f"the shear would take {steps:.3g} steps (dt = {dt:.3g} s, strain rate {rate:.3g} "
-            f"1/s; about {hours:.3g} h here), outside the valid range [1, {MAX_SHEAR_STEPS:g}]:"
-            " raise the strain rate or lower young / the time step's cost (or --force)")
+            f"{rate_name} gives the inertial number I = {number:.3g}, outside the quasi-static "
+            f"range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower {flag} / --inertial-number "
+            "(or --force)")
+    if not force and steps is not None and steps > most:
+        raise too_long("the shear" if isinstance(config, TriaxialConfig) else "the loading",
+                       steps, rate_name, f"raise {flag} / --inertial-number, or lower "
+                       f"{', '.join(('--young', *large, *config.LENGTH))}")
+    for stage, stage_rate, stage_steps in config.stage_rates() if not force else ():
+        stage_number = quasi_static_number(stage_rate, sample, pressure)
+        if stage_number > MAX_INERTIAL_NUMBER:
+            raise ValueError(
+                f"{stage}: strain rate {stage_rate:.3g} 1/s gives the inertial number I = "
+                f"{stage_number:.3g}, outside the quasi-static range (0, "
+                f"{MAX_INERTIAL_NUMBER:g}] at {where}: lower it (or --force)")
+        if stage_steps is not None and stage_steps > most:
+            raise too_long(stage, stage_steps, f"strain rate {stage_rate:.3g} 1/s",
+                           "raise its strain rate")
     if (not force and config.sample_path is None
             and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
         raise ValueError(
