@@ -106,3 +106,60 @@ def test_the_longest_cyclic_test_of_a_large_sample_is_refused_as_too_long(tmp_pa
     refused_here(capsys, tmp_path, "cyclic", ["--amplitude-strain", "0.001", "--cycles", "10000",
                                               "--quiet"],
                  "would take", "at 10000 spheres", "--cycles", "--particles", "--force")
+
+
+# ---------------------------------------------------------------- what the user typed
+@pytest.mark.parametrize("command, diameters, words", [
+    ("triaxial", "1e-7,2e-7,4e-7", ["7.14e-08 m", "[1e-06, 1] m"]),
+    ("triaxial", "4,6,8", ["2.63 m", "[1e-06, 1] m"]),
+    ("tension", "0.05,0.1,0.2", ["0.0357 m", "[1e-06, 0.01] m", "direct tension"]),
+])
+def test_grains_of_a_grading_curve_out_of_range_blame_psd(command, diameters, words, tmp_path,
+                                                           capsys):
+    curve = tmp_path / "psd.csv"
+    curve.write_text("".join(f"{d},{p}\n" for d, p in zip(diameters.split(","), (0, 50, 100))))
+    line = refused_here(capsys, tmp_path, command, ["--psd", str(curve), "--quiet"],
+                        "--psd: the grading curve's mean radius", *words)
+    assert "--radius" not in line
+
+
+def test_a_grip_depth_of_0_grips_the_layer_on_the_wall():
+    """The preparation grows the radii past the nominal one: a grip reaches at least the
+    largest sphere, so that --grip-depth 0 (the help's lower bound) grips the spheres touching
+    the wall instead of failing on a depth the user did not type."""
+    import numpy as np
+
+    from pendular.dem.state import Walls
+    from pendular.procedures.grips import grip_members, grip_reach
+
+    radius = 1e-4
+    radii = np.array([1.0002, 1.0001, 1.0003]) * radius          # grown by the preparation
+    position = np.array([[0.0, 0.0, radii[0]], [0.0, 0.0, 3.5 * radius],
+                         [0.0, 0.0, radii[2] + 1e-9]])
+    walls = Walls.box([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0])
+    reach = grip_reach(radius, 0.0, radii)
+    assert reach == radii.max()
+    assert grip_members(position, radii, walls, 4, reach).tolist() == [0]
+    assert grip_reach(radius, 1.0, radii) == 3.0 * radius          # the usual depth, as it was
+    assert grip_members(position, radii, walls, 4, grip_reach(radius, 1.5, radii)).tolist() == \
+        [0, 1, 2]
+
+
+def test_a_void_ratio_no_preparation_reaches_states_the_range_in_order(monkeypatch):
+    """A small graded sample's void ratio need not fall as the growth friction rises: the
+    range refused is the two preparations' void ratios in order, never an inverted one."""
+    import types
+
+    from pendular.procedures import tension
+    from pendular.procedures.config import TensionConfig, tension_sample
+
+    reached = {0.0: 0.477, 30.0: 0.429}                 # denser at the higher friction
+    monkeypatch.setattr(tension, "prepare_sample", lambda config, **_: (
+        types.SimpleNamespace(device="cpu", friction=config.prep_friction_deg),
+        {"porosity": 0.3}))
+    monkeypatch.setattr(tension, "sample_void_ratio", lambda sim, radius: reached[sim.friction])
+    config = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100))
+    with pytest.raises(ValueError) as error:
+        tension.prepare_void_ratio(config, 0.72, progress=False)
+    assert "valid range of this sample, [0.429, 0.477]" in str(error.value)
+    assert "growth friction 0 and 30 deg give e = 0.477 and 0.429" in str(error.value)

@@ -581,7 +581,17 @@ def check_tension_sample(fields):
         if name in fields:
             spec = spec_of(PrepareConfig, name)
             low, high = TENSION_RANGES.get(name, (spec.low, spec.high))
-            dataclasses.replace(spec, low=low, high=high).check(name, fields[name])
+            spec = dataclasses.replace(spec, low=low, high=high)
+            try:
+                spec.check(name, fields[name])
+            except ParameterError:
+                if name != "radius" or fields.get("psd") is None:
+                    raise
+                # the grading curve's sizes, not a --radius given
+                raise ParameterError("psd", f"psd: the grading curve's mean radius, "
+                                     f"{fields['radius']:.3g} m, is outside the valid range "
+                                     f"{spec.valid_range()} m of a direct tension's sphere",
+                                     "--psd") from None
 
 
 def tension_sample(**fields):

@@ -34,7 +34,7 @@ from pendular.dem.neighbors import NeighborList, spatial_order
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import TIMESTEP_RULES, critical_timestep, pwave_timestep
-from pendular.utils.parameters import fail, parameter, spec_of, validate
+from pendular.utils.parameters import ParameterError, fail, parameter, spec_of, validate
 from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
 
@@ -321,7 +321,14 @@ class PrepareConfig:
                            f"radius_spread = {self.radius_spread:g} and a psd given: valid is "
                            "one of them (the grading curve sets the sizes)")
             self.psd = check_grading_curve(self.psd)
-            self.radius = spec_of(self, "radius").check("radius", float(np.mean(self.radii())))
+            mean = float(np.mean(self.radii()))
+            radius = spec_of(self, "radius")
+            try:
+                self.radius = radius.check("radius", mean)
+            except ParameterError:          # the curve's sizes, not a --radius given
+                raise ParameterError("psd", f"psd: the grading curve's mean radius, {mean:.3g} "
+                                     f"m, is outside the valid range {radius.valid_range()} m "
+                                     "of a sphere's radius", "--psd") from None
         for name in ("prep_stress", "confining"):
             try:
                 check_soft_contacts(name, getattr(self, name), self.young)

@@ -904,6 +904,7 @@ class _PathRun:
         summary = self.test.summarize(history)
         rate = config.rate()
         sheared = sim.step - self.start_step
+        loaded = history["unbalanced_force"][1:]      # none when the first stage failed at once
         summary.update({
             "completed": completed,
             "initial_porosity": preparation["porosity"],
@@ -919,8 +920,8 @@ class _PathRun:
             "strain_rate": rate,
             "inertial_number": inertial_number(rate, sample.radius, sample.density,
                                                config.reference_pressure()),
-            "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
-            "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
+            "max_unbalanced_force": float(np.max(loaded)) if len(loaded) else None,
+            "mean_unbalanced_force": float(np.mean(loaded)) if len(loaded) else None,
             "threads": numba.get_num_threads(),
             "device": sim.device,
             "grading": grading(sim.particles.radius),
