@@ -163,3 +163,32 @@ def test_a_void_ratio_no_preparation_reaches_states_the_range_in_order(monkeypat
         tension.prepare_void_ratio(config, 0.72, progress=False)
     assert "valid range of this sample, [0.429, 0.477]" in str(error.value)
     assert "growth friction 0 and 30 deg give e = 0.477 and 0.429" in str(error.value)
+
+
+# ---------------------------------------------------------------- inconsistencies
+def test_a_repeat_given_as_text_is_refused_as_other_text_for_numbers_is(tmp_path, capsys):
+    path = table(tmp_path, 'repeat = "3"\nstages = [{stress = {x = 500, y = 500, z = 500}}]')
+    refused_here(capsys, tmp_path, "path", [path, *SMALL], f"{path}: stage 1", "repeat = '3'",
+                 "is text")
+    path = table(tmp_path, 'stress = {x = "confining", y = "confining"}\n'
+                           'strain_rate = {z = "0.1"}')
+    refused_here(capsys, tmp_path, "path", [path, *SMALL], "strain_rate['z'] = '0.1'")
+
+
+def test_an_isotropic_stress_repeated_in_a_row_is_refused_not_merged(tmp_path, capsys):
+    refused_here(capsys, tmp_path, "isotropic", [*SMALL, "--stresses", "1000,1000"],
+                 "--stresses = 1000,1000", "stage 2 repeats the 1000 Pa of stage 1")
+    from pendular.procedures.options import config_from_options
+
+    loop = config_from_options("isotropic", {"particles": 60, "stresses": "1000,2000,1000"})
+    assert loop.stresses == [1000.0, 2000.0, 1000.0]      # a loading and unloading: valid
+
+
+def test_the_smallest_simple_shear_is_its_own_documented_minimum(tmp_path, capsys):
+    from pendular.procedures.config import MIN_SIMPLE_SHEAR_PARTICLES
+    from pendular.procedures.options import options_of
+
+    particles = next(o for o in options_of("simple-shear") if o.key == "particles")
+    assert f"valid range [{MIN_SIMPLE_SHEAR_PARTICLES}, " in particles.help
+    refused_here(capsys, tmp_path, "simple-shear", ["--particles", "50", "--quiet"],
+                 "--particles = 50", f"[{MIN_SIMPLE_SHEAR_PARTICLES}, ", "periodic cell")

@@ -147,8 +147,12 @@ def _expand_group(entry, source, label, stages):
         raise ValueError(f"{source}: {label}: key {other[0]!r} beside repeat and stages; "
                          f"valid: {', '.join(GROUP_KEYS)} (a group: give {other[0]!r} to the "
                          "stages in it)")
+    repeat = entry.get("repeat")
+    if isinstance(repeat, str):         # text where a count belongs, refused as _value does
+        raise ValueError(f"{source}: {label}: repeat = {repeat!r} is text; valid: a number, "
+                         f"an integer in [1, {MAX_STAGES}]")
     try:
-        times = check_int("repeat", entry.get("repeat"), low=1, high=MAX_STAGES)
+        times = check_int("repeat", repeat, low=1, high=MAX_STAGES)
     except ValueError as error:
         raise ValueError(f"{source}: {label}: {error}") from None
     inner = entry.get("stages")
