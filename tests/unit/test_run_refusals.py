@@ -192,3 +192,9 @@ def test_the_smallest_simple_shear_is_its_own_documented_minimum(tmp_path, capsy
     assert f"valid range [{MIN_SIMPLE_SHEAR_PARTICLES}, " in particles.help
     refused_here(capsys, tmp_path, "simple-shear", ["--particles", "50", "--quiet"],
                  "--particles = 50", f"[{MIN_SIMPLE_SHEAR_PARTICLES}, ", "periodic cell")
+
+
+def test_the_crosschecks_settling_beyond_its_bound_names_settle_steps(tmp_path, capsys):
+    line = refused_here(capsys, tmp_path, "crosscheck", ["--settle-steps", HUGE],
+                        f"--settle-steps = {HUGE}", "[0, 100000000]")
+    assert "--wet-steps" not in line and "YADE" not in line
