@@ -44,3 +44,15 @@ def test_a_stage_whose_stress_is_reached_ends_at_once(stress, sample, tmp_path, 
                                           "--quiet", "--out", tmp_path / "out"], capsys)
     assert status == 0, err
     assert summary_of(tmp_path / "out")["stages"][0]["stage"] == 0
+
+
+def test_resuming_a_run_that_wrote_no_checkpoints_says_why(sample, capsys):
+    """The sample's own run (finished, --checkpoint-every 0) cannot be resumed; its folder is
+    left as it was."""
+    import os
+
+    folder = os.path.dirname(sample)
+    before = sorted(os.listdir(folder))
+    refused(*run_in_process("triaxial", ["--resume", folder], capsys),
+            "checkpoint.h5 is missing", "--checkpoint-every 0")
+    assert sorted(os.listdir(folder)) == before

@@ -198,3 +198,13 @@ def test_the_crosschecks_settling_beyond_its_bound_names_settle_steps(tmp_path, 
     line = refused_here(capsys, tmp_path, "crosscheck", ["--settle-steps", HUGE],
                         f"--settle-steps = {HUGE}", "[0, 100000000]")
     assert "--wet-steps" not in line and "YADE" not in line
+
+
+def test_resuming_a_run_stopped_before_its_sample_says_so(tmp_path, capsys):
+    """The folder of a run interrupted during its preparation holds no sample.h5: nothing to
+    resume, whatever its --checkpoint-every."""
+    folder = tmp_path / "stopped"
+    folder.mkdir()
+    line = refused(*run_in_process("oedometer", ["--resume", str(folder)], capsys),
+                   "sample.h5 is missing", "before its sample existed", "run it again")
+    assert "checkpoint_every" not in line

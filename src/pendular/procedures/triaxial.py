@@ -652,10 +652,16 @@ class LaboratoryTest:
         wrote the checkpoint); returns the summary."""
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
-        for path in (sample_file, checkpoint):
-            if not os.path.exists(path):
-                raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
-                                 "with checkpoint_every > 0?)")
+        if not os.path.exists(sample_file):
+            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
+                             "before its sample existed (in the preparation or the wetting), "
+                             "so nothing can be resumed; run it again")
+        if not os.path.exists(checkpoint):
+            stored = config_from_dict(load_sample(sample_file)[3].get("config"), sample_file)
+            why = ("the run stopped before its first checkpoint" if
+                   getattr(stored, "checkpoint_every", 0) > 0 else
+                   "the run was started with --checkpoint-every 0, which writes none")
+            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: {why}; run it again")
         with OutputFolder(out, f"{cls.NAME} --resume", keep=True) as folder:
             particles, walls, _, before_shear = load_sample(sample_file)
             config = config_from_dict(before_shear.get("config"), sample_file)
