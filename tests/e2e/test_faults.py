@@ -154,6 +154,11 @@ CHECKPOINT_FAULTS = {
     "another run's (seed 1)": (lambda p: forge(p, lambda h: None, seed=1), ["identity mismatch",
                                                                             "seed"]),
     "missing": (os.remove, ["checkpoint.h5 is missing"]),
+    "dt x 10, checksum forged": (lambda p: forge(p, lambda h: h.attrs.__setitem__(
+        "dt", 10.0 * h.attrs["dt"])), ["dt = ", "not this run's time step"]),
+    "two spheres at one position, checksum forged": (lambda p: forge(p, lambda h: h[
+        "particles/position"].__setitem__(1, h["particles/position"][0])),
+        ["particles 0 and 1 share the position"]),
 }
 
 

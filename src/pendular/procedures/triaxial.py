@@ -678,7 +678,18 @@ class LaboratoryTest:
             test = cls.__new__(cls)          # the stored run, checked when it started
             test.config = config
             run = _PathRun(sim, test, folder, before_shear, identity)
+            dt = sim.dt                      # the loading's time step, set from its sample
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
+            if sim.dt != dt:                 # a checksum can be forged
+                raise ValueError(f"{checkpoint}: dt = {sim.dt:g} s is not this run's time step, "
+                                 f"{dt:g} s (set from its sample.h5): an edited checkpoint")
+            position = sim.particles.position   # two centres at one point have no normal
+            order = np.lexsort(position.T[::-1])
+            same = np.flatnonzero(np.all(position[order[1:]] == position[order[:-1]], axis=1))
+            if len(same):
+                i, j = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+                raise ValueError(f"{checkpoint}: particles {i} and {j} share the position "
+                                 f"{position[i].tolist()} m: an edited checkpoint")
             if (not isinstance(state, dict) or state.get("phase") != "shear"
                     or state.get("steps") != run.steps
                     or not isinstance(state.get("start_step"), int)
