@@ -21,6 +21,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 #: The folder whose sitecustomize.py makes the simulator run a block's threads serially.
 SERIAL_SIMULATOR = os.path.join(HERE, "serial_simulator")
+#: Longest wait for one check of a script run under the simulator [s]: a bound on a hung
+#: process, far beyond a check's run on a loaded machine.
+CHECK_TIMEOUT = 900
 #: The tests' folder (its support package).
 TESTS = os.path.dirname(HERE)
 
@@ -41,10 +44,13 @@ def _run(argv, timeout):
     return done.stdout
 
 
-def simulated(script, *arguments, timeout=600):
+def simulated(script, *arguments, timeout=None):
     """The JSON object that ``script`` (a file of tests/gpu, or a path) prints last, run with
     ``arguments`` under the simulator in a process of its own. A script of checks
-    (``run_checks``) given several names runs them all in that one process."""
+    (``run_checks``) given several names runs them all in that one process (``timeout``
+    [s]: by default CHECK_TIMEOUT per check)."""
+    if timeout is None:
+        timeout = CHECK_TIMEOUT * max(1, len(arguments))
     stdout = _run([sys.executable, os.path.join(HERE, script), *arguments], timeout)
     return json.loads(stdout.strip().splitlines()[-1])
 
