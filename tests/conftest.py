@@ -4,12 +4,15 @@ The tests are split by reach: tests/unit (one function or kernel against a close
 independent computation), tests/integration (simulations through the library), tests/e2e (the
 commands as a user runs them, marked ``slow``: ``pytest -m "not slow"`` leaves them out)."""
 
+import importlib.util
 import json
 import os
+import shutil
 import subprocess
 import sys
 
 import h5py
+import numba
 import numpy as np
 import pytest
 
@@ -27,6 +30,31 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RADIUS = 1e-3
 DENSITY = 2650.0
 YOUNG = 1e6
+
+
+#: How to install what a test may need, by its name in ``requires``.
+INSTALL = {"numba_cuda": "pip install -e '.[gpu]'", "vtk": "pip install -e '.[test]'",
+           "dask.distributed": "pip install -e '.[test]'",
+           "grainlearning": "pip install -e '.[calibrate]' && pip install --no-deps "
+                            "grainlearning==2.0.5"}
+
+
+def requires(need):
+    """The skip mark of a test that needs what a machine may lack (the tests' one way to
+    skip): ``need`` an importable module ("numba_cuda", "vtk", "meshio", "dask.distributed",
+    "grainlearning"), "yade" (its executable on PATH) or "threads" (two Numba threads). Use
+    it as a decorator, or as ``pytestmark = requires(...)`` for a whole module."""
+    if need == "yade":
+        have, missing = any(shutil.which(name) for name in ("yade", "yadedaily")), \
+            "YADE (yade or yadedaily on PATH) is not installed"
+    elif need == "threads":
+        have, missing = numba.config.NUMBA_NUM_THREADS >= 2, "needs two Numba threads"
+    else:
+        have = importlib.util.find_spec(need.split(".")[0]) is not None and (
+            "." not in need or importlib.util.find_spec(need) is not None)
+        missing = f"{need} is not installed" + (f" ({INSTALL[need]})" if need in INSTALL
+                                                else "")
+    return pytest.mark.skipif(not have, reason=missing)
 
 
 class PrescribedGap:

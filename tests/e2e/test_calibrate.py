@@ -11,12 +11,12 @@ import shutil
 import numpy as np
 import pytest
 
-from conftest import assert_drawn, run_in_process
+from conftest import assert_drawn, requires, run_in_process
 
 from pendular.io.schema import undeclared_keys
 from pendular.studies.calibration import DATA_COLUMNS, SEED_REPLICATES
 
-pytest.importorskip("grainlearning")
+pytestmark = requires("grainlearning")
 
 CURVE = "axial_strain,q,volumetric_strain\n0.002,450,0.0008\n0.004,650,0.0010\n0.006,700,0.0007\n"
 

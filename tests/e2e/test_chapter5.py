@@ -17,7 +17,7 @@ from pendular.studies.chapter5 import Chapter5Grid, chapter5_campaign, envelopes
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.reference import FIG_5_5, TABLE_5_3
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, requires
 
 SCENARIO = os.path.join(ROOT, "scenarios", "chapter5.py")
 KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
@@ -235,8 +235,10 @@ def test_campaign_json_keeps_its_keys(campaign):
     assert list(data["thesis"]) == ["table_5_3", "fig_5_5_saturation", "dry_friction_deg"]
 
 
+@requires("dask.distributed")
 def test_campaign_on_a_dask_cluster(tmp_path):
-    distributed = pytest.importorskip("dask.distributed")
+    import dask.distributed as distributed
+
     out = tmp_path / "dask"
     grid = Chapter5Grid(suctions=[30000.0], confining=[500.0, 1000.0], particles=120,
                         max_strain=0.01, inertial_number=3e-3)

@@ -55,7 +55,7 @@ EXTREMES = {
     "young huge": (["--young", "1e300"], ["steps"]),
     "young 1e12": (["--young", "1e12"], ["young"]),
     "young 1e8 (growth cannot settle)": (["--young", "1e8"], ["young", "prep_stress"]),
-    "strain rate huge": (["--strain-rate", "1e300"], ["inertial number"]),
+    "strain rate huge": (["--strain-rate", "1e300"], ["--strain-rate", "(0, 1e+06] 1/s"]),
     "strain rate 1e6": (["--strain-rate", "1e6"], ["inertial number", "--force"]),
     "strain rate 1e-12": (["--strain-rate", "1e-12"], ["steps", "h here"]),
     "inertial number 1": (["--inertial-number", "1"], ["inertial number"]),
@@ -154,6 +154,11 @@ CHECKPOINT_FAULTS = {
     "another run's (seed 1)": (lambda p: forge(p, lambda h: None, seed=1), ["identity mismatch",
                                                                             "seed"]),
     "missing": (os.remove, ["checkpoint.h5 is missing"]),
+    "dt x 10, checksum forged": (lambda p: forge(p, lambda h: h.attrs.__setitem__(
+        "dt", 10.0 * h.attrs["dt"])), ["dt = ", "not this run's time step"]),
+    "two spheres at one position, checksum forged": (lambda p: forge(p, lambda h: h[
+        "particles/position"].__setitem__(1, h["particles/position"][0])),
+        ["particles 0 and 1 share the position"]),
 }
 
 

@@ -121,7 +121,7 @@ def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
     (["--max-strain", "-0.1"], ("--max-strain = -0.1", "[1e-06, 10]")),
     (["--max-strain", "20"], ("--max-strain = 20", "[1e-06, 10]")),
     (["--normal-stress", "-5"], ("--normal-stress = -5", "(0, 1e+07]")),
-    (["--shear-rate", "0"], ("--shear-rate = 0", "(0, inf]")),
+    (["--shear-rate", "0"], ("--shear-rate = 0", "(0, 1e+06]")),
     (["--record-strain", "0.5"], ("--record-strain = 0.5",)),
     (["--inertial-number", "0.5"], ("inertial number", "(0, 0.01]")),
 ])

@@ -17,7 +17,6 @@ line says that YADE is missing.
 import json
 import math
 import os
-import shutil
 import subprocess
 import sys
 
@@ -29,9 +28,9 @@ from pendular.studies import crosscheck
 from pendular.procedures.config import YADE_CHOICES
 from pendular.io.history import read_history
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, requires
+from support.yade_stand_in import pendular_as_yade
 
-HAVE_YADE = shutil.which("yade") is not None or shutil.which("yadedaily") is not None
 SCENARIO = os.path.join(ROOT, "scenarios", "yade_crosscheck.py")
 #: Tolerances of the agreement checks [-]: start of the shear (same packing), peak (same law).
 START_TOLERANCE = 1e-3
@@ -62,7 +61,7 @@ def check_result(result, max_strain, tolerance=0.01):
         assert summary["peak_q"] > 0.0
 
 
-@pytest.mark.skipif(not HAVE_YADE, reason="YADE (the cross-check reference) is not installed")
+@requires("yade")
 def test_wet_crosscheck_agrees(tmp_path):
     config = crosscheck.crosscheck_config(particles=300, suction=30000.0, max_strain=0.01,
                                           records=50, mimic_yade=True)
@@ -81,7 +80,7 @@ def test_wet_crosscheck_agrees(tmp_path):
     assert abs(result["volumetric_strain_at_peak_diff"]) < 1e-3
 
 
-@pytest.mark.skipif(not HAVE_YADE, reason="YADE (the cross-check reference) is not installed")
+@requires("yade")
 def test_periodic_crosscheck_agrees(tmp_path):
     config = crosscheck.crosscheck_config(particles=300, max_strain=0.03, records=30,
                                           periodic=True)
@@ -101,34 +100,6 @@ def test_periodic_crosscheck_agrees(tmp_path):
 
 
 # ---------------------------------------------------------------- without YADE
-
-def pendular_as_yade(config):
-    """A stand-in for pendular.interop.yade.runner.run_yade_triaxial: pendular shears the driver's packing
-    and writes the driver's history layout (box lengths chosen to give the same volume)."""
-
-    def run(settings, threads=1, env=None):
-        sim, shear = crosscheck.pendular_shear(config, settings["spheres"], threads)
-        box_volume = sim.walls.volume()
-        sim.run(shear.steps)
-        history = shear.recorder.arrays()
-        sigma = history["sigma_wall"]
-        columns = {"i": history["step"], "t": history["time"],
-                   "eps_axial": history["axial_strain"],
-                   "sx": sigma[:, 0], "sy": sigma[:, 1], "sz": sigma[:, 2],
-                   "lx": np.ones(len(sigma)), "ly": np.ones(len(sigma)),
-                   "lz": (1.0 - history["volumetric_strain"]) * box_volume,
-                   "porosity": history["porosity"],
-                   "unbalanced": history["unbalanced_force"]}
-        if "saturation" in history:
-            columns.update(saturation=history["saturation"], menisci=history["bridges"])
-        lines = ["# " + "\t\t".join(columns)]
-        lines += ["\t".join(repr(float(v)) for v in row) for row in zip(*columns.values())]
-        with open(settings["history"], "w") as handle:
-            handle.write("\n".join(lines) + "\n")
-        return {"steps": shear.steps, "wall_time_s": 1.0, "yade_version": "stand-in"}
-
-    return run
-
 
 def test_pendular_half_against_itself(tmp_path, monkeypatch):
     """The whole cross-check (settle, export, shear, compare, write) with pendular on both

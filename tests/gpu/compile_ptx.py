@@ -76,17 +76,17 @@ def compile_step_kernels(cuda, capability):
                               for a in args)
             ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
-    # the kernels a radius growth adds to a dry step (test_gpu_growth.py's scene), those
-    # of a dry and a wet step in a periodic cell (test_gpu_periodic.py's), of a simple shear
-    # (test_gpu_shear.py's), the grips' (test_gpu_grips.py's), volume-controlled bridges'
-    # liquid exchange (test_gpu_volume.py's), the rolling resistance and gravity
-    # (test_gpu_rolling.py's)
-    from test_gpu_grips import scene as grips_scene
-    from test_gpu_growth import scene as growth_scene
-    from test_gpu_periodic import scene as periodic_scene
-    from test_gpu_rolling import scene as rolling_scene
-    from test_gpu_shear import scene as shear_scene
-    from test_gpu_volume import scene as volume_scene
+    # the kernels a radius growth adds to a dry step (growth_checks.py's scene), those of a
+    # dry and a wet step in a periodic cell (periodic_checks.py's), of a simple shear
+    # (shear_checks.py's), the grips' (grips_checks.py's), volume-controlled bridges'
+    # liquid exchange (volume_checks.py's), the rolling resistance and gravity
+    # (rolling_checks.py's)
+    from grips_checks import scene as grips_scene
+    from growth_checks import scene as growth_scene
+    from periodic_checks import scene as periodic_scene
+    from rolling_checks import scene as rolling_scene
+    from shear_checks import scene as shear_scene
+    from volume_checks import scene as volume_scene
 
     for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
                        (periodic_scene(wet=True), " periodic wet"),

@@ -1,7 +1,7 @@
 """The GPU path against the CPU path under Numba's CUDA simulator, run as a script in its own
-process (``NUMBA_ENABLE_CUDASIM=1 python tests/gpu/simulated.py CHECK``) so that the simulator
-never reaches the process of the other tests; prints one JSON object of measurements, which
-test_gpu_dem.py and test_gpu_bridges.py judge.
+process (``NUMBA_ENABLE_CUDASIM=1 python tests/gpu/simulated.py dry wet``) so that the
+simulator never reaches the process of the other tests; prints one JSON object of
+measurements (simulator.run_checks), which test_gpu_dem.py judges.
 
 The scene: 27 spheres of radii within 5 % of 1 mm on a jittered cubic lattice, slightly
 overlapping, with random velocities, in six walls; friction 30 deg, damping 0.2, a stress servo
@@ -9,9 +9,7 @@ on x and y and a constant strain rate on z (a triaxial's shear in miniature; sev
 neighbour-list rebuilds in 200 steps), dry or wet (suction-controlled bridges at contact).
 """
 
-import json
 import math
-import sys
 
 import numpy as np
 
@@ -27,7 +25,7 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import GpuSimulation
 from pendular.gpu.cuda import cuda, device_twin
-from simulator import counted_copies, relative
+from simulator import counted_copies, relative, run_checks
 
 RADIUS = 1e-3
 YOUNG = 1e7
@@ -236,4 +234,4 @@ def wet():
 
 
 if __name__ == "__main__":
-    print(json.dumps({"dry": dry, "wet": wet}[sys.argv[1]]()))
+    run_checks({"dry": dry, "wet": wet})

@@ -21,12 +21,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 #: The folder whose sitecustomize.py makes the simulator run a block's threads serially.
 SERIAL_SIMULATOR = os.path.join(HERE, "serial_simulator")
+#: Longest wait for one check of a script run under the simulator [s]: a bound on a hung
+#: process, far beyond a check's run on a loaded machine.
+CHECK_TIMEOUT = 900
+#: The tests' folder (its support package).
+TESTS = os.path.dirname(HERE)
 
 
 def environment():
     """This process's environment with Numba's CUDA simulator on and its serial runner loaded
-    (SERIAL_SIMULATOR first on PYTHONPATH)."""
-    path = os.pathsep.join(filter(None, [SERIAL_SIMULATOR, os.environ.get("PYTHONPATH")]))
+    (SERIAL_SIMULATOR first on PYTHONPATH, then TESTS)."""
+    path = os.pathsep.join(filter(None, [SERIAL_SIMULATOR, TESTS, os.environ.get("PYTHONPATH")]))
     return dict(os.environ, NUMBA_ENABLE_CUDASIM="1", PYTHONPATH=path)
 
 
@@ -39,11 +44,25 @@ def _run(argv, timeout):
     return done.stdout
 
 
-def simulated(script, *arguments, timeout=600):
+def simulated(script, *arguments, timeout=None):
     """The JSON object that ``script`` (a file of tests/gpu, or a path) prints last, run with
-    ``arguments`` under the simulator in a process of its own."""
+    ``arguments`` under the simulator in a process of its own. A script of checks
+    (``run_checks``) given several names runs them all in that one process (``timeout``
+    [s]: by default CHECK_TIMEOUT per check)."""
+    if timeout is None:
+        timeout = CHECK_TIMEOUT * max(1, len(arguments))
     stdout = _run([sys.executable, os.path.join(HERE, script), *arguments], timeout)
     return json.loads(stdout.strip().splitlines()[-1])
+
+
+def run_checks(checks):
+    """The main of a script of checks run under the simulator: print one JSON object, each
+    check named on the command line -> its measurements (``checks``: name -> function)."""
+    names = sys.argv[1:]
+    unknown = [name for name in names if name not in checks]
+    if unknown or not names:
+        raise SystemExit(f"checks: {', '.join(checks)} (unknown or none: {unknown})")
+    print(json.dumps({name: checks[name]() for name in names}, default=float))
 
 
 def simulated_command(command, argv, timeout=600):

@@ -1,4 +1,4 @@
-"""``--device gpu`` on the commands (issue 38's done-means): a wet triaxial on the GPU path
+"""``--device gpu`` on the commands: a wet triaxial on the GPU path
 (the loaded sample's equilibrium, the wetting and the loading), under Numba's CUDA simulator
 in a process of its own, records the history of the same command on the CPU; a checkpoint
 written on either device resumes on the other; a GPU run where no GPU can run is refused in
@@ -12,22 +12,17 @@ takes 162 steps, not 538. Before the
 shear the sample is equilibrated at the confining stress (200 steps) and wetted (200 steps),
 on the device too.
 
-Measured (simulator, 162 steps of shear, a record every step): the rows, bridge and contact
-counts are the CPU's. The other columns differ from the CPU's by at most 7.2e-9 of their
-largest value (volumetric strain; sigma_wall 2.9e-9, sigma_contact 8.9e-10, the anisotropies
-9.4e-10, chi and psi 1.9e-11), the unbalanced force, a residual ratio, by 9.2e-7, and B, the
-surface-tension stress (a deviator whose bridge terms, each of psi's size, cancel), by 3.2e-12
-of psi's largest value (9.9e-10 of its own). That is the CPU's own sensitivity: the CPU run
-with one coordinate of the loaded sample moved by one ulp differs from the CPU run by 8.3e-9
-(volumetric strain), 4.3e-9 (sigma_wall), 1.2e-9, 9.9e-10, 1.9e-11, 9.0e-7 and 2.8e-12 (B over
-psi): the 400 steps of equilibrium and wetting before the shear amplify any round-off (with
-them on the CPU the GPU's columns agreed to 5.4e-13, the unbalanced force to 6.9e-11). The CPU's
-hot kernels contract multiply-adds, the simulator does not: the GPU's difference is that
-round-off, so the test runs the one-ulp CPU run too and holds each column to MARGIN times that
-run's difference (at least ROUND_OFF), B against psi's magnitude (SCALE_OF).
+The rows, bridge and contact counts are the CPU's; the other columns differ from the CPU's by
+round-off that the 400 steps of equilibrium and wetting before the shear amplify as they
+amplify the CPU's own: the CPU run with one coordinate of the loaded sample moved by one ulp
+differs from the CPU run by as much (docs/gpu.md). The CPU's hot kernels contract
+multiply-adds, the simulator does not, so the test runs the one-ulp CPU run too and holds each
+column to MARGIN times that run's difference (at least ROUND_OFF), B, the surface-tension
+stress (a deviator whose bridge terms cancel), against psi's magnitude (SCALE_OF).
 """
 
 import contextlib
+import importlib.util
 import os
 import shutil
 
@@ -35,16 +30,11 @@ import h5py
 import numpy as np
 import pytest
 
-from conftest import refused, run_in_process
+from conftest import refused, requires, run_in_process
 from simulator import history, simulated_command
 
-try:
-    import numba_cuda  # noqa: F401
-    HAVE_NUMBA_CUDA = True
-except ImportError:
-    HAVE_NUMBA_CUDA = False
-needs_numba_cuda = pytest.mark.skipif(not HAVE_NUMBA_CUDA, reason="numba-cuda is not "
-                                      "installed (pip install -e '.[gpu]')")
+#: Whether the gpu extra is installed (what the refusal of a GPU run says depends on it).
+HAVE_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
 
 #: A column may differ from the CPU's by MARGIN times the difference that one ulp in one
 #: coordinate of the loaded sample makes on the CPU (the dynamics' amplification of round-off) ...
@@ -140,7 +130,7 @@ def checkpoint_step(folder):
         return int(handle.attrs["step"])
 
 
-@needs_numba_cuda
+@requires("numba_cuda")
 def test_the_gpu_command_records_the_cpu_history(runs):
     cpu, gpu = history(runs / "cpu"), history(runs / "gpu")
     assert len(cpu["step"]) == 163 and np.array_equal(cpu["step"], gpu["step"])
@@ -155,7 +145,7 @@ def test_the_gpu_command_records_the_cpu_history(runs):
         assert os.listdir(runs / folder / "vtk")
 
 
-@needs_numba_cuda
+@requires("numba_cuda")
 @pytest.mark.parametrize("written, resumed", [("gpu", "cpu"), ("cpu", "gpu")])
 def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
     copy = runs / f"{written}_on_{resumed}"

@@ -6,20 +6,18 @@ YADE is replaced by pendular on the CPU (as tests/e2e/test_yade_crosscheck.py do
 YADE): a 60-sphere wet packing (30 kPa) settled and exported by a CPU cross-check is sheared
 again from that packing on the device, to 5e-4 axial strain (about 140 steps). The device's
 pendular history equals the CPU's to round-off and the comparison with the stand-in is zero
-to round-off. Measured (simulator): the same rows, contact and bridge counts; every other
-column within 1.7e-12 of its largest value (volumetric strain; sigma_wall 7.5e-13), the
-unbalanced force, a residual ratio, within 9.3e-12; peak q within 7.8e-13.
+to round-off.
 """
 
 import json
 import os
-import sys
 import tempfile
 
 import numpy as np
 import pytest
 
-from simulator import HERE, simulated
+from conftest import requires
+from simulator import simulated
 
 #: Axial strain of the shear (about 140 steps at the cross-check's inertial number).
 MAX_STRAIN = 5e-4
@@ -35,10 +33,7 @@ def measure(folder):
     config = crosscheck.crosscheck_config(particles=60, suction=30000.0, max_strain=MAX_STRAIN,
                                           records=5, mimic_yade=True)
 
-    # the e2e tests' stand-in (its module imports the tests' conftest)
-    tests = os.path.dirname(HERE)
-    sys.path[:0] = [tests, os.path.join(tests, "e2e")]
-    from test_yade_crosscheck import pendular_as_yade
+    from support.yade_stand_in import pendular_as_yade      # tests/ is on the path
 
     stand_in = pendular_as_yade(config)
 
@@ -68,10 +63,11 @@ def measure(folder):
                        gpu["yade"]["peak_q"]]}
 
 
+pytestmark = requires("numba_cuda")
+
+
 @pytest.fixture(scope="module")
 def measured():
-    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
-                        "(pip install -e '.[gpu]')")
     return simulated(os.path.basename(__file__))
 
 

@@ -1,12 +1,11 @@
-"""The GPU path (pendular.gpu) against the CPU path under Numba's CUDA simulator: a dry
-27-sphere triaxial step pipeline (contacts with friction, walls, stress servo, strain rate,
-leapfrog, neighbour list rebuilt on the device) over 200 steps. The simulator runs in a
-process of its own (tests/gpu/simulated.py), so that no other test meets it.
-
-Measured (simulator, 27 spheres, 200 steps, 7 rebuilds): largest relative differences from
-the CPU 1.0e-15 in positions, 9.4e-13 in velocities, 9.1e-13 in forces, 1.1e-12 in torques,
-9.3e-15 in wall stresses, 6.1e-13 in the tangential springs (the CPU's hot kernels contract
-multiply-adds and take reciprocals; the simulator computes each operation as written).
+"""The GPU path (pendular.gpu) against the CPU path under Numba's CUDA simulator: the 27-sphere
+triaxial step pipeline of tests/gpu/simulated.py (contacts with friction, walls, stress servo,
+strain rate, leapfrog, neighbour list rebuilt on the device) over 200 steps, dry and wet
+(suction-controlled bridges at contact at 30 kPa, and the device's table lookup, the CPU's
+lookup_suction compiled for the device by pendular.gpu.cuda.device_twin, against the CPU's).
+Both scenes run in one process of their own, so that no other test meets the simulator. The
+CPU's hot kernels contract multiply-adds and take reciprocals; the simulator computes each
+operation as written, hence round-off bounds (docs/gpu.md gives the differences measured).
 """
 
 import json
@@ -17,17 +16,26 @@ import sys
 import pytest
 
 from compile_ptx import extra_compiler_folder
+from conftest import requires
 from simulator import ROOT, simulated
 
-try:
-    import numba_cuda  # noqa: F401
-except ImportError:
-    pytest.skip("numba-cuda is not installed (pip install -e '.[gpu]')", allow_module_level=True)
+pytestmark = requires("numba_cuda")
 
 
 @pytest.fixture(scope="module")
-def dry():
-    return simulated("simulated.py", "dry")
+def measured():
+    """The dry and the wet scene's measurements, in one process."""
+    return simulated("simulated.py", "dry", "wet")
+
+
+@pytest.fixture(scope="module")
+def dry(measured):
+    return measured["dry"]
+
+
+@pytest.fixture(scope="module")
+def wet(measured):
+    return measured["wet"]
 
 
 def test_every_kernel_agrees_with_the_cpu_to_round_off(dry):
@@ -85,6 +93,23 @@ def test_what_the_gpu_does_not_run_is_refused_by_name(dry):
 
 def test_a_diverged_run_stops_with_an_error(dry):
     assert "not finite" in dry["diverged"]
+
+
+def test_the_device_reads_the_table_as_the_cpu(wet):
+    assert wet["lookups_existing"] > 16
+    assert wet["lookup"] < 1e-14
+
+
+def test_bridges_form_and_pull_as_on_the_cpu(wet):
+    count_cpu, count_gpu = wet["bridges"]
+    assert count_cpu == count_gpu == wet["agreement"]["touching_both"] > 20
+    for name, difference in wet["bridge_fields"].items():
+        assert difference < 1e-12, name
+    agreement = wet["agreement"]
+    assert agreement["position"] < 1e-13 and agreement["wall_stress"] < 1e-12
+    for name in ("velocity", "angular_velocity", "force", "torque", "springs"):
+        assert agreement[name] < 1e-10, name
+    assert wet["history"]["records"] == [4, 4] and wet["history"]["stress"] < 1e-12
 
 
 def compile_ptx(*arguments):

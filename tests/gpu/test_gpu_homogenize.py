@@ -1,8 +1,8 @@
 """Homogenisation on the device (pendular.gpu.homogenize) against the CPU's functions on the
 same state, under Numba's CUDA simulator: the 64-sphere walled scene of tests/gpu/simulated.py,
-the 64-sphere periodic cell of tests/gpu/test_gpu_periodic.py (74 of its 187 touching pairs
-through the faces: branch vectors with their images, the cell's volume, no walls), dry and wet
-at 30 kPa (exact bridges at contact), and wet the sheared cell of tests/gpu/test_gpu_shear.py
+the 64-sphere periodic cell of tests/gpu/periodic_checks.py (pairs through the faces:
+branch vectors with their images, the cell's volume, no walls), dry and wet
+at 30 kPa (exact bridges at contact), and wet the sheared cell of tests/gpu/shear_checks.py
 (Lees–Edwards: the images through the z faces offset along x), after 30 steps on the device.
 The device's quantities are computed from the state it holds, which then comes back for the
 CPU's (pendular.homogenize.contact_stress, pendular.dem.measure,
@@ -11,43 +11,25 @@ The reduction runs in two blocks (CHUNK = 32), and once more in one block (CHUNK
 in the simulated process, which reads the module's globals at each launch): in one block the
 dry sums are the CPU's in the CPU's order.
 
-The measurements run as this file's script in a process of its own (``NUMBA_ENABLE_CUDASIM=1
-python tests/gpu/test_gpu_homogenize.py [periodic-|sheared-]dry|wet``), so that the simulator
-never reaches the process of the other tests. Measured, largest relative differences from
-the CPU, inside walls: two blocks, 3.6e-16 (sigma_contact), 3.2e-16 (fabrics), 2.2e-16 (water
-volume), 5.1e-16 (chi), 6.5e-15 (B, a deviator: its terms cancel),
-5.6e-16 (psi), 1.9e-16 (sigma_capillary), 5.7e-16 (interface term), 1.8e-14 (the
-anisotropies, from eigenvalues); one block, dry: equal bit for bit; wet: the contact
-quantities, the water volume and sigma_capillary bit for bit, the bridge tensors within 2e-14
-(the CPU sums them with NumPy's vectorised sums and matrix product).
-In the periodic cell, largest over two blocks and one: 7.6e-16 (sigma_contact), 6.5e-16
-(fabrics), 6.0e-16 (unbalanced force), 5.5e-16 (water volume), 4.3e-16 (chi), 3.1e-14 (B),
-4.7e-16 (psi), 4.8e-16 (sigma_capillary), 8.4e-16 (interface term), 2.9e-14 (the
-anisotropies); in one block the counts, the fabric and the unbalanced force bit for bit; with
-the filling angles widened, the CPU's 729 overlapping menisci, pairs through the faces
-included. In the sheared cell (65 of 169 touching pairs through the faces): 6.3e-16
-(sigma_contact), 4.9e-16 (fabrics), 3.0e-16 (water volume), 4.2e-16 (chi), 2.1e-14 (B),
-4.5e-16 (psi), 2.7e-16 (sigma_capillary and the interface term), 7.6e-15 (the anisotropies),
-the CPU's 595 overlapping menisci widened.
-Bridges across gaps (GAPS: the 27 spheres of test_gpu_persist.py, persisting bridges, and of
-test_gpu_volume.py, volume-controlled, after GAP_STEPS = 75 steps pulled apart: 48 bridges, 4
-across gaps, and 54, 10 across gaps), two blocks of 16 and one, the largest: 2.1e-16
-(sigma_contact), 1.4e-16 (fabric), 2.8e-16 (unbalanced force), 2.7e-16 (water volume),
-5.2e-16 (chi), 8.2e-15 (B), 5.7e-16 (psi, volume control's at each bridge's own suction),
-1.9e-16 (sigma_capillary, from the forces applied along the branch vectors), 3.4e-16
-(interface term, at each gap; volume control's from the volume table), 3.3e-16 (bridge
-fabric), 2.2e-13 (the anisotropies); the counts equal; in one block the contact quantities
-and sigma_capillary bit for bit.
+The measurements run as this file's script, every scene in one process of its own
+(``NUMBA_ENABLE_CUDASIM=1 python tests/gpu/test_gpu_homogenize.py dry wet periodic-dry ...``,
+simulator.run_checks), so that the simulator never reaches the process of the other tests.
+The differences from the CPU are round-off (docs/gpu.md); in one block the dry sums, the
+contact quantities and sigma_capillary are the CPU's bit for bit. Bridges across gaps (GAPS:
+the 27 spheres of persist_checks.py, persisting bridges, and of volume_checks.py,
+volume-controlled, after GAP_STEPS steps pulled apart) are reduced in two blocks of GAP_CHUNK
+and in one.
 """
 
-import json
 import os
-import sys
 
 import numpy as np
 import pytest
 
-from simulator import relative, simulated
+from conftest import requires
+from simulator import relative, run_checks, simulated
+
+pytestmark = requires("numba_cuda")
 
 STEPS = 30
 #: Spheres a side of the scene's cubic lattice: 64 spheres, two blocks of CHUNK = 32.
@@ -59,8 +41,10 @@ CHUNK = 32
 WIDE = 50.0
 #: Largest values (exact in any order): the guard's largest overlap, the radii's range.
 MAXIMA = ("largest_overlap", "smallest_radius", "largest_radius")
-#: Scenes with bridges across gaps: the 27 spheres of test_gpu_persist.py (persisting
-#: suction-controlled bridges) and of test_gpu_volume.py (volume-controlled), pulled apart for
+#: The scenes without bridges across gaps: inside walls, in a periodic cell, sheared.
+SCENES = ("dry", "wet", "periodic-dry", "periodic-wet", "sheared-wet")
+#: Scenes with bridges across gaps: the 27 spheres of persist_checks.py (persisting
+#: suction-controlled bridges) and of volume_checks.py (volume-controlled), pulled apart for
 #: GAP_STEPS steps, reduced in blocks of GAP_CHUNK (two blocks) and in one.
 GAPS = ("persist", "volume")
 GAP_STEPS = 75
@@ -120,14 +104,14 @@ def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
     same step, a new one a step later), whether the state was still held by the device after
     it, and the error of GpuSimulation.homogenized once the state is back; the reduction in
     blocks of ``chunk`` particles; ``filling_angle`` [deg]: the bridges' widened to it first
-    (widen_menisci); ``cell``: "periodic" or "sheared", the cell of test_gpu_periodic.py or
-    of test_gpu_shear.py instead of the walls, and the touching pairs through its faces;
+    (widen_menisci); ``cell``: "periodic" or "sheared", the cell of periodic_checks.py or
+    of shear_checks.py instead of the walls, and the touching pairs through its faces;
     "persist" or "volume", GAPS' scenes after ``steps``, and their bridges across gaps."""
+    from periodic_checks import scene as periodic_scene
+    from persist_checks import scene as persist_scene
+    from shear_checks import scene as sheared_scene
     from simulated import scene
-    from test_gpu_periodic import scene as periodic_scene
-    from test_gpu_persist import scene as persist_scene
-    from test_gpu_shear import scene as sheared_scene
-    from test_gpu_volume import scene as volume_scene
+    from volume_checks import scene as volume_scene
 
     from pendular.capillary.bridge_state import ACROSS_GAP, BridgeState
 
@@ -182,12 +166,15 @@ def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
             "psi": device["psi"].tolist() if wet else None}
 
 
-@pytest.fixture(scope="module", params=["dry", "wet", "periodic-dry", "periodic-wet",
-                                        "sheared-wet"])
-def scene_run(request):
-    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
-                        "(pip install -e '.[gpu]')")
-    return request.param.endswith("wet"), simulated(os.path.basename(__file__), request.param)
+@pytest.fixture(scope="module")
+def measured():
+    """Every scene's measurements, in one process."""
+    return simulated(os.path.basename(__file__), *SCENES, *GAPS)
+
+
+@pytest.fixture(scope="module", params=SCENES)
+def scene_run(request, measured):
+    return request.param.endswith("wet"), measured[request.param]
 
 
 def test_the_reduction_runs_in_two_blocks():
@@ -263,10 +250,8 @@ def test_the_wet_capillary_stress_is_compressive(scene_run):
 
 
 @pytest.fixture(scope="module", params=GAPS)
-def gap_run(request):
-    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
-                        "(pip install -e '.[gpu]')")
-    return simulated(os.path.basename(__file__), request.param)
+def gap_run(request, measured):
+    return measured[request.param]
 
 
 def test_bridges_across_gaps_are_reduced_on_the_device_as_on_the_cpu(gap_run):
@@ -309,4 +294,4 @@ def main(check):
 
 
 if __name__ == "__main__":
-    print(json.dumps(main(sys.argv[1])))
+    run_checks({name: lambda name=name: main(name) for name in (*SCENES, *GAPS)})

@@ -3,12 +3,8 @@ under Numba's CUDA simulator in a process of its own (this file run as a script,
 tests/gpu/simulated.py is): the 27-sphere scene of simulated.py sheared at a constant mean
 stress p (one servo for x and y) and at a constant b (sigma_3 given on x, y set), the servos'
 targets set on the device each step from the walls' stresses. A condition that needs walls to
-pull raises the CPU's StageFailed, at the same step, with the same message.
-
-Measured (simulator, 27 spheres, 300 steps, 44 contacts): largest relative differences from
-the CPU at constant p: positions 1.0e-14, wall positions 7.3e-16, wall stresses 4.1e-14,
-velocities 5.8e-12, the servos' targets (recorded every 50 steps) 3.7e-14; at constant b:
-5.3e-15, 1.0e-15, 6.6e-15, 3.3e-12, 1.9e-14 (round-off, as in tests/gpu/test_gpu_dem.py).
+pull raises the CPU's StageFailed, at the same step, with the same message. The differences
+from the CPU are round-off, as in tests/gpu/test_gpu_dem.py.
 """
 
 import json
@@ -16,12 +12,10 @@ import os
 
 import pytest
 
+from conftest import requires
 from simulator import simulated
 
-try:
-    import numba_cuda  # noqa: F401
-except ImportError:
-    pytest.skip("numba-cuda is not installed (pip install -e '.[gpu]')", allow_module_level=True)
+pytestmark = requires("numba_cuda")
 
 STEPS = 300
 #: The mean stress held [Pa] (the scene's stresses are 3e4-1e5 Pa), and that of the failing

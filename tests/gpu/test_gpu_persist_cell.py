@@ -1,45 +1,36 @@
 """Bridges across gaps in a periodic cell on the GPU against the CPU under Numba's CUDA
-simulator: the 64 spheres of test_gpu_periodic.py in their periodic cell, pulled apart along z
+simulator: the 64 spheres of periodic_checks.py in their periodic cell, pulled apart along z
 (a constant strain rate of negative rate) under the cell's stress servo on x and y, wet with
 suction-controlled bridges that persist across gaps (SuctionBridges ``persist``, 30 kPa) or
 volume-controlled ones (VolumeBridges, formed at contact at 30 kPa from a reservoir). Bridges
 form at contact, stretch across the gaps that open (through the faces too) and rupture at
 their rupture distance; their forces enter the cell's stress through the faces (the CPU's
-gather_pair_forces_virial). The simulator runs in a process of its own (this file as a script:
-``NUMBA_ENABLE_CUDASIM=1 python test_gpu_persist_cell.py CONTROL`` prints one JSON object of
-measurements), so that no other test meets it.
+gather_pair_forces_virial). The simulator runs in a process of its own, every check in one (this file as a script:
+``NUMBA_ENABLE_CUDASIM=1 python test_gpu_persist_cell.py CONTROL ...`` prints one JSON object
+of measurements, simulator.run_checks), so that no other test meets it.
 
-Checked too: persisting bridges in test_gpu_shear.py's simple shear (a sheared cell), and
+Checked too: persisting bridges in shear_checks.py's simple shear (a sheared cell), and
 the periodic tension's phases (pendular.procedures.tension: the wetting to a water content,
 volume-controlled bridges at contacts and across gaps, and the pull).
 
-Measured (simulator, 64 spheres): suction control, 300 steps at 30 kPa (212 bridges formed,
-69 stretched across a gap, 39 ruptured over the path; 70 bridges held through a face), 100 at
-90 kPa in the same device run, 80 at 10 kPa in a new one (a farther reach); volume control,
-300 steps; the simple shear, 300 steps to a shear strain of 0.46 (139 bridges ruptured): at
-the end of each stage the same pairs hold bridges in the same states as on the CPU, the
-cell's faces are equal and the largest relative differences are 1.4e-14 in unwrapped
-positions, 7.0e-12 in velocities, 5.2e-14 in the cell's stress tensor, 9.6e-12 in bridge
-volumes (volume control: equal), 1.1e-11 in bridge forces, 9.5e-12 in forces on j from i,
-7.0e-12 in filling angles. Without the bridges' face terms the stress would differ by 1e-3.
-The periodic tension (w = 0.5 %, 200 steps of settling, 334 of pull): the formation suction,
-water content, bridge count and the rows equal the CPU's, the wetted positions within 1.2e-15,
-the tensile stress 8.5e-14, the cell's stress 1.6e-13, the unbalanced force 9.6e-12. The
-tests hold 1e-12 (positions, faces), 1e-10 (the rest), and the tension's columns 1e-11 (the
-unbalanced force 1e-10).
+At the end of each stage the same pairs hold bridges in the same states as on the CPU and
+the cell's faces are equal; the tests hold 1e-12 (positions, faces), 1e-10 (the rest), and the
+tension's columns 1e-11 (the unbalanced force 1e-10). Without the bridges' face terms the
+stress would differ by far more (docs/gpu.md).
 """
 
-import json
 import os
-import sys
 
 import numpy as np
 import pytest
 
-from simulator import relative, simulated
-from test_gpu_periodic import RADIUS, SIDE, SPACING, scene as periodic_scene
-from test_gpu_shear import scene as shear_scene
-from test_gpu_persist import bridge_events, compare, snapshot as persist_snapshot
+from conftest import requires
+from periodic_checks import RADIUS, SIDE, SPACING, scene as periodic_scene
+from persist_checks import bridge_events, compare, snapshot as persist_snapshot
+from shear_checks import scene as shear_scene
+from simulator import relative, run_checks, simulated
+
+pytestmark = requires("numba_cuda")
 
 #: Steps of each comparison; (suction [Pa], steps) of the suction path's later stages
 #: ("suction": a higher suction in the same device run, a lower one, which reaches farther,
@@ -170,10 +161,14 @@ def tension_agreement():
 
 
 # ---------------------------------------------------------------- the tests (pytest)
-def run(control):
-    """The measurements of ``control``'s comparison, run under the simulator."""
-    pytest.importorskip("numba_cuda")
-    return simulated(os.path.basename(__file__), control)
+#: The checks, each a test below.
+CHECKS = ("suction", "volume", "sheared", "tension")
+
+
+@pytest.fixture(scope="module")
+def measured():
+    """Every check's measurements, in one process."""
+    return simulated(os.path.basename(__file__), *CHECKS)
 
 
 def assert_agrees(measured):
@@ -190,29 +185,29 @@ def assert_agrees(measured):
             assert stage[name] < 1e-10, name
 
 
-def test_persisting_bridges_and_a_suction_path_in_a_periodic_cell_agree_with_the_cpu():
-    measured = run("suction")
+def test_persisting_bridges_and_a_suction_path_in_a_periodic_cell_agree_with_the_cpu(measured):
+    measured = measured["suction"]
     assert_agrees(measured)
     assert measured["stages"][0]["strain"] < 0.0                 # pulled apart
     assert measured["stages"][-1]["reach"][0] > measured["stages"][0]["reach"][0]
 
 
-def test_volume_bridges_in_a_periodic_cell_agree_with_the_cpu():
-    measured = run("volume")
+def test_volume_bridges_in_a_periodic_cell_agree_with_the_cpu(measured):
+    measured = measured["volume"]
     assert_agrees(measured)
     assert measured["stages"][0]["strain"] < 0.0
 
 
-def test_persisting_bridges_in_a_sheared_cell_agree_with_the_cpu():
-    measured = run("sheared")
+def test_persisting_bridges_in_a_sheared_cell_agree_with_the_cpu(measured):
+    measured = measured["sheared"]
     assert_agrees(measured)
     assert measured["stages"][0]["gamma"] > 0.4
 
 
-def test_the_periodic_tension_wets_and_pulls_as_on_the_cpu():
+def test_the_periodic_tension_wets_and_pulls_as_on_the_cpu(measured):
     """pendular.procedures.tension in a periodic cell (``pendular tension --periodic``'s
     phases): the wetting to a water content and the pull record the CPU's history."""
-    measured = run("tension")
+    measured = measured["tension"]
     assert measured["reports"][0] == measured["reports"][1]
     assert measured["reports"][0][2] > 50                       # bridges formed
     assert measured["position"] < 1e-12
@@ -222,5 +217,5 @@ def test_the_periodic_tension_wets_and_pulls_as_on_the_cpu():
 
 
 if __name__ == "__main__":
-    print(json.dumps(tension_agreement() if sys.argv[1] == "tension" else
-                     agreement(sys.argv[1]), default=float))
+    run_checks({"suction": lambda: agreement("suction"), "volume": lambda: agreement("volume"),
+                "sheared": lambda: agreement("sheared"), "tension": tension_agreement})

@@ -7,28 +7,24 @@ as the run returns. An equilibrium's test (static) reads the device's unbalanced
 same way.
 
 The 64-sphere walled scene of tests/gpu/simulated.py and the periodic one of
-tests/gpu/test_gpu_periodic.py (pairs through the faces; the homogenisation over the branch
+tests/gpu/periodic_checks.py (pairs through the faces; the homogenisation over the branch
 vectors through them, the cell's volume, no walls), dry and wet at 30 kPa, 30 steps recorded
-every 10, under Numba's CUDA simulator in a process of its own
-(``NUMBA_ENABLE_CUDASIM=1 python tests/gpu/test_gpu_records.py CHECK``). Measured, the largest
-relative differences of the columns from the CPU's history: 1.6e-14 inside walls; in the cell
-9.2e-16, but for B, a deviator whose terms cancel, 3.1e-14, and the anisotropies, from
-eigenvalues, 2.5e-14. The scene of tests/gpu/test_gpu_persist.py (27 spheres, persisting
-bridges, walls pulled apart; PERSIST_STEPS = 80 steps, 4 bridges across gaps at the end),
-whose records brought the whole state back before the device reduced bridges across gaps:
-its records copy the walls alone, its columns within 6.4e-14 of the CPU's (B; chi, psi and
-sigma_capillary 2.2e-14, the others within 1.0e-14), the two runs' step-by-step round-off
-grown over 80 steps.
+every 10, and the scene of tests/gpu/persist_checks.py (27 spheres, persisting bridges, walls
+pulled apart for PERSIST_STEPS, bridges across gaps at its later records), under Numba's CUDA
+simulator, every check in one process of its own (``NUMBA_ENABLE_CUDASIM=1 python
+tests/gpu/test_gpu_records.py CHECK ...``, simulator.run_checks). The columns are the CPU's
+history's to round-off (docs/gpu.md).
 """
 
-import json
 import os
-import sys
 
 import numpy as np
 import pytest
 
-from simulator import counted_copies, relative, simulated
+from conftest import requires
+from simulator import counted_copies, relative, run_checks, simulated
+
+pytestmark = requires("numba_cuda")
 
 STEPS = 30
 RECORD_PERIOD = 10
@@ -37,7 +33,7 @@ RECORD_PERIOD = 10
 UNBALANCED = (1.0, 0.5)
 #: The scenes: inside walls and in a periodic cell, dry and wet.
 WALLED = ("dry", "wet")
-#: The scene of test_gpu_persist.py (persisting bridges, walls pulled apart), run for
+#: The scene of persist_checks.py (persisting bridges, walls pulled apart), run for
 #: PERSIST_STEPS: bridges across gaps at its later records.
 PERSIST_STEPS = 80
 CHECKS = (*WALLED, "periodic-dry", "periodic-wet", "persist-wet")
@@ -46,9 +42,9 @@ CHECKS = (*WALLED, "periodic-dry", "periodic-wet", "persist-wet")
 def measure(check):
     """The copies back in order, the records, {column: largest relative difference from the
     CPU} of ``check`` (CHECKS); inside walls the equilibrium's test too."""
+    from periodic_checks import scene as periodic_scene
+    from persist_checks import scene as persist_scene
     from simulated import scene as walled_scene
-    from test_gpu_periodic import scene as periodic_scene
-    from test_gpu_persist import scene as persist_scene
 
     from pendular.capillary.bridge_state import ACROSS_GAP, BridgeState
     from pendular.capillary.bridges import CapillaryBridges
@@ -96,10 +92,14 @@ def measure(check):
 
 
 @pytest.fixture(scope="module")
-def recorded(request):
-    pytest.importorskip("numba_cuda", reason="numba-cuda is not installed "
-                        "(pip install -e '.[gpu]')")
-    return request.param.endswith("wet"), simulated(os.path.basename(__file__), request.param)
+def measured():
+    """Every check's measurements, in one process."""
+    return simulated(os.path.basename(__file__), *CHECKS)
+
+
+@pytest.fixture(scope="module")
+def recorded(request, measured):
+    return request.param.endswith("wet"), measured[request.param]
 
 
 @pytest.mark.parametrize("recorded", CHECKS, indirect=True)
@@ -133,4 +133,4 @@ def test_an_equilibrium_test_reads_the_walls_alone_and_stops_where_the_cpu_does(
 
 
 if __name__ == "__main__":
-    print(json.dumps(measure(sys.argv[1])))
+    run_checks({check: lambda check=check: measure(check) for check in CHECKS})

@@ -10,15 +10,11 @@ overlapping, servoed at 10 kPa) standing for a prepared sample (a whole preparat
 the simulator's reach): ``wet`` at w = 1 % (WET_STEPS steps of settling), then ``Pull`` (one
 grip layer at each z wall, 1 % of extension, a record every step).
 
-Measured (simulator): the wetting takes one try on both (200 steps, 54 bridges, 27 of them
-across gaps), its formation suction (303 Pa), water content and saturation equal the CPU's,
-the positions after it within 3.1e-15; the pull (334 steps) records the CPU's rows, bridge and
-contact counts, the tensile stress within 2.7e-13 of its largest value, the grips' pulls
-4.2e-13, the wall stresses 2.0e-13, the unbalanced force (a residual ratio) 4.8e-12, the water
-content and saturation exactly. TOLERANCE and UNBALANCED_TOLERANCE hold them with a margin of
-about 20. Each record brings back the walls with the pulls alone: the contacts' and the
-bridges' columns read the device's homogenisation (GpuSimulation.homogenized), bridges across
-gaps included; the whole state comes back once, as the run returns.
+The wetting's formation suction, water content and saturation equal the CPU's, the pull's
+rows and counts too, its columns within round-off (docs/gpu.md). Each record brings back the
+walls with the pulls alone: the contacts' and the bridges' columns read the device's
+homogenisation (GpuSimulation.homogenized), bridges across gaps included; the whole state
+comes back once, as the run returns.
 """
 
 import json
@@ -27,15 +23,8 @@ import os
 import numpy as np
 import pytest
 
+from conftest import requires
 from simulator import simulated
-
-try:
-    import numba_cuda  # noqa: F401
-    HAVE_NUMBA_CUDA = True
-except ImportError:
-    HAVE_NUMBA_CUDA = False
-needs_numba_cuda = pytest.mark.skipif(not HAVE_NUMBA_CUDA, reason="numba-cuda is not "
-                                      "installed (pip install -e '.[gpu]')")
 
 #: Largest difference of a history column from the CPU's over its largest magnitude [-].
 TOLERANCE = 1e-11
@@ -50,7 +39,7 @@ def tension():
     return simulated(os.path.basename(__file__))
 
 
-@needs_numba_cuda
+@requires("numba_cuda")
 def test_the_wetting_on_the_gpu_holds_the_cpus_water(tension):
     cpu, gpu = tension["wetting"]["cpu"], tension["wetting"]["gpu"]
     assert cpu["tries"] == gpu["tries"] == 1
@@ -60,7 +49,7 @@ def test_the_wetting_on_the_gpu_holds_the_cpus_water(tension):
     assert tension["wetting"]["position"] < 1e-13
 
 
-@needs_numba_cuda
+@requires("numba_cuda")
 def test_the_pull_on_the_gpu_records_the_cpu_history(tension):
     pull = tension["pull"]
     assert pull["rows"][0] == pull["rows"][1] == pull["steps"] + 1
@@ -71,7 +60,7 @@ def test_the_pull_on_the_gpu_records_the_cpu_history(tension):
     assert pull["members"] == [9, 9]
 
 
-@needs_numba_cuda
+@requires("numba_cuda")
 def test_a_record_of_the_pull_brings_back_the_walls_with_the_pulls(tension):
     """Each record reads the walls alone (the pulls come with them; module docstring), and
     the run's end the whole state once."""

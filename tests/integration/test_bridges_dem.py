@@ -17,7 +17,7 @@ from pendular import capillary
 from pendular.capillary import BridgeState, CapillaryBridges
 from pendular.capillary.bridge_kernels import (gather_contact_bridges, particle_pairs,
     pendular_overlap_counts)
-from conftest import PrescribedGap, ROOT, two_body_scene
+from conftest import PrescribedGap, ROOT, requires, two_body_scene
 from pendular.dem.contact_law import ContactForces, gather_contact_forces
 from pendular.dem.neighbors import NeighborList, build_contacts
 from pendular.dem.state import Walls
@@ -205,12 +205,11 @@ def test_wet_static_sample_balances_wall_contact_and_capillary_stresses(wet_samp
     assert np.allclose(np.diag(total), walls, rtol=2e-2)
 
 
+@requires("threads")
 def test_bridges_survive_rebuilds_and_thread_count_does_not_change_results(wet_sample):
     sim, _ = wet_sample
     neighbor_list = sim.operation(NeighborList)
     assert neighbor_list.rebuilds >= 1     # the bridges went through rebuilds
-    if numba.config.NUMBA_NUM_THREADS < 2:
-        pytest.skip("one Numba thread only")
     runs = []
     for threads in (1, numba.config.NUMBA_NUM_THREADS):
         copied = copy.deepcopy(sim)

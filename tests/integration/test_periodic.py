@@ -22,7 +22,7 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular import TriaxialConfig, TriaxialTest
 from pendular.procedures.config import BridgeConfig, ShearConfig
 
-from conftest import DENSITY, RADIUS, YOUNG
+from conftest import DENSITY, RADIUS, YOUNG, requires
 
 
 def periodic_scene(position, radius, edge, velocity=None, forces=None, dt=1e-5, skin=0.3,
@@ -203,7 +203,7 @@ def _periodic_prep(threads):
     return sim, report
 
 
-@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs two Numba threads")
+@requires("threads")
 def test_a_periodic_preparation_is_deterministic_and_thread_independent():
     one, report = _periodic_prep(1)
     two, _ = _periodic_prep(2)
@@ -320,8 +320,10 @@ def test_periodic_wet_triaxial_holds_the_lateral_stress_and_balances(periodic_we
     assert summary["peak_q"] > 3000.0 and 0.0 < summary["saturation_at_peak"] < 0.1
 
 
+@requires("meshio")
 def test_periodic_paraview_frames_show_the_cell_and_wrapped_particles(periodic_wet_triaxial):
-    meshio = pytest.importorskip("meshio")
+    import meshio
+
     out, _ = periodic_wet_triaxial
     summary = json.loads((out / "summary.json").read_text())
     frames = sorted((out / "vtk").glob("particles_*.vtu"))

@@ -5,7 +5,6 @@ threads, and an undamped frictionless dense packing conserves its energy on both
 multi-body packing runs on both thread counts, and the wet scene adds capillary bridges.)
 """
 
-import numba
 import numpy as np
 import pytest
 
@@ -18,7 +17,7 @@ from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
 
-from conftest import SpringEnergyProbe
+from conftest import SpringEnergyProbe, requires
 
 RADIUS, YOUNG, DENSITY, EDGE = 1e-3, 1e6, 2650.0, 0.016
 #: Steps run on two threads (each costs ~10-30 ms on a loaded 2-core machine).
@@ -26,8 +25,7 @@ TWO_THREAD_STEPS = 200
 #: Radius / placement radius: the overlaps that load the packing.
 INFLATION = 1.3
 
-pytestmark = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2,
-                                reason="needs 2 Numba threads (NUMBA_NUM_THREADS >= 2)")
+pytestmark = requires("threads")
 
 
 def dense_packing(threads, friction_deg=0.0, damping=0.0, suction=None, count=200):

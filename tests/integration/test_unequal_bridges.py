@@ -4,13 +4,12 @@ tables exact at the sample's own radius ratios, homogenisation with each sphere'
 
 import math
 
-import numba
 import numpy as np
 import pytest
 
 from pendular import capillary
 from pendular.capillary import BridgeState, CapillaryBridges, sample_radius_ratios
-from conftest import PrescribedGap, Still, two_body_scene
+from conftest import PrescribedGap, Still, requires, two_body_scene
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
@@ -233,7 +232,7 @@ def test_two_size_cluster_homogenises_with_each_spheres_own_radius_and_cap(contr
 
 
 # ---------------------------------------------------------------- determinism
-@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 Numba threads")
+@requires("threads")
 @pytest.mark.parametrize("control", ["suction", "volume"])
 def test_bidisperse_wet_packing_is_identical_on_one_and_two_threads(control):
     """Spheres of radii 1.3 R and 1.3 R / 2.5 (a ratio between YADE's nodes), loaded and moving,

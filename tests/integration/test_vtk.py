@@ -10,7 +10,7 @@ import pytest
 
 import pendular
 
-from conftest import two_body_scene
+from conftest import requires, two_body_scene
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.capillary import BridgeState
 from pendular.io.vtk import VtkWriter
@@ -215,8 +215,9 @@ SERIES_ARRAYS = {
 
 def vtk_frames(folder, series):
     """[(pvd timestep, vtkUnstructuredGrid)] of every frame of ``folder``/``series``.pvd, read
-    with VTK's own XML reader."""
-    vtk = pytest.importorskip("vtk")
+    with VTK's own XML reader (tests that call it need vtk: ``requires("vtk")``)."""
+    import vtk
+
     frames = []
     for timestep, name in read_pvd(folder / f"{series}.pvd"):
         reader = vtk.vtkXMLUnstructuredGridReader()
@@ -234,6 +235,7 @@ def vtk_arrays(data):
             for i in range(data.GetNumberOfArrays())}
 
 
+@requires("vtk")
 @pytest.mark.parametrize("folder", ["vtk", "vtk_prep"])
 def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder):
     """Each series of the shear (vtk/) and of the preparation and wetting (vtk_prep/) opens
@@ -241,7 +243,6 @@ def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder)
     the declared arrays, and field data step, time and axial_strain (shear: the .pvd time axis
     is the axial strain in %, field data axial_strain_percent) or phase (preparation: every
     phase of a wet run, in order)."""
-    pytest.importorskip("vtk")
     from pendular.procedures.triaxial import PREP_PHASES
 
     path = wet_triaxial_run / folder

@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import refused, run_in_process
+from conftest import refused, requires, run_in_process
 
 from pendular.studies.calibration import (MIN_POINTS, Calibration, Fit, parse_fit, read_curve)
 
@@ -182,11 +182,11 @@ def test_calibrate_refuses_a_curve_of_another_test(tmp_path, capsys):
     assert not out.exists()
 
 
+@requires("grainlearning")
 def test_the_inference_recovers_a_parameter_and_reports_one_it_cannot_see(tmp_path, monkeypatch):
     """A stand-in for the runs (a closed-form curve of the contact friction, in which Young's
     modulus plays no part, with a scatter of 2 % between seeds) in place of the campaign: the
     friction is recovered within its reported std, Young's modulus reported unconstrained."""
-    pytest.importorskip("grainlearning")
     import pendular.studies.calibration as calibration_module
     from pendular.studies.calibration import CurveKind, MeasuredCurve
     from pendular.studies.campaign import CampaignResult

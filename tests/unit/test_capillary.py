@@ -2,7 +2,6 @@
 
 import json
 import math
-import shutil
 import os
 import subprocess
 
@@ -10,6 +9,8 @@ import numba
 import numpy as np
 import pytest
 from scipy.integrate import quad
+
+from conftest import requires
 
 from pendular import capillary
 from pendular.capillary.verification import reference_bridge
@@ -305,7 +306,7 @@ print("RESULT" + json.dumps(out))
 """
 
 
-@pytest.mark.skipif(shutil.which("yade") is None, reason="YADE is not installed")
+@requires("yade")
 def test_yade_reads_the_files_and_reproduces_the_exact_bridges(tmp_path):
     """YADE's Law2_ScGeom_CapillaryPhys_Capillarity, fed our M(r=...) files, gives back our bridges."""
     table = capillary.BridgeTable.build(0.0, n_suction=60, n_distance=4, suction_max=200.0)

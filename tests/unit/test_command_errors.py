@@ -90,7 +90,7 @@ STUDY_OPTIONS = {
     "tradeoff seeds without knob": ("tradeoff", ["--seeds", "3"],
                                     ["--seeds and --jobs belong to a --knob study"]),
     "crosscheck settle steps -1": ("crosscheck", ["--settle-steps", "-1"],
-                                   ["--settle-steps = -1", "[0, inf]"]),
+                                   ["--settle-steps = -1", "[0, 100000000]"]),
     "crosscheck records 1": ("crosscheck", ["--records", "1"], ["--records = 1", "[2, "]),
     "crosscheck wet periodic": ("crosscheck", ["--periodic", "--suction", "1e4"],
                                 ["--suction 10000.0 Pa with --periodic"]),

@@ -233,7 +233,7 @@ REFUSED = [
      "cycles", "= 0 is outside the valid range [1, 10000]"),
     ("simple-shear", "--shear-rate", "-1", lambda: SimpleShearConfig(
         sample=PrepareConfig(particles=100, periodic=True), strain_rate=-1.0),
-     "strain_rate", "= -1.0 1/s is outside the valid range (0, inf] 1/s"),
+     "strain_rate", "= -1.0 1/s is outside the valid range (0, 1e+06] 1/s"),
     ("tension", "--residual", "1", lambda: TensionConfig(residual=1.0),
      "residual", "= 1.0 is outside the valid range (0, 1)"),
     ("tension", "--specific-gravity", "0.5", lambda: TensionConfig(
@@ -472,7 +472,7 @@ def test_the_crosscheck_options_build_its_default_configuration():
                            ({"suction": -5}, "suction = -5.0 Pa is outside the valid range "
                                              "[0, inf) Pa"),
                            ({"settle_steps": -1}, "settle_steps = -1 is outside the valid range "
-                                                  "[0, inf]")):
+                                                  "[0, 100000000]")):
         with pytest.raises(ParameterError) as refused:
             option_values(crosscheck.OPTIONS, given)
         assert str(refused.value) == message

@@ -4,11 +4,10 @@ sphere spinning on a fixed one in full rolling and full twisting, the viscous pa
 turning with the contact, carried across a neighbour-list rebuild, the same on 1 and 2 threads;
 the options' errors."""
 
-import numba
 import numpy as np
 import pytest
 
-from conftest import RADIUS, YOUNG, refused, run_in_process, two_body_scene
+from conftest import RADIUS, YOUNG, refused, requires, run_in_process, two_body_scene
 from pendular.capillary import CapillaryBridges
 from pendular.dem.contact_law import normal_stiffness
 from pendular.dem.integrate import Integrator
@@ -194,7 +193,7 @@ def test_the_springs_are_carried_to_the_same_pairs_across_a_rebuild():
     assert not state["rolling_moment"][pairs.index((0, 4))].any()
 
 
-@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 Numba threads")
+@requires("threads")
 def test_one_and_two_threads_give_identical_trajectories():
     runs = []
     for threads in (1, 2):

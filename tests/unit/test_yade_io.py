@@ -6,7 +6,7 @@ import gzip
 import numpy as np
 import pytest
 
-from conftest import ROOT
+from conftest import ROOT, requires
 
 from pendular.interop.yade.formats import (read_plot_data, read_plot_headers, read_spheres,
     write_spheres)
@@ -175,8 +175,7 @@ def test_runner_says_when_yade_is_missing(monkeypatch):
         runner.run_yade_triaxial({"spheres": "none.txt"}, threads=1)
 
 
-@pytest.mark.skipif(not any(__import__("shutil").which(n) for n in ("yade", "yadedaily")),
-                    reason="YADE not installed")
+@requires("yade")
 def test_yade_driver_end_to_end(tmp_path):
     runner = _runner()
     positions, radii, lo, hi = runner.random_packing(150, 2.4e-5, 0.5, seed=3)

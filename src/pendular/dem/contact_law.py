@@ -210,8 +210,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_i, pair_j, im
     i; the torques follow from it, the normal and the overlap in the gather).
 
     pair_i, pair_j: the pairs (pendular.dem.neighbors.Contacts), taken one by one; the one-thread
-    kernels take them row by row, from row_start instead of pair_i (a prange over the rows
-    was no faster on two threads). image, period: each pair's
+    kernels take them row by row, from row_start instead of pair_i. image, period: each pair's
     periodic image and the box period (pendular.dem.neighbors.branch_vector; zeros inside walls);
     affine_rate (3,) [1/s]: the homogeneous stretching of a periodic cell, whose velocity
     affine_rate * l adds to the relative velocity of a pair of branch l; a sheared cell's
@@ -576,7 +575,7 @@ class ContactForces:
         """The force operation after this one in ``sim.forces`` whose ``joins_contact_gather``
         is true (capillary bridges at contact: central forces along the contact normals), or
         None. That operation gathers this step's contact forces with its own in one pass
-        over the pairs (``gather``), 5-15 % of a wet step less than two gathers."""
+        over the pairs (``gather``), one pass instead of two."""
         after = False
         for op in sim.forces:
             if op is self:

@@ -123,8 +123,7 @@ def _box_position(lo, hi):
 _NO_STRETCHING = np.zeros(3)
 #: Zeros (3,) laid out as a periodic cell's ``period`` (a strided view of its (6,) faces), so
 #: that walled and periodic scenes call the kernels that take a period with one array type
-#: and share one compiled version of each (a second layout compiles each again, about 4 s for
-#: the pair kernel: the first runs of the four standard scenes took 112 s, now 99 s).
+#: and share one compiled version of each (a second layout would compile each kernel again).
 _NO_PERIOD = np.zeros(6)[1::2]
 _NO_VIRIAL = np.zeros((0, 9))
 

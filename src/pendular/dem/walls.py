@@ -108,9 +108,9 @@ class StressServo:
     #: Calls during which the stiffness is refreshed every step (YADE: scene->iter < 100).
     STIFFNESS_WARMUP = 100
     #: Fewest calls between refreshes of a periodic cell's stiffness after the warm-up: a sum
-    #: over every contact, as costly as the force gather (every 10 calls, YADE's
-    #: stiffnessUpdateInterval, it was 3 % of a 1,000-sphere step; the stiffness of a sample
-    #: under shear changes little in 50 steps, and the servo's tests hold).
+    #: over every contact, as costly as the force gather (YADE's stiffnessUpdateInterval is 10;
+    #: the stiffness of a sample under shear changes little in 50 steps, and the servo's tests
+    #: hold).
     CELL_STIFFNESS_EVERY = 50
     #: Default gain and memory (YADE's 1 - stressDamping and its 0.8).
     GAIN = 0.75

@@ -1,4 +1,4 @@
-"""The GPU engine (issue 38): a walled scene's step on one GPU with Numba's CUDA target
+"""The GPU engine: a walled scene's step on one GPU with Numba's CUDA target
 (numba-cuda, ``pip install -e '.[gpu]'``; the CUDA import lives in pendular.gpu.cuda alone).
 
 ``Simulation(..., device="gpu")`` runs a pendular.dem.simulation.Simulation's scene on the

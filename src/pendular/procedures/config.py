@@ -20,6 +20,7 @@ import numpy as np
 
 from pendular.dem.sample import load_sample
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
 from pendular.utils.parameters import (Parameter, ParameterError, default_of, fail, parameter,
@@ -64,6 +65,8 @@ AXIAL_STRAIN_LIMIT = ("a triaxial test ends by 20-30 % axial strain (the thesis'
 #: Most steps of a stage run to equilibrium (wetting, an isotropic or SWCC stage, a
 #: consolidation): beyond, a stage that has not settled will not.
 MAX_STAGE_STEPS = 100_000_000
+#: Largest strain rate a loading may name [1/s] (ConstantStrainRate's bound).
+MAX_STRAIN_RATE = ConstantStrainRate.MAX_RATE
 #: Most history rows of a shear (each a few hundred bytes; one a step at most).
 MAX_RECORDS = 10_000_000
 #: Fewest spheres of a triaxial test or an SWCC: their stresses and saturation are averages
@@ -73,6 +76,13 @@ MIN_SAMPLE_PARTICLES = 50
 #: Why a sample needs MIN_SAMPLE_PARTICLES (the end of the error refusing fewer).
 AVERAGES = ("its stresses and saturation are averages over the sample's contacts and bridges, "
             "which a few spheres do not give")
+#: Fewest spheres of a simple shear: its periodic cell must be 3 diameters plus the neighbour
+#: reach across (pendular.dem.neighbors), which 50 spheres at the default porosity miss by a
+#: hair; 60 hold it with a margin.
+MIN_SIMPLE_SHEAR_PARTICLES = 60
+#: Why a simple shear needs MIN_SIMPLE_SHEAR_PARTICLES (the end of the error refusing fewer).
+NARROW_CELL = ("its periodic cell must span 3 diameters plus the neighbour reach, which fewer "
+               "spheres do not")
 #: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
 #: void ratio is the core's, the box less a diameter along each wall; at 100 spheres the box
 #: is about 4.5 diameters across and the core 2.5.
@@ -97,8 +107,8 @@ def stage_steps_parameter(default, help):
 
 def strain_rate_parameter():
     """The field of a loading's strain rate [1/s], None for the inertial number's."""
-    return parameter(None, unit="1/s", low=0.0, low_inclusive=False, flag="--strain-rate",
-                     help="axial strain rate (overrides --inertial-number)")
+    return parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE, low_inclusive=False,
+                     flag="--strain-rate", help="axial strain rate (overrides --inertial-number)")
 
 
 @dataclass
@@ -317,7 +327,8 @@ class LaboratoryConfig:
     vtk_frames: ParaView frames over the loading (0: none; a path whose length is not known
     before it runs writes one every VTK_RECORDS history rows); vtk_every: steps between frames
     instead (None: from vtk_frames);
-    checkpoint_every: steps between checkpoints of the loading (0: none);
+    checkpoint_every: steps between checkpoints of the loading (0: none); both at most
+    MAX_STAGE_STEPS;
     wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.triaxial.wet_sample):
     'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
     (switched on at the first loading step), 'constant-volume' (added with the walls fixed,
@@ -333,10 +344,11 @@ class LaboratoryConfig:
                                help="most steps to equilibrate the wetted (or loaded) sample")
     vtk_frames: int = parameter(50, kind=int, low=0, flag="--vtk-frames",
                                 help="ParaView frames over the loading")
-    vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
+    vtk_every: int | None = parameter(None, kind=int, low=0, high=MAX_STAGE_STEPS,
+                                      flag="--vtk-every",
                                       help="steps between ParaView frames of the loading")
-    checkpoint_every: int = parameter(0, kind=int, low=0, flag="--checkpoint-every",
-                                      help="steps between checkpoints")
+    checkpoint_every: int = parameter(0, kind=int, low=0, high=MAX_STAGE_STEPS,
+                                      flag="--checkpoint-every", help="steps between checkpoints")
     wetting: str = parameter("isotropic", kind=str, choices=WETTING_PROTOCOLS, flag="--wetting",
                              help="when bridges appear (--suction): added to the static sample "
                                   "and re-equilibrated (isotropic), switched on at the first "
@@ -347,6 +359,10 @@ class LaboratoryConfig:
     TEST = "a laboratory test"
     #: Whether the loading holds the sample's volume and water (TriaxialConfig.undrained).
     undrained = False
+    #: The options that set the loading's estimated length (``estimated_steps``).
+    LENGTH = ()
+    #: Fewest spheres of the test, and why.
+    MIN_PARTICLES, FEWEST = MIN_SAMPLE_PARTICLES, AVERAGES
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -354,8 +370,8 @@ class LaboratoryConfig:
         if self.bridges is not None and not isinstance(self.bridges, BridgeConfig):
             raise TypeError(f"bridges must be a BridgeConfig or None, got "
                             f"{type(self.bridges).__name__}")
-        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, self.TEST,
-                        AVERAGES)
+        check_particles(self.sample.particles, self.MIN_PARTICLES, MAX_PARTICLES, self.TEST,
+                        self.FEWEST)
         if self.sample.confining <= 0.0:
             # the path's starting stress: the inertial number and the servo need it > 0
             raise fail(self.sample, "confining", f"confining = {self.sample.confining:g} Pa is "
@@ -365,6 +381,11 @@ class LaboratoryConfig:
                                             or self.bridges.water_content is not None):
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
+
+    def stage_rates(self):
+        """[(where, strain rate [1/s], steps or None)] of the loading's stages that name their
+        own rate (a path table's, TablePathConfig); none here: the test's rate is ``rate``."""
+        return []
 
     @property
     def confining(self):
@@ -426,6 +447,7 @@ class TriaxialConfig(LaboratoryConfig):
     shear: ShearConfig = field(default_factory=ShearConfig)
 
     TEST = "a triaxial test"
+    LENGTH = ("--max-strain",)
 
     def __post_init__(self):
         if not isinstance(self.shear, ShearConfig):
@@ -569,11 +591,16 @@ class IsotropicConfig(PathConfig):
 
     def __post_init__(self):
         super().__post_init__()
+        listed = ",".join(f"{v:g}" for v in self.stresses)
         if len(self.stresses) < MIN_ISOTROPIC_STAGES:
-            raise fail(self, "stresses", f"stresses = "
-                       f"{','.join(f'{v:g}' for v in self.stresses)}: at least "
+            raise fail(self, "stresses", f"stresses = {listed}: at least "
                        f"{MIN_ISOTROPIC_STAGES} stresses [Pa] expected (a loading or unloading "
                        "goes from one to the next)")
+        for k in range(1, len(self.stresses)):
+            if self.stresses[k] == self.stresses[k - 1]:
+                raise fail(self, "stresses", f"stresses = {listed}: stage {k + 1} repeats the "
+                           f"{self.stresses[k]:g} Pa of stage {k}; valid: each stress unlike "
+                           "the one before (a stage to the stress it holds does nothing)")
         for value in self.stresses:
             check_soft(self, "stresses", value)
 
@@ -628,7 +655,17 @@ def check_tension_sample(fields):
         if name in fields:
             spec = spec_of(PrepareConfig, name)
             low, high = TENSION_RANGES.get(name, (spec.low, spec.high))
-            dataclasses.replace(spec, low=low, high=high).check(name, fields[name])
+            spec = dataclasses.replace(spec, low=low, high=high)
+            try:
+                spec.check(name, fields[name])
+            except ParameterError:
+                if name != "radius" or fields.get("psd") is None:
+                    raise
+                # the grading curve's sizes, not a --radius given
+                raise ParameterError("psd", f"psd: the grading curve's mean radius, "
+                                     f"{fields['radius']:.3g} m, is outside the valid range "
+                                     f"{spec.valid_range()} m of a direct tension's sphere",
+                                     "--psd") from None
 
 
 def tension_sample(**fields):
@@ -921,6 +958,7 @@ class CyclicConfig(PathConfig):
                             help="cycles after the first loading")
 
     TEST = "a cyclic triaxial test"
+    LENGTH = ("--cycles", "--amplitude-strain")
 
     def __post_init__(self):
         super().__post_init__()
@@ -1013,6 +1051,40 @@ class TablePathConfig(PathConfig):
                             rate=self.rate(), young=self.sample.young,
                             wetting=wetting_of(self.bridges))
 
+    def stage_rates(self):
+        """[(where, rate, steps)] of each stage of the table that moves an axis: 'FILE: stage
+        N', its fastest |strain rate| or |shear rate| [1/s] and, when it ends at a strain
+        whose start is known (the path's start, or the end of an earlier stage at a strain
+        of that axis, not moved since), its steps estimated before anything runs (the strain
+        to go over the strain of a step, ``strain_per_step``), else None."""
+        from pendular.procedures.loading import ShearStrain, Strain
+        from pendular.procedures.path_table import labelled_stages
+
+        start = {"x": 0.0, "y": 0.0, "z": 0.0, "shear": 0.0}      # None: not known
+        found = []
+        for label, stage in labelled_stages(self.stages, self.source,
+                                            confining=self.sample.confining, rate=self.rate()):
+            rates = {**stage.strain_rate, "shear": stage.shear_rate}
+            until = stage.until
+            ends = isinstance(until, (Strain, ShearStrain))
+            axis = "shear" if isinstance(until, ShearStrain) else getattr(until, "axis", None)
+            steps = None
+            if ends and start[axis] is not None:
+                try:
+                    steps = (abs(until.value - start[axis])
+                             / self.strain_per_step(abs(rates[axis])))
+                except ValueError:              # a strain per step that underflows
+                    steps = math.inf
+            for name in start:
+                if ends and name == axis:
+                    start[name] = until.value
+                elif rates.get(name, 0.0) != 0.0 or name in stage.stress or name in stage.free:
+                    start[name] = None
+            fastest = max(abs(value) for value in rates.values())
+            if fastest > 0.0:
+                found.append((f"{self.source}: {label}", fastest, steps))
+        return found
+
     def reference_pressure(self):
         """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining
         stress or a lower target of a stage."""
@@ -1048,8 +1120,8 @@ class SimpleShearConfig(PathConfig):
     stress. The sample must be periodic (walls cannot shear it)."""
 
     # the shear rate gamma_dot [1/s]: PathConfig's strain rate, under the command's name
-    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, low_inclusive=False,
-                                          flag="--shear-rate",
+    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE,
+                                          low_inclusive=False, flag="--shear-rate",
                                           help="shear rate gamma_dot (overrides "
                                                "--inertial-number)")
     record_strain: float = parameter(4e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
@@ -1069,6 +1141,8 @@ class SimpleShearConfig(PathConfig):
         2_000_000, "most steps of the consolidation to --normal-stress")
 
     TEST = "a simple shear test"
+    LENGTH = ("--max-strain",)
+    MIN_PARTICLES, FEWEST = MIN_SIMPLE_SHEAR_PARTICLES, NARROW_CELL
 
     def __post_init__(self):
         super().__post_init__()

@@ -26,6 +26,14 @@ def grip_members(position, radius, walls, wall, depth):
     return np.flatnonzero(distance <= depth)
 
 
+def grip_reach(radius, grip_depth, radii):
+    """Distance from a wall [m] within which a grip holds particle centres: the spheres whose
+    surface lies within ``grip_depth`` mean diameters of the wall (``radius`` [m] the mean),
+    and at least every sphere touching it (the largest of ``radii`` [m], which the
+    preparation grew): grip_depth 0 grips the layer on the wall."""
+    return max(radius * (1.0 + 2.0 * grip_depth), float(np.max(radii)))
+
+
 def tensile_stress(grips, walls):
     """Mean pull of the grips over the cross-section normal to their axis [Pa], positive in
     tension (the axial stress, compression positive, is its opposite)."""

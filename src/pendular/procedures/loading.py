@@ -53,7 +53,7 @@ from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, ConstantVolume, StressServo
 from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
-from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN
+from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.hydraulic import SuctionChange, WaterContentChange
 from pendular.procedures.preparation import servo_speed, static
@@ -62,8 +62,6 @@ from pendular.utils.validate import check_int, check_positive, check_range
 
 #: The axes by name, in order (x, y lateral; z axial).
 AXIS_NAMES = tuple(AXES)
-#: Largest strain rate a stage may name [1/s] (ConstantStrainRate's bound).
-MAX_STRAIN_RATE = 1e6
 #: A path of unknown length writes a ParaView frame every this many history rows.
 VTK_RECORDS = 10
 #: What a stage's ``volume`` may hold: "constant" (x and y keep the box's volume).

@@ -22,11 +22,11 @@ from typing import Callable
 
 from pendular.dem.grading import MAX_RADIUS_RATIO, read_grading_curve
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, MAX_AXIAL_STRAIN,
-    MAX_TENSION_PARTICLES, MIN_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES, MIN_TENSION_PARTICLES,
-    SPECIFIC_GRAVITY_PARAMETER, TENSION_RANGES, TENSION_SAMPLE, VOID_RATIO_PARAMETER,
-    WATER_DENSITY, BridgeConfig, CyclicConfig, IsotropicConfig, LaboratoryConfig,
-    OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig, TablePathConfig,
-    TensionConfig, TriaxialConfig, check_steps_count, tension_sample)
+    MAX_TENSION_PARTICLES, MIN_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES, MIN_SIMPLE_SHEAR_PARTICLES,
+    MIN_TENSION_PARTICLES, SPECIFIC_GRAVITY_PARAMETER, TENSION_RANGES, TENSION_SAMPLE,
+    VOID_RATIO_PARAMETER, WATER_DENSITY, BridgeConfig, CyclicConfig, IsotropicConfig,
+    LaboratoryConfig, OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig,
+    TablePathConfig, TensionConfig, TriaxialConfig, check_steps_count, tension_sample)
 from pendular.procedures.preparation import PrepareConfig
 from pendular.procedures.reference import KIM_RADIUS, SPECIFIC_GRAVITY
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError, fields_of,
@@ -305,7 +305,9 @@ def simple_shear_config(values, given):
 SIMPLE_SHEAR_SAMPLE = tuple(
     dataclasses.replace(option, default=True, help="a periodic cell, with Lees–Edwards images "
                                                    "(implied: walls cannot shear a sample)")
-    if option.key == "periodic" else option for option in SAMPLE)
+    if option.key == "periodic" else
+    option_of(PrepareConfig, "particles", low=MIN_SIMPLE_SHEAR_PARTICLES)
+    if option.key == "particles" else option for option in SAMPLE)
 
 
 #: Each loading path's own options (its fields set by them as they are).

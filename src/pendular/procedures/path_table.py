@@ -157,8 +157,12 @@ def _expand_group(entry, source, label, stages):
         raise ValueError(f"{source}: {label}: key {other[0]!r} beside repeat and stages; "
                          f"valid: {', '.join(GROUP_KEYS)} (a group: give {other[0]!r} to the "
                          "stages in it)")
+    repeat = entry.get("repeat")
+    if isinstance(repeat, str):         # text where a count belongs, refused as _value does
+        raise ValueError(f"{source}: {label}: repeat = {repeat!r} is text; valid: a number, "
+                         f"an integer in [1, {MAX_STAGES}]")
     try:
-        times = check_int("repeat", entry.get("repeat"), low=1, high=MAX_STAGES)
+        times = check_int("repeat", repeat, low=1, high=MAX_STAGES)
     except ValueError as error:
         raise ValueError(f"{source}: {label}: {error}") from None
     inner = entry.get("stages")
@@ -252,7 +256,7 @@ def build_stages(entries, source, *, confining, rate, young=None, wetting=None):
 
 
 def labelled_stages(entries, source, *, confining, rate, young=None, wetting=None):
-    """[(label, loading.Stage)] of a table's ``entries``, as build_stages."""
+    """[(label, loading.Stage)] of build_stages, each with its entry's label ('stage 3.1')."""
     values = {"confining": confining, "quasi-static": rate, "-quasi-static": -rate}
     stages = []
     for label, entry in parse_entries(entries, source):

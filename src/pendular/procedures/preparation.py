@@ -42,7 +42,7 @@ from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import (TIMESTEP_RULES, critical_timestep, pwave_timestep,
     rayleigh_timestep)
-from pendular.utils.parameters import fail, parameter, spec_of, validate
+from pendular.utils.parameters import ParameterError, fail, parameter, spec_of, validate
 from pendular.utils.progress import PhaseBar
 from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int, check_positive
@@ -226,7 +226,7 @@ def random_cloud(count, radius, lo, hi, seed):
 MAX_STRESS_OVER_YOUNG = 0.02
 
 #: Largest sample: about 1 kB of state per sphere and hours per 1e-3 of strain at 1e6 spheres
-#: on a few cores; beyond, memory and run time are out of reach (issue 12).
+#: on a few cores; beyond, memory and run time are out of reach.
 MAX_PARTICLES = 10_000_000
 #: Sphere radii a run accepts [m]: grains of a micron to a metre. Outside, the strain rate of
 #: an inertial number, the box and the masses leave the floating-point range a run needs.
@@ -361,7 +361,14 @@ class PrepareConfig:
                            f"radius_spread = {self.radius_spread:g} and a psd given: valid is "
                            "one of them (the grading curve sets the sizes)")
             self.psd = check_grading_curve(self.psd)
-            self.radius = spec_of(self, "radius").check("radius", float(np.mean(self.radii())))
+            mean = float(np.mean(self.radii()))
+            radius = spec_of(self, "radius")
+            try:
+                self.radius = radius.check("radius", mean)
+            except ParameterError:          # the curve's sizes, not a --radius given
+                raise ParameterError("psd", f"psd: the grading curve's mean radius, {mean:.3g} "
+                                     f"m, is outside the valid range {radius.valid_range()} m "
+                                     "of a sphere's radius", "--psd") from None
         for name in ("prep_stress", "confining"):
             try:
                 check_soft_contacts(name, getattr(self, name), self.young)

@@ -143,10 +143,14 @@ class SwccTest:
         content."""
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
-        for path in (sample_file, checkpoint):
-            if not os.path.exists(path):
-                raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
-                                 "with checkpoint_every > 0?)")
+        if not os.path.exists(sample_file):
+            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
+                             "before its sample existed (in the preparation), so nothing can "
+                             "be resumed; run it again")
+        if not os.path.exists(checkpoint):
+            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: the run stopped "
+                             "before its first checkpoint, or was started with "
+                             "--checkpoint-every 0, which writes none; run it again")
         with OutputFolder(out, "swcc --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)

@@ -68,7 +68,7 @@ from pendular.procedures.preparation import (PrepareConfig, equilibrated, prepar
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.simulation import Simulation, check_device
 from pendular.dem.grips import Grip
-from pendular.procedures.grips import core_void_ratio, grip_members, tensile_stress
+from pendular.procedures.grips import core_void_ratio, grip_members, grip_reach, tensile_stress
 from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.homogenize import packing_state, regular_packing
 
@@ -172,9 +172,12 @@ def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
     if abs(error_low) > config.void_ratio_tolerance:
         error_high = prepared(high)
         if error_high < -config.void_ratio_tolerance:
+            # the ends of the friction range need not order the void ratios (small samples)
+            ends = sorted((target + error_low, target + error_high))
             raise ValueError(f"--void-ratio = {target:g} is outside the valid range of this "
-                             f"sample, [{target + error_low:.3f}, {target + error_high:.3f}] "
-                             f"(growth friction {low:g} to {high:g} deg)")
+                             f"sample, [{ends[0]:.3f}, {ends[1]:.3f}]: the preparations at "
+                             f"growth friction {low:g} and {high:g} deg give e = "
+                             f"{target + error_low:.3f} and {target + error_high:.3f}")
     def closest():
         return min(abs(report["void_ratio"] - target) for _, report in tried.values())
 
@@ -281,7 +284,7 @@ class Pull:
             lateral = StressServo("xy", 0.0, servo_speed(sim.walls, sim.dt))
             sim.controls = [self.extension, lateral]
         else:
-            depth = sample.radius * (1.0 + 2.0 * config.grip_depth)
+            depth = grip_reach(sample.radius, config.grip_depth, sim.particles.radius)
             self.grips = [Grip(wall, grip_members(sim.particles.position, sim.particles.radius,
                                                   sim.walls, wall, depth)) for wall in (4, 5)]
             sim.controls = [self.extension, *self.grips]   # the x, y walls held where they are
@@ -630,8 +633,9 @@ class TensionTest:
         content, bit for bit that of an uninterrupted run (timings aside)."""
         path = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(path):
-            raise ValueError(f"resume = {out!r}: {path} is missing (was the run started with "
-                             "checkpoint_every > 0?)")
+            raise ValueError(f"resume = {out!r}: {path} is missing: the run stopped before "
+                             "its first checkpoint, or was started with --checkpoint-every 0, "
+                             "which writes none; run it again")
         with OutputFolder(out, "tension --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)

@@ -41,7 +41,7 @@ from pendular.dem.grading import grading
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
 from pendular.utils.progress import whole_run
-from pendular.utils.parameters import fail, flat_options
+from pendular.utils.parameters import fail, flat_options, spec_of
 from pendular.dem.measure import coordination, porosity, unbalanced_force
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
     pwave_step, servoed_simulation, static, timestep, timestep_description)
@@ -75,6 +75,9 @@ from pendular.procedures.water_content import wet_to_water_volume
 MAX_INERTIAL_NUMBER = 1e-2
 #: Most shear steps a run may ask for without --force (about 1 h at 1,000 spheres here).
 MAX_SHEAR_STEPS = 20_000_000
+#: Most particle-steps (spheres x steps) of a loading without --force: about 7 h at
+#: ESTIMATE_RATE, a night's run; MAX_SHEAR_STEPS bounds the steps of smaller samples.
+MAX_PARTICLE_STEPS = 1e11
 #: Smallest prep_stress / young of a preparation: the radius growth (1e-4 R per step) settles
 #: only when the overlaps at the target stress (about 8 prep_stress / young R) are well above
 #: its step (60 spheres: 1.7e-4 settles in 7,400 steps, 5e-5 not in 2,000,000).
@@ -435,33 +438,63 @@ def stress_balance_error(history):
 
 # ---------------------------------------------------------------- the whole test
 
+def quasi_static_number(rate, sample, pressure):
+    """The inertial number [-] of the strain rate ``rate`` [1/s] for the grains of ``sample``
+    (a PrepareConfig) at the stress ``pressure`` [Pa]."""
+    return inertial_number(rate, sample.radius, sample.density, pressure)
+
+
 def check_feasible(config, force=False):
     """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
     MAX_INERTIAL_NUMBER at the lowest stress of its path) or would not finish in reasonable
     time (more than MAX_SHEAR_STEPS steps of a path whose length is known), with the estimate,
     or whose equilibrium phases cannot settle (a stress of the path below
     MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
-    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. Output periods
-    must fit the loading. ValueError naming the setting."""
+    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. A path
+    table's stages that name their own rates are held to the same bounds, each named by its
+    file and stage. Output periods must fit the loading. ValueError naming the setting."""
     sample = config.sample
     rate = config.rate()
+    # the option setting the rate: --strain-rate, or a simple shear's --shear-rate
+    flag = spec_of(config.shear if isinstance(config, TriaxialConfig) else config,
+                   "strain_rate").flag
+    rate_name = f"{flag[2:].replace('-', ' ')} {rate:.3g} 1/s"
     pressure = config.reference_pressure()
-    number = inertial_number(rate, sample.radius, sample.density, pressure)
+    number = quasi_static_number(rate, sample, pressure)
     dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
     steps = config.estimated_steps()
     where = (f"confining = {pressure:g} Pa" if pressure == sample.confining
              else f"{pressure:g} Pa, the lowest stress of the path")
+    # the most steps of a loading: MAX_SHEAR_STEPS, fewer for a large sample
+    most = min(MAX_SHEAR_STEPS, MAX_PARTICLE_STEPS / sample.particles)
+    large = ("--particles",) if most < MAX_SHEAR_STEPS else ()
+
+    def too_long(what, steps, rate_name, remedy):
+        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
+        return ValueError(
+            f"{what} would take {steps:.3g} steps (dt = {dt:.3g} s, {rate_name}; about "
+            f"{hours:.3g} h here at {sample.particles} spheres), outside the valid range "
+            f"[1, {most:.3g}]: {remedy} (or --force)")
+
     if not force and number > MAX_INERTIAL_NUMBER:
         raise ValueError(
-            f"strain rate {rate:.3g} 1/s gives the inertial number I = {number:.3g}, outside "
-            f"the quasi-static range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower "
-            "--strain-rate / --inertial-number (or --force)")
-    if not force and steps is not None and steps > MAX_SHEAR_STEPS:
-        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
-        raise ValueError(
-            f"the shear would take {steps:.3g} steps (dt = {dt:.3g} s, strain rate {rate:.3g} "
-            f"1/s; about {hours:.3g} h here), outside the valid range [1, {MAX_SHEAR_STEPS:g}]:"
-            " raise the strain rate or lower young / the time step's cost (or --force)")
+            f"{rate_name} gives the inertial number I = {number:.3g}, outside the quasi-static "
+            f"range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower {flag} / --inertial-number "
+            "(or --force)")
+    if not force and steps is not None and steps > most:
+        raise too_long("the shear" if isinstance(config, TriaxialConfig) else "the loading",
+                       steps, rate_name, f"raise {flag} / --inertial-number, or lower "
+                       f"{', '.join(('--young', *large, *config.LENGTH))}")
+    for stage, stage_rate, stage_steps in config.stage_rates() if not force else ():
+        stage_number = quasi_static_number(stage_rate, sample, pressure)
+        if stage_number > MAX_INERTIAL_NUMBER:
+            raise ValueError(
+                f"{stage}: strain rate {stage_rate:.3g} 1/s gives the inertial number I = "
+                f"{stage_number:.3g}, outside the quasi-static range (0, "
+                f"{MAX_INERTIAL_NUMBER:g}] at {where}: lower it (or --force)")
+        if stage_steps is not None and stage_steps > most:
+            raise too_long(stage, stage_steps, f"strain rate {stage_rate:.3g} 1/s",
+                           "raise its strain rate")
     if (not force and config.sample_path is None
             and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
         raise ValueError(
@@ -603,7 +636,7 @@ class LaboratoryTest:
         """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
         shear after this many steps as an interruption would (raises Interrupted); ``plots``:
         False leaves out triaxial.png and plots/ (a run timed for its physics, as the
-        trade-off study's: the figures cost about 2 s a run).
+        trade-off study's: the figures' cost is not the physics').
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same.
@@ -672,10 +705,16 @@ class LaboratoryTest:
         wrote the checkpoint); returns the summary."""
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
-        for path in (sample_file, checkpoint):
-            if not os.path.exists(path):
-                raise ValueError(f"resume = {out!r}: {path} is missing (was the run started "
-                                 "with checkpoint_every > 0?)")
+        if not os.path.exists(sample_file):
+            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
+                             "before its sample existed (in the preparation or the wetting), "
+                             "so nothing can be resumed; run it again")
+        if not os.path.exists(checkpoint):
+            stored = config_from_dict(load_sample(sample_file)[3].get("config"), sample_file)
+            why = ("the run stopped before its first checkpoint" if
+                   getattr(stored, "checkpoint_every", 0) > 0 else
+                   "the run was started with --checkpoint-every 0, which writes none")
+            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: {why}; run it again")
         with OutputFolder(out, f"{cls.NAME} --resume", keep=True) as folder:
             particles, walls, _, before_shear = load_sample(sample_file)
             config = config_from_dict(before_shear.get("config"), sample_file)
@@ -692,7 +731,18 @@ class LaboratoryTest:
             test = cls.__new__(cls)          # the stored run, checked when it started
             test.config = config
             run = _PathRun(sim, test, folder, before_shear, identity)
+            dt = sim.dt                      # the loading's time step, set from its sample
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
+            if sim.dt != dt:                 # a checksum can be forged
+                raise ValueError(f"{checkpoint}: dt = {sim.dt:g} s is not this run's time step, "
+                                 f"{dt:g} s (set from its sample.h5): an edited checkpoint")
+            position = sim.particles.position   # two centres at one point have no normal
+            order = np.lexsort(position.T[::-1])
+            same = np.flatnonzero(np.all(position[order[1:]] == position[order[:-1]], axis=1))
+            if len(same):
+                i, j = sorted((int(order[same[0]]), int(order[same[0] + 1])))
+                raise ValueError(f"{checkpoint}: particles {i} and {j} share the position "
+                                 f"{position[i].tolist()} m: an edited checkpoint")
             if (not isinstance(state, dict) or state.get("phase") != "shear"
                     or state.get("steps") != run.steps
                     or not isinstance(state.get("start_step"), int)
@@ -908,7 +958,7 @@ class _PathRun:
         self.shear_time = state["shear_time_s"]
         where = state.get("path")
         if where is None and self.steps is not None:
-            # written before paths had stages: the one stage of a shear
+            # a checkpoint that holds no path: a shear's one stage
             where = {"stage": 0, "stage_start": self.start_step, "stage_steps": self.steps}
         if not isinstance(where, dict):
             raise ValueError("the checkpoint does not say where its loading path stood")
@@ -975,6 +1025,7 @@ class _PathRun:
         summary = self.test.summarize(history)
         rate = config.rate()
         sheared = sim.step - self.start_step
+        loaded = history["unbalanced_force"][1:]      # none when the first stage failed at once
         summary.update({
             "completed": completed,
             "initial_porosity": preparation["porosity"],
@@ -990,8 +1041,8 @@ class _PathRun:
             "strain_rate": rate,
             "inertial_number": inertial_number(rate, sample.radius, sample.density,
                                                config.reference_pressure()),
-            "max_unbalanced_force": float(np.max(history["unbalanced_force"][1:])),
-            "mean_unbalanced_force": float(np.mean(history["unbalanced_force"][1:])),
+            "max_unbalanced_force": float(np.max(loaded)) if len(loaded) else None,
+            "mean_unbalanced_force": float(np.mean(loaded)) if len(loaded) else None,
             "threads": numba.get_num_threads(),
             "device": sim.device,
             "grading": grading(sim.particles.radius),

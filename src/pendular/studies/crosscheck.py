@@ -1,4 +1,4 @@
-"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing (issue 5).
+"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing.
 
 ``run_crosscheck(crosscheck_config(...), out)``; command ``pendular crosscheck``. Needs
 ``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md lists the differences by design.
@@ -62,8 +62,8 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.interop.yade.formats import read_spheres, write_spheres
 from pendular.homogenize.invariants import stress_ratio
 
-from pendular.procedures.config import (MIN_SAMPLE_PARTICLES, YADE_CHOICES, BridgeConfig,
-    ShearConfig, TriaxialConfig, config_to_dict)
+from pendular.procedures.config import (MAX_STAGE_STEPS, MIN_SAMPLE_PARTICLES, YADE_CHOICES,
+    BridgeConfig, ShearConfig, TriaxialConfig, config_to_dict)
 from pendular.procedures.options import SUCTION, axial_strain, sample_sizes, size_options
 from pendular.utils.parameters import (Option, OptionError, Parameter, default_of, option_from,
     option_of)
@@ -138,9 +138,11 @@ OPTIONS = (option_of(PrepareConfig, "particles", default=PARTICLES, low=MIN_SAMP
                   default=False, kind=bool),
            option_of(ShearConfig, "records", default=RECORDS, unset=False,
                      help="history rows over the shear"),
+           # the wetted sample's equilibrium (its wet_steps): at most MAX_STAGE_STEPS
            option_from(Parameter("1", "most steps to bring the (wetted) sample to rest before "
-                                      "export (0: export it as loaded)", low=0, kind=int,
-                                 flag="--settle-steps"), SETTLE_STEPS, checked=True),
+                                      "export (0: export it as loaded)", low=0,
+                                 high=MAX_STAGE_STEPS, kind=int, flag="--settle-steps"),
+                       SETTLE_STEPS, checked=True),
            Option("packing", "shear this exported packing (DIR/packing.txt of an earlier "
                              "cross-check of the same sample and suction) instead of settling",
                   kind=str, metavar="FILE"))

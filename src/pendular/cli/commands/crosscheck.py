@@ -1,4 +1,4 @@
-"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing (issue 5).
+"""Cross-check of pendular's drained triaxial shear against YADE's on the same packing.
 
 pendular prepares (cached) and settles the sample at --confining (wet with --suction > 0:
 bridges at every contact) and exports it to DIR/packing.txt; both codes shear that packing from
