@@ -59,11 +59,11 @@ OWN_GENERATED = {
                      "shear_rate", "record_strain", "stage_steps"},
     "tension": {"roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
                 "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
-                "vtk_every", "particles", "confining", "friction", "young", "seed",
-                "periodic"} | SIZES,
+                "vtk_every", "checkpoint_every", "particles", "confining", "friction",
+                "young", "seed", "periodic"} | SIZES,
     "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
              "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
-             "seed"} | SIZES,
+             "seed", "checkpoint_every"} | SIZES,
 }
 #: Options whose default is the command's own, not its field's (the field's otherwise).
 COMMAND_DEFAULTS = {("tension", "particles"), ("tension", "confining"), ("swcc", "particles"),

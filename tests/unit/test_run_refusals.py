@@ -39,6 +39,14 @@ def test_an_output_period_beyond_any_run_is_refused_naming_it(command, option, t
                  f"{option} = {HUGE}", "valid range [0, ")
 
 
+@pytest.mark.parametrize("command", ["tension", "swcc"])
+def test_a_checkpoint_period_beyond_any_run_is_refused_naming_it(command, tmp_path, capsys):
+    """A run setting of these commands (not a field of their configurations), checked as it
+    is read."""
+    refused_here(capsys, tmp_path, command, ["--checkpoint-every", HUGE],
+                 f"--checkpoint-every = {HUGE}", "valid range [0, ")
+
+
 # ---------------------------------------------------------------- loading rates and lengths
 def table(tmp_path, *stages):
     """A path table of ``stages`` (TOML text of each [[stage]]) in ``tmp_path``; its path."""

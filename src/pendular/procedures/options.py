@@ -129,9 +129,10 @@ def rate_options(config):
 
 
 #: Steps between checkpoints of a run (every command that resumes: the laboratory tests,
-#: swcc).
+#: tension, swcc; a run setting of the last two, not a field of their configurations, so
+#: checked as it is read).
 CHECKPOINT_EVERY = dataclasses.replace(option_of(
-    LaboratoryConfig, "checkpoint_every",
+    LaboratoryConfig, "checkpoint_every", checked=True,
     help="steps between checkpoints DIR/checkpoint.h5 (0: none)"), least=0)
 
 
@@ -376,7 +377,8 @@ TENSION = ((TENSION_VOID_RATIO, TENSION_OWN["roughness"], TENSION_WATER_CONTENT,
               TENSION_SAMPLE_OPTIONS["young"])
            + tuple(TENSION_OWN[name] for name in ("inertial_number", "max_strain", "residual",
                                                   "grip_depth", "void_ratio_tolerance"))
-           + TENSION_FRAMES + (TENSION_SAMPLE_OPTIONS["seed"], TENSION_SAMPLE_OPTIONS["periodic"]))
+           + TENSION_FRAMES + (CHECKPOINT_EVERY, TENSION_SAMPLE_OPTIONS["seed"],
+                               TENSION_SAMPLE_OPTIONS["periodic"]))
 
 
 def tension_config(values, given):
@@ -444,8 +446,8 @@ COMMANDS = {
                                                           check=amplitude_given))),
     "path": _laboratory(PATH_OWN, framed(table_path_config), first=(PATH_TABLE,)),
     "tension": CommandOptions(TENSION, tension_config),
-    "swcc": CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL,
-                           swcc_config),
+    "swcc": CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL
+                           + (CHECKPOINT_EVERY,), swcc_config),
 }
 
 

@@ -16,9 +16,8 @@ from __future__ import annotations
 
 import sys
 
-from pendular.cli import (INTERRUPTED, add_command_options, add_declared_options,
-    add_device_option, add_run_options, command_config, declared_values, print_summary,
-    set_threads)
+from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
+    add_run_options, command_config, declared_values, print_summary, set_threads)
 from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
 from pendular.procedures.options import CHECKPOINT_EVERY
 from pendular.procedures.swcc import SwccTest
@@ -39,7 +38,6 @@ def add_arguments(parser):
     add_run_options(parser)
     add_device_option(parser, "the preparation and the path (the wetting across gaps stays on "
                               "the CPU)")
-    add_declared_options(parser, (CHECKPOINT_EVERY,))
     add_resume_options(parser)
 
 

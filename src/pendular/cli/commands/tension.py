@@ -15,9 +15,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from pendular.cli import (INTERRUPTED, add_command_options, add_declared_options,
-    add_device_option, add_run_options, command_config, declared_values, print_summary,
-    set_threads)
+from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
+    add_run_options, command_config, declared_values, print_summary, set_threads)
 from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
 from pendular.procedures.config import TensionConfig
 from pendular.procedures.options import CHECKPOINT_EVERY
@@ -43,7 +42,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", default="runs/direct_tension", help="output folder")
     add_run_options(parser, threads_default=1)
     add_device_option(parser, "the preparations, the wettings and the pulls")
-    add_declared_options(parser, (CHECKPOINT_EVERY,))
     add_resume_options(parser)
 
 
