@@ -579,9 +579,7 @@ class LaboratoryTest:
         if not isinstance(config, self.CONFIG):
             raise TypeError(f"config must be a {self.CONFIG.__name__}, got "
                             f"{type(config).__name__}")
-        if config.sample_path is not None:      # the sample's count and sizes, unless given
-            config = dataclasses.replace(config, sample=sized_as_sample(config.sample,
-                                                                        config.sample_path))
+        config = self._sized(config)
         self.config = config
         check_feasible(config, force=force)
         if config.bridges is not None and config.bridges.suction is not None:
@@ -592,13 +590,23 @@ class LaboratoryTest:
             config.bridges.build().load_tables(float(radii.min()), float(radii.max()),
                                                radius_ratios=sample_radius_ratios(radii))
 
+    @staticmethod
+    def _sized(config):
+        """``config`` with the count and sizes of its prepared sample where not given
+        (sized_as_sample), once the sample exists: a campaign builds its tests before it
+        prepares their shared samples, and ``start`` sizes them then."""
+        if config.sample_path is None or not os.path.isfile(config.sample_path):
+            return config
+        return dataclasses.replace(config, sample=sized_as_sample(config.sample,
+                                                                  config.sample_path))
+
     # ------------------------------------------------------------ phases
     def start(self, progress=True, threads=None, writers=(), device="cpu"):
         """(static sample at the confining stress, preparation report, the host holding it);
         ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
         vtk_prep VtkWriter); ``device``: where the preparation or the loaded sample's
         equilibrium runs, and the returned simulation's runs (the wetting after it)."""
-        config = self.config
+        self.config = config = self._sized(self.config)
         if config.sample_path is not None:
             return self.load_sample(config.sample_path, progress, threads, writers, device)
         sim, report = prepare_sample(config.sample, progress=progress, threads=threads,
