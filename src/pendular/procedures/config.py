@@ -425,7 +425,9 @@ def sized_as_sample(sample, path):
     refuses when the sample contradicts it. ValueError naming the path for an unreadable
     sample."""
     particles, _, _, stored = load_sample(path)
-    made = {"particles": len(particles), "radius": float(np.mean(particles.radius))}
+    radius = particles.radius      # equal spheres: their radius exactly, not a rounded mean
+    made = {"particles": len(particles),
+            "radius": float(radius[0] if np.all(radius == radius[0]) else np.mean(radius))}
     if isinstance(stored.get("config"), dict):
         try:
             prepared = config_from_dict(stored["config"], f"sample = {path!r}").sample
