@@ -3,6 +3,7 @@
 
 Sphere–sphere, overlap delta, effective radius 1/R* = 1/R1 + 1/R2, contact radius
 a = sqrt(R* delta), effective mass 1/m* = 1/m1 + 1/m2:
+
 - normal: Hertz, F = (4/3) E* sqrt(R*) delta^(3/2) = (2/3) kn delta, kn = dF/d(delta) = 2 E* a,
   1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Johnson 1985, Eq. 4.22-4.23);
 - tangential: Mindlin's no-slip stiffness kt = 8 G* a, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2,
