@@ -58,7 +58,7 @@ class AxialStressGuard:
         self.remedy = remedy
 
     def apply(self, sim):
-        sigma = sim.walls.stress()[2]
+        sigma = sim.fetch("walls").walls.stress()[2]
         if not sigma > 0.0:
             raise AxialContactLost(
                 f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa at step "
@@ -99,6 +99,7 @@ class SampleGuard:
     def check(self, sim):
         """Measure the state now; SampleCrushed when a bound is crossed, else (largest overlap
         over the radius, porosity)."""
+        sim.fetch("walls")
         device = sim.homogenized()
         if device is None:
             overlap = largest_overlap(sim)

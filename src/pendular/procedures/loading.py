@@ -447,6 +447,7 @@ def history_columns(sim, axial, reference_volume, bridges=None):
 
 def void_ratio(sim):
     """Void ratio e = n / (1 - n) of the box [-] (n: pendular.dem.measure.porosity)."""
+    sim.fetch("particles")          # all of a device run's state (Simulation.fetch)
     n = porosity(sim.particles, sim.walls)
     return n / (1.0 - n)
 
@@ -527,7 +528,8 @@ class LoadingPath:
         quantities.update(columns or {})
         if len(self.stages) > 1:
             quantities["stage"] = lambda s: self.stage
-        self.recorder = HistoryRecorder(period, quantities, origin=sim.step, end=end)
+        self.recorder = HistoryRecorder(period, quantities, origin=sim.step, end=end,
+                                        reads=("walls",))
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         if guard:
@@ -653,7 +655,7 @@ class LoadingPath:
         if isinstance(until, (Strain, ShearStrain)):
             return sim.step - self.stage_start >= self.stage_steps
         if isinstance(until, Stress):
-            sigma = sim.walls.stress()[AXES[until.axis]]
+            sigma = sim.fetch("walls").walls.stress()[AXES[until.axis]]
             return (sigma - until.value) * stage.strain_rate[until.axis] >= 0.0
         return ((sim.step - self.stage_start) % until.check_every == 0
                 and all(op.done for op in self.controls if hasattr(op, "done"))
@@ -724,7 +726,7 @@ class LoadingPath:
     def status(self, sim):
         """Progress-bar fields: strain, axial and lateral stress, q/p; in a sheared cell the
         shear strain, tau and tau / sigma_z instead of the last two."""
-        sigma = sim.walls.stress()
+        sigma = sim.fetch("walls").walls.stress()
         fields = {"strain": f"{self.axial.strain(sim.walls):.3f}", "sz": f"{sigma[2]:.0f}Pa"}
         if getattr(sim.walls, "sheared", False):
             tau = sim.walls.shear_stress()

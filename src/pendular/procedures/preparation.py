@@ -403,6 +403,7 @@ def static(unbalanced=0.01, tolerance=0.01):
                     else device["unbalanced_force"])
         if measured > unbalanced:
             return False
+        sim.fetch("walls")
         # the servos' targets are the host's (set between runs), read without the state
         for servo in (op for op in sim.peek("controls") if isinstance(op, StressServo)):
             error = np.abs(sim.walls.stress()[list(servo.axes)] - servo.target)
@@ -528,10 +529,11 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     done = equilibrated(config)
 
     def grown(s):
-        stress = float(np.mean(s.walls.stress()))
+        stress = float(np.mean(s.fetch("walls").walls.stress()))
         return (abs(stress - config.prep_stress) <= 0.02 * config.prep_stress and done(s))
 
     def status(s):
+        s.fetch()
         return {"sigma": f"{np.mean(s.walls.stress()):.0f}/{config.prep_stress:g}Pa",
                 "n": f"{porosity(s.particles, s.walls):.3f}",
                 "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"

@@ -306,7 +306,7 @@ class Pull:
                 "water_content": lambda s: gravimetric_water_content(
                     water_volume(s), solid, config.specific_gravity),
                 "saturation": saturation})
-        self.recorder = HistoryRecorder(period, columns, origin=sim.step)
+        self.recorder = HistoryRecorder(period, columns, origin=sim.step, reads=("walls",))
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
@@ -314,14 +314,14 @@ class Pull:
 
     def pulls(self, sim: Simulation) -> list[float]:
         """The grips' pulls [N] (z-, z+) of ``sim``'s state."""
-        sim.walls           # on a device the pulls come back with the walls (dem.grips.Grip)
+        sim.fetch("walls")  # on a device the pulls come back with the walls (dem.grips.Grip)
         return [grip.pull for grip in self.grips]
 
     def tensile_stress(self, sim: Simulation) -> float:
         """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
         the cross-section (pendular.procedures.grips.tensile_stress), or minus a periodic cell's
         z stress."""
-        walls = sim.walls              # on a device, the grips' pulls come back with the walls
+        walls = sim.fetch("walls").walls   # on a device the pulls come back with the walls
         if walls.periodic:
             return -float(walls.stress()[2])
         return tensile_stress(self.grips, walls)
@@ -337,7 +337,7 @@ class Pull:
 
     def run(self, label: str | None) -> tuple[int, dict]:
         def status(s):
-            return {"ext": f"{-self.extension.strain(s.walls):.4f}",
+            return {"ext": f"{-self.extension.strain(s.fetch('walls').walls):.4f}",
                     "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
 
         steps = self.sim.run(self.steps, until=self.ruptured, check_every=self.recorder.period,

@@ -128,6 +128,7 @@ def equilibrium_status(unbalanced):
     each servo's stress against its target."""
 
     def status(sim):
+        sim.fetch()                 # all of a device run's state (Simulation.fetch)
         fields = {"unbalanced": f"{unbalanced_force(sim.particles, sim.contacts):.3g}"
                                 f"/{unbalanced:g}"}
         for servo in (op for op in sim.controls if isinstance(op, StressServo)):
