@@ -6,7 +6,7 @@ at 30 kPa (exact bridges at contact), and wet the sheared cell of tests/gpu/test
 (Lees–Edwards: the images through the z faces offset along x), after 30 steps on the device.
 The device's quantities are computed from the state it holds, which then comes back for the
 CPU's (pendular.homogenize.contact_stress, pendular.dem.measure,
-pendular.homogenize.on_the_fly, pendular.procedures.guards.largest_overlap).
+pendular.homogenize.on_the_fly, pendular.dem.measure.largest_overlap).
 The reduction runs in two blocks (CHUNK = 32), and once more in one block (CHUNK raised to 64
 in the simulated process, which reads the module's globals at each launch): in one block the
 dry sums are the CPU's in the CPU's order.
@@ -74,7 +74,7 @@ def cpu_homogenization(sim):
     from pendular.homogenize.contact_stress import contact_stress
     from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
     from pendular.homogenize.on_the_fly import CapillaryHomogenization
-    from pendular.procedures.guards import largest_overlap
+    from pendular.dem.measure import largest_overlap
 
     fabric = fabric_tensor(sim.contacts.normal, sim.contacts.overlap > 0.0)
     out = {"sigma_contact": contact_stress(sim.particles, sim.contacts, sim.walls),

@@ -26,8 +26,8 @@ device run the state (DEVICE_HELD) is the device's: whatever reads it during the
 at its step, ``until``, ``status``) brings it back first with an explicit
 ``sim.fetch(...)`` ("walls" alone: a cheap copy), and reading a held attribute that was not
 fetched raises StaleState, so that nothing reads a stale host copy. After ``run`` the host
-holds the state. ``homogenized()`` measures the state where it is held (on the device without
-bringing it back).
+holds the state; pendular.homogenize.on_the_fly.homogenized measures it where it is held (on
+the device without bringing it back).
 """
 
 import importlib
@@ -195,12 +195,11 @@ class Simulation:
         run.copy_back(None)
         return self
 
-    def homogenized(self):
-        """The homogenised quantities of the state from the device run holding it, reduced
-        there (its ``homogenized()``: a dict named as the history's columns, the state left
-        on the device), or None when the host holds the state (measure it here)."""
-        run = self.__dict__.get("_holder")
-        return None if run is None else run.homogenized()
+    @property
+    def holder(self):
+        """The device run holding the state (``hold``; its ``homogenized()`` measures it
+        there, pendular.homogenize.on_the_fly.homogenized), None when the host holds it."""
+        return self.__dict__.get("_holder")
 
     def peek(self, name):
         """The host's ``name`` (one of DEVICE_HELD) without bringing a device run's state back:

@@ -43,6 +43,7 @@ from pendular.dem.timestep import TIMESTEP_RULES, critical_timestep, pwave_times
 from pendular.utils.parameters import fail, parameter, spec_of, validate
 from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
+from pendular.homogenize.on_the_fly import homogenized
 
 
 @numba.njit(cache=True, inline="always")
@@ -395,13 +396,11 @@ class GrowthTimeStep(growth.GrowthTimeStep):
 def static(unbalanced=0.01, tolerance=0.01):
     """Predicate (a function of sim): the unbalanced force is at most ``unbalanced`` and every
     StressServo's walls hold their target within ``tolerance`` (relative). A device run
-    holding the state measures it there (Simulation.homogenized): only the walls come back."""
+    holding the state measures it there (pendular.homogenize.on_the_fly.homogenized): only the
+    walls come back."""
 
     def done(sim):
-        device = sim.homogenized()
-        measured = (unbalanced_force(sim.particles, sim.contacts) if device is None
-                    else device["unbalanced_force"])
-        if measured > unbalanced:
+        if homogenized(sim)["unbalanced_force"] > unbalanced:
             return False
         sim.fetch("walls")
         # the servos' targets are the host's (set between runs), read without the state

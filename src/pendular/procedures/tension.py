@@ -70,6 +70,7 @@ from pendular.homogenize import packing_state, regular_packing
 
 from pendular.procedures.config import TensionConfig, case_name, config_to_dict, inertial_number
 from pendular.procedures.loading import measured
+from pendular.homogenize.on_the_fly import homogenized
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -275,31 +276,25 @@ class Pull:
                 op.apply(sim)
         self.steps = int(math.ceil(config.max_strain / (self.rate * sim.dt)))
         period = max(1, self.steps // RECORDS)
-        count = len(sim.particles)
-        # the homogenised columns reduced on the device when a device run holds the state
-        # (loading.measured): a record then brings back the walls alone, with the grips' pulls
+        # the homogenised columns measured where the state is held (loading.measured): on a
+        # device a record then brings back the walls alone, with the grips' pulls
         columns = {
             "step": lambda s: s.step,
             "time": lambda s: s.time,
             "axial_strain": lambda s: self.extension.strain(s.walls),
             "tensile_stress": self.tensile_stress,
             "sigma_wall": lambda s: s.walls.stress(),
-            "coordination": measured("coordination",
-                                     lambda s: coordination(s.contacts, count)),
-            "unbalanced_force": measured("unbalanced_force",
-                                         lambda s: unbalanced_force(s.particles, s.contacts)),
+            "coordination": measured("coordination"),
+            "unbalanced_force": measured("unbalanced_force"),
         }
         if self.grips:
             columns["grip_pull"] = self.pulls
         if bridges is not None:
             solid = sim.particles.solid_volume()
-            water_volume = measured("water_volume", lambda s: bridges.water_volume(s.contacts))
+            water_volume = measured("water_volume")
 
             def saturation(s):
-                device = s.homogenized()
-                if device is None:
-                    return bridges.saturation(s)
-                return device["water_volume"] / (s.walls.volume() - solid)
+                return homogenized(s)["water_volume"] / (s.walls.volume() - solid)
 
             columns.update({
                 "bridges": measured("bridges", bridges.count),
