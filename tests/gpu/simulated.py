@@ -81,6 +81,7 @@ def lookups(radius_ratios, suction_axis, distance_low, log_distance_rupture, log
 
 def snapshot(sim):
     """The state a comparison reads: particles, walls, per-pair springs keyed by (i, j)."""
+    sim.fetch()                         # a device run's state, all of it
     c = sim.contacts
     return {"position": sim.particles.position.copy(), "velocity": sim.particles.velocity.copy(),
             "angular_velocity": sim.particles.angular_velocity.copy(),

@@ -75,6 +75,7 @@ def scene(wet=False, seed=3, controls=servo_and_strain_rate, offset=0.0):
 
 def snapshot(sim):
     """The state a comparison reads (positions unwrapped: the runs may wrap at other steps)."""
+    sim.fetch()                         # a device run's state, all of it
     cell = sim.walls
     return {"position": cell.unwrapped(sim.particles),
             "velocity": sim.particles.velocity.copy(),

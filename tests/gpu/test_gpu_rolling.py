@@ -108,6 +108,7 @@ def snapshot(sim):
     """simulated.py's snapshot (test_gpu_periodic.py's in a cell: positions unwrapped) with
     the torques and, keyed by pair (i, j) for the touching pairs, the tangential springs, the
     rolling and twisting springs and the pairs' moments."""
+    sim.fetch()                         # a device run's state, all of it
     from pendular.dem.protocols import pair_key
     from pendular.dem.rolling import FIELDS, OWNER, RollingResistance
     from simulated import snapshot as walled

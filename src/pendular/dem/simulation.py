@@ -252,6 +252,7 @@ class Simulation:
         reading the state they fetch (module docstring)."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
+        self.fetch()                        # a run starts from the host's state
         caller_threads = numba.get_num_threads()
         numba.set_num_threads(self.threads)
         try:

@@ -495,8 +495,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     (PREPARATION_PHASES) when the phase starts. They change no result.
     ``device``: where the phases run, "cpu" or "gpu" (docs/gpu.md): each phase's run copies
     the state to the device and back (the rescaling and the change of controls between them
-    run on the host); the returned simulation runs on the CPU (set its ``device`` to go on
-    elsewhere).
+    run on the host); the returned simulation's runs go on there (set its ``device`` to move
+    them).
     """
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -571,7 +571,6 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)
     sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
-    sim.device = "cpu"
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),

@@ -565,10 +565,8 @@ class LaboratoryTest:
         config = self.config
         if config.sample_path is not None:
             return self.load_sample(config.sample_path, progress, threads, writers, device)
-        sim, report = prepare_sample(config.sample, progress=progress, threads=threads,
-                                     writers=writers, device=device)
-        sim.device = device
-        return sim, report
+        return prepare_sample(config.sample, progress=progress, threads=threads,
+                              writers=writers, device=device)
 
     def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
         """(sample saved at ``path`` servoed at the confining stress and run until static on
