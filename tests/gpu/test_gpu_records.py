@@ -70,7 +70,8 @@ def measure(check):
         bridges = sim.operation(CapillaryBridges) if wet else None
         columns = history_columns(sim, AxisStrain(2, sim.walls.lengths()[2]),
                                   sim.walls.volume(), bridges)
-        sim.writers = [HistoryRecorder(RECORD_PERIOD, columns), SampleGuard(RECORD_PERIOD)]
+        sim.writers = [HistoryRecorder(RECORD_PERIOD, columns, reads=("walls",)),
+                       SampleGuard(RECORD_PERIOD)]
         sim.device = device
         return sim
 
