@@ -3,8 +3,8 @@ column a record needs (pendular.procedures.loading.history_columns, with the bri
 scene) and the crushed-sample guard read the device's homogenisation
 (pendular.homogenize.on_the_fly.homogenized, pendular.gpu.homogenize), so that a record step
 fetches the walls (a periodic cell's faces, rate, stress and stiffness) alone and the whole
-state comes back once, as the run returns. An equilibrium's test (static) reads the device's unbalanced force the
-same way.
+state comes back once, as the run returns. An equilibrium's test (static) reads the device's
+unbalanced force the same way.
 
 The 64-sphere walled scene of tests/gpu/simulated.py and the periodic one of
 tests/gpu/test_gpu_periodic.py (pairs through the faces; the homogenisation over the branch

@@ -61,8 +61,8 @@ def register_device(name, start, unavailable):
     imported) runs a Simulation: ``start(sim)`` returns a run with ``run(steps, until=,
     check_every=, progress=, status=)`` as Simulation.run (its loop ``run_chunks``, with the
     device's step and checks), which holds the state (``hold``) after each of its steps, and
-    ``copy_back(part)``, which writes the device's state into sim
-    (``part`` "walls": those alone; Simulation.fetch calls it); ``unavailable()`` says why the device cannot run here
+    ``copy_back(part)``, which writes the device's state into sim (``part`` "walls": those
+    alone; Simulation.fetch calls it); ``unavailable()`` says why the device cannot run here
     (text), or None."""
     if name not in DEVICE_MODULES or DEVICE_MODULES[name] is None:
         raise ValueError(f"device = {name!r} is not one of the plug-in devices "
@@ -119,6 +119,8 @@ class Simulation:
     neighbour list. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
     SERIAL_BELOW particles or more, else 1). Results do not depend on the thread count.
     ``device``: where ``run`` advances, "cpu" or "gpu" (module docstring; docs/gpu.md).
+    While a device run holds the state, read it after ``fetch("walls")`` (the box alone) or
+    ``fetch()`` (all of it); an unfetched read raises StaleState.
     """
 
     def __init__(self, particles, walls, dt, *, neighbors, forces=(), controls=(),

@@ -268,9 +268,8 @@ WET_MEASURES = {
     "fabric_bridges": lambda sim, m, op: m.bridge_stress.fabric,
     "anisotropy_bridges": lambda sim, m, op: m.bridge_stress.anisotropy,
     "a_psi": lambda sim, m, op: m.bridge_stress.a_psi,
+    "psi_interface": lambda sim, m, op: m.bridge_stress.interface,      # the exact model's
 }
-#: The exact model's interface term (BridgeStress.interface), with the wet measures.
-INTERFACE = "psi_interface"
 
 
 class HostMeasures(Mapping):
@@ -289,16 +288,15 @@ class HostMeasures(Mapping):
     def _names(self):
         if self.bridges is None:
             return tuple(DRY_MEASURES)
-        interface = (INTERFACE,) if self.bridges.model == "exact" else ()
-        return (*DRY_MEASURES, *WET_MEASURES, *interface)
+        return (*DRY_MEASURES, *(name for name in WET_MEASURES
+                                 if name != "psi_interface" or self.bridges.model == "exact"))
 
     def __getitem__(self, name):
         if name not in self._values:
             if name in DRY_MEASURES:
                 self._values[name] = DRY_MEASURES[name](self.sim, self)
             elif name in self._names():
-                self._values[name] = (self.bridge_stress.interface if name == INTERFACE else
-                                      WET_MEASURES[name](self.sim, self, self.bridges))
+                self._values[name] = WET_MEASURES[name](self.sim, self, self.bridges)
             else:
                 raise KeyError(f"{name!r} is not a homogenised quantity of this scene (valid: "
                                f"{', '.join(self._names())})")

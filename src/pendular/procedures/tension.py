@@ -297,7 +297,7 @@ class Pull:
                 return homogenized(s)["water_volume"] / (s.walls.volume() - solid)
 
             columns.update({
-                "bridges": measured("bridges", bridges.count),
+                "bridges": measured("bridges"),
                 "water_content": lambda s: gravimetric_water_content(
                     water_volume(s), solid, config.specific_gravity),
                 "saturation": saturation})
