@@ -207,3 +207,7 @@ class StressScene:
 
     def __init__(self, sigma, step=0):
         self.walls, self.step = self._Walls(sigma), step
+
+    def fetch(self, *parts):
+        """Nothing is held by a device run here (Simulation.fetch): the scene itself."""
+        return self

@@ -38,10 +38,11 @@ def scene(wet=True):
     sim.controls = [ConstantStrainRate("z", -rate, length), *grips]
 
     def pulls(s):
-        walls = s.walls            # the pulls come back with the walls on a device
+        walls = s.walls            # fetched by the recorder: the pulls come with the walls
         return [walls.force[4], walls.force[5], *(grip.pull for grip in grips)]
 
-    sim.writers = [HistoryRecorder(RECORD_PERIOD, {"pulls": pulls}, origin=sim.step)]
+    sim.writers = [HistoryRecorder(RECORD_PERIOD, {"pulls": pulls}, origin=sim.step,
+                                   reads=("walls",))]
     sim.writers[0].record(sim)
     return sim, np.concatenate([grip.members for grip in grips])
 

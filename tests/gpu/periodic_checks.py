@@ -82,6 +82,7 @@ def hertz_scene(wet=False):
 
 def snapshot(sim):
     """The state a comparison reads (positions unwrapped: the runs may wrap at other steps)."""
+    sim.fetch()                         # a device run's state, all of it
     cell = sim.walls
     return {"position": cell.unwrapped(sim.particles),
             "velocity": sim.particles.velocity.copy(),

@@ -57,6 +57,7 @@ def snapshot(sim, bridges):
     """The state a comparison reads: particles, walls, and per pair (i, j) of the list the
     bridges' state, volume, force, filling angles, suction (0 under suction control) and force
     on j from i."""
+    sim.fetch()                         # a device run's state, all of it
     from pendular.capillary.bridge_state import BridgeState
 
     c = sim.contacts

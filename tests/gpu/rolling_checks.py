@@ -45,6 +45,7 @@ def snapshot(sim):
     """simulated.py's snapshot (periodic_checks.py's in a cell: positions unwrapped) with
     the torques and, keyed by pair (i, j) for the touching pairs, the tangential springs, the
     rolling and twisting springs and the pairs' moments."""
+    sim.fetch()                         # a device run's state, all of it
     from pendular.dem.protocols import pair_key
     from pendular.dem.rolling import FIELDS, OWNER, RollingResistance
     from simulated import snapshot as walled

@@ -79,6 +79,7 @@ def lookups(radius_ratios, suction_axis, distance_low, log_distance_rupture, log
 
 def snapshot(sim):
     """The state a comparison reads: particles, walls, per-pair springs keyed by (i, j)."""
+    sim.fetch()                         # a device run's state, all of it
     c = sim.contacts
     return {"position": sim.particles.position.copy(), "velocity": sim.particles.velocity.copy(),
             "angular_velocity": sim.particles.angular_velocity.copy(),
@@ -152,13 +153,13 @@ def dry():
 def device_run():
     """``Simulation(device="gpu").run`` with ``until`` against the CPU: the steps taken, the
     state and the history, and the device's copies back (GpuSimulation.copy_back) by part: an
-    ``until`` that reads the walls brings back the walls alone, the recorder everything."""
+    ``until`` that fetches the walls brings back the walls alone, the recorder everything."""
     cpu, gpu = scene(), scene()
     gpu.device = "gpu"
     length = cpu.walls.lengths()[2]
 
     def until(sim):                 # the axial walls closer by 110 steps of the strain rate
-        return sim.walls.lengths()[2] < length * (1.0 - 110 * sim.dt * 1.0)
+        return sim.fetch("walls").walls.lengths()[2] < length * (1.0 - 110 * sim.dt * 1.0)
 
     with counted_copies() as copies:
         taken = [sim.run(STEPS, until=until, check_every=25) for sim in (cpu, gpu)]

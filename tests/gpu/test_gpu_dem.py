@@ -59,14 +59,12 @@ def test_writers_record_the_cpu_history_at_the_same_steps(dry):
 
 def test_a_gpu_simulation_runs_until_as_the_cpu_and_copies_back_what_is_read(dry):
     """Simulation(device="gpu").run(until=, check_every=25), until 110 steps of the axial
-    strain rate: the CPU's steps (125) and state. The until reads the walls' lengths: the walls
-    alone come back at each check; the recorder (every 50 steps) reads the wall stress, then
-    the particles: the walls, then everything; the end of the run brings back the rest."""
+    strain rate: the CPU's steps (125) and state. The until fetches the walls' lengths: the
+    walls alone come back at each check; the recorder (every 50 steps, before the check)
+    fetches everything, which the check then reads; the end of the run brings back the rest."""
     run = dry["device"]
     assert run["taken"] == run["step"] == [125, 125]
-    expected = []
-    for step in range(25, 126, 25):
-        expected += ["walls", "all"] if step % 50 == 0 else ["walls"]
+    expected = ["all" if step % 50 == 0 else "walls" for step in range(25, 126, 25)]
     assert run["copies"] == expected + ["all"]
     assert run["released"] == ["contacts", "controls", "particles", "walls"]
     assert run["agreement"]["position"] < 1e-13 and run["agreement"]["wall_stress"] < 1e-12

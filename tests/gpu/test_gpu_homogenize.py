@@ -6,7 +6,7 @@ at 30 kPa (exact bridges at contact), and wet the sheared cell of tests/gpu/shea
 (Lees–Edwards: the images through the z faces offset along x), after 30 steps on the device.
 The device's quantities are computed from the state it holds, which then comes back for the
 CPU's (pendular.homogenize.contact_stress, pendular.dem.measure,
-pendular.homogenize.on_the_fly, pendular.procedures.guards.largest_overlap).
+pendular.homogenize.on_the_fly, pendular.dem.measure.largest_overlap).
 The reduction runs in two blocks (CHUNK = 32), and once more in one block (CHUNK raised to 64
 in the simulated process, which reads the module's globals at each launch): in one block the
 dry sums are the CPU's in the CPU's order.
@@ -52,27 +52,18 @@ GAP_CHUNK = 16
 
 
 def cpu_homogenization(sim):
-    """The CPU's quantities of sim's state, named as device_homogenization names them."""
-    from pendular.capillary.bridges import CapillaryBridges
-    from pendular.dem.measure import coordination, unbalanced_force
-    from pendular.homogenize.contact_stress import contact_stress
-    from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
-    from pendular.homogenize.on_the_fly import CapillaryHomogenization
-    from pendular.procedures.guards import largest_overlap
+    """The CPU's quantities of sim's state (the host holding it), named as
+    device_homogenization names them: pendular.homogenize.on_the_fly.homogenized on the host,
+    each quantity by its CPU function (tests/integration/test_homogenize_dem.py), the water
+    volume homogenize_bridges's (CapillaryBridges.water_volume sums every pair's, zeros
+    included: the same to round-off)."""
+    from pendular.homogenize.on_the_fly import homogenized
 
-    fabric = fabric_tensor(sim.contacts.normal, sim.contacts.overlap > 0.0)
-    out = {"sigma_contact": contact_stress(sim.particles, sim.contacts, sim.walls),
-           "coordination": coordination(sim.contacts, len(sim.particles)),
-           "fabric": fabric, "anisotropy": principal_anisotropy(fabric),
-           "unbalanced_force": unbalanced_force(sim.particles, sim.contacts),
-           "solid_volume": sim.particles.solid_volume(),
-           "largest_overlap": largest_overlap(sim),
-           "smallest_radius": sim.particles.radius.min(),
-           "largest_radius": sim.particles.radius.max()}
-    try:
-        bridges = sim.operation(CapillaryBridges)
-    except KeyError:
-        return out
+    measures = homogenized(sim)
+    out = dict(measures)
+    if measures.bridges is not None:    # V_w summed over the bridges alone, as the device sums
+        out["water_volume"] = measures.bridge_stress.water_volume
+    return out
     homogenization = CapillaryHomogenization(bridges)
     state, _ = homogenization.evaluate(sim)
     out.update({"bridges": state.bridges,
@@ -158,7 +149,7 @@ def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
             "difference": {name: relative(cpu[name], device[name]) for name in cpu},
             "equal": {name: bool(np.array_equal(cpu[name], device[name])) for name in cpu},
             "repeatable": all(np.array_equal(device[name], again[name]) for name in device),
-            "touching": device["coordination"] * len(gpu.sim.particles) / 2.0,
+            "touching": device["coordination"] * len(gpu.sim.peek("particles")) / 2.0,
             "bridges": device.get("bridges", 0),
             "pendular_overlaps": device.get("pendular_overlaps", 0), "copies": copies,
             "held": held, "through_faces": through_faces, "across_gaps": across_gaps,

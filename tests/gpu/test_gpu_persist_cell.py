@@ -70,6 +70,7 @@ def scene(control):
 def snapshot(sim, bridges):
     """test_gpu_persist.py's snapshot (each bridge per pair (i, j)) with the positions
     unwrapped (the runs may wrap at other steps) and the cell's faces and stress tensor."""
+    sim.fetch()                         # a device run's state, all of it
     cell = sim.walls
     return {**persist_snapshot(sim, bridges), "position": cell.unwrapped(sim.particles),
             "walls": cell.position.copy(), "stress": cell.stress_tensor.copy()}

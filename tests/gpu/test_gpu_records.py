@@ -1,10 +1,10 @@
 """A loading path's history recorded from a GPU run without bringing the state back: every
 column a record needs (pendular.procedures.loading.history_columns, with the bridges' for a wet
 scene) and the crushed-sample guard read the device's homogenisation
-(Simulation.homogenized, pendular.gpu.homogenize), so that a record step copies the walls (a
-periodic cell's faces, rate, stress and stiffness) alone and the whole state comes back once,
-as the run returns. An equilibrium's test (static) reads the device's unbalanced force the
-same way.
+(pendular.homogenize.on_the_fly.homogenized, pendular.gpu.homogenize), so that a record step
+fetches the walls (a periodic cell's faces, rate, stress and stiffness) alone and the whole
+state comes back once, as the run returns. An equilibrium's test (static) reads the device's
+unbalanced force the same way.
 
 The 64-sphere walled scene of tests/gpu/simulated.py and the periodic one of
 tests/gpu/periodic_checks.py (pairs through the faces; the homogenisation over the branch
@@ -66,7 +66,8 @@ def measure(check):
         bridges = sim.operation(CapillaryBridges) if wet else None
         columns = history_columns(sim, AxisStrain(2, sim.walls.lengths()[2]),
                                   sim.walls.volume(), bridges)
-        sim.writers = [HistoryRecorder(RECORD_PERIOD, columns), SampleGuard(RECORD_PERIOD)]
+        sim.writers = [HistoryRecorder(RECORD_PERIOD, columns, reads=("walls",)),
+                       SampleGuard(RECORD_PERIOD)]
         sim.device = device
         return sim
 
@@ -79,6 +80,8 @@ def measure(check):
            "difference": {name: relative(a[name], b[name]) for name in a},
            "across_gaps": (int(np.count_nonzero(BridgeState.of(gpu.contacts).state
                                                 == ACROSS_GAP)) if wet else 0)}
+    if check == "dry":
+        out["fetch"] = fetched(build("gpu"))
     if periodic or persist:
         return out
     # an equilibrium's test (pendular.procedures.preparation.static, its unbalanced force
@@ -89,6 +92,28 @@ def measure(check):
                                       check_every=RECORD_PERIOD) for device in ("cpu", "gpu")]
                    for unbalanced in UNBALANCED]
     return {**out, "static": {"stopped": stopped, "copies": copies}}
+
+
+def fetched(sim):
+    """What reading the state of ``sim`` held by a GpuSimulation run directly (one step)
+    gives: the StaleState's message unfetched, then the copies of fetch("walls") (twice) and
+    fetch(), and whether the particles were still held between them."""
+    from pendular.dem.simulation import StaleState
+    from pendular.gpu import GpuSimulation
+
+    gpu = GpuSimulation(sim)
+    gpu.run(1)
+    try:
+        sim.particles
+        message = None
+    except StaleState as error:
+        message = str(error)
+    with counted_copies() as copies:
+        sim.fetch("walls").fetch("walls")
+        held = "particles" not in sim.__dict__
+        sim.fetch()
+    return {"message": message, "copies": copies, "held_after_walls": held,
+            "released": sim.holder is None}
 
 
 @pytest.fixture(scope="module")
@@ -121,6 +146,17 @@ def test_the_recorded_columns_are_the_cpus(recorded):
         assert {"chi", "psi", "saturation", "bridges"} <= set(measured["columns"])
     for name, difference in measured["difference"].items():
         assert difference < 1e-12, name
+
+
+@pytest.mark.parametrize("recorded", ["dry"], indirect=True)
+def test_held_state_is_read_through_an_explicit_fetch(recorded):
+    """Unfetched, the state of a device run is refused by name; fetch("walls") copies the walls
+    once and leaves the particles on the device; fetch() brings the rest and ends the hold."""
+    _, measured = recorded
+    fetch = measured["fetch"]
+    assert "sim.fetch('particles')" in fetch["message"]
+    assert fetch["copies"] == ["walls", "all"]
+    assert fetch["held_after_walls"] and fetch["released"]
 
 
 @pytest.mark.parametrize("recorded", WALLED, indirect=True)

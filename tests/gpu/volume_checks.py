@@ -35,6 +35,7 @@ def scene():
 def snapshot(sim, bridges):
     """persist_checks.py's snapshot (particles, walls, each bridge per pair (i, j)) and the
     liquid's account."""
+    sim.fetch()                         # a device run's state, all of it
     in_bridges, film, lost, error = bridges.liquid_balance(sim)
     return {**persist_snapshot(sim, bridges), "film": bridges.film.copy(),
             "liquid": [in_bridges, film, lost], "balance_error": error}

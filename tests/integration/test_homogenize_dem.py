@@ -188,9 +188,57 @@ def test_recorder_columns_follow_the_bridge_operation_volume_control_included():
         assert columns["psi"](sim) == pytest.approx(expected.chi * SUCTION + expected.B, rel=1e-2)
         homogenization = columns["chi"].__self__
         assert isinstance(homogenization, CapillaryHomogenization)
-        assert homogenization.evaluate(sim) is homogenization.evaluate(sim)      # cached
+        assert homogenization.measured(sim) is homogenization.measured(sim)      # cached
         copied = copy.deepcopy({"sim": sim, "columns": columns})
         assert copied["columns"]["chi"].__self__.bridges is copied["sim"].operation(CapillaryBridges)
+
+
+def test_homogenized_on_the_host_is_the_cpus_measures_bit_for_bit():
+    """homogenized(sim) of a state the host holds: one mapping with the device's keys, each
+    value that of the CPU function the history's columns used (equal bit for bit), measured
+    once per mapping; an unknown name is refused naming the valid ones."""
+    from pendular.dem.measure import coordination, largest_overlap, unbalanced_force
+    from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
+    from pendular.homogenize.on_the_fly import capillary_force_stress, homogenized
+
+    sim = lattice(regular_packing("bcc"), cells=3)
+    dry = homogenized(sim)
+    assert set(dry) == {"sigma_contact", "coordination", "fabric", "anisotropy",
+                        "unbalanced_force", "solid_volume", "largest_overlap",
+                        "smallest_radius", "largest_radius"}
+    p, c = sim.particles, sim.contacts
+    fabric = fabric_tensor(c.normal, c.overlap > 0.0)
+    expected = {"sigma_contact": contact_stress(p, c, sim.walls),
+                "coordination": coordination(c, len(p)), "fabric": fabric,
+                "anisotropy": principal_anisotropy(fabric),
+                "unbalanced_force": unbalanced_force(p, c), "solid_volume": p.solid_volume(),
+                "largest_overlap": largest_overlap(sim), "smallest_radius": p.radius.min(),
+                "largest_radius": p.radius.max()}
+    for name, value in expected.items():
+        assert np.array_equal(dry[name], value), name
+    assert dry["fabric"] is dry["fabric"]                   # measured once
+    with pytest.raises(KeyError, match="'chi' is not a homogenised quantity.*sigma_contact"):
+        dry["chi"]
+    bridges = CapillaryBridges(SUCTION, GAMMA, contact_angle=0.0, model="exact")
+    sim.forces.append(bridges)
+    bridges.apply(sim)
+    wet = homogenized(sim)
+    state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(), suction=SUCTION,
+                               contact_angle=0.0, surface_tension=GAMMA,
+                               interfaces=bridges.interfaces(sim, np.flatnonzero(
+                                   BridgeState.of(sim.contacts).mask())))
+    assert set(wet) == set(dry) | {"bridges", "pendular_overlaps", "water_volume", "chi", "B",
+                                   "psi", "sigma_capillary", "fabric_bridges",
+                                   "anisotropy_bridges", "a_psi", "psi_interface"}
+    expected = {"bridges": bridges.count(sim), "water_volume": bridges.water_volume(sim.contacts),
+                "pendular_overlaps": bridges.pendular_overlaps(sim),
+                "sigma_capillary": capillary_force_stress(sim, bridges), "chi": state.chi,
+                "B": state.B, "psi": state.psi, "fabric_bridges": state.fabric,
+                "anisotropy_bridges": state.anisotropy, "a_psi": state.a_psi,
+                "psi_interface": state.interface}
+    assert wet["bridges"] > 0
+    for name, value in expected.items():
+        assert np.array_equal(wet[name], value, equal_nan=True), name
 
 
 CAPILLARY_COLUMNS = ("chi", "B", "psi", "sigma_effective", "fabric_bridges", "anisotropy_bridges",

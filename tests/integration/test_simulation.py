@@ -9,7 +9,7 @@ from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.simulation import Simulation
+from pendular.dem.simulation import Simulation, StaleState
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import StressServo, WallForces
 
@@ -171,7 +171,8 @@ def test_a_check_that_raises_stops_the_run():
 
 def test_peek_reads_the_scene_without_bringing_a_device_run_state_back():
     """While a device run holds the state, ``peek`` gives the host's objects (what the scene
-    is made of) and copies nothing; reading the attribute brings the state back."""
+    is made of) and copies nothing; ``fetch`` brings the state back: the walls alone, then
+    the rest, which ends the hold."""
     sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
     walls, controls = sim.walls, sim.controls
 
@@ -184,6 +185,35 @@ def test_peek_reads_the_scene_without_bringing_a_device_run_state_back():
     sim.hold(Device())
     assert sim.peek("walls") is walls and sim.peek("controls") is controls
     assert Device.copies == []
-    assert sim.walls is walls and Device.copies == ["walls"]
-    assert sim.peek("controls") is controls and sim.peek("walls") is walls
+    assert sim.fetch("walls") is sim and sim.walls is walls and Device.copies == ["walls"]
+    sim.fetch("walls")                  # fetched already: no second copy
+    assert sim.peek("controls") is controls and Device.copies == ["walls"]
+    sim.fetch("controls")
     assert sim.controls is controls and Device.copies == ["walls", None]
+    sim.fetch()                         # the host holds it all: nothing to copy
+    assert Device.copies == ["walls", None]
+
+
+def test_reading_held_state_without_fetching_it_is_refused():
+    """A read of what a device run holds, not fetched, raises StaleState naming the call that
+    brings it back (never a stale host copy); after a fetch of the walls alone, the particles
+    are still the device's. On the host, fetch costs nothing and reads as before."""
+    sim = two_body_scene([[0.0, 0, 0]], np.zeros((1, 3)))
+    assert sim.fetch() is sim and sim.fetch("walls", "particles") is sim
+
+    class Device:
+        def copy_back(self, part):
+            pass
+
+    sim.hold(Device())
+    for name in ("particles", "walls", "contacts", "controls"):
+        with pytest.raises(StaleState, match=rf"sim\.fetch\('{name}'\)"):
+            getattr(sim, name)
+    sim.fetch("walls")
+    sim.walls.stress()
+    with pytest.raises(StaleState, match="particles"):
+        sim.particles.position
+    with pytest.raises(ValueError, match="cannot fetch 'forces'"):
+        sim.fetch("forces")
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        sim.nothing

@@ -18,11 +18,11 @@ from pendular.procedures.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES,
     MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name,
     tension_sample)
 from pendular.dem.grading import read_grading_curve
-from pendular.dem.measure import porosity
+from pendular.dem.measure import largest_overlap, porosity
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.guards import (MAX_OVERLAP_OVER_RADIUS, MIN_POROSITY_EQUAL, SampleCrushed,
-    SampleGuard, largest_overlap)
+    SampleGuard)
 from pendular.procedures.tension import case_line
 from pendular.procedures.triaxial import TriaxialShear, summarize
 

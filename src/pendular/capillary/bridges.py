@@ -344,7 +344,8 @@ class CapillaryBridges(metaclass=_ByControl):
 
     def _sync(self, sim):
         """Tables, stiffness check and per-pair arrays for the current radii and neighbour
-        list."""
+        list (a device run's state fetched first: every measure reads it through here)."""
+        sim.fetch("contacts")
         if sim.contacts is self._contacts:
             return
         self._prepare(sim)

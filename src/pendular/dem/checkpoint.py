@@ -313,7 +313,7 @@ def save_checkpoint(path, sim, extra_state=None, identity=None):
     plain values, or a per-pair array that no operation declares.
     """
     path = os.fspath(path)
-    sim.release()                   # a device run's state back on the host first
+    sim.fetch()                     # a device run's state back on the host first
     contacts = sim.contacts
     particle_arrays, particle_scalars = _owned_arrays(sim.particles, "particles")
     wall_arrays, wall_scalars = _owned_arrays(sim.walls, "walls")

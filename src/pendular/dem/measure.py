@@ -1,4 +1,5 @@
-"""Scalar measures of the packing state: porosity, coordination, unbalanced force."""
+"""Scalar measures of the packing state: porosity, coordination, unbalanced force, largest
+overlap."""
 
 import numba
 import numpy as np
@@ -39,6 +40,22 @@ def unbalanced_force(particles, contacts):
     Reads the forces of the last step (call after the force operations); inf without contacts.
     """
     return float(_unbalanced(particles.force, contacts.force, contacts.overlap))
+
+
+def largest_overlap(sim):
+    """Largest overlap over the smaller radius [-] of the pairs of ``sim`` (as at its last
+    force evaluation) and, inside walls, of the spheres with the walls; at most 0 when nothing
+    touches, NaN when a position is not finite."""
+    particles, contacts = sim.particles, sim.contacts
+    radius = particles.radius
+    overlaps = [np.zeros(1)]
+    if contacts is not None:
+        smaller = np.minimum(radius[contacts.pair_i], radius[contacts.pair_j])
+        overlaps.append(contacts.overlap / smaller)
+    if not sim.walls.periodic:
+        inside = np.minimum(particles.position - sim.walls.lo, sim.walls.hi - particles.position)
+        overlaps.append((1.0 - inside / radius[:, None]).ravel())
+    return float(np.max(np.concatenate(overlaps)))
 
 
 def kinetic_energy(particles):

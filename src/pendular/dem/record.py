@@ -3,6 +3,7 @@
 import numpy as np
 
 from pendular.dem.protocols import state_array
+from pendular.dem.simulation import DEVICE_HELD
 from pendular.utils.validate import check_int
 
 
@@ -12,10 +13,12 @@ class HistoryRecorder:
     append it as a row.
 
     Quantities are only computed on recording steps, so costly measures (homogenisation) do not
-    run every step. ``rows`` maps name -> list of values; ``arrays()`` stacks them.
+    run every step. ``rows`` maps name -> list of values; ``arrays()`` stacks them. ``reads``:
+    the parts of the state the quantities read, fetched before each record (Simulation.fetch:
+    a device run brings those back alone; the default, all of it).
     """
 
-    def __init__(self, period, quantities, origin=0, end=None):
+    def __init__(self, period, quantities, origin=0, end=None, reads=DEVICE_HELD):
         self.period = check_int("record period", period, low=1)
         self.origin = check_int("record origin", origin)
         self.end = None if end is None else check_int("record end", end, low=self.origin)
@@ -24,6 +27,7 @@ class HistoryRecorder:
             if not callable(quantity):
                 raise TypeError(f"quantities[{name!r}] = {quantity!r} is not a function of sim")
         self.rows = {name: [] for name in self.quantities}
+        self.reads = tuple(reads)
 
     def state_dict(self):
         """``origin`` and ``end`` (the steps its records count from and end at, None: no
@@ -67,6 +71,7 @@ class HistoryRecorder:
     def record(self, sim):
         """Sample every quantity now. The row is computed whole before any column grows, so an
         interrupt (Ctrl-C) while the quantities are computed leaves no partial row."""
+        sim.fetch(*self.reads)
         row = {name: np.asarray(quantity(sim), dtype=np.float64)
                for name, quantity in self.quantities.items()}
         for name, value in row.items():

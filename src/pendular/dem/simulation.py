@@ -22,9 +22,12 @@ needs pairs beyond contact says so with ``reach(sim)`` [m] (pendular.dem.neighbo
 ``device`` chooses where ``run`` advances: "cpu" (here) or another device, whose module
 (DEVICE_MODULES) is imported by name when first asked for and registers its run
 (``register_device``): the one plug-in point of the layers (docs/architecture.md). During a
-device run the state (DEVICE_HELD) is the device's: reading one of these attributes of the
-Simulation (a writer, ``until``, ``status``) brings it back first, so nothing reads a stale
-host copy; after ``run`` the host holds the state.
+device run the state (DEVICE_HELD) is the device's: whatever reads it during the run (a writer
+at its step, ``until``, ``status``) brings it back first with an explicit
+``sim.fetch(...)`` ("walls" alone: a cheap copy), and reading a held attribute that was not
+fetched raises StaleState, so that nothing reads a stale host copy. After ``run`` the host
+holds the state; pendular.homogenize.on_the_fly.homogenized measures it where it is held (on
+the device without bringing it back).
 """
 
 import importlib
@@ -47,6 +50,8 @@ DEVICE_MODULES = {"cpu": None, "gpu": "pendular.gpu"}
 DEVICES = tuple(DEVICE_MODULES)
 #: What a device run holds between its syncs (module docstring).
 DEVICE_HELD = ("particles", "walls", "contacts", "controls")
+#: The part of the held state that ``fetch`` brings back alone (the rest comes back together).
+FETCHED_ALONE = "walls"
 #: Registered devices: name -> (start(sim), unavailable()) (``register_device``).
 _DEVICES = {}
 
@@ -56,8 +61,8 @@ def register_device(name, start, unavailable):
     imported) runs a Simulation: ``start(sim)`` returns a run with ``run(steps, until=,
     check_every=, progress=, status=)`` as Simulation.run (its loop ``run_chunks``, with the
     device's step and checks), which holds the state (``hold``) after each of its steps, and
-    ``copy_back(part)``, which writes the device's state into sim
-    (``part`` "walls": those alone); ``unavailable()`` says why the device cannot run here
+    ``copy_back(part)``, which writes the device's state into sim (``part`` "walls": those
+    alone; Simulation.fetch calls it); ``unavailable()`` says why the device cannot run here
     (text), or None."""
     if name not in DEVICE_MODULES or DEVICE_MODULES[name] is None:
         raise ValueError(f"device = {name!r} is not one of the plug-in devices "
@@ -95,6 +100,10 @@ def check_device(device):
     device_start(device, f"--device {device}")
 
 
+class StaleState(RuntimeError):
+    """A read of state that a device run holds, not brought back first (Simulation.fetch)."""
+
+
 def _check_operation(op):
     """``op`` if it meets the Operation contract (pendular.dem.protocols), else TypeError."""
     if not isinstance(op, Operation) or not callable(op.apply):
@@ -110,6 +119,8 @@ class Simulation:
     neighbour list. ``threads``: Numba threads used by ``run`` (default: all of Numba's for
     SERIAL_BELOW particles or more, else 1). Results do not depend on the thread count.
     ``device``: where ``run`` advances, "cpu" or "gpu" (module docstring; docs/gpu.md).
+    While a device run holds the state, read it after ``fetch("walls")`` (the box alone) or
+    ``fetch()`` (all of it); an unfetched read raises StaleState.
     """
 
     def __init__(self, particles, walls, dt, *, neighbors, forces=(), controls=(),
@@ -148,13 +159,13 @@ class Simulation:
     def __getattr__(self, name):
         # reached only for an attribute that is not there: the state a device run holds
         if name in DEVICE_HELD and "_holder" in self.__dict__:
-            self.release(name)
-            return self.__dict__[name]
+            raise StaleState(f"sim.{name} is held by a device run: bring it back first with "
+                             f"sim.fetch({name!r})")
         raise AttributeError(f"'Simulation' object has no attribute {name!r}")
 
     def hold(self, run):
-        """The device run ``run`` changed the state (DEVICE_HELD): until released, reading it
-        brings it back from there (``run.copy_back``). Called by a device run after a step."""
+        """The device run ``run`` changed the state (DEVICE_HELD): until fetched, reading it
+        raises StaleState. Called by a device run after a step."""
         state = self.__dict__
         held = state.setdefault("_held", {})
         for name in DEVICE_HELD:
@@ -162,28 +173,35 @@ class Simulation:
                 held[name] = state.pop(name)
         state["_holder"] = run
 
-    def release(self, name=None):
-        """The held state back from the device run holding it: the walls alone for ``name``
-        "walls" (a wall stress read every step stays cheap), else all of it, which ends the
-        hold (nothing is held: nothing to do)."""
+    def fetch(self, *parts):
+        """Bring the state a device run holds back to the host before reading it: with
+        ``parts`` "walls" alone, the box (its walls' positions, forces and stresses, a cell's
+        shear, the grips' pulls: a copy cheap enough for every step), the rest left on the
+        device; with any other of DEVICE_HELD, or none named, all of it (``run.copy_back``),
+        which ends the hold. Nothing to do for what the host holds already. Returns sim."""
+        unknown = [part for part in parts if part not in DEVICE_HELD]
+        if unknown:
+            raise ValueError(f"cannot fetch {', '.join(map(repr, unknown))}: the held state is "
+                             f"{', '.join(map(repr, DEVICE_HELD))}")
         state = self.__dict__
         run = state.get("_holder")
         if run is None:
-            return
-        if name == "walls":
-            state["walls"] = state["_held"].pop("walls")
-            run.copy_back("walls")
-            return
+            return self
+        if set(parts) == {FETCHED_ALONE}:
+            if FETCHED_ALONE not in state:
+                state[FETCHED_ALONE] = state["_held"].pop(FETCHED_ALONE)
+                run.copy_back(FETCHED_ALONE)
+            return self
         state.update(state.pop("_held"))
         del state["_holder"]
         run.copy_back(None)
+        return self
 
-    def homogenized(self):
-        """The homogenised quantities of the state from the device run holding it, reduced
-        there (its ``homogenized()``: a dict named as the history's columns, the state left
-        on the device), or None when the host holds the state (measure it here)."""
-        run = self.__dict__.get("_holder")
-        return None if run is None else run.homogenized()
+    @property
+    def holder(self):
+        """The device run holding the state (``hold``; its ``homogenized()`` measures it
+        there, pendular.homogenize.on_the_fly.homogenized), None when the host holds it."""
+        return self.__dict__.get("_holder")
 
     def peek(self, name):
         """The host's ``name`` (one of DEVICE_HELD) without bringing a device run's state back:
@@ -234,9 +252,10 @@ class Simulation:
         gauge counts the quantity that ends it; ``status(sim)`` returns a dict shown beside
         it. Returns the steps taken.
         On another ``device`` the steps run there, the writers, ``until`` and ``status``
-        reading the state brought back (module docstring)."""
+        reading the state they fetch (module docstring)."""
         steps = check_int("steps", steps)
         check_every = check_int("check_every", check_every, low=1)
+        self.fetch()                        # a run starts from the host's state
         caller_threads = numba.get_num_threads()
         numba.set_num_threads(self.threads)
         try:
@@ -248,7 +267,7 @@ class Simulation:
                 return self._device_start(self).run(steps, until=until, check_every=check_every,
                                                     progress=progress, status=status)
             finally:
-                self.release()              # after a run, the host holds the state
+                self.fetch()                # after a run, the host holds the state
         finally:
             numba.set_num_threads(caller_threads)
 

@@ -129,7 +129,8 @@ class DeviceGrowth:
         controls = next(i for i, step in enumerate(steps) if step[0].py_func.__name__
                         in ("wall_controls", "cell_controls"))
         steps.insert(controls + 1, (grow, n, (state.radius, state.mass, state.inertia,
-                                              float(sim.particles.density), state.parameters,
+                                              float(sim.peek("particles").density),
+                                              state.parameters,
                                               self.row)))
         steps.insert(3, (mark_rebuild, n, (state.radius, self.reference_radius, state.flags)))
         steps.append((grown_beyond, n, (state.position, state.reference_position, state.radius,

@@ -76,7 +76,7 @@ SUMS = (("touching", 1), ("resultant", 1), ("contact_force", 1), ("stress", 9),
         ("interface_axial", 9), ("pendular_overlaps", 1), ("suction_water", 1),
         ("suction_cap_lateral", 1), ("suction_cap_axial", 9))
 #: The columns after SUMS, reduced to their largest value: the largest overlap over the smaller
-#: radius [-] (at least 0, as guards.largest_overlap), the largest radius and minus the
+#: radius [-] (at least 0, as dem.measure.largest_overlap), the largest radius and minus the
 #: smallest [m].
 MAXIMA = (("largest_overlap", 1), ("largest_radius", 1), ("negative_smallest_radius", 1))
 
@@ -429,7 +429,7 @@ def device_homogenization(gpu, volume=None):
     history_columns, pendular.homogenize.on_the_fly.CapillaryHomogenization): a dict of
     ``sigma_contact`` (3, 3) [Pa], ``coordination`` [-], ``fabric`` (3, 3), ``anisotropy``
     (Eq. 3.51), ``unbalanced_force`` [-], ``solid_volume`` [m^3] (the spheres'),
-    ``largest_overlap`` [-] (pendular.procedures.guards.largest_overlap), ``smallest_radius``
+    ``largest_overlap`` [-] (pendular.dem.measure.largest_overlap), ``smallest_radius``
     and ``largest_radius`` [m]; wet, also ``bridges``, ``pendular_overlaps``,
     ``water_volume`` [m^3], ``chi`` (3, 3) [-], ``B``, ``psi``, ``sigma_capillary`` (3, 3)
     [Pa], ``fabric_bridges``, ``anisotropy_bridges``, ``a_psi``, and with the exact model

@@ -16,15 +16,16 @@ The host reads nothing per step. It reads the device's flags at its checks (ever
 ``check_every`` steps, as Simulation.run checks ``until``: the loop is Simulation.run_chunks).
 After each step the Simulation's state is held by the device (Simulation.hold) and the writers
 are called as on the CPU: one that reads the state (a HistoryRecorder at its recording steps,
-a checkpoint at its period) brings it back first (``copy_back``; the walls alone when only
-they are read, as a stress ``until`` does every step), one that is not due reads nothing and
-costs no copy. Simulation.run brings the state back as it returns; a GpuSimulation driven
-directly leaves it held until read (or ``to_host``), so that runs in a row copy nothing
-between them (a run's set-up reads what the scene is made of with Simulation.peek).
+a checkpoint at its period) fetches it first (Simulation.fetch, which calls ``copy_back``; the
+walls alone when only they are read, as a stress ``until`` does every step), one that is not
+due reads nothing and costs no copy. Simulation.run brings the state back as it returns; a
+GpuSimulation driven directly leaves it held until fetched (or ``to_host``), so that runs in a
+row copy nothing between them (a run's set-up reads what the scene is made of with
+Simulation.peek).
 
 A mixed stress condition (MixedStress) sets its servos' targets on the device from the walls'
 stresses, as the CPU does. When a target falls below zero the device records it and the host
-raises the CPU's StageFailed at its next check or, earlier, when anything reads the state
+raises the CPU's StageFailed at its next check or, earlier, when anything fetches the state
 (``copy_back``), so that no writer records a state past the failure.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces (or the damped
@@ -637,12 +638,12 @@ class GpuSimulation:
                                    status=status)
 
     def to_host(self):
-        """Bring the device's state into ``sim`` now (Simulation.release; nothing to do when
+        """Bring the device's state into ``sim`` now (Simulation.fetch; nothing to do when
         sim holds it already)."""
-        self.sim.release()
+        self.sim.fetch()
 
     def copy_back(self, part=None):
-        """Copy the device's state into ``sim`` (called by Simulation.release): particles,
+        """Copy the device's state into ``sim`` (called by Simulation.fetch): particles,
         walls, the neighbour list with its per-pair state (rebuilt by the CPU's NeighborList
         from it, so that the CPU can go on from here) and the servos' memory; with ``part``
         "walls", the walls alone. Then StageFailed if a mixed condition could not be held

@@ -57,20 +57,26 @@ the exact solver and in a static packing in tests/integration/test_complete_capi
 sigma'^c = sigma_net + psi + I is the stress the contacts carry. I is taken from the exact
 tables (nn11, nn33 at each bridge's suction and gap); the toroidal model has none.
 
-A wet scene's recorder builds ``CapillaryHomogenization(bridges)`` from its bridge operation;
-a dry scene never does.
+``homogenized(sim)`` gives the homogenised quantities of a simulation's state, named as the
+history's columns, wherever the state is held: reduced on the device when a device run holds
+it (its ``homogenized()``, pendular.gpu.homogenize: no particle state comes back), else
+measured here by the CPU's own functions (HostMeasures). A wet scene's recorder builds
+``CapillaryHomogenization(bridges)`` from its bridge operation; a dry scene never does.
 """
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
+from pendular.capillary.bridges import CapillaryBridges
+from pendular.dem.measure import coordination, largest_overlap, unbalanced_force
 from pendular.dem.neighbors import branch_vectors
 from pendular.utils.validate import check_positive
 from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stress_anisotropy,
     effective_stress_parameter, interface_stress, surface_tension_stress, wetted_caps_sum)
-from pendular.homogenize.contact_stress import pair_stress_sum
+from pendular.homogenize.contact_stress import contact_stress, pair_stress_sum
 from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
 
 
@@ -219,96 +225,170 @@ def capillary_force_stress(sim, bridges):
     return total / sim.walls.volume()
 
 
+def homogenized(sim):
+    """The homogenised quantities of ``sim``'s state, a mapping named as the history's columns
+    (module docstring): the device run's reduction when one holds the state
+    (Simulation.holder), else HostMeasures(sim). Keys: sigma_contact [Pa] (3, 3),
+    coordination, fabric (3, 3), anisotropy, unbalanced_force [-], solid_volume [m^3],
+    largest_overlap [-], smallest_radius and largest_radius [m]; wet, bridges,
+    pendular_overlaps, water_volume [m^3], chi (3, 3), B, psi, sigma_capillary [Pa] (3, 3),
+    fabric_bridges (3, 3), anisotropy_bridges, a_psi [-] and, with the exact model,
+    psi_interface [Pa] (3, 3)."""
+    run = sim.holder
+    return HostMeasures(sim) if run is None else run.homogenized()
+
+
+def _contact_fabric(sim):
+    return fabric_tensor(sim.contacts.normal, sim.contacts.overlap > 0.0)      # Eq. 4.1
+
+
+#: The host's measure of each dry quantity of ``homogenized``: a function of (sim, the
+#: HostMeasures asked).
+DRY_MEASURES = {
+    "sigma_contact": lambda sim, m: contact_stress(sim.particles, sim.contacts, sim.walls),
+    "coordination": lambda sim, m: coordination(sim.contacts, len(sim.particles)),
+    "fabric": lambda sim, m: _contact_fabric(sim),
+    "anisotropy": lambda sim, m: principal_anisotropy(m["fabric"]),           # Eq. 3.51
+    "unbalanced_force": lambda sim, m: unbalanced_force(sim.particles, sim.contacts),
+    "solid_volume": lambda sim, m: sim.particles.solid_volume(),
+    "largest_overlap": lambda sim, m: largest_overlap(sim),
+    "smallest_radius": lambda sim, m: float(sim.particles.radius.min()),
+    "largest_radius": lambda sim, m: float(sim.particles.radius.max()),
+}
+#: The host's measure of each wet quantity: a function of (sim, the HostMeasures asked, the
+#: scene's CapillaryBridges).
+WET_MEASURES = {
+    "bridges": lambda sim, m, op: op.count(sim),
+    "pendular_overlaps": lambda sim, m, op: op.pendular_overlaps(sim),
+    "water_volume": lambda sim, m, op: op.water_volume(sim.contacts),
+    "sigma_capillary": lambda sim, m, op: capillary_force_stress(sim, op),
+    "chi": lambda sim, m, op: m.bridge_stress.chi,
+    "B": lambda sim, m, op: m.bridge_stress.B,
+    "psi": lambda sim, m, op: m.bridge_stress.psi,
+    "fabric_bridges": lambda sim, m, op: m.bridge_stress.fabric,
+    "anisotropy_bridges": lambda sim, m, op: m.bridge_stress.anisotropy,
+    "a_psi": lambda sim, m, op: m.bridge_stress.a_psi,
+    "psi_interface": lambda sim, m, op: m.bridge_stress.interface,      # the exact model's
+}
+
+
+class HostMeasures(Mapping):
+    """``homogenized`` of a state the host holds: each quantity measured on first read by the
+    CPU's function (DRY_MEASURES, WET_MEASURES with the scene's bridge operation), then kept,
+    so that the columns of one record share one evaluation (the bridges' sums of
+    homogenize_bridges among them)."""
+
+    def __init__(self, sim):
+        self.sim = sim
+        found = [op for op in sim.forces if isinstance(op, CapillaryBridges)]
+        self.bridges = found[0] if found else None
+        self._values = {}
+        self._bridge_stress = None
+
+    def _names(self):
+        if self.bridges is None:
+            return tuple(DRY_MEASURES)
+        return (*DRY_MEASURES, *(name for name in WET_MEASURES
+                                 if name != "psi_interface" or self.bridges.model == "exact"))
+
+    def __getitem__(self, name):
+        if name not in self._values:
+            if name in DRY_MEASURES:
+                self._values[name] = DRY_MEASURES[name](self.sim, self)
+            elif name in self._names():
+                self._values[name] = WET_MEASURES[name](self.sim, self, self.bridges)
+            else:
+                raise KeyError(f"{name!r} is not a homogenised quantity of this scene (valid: "
+                               f"{', '.join(self._names())})")
+        return self._values[name]
+
+    def __iter__(self):
+        return iter(self._names())
+
+    def __len__(self):
+        return len(self._names())
+
+    @property
+    def bridge_stress(self):
+        """The BridgeStress of the bridges over the box inside the walls (homogenize_bridges
+        with the operation's suction, contact angle and surface tension; volume control:
+        each bridge's own suction; the exact model: its interfaces)."""
+        if self._bridge_stress is None:
+            sim, op = self.sim, self.bridges
+            suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
+                       else op.suction)
+            interfaces = None
+            if op.model == "exact":
+                interfaces = op.interfaces(sim, np.flatnonzero(bridge_mask(sim.contacts)))
+            self._bridge_stress = homogenize_bridges(
+                sim.particles, sim.contacts, sim.walls.volume(), suction=suction,
+                contact_angle=op.contact_angle, surface_tension=op.surface_tension,
+                interfaces=interfaces, period=sim.walls.period)
+        return self._bridge_stress
+
+
 class CapillaryHomogenization:
     """The capillary state of a wet scene, evaluated when a recorder asks.
 
     bridges: the scene's capillary.CapillaryBridges operation (its suction, contact angle and
     surface tension, and its per-pair BridgeState). The volume is the box inside the walls; the
     total stress of Eq. 3.43 is the wall stress diag(sigma_x, sigma_y, sigma_z), u_a = 0. One
-    evaluation serves every column of a record (cached for the state's step and contact list).
-    The exact model adds the interface term and the complete effective stress.
+    ``homogenized`` serves every column of a record (kept for the state's step, contact list
+    and holder). The exact model adds the interface term and the complete effective stress.
     """
 
     def __init__(self, bridges):
         self.bridges = bridges
-        self._step = None
-        self._contacts = None
-        self._state = None
+        self._key = None
+        self._measured = None
 
-    def evaluate(self, sim):
-        """(BridgeStress over the box, sigma'_ij (3, 3) [Pa]) of the current state (reduced
-        on the device when a device run holds it, Simulation.homogenized)."""
-        device = sim.homogenized()
-        if device is not None:
-            state = BridgeStress(
-                bridges=device["bridges"], water_volume=device["water_volume"],
-                volume=sim.walls.volume(), chi=device["chi"], B=device["B"], psi=device["psi"],
-                fabric=device["fabric_bridges"], anisotropy=device["anisotropy_bridges"],
-                a_psi=device["a_psi"], interface=device.get("psi_interface"))
-            return state, np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
-        if (sim.step, sim.time) != self._step or sim.contacts is not self._contacts:
-            op = self.bridges
-            suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
-                       else op.suction)
-            interfaces = None
-            if op.model == "exact":
-                interfaces = op.interfaces(sim, np.flatnonzero(bridge_mask(sim.contacts)))
-            state = homogenize_bridges(sim.particles, sim.contacts, sim.walls.volume(),
-                                       suction=suction, contact_angle=op.contact_angle,
-                                       surface_tension=op.surface_tension,
-                                       interfaces=interfaces, period=sim.walls.period)
-            effective = np.diag(sim.walls.stress()) + state.psi   # Eq. 3.43, u_a = 0
-            self._step, self._contacts = (sim.step, sim.time), sim.contacts
-            self._state = (state, effective)
-        return self._state
+    def measured(self, sim):
+        """homogenized(sim), once per state (step, time, contact list and holder)."""
+        key = (sim.step, sim.time, sim.peek("contacts"), sim.holder)
+        if (self._key is None or key[:2] != self._key[:2]
+                or any(a is not b for a, b in zip(key[2:], self._key[2:]))):
+            self._key, self._measured = key, homogenized(sim)
+        return self._measured
 
     def sigma_capillary(self, sim):
-        device = sim.homogenized()
-        if device is not None:
-            return device["sigma_capillary"]
-        return capillary_force_stress(sim, self.bridges)
+        return self.measured(sim)["sigma_capillary"]
 
     def saturation(self, sim):
-        device = sim.homogenized()
-        if device is None:
-            return self.bridges.saturation(sim)
-        return device["water_volume"] / (sim.walls.volume() - device["solid_volume"])
+        measured = self.measured(sim)
+        return measured["water_volume"] / (sim.walls.volume() - measured["solid_volume"])
 
     def count(self, sim):
-        device = sim.homogenized()
-        return self.bridges.count(sim) if device is None else device["bridges"]
+        return self.measured(sim)["bridges"]
 
     def pendular_overlaps(self, sim):
-        device = sim.homogenized()
-        return (self.bridges.pendular_overlaps(sim) if device is None
-                else device["pendular_overlaps"])
+        return self.measured(sim)["pendular_overlaps"]
 
     def chi(self, sim):
-        return self.evaluate(sim)[0].chi
+        return self.measured(sim)["chi"]
 
     def B(self, sim):
-        return self.evaluate(sim)[0].B
+        return self.measured(sim)["B"]
 
     def psi(self, sim):
-        return self.evaluate(sim)[0].psi
+        return self.measured(sim)["psi"]
 
     def sigma_effective(self, sim):
-        return self.evaluate(sim)[1]
+        return np.diag(sim.walls.stress()) + self.measured(sim)["psi"]    # Eq. 3.43, u_a = 0
 
     def psi_interface(self, sim):
-        return self.evaluate(sim)[0].interface
+        return self.measured(sim)["psi_interface"]
 
     def sigma_effective_complete(self, sim):
-        return self.evaluate(sim)[1] + self.evaluate(sim)[0].interface
+        return self.sigma_effective(sim) + self.psi_interface(sim)
 
     def fabric_bridges(self, sim):
-        return self.evaluate(sim)[0].fabric
+        return self.measured(sim)["fabric_bridges"]
 
     def anisotropy_bridges(self, sim):
-        return self.evaluate(sim)[0].anisotropy
+        return self.measured(sim)["anisotropy_bridges"]
 
     def a_psi(self, sim):
-        return self.evaluate(sim)[0].a_psi
+        return self.measured(sim)["a_psi"]
 
     def quantities(self):
         """Recorded columns of a wet scene, name -> function of sim (bound methods, so that a

@@ -334,6 +334,7 @@ class VtkWriter:
         """Write the frame of the current step (once per step) and update the index files."""
         if self.frames and self.frames[-1][0] == sim.step:
             return
+        sim.fetch()                 # a device run's state, all of it (Simulation.fetch)
         meshes = {"particles": particle_mesh(sim), "walls": wall_mesh(sim.walls),
                   "bridges": bridge_mesh(sim), "contacts": contact_mesh(sim)}
         fields = {"step": sim.step, "time": sim.time}

@@ -10,10 +10,8 @@ law then answers with stresses of no physical meaning, and the guard stops it in
 
 import math
 
-import numpy as np
-
-from pendular.dem.measure import porosity
 from pendular.dem.mixed_stress import StageFailed
+from pendular.homogenize.on_the_fly import homogenized
 from pendular.utils.validate import check_int, check_range
 
 #: Largest overlap of two spheres, or of a sphere and a wall, over the smaller radius [-]. The
@@ -58,7 +56,7 @@ class AxialStressGuard:
         self.remedy = remedy
 
     def apply(self, sim):
-        sigma = sim.walls.stress()[2]
+        sigma = sim.fetch("walls").walls.stress()[2]
         if not sigma > 0.0:
             raise AxialContactLost(
                 f"{self.describe(sim)}: the axial stress fell to {sigma:.4g} Pa at step "
@@ -99,15 +97,11 @@ class SampleGuard:
     def check(self, sim):
         """Measure the state now; SampleCrushed when a bound is crossed, else (largest overlap
         over the radius, porosity)."""
-        device = sim.homogenized()
-        if device is None:
-            overlap = largest_overlap(sim)
-            measured = porosity(sim.particles, sim.walls)
-            radii = (sim.particles.radius.min(), sim.particles.radius.max())
-        else:                       # measured by the device run holding the state
-            overlap = device["largest_overlap"]
-            measured = 1.0 - device["solid_volume"] / sim.walls.volume()
-            radii = (device["smallest_radius"], device["largest_radius"])
+        sim.fetch("walls")
+        state = homogenized(sim)    # where the state is held: no particle comes back
+        overlap = state["largest_overlap"]
+        measured = 1.0 - state["solid_volume"] / sim.walls.volume()   # dem.measure.porosity
+        radii = (state["smallest_radius"], state["largest_radius"])
         low, high = self.porosity_range or default_porosity_range(*radii)
         if not overlap <= self.max_overlap:
             self._crushed(sim, f"an overlap of {overlap:.3g} of the radius, beyond the bound "
@@ -129,19 +123,3 @@ def default_porosity_range(smallest, largest):
     MAX_POROSITY."""
     equal = smallest == largest
     return (MIN_POROSITY_EQUAL if equal else MIN_POROSITY_GRADED), MAX_POROSITY
-
-
-def largest_overlap(sim):
-    """Largest overlap over the smaller radius [-] of the pairs of ``sim`` (as at its last
-    force evaluation) and, inside walls, of the spheres with the walls; at most 0 when nothing
-    touches, NaN when a position is not finite."""
-    particles, contacts = sim.particles, sim.contacts
-    radius = particles.radius
-    overlaps = [np.zeros(1)]
-    if contacts is not None:
-        smaller = np.minimum(radius[contacts.pair_i], radius[contacts.pair_j])
-        overlaps.append(contacts.overlap / smaller)
-    if not sim.walls.periodic:
-        inside = np.minimum(particles.position - sim.walls.lo, sim.walls.hi - particles.position)
-        overlaps.append((1.0 - inside / radius[:, None]).ravel())
-    return float(np.max(np.concatenate(overlaps)))

@@ -47,11 +47,11 @@ import numpy as np
 
 from pendular.dem import mixed_stress
 from pendular.dem.cell import ConstantShearRate
-from pendular.dem.measure import coordination, porosity, unbalanced_force
+from pendular.dem.measure import porosity
 from pendular.dem.mixed_stress import StageFailed
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, ConstantVolume, StressServo
-from pendular.homogenize import contact_stress, fabric_tensor, principal_anisotropy
+from pendular.homogenize.on_the_fly import homogenized
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE
 from pendular.procedures.guards import SampleGuard
@@ -387,24 +387,20 @@ def capillary_operation(sim):
     return found[0] if found else None
 
 
-def measured(name, on_host):
-    """Column ``name`` of a history: the device's value when a device run holds sim's state
-    (Simulation.homogenized), else ``on_host(sim)``."""
+def measured(name):
+    """Column ``name`` of a history: the homogenised quantity ``name`` of the state, measured
+    where it is held (pendular.homogenize.on_the_fly.homogenized)."""
 
     def quantity(sim):
-        device = sim.homogenized()
-        return on_host(sim) if device is None else device[name]
+        return homogenized(sim)[name]
 
     return quantity
 
 
 def solid_fraction_porosity(sim):
-    """Porosity of the box [-] (pendular.dem.measure.porosity), with the spheres' volume from
-    the device run holding the state when one does."""
-    device = sim.homogenized()
-    if device is None:
-        return porosity(sim.particles, sim.walls)
-    return 1.0 - device["solid_volume"] / sim.walls.volume()
+    """Porosity of the box [-] (pendular.dem.measure.porosity) from the spheres' volume
+    measured where the state is held (pendular.homogenize.on_the_fly.homogenized)."""
+    return 1.0 - homogenized(sim)["solid_volume"] / sim.walls.volume()
 
 
 def history_columns(sim, axial, reference_volume, bridges=None):
@@ -413,25 +409,18 @@ def history_columns(sim, axial, reference_volume, bridges=None):
     wet scene adds the capillary and homogenised columns of
     pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
 
-    def contact_fabric(s):
-        return fabric_tensor(s.contacts.normal, s.contacts.overlap > 0.0)   # Eq. 4.1
-
     columns = {
         "step": lambda s: s.step,
         "time": lambda s: s.time,
         "axial_strain": lambda s: axial.strain(s.walls),
         "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
         "sigma_wall": lambda s: s.walls.stress(),
-        "sigma_contact": measured("sigma_contact", lambda s: contact_stress(
-            s.particles, s.contacts, s.walls)),
+        "sigma_contact": measured("sigma_contact"),
         "porosity": solid_fraction_porosity,
-        "coordination": measured("coordination",
-                                 lambda s: coordination(s.contacts, len(s.particles))),
-        "fabric": measured("fabric", contact_fabric),
-        "anisotropy": measured("anisotropy",                                 # Eq. 3.51
-                               lambda s: principal_anisotropy(contact_fabric(s))),
-        "unbalanced_force": measured("unbalanced_force",
-                                     lambda s: unbalanced_force(s.particles, s.contacts)),
+        "coordination": measured("coordination"),
+        "fabric": measured("fabric"),                                       # Eq. 4.1
+        "anisotropy": measured("anisotropy"),                               # Eq. 3.51
+        "unbalanced_force": measured("unbalanced_force"),
     }
     if bridges is not None:
         from pendular.homogenize.on_the_fly import CapillaryHomogenization
@@ -446,6 +435,7 @@ def history_columns(sim, axial, reference_volume, bridges=None):
 
 def void_ratio(sim):
     """Void ratio e = n / (1 - n) of the box [-] (n: pendular.dem.measure.porosity)."""
+    sim.fetch("particles")          # all of a device run's state (Simulation.fetch)
     n = porosity(sim.particles, sim.walls)
     return n / (1.0 - n)
 
@@ -526,7 +516,8 @@ class LoadingPath:
         quantities.update(columns or {})
         if len(self.stages) > 1:
             quantities["stage"] = lambda s: self.stage
-        self.recorder = HistoryRecorder(period, quantities, origin=sim.step, end=end)
+        self.recorder = HistoryRecorder(period, quantities, origin=sim.step, end=end,
+                                        reads=("walls",))
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         if guard:
@@ -652,7 +643,7 @@ class LoadingPath:
         if isinstance(until, (Strain, ShearStrain)):
             return sim.step - self.stage_start >= self.stage_steps
         if isinstance(until, Stress):
-            sigma = sim.walls.stress()[AXES[until.axis]]
+            sigma = sim.fetch("walls").walls.stress()[AXES[until.axis]]
             return (sigma - until.value) * stage.strain_rate[until.axis] >= 0.0
         return ((sim.step - self.stage_start) % until.check_every == 0
                 and all(op.done for op in self.controls if hasattr(op, "done"))
@@ -732,7 +723,7 @@ class LoadingPath:
     def status(self, sim):
         """Progress-bar fields: strain, axial and lateral stress, q/p; in a sheared cell the
         shear strain, tau and tau / sigma_z instead of the last two."""
-        sigma = sim.walls.stress()
+        sigma = sim.fetch("walls").walls.stress()
         fields = {"strain": f"{self.axial.strain(sim.walls):.3f}", "sz": f"{sigma[2]:.0f}Pa"}
         if getattr(sim.walls, "sheared", False):
             tau = sim.walls.shear_stress()

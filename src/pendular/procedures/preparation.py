@@ -47,6 +47,7 @@ from pendular.utils.progress import PhaseBar
 from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int, check_positive
 from pendular.dem.walls import StressServo, WallForces
+from pendular.homogenize.on_the_fly import homogenized
 
 
 @numba.njit(cache=True, inline="always")
@@ -429,14 +430,13 @@ class GrowthTimeStep(growth.GrowthTimeStep):
 def static(unbalanced=0.01, tolerance=0.01):
     """Predicate (a function of sim): the unbalanced force is at most ``unbalanced`` and every
     StressServo's walls hold their target within ``tolerance`` (relative). A device run
-    holding the state measures it there (Simulation.homogenized): only the walls come back."""
+    holding the state measures it there (pendular.homogenize.on_the_fly.homogenized): only the
+    walls come back."""
 
     def done(sim):
-        device = sim.homogenized()
-        measured = (unbalanced_force(sim.particles, sim.contacts) if device is None
-                    else device["unbalanced_force"])
-        if measured > unbalanced:
+        if homogenized(sim)["unbalanced_force"] > unbalanced:
             return False
+        sim.fetch("walls")
         # the servos' targets are the host's (set between runs), read without the state
         for servo in (op for op in sim.peek("controls") if isinstance(op, StressServo)):
             error = np.abs(sim.walls.stress()[list(servo.axes)] - servo.target)
@@ -544,8 +544,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     (PREPARATION_PHASES) when the phase starts. They change no result.
     ``device``: where the phases run, "cpu" or "gpu" (docs/gpu.md): each phase's run copies
     the state to the device and back (the rescaling and the change of controls between them
-    run on the host); the returned simulation runs on the CPU (set its ``device`` to go on
-    elsewhere).
+    run on the host); the returned simulation's runs go on there (set its ``device`` to move
+    them).
     """
     if not isinstance(config, PrepareConfig):
         raise TypeError(f"config must be a PrepareConfig, got {type(config).__name__}")
@@ -577,10 +577,11 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     done = equilibrated(config)
 
     def grown(s):
-        stress = float(np.mean(s.walls.stress()))
+        stress = float(np.mean(s.fetch("walls").walls.stress()))
         return (abs(stress - config.prep_stress) <= 0.02 * config.prep_stress and done(s))
 
     def status(s):
+        s.fetch()
         return {"sigma": f"{np.mean(s.walls.stress()):.0f}/{config.prep_stress:g}Pa",
                 "n": f"{porosity(s.particles, s.walls):.3f}",
                 "unbal": f"{unbalanced_force(s.particles, s.contacts):.3f}"
@@ -627,7 +628,6 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     _require(done(sim), "equilibrium at the confining stress", steps["equilibrate"],
              status(sim), config)
     sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
-    sim.device = "cpu"
     report = {
         "porosity": porosity(sim.particles, sim.walls),
         "coordination": coordination(sim.contacts, len(sim.particles)),

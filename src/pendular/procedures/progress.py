@@ -23,8 +23,8 @@ end.
 
 import numpy as np
 
-from pendular.dem.measure import unbalanced_force
 from pendular.dem.walls import StressServo
+from pendular.homogenize.on_the_fly import homogenized
 from pendular.utils.progress import Approach, Decades, Phase
 
 #: Estimated steps of an equilibrium (the run bar's share of it) [-].
@@ -38,10 +38,7 @@ TUNING_PREPARATIONS = 3
 def unbalanced_now(sim):
     """The unbalanced force of ``sim``'s state [-], measured where the state is, as
     pendular.procedures.preparation.static measures it (a device run: there)."""
-    device = sim.homogenized()
-    if device is None:
-        return unbalanced_force(sim.particles, sim.contacts)
-    return device["unbalanced_force"]
+    return homogenized(sim)["unbalanced_force"]
 
 
 def off_equilibrium(unbalanced, tolerance):
@@ -53,7 +50,7 @@ def off_equilibrium(unbalanced, tolerance):
     def ratio(sim):
         worst = unbalanced_now(sim) / unbalanced
         for servo in (op for op in sim.peek("controls") if isinstance(op, StressServo)):
-            error = np.max(np.abs(sim.walls.stress()[list(servo.axes)] - servo.target))
+            error = np.max(np.abs(sim.fetch("walls").walls.stress()[list(servo.axes)] - servo.target))
             worst = max(worst, error / (tolerance * max(servo.target, 1e-12)))
         return worst
 
@@ -62,7 +59,7 @@ def off_equilibrium(unbalanced, tolerance):
 
 def mean_wall_stress(sim):
     """The walls' mean stress [Pa]."""
-    return float(sim.walls.stress().mean())
+    return float(sim.fetch("walls").walls.stress().mean())
 
 
 def growth_bar(label, target):
@@ -81,7 +78,8 @@ def equilibrium_bar(label, unbalanced, tolerance):
 def stress_bar(label, axis, target):
     """The bar of a loading stage until the stress of wall axis ``axis`` (0, 1, 2) reaches
     ``target`` [Pa]; None without ``label``."""
-    return label and Phase(label, Approach(lambda sim: sim.walls.stress()[axis], target, "Pa"))
+    return label and Phase(label, Approach(
+        lambda sim: sim.fetch("walls").walls.stress()[axis], target, "Pa"))
 
 
 def preparation_plan(sample, *, loaded=False):

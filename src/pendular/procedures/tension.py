@@ -78,6 +78,7 @@ from pendular.procedures.config import (TensionConfig, case_name, config_from_di
 from pendular.procedures.loading import measured
 from pendular.procedures.progress import equilibrium_bar, tension_plan
 from pendular.utils.progress import whole_run
+from pendular.homogenize.on_the_fly import homogenized
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -153,7 +154,6 @@ def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
     def prepared(friction):
         sim, report = prepare_sample(prepare_config(config, friction), progress=progress,
                                      device=device)
-        sim.device = device
         report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
         report["box_void_ratio"] = report["porosity"] / (1.0 - report["porosity"])
         report["prep_friction_deg"] = friction
@@ -292,39 +292,33 @@ class Pull:
                 op.apply(sim)
         self.steps = int(math.ceil(config.max_strain / (self.rate * sim.dt)))
         period = max(1, self.steps // RECORDS)
-        count = len(sim.particles)
-        # the homogenised columns reduced on the device when a device run holds the state
-        # (loading.measured): a record then brings back the walls alone, with the grips' pulls
+        # the homogenised columns measured where the state is held (loading.measured): on a
+        # device a record then brings back the walls alone, with the grips' pulls
         columns = {
             "step": lambda s: s.step,
             "time": lambda s: s.time,
             "axial_strain": lambda s: self.extension.strain(s.walls),
             "tensile_stress": self.tensile_stress,
             "sigma_wall": lambda s: s.walls.stress(),
-            "coordination": measured("coordination",
-                                     lambda s: coordination(s.contacts, count)),
-            "unbalanced_force": measured("unbalanced_force",
-                                         lambda s: unbalanced_force(s.particles, s.contacts)),
+            "coordination": measured("coordination"),
+            "unbalanced_force": measured("unbalanced_force"),
         }
         if self.grips:
             columns["grip_pull"] = self.pulls
         if bridges is not None:
             solid = sim.particles.solid_volume()
-            water_volume = measured("water_volume", lambda s: bridges.water_volume(s.contacts))
+            water_volume = measured("water_volume")
 
             def saturation(s):
-                device = s.homogenized()
-                if device is None:
-                    return bridges.saturation(s)
-                return device["water_volume"] / (s.walls.volume() - solid)
+                return homogenized(s)["water_volume"] / (s.walls.volume() - solid)
 
             columns.update({
-                "bridges": measured("bridges", bridges.count),
+                "bridges": measured("bridges"),
                 "water_content": lambda s: gravimetric_water_content(
                     water_volume(s), solid, config.specific_gravity),
                 "saturation": saturation})
         self.start = sim.step
-        self.recorder = HistoryRecorder(period, columns, origin=sim.step)
+        self.recorder = HistoryRecorder(period, columns, origin=sim.step, reads=("walls",))
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
         self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
@@ -332,14 +326,14 @@ class Pull:
 
     def pulls(self, sim: Simulation) -> list[float]:
         """The grips' pulls [N] (z-, z+) of ``sim``'s state."""
-        sim.walls           # on a device the pulls come back with the walls (dem.grips.Grip)
+        sim.fetch("walls")  # on a device the pulls come back with the walls (dem.grips.Grip)
         return [grip.pull for grip in self.grips]
 
     def tensile_stress(self, sim: Simulation) -> float:
         """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
         the cross-section (pendular.procedures.grips.tensile_stress), or minus a periodic cell's
         z stress."""
-        walls = sim.walls              # on a device, the grips' pulls come back with the walls
+        walls = sim.fetch("walls").walls   # on a device the pulls come back with the walls
         if walls.periodic:
             return -float(walls.stress()[2])
         return tensile_stress(self.grips, walls)
@@ -364,7 +358,7 @@ class Pull:
         """Pull on from where the pull stands (a resumed one too: its checks fall where they
         fell before) to rupture or --max-strain, at most ``budget`` steps; whether it ended."""
         def status(s):
-            return {"ext": f"{-self.extension.strain(s.walls):.4f}",
+            return {"ext": f"{-self.extension.strain(s.fetch('walls').walls):.4f}",
                     "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
 
         sim, period = self.sim, self.recorder.period

@@ -135,6 +135,7 @@ def equilibrium_status(unbalanced):
     each servo's stress against its target."""
 
     def status(sim):
+        sim.fetch()                 # all of a device run's state (Simulation.fetch)
         fields = {"unbalanced": f"{unbalanced_force(sim.particles, sim.contacts):.3g}"
                                 f"/{unbalanced:g}"}
         for servo in (op for op in sim.controls if isinstance(op, StressServo)):
@@ -609,10 +610,8 @@ class LaboratoryTest:
         self.config = config = self._sized(self.config)
         if config.sample_path is not None:
             return self.load_sample(config.sample_path, progress, threads, writers, device)
-        sim, report = prepare_sample(config.sample, progress=progress, threads=threads,
-                                     writers=writers, device=device)
-        sim.device = device
-        return sim, report
+        return prepare_sample(config.sample, progress=progress, threads=threads,
+                              writers=writers, device=device)
 
     def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
         """(sample saved at ``path`` servoed at the confining stress and run until static on
