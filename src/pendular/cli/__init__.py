@@ -18,7 +18,7 @@ import sys
 
 #: Command name -> (module under pendular.cli.commands, one-line description).
 COMMANDS = {
-    "triaxial": ("triaxial", "drained triaxial test (thesis Ch. 5), dry or wet"),
+    "triaxial": ("triaxial", "triaxial test (thesis Ch. 5), dry or wet, drained or undrained"),
     "oedometer": ("oedometer", "oedometric (K0) compression and unloading, dry or wet"),
     "isotropic": ("isotropic", "isotropic loading and unloading in stages: e against log p"),
     "simple-shear": ("simple_shear", "simple shear (periodic cell), drained or constant volume"),
