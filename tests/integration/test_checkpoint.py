@@ -355,10 +355,14 @@ def test_checkpoint_writer_saves_every_period(tmp_path):
 def bulky_scene():
     """50,000 spheres (a 7 MB checkpoint), no contacts: a checkpoint takes some milliseconds."""
     count = 50_000
-    particles = Particles(np.zeros((count, 3)), np.ones(count), 1000.0)
+    particles = Particles(np.full((count, 3), 0.5), np.full(count, 0.1), 1000.0)
     return Simulation(particles, Walls.box([0, 0, 0], [1, 1, 1]), 1.0,
                       neighbors=NeighborList(1.0), controls=[StressServo("xyz", 1.0, 1.0)],
                       integrator=Integrator(0.0))
+
+
+#: The faces of the unit box of bulky_scene.
+BOX_FACES = np.array([0.0, 1.0, 0.0, 1.0, 0.0, 1.0])
 
 
 def checkpoint_forever(path):
@@ -367,9 +371,10 @@ def checkpoint_forever(path):
     while True:
         sim.step += 1
         sim.time = 0.5 * sim.step
-        for array in (sim.particles.position, sim.particles.velocity, sim.walls.position,
-                      sim.controls[0].previous):
+        for array in (sim.particles.velocity, sim.controls[0].previous):
             array[:] = sim.step
+        sim.particles.position[:] = sim.step + 0.5      # the box moves with its spheres
+        sim.walls.position[:] = sim.step + BOX_FACES
         save_checkpoint(path, sim, extra_state=sim.step)
 
 
@@ -397,9 +402,10 @@ def test_kill_during_checkpointing_leaves_a_loadable_checkpoint(tmp_path):
     sim = bulky_scene()
     step = load_checkpoint(path, sim)
     assert step == sim.step > 1 and sim.time == 0.5 * step
-    for array in (sim.particles.position, sim.particles.velocity, sim.walls.position,
-                  sim.controls[0].previous):
+    for array in (sim.particles.velocity, sim.controls[0].previous):
         assert np.all(array == step)
+    assert np.all(sim.particles.position == step + 0.5)
+    assert np.array_equal(sim.walls.position, step + BOX_FACES)
 
 
 def test_samples_and_checkpoints_describe_their_datasets(prepared, tmp_path):
@@ -540,6 +546,15 @@ FORGED = {
                           "particles/radius[2] = -0.001 is outside the valid range (0, inf)"),
     "a wall at infinity": (put("walls/position", 1, np.inf), "walls/position[1] = inf is not "
                                                              "finite"),
+    "walls swapped on their axes": (
+        lambda handle: replace("walls/position", handle["walls/position"][()][[1, 0, 3, 2, 5, 4]])(
+            handle),
+        "on the x axis the high face lies at or below the low face"),
+    "a sphere wider than the box": (put("particles/radius", 0, 1.0),
+                                    "particles/radius[0] = 1 m: a sphere of that diameter does "
+                                    "not fit in the box"),
+    "a centre outside the walls": (put("particles/position", (1, 0), 10.0),
+                                   "lies outside the walls"),
     "dt NaN": (attribute("dt", np.nan), "dt = nan is outside the valid range (0, inf) s"),
     "extra_state not JSON": (attribute("extra_state", "{not json"),
                              "its extra_state attribute is not JSON"),

@@ -99,6 +99,10 @@ CASES = {
     "run steps": (lambda: scene().run(-1), "steps"),
     "record period": (lambda: HistoryRecorder(0, {}), "record period"),
     "record quantity": (lambda: HistoryRecorder(1, {"x": 3.0}), "quantities['x']"),
+    "record rows of unequal lengths": (
+        lambda: HistoryRecorder(1, {"step": lambda s: s.step, "time": lambda s: s.time}).load_state(
+            {"origin": 0, "end": None, "rows": {"step": np.zeros(3), "time": np.zeros(2)}}),
+        "rows/time holds 2 rows and rows/step 3"),
     "checkpoint period": (lambda: CheckpointWriter("c.h5", 0), "checkpoint period"),
     "vtk period": (lambda: VtkWriter("vtk", 0), "vtk period"),
     "vtk compression": (lambda: VtkWriter("vtk", 1, compression="gzip"), "compression"),

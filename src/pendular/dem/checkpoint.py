@@ -501,6 +501,33 @@ def _check_particles(source, arrays, scalars, particles):
     return count
 
 
+def _check_box(source, particle_arrays, wall_arrays, walls):
+    """ValueError unless the box of a checkpoint is one (each high face above its low face)
+    that holds its spheres: none wider than the box's narrowest side and, inside walls (not a
+    periodic cell), every centre between the faces."""
+    position = wall_arrays["position"]
+    width = position[1::2] - position[0::2]
+    if (width <= 0).any():
+        axis = "xyz"[int(np.argmin(width))]
+        raise ValueError(f"{source}: walls/position = {position.tolist()} m: on the {axis} axis "
+                         "the high face lies at or below the low face (valid: high > low on "
+                         "every axis)")
+    radius = particle_arrays["radius"]
+    widest = int(np.argmax(radius))
+    if 2.0 * radius[widest] >= width.min():
+        raise ValueError(f"{source}: particles/radius[{widest}] = {radius[widest]:g} m: a "
+                         f"sphere of that diameter does not fit in the box, whose narrowest "
+                         f"side is {width.min():g} m (valid: a diameter below it)")
+    if not walls.periodic:
+        centre = particle_arrays["position"]
+        outside = ((centre < position[0::2]) | (centre > position[1::2])).any(axis=1)
+        if outside.any():
+            k = int(np.flatnonzero(outside)[0])
+            raise ValueError(f"{source}: particles/position[{k}] = {centre[k].tolist()} m lies "
+                             f"outside the walls {position.tolist()} m (valid: every centre "
+                             "between its walls)")
+
+
 def _check_contacts(source, arrays, extra, count, fields):
     """ValueError unless the contact arrays of a checkpoint form a valid neighbour list of
     ``count`` particles (pendular.dem.neighbors.Contacts): dtypes and shapes, finite per-pair
@@ -681,6 +708,7 @@ def load_checkpoint(path, sim, expected_identity=None):
     step, time, dt = _check_clock(source, step, time, dt)
     count = _check_particles(source, particle_arrays, particle_scalars, sim.particles)
     _check_owned(source, "walls", wall_arrays, wall_scalars, sim.walls, count, False)
+    _check_box(source, particle_arrays, wall_arrays, sim.walls)
     contacts = None
     if has_contacts:
         try:

@@ -60,6 +60,12 @@ class HistoryRecorder:
                                             finite=False)
             except ValueError as error:
                 raise ValueError(f"rows/{error}") from None
+        lengths = {name: len(column) for name, column in columns.items()}
+        if len(set(lengths.values())) > 1:
+            shortest = min(lengths, key=lengths.get)
+            longest = max(lengths, key=lengths.get)
+            raise ValueError(f"rows/{shortest} holds {lengths[shortest]} rows and rows/{longest} "
+                             f"{lengths[longest]}; valid: one row per record in every quantity")
         self.origin, self.end = origin, end
         self.rows = {name: [np.array(row) for row in column]
                      for name, column in columns.items()}
