@@ -125,8 +125,8 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
         suction now (forces.refresh_bridges)."""
         s = state
         return (forces.refresh_bridges, s.count,
-                (s.radius, s.pair_count, s.pair_j, *s.bridge_columns()[:5], self.op.suction,
-                 self.op.surface_tension, *self.table))
+                (s.radius, s.pair_count, s.pair_j, s.bridge_columns()[:5], self.op.suction,
+                 self.op.surface_tension, self.table))
 
     def to_host(self, sim, state, index):
         """Persisting bridges' host state for the CPU's list (``index``: its pairs in the
@@ -186,8 +186,9 @@ class VolumeBridgesOnDevice(SuctionBridgesOnDevice):
         s = state
         smallest, largest = self.op.volume_table.volume_star_bounds()
         return (forces.exchange_liquid, 1,
-                (s.radius, s.pair_count, s.pair_i, s.pair_j, s.second_count, s.second_pair,
-                 *s.bridge_columns()[:2], s.film, s.released, s.events, s.marked,
+                (s.radius, s.pairs(), s.transposed(), *s.bridge_columns()[:2],
+                 forces.Liquid(self.roughness, self.closed, s.film, s.released, s.events,
+                               s.marked),
                  self.op.shares, smallest, largest, s.liquid_lost))
 
     def to_host(self, sim, state, index):

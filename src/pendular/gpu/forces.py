@@ -66,6 +66,12 @@ Bridges = namedtuple("Bridges", "wet persist volume_control state volume force f
 #: Volume control's liquid: ``roughness``, ``closed`` and pendular.gpu.state's ``film``,
 #: ``released``, ``events``, ``marked``.
 Liquid = namedtuple("Liquid", "roughness closed film released events marked")
+#: The transposed index of pendular.gpu.neighbors: per particle the ``count`` of pairs in
+#: which it is the second member and those pairs, ``pair`` (slot by slot).
+Transposed = namedtuple("Transposed", "count pair")
+#: The bridges as the gather reads them: at contact (``wet``) their ``attraction`` (K,) [N]
+#: along the normals, across gaps (``persist``) their forces on j from i ``pair_force``.
+Gathered = namedtuple("Gathered", "wet attraction persist pair_force")
 
 
 @cuda.jit
@@ -140,8 +146,7 @@ def pair_forces(particles, pairs, images, law, bridges, table, liquid, volume_ta
 
 
 @cuda.jit
-def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pair, state,
-                    volume, film, released, events, marked, share, smallest_star,
+def exchange_liquid(radius, pairs, transposed, state, volume, liquid, share, smallest_star,
                     largest_star, liquid_lost):
     """The liquid exchanges of the events pair_forces marked (volume control, a closed amount:
     the CPU's exchange_liquid), on one thread, in the CPU's pair order (each particle's row in
@@ -149,7 +154,10 @@ def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pai
     lost, added to ``liquid_lost`` (1,) [m^3], then the bridges that form from films; nothing
     when ``marked`` (1,) counted no event (the CPU's test), else it is cleared. The pairs of a
     grain q are ranges of step N: its own, slots q + s N, and those where it is second,
-    ``second_pair[q + s N]``."""
+    ``second_pair[q + s N]`` (the bundles Pairs, Transposed, Liquid)."""
+    pair_count, pair_i, pair_j = pairs.count, pairs.first, pairs.second
+    second_count, second_pair = transposed
+    film, released, events, marked = liquid.film, liquid.released, liquid.events, liquid.marked
     if cuda.grid(1) != 0 or marked[0] == 0:
         return
     marked[0] = 0
@@ -175,12 +183,14 @@ def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pai
 
 
 @cuda.jit
-def refresh_bridges(radius, pair_count, pair_j, state, volume, bridge_force, filling_i,
-                    filling_j, suction, surface_tension, radius_ratios, suction_axis,
-                    distance_low, log_distance_rupture, log_values):
+def refresh_bridges(radius, pair_count, pair_j, columns, suction, surface_tension, table):
     """Every bridge at contact (AT_CONTACT) of particle p's row looked up again at a new
     ``suction`` [Pa] (the CPU's refresh_contact_bridges at the first step after
-    SuctionBridges.set_suction; its values depend on the radii alone), one thread per row."""
+    SuctionBridges.set_suction; its values depend on the radii alone), one thread per row;
+    ``columns`` the bridges' state, volume, force and filling angles, ``table`` a
+    BridgeTable's arrays()."""
+    state, volume, bridge_force, filling_i, filling_j = columns
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
     p = cuda.grid(1)
     n = radius.shape[0]
     if p >= n:
@@ -224,9 +234,8 @@ def add_wall_pushes(p, f0, f1, f2, position, radius, wall_position, young):
 
 
 @cuda.jit
-def gather(position, radius, pair_count, second_count, second_pair, pair_force, normal,
-           overlap, wet, attraction, walls_first, wall_position, wall_young, persist,
-           bridge_pair_force, force, torque):
+def gather(position, radius, pairs, transposed, gathered, walls_first, wall_position,
+           wall_young, force, torque):
     """Each particle's force and torque from its pairs, by the CPU's sum (_sum_pair_terms
     over the device's rows; less the ``attraction`` (K,) [N] along the normals when ``wet``:
     bridges at contact) and the walls, set (not added), in the CPU's order: the walls first
@@ -235,7 +244,11 @@ def gather(position, radius, pair_count, second_count, second_pair, pair_force, 
     a periodic cell, which has no walls (their springs add zeros). With ``persist`` the
     bridges' forces on j from i ``bridge_pair_force`` (K, 3) [N] are added last, by the CPU's
     sum (_sum_pair_forces, the CPU's gather_pair_forces after the contact law and the
-    walls)."""
+    walls). The bundles Pairs, Transposed and Gathered."""
+    pair_count, pair_force, normal, overlap = (pairs.count, pairs.force, pairs.normal,
+                                               pairs.overlap)
+    second_count, second_pair = transposed
+    wet, attraction, persist, bridge_pair_force = gathered
     p = cuda.grid(1)
     n = position.shape[0]
     if p >= n:

@@ -29,13 +29,18 @@ COLUMNS = sum(size for _, size in LAYOUT)
 
 
 @cuda.jit
-def pair_moments(radius, mass, inertia, angular_velocity, pair_count, pair_j, normal, overlap,
-                 normal_force, rolling_moment, twisting_moment, last_normal, moment, rolling,
-                 twisting, damping_ratio, dt):
+def pair_moments(radius, mass, inertia, angular_velocity, pairs, springs, moment,
+                 coefficients, dt):
     """Every pair of particle p's row (one thread per particle): the CPU's update of its
     springs (``rolling_moment`` (K, 3), ``twisting_moment`` (K,), ``last_normal`` (K, 3): the
     columns of the device's ``rolling``) and its ``moment`` (K, 3) [N m] on p
-    (pendular.dem.rolling.pair_moments)."""
+    (pendular.dem.rolling.pair_moments); ``pairs`` pendular.gpu.forces.Pairs, ``springs``
+    the three (columns), ``coefficients`` the operation's (rolling, twisting, damping_ratio)."""
+    pair_count, pair_j, normal, overlap, normal_force = (pairs.count, pairs.second,
+                                                         pairs.normal, pairs.overlap,
+                                                         pairs.normal_force)
+    rolling_moment, twisting_moment, last_normal = springs
+    rolling, twisting, damping_ratio = coefficients
     p = cuda.grid(1)
     n = radius.shape[0]
     if p >= n:
@@ -107,10 +112,9 @@ class Resistance(DeviceSide):
         s = state
         op = self.op
         n = s.count
-        return [(pair_moments, n, (s.radius, s.mass, s.inertia, s.angular_velocity,
-                                   s.pair_count, s.pair_j, s.normal, s.overlap,
-                                   s.normal_force, *columns(s.rolling), s.pair_moment,
-                                   op.rolling, op.twisting, op.damping_ratio, dt)),
+        return [(pair_moments, n, (s.radius, s.mass, s.inertia, s.angular_velocity, s.pairs(),
+                                   columns(s.rolling), s.pair_moment,
+                                   (op.rolling, op.twisting, op.damping_ratio), dt)),
                 (gather_moments, n, (s.pair_count, s.second_count, s.second_pair,
                                      s.pair_moment, s.torque))]
 

@@ -204,10 +204,10 @@ class GpuSimulation:
                             s.marked),
               bridges.volume_table, s.flags)),
             *((bridges.exchange_step(s),) if bridges.volume_control else ()),
-            (forces.gather, n, (s.position, s.radius, s.pair_count, s.second_count,
-                                s.second_pair, s.pair_force, s.normal, s.overlap, joined,
-                                columns[2], walls_first, s.wall_position, wall_young,
-                                s.persist, s.bridge_pair_force, s.force, s.torque)),
+            (forces.gather, n, (s.position, s.radius, s.pairs(), s.transposed(),
+                                forces.Gathered(joined, columns[2], s.persist,
+                                                s.bridge_pair_force),
+                                walls_first, s.wall_position, wall_young, s.force, s.torque)),
             *(launch for role in ("rolling", "gravity")
               for side in self.scene.forces_of(role) for launch in side.launches(s, sim.dt)),
         ]

@@ -29,7 +29,7 @@ from pendular.dem.protocols import pair_key
 from pendular.gpu.cell import CELL_SUMS
 from pendular.gpu import rolling as device_rolling
 from pendular.gpu.cuda import cuda
-from pendular.gpu.forces import Images, Pairs
+from pendular.gpu.forces import Images, Pairs, Transposed
 from pendular.gpu.integrate import Motion
 from pendular.gpu.neighbors import Grid, PairState, Rows
 from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS, Program
@@ -242,6 +242,10 @@ class DeviceState:
         .Pairs)."""
         return Pairs(self.pair_count, self.pair_i, self.pair_j, self.shear_force, self.normal,
                      self.overlap, self.normal_force, self.pair_force)
+
+    def transposed(self):
+        """The transposed pair index (pendular.gpu.forces.Transposed)."""
+        return Transposed(self.second_count, self.second_pair)
 
     def images(self):
         """A periodic cell's images, period and stretching (pendular.gpu.forces.Images; inside
