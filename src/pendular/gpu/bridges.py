@@ -48,7 +48,7 @@ class NoBridges:
     def follow_suction(self, state, holding):
         """Nothing to follow."""
 
-    def to_host(self, sim, state, index):
+    def pairs_to_host(self, sim, state, index):
         """Nothing to bring back."""
 
 
@@ -128,7 +128,7 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
                 (s.radius, s.pair_count, s.pair_j, s.bridge_columns()[:5], self.op.suction,
                  self.op.surface_tension, self.table))
 
-    def to_host(self, sim, state, index):
+    def pairs_to_host(self, sim, state, index):
         """Persisting bridges' host state for the CPU's list (``index``: its pairs in the
         device's, previous_pair_index): their count, which the CPU's next list must carry
         (CapillaryBridges._attach), and their forces on j from i at the last step, carried to
@@ -191,8 +191,8 @@ class VolumeBridgesOnDevice(SuctionBridgesOnDevice):
                                s.marked),
                  self.op.shares, smallest, largest, s.liquid_lost))
 
-    def to_host(self, sim, state, index):
+    def pairs_to_host(self, sim, state, index):
         """As the suction's across gaps, with the film on each grain and the liquid lost."""
-        super().to_host(sim, state, index)
+        super().pairs_to_host(sim, state, index)
         self.op.film = state.film.copy_to_host()
         self.op.liquid_lost = float(state.liquid_lost.copy_to_host()[0])

@@ -33,10 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: What a force's side is to the step (pendular.gpu.simulation): the one contact law (the pair
-#: forces' kernel and its gather), the walls' springs, the capillary bridges (joining the pair
-#: forces' kernel), a rolling resistance and gravity (their launches after the gather).
-FORCE_ROLES = ("contact law", "walls", "bridges", "rolling", "gravity")
+#: The roles of forces the step reads by name (pendular.gpu.simulation): the one contact law
+#: (the pair forces' kernel and its gather), the walls' springs, the capillary bridges (joining
+#: the pair forces' kernel). Any other force runs by its own ``launches`` after the gather
+#: (a rolling resistance, gravity), its role its own name.
+FORCE_ROLES = ("contact law", "walls", "bridges")
 
 #: CPU operation class -> its DeviceSide class (``device_side``).
 _SIDES = {}
@@ -62,6 +63,17 @@ class DeviceSide:
 
     def check(self, scene):
         """ValueError naming what of ``scene`` this side does not run (nothing by default)."""
+
+    def launches(self, state, dt):
+        """A force's (kernel, items, arguments) after the pairs' gather, in the scene's order
+        (``state`` a DeviceState, ``dt`` [s]); none by default (the contact law, the walls'
+        springs and the bridges run in the pair forces' kernel and the gather)."""
+        return []
+
+    def pairs_to_host(self, sim, state, index):
+        """A force's per-pair state from ``state`` (a DeviceState) into its operation, carried
+        to the host list's pairs (``index``: pendular.dem.neighbors.previous_pair_index), when
+        the state comes back to ``sim``; nothing by default."""
 
 
 class ControlSide(DeviceSide):

@@ -118,7 +118,7 @@ class Resistance(DeviceSide):
                 (gather_moments, n, (s.pair_count, s.second_count, s.second_pair,
                                      s.pair_moment, s.torque))]
 
-    def to_host(self, state, index):
+    def pairs_to_host(self, sim, state, index):
         """The device's pair moments into the operation's ``moment``, carried to the host
         list's pairs (``index``: pendular.dem.neighbors.previous_pair_index)."""
         self.op.moment = carry_pair_array(state.pair_moments(), index)

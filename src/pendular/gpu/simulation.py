@@ -183,8 +183,8 @@ class GpuSimulation:
         """(kernel, items, arguments) of the pair forces and their gather (walls' springs of
         stiffness ``wall_young`` [Pa] E R, 0: none, added before the pairs' terms when
         ``walls_first``; a periodic cell's images and stretching: DeviceState.images), then
-        the rolling resistance and the weight, if the scene has them (their sides'
-        ``launches``)."""
+        every force's own launches (a rolling resistance, the weight: their sides'
+        ``launches``) in the scene's order."""
         sim = self.sim
         s = self.state
         n = s.count
@@ -208,8 +208,7 @@ class GpuSimulation:
                                 forces.Gathered(joined, columns[2], s.persist,
                                                 s.bridge_pair_force),
                                 walls_first, s.wall_position, wall_young, s.force, s.torque)),
-            *(launch for role in ("rolling", "gravity")
-              for side in self.scene.forces_of(role) for launch in side.launches(s, sim.dt)),
+            *(launch for side in self.scene.forces for launch in side.launches(s, sim.dt)),
         ]
 
     def finish_step(self):
@@ -330,9 +329,8 @@ class GpuSimulation:
                                     sim.contacts.pair_j)
         sim.contacts.force = carry_pair_array(listed.force, index)
         sim.contacts.normal_force = carry_pair_array(listed.normal_force, index)
-        for side in self.scene.forces_of("rolling"):
-            side.to_host(self.state, index)
-        self.bridges.to_host(sim, self.state, index)
+        for side in self.scene.forces:
+            side.pairs_to_host(sim, self.state, index)
         if self._growth is not None:
             self._growth.after_copy_back(sim)
         self._report_failure()
