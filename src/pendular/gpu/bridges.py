@@ -67,6 +67,7 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
 
     @property
     def persist(self):
+        """Whether the bridges persist across gaps (the operation's option)."""
         return self.op.persist
 
     @property
@@ -149,6 +150,7 @@ class VolumeBridgesOnDevice(SuctionBridgesOnDevice):
 
     @property
     def persist(self):
+        """Volume-controlled bridges always persist across gaps."""
         return True
 
     @property
