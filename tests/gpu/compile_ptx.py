@@ -51,10 +51,27 @@ class HostArray(np.ndarray):
         return np.array(self)
 
 
+def plain(argument):
+    """``argument`` with its host arrays as plain ndarrays, in tuples (a kernel's bundles of
+    arrays) too."""
+    if isinstance(argument, np.ndarray):
+        return np.asarray(argument)
+    if isinstance(argument, tuple):
+        values = [plain(value) for value in argument]
+        return type(argument)(*values) if hasattr(argument, "_fields") else tuple(values)
+    return argument
+
+
+def signature(arguments):
+    """The Numba types of a kernel's ``arguments``."""
+    import numba
+
+    return tuple(numba.typeof(plain(argument)) for argument in arguments)
+
+
 def compile_step_kernels(cuda, capability):
     """{kernel (and " wet"): PTX lines} of every kernel of a dry and a wet step, and of the
     homogenisation at a record step (pendular.gpu.homogenize)."""
-    import numba
     import numba.cuda.dispatcher as dispatcher
 
     dispatcher.get_current_device = lambda: types.SimpleNamespace(
@@ -67,14 +84,12 @@ def compile_step_kernels(cuda, capability):
     compiled = {}
     for wet in (False, True):
         gpu = GpuSimulation(scene(wet=wet))
-        gpu._configure()
+        gpu.configure()
         reduction = launches(gpu, np.zeros((2, COLUMNS)), np.zeros(COLUMNS))
         # wet, the bridges' refresh at a new suction (a suction path, between runs)
-        refresh = (gpu._refresh_step(),) if wet else ()
-        for kernel, _, args in (*gpu._steps, *reduction, *refresh):
-            signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray) else a)
-                              for a in args)
-            ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
+        refresh = (gpu.bridges.refresh_step(gpu.state),) if wet else ()
+        for kernel, _, args in (*gpu.steps, *reduction, *refresh):
+            ptx, _ = cuda.compile_ptx(kernel.py_func, signature(args), cc=capability)
             compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
     # the kernels a radius growth adds to a dry step (growth_checks.py's scene), those of a
     # dry and a wet step in a periodic cell (periodic_checks.py's), of a simple shear
@@ -94,13 +109,11 @@ def compile_step_kernels(cuda, capability):
                        (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume"),
                        (rolling_scene(), "")):
         gpu = GpuSimulation(sim)
-        gpu._configure()
-        for kernel, _, args in gpu._steps:
+        gpu.configure()
+        for kernel, _, args in gpu.steps:
             name = kernel.py_func.__name__
             if name not in compiled and f"{name}{label}" not in compiled:
-                signature = tuple(numba.typeof(np.asarray(a) if isinstance(a, np.ndarray)
-                                               else a) for a in args)
-                ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=capability)
+                ptx, _ = cuda.compile_ptx(kernel.py_func, signature(args), cc=capability)
                 compiled[f"{name}{label}"] = ptx.count("\n")
     return compiled
 

@@ -76,7 +76,7 @@ def growth_run():
     sim = scene()
     gpu = GpuSimulation(sim)
     gpu.run(STEPS)
-    gpu_rebuilds = gpu.rebuilds
+    gpu_rebuilds = gpu.fetch_rebuilds()
     gpu.to_host()
     # the same steps in two GpuSimulations, the state back on the host between them
     split = scene()

@@ -116,7 +116,7 @@ def agreement(wet, build=scene, steps=None, handover=HANDOVER, continued=CONTINU
     gpu_sim = build(wet)
     gpu = GpuSimulation(gpu_sim)
     gpu.run(steps)
-    rebuilds = gpu.rebuilds
+    rebuilds = gpu.fetch_rebuilds()
     gpu.to_host()
     out = compare(snapshot(cpu), snapshot(gpu_sim))
     cell = gpu_sim.walls

@@ -135,8 +135,8 @@ def walls():
         other.run(STEPS)
         without[name] = plain_compare(plain_snapshot(cpu), plain_snapshot(other))
     return {"steps": STEPS, "agreement": compare(snapshot(cpu), snapshot(gpu.sim)),
-            "rebuilds": gpu.rebuilds, "rebuilds_cpu": cpu.neighbors.rebuilds,
-            "rebuilds_forced": forced.rebuilds,
+            "rebuilds": gpu.fetch_rebuilds(), "rebuilds_cpu": cpu.neighbors.rebuilds,
+            "rebuilds_forced": forced.fetch_rebuilds(),
             "forced_equals_plain": identical(snapshot(gpu.sim), snapshot(forced.sim)),
             "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim)),
             "rolling_on_limit": on_limit(cpu), "without": without}

@@ -179,7 +179,7 @@ def growth_agreement():
     sim = growth_scene()
     gpu = GpuSimulation(sim)
     gpu.run(GROWTH_STEPS)
-    rebuilds = gpu.rebuilds
+    rebuilds = gpu.fetch_rebuilds()
     gpu.to_host()
     fixed, split = growth_scene(timestep=False), growth_scene(timestep=False)
     fixed.run(GROWTH_STEPS)

@@ -167,7 +167,7 @@ def main():
     row.sim.writers.clear()
     row.run(STEPS // 2)
     device_parameters = row.state.parameters.copy_to_host()
-    row._configure()                        # the set-up of the next run
+    row.configure()                         # the set-up of the next run
     kept = np.array_equal(row.state.parameters.copy_to_host(), device_parameters,
                           equal_nan=True)         # NaN: what a MixedStress does not hold
     row.run(STEPS - STEPS // 2)

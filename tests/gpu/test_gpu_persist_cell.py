@@ -100,7 +100,7 @@ def agreement(control):
             gpu_sim.device = "gpu"
             gpu_sim.run(steps)
         if stage == 0:      # the device run's own count
-            out["rebuilds"] = [cpu.neighbors.rebuilds, gpu.rebuilds]
+            out["rebuilds"] = [cpu.neighbors.rebuilds, gpu.fetch_rebuilds()]
         held = snapshot(cpu, cpu_bridges)
         result = compare(held, snapshot(gpu_sim, gpu_bridges))
         c = cpu.contacts

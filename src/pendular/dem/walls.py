@@ -15,6 +15,8 @@ from pendular.dem.protocols import state_array
 from pendular.utils.validate import check_int, check_positive, check_range
 
 AXES = {"x": 0, "y": 1, "z": 2}
+#: Servo calls during which the stiffness is refreshed every call (YADE: scene->iter < 100).
+STIFFNESS_WARMUP = 100
 
 
 def _axes(names):
@@ -38,6 +40,13 @@ def move_walls(wall_position, wall_velocity, wall_indices, outward, dt):
         sign = 1.0 if w % 2 else -1.0
         wall_position[w] += sign * outward[slot]
         wall_velocity[w] = outward[slot] / dt
+
+
+@numba.njit(cache=True)
+def servo_refreshes(calls, every):
+    """Whether a servo refreshes its stiffness at its call after ``calls`` calls: at each call
+    of the warm-up (STIFFNESS_WARMUP), then every ``every`` calls."""
+    return calls < STIFFNESS_WARMUP or calls % every == 0
 
 
 @numba.njit(cache=True)
@@ -105,8 +114,8 @@ class StressServo:
       a periodic cell's stiffness every max(stiffness_every, CELL_STIFFNESS_EVERY) calls.
     """
 
-    #: Calls during which the stiffness is refreshed every step (YADE: scene->iter < 100).
-    STIFFNESS_WARMUP = 100
+    #: Calls during which the stiffness is refreshed every step.
+    STIFFNESS_WARMUP = STIFFNESS_WARMUP
     #: Fewest calls between refreshes of a periodic cell's stiffness after the warm-up: a sum
     #: over every contact, as costly as the force gather (YADE's stiffnessUpdateInterval is 10;
     #: the stiffness of a sample under shear changes little in 50 steps, and the servo's tests
@@ -169,7 +178,7 @@ class StressServo:
         every = self.stiffness_every
         if walls.periodic:
             every = max(every, self.CELL_STIFFNESS_EVERY)
-        refresh = self.calls < self.STIFFNESS_WARMUP or self.calls % every == 0
+        refresh = servo_refreshes(self.calls, every)
         self.calls += 1
         if walls.periodic:          # slots 0 .. len(axes) - 1 of stiffness and previous
             if refresh:

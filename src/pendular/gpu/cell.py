@@ -37,12 +37,15 @@ shears nor is sheared keeps (3,) arrays and a one-entry ``shear``: the code of b
 
 import numpy as np
 
-from pendular.dem.cell import ConstantShearRate, pair_stiffness as cpu_pair_stiffness, servo_cell
+from pendular.dem.cell import (ConstantShearRate, PeriodicCell,
+    pair_stiffness as cpu_pair_stiffness, servo_cell)
 from pendular.dem.virial import add_face_term, add_outer, pair_force_with_attraction
 from pendular.dem.walls import StressServo
+from pendular.gpu import integrate, neighbors
 from pendular.gpu.cuda import cuda, device, device_twin
+from pendular.gpu.operations import BoxSide, ControlSide, device_side
 from pendular.gpu.walls import (MIXED_STRESS, RADIUS_GROWTH, REDUCE_CHUNK, SHEAR_RATE,
-    STIFFNESS_WARMUP, STRAIN_RATE, STRESS_SERVO, growth_rate, mixed_stress)
+    STRAIN_RATE, STRESS_SERVO, growth_rate, mixed_stress, servo_refreshes)
 
 servo = device_twin(servo_cell)
 outer = device_twin(add_outer)
@@ -65,19 +68,23 @@ def refreshes(c, parameters, calls):
     """Whether the servo of row c refreshes the cell's stiffness at its next call
     (StressServo.apply in a periodic cell: every call of the warm-up, then every
     max(stiffness_every, CELL_STIFFNESS_EVERY) calls)."""
-    every = max(int(parameters[c, 5]), CELL_STIFFNESS_EVERY)
-    return calls[c] < STIFFNESS_WARMUP or calls[c] % every == 0
+    return servo_refreshes(calls[c], max(int(parameters[c, 5]), CELL_STIFFNESS_EVERY))
 
 
 @cuda.jit
-def cell_partials(position, force, radius, pair_count, pair_j, image, period, pair_force,
-                  normal, overlap, normal_force, wet, attraction, persist, bridge_pair_force,
-                  kinds, parameters, calls, partial):
+def cell_partials(position, force, radius, pairs, images, wet, attraction, persist,
+                  bridge_pair_force, program, partial):
     """partial[b]: block b's sums (module docstring), its particles in order; the face terms
     with the ``attraction`` (K,) [N] along the normals when ``wet`` (bridges at contact),
     with ``persist`` those of the bridges' forces on j from i ``bridge_pair_force`` (K, 3) [N]
     too (bridges across gaps: the CPU's gather_pair_forces_virial); the stiffness when a
-    servo among the controls (``kinds``) refreshes it this step."""
+    servo among the controls (``program``'s kinds) refreshes it this step. The bundles
+    pendular.gpu.forces.Pairs and Images, pendular.gpu.walls.Program."""
+    pair_count, pair_j = pairs.count, pairs.second
+    pair_force, normal, overlap, normal_force = (pairs.force, pairs.normal, pairs.overlap,
+                                                 pairs.normal_force)
+    image, period = images.image, images.period
+    kinds, parameters, calls = program.kinds, program.parameters, program.calls
     b = cuda.grid(1)
     n = position.shape[0]
     if b >= partial.shape[0]:
@@ -140,12 +147,14 @@ def follow(cell_position, rate, shear, dt):
 
 @cuda.jit
 def cell_controls(partial, cell_position, rate, stress_tensor, cell_stiffness, period,
-                  affine_rate, shear, kinds, control_walls, wall_counts, parameters, previous,
-                  stiffness, calls, dt, step, failure):
+                  affine_rate, shear, program, dt):
     """The cell's stress from the blocks' sums, its rates (and shear rate) to zero, its
     controls, the step counted (``step``, for a mixed condition's ``failure``:
     pendular.gpu.walls), the offset followed over the step (a sheared layout: ``period``
-    (4,)), then ``period`` and ``affine_rate`` (module docstring). One thread."""
+    (4,)), then ``period`` and ``affine_rate`` (module docstring). One thread; ``program``
+    the controls' (pendular.gpu.walls.Program)."""
+    (kinds, control_walls, wall_counts, parameters, previous, stiffness, calls, step,
+     failure) = program
     if cuda.grid(1) != 0:
         return
     sheared = period.shape[0] > 3
@@ -200,16 +209,23 @@ def cell_controls(partial, cell_position, rate, stress_tensor, cell_stiffness, p
         affine_rate[3] = shear[1]
 
 
-def sheared_layout(cell, controls):
-    """Whether a scene in the periodic cell ``cell`` with ``controls`` needs the sheared
-    layout (module docstring): the cell is sheared or a control shears it."""
-    return cell.sheared or any(isinstance(op, ConstantShearRate) for op in controls)
+@device_side(ConstantShearRate)
+class ShearRateRow(ControlSide):
+    """A ConstantShearRate's row (SHEAR_RATE): its rate gamma_dot [1/s] in the row's first
+    parameter; a periodic cell's only."""
+
+    role = SHEAR_RATE
+    in_walls = False
+
+    def parameters(self, values):
+        values[0] = self.op.rate
 
 
 def upload_shear(state, cell, sheared):
     """A periodic cell's shear on the device (``state``: pendular.gpu.state.DeviceState, its
     ``period``, ``affine_rate`` and ``shear``): the sheared layout from the host's ``cell``
-    when ``sheared`` (sheared_layout), else a one-entry ``shear`` that nothing reads."""
+    when ``sheared`` (the cell is sheared or a control shears it), else a one-entry ``shear``
+    that nothing reads."""
     if not sheared:
         state.shear = cuda.to_device(np.zeros(1))
         return
@@ -226,3 +242,51 @@ def shear_to_host(state, cell):
         offset, rate, strain, _ = state.shear.copy_to_host()
         cell.shear_offset, cell.shear_rate, cell.shear_strain = (float(offset), float(rate),
                                                                  float(strain))
+
+
+@device_side(PeriodicCell)
+class CellBox(BoxSide):
+    """A periodic cell (module docstring): its shear's layout and state, a step's launches."""
+
+    def upload(self, state, scene):
+        upload_shear(state, self.op, self.op.sheared or bool(scene.controls_of(SHEAR_RATE)))
+
+    def to_host(self, state, box):
+        shear_to_host(state, box)
+
+    def steps(self, gpu):
+        """(kernel, items, arguments) of a step in a periodic cell: the rebuild (wrap and
+        bin, pairs through the faces, finish; in a sheared cell the offset it took stored),
+        the forces (no walls), the cell's stress and controls, the leapfrog carried by the
+        cell's stretching and shear."""
+        sim = gpu.sim
+        s = gpu.state
+        n = s.count
+        # bridges at contact join the contact law's gather (their attraction in the face
+        # terms); persisting ones add their own forces' face terms (the CPU's
+        # gather_pair_forces_virial)
+        joined = s.wet and not s.persist
+        bridges = s.bridges
+        sheared = s.period.shape[0] > 3
+        return [
+            (neighbors.bin_periodic, n, (s.position, s.wall_position, s.period, s.wraps,
+                                         s.grid(), s.flags)),
+            (neighbors.find_periodic_pairs, n,
+             (s.position, s.radius, s.skin + s.reach, s.wall_position, s.period, s.grid(),
+              s.rows(), s.image, s.carried(), s.new_carried(), s.flags)),
+            gpu.finish_step(),
+            *([(neighbors.shear_rebuilt, 1, (s.period, s.shear, s.flags))] if sheared else []),
+            *gpu.force_steps(False, 0.0),
+            (cell_partials, s.cell_partial.shape[0],
+             (s.position, s.force, s.radius, s.pairs(), s.images(), joined, bridges[:, 2],
+              s.persist, s.bridge_pair_force, s.program(), s.cell_partial)),
+            (cell_controls, 1,
+             (s.cell_partial, s.wall_position, s.cell_rate, s.stress_tensor, s.cell_stiffness,
+              s.period, s.affine_rate, s.shear, s.program(), sim.dt)),
+            (integrate.cell_leapfrog, n,
+             (s.motion(), gpu.scene.integrator.damping, s.affine_rate, sim.dt,
+              s.reference_position, s.wall_position, s.reference_walls, s.period, s.shear,
+              0.5 * s.skin,
+              2.0 * float(sim.peek("particles").radius.max()) + s.skin + s.reach,
+              s.flags)),
+        ]

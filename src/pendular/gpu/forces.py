@@ -13,15 +13,22 @@ CPU's sum of a particle's terms (pendular.dem.contact_law._sum_pair_terms) over 
 particle's force is the CPU's sum in the CPU's order.
 """
 
+from collections import namedtuple
+
+import numpy as np
+
 from pendular.capillary.bridge_kernels import (FORMS_FROM_FILMS, RUPTURED,
     _exchange_ruptured, _follow_across_gap, _follow_contact, _follow_volume, _form_at_contact,
     _form_from_films)
 from pendular.capillary.bridge_state import AT_CONTACT
-from pendular.dem.contact_law import (_evaluate_pair, _first_member, _store_row_sums,
-    _stretched, _sum_pair_terms, wall_contact_stiffness)
-from pendular.dem.hertz_mindlin import _evaluate_damped_pair
+from pendular.dem.contact_law import (ContactForces, _evaluate_pair, _first_member,
+    _store_row_sums, _stretched, _sum_pair_terms, wall_contact_stiffness)
+from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
+    _evaluate_damped_pair)
 from pendular.dem.neighbors import _sum_pair_forces
+from pendular.dem.walls import WallForces
 from pendular.gpu.cuda import cuda, device, device_twin
+from pendular.gpu.operations import DeviceSide, device_side
 
 first_member = device_twin(_first_member)
 evaluate_pair = device_twin(_evaluate_pair)
@@ -39,35 +46,63 @@ store_row_sums = device_twin(_store_row_sums)
 wall_stiffness = device_twin(wall_contact_stiffness)
 
 
+#: The particles' state the pair law reads: (N, 3) [m], [m/s], [rad/s]; (N,) [m], [kg].
+Particles = namedtuple("Particles", "position velocity angular_velocity radius mass")
+#: The pairs (pendular.gpu.neighbors' rows: ``count`` per particle, ``first`` and ``second``
+#: members per pair) and their state: the tangential spring, normal, overlap, normal force
+#: and force on j from i (pendular.gpu.state).
+Pairs = namedtuple("Pairs", "count first second shear_force normal overlap normal_force force")
+#: The box as the pair law sees it: each pair's ``image`` (K, 3) int8, ``period`` and
+#: ``affine_rate`` (zeros inside walls: pendular.gpu.state's no_image, no_period).
+Images = namedtuple("Images", "image period affine_rate")
+#: The contact law's parameters (a law's device side, pendular.gpu.forces.LinearLaw.law) and
+#: the time step dt [s].
+Law = namedtuple("Law", "stiffness shear_stiffness tan_friction damped hertz damping dt")
+#: Capillary bridges: what runs (``wet``, ``persist``, ``volume_control``), the columns of
+#: pendular.gpu.state's ``bridges`` (BridgeState's fields), the forces on j from i of bridges
+#: across gaps ``pair_force`` (K, 3) [N], ``suction`` [Pa] and ``surface_tension`` [N/m].
+Bridges = namedtuple("Bridges", "wet persist volume_control state volume force filling_i "
+                                "filling_j pair_suction pair_force suction surface_tension")
+#: Volume control's liquid: ``roughness``, ``closed`` and pendular.gpu.state's ``film``,
+#: ``released``, ``events``, ``marked``.
+Liquid = namedtuple("Liquid", "roughness closed film released events marked")
+#: The transposed index of pendular.gpu.neighbors: per particle the ``count`` of pairs in
+#: which it is the second member and those pairs, ``pair`` (slot by slot).
+Transposed = namedtuple("Transposed", "count pair")
+#: The bridges as the gather reads them: at contact (``wet``) their ``attraction`` (K,) [N]
+#: along the normals, across gaps (``persist``) their forces on j from i ``pair_force``.
+Gathered = namedtuple("Gathered", "wet attraction persist pair_force")
+
+
 @cuda.jit
-def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i, pair_j,
-                image, period, affine_rate, shear_force, normal, overlap, normal_force, force,
-                young, shear_ratio, tan_friction, dt, mass, damped, hertz, damping, flags, wet,
-                persist, volume_control,
-                state, volume, bridge_force, filling_i, filling_j, bridge_suction,
-                bridge_pair_force, suction, surface_tension, radius_ratios, suction_axis,
-                distance_low, log_distance_rupture, log_values, roughness, closed, film,
-                released, events, marked, volume_ratios, volume_axes, volume_distance_low,
-                volume_log_rupture, grid):
-    """Every pair of particle p's row (one thread per particle): the CPU's contact law
+def pair_forces(particles, pairs, images, law, bridges, table, liquid, volume_table, flags):
+    """Every pair of particle p's row (one thread per particle; the bundles Particles,
+    Pairs, Images, Law, Bridges, Liquid; ``table`` a BridgeTable's arrays(),
+    ``volume_table`` a VolumeBridgeTable's, stand-ins when dry): the CPU's contact law
     (_evaluate_pair; with ``damped``, the damped law of pendular.dem.hertz_mindlin,
-    _evaluate_damped_pair, of ``mass`` (N,) [kg], ``hertz``, ``damping`` and ``young``,
-    ``shear_ratio`` standing for its modulus and tangential stiffness; with its tests as the
-    CPU's pair_forces: images where ``period`` (3,)
-    [m] is not zero, each pair's in ``image`` (K, 3) int8, and stretching where
-    ``affine_rate`` (3,) [1/s] is not; inside walls (1, 3) and (3,) zeros stand for the
-    arrays it then does not read), then (``wet``) its suction-controlled bridge at contact
-    (_follow_contact: the bridge arrays of pendular.capillary.bridge_state.BridgeState, a
-    BridgeTable's arrays(); ``pair_i``
-    (K,) the pairs' first members, read when a bridge forms) or, with ``persist``, across
-    gaps up to its rupture distance (_follow_across_gap, the CPU's suction_bridges per pair:
-    its force on j from i [N] into ``bridge_pair_force`` (K, 3), pulling along the branch
-    vector, which reads ``image`` and ``period``: zeros for every pair inside walls); with
-    ``volume_control`` a volume-controlled bridge (_follow_volume, the CPU's volume_bridges per
-    pair: ``suction`` the formation suction, ``roughness``, ``closed`` liquid, the liquid's
-    arrays of pendular.gpu.state and a VolumeBridgeTable's arrays(); the events it marks
-    counted in ``marked``, for exchange_liquid). Thread 0 clears the rebuild flag: this step's
+    _evaluate_damped_pair, of ``mass`` (N,) [kg], ``hertz``, ``damping`` and the stiffnesses
+    standing for its modulus and tangential stiffness; with its tests as the CPU's
+    pair_forces: images where ``period`` (3,) [m] is not zero, each pair's in ``image``
+    (K, 3) int8, and stretching where ``affine_rate`` (3,) [1/s] is not; inside walls
+    (1, 3) and (3,) zeros stand for the arrays it then does not read), then (``wet``) its
+    suction-controlled bridge at contact (_follow_contact: the bridge arrays of
+    pendular.capillary.bridge_state.BridgeState; the pairs' first members read when a
+    bridge forms) or, with ``persist``, across gaps up to its rupture distance
+    (_follow_across_gap, the CPU's suction_bridges per pair: its force on j from i [N] into
+    the bridges' ``pair_force`` (K, 3), pulling along the branch vector, which reads
+    ``image`` and ``period``: zeros for every pair inside walls); with ``volume_control`` a
+    volume-controlled bridge (_follow_volume, the CPU's volume_bridges per pair:
+    ``suction`` the formation suction, the liquid; the events it marks counted in
+    ``marked``, for exchange_liquid). Thread 0 clears the rebuild flag: this step's
     rebuild, if any, is done."""
+    position, velocity, angular_velocity, radius, mass = particles
+    pair_count, pair_i, pair_j, shear_force, normal, overlap, normal_force, force = pairs
+    image, period, affine_rate = images
+    young, shear_ratio, tan_friction, damped, hertz, damping, dt = law
+    (wet, persist, volume_control, state, volume, bridge_force, filling_i, filling_j,
+     bridge_suction, bridge_pair_force, suction, surface_tension) = bridges
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    roughness, closed, film, released, events, marked = liquid
     p = cuda.grid(1)
     if p == 0:
         flags[0] = 0
@@ -95,8 +130,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
                 k, position, radius, pair_i, pair_j, image, period, overlap, normal, state,
                 volume, bridge_force, filling_i, filling_j, bridge_suction, bridge_pair_force,
                 film, released, events, suction, surface_tension, roughness, radius_ratios,
-                suction_axis, distance_low, log_distance_rupture, log_values,
-                (volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, grid),
+                suction_axis, distance_low, log_distance_rupture, log_values, volume_table,
                 closed)
         elif wet and persist:
             follow_across_gap(k, position, radius, pair_i, pair_j, image, period, overlap,
@@ -112,8 +146,7 @@ def pair_forces(position, velocity, angular_velocity, radius, pair_count, pair_i
 
 
 @cuda.jit
-def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pair, state,
-                    volume, film, released, events, marked, share, smallest_star,
+def exchange_liquid(radius, pairs, transposed, state, volume, liquid, share, smallest_star,
                     largest_star, liquid_lost):
     """The liquid exchanges of the events pair_forces marked (volume control, a closed amount:
     the CPU's exchange_liquid), on one thread, in the CPU's pair order (each particle's row in
@@ -121,7 +154,10 @@ def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pai
     lost, added to ``liquid_lost`` (1,) [m^3], then the bridges that form from films; nothing
     when ``marked`` (1,) counted no event (the CPU's test), else it is cleared. The pairs of a
     grain q are ranges of step N: its own, slots q + s N, and those where it is second,
-    ``second_pair[q + s N]``."""
+    ``second_pair[q + s N]`` (the bundles Pairs, Transposed, Liquid)."""
+    pair_count, pair_i, pair_j = pairs.count, pairs.first, pairs.second
+    second_count, second_pair = transposed
+    film, released, events, marked = liquid.film, liquid.released, liquid.events, liquid.marked
     if cuda.grid(1) != 0 or marked[0] == 0:
         return
     marked[0] = 0
@@ -147,12 +183,14 @@ def exchange_liquid(radius, pair_count, pair_i, pair_j, second_count, second_pai
 
 
 @cuda.jit
-def refresh_bridges(radius, pair_count, pair_j, state, volume, bridge_force, filling_i,
-                    filling_j, suction, surface_tension, radius_ratios, suction_axis,
-                    distance_low, log_distance_rupture, log_values):
+def refresh_bridges(radius, pair_count, pair_j, columns, suction, surface_tension, table):
     """Every bridge at contact (AT_CONTACT) of particle p's row looked up again at a new
     ``suction`` [Pa] (the CPU's refresh_contact_bridges at the first step after
-    SuctionBridges.set_suction; its values depend on the radii alone), one thread per row."""
+    SuctionBridges.set_suction; its values depend on the radii alone), one thread per row;
+    ``columns`` the bridges' state, volume, force and filling angles, ``table`` a
+    BridgeTable's arrays()."""
+    state, volume, bridge_force, filling_i, filling_j = columns
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
     p = cuda.grid(1)
     n = radius.shape[0]
     if p >= n:
@@ -196,9 +234,8 @@ def add_wall_pushes(p, f0, f1, f2, position, radius, wall_position, young):
 
 
 @cuda.jit
-def gather(position, radius, pair_count, second_count, second_pair, pair_force, normal,
-           overlap, wet, attraction, walls_first, wall_position, wall_young, persist,
-           bridge_pair_force, force, torque):
+def gather(position, radius, pairs, transposed, gathered, walls_first, wall_position,
+           wall_young, force, torque):
     """Each particle's force and torque from its pairs, by the CPU's sum (_sum_pair_terms
     over the device's rows; less the ``attraction`` (K,) [N] along the normals when ``wet``:
     bridges at contact) and the walls, set (not added), in the CPU's order: the walls first
@@ -207,7 +244,11 @@ def gather(position, radius, pair_count, second_count, second_pair, pair_force, 
     a periodic cell, which has no walls (their springs add zeros). With ``persist`` the
     bridges' forces on j from i ``bridge_pair_force`` (K, 3) [N] are added last, by the CPU's
     sum (_sum_pair_forces, the CPU's gather_pair_forces after the contact law and the
-    walls)."""
+    walls). The bundles Pairs, Transposed and Gathered."""
+    pair_count, pair_force, normal, overlap = (pairs.count, pairs.force, pairs.normal,
+                                               pairs.overlap)
+    second_count, second_pair = transposed
+    wet, attraction, persist, bridge_pair_force = gathered
     p = cuda.grid(1)
     n = position.shape[0]
     if p >= n:
@@ -235,3 +276,54 @@ def gather(position, radius, pair_count, second_count, second_pair, pair_force, 
         f1 += v1
         f2 += v2
     store_row_sums(p, (f0, f1, f2, t0, t1, t2), force, torque)
+
+
+def tan_friction(law):
+    """tan of the friction angle of ``law`` (a contact law: ``friction_deg`` [deg]) [-], as
+    the CPU's."""
+    return float(np.tan(np.radians(law.friction_deg)))
+
+
+@device_side(ContactForces)
+class LinearLaw(DeviceSide):
+    """The linear contact law's side (ContactForces): pair_forces runs _evaluate_pair."""
+
+    family = "force"
+    role = "contact law"
+    #: Whether pair_forces runs the damped law (_evaluate_damped_pair).
+    damped = False
+
+    def law(self, dt):
+        """The Law of pair_forces now, over steps of ``dt`` [s]: E [Pa] and ks / kn [-]."""
+        op = self.op
+        return Law(op.young, op.shear_ratio, tan_friction(op), False, False, 0.0, dt)
+
+
+@device_side(HertzMindlinForces, DampedLinearForces)
+class DampedLaw(LinearLaw):
+    """The damped and Hertz–Mindlin laws' side (pendular.dem.hertz_mindlin): pair_forces runs
+    _evaluate_damped_pair."""
+
+    damped = True
+
+    def law(self, dt):
+        """The Law of pair_forces now: its modulus and tangential stiffness, damping."""
+        op = self.op
+        return Law(op.modulus, op.tangential, tan_friction(op), True, op.hertz, op.damping,
+                   dt)
+
+
+@device_side(WallForces)
+class WallSprings(DeviceSide):
+    """The frictionless walls' springs (WallForces, kn = E R): added in the gather, before
+    or after the pair forces as the scene lists them, and reduced on each wall
+    (pendular.gpu.walls)."""
+
+    family = "force"
+    role = "walls"
+    in_cell = False
+
+    @property
+    def young(self):
+        """E [Pa] of the springs now."""
+        return self.op.young

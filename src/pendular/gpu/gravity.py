@@ -4,8 +4,9 @@ the pair forces and the walls (pendular.gpu.forces.gather). The CPU subtracts th
 Gravity stands among the forces; the device after every force it gathers, the same sum in
 another order (round-off) when Gravity precedes one of them (the bridges, listed last)."""
 
-from pendular.dem.gravity import _add_particle_weight
+from pendular.dem.gravity import Gravity, _add_particle_weight
 from pendular.gpu.cuda import cuda, device_twin
+from pendular.gpu.operations import DeviceSide, device_side
 
 add_particle_weight = device_twin(_add_particle_weight)
 
@@ -20,7 +21,15 @@ def add_weight(force, mass, gravity):
     add_particle_weight(p, force, mass, gravity)
 
 
-def launches(gravity, state):
-    """(kernel, items, arguments) of a step's weight (``gravity`` a Gravity, its acceleration
-    now; ``state`` a DeviceState), to run after the gather."""
-    return [(add_weight, state.count, (state.force, state.mass, gravity.acceleration))]
+@device_side(Gravity)
+class Weight(DeviceSide):
+    """Gravity's side: its launch after the gather; inside walls only."""
+
+    family = "force"
+    role = "gravity"
+    in_cell = False
+
+    def launches(self, state, dt):
+        """(kernel, items, arguments) of a step's weight (its acceleration now; ``state`` a
+        DeviceState), to run after the gather."""
+        return [(add_weight, state.count, (state.force, state.mass, self.op.acceleration))]

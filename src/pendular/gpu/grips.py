@@ -17,30 +17,47 @@ import numpy as np
 
 from pendular.dem.grips import Grip
 from pendular.gpu.cuda import cuda
+from pendular.gpu.operations import ControlSide, device_side
+from pendular.gpu.walls import GRIP
 
 #: Members summed by one thread of grip_partials.
 GRIP_CHUNK = 16
 
 
-def check_grips(controls, count):
-    """ValueError naming what of the grips among ``controls`` the device does not run: a grip
-    before a wall control (the device holds the grips after every wall control, which the
-    CPU's order then matches), members outside the ``count`` particles, a particle in two
-    grips (the CPU holds it by the later one, which a reduction of all grips at once would not
-    match)."""
-    grips = [c for c, op in enumerate(controls) if type(op) is Grip]
-    if not grips:
+def check_grips(scene, count):
+    """ValueError naming what of the grips among ``scene``'s controls (sides,
+    pendular.gpu.operations.Scene) the device does not run: a grip before a wall control (the
+    device holds the grips after every wall control, which the CPU's order then matches),
+    members outside the ``count`` particles, a particle in two grips (the CPU holds it by the
+    later one, which a reduction of all grips at once would not match)."""
+    controls = scene.controls
+    rows = [c for c, side in enumerate(controls) if side.role == GRIP]
+    if not rows:
         return
-    late = [type(op).__name__ for op in controls[grips[0]:] if type(op) is not Grip]
+    late = [side.name for side in controls[rows[0]:] if side.role != GRIP]
     if late:
         raise ValueError(f"device='gpu' runs the grips after every wall control; the control "
                          f"{late[0]} comes after a Grip (put the grips last)")
-    members = np.concatenate([controls[c].members for c in grips])
+    members = np.concatenate([controls[c].op.members for c in rows])
     if members.size and (members.min() < 0 or members.max() >= count):
         raise ValueError(f"a Grip's members lie outside the valid range [0, {count - 1}]")
     if len(np.unique(members)) != len(members):
         raise ValueError("device='gpu' runs grips whose members are distinct; a particle is "
                          "in two grips")
+
+
+@device_side(Grip)
+class GripRow(ControlSide):
+    """A Grip's row (GRIP): no wall control; the grips' own launches (DeviceGrips) hold their
+    members after every wall control. Inside walls only."""
+
+    role = GRIP
+    in_cell = False
+
+    def check(self, scene):
+        """The grips of the scene together (check_grips), once, at the first grip."""
+        if scene.controls_of(GRIP)[0] is self:
+            check_grips(scene, len(scene.sim.peek("particles")))
 
 
 @cuda.jit
@@ -110,9 +127,10 @@ class DeviceGrips:
         self.member_count = start
 
     @classmethod
-    def of(cls, controls):
-        """The DeviceGrips of the Grip controls among ``controls``, None when there are none."""
-        grips = [op for op in controls if type(op) is Grip]
+    def of(cls, scene):
+        """The DeviceGrips of the grips among ``scene``'s controls (sides,
+        pendular.gpu.operations.Scene), None when there are none."""
+        grips = [side.op for side in scene.controls_of(GRIP)]
         return cls(grips) if grips else None
 
     def launches(self, state):

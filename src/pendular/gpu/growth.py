@@ -24,10 +24,10 @@ import types
 
 import numpy as np
 
-from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.state import Particles
 from pendular.gpu.cuda import cuda
 from pendular.gpu.state import DENSEST, DeviceState
+from pendular.gpu.walls import GROWTH_TIMESTEP, RADIUS_GROWTH
 
 
 @cuda.jit
@@ -78,25 +78,29 @@ def growth_factor_bound(particles, walls):
 
 
 class DeviceGrowth:
-    """A scene's radius growth on the device (module docstring): ``of(controls, box)`` (None
-    without a RadiusGrowth among the controls), ``grown_state`` for the device's arrays, ``launches``
+    """A scene's radius growth on the device (module docstring): ``of(scene)`` (None without
+    a RadiusGrowth among the controls), ``grown_state`` for the device's arrays, ``launches``
     for the step's, ``advance`` for a step that sets the time step."""
 
-    def __init__(self, controls):
-        self.row = next(c for c, op in enumerate(controls) if type(op) is RadiusGrowth)
-        self.timestep = next((op for op in controls if isinstance(op, GrowthTimeStep)), None)
-        if self.timestep is not None and controls.index(self.timestep) < self.row:
+    def __init__(self, scene):
+        controls = scene.controls
+        self.row = next(c for c, side in enumerate(controls) if side.role == RADIUS_GROWTH)
+        timestep = next((c for c, side in enumerate(controls)
+                         if side.role == GROWTH_TIMESTEP), None)
+        if timestep is not None and timestep < self.row:
             raise ValueError("device='gpu' runs a GrowthTimeStep after the RadiusGrowth only "
                              "(it reads the grown radii)")
+        self.timestep = None if timestep is None else controls[timestep].op
         self.reference_radius = None
         self._first = True
 
     @classmethod
-    def of(cls, controls):
-        """The growth of ``controls`` (a scene's, in order), or None."""
-        if not any(type(op) is RadiusGrowth for op in controls):
+    def of(cls, scene):
+        """The growth of ``scene``'s controls (sides, pendular.gpu.operations.Scene), or
+        None."""
+        if not scene.controls_of(RADIUS_GROWTH):
             return None
-        return cls(controls)
+        return cls(scene)
 
     def grown_state(self, sim, skin, wet, resisting=False):
         """DeviceState of ``sim`` whose grid cells and rows hold the neighbours of the
@@ -113,7 +117,7 @@ class DeviceGrowth:
         for name in ("radius", "mass", "inertia"):
             setattr(state, name, cuda.to_device(np.ascontiguousarray(getattr(p, name))))
         if sim.contacts is not None and len(sim.contacts):
-            rows = state._host_rows(sim.contacts, state.count)
+            rows = state.host_rows(sim.contacts, state.count)
             for name in ("pair_count", "pair_j", "shear_force", "normal", "overlap", "bridges",
                          "rolling"):
                 setattr(state, name, cuda.to_device(rows[name]))
@@ -160,9 +164,9 @@ class DeviceGrowth:
         for kernel, args in launches[:-2]:
             kernel(*args)
         sim.dt = self.timestep.step_for(state.radius.copy_to_host())
-        gpu._configure()
+        gpu.configure()
         state.control_step.copy_to_device(np.array([sim.step + 1], np.int64))
-        for kernel, args in gpu._launches[-2:]:
+        for kernel, args in gpu.launches[-2:]:
             kernel(*args)
 
     def to_host(self, sim, state):

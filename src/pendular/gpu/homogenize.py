@@ -38,6 +38,7 @@ device does without: each pair of a particle's menisci is read from its pairs).
 """
 
 import math
+from collections import namedtuple
 
 import numpy as np
 
@@ -58,6 +59,20 @@ volume_interface_lookup = device_twin(lookup_volume_interface)
 
 #: Particles summed by one thread of homogenize_partials.
 CHUNK = 32
+
+#: The pairs' index: rows (``count``, ``first`` and ``second`` members) and the transposed
+#: index (``second_count``, ``second_pair``) of pendular.gpu.neighbors.
+PairIndex = namedtuple("PairIndex", "count first second second_count second_pair")
+#: The box as a pair's branch vector reads it: ``periodic``, the pairs' ``image``, ``period``.
+Box = namedtuple("Box", "periodic image period")
+#: The pairs' contacts: overlap [m], normal, force on j from i [N].
+Contacts = namedtuple("Contacts", "overlap normal force")
+#: The bridges as the homogenisation reads them (add_bridge): ``wet``, the columns
+#: ``bridges``, ``persist`` and their forces ``pair_force``, ``own_suction`` (volume control),
+#: ``contact_angle`` [deg], ``surface_tension`` [N/m], ``interface``, ``suction`` [Pa],
+#: ``roughness``.
+Capillary = namedtuple("Capillary", "wet bridges persist pair_force own_suction contact_angle "
+                                    "surface_tension interface suction roughness")
 #: Radians per degree (numpy.radians multiplies by it).
 RADIAN = math.pi / 180.0
 
@@ -303,13 +318,8 @@ def overlapping_menisci(p, n, position, pair_count, pair_j, second_count, second
 
 
 @cuda.jit
-def homogenize_partials(position, radius, force, wall_position, pair_count, pair_i, pair_j,
-                        second_count, second_pair, periodic, image, period, overlap, normal,
-                        pair_force, wet, bridges, persist, bridge_pair_force, own_suction,
-                        contact_angle, surface_tension, interface, radius_ratios, suction_axis,
-                        distance_low, log_distance_rupture, log_values, suction, roughness,
-                        volume_ratios, volume_axes, volume_distance_low, volume_log_rupture,
-                        volume_grid, partial):
+def homogenize_partials(position, radius, force, wall_position, pairs, box, contacts,
+                        capillary, table, volume_table, partial):
     """partial[b, :]: block b's sums (SUMS) over its CHUNK particles in order and, for each, its
     row of pairs in order: the touching pairs' (overlap > 0) contact terms and, ``wet``, the
     bridges' (BridgeState ``state`` != NO_BRIDGE; ``bridges`` (K, BRIDGE_COLUMNS)); the
@@ -317,7 +327,17 @@ def homogenize_partials(position, radius, force, wall_position, pair_count, pair
     ``own_suction``, the volume table's and the roughness); ``persist``, ``bridge_pair_force``
     and ``own_suction`` as ``add_bridge``; then its
     largest values (MAXIMA), the walls' overlaps inside walls. ``periodic``: a periodic cell,
-    the pairs' ``image`` (K, 3) and the ``period`` [m] (``branch``)."""
+    the pairs' ``image`` (K, 3) and the ``period`` [m] (``branch``). The bundles PairIndex,
+    Box, Contacts and Capillary; ``table`` a BridgeTable's arrays(), ``volume_table`` a
+    VolumeBridgeTable's (stand-ins when unread)."""
+    pair_count, pair_i, pair_j, second_count, second_pair = pairs
+    periodic, image, period = box
+    overlap, normal, pair_force = contacts
+    (wet, bridges, persist, bridge_pair_force, own_suction, contact_angle, surface_tension,
+     interface, suction, roughness) = capillary
+    radius_ratios, suction_axis, distance_low, log_distance_rupture, log_values = table
+    volume_ratios, volume_axes, volume_distance_low, volume_log_rupture, volume_grid = \
+        volume_table
     b = cuda.grid(1)
     if b >= partial.shape[0]:
         return
@@ -396,19 +416,19 @@ def launches(gpu, partial, totals):
     pendular.gpu.GpuSimulation) into ``totals`` (COLUMNS,) through ``partial`` (blocks,
     COLUMNS), blocks = ceil(N / CHUNK)."""
     s = gpu.state
-    bridges = gpu._bridges
-    wet = bridges is not None
-    interface = wet and bridges.model == "exact"
+    bridges = gpu.bridges       # their device side (pendular.gpu.bridges)
+    wet = bridges.wet
+    interface = wet and bridges.op.model == "exact"
     period = s.period if s.periodic else s.no_period
     image = s.image if s.periodic else s.no_image   # zeros where bridges across gaps read it
-    roughness = bridges.roughness if gpu._volume_control else 0.0
     return ((homogenize_partials, partial.shape[0],
-             (s.position, s.radius, s.force, s.wall_position, s.pair_count, s.pair_i, s.pair_j,
-              s.second_count, s.second_pair, s.periodic, image, period, s.overlap, s.normal,
-              s.pair_force, wet, s.bridges, s.persist, s.bridge_pair_force, gpu._volume_control,
-              bridges.contact_angle if wet else 0.0, bridges.surface_tension if wet else 1.0,
-              interface, *gpu._table, gpu._suction, roughness, *gpu._volume_table,
-              partial)),
+             (s.position, s.radius, s.force, s.wall_position,
+              PairIndex(s.pair_count, s.pair_i, s.pair_j, s.second_count, s.second_pair),
+              Box(s.periodic, image, period), Contacts(s.overlap, s.normal, s.pair_force),
+              Capillary(wet, s.bridges, s.persist, s.bridge_pair_force, bridges.volume_control,
+                        bridges.op.contact_angle if wet else 0.0, bridges.surface_tension,
+                        interface, bridges.suction, bridges.roughness),
+              bridges.table, bridges.volume_table, partial)),
             (sum_columns, COLUMNS, (partial, totals)))
 
 
@@ -466,17 +486,17 @@ def device_homogenization(gpu, volume=None):
            "largest_overlap": float(sums[LARGEST_OVERLAP]),
            "smallest_radius": float(-sums[NEGATIVE_SMALLEST_RADIUS]),
            "largest_radius": float(sums[LARGEST_RADIUS])}
-    bridges = gpu._bridges
-    if bridges is None:
+    bridges = gpu.bridges
+    if not bridges.wet:
         return out
     water_volume = float(sums[WATER_VOLUME])
     chi = (water_volume * np.eye(3) + _axisymmetric_sum(sums, "cap")) / volume   # Eq. 3.44
     tension = _axisymmetric_sum(sums, "line") / volume                          # Eq. 3.45
-    if gpu._volume_control:     # each bridge at its own suction (on_the_fly's psi)
+    if bridges.volume_control:  # each bridge at its own suction (on_the_fly's psi)
         psi = (sums[SUCTION_WATER] * np.eye(3) + _axisymmetric_sum(sums, "suction_cap")
                ) / volume + tension
     else:
-        psi = chi * gpu._suction + tension                                      # Eq. 3.46
+        psi = chi * bridges.suction + tension                                     # Eq. 3.46
     bridge_count = sums[BRIDGES]
     bridge_fabric = _tensor(sums, "bridge_fabric")
     if bridge_count:
@@ -488,7 +508,7 @@ def device_homogenization(gpu, volume=None):
                 "fabric_bridges": bridge_fabric,
                 "anisotropy_bridges": principal_anisotropy(bridge_fabric),      # Eq. 3.54
                 "a_psi": principal_anisotropy(psi)})                            # Eq. 4.5
-    if bridges.model == "exact":
+    if bridges.op.model == "exact":
         out["psi_interface"] = (bridges.surface_tension
                                 * _axisymmetric_sum(sums, "interface") / volume)
     return out

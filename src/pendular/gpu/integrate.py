@@ -5,20 +5,26 @@ half the skin since the last one (pendular.dem.neighbors.moved_beyond) and flags
 that is not finite (a diverged run, which the CPU catches at its next rebuild)."""
 
 import math
+from collections import namedtuple
 
-from pendular.dem.integrate import _advance
+from pendular.dem.integrate import Integrator, _advance
 from pendular.gpu.cuda import cuda, device_twin
+from pendular.gpu.operations import DeviceSide, device_side
 
 advance = device_twin(_advance)
 
+#: What the leapfrog moves: positions, velocities, angular velocities (N, 3) from forces and
+#: torques (N, 3), masses and moments of inertia (N,) (pendular.gpu.state).
+Motion = namedtuple("Motion", "position velocity angular_velocity force torque mass inertia")
+
 
 @cuda.jit
-def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
-             no_stretching, dt, reference_position, limit, flags):
+def leapfrog(motion, damping, no_stretching, dt, reference_position, limit, flags):
     """Advance particle p's velocities to t + dt/2 and position to t + dt (the CPU's _advance
     inside walls: ``no_stretching`` zeros (3,)); set flags[0] when it is farther than
     ``limit`` [m] from its position at the last rebuild, flags[2] when its position is not
-    finite (every thread that sets one writes the same 1)."""
+    finite (every thread that sets one writes the same 1). ``motion``: a Motion."""
+    position, velocity, angular_velocity, force, torque, mass, inertia = motion
     p = cuda.grid(1)
     if p >= position.shape[0]:
         return
@@ -35,9 +41,8 @@ def leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia,
 
 
 @cuda.jit
-def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, inertia, damping,
-                  affine_rate, dt, reference_position, cell_position, reference_cell, period,
-                  shear, limit, shortest_unlisted, flags):
+def cell_leapfrog(motion, damping, affine_rate, dt, reference_position, cell_position,
+                  reference_cell, period, shear, limit, shortest_unlisted, flags):
     """leapfrog in a periodic cell (the CPU's _advance with stretching: the velocity
     ``affine_rate`` (3,) [1/s] * x carrying the particle on top of its own; a sheared cell's
     (4,) adds gamma_dot * z along x); the rebuild test is pendular.dem.neighbors.moved_beyond
@@ -46,7 +51,8 @@ def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, ine
     ``reference_cell`` at the last rebuild) and, in a sheared cell (``period`` (4,), its
     offset delta now last; ``shear`` pendular.gpu.cell.SHEAR_FIELDS, delta at the last
     rebuild), g = (delta - s_x delta_ref) / Lz_ref (else 0), against ``limit`` [m] less
-    (max|s - 1| + |g|) / 2 times ``shortest_unlisted`` [m]."""
+    (max|s - 1| + |g|) / 2 times ``shortest_unlisted`` [m]. ``motion``: a Motion."""
+    position, velocity, angular_velocity, force, torque, mass, inertia = motion
     p = cuda.grid(1)
     if p >= position.shape[0]:
         return
@@ -71,3 +77,15 @@ def cell_leapfrog(position, velocity, angular_velocity, force, torque, mass, ine
     if not (math.isfinite(position[p, 0]) and math.isfinite(position[p, 1])
             and math.isfinite(position[p, 2])):
         flags[2] = 1
+
+
+@device_side(Integrator)
+class Leapfrog(DeviceSide):
+    """The Integrator's side: the leapfrog launches (the box's steps) read its damping."""
+
+    family = "integrator"
+
+    @property
+    def damping(self):
+        """The numerical damping [-] now."""
+        return self.op.damping

@@ -21,10 +21,12 @@ checks (pendular.gpu.simulation).
 """
 
 import math
+from collections import namedtuple
 
-from pendular.dem.neighbors import (_cell_coordinates, _sheared_cell, _within_reach,
-    _wrap_cell)
+from pendular.dem.neighbors import (NeighborList, _cell_coordinates, _sheared_cell,
+    _within_reach, _wrap_cell)
 from pendular.gpu.cuda import cuda, device, device_twin
+from pendular.gpu.operations import DeviceSide, device_side
 
 within_reach = device_twin(_within_reach)
 cell_coordinates = device_twin(_cell_coordinates)
@@ -32,6 +34,17 @@ cell_coordinates = device_twin(_cell_coordinates)
 #: Bits of flags[1].
 CELL_OVERFLOW = 1
 ROW_OVERFLOW = 2
+
+#: The cell grid: its cells' least edge [m], the most cells per axis allocated (3,), each
+#: cell's member count and members (cells, ``cell_width``), each particle's cell.
+Grid = namedtuple("Grid", "cell_size max_dims cell_count cell_members cell_width cell_of")
+#: The rows (module docstring): slots per row, the list's rows (``pair_count``, ``pair_j``),
+#: the rows a rebuild fills (``new_count``, ``new_pair_j``) and the pairs below each particle
+#: it finds (``lower_count``, ``lower``).
+Rows = namedtuple("Rows", "width pair_count pair_j new_count new_pair_j lower_count lower")
+#: The per-pair state carried across a rebuild (pendular.gpu.state): the tangential spring,
+#: normal, overlap, the bridges' and the rolling resistance's columns.
+PairState = namedtuple("PairState", "shear_force normal overlap bridges rolling")
 
 
 @device
@@ -80,9 +93,10 @@ def append_to_cell(p, c, cell_of, cell_count, cell_members, cell_width, flags):
 
 
 @cuda.jit
-def bin_particles(position, wall_position, cell_size, max_dims, cell_count, cell_members,
-                  cell_width, cell_of, flags):
-    """Append each particle to its cell (x-major numbering, as the CPU's grid)."""
+def bin_particles(position, wall_position, grid, flags):
+    """Append each particle to its cell of the Grid ``grid`` (x-major numbering, as the CPU's
+    grid)."""
+    cell_size, max_dims, cell_count, cell_members, cell_width, cell_of = grid
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -124,16 +138,18 @@ def carry(old, new, source, k, fill):
 
 
 @cuda.jit
-def find_pairs(position, radius, skin, wall_position, cell_size, max_dims, cell_count,
-               cell_members, cell_width, cell_of, width, pair_count, pair_j, new_count,
-               new_pair_j, lower_count, lower, shear_force, normal, overlap, bridges, rolling,
-               new_shear_force, new_normal, new_overlap, new_bridges, new_rolling, flags):
+def find_pairs(position, radius, skin, wall_position, grid, rows, carried, new, flags):
     """Particle p's neighbours within r_p + r_q + skin from the 27 cells around its own:
     those above p into its new row, those below into ``lower`` (both sorted); then the per-pair
     state of the new row from the same (p, j) pairs of the old one (the CPU's
     previous_pair_index and carry_pair_array): shear force, normal, overlap (-inf: never
     touched), the bridges' (K, C) values (state, volume, force, filling angles; zeros) and
-    the rolling resistance's springs (K, C) (pendular.gpu.rolling; zeros)."""
+    the rolling resistance's springs (K, C) (pendular.gpu.rolling; zeros): the bundles Grid,
+    Rows and PairState (``carried`` the list's, ``new`` the new rows')."""
+    cell_size, max_dims, cell_count, cell_members, cell_width, cell_of = grid
+    width, pair_count, pair_j, new_count, new_pair_j, lower_count, lower = rows
+    shear_force, normal, overlap, bridges, rolling = carried
+    new_shear_force, new_normal, new_overlap, new_bridges, new_rolling = new
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -194,15 +210,18 @@ def copy_row(new, current, k):
 
 
 @cuda.jit
-def finish_rebuild(position, new_count, new_pair_j, lower_count, lower, new_shear_force,
-                   new_normal, new_overlap, new_bridges, new_rolling, pair_count, pair_j,
-                   second_count, second_pair, shear_force, normal, overlap, bridges, rolling,
-                   normal_force, force, reference_position, wall_position, reference_walls,
-                   cell_count, cell_of, flags, rebuilds):
+def finish_rebuild(position, rows, new, second_count, second_pair, carried, normal_force,
+                   force, reference_position, wall_position, reference_walls, grid, flags,
+                   rebuilds):
     """Make the new rows the list: counts, neighbours and carried state (force and normal
     force zero, as a new CPU list's), the transposed index (for each q below p, the slot of p
     in q's row), the reference positions and walls of the displacement test; empty the cells
-    used."""
+    used (the bundles Rows, Grid and PairState: ``new`` the new rows', ``carried`` the
+    list's)."""
+    _, pair_count, pair_j, new_count, new_pair_j, lower_count, lower = rows
+    new_shear_force, new_normal, new_overlap, new_bridges, new_rolling = new
+    shear_force, normal, overlap, bridges, rolling = carried
+    cell_count, cell_of = grid.cell_count, grid.cell_of
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -304,11 +323,11 @@ def wrap_particle(p, position, cell_position, wraps):
 
 
 @cuda.jit
-def bin_periodic(position, cell_position, period, wraps, cell_size, max_dims, cell_count,
-                 cell_members, cell_width, cell_of, flags):
+def bin_periodic(position, cell_position, period, wraps, grid, flags):
     """Wrap each particle into the cell (a sheared cell's ``period`` (4,): wrap_sheared first,
     as PeriodicCell.wrap; then wrap_particle), then append it to its cell of the periodic grid
-    (x-major numbering, the CPU's _sort_into_cells over [0, L))."""
+    (x-major numbering, the CPU's _sort_into_cells over [0, L)) of the Grid ``grid``."""
+    cell_size, max_dims, cell_count, cell_members, cell_width, cell_of = grid
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -344,17 +363,18 @@ def insert_with_image(row, image, p, n, found, width, q, sx, sy, sz, flags):
 
 
 @cuda.jit
-def find_periodic_pairs(position, radius, skin, cell_position, period, cell_size, max_dims,
-                        cell_count, cell_members, cell_width, cell_of, width, pair_count,
-                        pair_j, new_count, new_pair_j, image, lower_count, lower, shear_force,
-                        normal, overlap, bridges, rolling, new_shear_force, new_normal,
-                        new_overlap, new_bridges, new_rolling, flags):
+def find_periodic_pairs(position, radius, skin, cell_position, period, grid, rows, image,
+                        carried, new, flags):
     """find_pairs in a periodic cell: particle p's neighbours through the nearest image from
     the 27 cells around its own, wrapped across the faces (the CPU's _periodic_neighbors_of:
     in a sheared cell, ``period`` (4,), the rows through a z face around p's x less their
     offset, with the offset reduced_offset), each with its image into ``image`` (written in
     place: the forces read it after this rebuild; lower rows hold no image); then the per-pair
-    state carried as find_pairs."""
+    state carried as find_pairs (its bundles)."""
+    cell_size, max_dims, cell_count, cell_members, cell_width, cell_of = grid
+    width, pair_count, pair_j, new_count, new_pair_j, lower_count, lower = rows
+    shear_force, normal, overlap, bridges, rolling = carried
+    new_shear_force, new_normal, new_overlap, new_bridges, new_rolling = new
     p = cuda.grid(1)
     if flags[0] == 0 or p >= position.shape[0]:
         return
@@ -408,3 +428,16 @@ def shear_rebuilt(period, shear, flags):
     period[3] = offset
     shear[0] = offset
     shear[3] = offset
+
+
+@device_side(NeighborList)
+class VerletList(DeviceSide):
+    """The NeighborList's side: the rebuild's launches (the box's steps) and the device's
+    grid read its skin; its ``rebuild`` makes the host's list when the state comes back."""
+
+    family = "neighbor list"
+
+    @property
+    def skin(self):
+        """The list's skin [m]."""
+        return self.op.skin

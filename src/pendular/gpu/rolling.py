@@ -12,9 +12,11 @@ pendular.gpu.state, carried across the device's rebuilds as the bridges' columns
 
 import numpy as np
 
+from pendular.dem.neighbors import carry_pair_array
 from pendular.dem.protocols import pair_key
-from pendular.dem.rolling import FIELDS, OWNER, _pair_moment, _sum_moments
+from pendular.dem.rolling import FIELDS, OWNER, RollingResistance, _pair_moment, _sum_moments
 from pendular.gpu.cuda import cuda, device_twin
+from pendular.gpu.operations import DeviceSide, device_side
 
 pair_moment = device_twin(_pair_moment)
 sum_moments = device_twin(_sum_moments)
@@ -27,13 +29,18 @@ COLUMNS = sum(size for _, size in LAYOUT)
 
 
 @cuda.jit
-def pair_moments(radius, mass, inertia, angular_velocity, pair_count, pair_j, normal, overlap,
-                 normal_force, rolling_moment, twisting_moment, last_normal, moment, rolling,
-                 twisting, damping_ratio, dt):
+def pair_moments(radius, mass, inertia, angular_velocity, pairs, springs, moment,
+                 coefficients, dt):
     """Every pair of particle p's row (one thread per particle): the CPU's update of its
     springs (``rolling_moment`` (K, 3), ``twisting_moment`` (K,), ``last_normal`` (K, 3): the
     columns of the device's ``rolling``) and its ``moment`` (K, 3) [N m] on p
-    (pendular.dem.rolling.pair_moments)."""
+    (pendular.dem.rolling.pair_moments); ``pairs`` pendular.gpu.forces.Pairs, ``springs``
+    the three (columns), ``coefficients`` the operation's (rolling, twisting, damping_ratio)."""
+    pair_count, pair_j, normal, overlap, normal_force = (pairs.count, pairs.second,
+                                                         pairs.normal, pairs.overlap,
+                                                         pairs.normal_force)
+    rolling_moment, twisting_moment, last_normal = springs
+    rolling, twisting, damping_ratio = coefficients
     p = cuda.grid(1)
     n = radius.shape[0]
     if p >= n:
@@ -85,15 +92,33 @@ def host_fields(values):
             for view, field in zip(columns(values), FIELDS)}
 
 
-def launches(resistance, state, dt):
-    """(kernel, items, arguments) of a step's rolling resistance (``resistance`` a
-    RollingResistance, its coefficients now; ``state`` a DeviceState), to run after the
-    gather."""
-    s = state
-    n = s.count
-    return [(pair_moments, n, (s.radius, s.mass, s.inertia, s.angular_velocity, s.pair_count,
-                               s.pair_j, s.normal, s.overlap, s.normal_force,
-                               *columns(s.rolling), s.pair_moment, resistance.rolling,
-                               resistance.twisting, resistance.damping_ratio, dt)),
-            (gather_moments, n, (s.pair_count, s.second_count, s.second_pair, s.pair_moment,
-                                 s.torque))]
+@device_side(RollingResistance)
+class Resistance(DeviceSide):
+    """A RollingResistance's side: its launches after the contact law's gather, its pairs'
+    moments back into the operation."""
+
+    family = "force"
+    role = "rolling"
+
+    def check(self, scene):
+        """It reads the contact law's pairs of the same step: listed after the law."""
+        if scene.index(self) < scene.index(scene.force("contact law")):
+            raise ValueError("device='gpu' runs a RollingResistance listed after the contact "
+                             "law only (it reads the contact law's pairs of the same step)")
+
+    def launches(self, state, dt):
+        """(kernel, items, arguments) of a step's rolling resistance (its coefficients now;
+        ``state`` a DeviceState, ``dt`` [s]), to run after the gather."""
+        s = state
+        op = self.op
+        n = s.count
+        return [(pair_moments, n, (s.radius, s.mass, s.inertia, s.angular_velocity, s.pairs(),
+                                   columns(s.rolling), s.pair_moment,
+                                   (op.rolling, op.twisting, op.damping_ratio), dt)),
+                (gather_moments, n, (s.pair_count, s.second_count, s.second_pair,
+                                     s.pair_moment, s.torque))]
+
+    def pairs_to_host(self, sim, state, index):
+        """The device's pair moments into the operation's ``moment``, carried to the host
+        list's pairs (``index``: pendular.dem.neighbors.previous_pair_index)."""
+        self.op.moment = carry_pair_array(state.pair_moments(), index)

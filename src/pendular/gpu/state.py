@@ -29,7 +29,10 @@ from pendular.dem.protocols import pair_key
 from pendular.gpu.cell import CELL_SUMS
 from pendular.gpu import rolling as device_rolling
 from pendular.gpu.cuda import cuda
-from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS
+from pendular.gpu.forces import Images, Pairs, Transposed
+from pendular.gpu.integrate import Motion
+from pendular.gpu.neighbors import Grid, PairState, Rows
+from pendular.gpu.walls import REDUCE_CHUNK, WALL_SUMS, Program
 
 #: BridgeState fields kept on the device, in the columns of ``bridges``.
 BRIDGE_COLUMNS = tuple(field.name for field in FIELDS)
@@ -121,7 +124,7 @@ class DeviceState:
         self.cell_members = to(np.zeros(cells * self.cell_width, np.int32))
         self.cell_of = to(np.zeros(count, np.int32))
         # the list in use, filled from the host's if it has one; flags[0] = 1: rebuild first
-        rows = self._host_rows(sim.contacts, count)
+        rows = self.host_rows(sim.contacts, count)
         self.pair_count = to(rows["pair_count"])
         self.pair_j = to(rows["pair_j"])
         self.shear_force = to(rows["shear_force"])
@@ -180,7 +183,7 @@ class DeviceState:
         self.wraps = to(np.ascontiguousarray(wraps))
         self.cell_partial = to(np.zeros((max(1, -(-count // REDUCE_CHUNK)), CELL_SUMS)))
 
-    def _host_rows(self, contacts, count):
+    def host_rows(self, contacts, count):
         """The host's list (or none) as device rows: counts, neighbours and per-pair state."""
         width = self.width
         bridge_rows = width * count if self.wet else 1
@@ -213,6 +216,58 @@ class DeviceState:
                 "rolling": rolling,
                 "image": (_to_ell(contacts.image, slots, count, width, 0) if self.periodic
                           else np.zeros((1, 3), np.int8))}
+
+    def grid(self):
+        """The cell grid's bundle (pendular.gpu.neighbors.Grid)."""
+        return Grid(self.cell_size, self.max_dims, self.cell_count, self.cell_members,
+                    self.cell_width, self.cell_of)
+
+    def rows(self):
+        """The rows' bundle (pendular.gpu.neighbors.Rows)."""
+        return Rows(self.width, self.pair_count, self.pair_j, self.new_count, self.new_pair_j,
+                    self.lower_count, self.lower)
+
+    def carried(self):
+        """The list's per-pair state (pendular.gpu.neighbors.PairState)."""
+        return PairState(self.shear_force, self.normal, self.overlap, self.bridges,
+                         self.rolling)
+
+    def new_carried(self):
+        """The per-pair state of the rows a rebuild fills (pendular.gpu.neighbors.PairState)."""
+        return PairState(self.new_shear_force, self.new_normal, self.new_overlap,
+                         self.new_bridges, self.new_rolling)
+
+    def pairs(self):
+        """The pairs and their state as the pair kernels read them (pendular.gpu.forces
+        .Pairs)."""
+        return Pairs(self.pair_count, self.pair_i, self.pair_j, self.shear_force, self.normal,
+                     self.overlap, self.normal_force, self.pair_force)
+
+    def transposed(self):
+        """The transposed pair index (pendular.gpu.forces.Transposed)."""
+        return Transposed(self.second_count, self.second_pair)
+
+    def images(self):
+        """A periodic cell's images, period and stretching (pendular.gpu.forces.Images; inside
+        walls the zeros that stand for them)."""
+        if self.periodic:
+            return Images(self.image, self.period, self.affine_rate)
+        return Images(self.no_image, self.no_period, self.no_period)
+
+    def motion(self):
+        """What the leapfrog moves (pendular.gpu.integrate.Motion)."""
+        return Motion(self.position, self.velocity, self.angular_velocity, self.force,
+                      self.torque, self.mass, self.inertia)
+
+    def program(self):
+        """The controls' program (pendular.gpu.walls.Program), uploaded by GpuSimulation."""
+        return Program(self.kinds, self.control_walls, self.wall_counts, self.parameters,
+                       self.previous, self.stiffness, self.calls, self.control_step,
+                       self.failure)
+
+    def bridge_columns(self):
+        """The columns of ``bridges`` (BRIDGE_COLUMNS) as the bridge law's arrays."""
+        return tuple(self.bridges[:, c] for c in range(self.bridges.shape[1]))
 
     def flags_now(self):
         """(rebuild asked, overflow bits, not-finite flag) read from the device (a sync)."""

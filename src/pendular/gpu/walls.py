@@ -23,13 +23,24 @@ Simulation does (its ``step`` when the run started), for that message.
 """
 
 import math
+from collections import namedtuple
 
-from pendular.dem.walls import StressServo
-from pendular.gpu.cuda import cuda, device
+import numpy as np
+
+from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
+from pendular.dem.mixed_stress import MixedStress
+from pendular.dem.walls import (ConstantStrainRate, StressServo, move_walls as cpu_move_walls,
+    servo_refreshes as cpu_servo_refreshes, servo_walls as cpu_servo_walls)
+from pendular.gpu.cuda import cuda, device, device_twin
+from pendular.dem.state import Walls
+from pendular.gpu import integrate, neighbors
 from pendular.gpu.forces import wall_push
+from pendular.gpu.operations import BoxSide, ControlSide, device_side
 
-#: Servo calls during which the stiffness is refreshed every call (StressServo's).
-STIFFNESS_WARMUP = StressServo.STIFFNESS_WARMUP
+servo_walls = device_twin(cpu_servo_walls)
+servo_refreshes = device_twin(cpu_servo_refreshes)
+move_walls = device_twin(cpu_move_walls)
+
 #: Particles summed by one thread of wall_partials.
 REDUCE_CHUNK = 1024
 #: Wall quantities summed: force [N], stiffness [N/m], moment [N m] (pendular.dem.state.Walls).
@@ -56,6 +67,11 @@ STRAIN_RATE_FIELDS = ("rate", "reference_length", "on_current_length")
 MIXED_FIELDS = ("mean_stress", "b", "stress_x", "stress_y", "stress_z")
 #: parameters[c] of a radius growth: its target [Pa] and max_rate, the rate g it sets this step.
 GROWTH_FIELDS = ("target_stress", "max_rate", "rate")
+#: The controls' program on the device (module docstring): ``kinds``, ``control_walls``,
+#: ``wall_counts``, ``parameters``, a servo's memory ``previous``, ``stiffness``, ``calls``,
+#: the ``step`` counted and a mixed condition's ``failure``.
+Program = namedtuple("Program", "kinds control_walls wall_counts parameters previous "
+                                "stiffness calls step failure")
 #: failure[:] of a mixed condition that cannot hold (failed: 0 none, 1 one to report; row:
 #: the control's; step, axis, target [Pa] and sigma_z [Pa] of the message).
 FAILURE_FIELDS = ("failed", "row", "step", "axis", "target", "sigma_z")
@@ -84,54 +100,23 @@ def wall_partials(position, radius, wall_position, young, partial):
 
 
 @device
-def move_walls(wall_position, wall_velocity, c, control_walls, count, outward, dt):
-    """Shift control c's walls outward by ``outward[c, slot]`` [m] each and record their
-    velocity (pendular.dem.walls.move_walls)."""
-    for slot in range(count):
-        w = control_walls[c, slot]
-        sign = 1.0 if w % 2 else -1.0
-        wall_position[w] += sign * outward[c, slot]
-        wall_velocity[w] = outward[c, slot] / dt
-
-
-@device
 def servo(c, control_walls, count, parameters, previous, stiffness, calls, wall_position,
           wall_velocity, wall_force, wall_stiffness, dt):
-    """One call of StressServo c (pendular.dem.walls.StressServo.apply and servo_walls)."""
-    target = parameters[c, 0]
-    gain = parameters[c, 1]
-    memory = parameters[c, 2]
-    max_velocity = parameters[c, 3]
-    scale_max_velocity = parameters[c, 4] != 0.0
-    every = int(parameters[c, 5])
-    refresh = calls[c] < STIFFNESS_WARMUP or calls[c] % every == 0
+    """One call of StressServo c (StressServo.apply): the CPU's own refresh rule and law on
+    its walls (pendular.dem.walls.servo_refreshes and servo_walls, compiled by
+    device_twin)."""
+    refresh = servo_refreshes(calls[c], int(parameters[c, 5]))
     calls[c] += 1
-    lx = wall_position[1] - wall_position[0]
-    ly = wall_position[3] - wall_position[2]
-    lz = wall_position[5] - wall_position[4]
-    for slot in range(count):
-        w = control_walls[c, slot]
-        axis = w // 2
-        if refresh:
-            stiffness[c, slot] = wall_stiffness[w]
-        cap = max_velocity * dt
-        if scale_max_velocity:
-            length = lx if axis == 0 else (ly if axis == 1 else lz)
-            cap = cap * (3.0 * length / (lx + ly + lz))
-        if stiffness[c, slot] > 0.0:
-            area = ly * lz if axis == 0 else (lx * lz if axis == 1 else lx * ly)
-            shift = (wall_force[w] - target * area) / stiffness[c, slot]
-            shift = min(max(shift, -cap), cap)
-        else:
-            shift = -cap
-        previous[c, slot] = gain * shift + memory * previous[c, slot]
-    move_walls(wall_position, wall_velocity, c, control_walls, count, previous, dt)
+    servo_walls(wall_position, wall_velocity, wall_force, wall_stiffness, stiffness[c],
+                previous[c], control_walls[c, :count], parameters[c, 0], parameters[c, 1],
+                parameters[c, 2], parameters[c, 3], parameters[c, 4] != 0.0, refresh, dt)
 
 
 @device
 def strain_rate(c, control_walls, parameters, previous, wall_position, wall_velocity, dt):
     """One call of ConstantStrainRate c (pendular.dem.walls.ConstantStrainRate.apply): both
-    walls of its axis move inward at rate * L / 2, L the reference or current length."""
+    walls of its axis move inward at rate * L / 2, L the reference or current length (the
+    CPU's move_walls, compiled by device_twin)."""
     rate = parameters[c, 0]
     axis = control_walls[c, 0] // 2
     length = parameters[c, 1]
@@ -140,7 +125,7 @@ def strain_rate(c, control_walls, parameters, previous, wall_position, wall_velo
     shift = -0.5 * rate * length * dt
     previous[c, 0] = shift
     previous[c, 1] = shift
-    move_walls(wall_position, wall_velocity, c, control_walls, 2, previous, dt)
+    move_walls(wall_position, wall_velocity, control_walls[c, :2], previous[c], dt)
 
 
 @device
@@ -255,11 +240,13 @@ def wall_sums(partial, wall_force, wall_stiffness, wall_moment):
 
 
 @cuda.jit
-def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts, parameters,
-                  previous, stiffness, calls, wall_position, wall_velocity, reference_walls,
-                  limit, dt, step, failure, flags):
-    """One thread: the controls in order, the step counted, then a neighbour-list rebuild
-    asked when a wall has moved more than ``limit`` [m] since the last one."""
+def wall_controls(wall_force, wall_stiffness, program, wall_position, wall_velocity,
+                  reference_walls, limit, dt, flags):
+    """One thread: the controls of ``program`` (Program) in order, the step counted, then a
+    neighbour-list rebuild asked when a wall has moved more than ``limit`` [m] since the last
+    one."""
+    (kinds, control_walls, wall_counts, parameters, previous, stiffness, calls, step,
+     failure) = program
     if cuda.grid(1) != 0:
         return
     for c in range(kinds.shape[0]):
@@ -278,3 +265,162 @@ def wall_controls(wall_force, wall_stiffness, kinds, control_walls, wall_counts,
     for w in range(6):
         if abs(wall_position[w] - reference_walls[w]) > limit:
             flags[0] = 1
+
+
+@device_side(StressServo)
+class ServoRow(ControlSide):
+    """A StressServo's row: its walls (a periodic cell's axes: pendular.gpu.cell), its
+    parameters (SERVO_FIELDS) and its memory, which comes back into the servo."""
+
+    role = STRESS_SERVO
+
+    def upload(self, row, program, scene):
+        op = self.op
+        super().upload(row, program, scene)
+        walls = op.axes if scene.periodic else op.walls
+        program.control_walls[row, :len(walls)] = walls
+        program.wall_counts[row] = len(walls)
+        program.previous[row, :len(op.walls)] = op.previous
+        program.stiffness[row, :len(op.walls)] = op.stiffness
+        program.calls[row] = op.calls
+
+    def parameters(self, values):
+        op = self.op
+        values[:] = (op.target, op.gain, op.memory, op.max_velocity,
+                     float(op.scale_max_velocity), float(op.stiffness_every))
+
+    def to_host(self, row, program):
+        op = self.op
+        op.previous[:] = program.previous[row, :len(op.walls)]
+        op.stiffness[:] = program.stiffness[row, :len(op.walls)]
+        op.calls = int(program.calls[row])
+
+
+@device_side(ConstantStrainRate)
+class StrainRateRow(ControlSide):
+    """A ConstantStrainRate's row: its axis's two walls (a periodic cell's axis), its
+    parameters (STRAIN_RATE_FIELDS)."""
+
+    role = STRAIN_RATE
+
+    def upload(self, row, program, scene):
+        axis = self.op.axis
+        super().upload(row, program, scene)
+        walls = (axis,) if scene.periodic else (2 * axis, 2 * axis + 1)
+        program.control_walls[row, :len(walls)] = walls
+        program.wall_counts[row] = len(walls)
+
+    def parameters(self, values):
+        op = self.op
+        values[:3] = (op.rate, op.reference_length, float(op.on_current_length))
+
+
+@device_side(MixedStress)
+class MixedStressRow(ControlSide):
+    """A MixedStress's row (module docstring): the rows of its servos, its free axes, its
+    parameters (MIXED_FIELDS); the targets it sets on the device come back into its servos
+    (``driven``)."""
+
+    role = MIXED_STRESS
+
+    def check(self, scene):
+        """Its servos must be among the scene's controls (their rows hold the targets)."""
+        controls = [side.op for side in scene.controls]
+        if not all(any(self.op.servos[axis] is other for other in controls)
+                   for axis in self.op.free):
+            raise ValueError("device='gpu' runs a MixedStress whose servos are among the "
+                             "scene's controls only")
+
+    def driven(self, scene):
+        """The rows of the servos whose targets it sets (``scene``: pendular.gpu.operations.
+        Scene)."""
+        return [scene.row(self.op.servos[axis]) for axis in self.op.free]
+
+    def upload(self, row, program, scene):
+        op = self.op
+        super().upload(row, program, scene)
+        program.control_walls[row, :3] = [scene.row(op.servos[axis]) if axis in op.free
+                                          else -1 for axis in range(3)]
+        program.control_walls[row, 3:3 + len(op.free)] = op.free
+        program.wall_counts[row] = len(op.free)
+
+    def parameters(self, values):
+        op = self.op
+        values[:5] = (np.nan if op.mean_stress is None else op.mean_stress,
+                      np.nan if op.b is None else op.b,
+                      *(op.stress.get(axis, np.nan) for axis in range(3)))
+
+
+@device_side(RadiusGrowth)
+class RadiusGrowthRow(ControlSide):
+    """A RadiusGrowth's row: it sets the growth's rate (GROWTH_FIELDS); the radii grow in
+    pendular.gpu.growth."""
+
+    role = RADIUS_GROWTH
+    single = True
+    grows_radii = True
+
+    def check(self, scene):
+        """In a periodic cell, a growth runs where no control moves the faces and the cell is
+        not sheared (its rebuild test: pendular.gpu.growth)."""
+        if not scene.periodic:
+            return
+        moving = [side.name for side in scene.controls
+                  if side.role not in (RADIUS_GROWTH, GROWTH_TIMESTEP)]
+        if moving or scene.box.op.sheared:
+            raise ValueError("device='gpu' runs a RadiusGrowth in a periodic cell whose faces "
+                             "no control moves only (its rebuild test: pendular.gpu.growth); "
+                             f"found {', '.join(moving) or 'a sheared cell'}")
+
+    def parameters(self, values):
+        values[:2] = (self.op.target_stress, self.op.max_rate)
+
+
+@device_side(GrowthTimeStep)
+class GrowthTimeStepRow(ControlSide):
+    """A GrowthTimeStep's row: nothing on the device (the host sets dt at the rebuilds,
+    pendular.gpu.growth)."""
+
+    role = GROWTH_TIMESTEP
+    single = True
+
+
+@device_side(Walls)
+class WallBox(BoxSide):
+    """Six walls (Walls, with WallForces among the forces): a step's launches (module
+    docstring of pendular.gpu.simulation), the walls' reduction and controls here."""
+
+    def check(self, scene):
+        scene.force("walls", required=True)
+
+    def steps(self, gpu):
+        """(kernel, items, arguments) of a step inside walls: the rebuild, the forces (the
+        walls' springs before or after the pairs' gather as the forces are listed), the
+        walls' sums and controls, the grips, the leapfrog."""
+        sim = gpu.sim
+        scene = gpu.scene
+        s = gpu.state
+        n = s.count
+        springs = scene.force("walls")
+        gatherer = (scene.force("bridges") if s.wet and not s.persist
+                    else scene.force("contact law"))
+        walls_first = scene.index(springs) < scene.index(gatherer)
+        limit = 0.5 * s.skin
+        return [
+            (neighbors.bin_particles, n, (s.position, s.wall_position, s.grid(), s.flags)),
+            (neighbors.find_pairs, n, (s.position, s.radius, s.skin + s.reach,
+                                       s.wall_position, s.grid(), s.rows(), s.carried(),
+                                       s.new_carried(), s.flags)),
+            gpu.finish_step(),
+            *gpu.force_steps(walls_first, springs.young),
+            (wall_partials, s.partial.shape[0],
+             (s.position, s.radius, s.wall_position, springs.young, s.partial)),
+            (wall_sums, 6 * WALL_SUMS,
+             (s.partial, s.wall_force, s.wall_stiffness, s.wall_moment)),
+            (wall_controls, 1,
+             (s.wall_force, s.wall_stiffness, s.program(), s.wall_position, s.wall_velocity,
+              s.reference_walls, limit, sim.dt, s.flags)),
+            *(gpu.grips.launches(s) if gpu.grips is not None else ()),
+            (integrate.leapfrog, n, (s.motion(), scene.integrator.damping, s.no_period,
+                                     sim.dt, s.reference_position, limit, s.flags)),
+        ]
