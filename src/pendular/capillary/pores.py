@@ -452,7 +452,7 @@ def _periodic_units(position, radius, period):
     wanted = np.sort(translated.reshape(-1, 4), axis=1)
     order = np.lexsort(key.T[::-1])
     sorted_keys = key[order]
-    position_of = _search_rows(sorted_keys, wanted)
+    position_of = search_rows(sorted_keys, wanted)
     if (position_of < 0).any():
         raise ValueError("the periodic pore decomposition is inconsistent (degenerate packing)")
     neighbours = order[position_of].reshape(-1, 4)
@@ -465,7 +465,7 @@ def _image_code(shift):
     return (shift[..., 0] + 2) * 25 + (shift[..., 1] + 2) * 5 + (shift[..., 2] + 2)
 
 
-def _search_rows(sorted_rows, rows):
+def search_rows(sorted_rows, rows):
     """Index in ``sorted_rows`` (lexicographically sorted, unique) of each of ``rows``; -1 if
     absent."""
     dtype = np.dtype([(f"f{i}", sorted_rows.dtype) for i in range(sorted_rows.shape[1])])

@@ -231,7 +231,12 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "bridges_across_gaps": "1", "porosity": "1", "volumetric_strain": "1",
                     "chi": "1", "chi_tensor": "1", "psi": "Pa", "psi_interface": "Pa",
                     "sigma_wall": "Pa", "coordination": "1", "pendular_overlaps": "1",
-                    "steps": "1"}
+                    "steps": "1",
+                    # --liquid clusters (pendular.capillary.liquid_clusters.statistics)
+                    "clusters": "1", "filled_units": "1", "pore_units": "1",
+                    "liquid_in_bridges": "1", "liquid_in_clusters": "1",
+                    "liquid_in_largest_cluster": "1", "largest_cluster_percolates": "1",
+                    "psi_clusters": "Pa"}
 
 #: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.

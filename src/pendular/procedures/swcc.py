@@ -43,6 +43,7 @@ import time
 import numpy as np
 
 from pendular.capillary import CapillaryBridges, sample_radius_ratios
+from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.utils.atomic import write_json
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
@@ -113,6 +114,10 @@ class SwccTest:
         interruption would (raises Interrupted)."""
         check_device(device)
         checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
+        if self.config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
+            raise ValueError(f"liquid = 'clusters' runs on the CPU without checkpoints (its pore "
+                             f"units are the host's and not yet checkpointed); got device = "
+                             f"{device!r}, checkpoint_every = {checkpoint_every}")
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -184,11 +189,14 @@ class SwccTest:
             + "): raise --stage-steps or check the settings")
 
     @staticmethod
-    def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):
-        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS)."""
+    def stage_row(sim, bridges, homogenization, suction, dry_volume, steps, clusters=None):
+        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS); with
+        liquid ``clusters`` (LiquidClusters), their figures, and the saturation of bridges and
+        clusters together (chi, psi: the bridges' whole, their shares in filled units
+        included; the clusters' share of the complete stress is psi_clusters)."""
         state = bridges.state(sim)
         chi = homogenization.chi(sim)
-        return {"suction": suction,
+        row = {"suction": suction,
                 "saturation": bridges.saturation(sim),
                 "bridges": state.count(),
                 "bridges_across_gaps": int(np.count_nonzero(state.state == 2)),
@@ -202,6 +210,9 @@ class SwccTest:
                 "coordination": coordination(sim.contacts, len(sim.particles)),
                 "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
+        if clusters is not None:
+            row.update(clusters.statistics(sim))
+        return row
 
 
 class SwccPath:
@@ -222,6 +233,10 @@ class SwccPath:
         self.preparation, self.preparation_time = preparation, preparation_time
         self.dry_volume = sim.walls.volume()
         sim.forces.append(bridges)
+        self.clusters = None
+        if config.liquid == "clusters":          # the pore space starts full: main drying
+            self.clusters = LiquidClusters(bridges, saturated=True)
+            sim.forces.append(self.clusters)
         axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
         self.recorder = HistoryRecorder(config.record_every,
                                         history_columns(sim, axial, self.dry_volume, bridges),
@@ -296,6 +311,8 @@ class SwccPath:
                     continue
                 if self.stage_start is None:
                     bridges.set_suction(suction)
+                    if self.clusters is not None:
+                        self.clusters.set_suction(sim, suction)
                     self.stage_start = sim.step
                 budget -= self.run_stage(budget, f"{branch} {suction:g} Pa" if progress
                                          else None)
@@ -304,7 +321,7 @@ class SwccPath:
                 self.recorder.record(sim)
                 self.stages[branch].append(self.test.stage_row(
                     sim, bridges, self.homogenization, suction, self.dry_volume,
-                    sim.step - self.stage_start))
+                    sim.step - self.stage_start, self.clusters))
                 self.index, self.stage_start = self.index + 1, None
         except KeyboardInterrupt:
             pass
