@@ -9,6 +9,8 @@ import pytest
 
 from pendular.capillary import CapillaryBridges
 from pendular.capillary.liquid_clusters import LiquidClusters
+from pendular.homogenize.clusters import chi_with_clusters
+from pendular.homogenize.on_the_fly import CapillaryHomogenization
 
 GAMMA = 0.073
 
@@ -42,6 +44,8 @@ def test_clusters_below_every_filling_suction_are_the_pendular_bridges(small_sam
     account = clusters.account(clustered)
     assert account.clusters == 0.0 and account.absorbed == 0.0
     assert clusters.saturation(clustered) == bridges.saturation(pendular)
+    assert np.allclose(chi_with_clusters(clustered, clusters),
+                       CapillaryHomogenization(bridges).chi(pendular), rtol=1e-12, atol=0)
 
 
 def test_a_saturated_sample_drains_and_its_cluster_forces_balance(small_sample):
@@ -52,6 +56,11 @@ def test_a_saturated_sample_drains_and_its_cluster_forces_balance(small_sample):
     assert stats["clusters"] >= 1 and stats["filled_units"] == filled
     assert stats["liquid_in_bridges"] + stats["liquid_in_clusters"] == pytest.approx(1.0)
     assert 0 < stats["liquid_in_largest_cluster"] <= stats["liquid_in_clusters"]
+    assert 0 < stats["saturation"] < stats["saturation_pore_units"]
+    # the clusters' share of chi: positive, below the saturated sample's
+    chi = np.trace(chi_with_clusters(sim, clusters)) / 3
+    bridges_alone = np.trace(CapillaryHomogenization(bridges).chi(sim)) / 3
+    assert 0 < chi < 1.5 and chi != bridges_alone
     assert np.abs(clusters._force.sum(axis=0)).max() < 1e-10 * np.abs(clusters._force).max()
     # the account: a filled unit's pore volume, a bridge's share outside the filled units
     account = clusters.account(sim)

@@ -108,14 +108,14 @@ class LiquidClusters:
         particles, contacts = sim.particles, sim.contacts
         particles.force += self._force
         if contacts is not self._contacts:
-            self._share = self._pair_share(contacts)
+            self._share = self.pair_share(contacts)
             self._contacts = contacts
         pair_force = self.bridges.pair_force
         if len(pair_force) == len(self._share):
             gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, particles.force)
 
-    def _pair_share(self, contacts):
+    def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold."""
         edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
         share = self._edges.filled_share(self.filled)
@@ -129,6 +129,17 @@ class LiquidClusters:
         volume = BridgeState.of(contacts).volume
         edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
         return liquid_account(self.units, self._edges, self.found, volume, edge)
+
+    def _units_liquid(self, sim, account):
+        """[m^3] the liquid inside the pore units: the filled units, and the bridges' shares in
+        the empty ones (their dihedral angles there over 2 pi; a bridge between grains that
+        share no unit, across a gap, all)."""
+        contacts = sim.contacts
+        volume = BridgeState.of(contacts).volume
+        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        inside = self._edges.filled_share(np.ones(self.units.count, bool))
+        inside = np.where(edge >= 0, inside[np.maximum(edge, 0)], 1.0)
+        return account.clusters + float(np.sum(volume * inside)) - account.absorbed
 
     def saturation(self, sim):
         """Degree of saturation: the liquid held over the voids (the box less the solid)."""
@@ -144,10 +155,12 @@ class LiquidClusters:
     def statistics(self, sim):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
         the liquid fractions in bridges, in clusters and in the largest cluster, whether the
-        largest percolates along x, y, z, the saturation and the clusters' stress."""
+        largest percolates along x, y, z, the saturation (over the voids of the box, and over
+        the pore units' void alone) and the clusters' stress."""
         account = self.account(sim)
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
+        in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))
         return {"clusters": int(self.found.count),
                 "filled_units": int(np.count_nonzero(self.filled)),
                 "pore_units": int(self.units.count),
@@ -156,6 +169,7 @@ class LiquidClusters:
                 "liquid_in_largest_cluster": fractions["largest"],
                 "largest_cluster_percolates": [bool(v) for v in self.found.percolates],
                 "saturation": account.total / voids,
+                "saturation_pore_units": in_units,
                 "psi_clusters": self.stress(sim).tolist()}
 
 

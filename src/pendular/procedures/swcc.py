@@ -57,6 +57,7 @@ from pendular.dem.walls import ConstantStrainRate
 from pendular.utils.progress import whole_run
 from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
+from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
 
@@ -212,6 +213,7 @@ class SwccTest:
                 "steps": steps}
         if clusters is not None:
             row.update(clusters.statistics(sim))
+            row["chi_with_clusters"] = float(np.trace(chi_with_clusters(sim, clusters)) / 3.0)
         return row
 
 
