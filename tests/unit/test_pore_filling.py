@@ -224,3 +224,20 @@ def test_cluster_forces_balance_and_vanish_inside(packing):
     assert np.abs(everything[inner]).max() < 1e-12 * scale
     stress = cluster_forces.cluster_stress(units, forces, filled, 1e3, 1e-9)
     assert np.isfinite(stress).all()
+
+
+def test_pore_units_coloured_by_cluster_for_paraview(packing, tmp_path):
+    import meshio
+
+    from pendular.io.vtk import pore_mesh, write_vtu
+
+    _, _, units, _ = packing
+    filled = np.zeros(units.count, bool)
+    filled[: units.count // 3] = True
+    found = clusters.find_clusters(units, filled)
+    write_vtu(tmp_path / "pores.vtu", pore_mesh(units, found.label), field_data={"stage": 3})
+    back = meshio.read(tmp_path / "pores.vtu")
+    assert back.cells[0].type == "tetra" and len(back.cells[0].data) == units.count
+    assert np.array_equal(back.cell_data["cluster"][0], found.label)
+    corners = back.points[back.cells[0].data]
+    assert np.allclose(corners, units.vertices)

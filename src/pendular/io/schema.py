@@ -191,6 +191,9 @@ HISTORY_COLUMNS = {name: replace(column, commands=HISTORY_WRITERS.get(name, ()))
 #: slider) is one of these, named in a comment of its .pvd file.
 VTK_FIELDS = {
     "step": Column("1", "time step number of the frame"),
+    "stage": Column("1", "the stage of an SWCC path (drying then wetting, from 0): the time "
+                         "axis of its pores/"),
+    "suction": Column("Pa", "the suction of the stage (an SWCC's pores/)"),
     "time": Column("s", "simulated time; the time axis of the direct tension's vtk/ and of "
                         "vtk_prep/"),
     "axial_strain": Column("1", "axial (z) strain 1 - L/L0 of a loading path's vtk/ "

@@ -29,6 +29,13 @@ triaxial's columns, pendular.io.schema, recorded through the whole path) and sam
 ``run(out, checkpoint_every=N)`` checkpoint.h5 (SwccPath), from which ``SwccTest.resume(out)``
 continues an interrupted path bit for bit.
 
+With ``liquid = "clusters"`` (docs/liquid_clusters.md) the pore space starts saturated and
+liquid clusters of filled pore units join the bridges (pendular.capillary.liquid_clusters):
+drying empties units by Haines jumps from the hull, wetting fills them at their filling
+suction, so that the path gives the main drying and wetting curves; each row adds the
+clusters' figures, and pores/ holds the pore units coloured by cluster, one ParaView frame per
+stage (CPU only, without checkpoints).
+
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
 wetting across gaps and the rows of swcc.json are computed on the host between the stages.
@@ -63,6 +70,7 @@ from pendular.homogenize.regular_packing import KINDS
 
 from pendular.procedures.config import SwccConfig, config_from_dict, config_to_dict
 from pendular.io.history import write_history
+from pendular.io.vtk import pore_mesh, write_pvd, write_vtu
 from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -122,6 +130,8 @@ class SwccTest:
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
+            if self.config.liquid == "clusters":
+                folder.claim("pores")
             with whole_run(swcc_plan(self.config), enabled=progress):
                 return self._run(out, progress, threads, device, checkpoint_every, stop_after)
 
@@ -249,6 +259,7 @@ class SwccPath:
         self.index, self.stage_start = 0, None
         self.stages = {"drying": [], "wetting": []}
         self.formed = 0
+        self.pore_frames = []
         self.path_time = 0.0         # seconds spent on the path by earlier (interrupted) runs
         self._static = static(config.sample.equilibrium_unbalanced,
                               config.sample.stress_tolerance)
@@ -324,6 +335,8 @@ class SwccPath:
                 self.stages[branch].append(self.test.stage_row(
                     sim, bridges, self.homogenization, suction, self.dry_volume,
                     sim.step - self.stage_start, self.clusters))
+                if self.clusters is not None:
+                    self.write_pores(suction)
                 self.index, self.stage_start = self.index + 1, None
         except KeyboardInterrupt:
             pass
@@ -364,6 +377,18 @@ class SwccPath:
             taken += sim.run(steps, until=self._ended, check_every=self.CHECK_EVERY,
                              progress=label, status=status)
         return taken
+
+    def write_pores(self, suction):
+        """pores/pores_NNNN.vtu of the stage just ended (its index NNNN) and pores/pores.pvd
+        of the stages so far (pendular.io.vtk.pore_mesh)."""
+        folder = os.path.join(self.out, "pores")
+        os.makedirs(folder, exist_ok=True)
+        name = f"pores_{self.index:04d}.vtu"
+        write_vtu(os.path.join(folder, name),
+                  pore_mesh(self.clusters.units, self.clusters.found.label),
+                  field_data={"stage": self.index, "suction": suction})
+        self.pore_frames.append((self.index, name))
+        write_pvd(os.path.join(folder, "pores.pvd"), self.pore_frames, time_axis="stage")
 
     def write_outputs(self):
         """history.h5, swcc.json and swcc.png; returns the swcc.json content."""
