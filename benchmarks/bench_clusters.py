@@ -12,7 +12,9 @@ ascending from a saturated pore space (drying: Haines jumps from the hull),
 pendular.capillary.liquid_clusters.LiquidClusters gives the liquid account; W is the liquid
 over the volume between the walls (Scheel et al.'s liquid content), with the fractions in
 bridges, in clusters and in the largest cluster, the number of clusters and the percolation of
-the largest. Timed: ``set_suction`` (decomposition, thresholds, filling, forces) and one DEM
+the largest. For Kim (2001)'s direct-tension cases, the mean capillary stress chi s at each
+case's saturation on the wetting branch, bridges alone and with clusters (an estimate of how
+much the clusters raise the tensile strength, not a pull). Timed: ``set_suction`` (decomposition, thresholds, filling, forces) and one DEM
 step of the wet scene without and with the clusters.
 """
 
@@ -25,12 +27,17 @@ import numpy as np
 
 from pendular.capillary import CapillaryBridges
 from pendular.capillary.liquid_clusters import LiquidClusters
+from pendular.homogenize.clusters import chi_with_clusters
+from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.interop.yade.runner import cached_sample
 from pendular.procedures.preparation import PrepareConfig, servoed_simulation
 
-SUCTIONS = (300000.0, 150000.0, 100000.0, 70000.0, 50000.0, 40000.0, 30000.0, 25000.0,
-            20000.0, 15000.0, 12000.0, 10000.0, 8000.0, 6000.0, 5000.0, 4000.0, 3000.0)
+SUCTIONS = tuple(np.geomspace(300000.0, 3000.0, 25))
 GAMMA = 0.073
+#: Kim (2001)'s cases (void ratio, gravimetric water content), Gs = 2.65 (pendular tension).
+KIM_CASES = ((0.72, 0.0047), (0.72, 0.0104), (0.72, 0.0211),
+             (0.58, 0.0043), (0.58, 0.0104), (0.58, 0.0201))
+SPECIFIC_GRAVITY = 2.65
 
 
 def branch(sim, suctions, saturated, gap):
@@ -53,7 +60,11 @@ def branch(sim, suctions, saturated, gap):
         sim.evaluate_forces()
         account = clusters.account(sim)
         stats = clusters.statistics(sim)
+        alone = np.trace(CapillaryHomogenization(bridges).chi(sim)) / 3.0
         rows.append({"suction": suction, "W": account.total / sim.walls.volume(),
+                     "saturation_bridges_alone": bridges.saturation(sim),
+                     "chi_bridges_alone": float(alone),
+                     "chi_with_clusters": float(np.trace(chi_with_clusters(sim, clusters)) / 3),
                      **{k: stats[k] for k in ("saturation", "saturation_pore_units",
                                               "liquid_in_bridges", "liquid_in_clusters",
                                               "liquid_in_largest_cluster", "clusters",
@@ -61,6 +72,26 @@ def branch(sim, suctions, saturated, gap):
                                               "largest_cluster_percolates")},
                      "bridges": bridges.count(sim)})
     return rows, times, sim
+
+
+def kim_estimate(rows):
+    """Per Kim case: the mean capillary stress chi s [Pa] at its saturation w Gs / e on the
+    wetting branch ``rows``, bridges alone and with clusters (log-log interpolation in the
+    saturation), and their ratio. At theta = 0 tr B = 0, so chi s is psi's mean."""
+    def at(saturation_key, chi_key, target):
+        s = np.array([r[saturation_key] for r in rows])
+        psi = np.array([r[chi_key] * r["suction"] for r in rows])
+        order = np.argsort(s)
+        return float(np.exp(np.interp(np.log(target), np.log(s[order]), np.log(psi[order]))))
+    estimates = []
+    for void_ratio, water in KIM_CASES:
+        saturation = water * SPECIFIC_GRAVITY / void_ratio
+        pendular = at("saturation_bridges_alone", "chi_bridges_alone", saturation)
+        clustered = at("saturation", "chi_with_clusters", saturation)
+        estimates.append({"void_ratio": void_ratio, "water_content": water,
+                          "saturation": saturation, "psi_bridges_alone": pendular,
+                          "psi_with_clusters": clustered, "ratio": clustered / pendular})
+    return estimates
 
 
 def step_time(sim, repeat=20):
@@ -88,7 +119,8 @@ def main(argv=None):
     result = {"particles": len(particles.radius), "wetting": wetting, "drying": drying,
               "set_suction_s": {"mean": float(np.mean(wetting_times + drying_times)),
                                 "max": float(np.max(wetting_times + drying_times))},
-              "step_s": {"pendular": step_time(pendular), "clusters": step_time(wet)}}
+              "step_s": {"pendular": step_time(pendular), "clusters": step_time(wet)},
+              "kim_estimate": kim_estimate(wetting)}
     print(json.dumps(result, indent=1))
     if args.out:
         with open(args.out, "w") as handle:
