@@ -37,7 +37,7 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "gravity", "young", "contact", "poisson", "restitution", "damping",
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
-             "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
+             "surface_tension", "rupture_liquid", "wetting", "persist_bridges", "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}
@@ -63,7 +63,7 @@ OWN_GENERATED = {
                 "young", "seed", "periodic"} | SIZES,
     "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
              "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
-             "seed", "checkpoint_every"} | SIZES,
+             "seed", "checkpoint_every", "liquid"} | SIZES,
 }
 #: Options whose default is the command's own, not its field's (the field's otherwise).
 COMMAND_DEFAULTS = {("tension", "particles"), ("tension", "confining"), ("swcc", "particles"),
