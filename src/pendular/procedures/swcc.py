@@ -113,6 +113,10 @@ class SwccTest:
                 "servoed walls never hold a lower confining stress (every stage would run to "
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
+        if config.liquid == "clusters" and sample.periodic:
+            raise ValueError("liquid = 'clusters' runs between walls, not in a periodic cell "
+                             "(the clusters' forces would need their face terms in the cell's "
+                             "stress)")
 
     def run(self, out, *, progress=True, threads=None, device="cpu", checkpoint_every=0,
             stop_after=None):
