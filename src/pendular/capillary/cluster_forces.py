@@ -19,7 +19,7 @@ vector in closed form:
     R_k^2 ∫_cone n dOmega = - sum_{faces f at k} (alpha_kf R_k^2 / 2) n_f.
 
 The meniscus across a throat f through which a cluster meets gas closes the liquid body: its
-equilibrium (pressure s on the throat's open area A_f = |face| - sum alpha_if R_i^2 / 2, the
+equilibrium (pressure s on the throat's open area A_f = area(face) - sum alpha_if R_i^2 / 2, the
 tension along its contact line) hands the line's total pull -s A_f n_f to the face's three
 grains, shared by their arcs alpha_if R_i. This closure takes the line integral from the
 meniscus's equilibrium instead of its shape: every cluster's forces then sum to zero to

@@ -38,9 +38,9 @@ def pore_body_radius(vertices, radii):
     (``vertices`` (M, 4, 3) [m], ``radii`` (M, 4) [m]), where its centre lies inside the
     tetrahedron; NaN where it does not (a flat unit) or does not exist.
 
-    With c_0 at the origin, |p - c_i| = R_i + r minus the same for i = 0 is linear in p:
-    2 d_i . p = |d_i|^2 - R_i^2 + R_0^2 - 2 r (R_i - R_0), so p = a + r b, and
-    |a + r b| = R_0 + r leaves a quadratic in r (R_circumscribed - R for equal spheres)."""
+    With c_0 at the origin, norm(p - c_i)^2 = (R_i + r)^2 minus the same for i = 0 is linear
+    in p: 2 d_i . p = d_i . d_i - R_i^2 + R_0^2 - 2 r (R_i - R_0), so p = a + r b, and
+    norm(a + r b) = R_0 + r leaves a quadratic in r (R_circumscribed - R for equal spheres)."""
     d = vertices[:, 1:] - vertices[:, :1]
     r0 = radii[:, :1]
     rhs_a = np.sum(d * d, axis=2) - radii[:, 1:] ** 2 + r0 ** 2
