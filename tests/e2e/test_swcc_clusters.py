@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 
+from pendular import read_history
 from pendular.cli import run_command
 from pendular.io.schema import undeclared_keys
 
@@ -30,6 +31,14 @@ def test_swcc_with_clusters_dries_from_saturation_and_wets_back(tmp_path):
     # at 20 kPa drying holds pore units that wetting has not filled again
     assert drying[1]["filled_units"] > wetting[1]["filled_units"]
     assert result["hysteresis"][1]["saturation_difference"] > 0.0
+    history = read_history(out / "history.h5")
+    for column in ("clusters", "liquid_in_bridges", "liquid_in_clusters",
+                   "liquid_in_largest_cluster", "largest_cluster_percolates",
+                   "saturation_pore_units"):
+        assert np.isfinite(history[column].values).all(), column
+    assert history["clusters"].values.max() >= 1
+    assert history["saturation"].values.max() == pytest.approx(
+        max(r["saturation"] for r in drying), rel=0.2)
     assert (out / "pores" / "pores.pvd").exists()
     assert len(list((out / "pores").glob("pores_*.vtu"))) == 5       # the turning point apart
 

@@ -75,6 +75,9 @@ HISTORY_WRITERS = {
                      "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
     **dict.fromkeys(("liquid_bridges", "liquid_film", "liquid_lost"), LABORATORY),
     **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
+    **dict.fromkeys(("clusters", "liquid_in_bridges", "liquid_in_clusters",
+                     "liquid_in_largest_cluster", "largest_cluster_percolates",
+                     "saturation_pore_units"), ("swcc",)),
     "water_content": ("tension", "path"),
     "liquid_total": ("path",),
     "excess_pore_pressure": ("triaxial",),
@@ -138,6 +141,20 @@ HISTORY_COLUMNS = {
                                       "(NaN without bridges)", equation="Eq. 3.54"),
     "a_psi": Column("1", "capillary stress anisotropy 5/2 (psi_z - psi_x) / tr psi (NaN "
                          "without bridges)", equation="Eq. 4.5"),
+    "clusters": Column("1", "number of liquid clusters (connected filled pore units; "
+                            "--liquid clusters)", dtype="int64"),
+    "liquid_in_bridges": Column("1", "fraction of the liquid held in bridges (their shares "
+                                     "outside filled pore units; --liquid clusters)"),
+    "liquid_in_clusters": Column("1", "fraction of the liquid held in filled pore units "
+                                      "(--liquid clusters)"),
+    "liquid_in_largest_cluster": Column("1", "fraction of the liquid held in the largest "
+                                             "cluster (--liquid clusters)"),
+    "largest_cluster_percolates": Column("1", "1 where the largest cluster spans the sample "
+                                              "along the axis, else 0 (--liquid clusters)",
+                                         _VECTOR),
+    "saturation_pore_units": Column("1", "liquid in the pore units over their pore volume "
+                                         "(--liquid clusters; the strip along the walls "
+                                         "left out)"),
     "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
                                     "water content)"),
     "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "

@@ -254,9 +254,10 @@ class SwccPath:
             self.clusters = LiquidClusters(bridges, saturated=True)
             sim.forces.append(self.clusters)
         axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
-        self.recorder = HistoryRecorder(config.record_every,
-                                        history_columns(sim, axial, self.dry_volume, bridges),
-                                        origin=sim.step)
+        columns = history_columns(sim, axial, self.dry_volume, bridges)
+        if self.clusters is not None:
+            columns.update(cluster_columns(self.clusters))
+        self.recorder = HistoryRecorder(config.record_every, columns, origin=sim.step)
         self.homogenization = CapillaryHomogenization(bridges)
         suctions = list(config.suctions)
         self.path = [("drying", s) for s in suctions] + [("wetting", s) for s in suctions[::-1]]
@@ -416,6 +417,27 @@ class SwccPath:
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
         return result
+
+
+def cluster_columns(clusters):
+    """History columns of the liquid clusters (pendular.io.schema.HISTORY_COLUMNS), their
+    figures measured once per state; ``saturation``: of the bridges and clusters together."""
+    last = {}
+
+    def figure(name):
+        def column(sim):
+            key = (sim.step, id(clusters.found))      # a stage's start changes the state
+            if last.get("key") != key:
+                last.update(clusters.statistics(sim), key=key)
+            return last[name]
+        return column
+
+    columns = {name: figure(name) for name in (
+        "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
+        "saturation_pore_units", "saturation")}
+    percolates = figure("largest_cluster_percolates")
+    columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
+    return columns
 
 
 def hysteresis(stages):
