@@ -241,3 +241,16 @@ def test_pore_units_coloured_by_cluster_for_paraview(packing, tmp_path):
     assert np.array_equal(back.cell_data["cluster"][0], found.label)
     corners = back.points[back.cells[0].data]
     assert np.allclose(corners, units.vertices)
+
+
+def test_a_saturated_periodic_cell_drains_from_its_weakest_unit():
+    centres, radius = random_packing(cells=4, seed=5)
+    period = np.full(3, 4 * 2.6 * RADIUS)
+    units = pores.decompose(np.mod(centres, period), radius, period=period)
+    thresholds = pore_filling.filling_thresholds(units, radius, GAMMA)
+    full = np.ones(units.count, bool)
+    entry = thresholds.throat_entry
+    assert pore_filling.drain(units, thresholds, full, 0.999 * entry.min()).all()
+    assert not pore_filling.drain(units, thresholds, full, 1.001 * entry.max()).any()
+    partly = pore_filling.drain(units, thresholds, full, np.median(entry))
+    assert 0 < partly.sum() < units.count

@@ -31,8 +31,7 @@ import math
 
 import numpy as np
 
-from pendular.capillary.pores import FACES
-from pendular.capillary.pore_filling import face_angles
+from pendular.capillary.pores import FACES, face_angles
 
 
 def cap_force(suction, surface_tension, contact_angle, radius, filling_angle):

@@ -59,6 +59,8 @@ class LiquidClusters:
                 "filled_units": self.units.grains[self.filled].copy()}
 
     def load_state(self, state):
+        """Take back a ``state_dict``: the filled units are carried into the next
+        ``set_suction``, which the loading scene calls before the clusters pull again."""
         filled = state_array(state, "filled_units", np.int64, (None, 4))
         suction = state["suction"]
         if suction is not None and not (isinstance(suction, float) and suction > 0):

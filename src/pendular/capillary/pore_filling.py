@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pendular.capillary.pores import EDGES, FACES, dihedral_angles, entry_suction
+from pendular.capillary.pores import EDGES, dihedral_angles, entry_suction
 
 
 def pore_body_radius(vertices, radii):
@@ -217,16 +217,3 @@ def liquid_account(pore_units, edges, clusters, bridge_volume, pair_edge):
     return LiquidAccount(bridges=float(np.sum(bridge_volume)) - absorbed,
                          clusters=float(np.sum(clusters.volume)), largest=largest,
                          absorbed=absorbed)
-
-
-def face_angles(vertices):
-    """(M, 4, 3) [rad] the angle of the face opposite each vertex at each of its three
-    vertices (``FACES`` order)."""
-    corners = vertices[:, FACES]                          # (M, 4, 3, 3)
-    angles = np.empty(corners.shape[:3])
-    for k in range(3):
-        u = corners[:, :, (k + 1) % 3] - corners[:, :, k]
-        v = corners[:, :, (k + 2) % 3] - corners[:, :, k]
-        angles[..., k] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1),
-                                    np.sum(u * v, axis=-1))
-    return angles

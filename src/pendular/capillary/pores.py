@@ -127,6 +127,19 @@ def dihedral_angles(vertices):
     return np.arctan2(np.linalg.norm(np.cross(pc, pd), axis=2), np.sum(pc * pd, axis=2))
 
 
+def face_angles(vertices):
+    """(M, 4, 3) [rad] the angle of the face opposite each vertex at each of its three
+    vertices (``FACES`` order)."""
+    corners = vertices[:, FACES]                          # (M, 4, 3, 3)
+    angles = np.empty(corners.shape[:3])
+    for k in range(3):
+        u = corners[:, :, (k + 1) % 3] - corners[:, :, k]
+        v = corners[:, :, (k + 2) % 3] - corners[:, :, k]
+        angles[..., k] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1),
+                                    np.sum(u * v, axis=-1))
+    return angles
+
+
 def lens_volume(distance, radius1, radius2):
     """[m^3] volume of the intersection of two balls of radii ``radius1``, ``radius2`` [m] with
     centres ``distance`` [m] apart (0 apart from overlaps; the smaller ball if one holds the
