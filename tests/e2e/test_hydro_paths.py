@@ -110,7 +110,7 @@ def test_wetting_protocols_run_and_report(tmp_path):
 
 @pytest.mark.parametrize("argv, words", [
     (["--suction", "30000", "--water-content", "0.5"], ["--suction", "--water-content"]),
-    (["--liquid", "lost"], ["--liquid needs --water-content"]),
+    (["--rupture-liquid", "lost"], ["--rupture-liquid needs --water-content"]),
     (["--wetting", "at-shear"], ["--wetting", "--suction > 0"]),
     (["--water-content", "-1"], ["--water-content", "valid range"]),
     (["--water-content", "0.5", "--persist-bridges"], ["--water-content", "--persist-bridges"]),

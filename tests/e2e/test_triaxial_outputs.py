@@ -134,7 +134,7 @@ def test_resume_refuses_new_arguments_and_runs_without_checkpoint(tmp_path):
 def test_a_run_at_a_water_content_resumes_with_its_liquid_account(tmp_path):
     """The closed liquid (--water-content, shared at rupture) comes back from the checkpoint:
     the resumed history has the uninterrupted one's liquid columns, to the bit."""
-    argv = [*BASE, "--water-content", "1", "--liquid", "shared"]
+    argv = [*BASE, "--water-content", "1", "--rupture-liquid", "shared"]
     whole, run = tmp_path / "whole", tmp_path / "interrupted"
     triaxial(*argv, "--out", str(whole))
     stopped = triaxial(*argv, "--out", str(run), "--stop-after", "237", check=False)

@@ -37,7 +37,7 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "gravity", "young", "contact", "poisson", "restitution", "damping",
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
-             "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
+             "surface_tension", "rupture_liquid", "wetting", "persist_bridges", "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}
@@ -63,7 +63,7 @@ OWN_GENERATED = {
                 "young", "seed", "periodic"} | SIZES,
     "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
              "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
-             "seed", "checkpoint_every"} | SIZES,
+             "seed", "checkpoint_every", "liquid"} | SIZES,
 }
 #: Options whose default is the command's own, not its field's (the field's otherwise).
 COMMAND_DEFAULTS = {("tension", "particles"), ("tension", "confining"), ("swcc", "particles"),
@@ -274,8 +274,8 @@ def test_a_list_field_checks_each_value():
                   "--persist-bridges", "--max-strain", "0.02", "--vtk-every", "0"],
      {"particles": 300, "suction": 30000, "table_resolution": [100, 40],
       "persist_bridges": True, "max_strain": "0.02", "vtk_every": 0}),
-    ("triaxial", ["--water-content", "1.5", "--liquid", "lost", "--friction", "20"],
-     {"water_content": 1.5, "liquid": "lost", "friction": 20}),
+    ("triaxial", ["--water-content", "1.5", "--rupture-liquid", "lost", "--friction", "20"],
+     {"water_content": 1.5, "rupture_liquid": "lost", "friction": 20}),
     ("isotropic", ["--stresses", "500,1000", "--sample", "s.h5"],
      {"stresses": [500, 1000], "sample": "s.h5"}),
     ("isotropic", ["--stresses", "800"] + ["--stresses", "500,1000"],
@@ -496,3 +496,17 @@ def test_every_laboratory_command_takes_vtk_frames_where_it_can_spread_them():
     with pytest.raises(OptionError) as refused:
         config_from_options("oedometer", {"vtk_frames": 5})
     assert "length is not known before it runs" in str(refused.value)
+
+
+def test_the_old_liquid_option_is_a_deprecated_alias_of_rupture_liquid(capsys):
+    from pendular.cli import command_parser, deprecated_liquid
+
+    parser, _ = command_parser("triaxial")
+    assert deprecated_liquid(parser, ["--water-content", "1", "--liquid", "lost"]) == \
+        ["--water-content", "1", "--rupture-liquid", "lost"]
+    assert deprecated_liquid(parser, ["--liquid=shared"]) == ["--rupture-liquid=shared"]
+    assert capsys.readouterr().err.count("deprecated") == 2
+    assert deprecated_liquid(parser, ["--liquid", "clusters"]) == ["--liquid", "clusters"]
+    swcc, _ = command_parser("swcc")              # its --liquid is the regime
+    assert deprecated_liquid(swcc, ["--liquid", "clusters"]) == ["--liquid", "clusters"]
+    assert swcc.parse_args(["--liquid", "clusters"]).liquid == "clusters"

@@ -24,6 +24,9 @@ TENSION = ["step", "time", "axial_strain", "tensile_stress", "grip_pull", "sigma
 LIQUID = ["liquid_bridges", "liquid_film", "liquid_lost", "liquid_total"]
 PATHS = ["void_ratio", "k0", "stage", "cycle", "shear_strain", "shear_stress", "normal_stress",
          "excess_pore_pressure"]
+#: Columns of an SWCC with liquid clusters (swcc --liquid clusters), besides WET.
+CLUSTERS = ["clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
+            "largest_cluster_percolates", "saturation_pore_units"]
 #: Columns of an impact (pendular.procedures.impact), besides time.
 IMPACT = ["overlap", "normal_force", "tangential_force", "angular_velocity"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}
@@ -84,7 +87,7 @@ def test_every_declared_column_has_units_a_description_and_known_dimensions():
     assert HISTORY_COLUMNS["psi"].equation == "Eq. 3.46"
     assert HISTORY_COLUMNS["sigma_contact"].dims == ("axis", "component")
     assert HISTORY_COLUMNS["grip_pull"].dims == ("grip",)
-    assert (set(WET) | set(TENSION) | set(LIQUID) | set(PATHS) | set(IMPACT)
+    assert (set(WET) | set(TENSION) | set(LIQUID) | set(PATHS) | set(IMPACT) | set(CLUSTERS)
             == set(HISTORY_COLUMNS))
 
 

@@ -127,6 +127,19 @@ def dihedral_angles(vertices):
     return np.arctan2(np.linalg.norm(np.cross(pc, pd), axis=2), np.sum(pc * pd, axis=2))
 
 
+def face_angles(vertices):
+    """(M, 4, 3) [rad] the angle of the face opposite each vertex at each of its three
+    vertices (``FACES`` order)."""
+    corners = vertices[:, FACES]                          # (M, 4, 3, 3)
+    angles = np.empty(corners.shape[:3])
+    for k in range(3):
+        u = corners[:, :, (k + 1) % 3] - corners[:, :, k]
+        v = corners[:, :, (k + 2) % 3] - corners[:, :, k]
+        angles[..., k] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1),
+                                    np.sum(u * v, axis=-1))
+    return angles
+
+
 def lens_volume(distance, radius1, radius2):
     """[m^3] volume of the intersection of two balls of radii ``radius1``, ``radius2`` [m] with
     centres ``distance`` [m] apart (0 apart from overlaps; the smaller ball if one holds the
@@ -452,7 +465,7 @@ def _periodic_units(position, radius, period):
     wanted = np.sort(translated.reshape(-1, 4), axis=1)
     order = np.lexsort(key.T[::-1])
     sorted_keys = key[order]
-    position_of = _search_rows(sorted_keys, wanted)
+    position_of = search_rows(sorted_keys, wanted)
     if (position_of < 0).any():
         raise ValueError("the periodic pore decomposition is inconsistent (degenerate packing)")
     neighbours = order[position_of].reshape(-1, 4)
@@ -465,7 +478,7 @@ def _image_code(shift):
     return (shift[..., 0] + 2) * 25 + (shift[..., 1] + 2) * 5 + (shift[..., 2] + 2)
 
 
-def _search_rows(sorted_rows, rows):
+def search_rows(sorted_rows, rows):
     """Index in ``sorted_rows`` (lexicographically sorted, unique) of each of ``rows``; -1 if
     absent."""
     dtype = np.dtype([(f"f{i}", sorted_rows.dtype) for i in range(sorted_rows.shape[1])])

@@ -248,6 +248,28 @@ def command_parser(name, prog=None):
     return parser, module
 
 
+#: The old values of --rupture-liquid, once given as --liquid (now the liquid regime).
+RUPTURE_LIQUIDS = ("shared", "lost")
+
+
+def deprecated_liquid(parser, argv):
+    """``argv`` with ``--liquid shared|lost`` (the old name of ``--rupture-liquid``) renamed,
+    one warning line on stderr, for a command that has --rupture-liquid and no --liquid."""
+    flags = {flag for action in parser._actions for flag in action.option_strings}
+    if "--rupture-liquid" not in flags or "--liquid" in flags:
+        return argv
+    renamed = list(argv)
+    for k, word in enumerate(renamed):
+        value = (word.partition("=")[2] if word.startswith("--liquid=")
+                 else renamed[k + 1] if word == "--liquid" and k + 1 < len(renamed) else None)
+        if value in RUPTURE_LIQUIDS:
+            renamed[k] = word.replace("--liquid", "--rupture-liquid", 1)
+            print(f"warning: --liquid {value} is deprecated: it is now --rupture-liquid "
+                  f"{value} (--liquid chooses the liquid regime, pendular|clusters)",
+                  file=sys.stderr)
+    return renamed
+
+
 def run_command(name, argv, prog=None):
     """Parse ``argv`` for command ``name`` and run it; returns the exit status."""
     import numba
@@ -256,7 +278,7 @@ def run_command(name, argv, prog=None):
 
     parser, module = command_parser(name, prog)
     pause_point("import")
-    args = parser.parse_args(argv)
+    args = parser.parse_args(deprecated_liquid(parser, argv))
     try:
         with catching_interrupts():
             return module.run(args) or 0

@@ -75,6 +75,9 @@ HISTORY_WRITERS = {
                      "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
     **dict.fromkeys(("liquid_bridges", "liquid_film", "liquid_lost"), LABORATORY),
     **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
+    **dict.fromkeys(("clusters", "liquid_in_bridges", "liquid_in_clusters",
+                     "liquid_in_largest_cluster", "largest_cluster_percolates",
+                     "saturation_pore_units"), ("swcc",)),
     "water_content": ("tension", "path"),
     "liquid_total": ("path",),
     "excess_pore_pressure": ("triaxial",),
@@ -138,6 +141,20 @@ HISTORY_COLUMNS = {
                                       "(NaN without bridges)", equation="Eq. 3.54"),
     "a_psi": Column("1", "capillary stress anisotropy 5/2 (psi_z - psi_x) / tr psi (NaN "
                          "without bridges)", equation="Eq. 4.5"),
+    "clusters": Column("1", "number of liquid clusters (connected filled pore units; "
+                            "--liquid clusters)", dtype="int64"),
+    "liquid_in_bridges": Column("1", "fraction of the liquid held in bridges (their shares "
+                                     "outside filled pore units; --liquid clusters)"),
+    "liquid_in_clusters": Column("1", "fraction of the liquid held in filled pore units "
+                                      "(--liquid clusters)"),
+    "liquid_in_largest_cluster": Column("1", "fraction of the liquid held in the largest "
+                                             "cluster (--liquid clusters)"),
+    "largest_cluster_percolates": Column("1", "1 where the largest cluster spans the sample "
+                                              "along the axis, else 0 (--liquid clusters)",
+                                         _VECTOR),
+    "saturation_pore_units": Column("1", "liquid in the pore units over their pore volume "
+                                         "(--liquid clusters; the strip along the walls "
+                                         "left out)"),
     "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
                                     "water content)"),
     "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "
@@ -191,6 +208,9 @@ HISTORY_COLUMNS = {name: replace(column, commands=HISTORY_WRITERS.get(name, ()))
 #: slider) is one of these, named in a comment of its .pvd file.
 VTK_FIELDS = {
     "step": Column("1", "time step number of the frame"),
+    "stage": Column("1", "the stage of an SWCC path (drying then wetting, from 0): the time "
+                         "axis of its pores/"),
+    "suction": Column("Pa", "the suction of the stage (an SWCC's pores/)"),
     "time": Column("s", "simulated time; the time axis of the direct tension's vtk/ and of "
                         "vtk_prep/"),
     "axial_strain": Column("1", "axial (z) strain 1 - L/L0 of a loading path's vtk/ "
@@ -231,7 +251,13 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "bridges_across_gaps": "1", "porosity": "1", "volumetric_strain": "1",
                     "chi": "1", "chi_tensor": "1", "psi": "Pa", "psi_interface": "Pa",
                     "sigma_wall": "Pa", "coordination": "1", "pendular_overlaps": "1",
-                    "steps": "1"}
+                    "steps": "1",
+                    # --liquid clusters (pendular.capillary.liquid_clusters.statistics)
+                    "clusters": "1", "filled_units": "1", "pore_units": "1",
+                    "liquid_in_bridges": "1", "liquid_in_clusters": "1",
+                    "liquid_in_largest_cluster": "1", "largest_cluster_percolates": "1",
+                    "psi_clusters": "Pa", "saturation_pore_units": "1",
+                    "chi_with_clusters": "1"}
 
 #: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.

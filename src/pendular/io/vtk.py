@@ -51,6 +51,12 @@ axis, force that stress times the face area, velocity the face's speed (low face
 A scene without bridges (or contacts) gets empty, valid files (0 points, 0 cells). meshio 5.3 cannot read a
 file without cells back; ParaView and VTK can.
 
+``pore_mesh`` draws the pore units of the liquid clusters (``pores/pores_NNNN.vtu`` of
+``pendular swcc --liquid clusters``, one per stage, indexed by ``pores.pvd`` whose time axis is
+the stage): one tetrahedron per unit, cell data ``cluster`` (its cluster, -1 for an empty
+unit; ParaView: Threshold cluster >= 0, colour by cluster) and ``pore_volume`` [m^3]; field
+data ``stage`` and ``suction`` [Pa].
+
 A writer given ``phases`` (names) also writes a frame whenever its ``phase`` attribute changes
 (set by whoever drives the simulation, e.g. pendular.procedures.preparation.prepare_sample), and every frame's
 field data holds ``phase``: the index of the current phase in ``phases`` (the triaxial test's
@@ -250,6 +256,17 @@ def bridge_mesh(sim):
             "delta1": [np.where(i_smaller, on_i, on_j)],
             "delta2": [np.where(i_smaller, on_j, on_i)]}
     return meshio.Mesh(points, [("line", lines)], cell_data=data)
+
+
+def pore_mesh(pore_units, label):
+    """The pore units (pendular.capillary.pores.PoreUnits) as tetrahedra over their grains'
+    centres (a periodic unit's vertices as it sees them), cell data: ``cluster`` (``label``
+    (M,), the unit's cluster, -1 empty; pendular.capillary.clusters), ``pore_volume`` [m^3]."""
+    points = pore_units.vertices.reshape(-1, 3)
+    cells = np.arange(len(points), dtype=np.int64).reshape(-1, 4)
+    data = {"cluster": [np.asarray(label, np.int64)],
+            "pore_volume": [np.array(pore_units.pore_volume)]}
+    return meshio.Mesh(points, [("tetra", cells)], cell_data=data)
 
 
 def contact_mesh(sim):

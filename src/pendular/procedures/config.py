@@ -35,6 +35,9 @@ from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, K
 #: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
 MAX_TABLE_NODES = 200_000
 
+#: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them
+#: (pendular.capillary.liquid_clusters).
+LIQUID_REGIMES = ("pendular", "clusters")
 #: Largest surface tension of a wetting liquid [N/m] (water 0.0728, mercury 0.485).
 MAX_SURFACE_TENSION = 1.0
 
@@ -258,7 +261,8 @@ class BridgeConfig:
         help="bridge table nodes in suction and in distance")
     water_content: float | None = parameter(None, low=0.0, high=1.0, low_inclusive=False,
                                             help="gravimetric water content (a fraction)")
-    liquid: str = parameter("shared", kind=str, choices=LIQUID_MODELS[1:], flag="--liquid",
+    liquid: str = parameter("shared", kind=str, choices=LIQUID_MODELS[1:],
+                            flag="--rupture-liquid",
                             unset=True,
                             help="with --water-content: the liquid of a ruptured bridge goes "
                                  "to its grains' other bridges (shared, default) or is lost")
@@ -864,6 +868,10 @@ class SwccConfig:
     stage_steps: int = stage_steps_parameter(200000, "most steps per stage to reach equilibrium")
     record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
                                   help="steps between history records")
+    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                            help="liquid regime: pendular bridges alone, or clusters of filled "
+                                 "pore units beside them (drying from saturation; "
+                                 "docs/liquid_clusters.md)")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):

@@ -193,8 +193,9 @@ def laboratory_fields(values, given, path):
         raise OptionError(lambda name: f"{name('water_content')} uses volume-controlled exact "
                                        f"bridges: {name('bridges')} toroidal and "
                                        f"{name('persist_bridges')} do not apply")
-    if values["liquid"] is not None and water is None:
-        raise OptionError(lambda name: f"{name('liquid')} needs {name('water_content')}")
+    if values["rupture_liquid"] is not None and water is None:
+        raise OptionError(lambda name: f"{name('rupture_liquid')} needs "
+                                       f"{name('water_content')}")
     wet_only = [key for key in WET_ONLY if key in given]
     if suction == 0.0 and water is None and wet_only:
         raise OptionError(lambda name: f"{', '.join(map(name, wet_only))} need(s) a wet test: "
@@ -405,7 +406,7 @@ def tension_config(values, given):
 SWCC_SAMPLE = (option_of(PrepareConfig, "particles", default=1000, low=MIN_SAMPLE_PARTICLES),
                option_of(PrepareConfig, "confining"))
 SWCC_OWN = _options(SwccConfig, ("suctions", "contact_angle", "surface_tension", "form_gap",
-                                 "stage_steps", "record_every"))
+                                 "stage_steps", "record_every", "liquid"))
 SWCC_MATERIAL = _options(PrepareConfig, ("friction_deg", "prep_friction_deg", "seed"))
 
 

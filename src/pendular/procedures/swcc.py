@@ -29,6 +29,13 @@ triaxial's columns, pendular.io.schema, recorded through the whole path) and sam
 ``run(out, checkpoint_every=N)`` checkpoint.h5 (SwccPath), from which ``SwccTest.resume(out)``
 continues an interrupted path bit for bit.
 
+With ``liquid = "clusters"`` (docs/liquid_clusters.md) the pore space starts saturated and
+liquid clusters of filled pore units join the bridges (pendular.capillary.liquid_clusters):
+drying empties units by Haines jumps from the hull, wetting fills them at their filling
+suction, so that the path gives the main drying and wetting curves; each row adds the
+clusters' figures, and pores/ holds the pore units coloured by cluster, one ParaView frame per
+stage (CPU only, without checkpoints).
+
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
 wetting across gaps and the rows of swcc.json are computed on the host between the stages.
@@ -43,6 +50,7 @@ import time
 import numpy as np
 
 from pendular.capillary import CapillaryBridges, sample_radius_ratios
+from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.utils.atomic import write_json
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
@@ -56,11 +64,13 @@ from pendular.dem.walls import ConstantStrainRate
 from pendular.utils.progress import whole_run
 from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
+from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
 
 from pendular.procedures.config import SwccConfig, config_from_dict, config_to_dict
 from pendular.io.history import write_history
+from pendular.io.vtk import pore_mesh, write_pvd, write_vtu
 from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -103,6 +113,10 @@ class SwccTest:
                 "servoed walls never hold a lower confining stress (every stage would run to "
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
+        if config.liquid == "clusters" and sample.periodic:
+            raise ValueError("liquid = 'clusters' runs between walls, not in a periodic cell "
+                             "(the clusters' forces would need their face terms in the cell's "
+                             "stress)")
 
     def run(self, out, *, progress=True, threads=None, device="cpu", checkpoint_every=0,
             stop_after=None):
@@ -113,9 +127,15 @@ class SwccTest:
         interruption would (raises Interrupted)."""
         check_device(device)
         checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
+        if self.config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
+            raise ValueError(f"liquid = 'clusters' runs on the CPU without checkpoints (its pore "
+                             f"units are the host's and not yet checkpointed); got device = "
+                             f"{device!r}, checkpoint_every = {checkpoint_every}")
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
+            if self.config.liquid == "clusters":
+                folder.claim("pores")
             with whole_run(swcc_plan(self.config), enabled=progress):
                 return self._run(out, progress, threads, device, checkpoint_every, stop_after)
 
@@ -184,11 +204,14 @@ class SwccTest:
             + "): raise --stage-steps or check the settings")
 
     @staticmethod
-    def stage_row(sim, bridges, homogenization, suction, dry_volume, steps):
-        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS)."""
+    def stage_row(sim, bridges, homogenization, suction, dry_volume, steps, clusters=None):
+        """The swcc.json row of a static stage (pendular.io.schema.SWCC_STAGE_UNITS); with
+        liquid ``clusters`` (LiquidClusters), their figures, and the saturation of bridges and
+        clusters together (chi, psi: the bridges' whole, their shares in filled units
+        included; the clusters' share of the complete stress is psi_clusters)."""
         state = bridges.state(sim)
         chi = homogenization.chi(sim)
-        return {"suction": suction,
+        row = {"suction": suction,
                 "saturation": bridges.saturation(sim),
                 "bridges": state.count(),
                 "bridges_across_gaps": int(np.count_nonzero(state.state == 2)),
@@ -202,6 +225,10 @@ class SwccTest:
                 "coordination": coordination(sim.contacts, len(sim.particles)),
                 "pendular_overlaps": bridges.pendular_overlaps(sim),
                 "steps": steps}
+        if clusters is not None:
+            row.update(clusters.statistics(sim))
+            row["chi_with_clusters"] = float(np.trace(chi_with_clusters(sim, clusters)) / 3.0)
+        return row
 
 
 class SwccPath:
@@ -222,16 +249,22 @@ class SwccPath:
         self.preparation, self.preparation_time = preparation, preparation_time
         self.dry_volume = sim.walls.volume()
         sim.forces.append(bridges)
+        self.clusters = None
+        if config.liquid == "clusters":          # the pore space starts full: main drying
+            self.clusters = LiquidClusters(bridges, saturated=True)
+            sim.forces.append(self.clusters)
         axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
-        self.recorder = HistoryRecorder(config.record_every,
-                                        history_columns(sim, axial, self.dry_volume, bridges),
-                                        origin=sim.step)
+        columns = history_columns(sim, axial, self.dry_volume, bridges)
+        if self.clusters is not None:
+            columns.update(cluster_columns(self.clusters))
+        self.recorder = HistoryRecorder(config.record_every, columns, origin=sim.step)
         self.homogenization = CapillaryHomogenization(bridges)
         suctions = list(config.suctions)
         self.path = [("drying", s) for s in suctions] + [("wetting", s) for s in suctions[::-1]]
         self.index, self.stage_start = 0, None
         self.stages = {"drying": [], "wetting": []}
         self.formed = 0
+        self.pore_frames = []
         self.path_time = 0.0         # seconds spent on the path by earlier (interrupted) runs
         self._static = static(config.sample.equilibrium_unbalanced,
                               config.sample.stress_tolerance)
@@ -296,6 +329,8 @@ class SwccPath:
                     continue
                 if self.stage_start is None:
                     bridges.set_suction(suction)
+                    if self.clusters is not None:
+                        self.clusters.set_suction(sim, suction)
                     self.stage_start = sim.step
                 budget -= self.run_stage(budget, f"{branch} {suction:g} Pa" if progress
                                          else None)
@@ -304,7 +339,9 @@ class SwccPath:
                 self.recorder.record(sim)
                 self.stages[branch].append(self.test.stage_row(
                     sim, bridges, self.homogenization, suction, self.dry_volume,
-                    sim.step - self.stage_start))
+                    sim.step - self.stage_start, self.clusters))
+                if self.clusters is not None:
+                    self.write_pores(suction)
                 self.index, self.stage_start = self.index + 1, None
         except KeyboardInterrupt:
             pass
@@ -346,6 +383,18 @@ class SwccPath:
                              progress=label, status=status)
         return taken
 
+    def write_pores(self, suction):
+        """pores/pores_NNNN.vtu of the stage just ended (its index NNNN) and pores/pores.pvd
+        of the stages so far (pendular.io.vtk.pore_mesh)."""
+        folder = os.path.join(self.out, "pores")
+        os.makedirs(folder, exist_ok=True)
+        name = f"pores_{self.index:04d}.vtu"
+        write_vtu(os.path.join(folder, name),
+                  pore_mesh(self.clusters.units, self.clusters.found.label),
+                  field_data={"stage": self.index, "suction": suction})
+        self.pore_frames.append((self.index, name))
+        write_pvd(os.path.join(folder, "pores.pvd"), self.pore_frames, time_axis="stage")
+
     def write_outputs(self):
         """history.h5, swcc.json and swcc.png; returns the swcc.json content."""
         sim, config, out = self.sim, self.test.config, self.out
@@ -368,6 +417,27 @@ class SwccPath:
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
         return result
+
+
+def cluster_columns(clusters):
+    """History columns of the liquid clusters (pendular.io.schema.HISTORY_COLUMNS), their
+    figures measured once per state; ``saturation``: of the bridges and clusters together."""
+    last = {}
+
+    def figure(name):
+        def column(sim):
+            key = (sim.step, id(clusters.found))      # a stage's start changes the state
+            if last.get("key") != key:
+                last.update(clusters.statistics(sim), key=key)
+            return last[name]
+        return column
+
+    columns = {name: figure(name) for name in (
+        "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
+        "saturation_pore_units", "saturation")}
+    percolates = figure("largest_cluster_percolates")
+    columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
+    return columns
 
 
 def hysteresis(stages):

@@ -9,7 +9,9 @@ swcc.json (drying and wetting rows: suction, saturation, bridges, porosity, volu
 chi), swcc.png (Sr against log suction with thesis Fig. 5.5 and the Chapter 4 packings),
 history.h5 and sample.h5, with --checkpoint-every N checkpoint.h5; --resume DIR continues an
 interrupted run bit for bit. --device gpu runs the preparation and the path on the GPU
-(docs/gpu.md).
+(docs/gpu.md). --liquid clusters adds liquid clusters of filled pore units to the bridges,
+the sample starting saturated: the main drying and wetting curves, with the clusters' figures
+in the rows and pores/ for ParaView (docs/liquid_clusters.md; CPU, no checkpoints).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ preparation and wetting); --resume DIR continues an interrupted run. Stresses
 compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at the confining
 stress, re-equilibrated, then sheared (pendular.procedures.triaxial); --wetting chooses when the bridges
 appear. Constant water content (--water-content W): volume-controlled bridges holding W % of
-the grains' mass, the liquid then conserved during the shear (--liquid) and the suction an
+the grains' mass, the liquid then conserved during the shear (--rupture-liquid) and the suction an
 output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
 extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
 axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises

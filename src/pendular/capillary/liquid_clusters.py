@@ -1,0 +1,184 @@
+"""The liquid clusters of a wet DEM scene: the operation that holds which pore units are filled,
+applies the clusters' forces and hands bridges' liquid to them (docs/liquid_clusters.md).
+
+``LiquidClusters(bridges)`` joins a scene whose liquid is at one imposed suction: the
+suction-controlled bridges that persist across gaps (capillary.SuctionBridges, ``persist``),
+listed before it among the scene's forces. ``set_suction(sim, s)`` is the quasi-static step
+of the model (pendular.capillary.pore_filling): the packing is decomposed into pore units
+again, the filled state carried over unit by unit (a unit is its four grains), the units
+whose filling suction is at least s fill, then the Haines jumps empty those the gas reaches.
+Until the next ``set_suction`` (a stage of a path run to equilibrium) the clusters' forces are
+those of the packing at that moment (pendular.capillary.cluster_forces), added to the grains
+each step, and a bridge on an edge of filled units keeps only the share of its force and
+liquid that lies in empty units (its force is taken off in the share the filled units hold:
+the cluster's pressure and menisci replace it there). Between walls only; on the CPU.
+"""
+
+import numpy as np
+
+from pendular.capillary.bridge_state import BridgeState
+from pendular.capillary.cluster_forces import UnitForces, cluster_forces, cluster_stress
+from pendular.capillary.clusters import find_clusters
+from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
+    liquid_account, unit_edges)
+from pendular.capillary.pores import decompose, search_rows
+from pendular.dem.neighbors import gather_pair_forces
+from pendular.dem.protocols import state_array
+
+
+class LiquidClusters:
+    """Liquid clusters beside persisting suction-controlled ``bridges`` (module docstring).
+    ``saturated``: the pore units start filled (a sample drying from saturation) or empty
+    (bridges alone, a sample wetted from dry)."""
+
+    def __init__(self, bridges, saturated=True):
+        if bridges.control != "suction" or not bridges.persist:
+            raise ValueError("liquid = 'clusters' needs suction-controlled bridges that persist "
+                             "across gaps (control = 'suction', persist = True)")
+        self.bridges = bridges
+        self.saturated = bool(saturated)
+        self.suction = None
+        self.units = None
+        self.filled = None
+        self.found = None
+        self._unit_forces = None
+        self._edges = None
+        self._force = None
+        self._contacts = None
+        self._share = None
+        self._carried = None          # filled units of a checkpoint, until set_suction
+
+    # ---------------------------------------------------------------- checkpoints
+    def state_dict(self):
+        """The filled units, each as its four grains, and the suction of the last step of the
+        model (None before the first)."""
+        if self.units is None:
+            return {"suction": None, "saturated": self.saturated,
+                    "filled_units": np.zeros((0, 4), np.int64)}
+        return {"suction": self.suction, "saturated": self.saturated,
+                "filled_units": self.units.grains[self.filled].copy()}
+
+    def load_state(self, state):
+        """Take back a ``state_dict``: the filled units are carried into the next
+        ``set_suction``, which the loading scene calls before the clusters pull again."""
+        filled = state_array(state, "filled_units", np.int64, (None, 4))
+        suction = state["suction"]
+        if suction is not None and not (isinstance(suction, float) and suction > 0):
+            raise ValueError(f"suction = {suction!r}: a suction > 0 [Pa] or None expected")
+        self.saturated = bool(state["saturated"])
+        self._carried, self.suction = filled, suction
+
+    # ---------------------------------------------------------------- the model's step
+    def set_suction(self, sim, suction):
+        """Impose ``suction`` [Pa] on the clusters of ``sim``'s packing now (module docstring):
+        decompose, carry, fill, drain; the forces of the stage that follows."""
+        if sim.walls.periodic:
+            raise ValueError("liquid = 'clusters' runs between walls (a periodic cell's "
+                             "cluster forces would need their face terms in the cell's stress)")
+        sim.fetch("particles")
+        particles = sim.particles
+        previous = self._filled_grains()
+        units = decompose(particles.position, particles.radius)
+        if previous is None:
+            filled = np.full(units.count, self.saturated)
+        else:
+            filled = _carry(units.grains, previous)
+        thresholds = filling_thresholds(units, particles.radius, self.bridges.surface_tension,
+                                        self.bridges.contact_angle)
+        filled = drain(units, thresholds, imbibe(thresholds, filled, suction), suction)
+        self.units, self.filled, self.suction = units, filled, float(suction)
+        self._unit_forces = UnitForces(units.vertices, particles.radius[units.grains])
+        self._edges = unit_edges(units)
+        self.found = find_clusters(units, filled)
+        self._force = cluster_forces(units, self._unit_forces, filled, self.suction,
+                                     len(particles))
+        self._contacts = None
+        self._carried = None
+
+    def _filled_grains(self):
+        """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
+        if self._carried is not None:
+            return self._carried
+        if self.units is None:
+            return None
+        return self.units.grains[self.filled]
+
+    # ---------------------------------------------------------------- every step
+    def apply(self, sim):
+        if self._force is None or not self.filled.any():
+            return
+        particles, contacts = sim.particles, sim.contacts
+        particles.force += self._force
+        if contacts is not self._contacts:
+            self._share = self.pair_share(contacts)
+            self._contacts = contacts
+        pair_force = self.bridges.pair_force
+        if len(pair_force) == len(self._share):
+            gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
+                               contacts.second_start, contacts.second_pair, particles.force)
+
+    def pair_share(self, contacts):
+        """(K,) the share of each pair's bridge that the filled units hold."""
+        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        share = self._edges.filled_share(self.filled)
+        return np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+
+    # ---------------------------------------------------------------- measures
+    def account(self, sim):
+        """LiquidAccount (pendular.capillary.pore_filling) of the liquid now [m^3]."""
+        sim.fetch("contacts")
+        contacts = sim.contacts
+        volume = BridgeState.of(contacts).volume
+        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        return liquid_account(self.units, self._edges, self.found, volume, edge)
+
+    def _units_liquid(self, sim, account):
+        """[m^3] the liquid inside the pore units: the filled units, and the bridges' shares in
+        the empty ones (their dihedral angles there over 2 pi; a bridge between grains that
+        share no unit, across a gap, all)."""
+        contacts = sim.contacts
+        volume = BridgeState.of(contacts).volume
+        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        inside = self._edges.filled_share(np.ones(self.units.count, bool))
+        inside = np.where(edge >= 0, inside[np.maximum(edge, 0)], 1.0)
+        return account.clusters + float(np.sum(volume * inside)) - account.absorbed
+
+    def saturation(self, sim):
+        """Degree of saturation: the liquid held over the voids (the box less the solid)."""
+        voids = sim.walls.volume() - sim.particles.solid_volume()
+        return self.account(sim).total / voids
+
+    def stress(self, sim):
+        """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box
+        (cluster_forces.cluster_stress)."""
+        return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
+                              sim.walls.volume())
+
+    def statistics(self, sim):
+        """The clusters' figures of a stage row: their number, the filled and all pore units,
+        the liquid fractions in bridges, in clusters and in the largest cluster, whether the
+        largest percolates along x, y, z, the saturation (over the voids of the box, and over
+        the pore units' void alone) and the clusters' stress."""
+        account = self.account(sim)
+        fractions = account.fractions()
+        voids = sim.walls.volume() - sim.particles.solid_volume()
+        in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))
+        return {"clusters": int(self.found.count),
+                "filled_units": int(np.count_nonzero(self.filled)),
+                "pore_units": int(self.units.count),
+                "liquid_in_bridges": fractions["bridges"],
+                "liquid_in_clusters": fractions["clusters"],
+                "liquid_in_largest_cluster": fractions["largest"],
+                "largest_cluster_percolates": [bool(v) for v in self.found.percolates],
+                "saturation": account.total / voids,
+                "saturation_pore_units": in_units,
+                "psi_clusters": self.stress(sim).tolist()}
+
+
+def _carry(grains, previous):
+    """(M,) bool: the units of ``grains`` (M, 4) that are among ``previous`` (F, 4), each a
+    set of four grains."""
+    if len(previous) == 0:
+        return np.zeros(len(grains), bool)
+    table = np.unique(np.sort(np.asarray(previous, np.int64), axis=1), axis=0)
+    return search_rows(table, np.sort(grains, axis=1)) >= 0
