@@ -56,10 +56,10 @@ print(open("runs/calibration/friction15.csv").read()[:300])
 #         --max-strain 0.04 --inertial-number 0.01 --records 40 \
 #         --fit friction=5:40 --iterations 2 --samples 6 --out runs/calibration/fit
 #
-# The first iteration also runs the prior's centre (22.5°) at four seeds: the scatter between
-# those samples is the least uncertainty the filter may give a curve, so the posterior is no
-# narrower than the difference between two specimens allows, although here the data and the
-# runs share their sample.
+# After its runs, the first iteration runs its best sample again at seven other seeds: the
+# scatter between those eight specimens is the least uncertainty the filter may give a curve,
+# so the posterior is no narrower than the difference between two specimens allows, although
+# here the data and the runs share their specimen.
 
 import json
 
@@ -114,9 +114,9 @@ figure.tight_layout()
 # ``pendular calibrate`` draws the same figures into its folder (``calibration.png``,
 # ``posterior.png``, ``errors.png``).
 #
-# A laboratory curve comes from another specimen than any run. At 100 spheres two specimens
-# differ by more than four samples of the scatter reveal: a curve made at 15° on the sample of
-# seed 7, which packs to a porosity of 0.453 where seeds 0–3 pack to 0.469–0.474, is calibrated
-# to 31.5 ± 2.9°. Calibrate on samples large enough for the scatter between specimens to be
-# small: the recoveries at 500–1,000 spheres, and a calibration to a laboratory curve of a
-# sand, are on :doc:`/calibration`.
+# The best runs lie near 15°, but at 100 spheres two specimens of one material differ by as much
+# as runs many degrees of friction apart (their porosities alone spread over a few hundredths),
+# so the posterior stays wide, and is reported unconstrained when its standard deviation is
+# above 70 % of the prior's: the data of one 100-sphere specimen cannot say more. Calibrate on
+# samples large enough for that scatter to be small: the recoveries at 1,000 spheres, and a
+# calibration to a laboratory curve of a sand, are on :doc:`/calibration`.
