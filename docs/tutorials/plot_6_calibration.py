@@ -71,21 +71,23 @@ with open("runs/calibration/fit/summary.json") as handle:
     summary = json.load(handle)
 friction = summary["parameters"]["friction"]
 print(f"{summary['runs']} runs; friction {friction['mean']:.1f} ± {friction['std']:.1f}° "
-      f"(prior 5–40°, its std {friction['prior_std']:.1f}°), best run {friction['best']:.1f}°, "
-      f"constrained: {friction['constrained']}")
+      f"(prior 5–40°, its std {friction['prior_std']:.1f}°), "
+      f"best run {friction['best']:.1f}°, constrained: {friction['constrained']}")
 print(f"the truth, 15°, is {abs(friction['mean'] - 15.0) / friction['std']:.2f} reported "
       "standard deviations from the posterior mean")
 
 # %%
 # ``posterior.csv`` holds every run: its friction, its weight in its iteration and its error to
-# the data (the RMS difference, each column in units of its range in the data). The second
-# iteration's samples gather where the first found the error small:
+# the data (the RMS difference, each column in units of its range in the data). Each weight is
+# divided by the density its sample was drawn from, so that every iteration estimates the same
+# posterior; where the seed noise makes the likelihood nearly flat, as here, a sample drawn
+# where the proposal was thin weighs most:
 
 import matplotlib.pyplot as plt
 import pandas as pd
 
 posterior = pd.read_csv("runs/calibration/fit/posterior.csv")
-figure, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+figure, left = plt.subplots(figsize=(6, 4))
 for iteration, runs in posterior.groupby("iteration"):
     left.scatter(runs["friction"], runs["error"], s=20 + 300 * runs["weight"],
                  label=f"iteration {iteration + 1}")
@@ -95,6 +97,7 @@ left.axvspan(friction["mean"] - friction["std"], friction["mean"] + friction["st
 left.set(xlabel="contact friction [deg]", ylabel="error to the data [-]",
          title="runs (size: weight)")
 left.legend(fontsize=8)
+figure.tight_layout()
 
 # %%
 # The data against the best run (its folder is ``best_run``):
@@ -103,6 +106,7 @@ from pendular.studies.calibration import DATA_COLUMNS, read_curve
 
 data = read_curve("runs/calibration/friction15.csv", "triaxial")
 best = DATA_COLUMNS["triaxial"].read("runs/calibration/fit/" + summary["best_run"])
+figure, right = plt.subplots(figsize=(6, 4))
 right.plot(100 * data.control, data.observed["q"], "ko", label="data (15°)")
 right.plot(100 * best["axial_strain"], best["q"], "C3",
            label=f"best run ({friction['best']:.1f}°)")
