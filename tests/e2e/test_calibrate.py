@@ -14,7 +14,8 @@ import pytest
 from conftest import assert_drawn, requires, run_in_process
 
 from pendular.io.schema import undeclared_keys
-from pendular.studies.calibration import DATA_COLUMNS, SEED_REPLICATES
+from pendular.studies.calibration import (DATA_COLUMNS, SEED_REPLICATES, read_curve,
+                                          write_curve)
 
 pytestmark = requires("grainlearning")
 
@@ -48,7 +49,7 @@ def test_calibrate_writes_its_posterior_and_resumes(tmp_path, capsys):
     assert not undeclared_keys(summary, "calibrate")
     assert (out / summary["best_run"] / "history.h5").is_file()
     runs = sorted(os.listdir(out / "runs"))
-    assert len(runs) == 8 + SEED_REPLICATES + 1 == summary["runs"]
+    assert len(runs) == 8 + SEED_REPLICATES == summary["runs"]
     for name in ("calibration.png", "posterior.png", "errors.png"):
         assert_drawn(out / name)
 
@@ -66,8 +67,9 @@ def test_calibrate_writes_its_posterior_and_resumes(tmp_path, capsys):
 
 
 def test_calibrate_fits_an_oedometer_to_a_curve_of_its_own(tmp_path, capsys):
-    """An oedometer's curve (axial stress, void ratio) made by a run at friction 22.5 deg: the
-    calibration's sample at 22.5 deg, the same sample seed, reproduces it exactly."""
+    """An oedometer's curve (axial stress, void ratio) made by a run at friction 22.5 deg and
+    written by write_curve: the calibration's sample at 22.5 deg, the same sample seed,
+    reproduces it exactly."""
     test = ["--particles", "50", "--confining", "500", "--axial-stress", "2000",
             "--inertial-number", "0.003", "--quiet"]
     status, err = run_in_process("oedometer", [*test, "--friction", "22.5",
@@ -76,11 +78,14 @@ def test_calibrate_fits_an_oedometer_to_a_curve_of_its_own(tmp_path, capsys):
     branch = DATA_COLUMNS["oedometer"].read(tmp_path / "data")
     order = np.argsort(branch["axial_stress"], kind="stable")     # as calibrate reads a run
     stress = np.linspace(700.0, 1900.0, 4)
-    void = np.interp(stress, branch["axial_stress"][order], branch["void_ratio"][order])
     data = tmp_path / "curve.csv"
-    data.write_text("axial_stress,void_ratio\n"
-                    + "".join(f"{s!r},{e!r}\n" for s, e in zip(stress.tolist(),
-                                                                 void.tolist())))
+    write_curve(data, tmp_path / "data", "oedometer", stress)
+    curve = read_curve(data, "oedometer")
+    np.testing.assert_array_equal(curve.control, stress)
+    np.testing.assert_array_equal(curve.observed["void_ratio"], np.interp(
+        stress, branch["axial_stress"][order], branch["void_ratio"][order]))
+    with pytest.raises(ValueError, match="within the run's axial_stress"):
+        write_curve(tmp_path / "beyond.csv", tmp_path / "data", "oedometer", [700.0, 1e6])
     out = tmp_path / "calibration"
     status, err = run_in_process("calibrate", ["--data", data, "--test", "oedometer", *test,
                                                "--fit", "friction=5:40", "--iterations", "1",

@@ -10,7 +10,8 @@ import pytest
 
 from conftest import refused, requires, run_in_process
 
-from pendular.studies.calibration import (MIN_POINTS, Calibration, Fit, parse_fit, read_curve)
+from pendular.studies.calibration import (MIN_POINTS, SEED_REPLICATES, Calibration, Fit,
+                                          parse_fit, read_curve)
 
 TRIAXIAL = "axial_strain,q,volumetric_strain\n0.01,300,0.001\n0.02,450,-0.001\n0.04,500,-0.004\n"
 
@@ -137,9 +138,9 @@ def test_calibration_checks_the_prior_against_the_options_declaration(tmp_path):
                     samples=3)
     calibration = Calibration("triaxial", options, [parse_fit("friction=5:40", "triaxial")],
                               curve)
-    seeds = calibration.seed_runs()
-    assert [run.config.sample.seed for run in seeds] == [0, 1, 2, 3]
-    assert {run.config.sample.friction_deg for run in seeds} == {22.5}
+    seeds = calibration.seed_runs({"friction": 17.0})
+    assert [run.config.sample.seed for run in seeds] == list(range(1, SEED_REPLICATES + 1))
+    assert {run.config.sample.friction_deg for run in seeds} == {17.0}
 
 
 def test_the_seed_noise_is_counted_once_per_curve(tmp_path):

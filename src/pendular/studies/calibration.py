@@ -16,8 +16,10 @@ Honest uncertainty:
   the data and in units of its range there (0 to 1 over the data: the filter's covariance,
   scaled by each column's largest value, is then ``sigma`` itself, a variance in units of that
   range squared);
-- the first iteration also runs the prior's centre with SEED_REPLICATES other seeds: the
-  scatter between samples of different seeds at equal parameters. The data are one sample and
+- the first iteration also runs its best sample (the least error to the data) with
+  SEED_REPLICATES other seeds: the scatter between samples of different seeds at equal
+  parameters, where the data are (the scatter grows with the friction, so a prior's centre far
+  from the data would overstate it, or understate it). The data are one sample and
   each run another, so their curves differ by twice that variance at equal parameters. The
   filter's ``sigma`` is held at or above this seed noise (the library's lower bound), counted
   once per curve, not once per point, since the scatter of neighbouring points is correlated:
@@ -54,8 +56,10 @@ from pendular.utils.parameters import spec_of
 
 #: Fewest points of a measured curve.
 MIN_POINTS = 3
-#: Runs of the prior's centre at other seeds in the first iteration (the seed noise).
-SEED_REPLICATES = 3
+#: Runs of the first iteration's best sample at other seeds (the seed noise): with its own,
+#: eight samples, whose variance is known to about half itself (a chi-squared of 7 degrees of
+#: freedom).
+SEED_REPLICATES = 7
 #: Target effective sample size of the filter, a fraction of the samples (GrainLearning's
 #: default).
 ESS_TARGET = 0.3
@@ -280,6 +284,33 @@ def read_curve(path, test):
     return MeasuredCurve(path, kind, control, observed)
 
 
+def write_curve(path, folder, test, control):
+    """Write the curve of the finished run ``folder`` of ``test`` as a data file read_curve
+    reads: every column of DATA_COLUMNS[test] at the ``control`` values (rising, within the
+    run's loading branch), interpolated along that branch as a calibration compares a run with
+    the data. A synthetic curve with known parameters, for testing a calibration. ValueError
+    for control values the run does not span."""
+    kind = DATA_COLUMNS[test]
+    columns = kind.read(os.fspath(folder))
+    control = np.asarray(control, dtype=float)
+    reached = columns[kind.control]
+    if np.any(np.diff(control) <= 0.0) or control[0] < reached.min() \
+            or control[-1] > reached.max():
+        raise ValueError(f"control values {control[0]:g} ... {control[-1]:g}: valid: rising, "
+                         f"within the run's {kind.control} {reached.min():g} ... "
+                         f"{reached.max():g}")
+    order = np.argsort(reached, kind="stable")
+    values = {name: np.interp(control, reached[order], columns[name][order])
+              for name in kind.columns[1:] if name in columns}
+    with replacing(os.fspath(path)) as temporary, open(temporary, "w", newline="",
+                                                       encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow([kind.control, *values])
+        for index, point in enumerate(control):
+            writer.writerow([repr(float(point)), *(repr(float(column[index]))
+                                                    for column in values.values())])
+
+
 # ---------------------------------------------------------------- what is fitted
 
 @dataclass(frozen=True)
@@ -475,20 +506,24 @@ class Calibration:
                                 for sample in ibf.param_data_list[-1]], dtype=float)
             runs = [Run(_sample_name(iteration, index), self.config(self.sample_values(sample)))
                     for index, sample in enumerate(samples)]
-            seeds = self.seed_runs() if iteration == 0 else []
-            log(f"iteration {iteration + 1} of {self.iterations}: {len(runs + seeds)} runs")
-            curves = self.campaign_curves(runs + seeds, out, log, jobs=jobs,
-                                          scheduler=scheduler, threads=threads, device=device,
-                                          quiet=quiet)
-            if iteration == 0:
-                noise = self.seed_noise([curves[run.name] for run in seeds
-                                         if run.name in curves])
+            settings = dict(jobs=jobs, scheduler=scheduler, threads=threads, device=device,
+                            quiet=quiet)
+            log(f"iteration {iteration + 1} of {self.iterations}: {len(runs)} runs")
+            curves = self.campaign_curves(runs, out, log, **settings)
             kept = [i for i in range(len(samples)) if _sample_name(iteration, i) in curves]
             if len(kept) < 2:
                 raise ValueError(f"iteration {iteration + 1}: fewer than two of its runs "
                                  "finished (their errors are in their log.txt)")
             simulated = np.array([curves[_sample_name(iteration, i)] for i in kept])
             errors = np.sqrt(np.mean((simulated - observed[None]) ** 2, axis=(1, 2)))
+            if iteration == 0:
+                best = kept[int(np.argmin(errors))]
+                seeds = self.seed_runs(self.sample_values(samples[best]))
+                log(f"seed noise: {len(seeds)} runs of {_sample_name(0, best)} at other seeds")
+                replicates = self.campaign_curves(seeds, out, log, **settings)
+                noise = self.seed_noise([curves[_sample_name(0, best)],
+                                         *(replicates[run.name] for run in seeds
+                                           if run.name in replicates)])
             system.param_data = samples[kept]
             system.num_samples = len(kept)
             system.set_sim_data(simulated)
@@ -535,13 +570,12 @@ class Calibration:
                 curves[run.name] = curve
         return curves
 
-    def seed_runs(self):
-        """Runs of the prior's centre at its own seed and SEED_REPLICATES others."""
-        centre = self.sample_values([(fit.low + fit.high) / 2.0 for fit in self.fits])
-        seed = self.config(centre)
-        base = _seed_of(seed)
-        return [Run(_seed_name(offset), self.config({**centre, "seed": base + offset}))
-                for offset in range(SEED_REPLICATES + 1)]
+    def seed_runs(self, values):
+        """Runs of the fitted ``values`` {key: value} at SEED_REPLICATES seeds after the
+        test's own."""
+        base = _seed_of(self.config(values))
+        return [Run(_seed_name(offset), self.config({**values, "seed": base + offset}))
+                for offset in range(1, SEED_REPLICATES + 1)]
 
     def seed_noise(self, curves):
         """The filter's least uncertainty: the variance of the difference between two
@@ -596,7 +630,7 @@ class Calibration:
                 "columns": self.curve.columns, "parameters": parameters,
                 "best_run": os.path.join("runs", best["run"]), "best_error": best["error"],
                 "seed_noise": noise, "iterations": history,
-                "runs": len(rows) + SEED_REPLICATES + 1, "rows": rows}
+                "runs": len(rows) + SEED_REPLICATES, "rows": rows}
 
 
 def _seed_of(config):
