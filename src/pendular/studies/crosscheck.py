@@ -12,7 +12,7 @@
    centres, radii, wall box). Both codes start the shear from it in the same state: velocities
    zero, contacts found afresh (no shear-spring history), every touching pair getting a bridge
    at the first step (YADE: Law2_ScGeom_CapillaryPhys_Capillarity with menisci created at
-   contact from the files of capillary.BridgeTable.write_yade, pendular.interop.yade.runner.
+   contact from the files of pendular.interop.yade.capillary_files, pendular.interop.yade.runner.
    yade_capillary_files). The wet state is thus identical in both codes at the start of the
    shear (same contacts, bridges, Sr, stresses), and only the shear's dynamics can differ.
    ``packing=FILE`` starts from a packing exported by an earlier cross-check of the same sample
