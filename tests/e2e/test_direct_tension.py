@@ -21,8 +21,8 @@ from pendular.procedures.grips import grip_members
 from pendular.procedures import tension as direct_tension
 from pendular.procedures.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
-from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from_dict,
-    config_to_dict, tension_sample)
+from pendular.procedures.config import CONFIG_TYPES, config_from_dict, config_to_dict
+from pendular.procedures.tension import TensionConfig, tension_sample
 from pendular.procedures.preparation import PrepareConfig
 
 from conftest import ROOT

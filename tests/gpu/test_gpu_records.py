@@ -50,7 +50,8 @@ def measure(check):
     from pendular.capillary.bridges import CapillaryBridges
     from pendular.dem.record import HistoryRecorder
     from pendular.procedures.guards import SampleGuard
-    from pendular.procedures.loading import AxisStrain, history_columns
+    from pendular.procedures.loading import AxisStrain
+    from pendular.procedures.columns import history_columns
     from pendular.procedures.preparation import static
 
     wet = check.endswith("wet")

@@ -78,7 +78,7 @@ def wetted_and_pulled(device, folder):
 
     from pendular.dem.walls import StressServo
     from pendular.procedures import tension
-    from pendular.procedures.config import TensionConfig, tension_sample
+    from pendular.procedures.tension import TensionConfig, tension_sample
     from simulated import RADIUS, scene
     from simulator import counted_copies
 

@@ -68,7 +68,7 @@ def test_a_table_stage_at_a_strain_rate_that_never_ends_is_refused_naming_it(tmp
 
 
 def test_a_later_stage_counts_its_strain_from_where_the_earlier_one_ended(tmp_path):
-    from pendular.procedures.options import config_from_options
+    from pendular.procedures.registry import config_from_options
 
     quick = LATERAL + 'strain_rate = {z = 1.0}\nuntil = {strain = 0.01, axis = "z"}'
     slow = LATERAL + 'strain_rate = {z = 1e-3}\nuntil = {strain = 0.012, axis = "z"}'
@@ -158,17 +158,18 @@ def test_a_void_ratio_no_preparation_reaches_states_the_range_in_order(monkeypat
     range refused is the two preparations' void ratios in order, never an inverted one."""
     import types
 
-    from pendular.procedures import tension
-    from pendular.procedures.config import TensionConfig, tension_sample
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
 
     reached = {0.0: 0.477, 30.0: 0.429}                 # denser at the higher friction
-    monkeypatch.setattr(tension, "prepare_sample", lambda config, **_: (
+    monkeypatch.setattr(tension_pull, "prepare_sample", lambda config, **_: (
         types.SimpleNamespace(device="cpu", friction=config.prep_friction_deg),
         {"porosity": 0.3}))
-    monkeypatch.setattr(tension, "sample_void_ratio", lambda sim, radius: reached[sim.friction])
+    monkeypatch.setattr(tension_pull, "sample_void_ratio",
+                        lambda sim, radius: reached[sim.friction])
     config = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100))
     with pytest.raises(ValueError) as error:
-        tension.prepare_void_ratio(config, 0.72, progress=False)
+        tension_pull.prepare_void_ratio(config, 0.72, progress=False)
     assert "valid range of this sample, [0.429, 0.477]" in str(error.value)
     assert "growth friction 0 and 30 deg give e = 0.477 and 0.429" in str(error.value)
 
@@ -186,15 +187,15 @@ def test_a_repeat_given_as_text_is_refused_as_other_text_for_numbers_is(tmp_path
 def test_an_isotropic_stress_repeated_in_a_row_is_refused_not_merged(tmp_path, capsys):
     refused_here(capsys, tmp_path, "isotropic", [*SMALL, "--stresses", "1000,1000"],
                  "--stresses = 1000,1000", "stage 2 repeats the 1000 Pa of stage 1")
-    from pendular.procedures.options import config_from_options
+    from pendular.procedures.registry import config_from_options
 
     loop = config_from_options("isotropic", {"particles": 60, "stresses": "1000,2000,1000"})
     assert loop.stresses == [1000.0, 2000.0, 1000.0]      # a loading and unloading: valid
 
 
 def test_the_smallest_simple_shear_is_its_own_documented_minimum(tmp_path, capsys):
-    from pendular.procedures.config import MIN_SIMPLE_SHEAR_PARTICLES
-    from pendular.procedures.options import options_of
+    from pendular.procedures.simple_shear import MIN_SIMPLE_SHEAR_PARTICLES
+    from pendular.procedures.registry import options_of
 
     particles = next(o for o in options_of("simple-shear") if o.key == "particles")
     assert f"valid range [{MIN_SIMPLE_SHEAR_PARTICLES}, " in particles.help

@@ -90,7 +90,7 @@ def test_every_declared_column_has_units_a_description_and_known_dimensions():
 
 def test_the_columns_the_triaxial_records_are_all_declared():
     from pendular.homogenize.on_the_fly import CapillaryHomogenization
-    from pendular.procedures.loading import history_columns
+    from pendular.procedures.columns import history_columns
 
     bridges = SimpleNamespace(saturation=None, mean_suction=None, count=None,
                               pendular_overlaps=None, model="exact")

@@ -11,9 +11,11 @@ import pytest
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, ConstantVolume
-from pendular.procedures.config import BridgeConfig, PrepareConfig, ShearConfig, TriaxialConfig
-from pendular.procedures.loading import (Stage, Strain, excess_pore_pressure, shear_stage,
-    undrained_summary)
+from pendular.procedures.config import BridgeConfig, ShearConfig
+from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.loading import Stage, Strain
+from pendular.procedures.triaxial import excess_pore_pressure, shear_stage, undrained_summary
 from pendular.utils.parameters import ParameterError
 
 

@@ -47,11 +47,9 @@ import numpy as np
 
 from pendular.dem import mixed_stress
 from pendular.dem.cell import ConstantShearRate
-from pendular.dem.measure import porosity
 from pendular.dem.mixed_stress import StageFailed
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, ConstantVolume, StressServo
-from pendular.homogenize.on_the_fly import homogenized
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
 from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE
 from pendular.procedures.guards import SampleGuard
@@ -59,6 +57,7 @@ from pendular.procedures.hydraulic import SuctionChange, WaterContentChange
 from pendular.procedures.preparation import servo_speed, static
 from pendular.procedures.progress import equilibrium_bar, stress_bar
 from pendular.utils.validate import check_int, check_positive, check_range
+from pendular.procedures.columns import capillary_operation, history_columns
 
 #: The axes by name, in order (x, y lateral; z axial).
 AXIS_NAMES = tuple(AXES)
@@ -70,9 +69,6 @@ VOLUME_CONTROLS = ("constant",)
 #: rate of change [Pa/s].
 MAX_SUCTION = 1e9
 MAX_SUCTION_RATE = 1e12
-#: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b
-#: (its ratio is noise over nearly zero at the start of a true triaxial shear).
-B_MEASURE_FROM = 0.1
 
 
 # ---------------------------------------------------------------- ends of a stage
@@ -381,72 +377,6 @@ class AxisStrain:
         return 1.0 - walls.lengths()[self.axis] / self.reference_length
 
 
-def capillary_operation(sim):
-    """The scene's capillary bridge operation, or None for a dry scene."""
-    found = [op for op in sim.forces if hasattr(op, "water_volume")]
-    return found[0] if found else None
-
-
-def measured(name):
-    """Column ``name`` of a history: the homogenised quantity ``name`` of the state, measured
-    where it is held (pendular.homogenize.on_the_fly.homogenized)."""
-
-    def quantity(sim):
-        return homogenized(sim)[name]
-
-    return quantity
-
-
-def solid_fraction_porosity(sim):
-    """Porosity of the box [-] (pendular.dem.measure.porosity) from the spheres' volume
-    measured where the state is held (pendular.homogenize.on_the_fly.homogenized)."""
-    return 1.0 - homogenized(sim)["solid_volume"] / sim.walls.volume()
-
-
-def history_columns(sim, axial, reference_volume, bridges=None):
-    """Recorded columns of a loading path's history (name -> function of sim); ``axial``
-    measures the axial strain (``strain(walls)``); pendular.io.schema declares their units. A
-    wet scene adds the capillary and homogenised columns of
-    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
-
-    columns = {
-        "step": lambda s: s.step,
-        "time": lambda s: s.time,
-        "axial_strain": lambda s: axial.strain(s.walls),
-        "volumetric_strain": lambda s: 1.0 - s.walls.volume() / reference_volume,
-        "sigma_wall": lambda s: s.walls.stress(),
-        "sigma_contact": measured("sigma_contact"),
-        "porosity": solid_fraction_porosity,
-        "coordination": measured("coordination"),
-        "fabric": measured("fabric"),                                       # Eq. 4.1
-        "anisotropy": measured("anisotropy"),                               # Eq. 3.51
-        "unbalanced_force": measured("unbalanced_force"),
-    }
-    if bridges is not None:
-        from pendular.homogenize.on_the_fly import CapillaryHomogenization
-
-        columns.update(CapillaryHomogenization(bridges).quantities())
-        if bridges.liquid != "reservoir":             # a closed amount of liquid
-            columns.update({"liquid_bridges": lambda s: bridges.liquid_balance(s)[0],
-                            "liquid_film": lambda s: bridges.liquid_balance(s)[1],
-                            "liquid_lost": lambda s: bridges.liquid_balance(s)[2]})
-    return columns
-
-
-def void_ratio(sim):
-    """Void ratio e = n / (1 - n) of the box [-] (n: pendular.dem.measure.porosity)."""
-    sim.fetch("particles")          # all of a device run's state (Simulation.fetch)
-    n = porosity(sim.particles, sim.walls)
-    return n / (1.0 - n)
-
-
-def k0(sim):
-    """sigma_lateral / sigma_axial of the walls [-] (the coefficient of earth pressure; NaN
-    while the axial stress is not positive)."""
-    sigma = sim.walls.stress()
-    return float(lateral_stress(sigma) / sigma[2]) if sigma[2] > 0.0 else math.nan
-
-
 class LoadingPath:
     """Run ``stages`` (Stage) of the static sample ``sim`` one after the other, recording one
     history: ``history_columns`` plus ``columns`` (name -> function of sim) and, for more than
@@ -737,281 +667,7 @@ class LoadingPath:
 
 # ---------------------------------------------------------------- the laboratory's paths
 
-def shear_stage(shear, confining, rate):
-    """The Stage of a triaxial shear of ``shear`` (pendular.procedures.config.ShearConfig)
-    from the isotropic ``confining`` stress [Pa] at the axial strain rate ``rate`` [1/s]: the
-    axial walls compressed (or, in extension, pulled apart) to ``shear.max_strain``; the lateral
-    walls at the confining stress, or with ``shear.b`` sigma_3 = confining on x and sigma_y =
-    sigma_3 + b (sigma_z - sigma_3), or with ``shear.constant_p`` at the stresses that keep
-    p = confining (and b, when given), or with ``shear.drainage`` "undrained" the lateral
-    walls moved so that the volume stays that of the start (the pore water of a saturated
-    sample, or the closed liquid of a wet one, cannot leave). b = 0 alone is the conventional
-    compression."""
-    sign = 1.0 if shear.direction == "compression" else -1.0
-    until = Strain(sign * shear.max_strain)
-    axial = {"z": sign * rate}
-    if shear.drainage == "undrained":
-        return Stage(strain_rate=axial, volume="constant", until=until)
-    if shear.constant_p:
-        return Stage(strain_rate=axial, mean_stress=confining, b=shear.b, until=until)
-    if shear.b is not None and shear.b > 0.0:
-        return Stage(stress={"x": confining}, strain_rate=axial, b=shear.b, until=until)
-    return Stage(stress={"x": confining, "y": confining}, strain_rate=axial, until=until)
-
-
-def oedometer_stages(axial_stress, rate, unload_to=None):
-    """Stages of an oedometric (K0) test: the lateral walls held, the axial walls compressed at
-    ``rate`` [1/s] until the axial stress is ``axial_stress`` [Pa], then with ``unload_to``
-    [Pa] pulled back at the same rate until it is that."""
-    held = {"x": 0.0, "y": 0.0}
-    stages = [Stage(strain_rate={**held, "z": rate}, until=Stress(axial_stress))]
-    if unload_to is not None:
-        stages.append(Stage(strain_rate={**held, "z": -rate}, until=Stress(unload_to)))
-    return stages
-
-
-def isotropic_stages(stresses, rate, *, max_steps=200000, unbalanced=0.01, tolerance=0.01):
-    """Stages of an isotropic loading and unloading: the six walls servoed to each of
-    ``stresses`` [Pa] in turn, at most at the strain rate ``rate`` [1/s], each until static
-    (``unbalanced``, ``tolerance``) within ``max_steps``."""
-    return [Stage(stress={axis: value for axis in AXIS_NAMES}, max_strain_rate=rate,
-                  until=Static(max_steps, unbalanced, tolerance)) for value in stresses]
-
 
 # ---------------------------------------------------------------- results
 
-def friction_angle(sigma):
-    """Mobilised friction angle [deg] of principal stresses ``sigma`` (..., 3) [Pa]:
-    asin((sigma_1 - sigma_3) / (sigma_1 + sigma_3)), sigma_1 and sigma_3 the largest and the
-    least (Mohr-Coulomb without cohesion); NaN where sigma_1 + sigma_3 <= 0."""
-    sigma = np.asarray(sigma, dtype=np.float64)
-    high, low = sigma.max(axis=-1), sigma.min(axis=-1)
-    total = high + low
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = np.where(total > 0.0, (high - low) / np.where(total > 0.0, total, 1.0), np.nan)
-    return np.degrees(np.arcsin(np.clip(ratio, -1.0, 1.0)))
 
-
-def measured_b(sigma, mean):
-    """b = (sigma_y - sigma_x) / (sigma_z - sigma_x) of wall stresses ``sigma`` (n, 3) [Pa],
-    NaN where sigma_z - sigma_x is below B_MEASURE_FROM times ``mean`` [Pa]."""
-    sigma = np.asarray(sigma, dtype=np.float64)
-    span = sigma[:, 2] - sigma[:, 0]
-    measured = span > B_MEASURE_FROM * mean
-    return np.where(measured, (sigma[:, 1] - sigma[:, 0]) / np.where(measured, span, 1.0),
-                    np.nan)
-
-
-def path_deviations(history, shear, confining):
-    """How closely a shear of ``shear`` (ShearConfig) held its mixed condition: with
-    ``constant_p``, ``mean_stress_deviation`` max over the records of |p / confining - 1|;
-    with ``b``, ``b_deviation`` max of |b measured - b| over the records with sigma_z - sigma_x
-    of at least B_MEASURE_FROM confining (measured_b), None with ``b_deviation_note`` without
-    such records. Both [-]; {} for neither."""
-    sigma = history["sigma_wall"]
-    found = {}
-    if shear.constant_p:
-        found["mean_stress_deviation"] = float(np.max(np.abs(mean_stress(sigma) / confining
-                                                             - 1.0)))
-    if shear.b is not None:
-        b = measured_b(sigma, confining)
-        found["b_deviation"] = (float(np.nanmax(np.abs(b - shear.b)))
-                                if np.isfinite(b).any() else None)
-        if found["b_deviation"] is None:
-            found["b_deviation_note"] = (
-                f"not measured: no record has sigma_z - sigma_x of at least {B_MEASURE_FROM:g} "
-                "of the confining stress, where b is more than noise")
-    return found
-
-
-#: Rows of the effective stress path an undrained summary lists (undrained_summary).
-PATH_POINTS = 21
-
-
-def excess_pore_pressure(sigma):
-    """Excess pore pressure Delta u [Pa] of each record of wall stresses ``sigma`` (n, 3) [Pa]
-    from the first: the pressure a saturating, incompressible pore fluid takes up in an
-    undrained shear along the conventional total stress path (the cell pressure sigma_3
-    held): Delta u = Delta p_total - Delta p', p_total = sigma_3 + q / 3 and p' the mean wall
-    stress, the skeleton's (the effective stress of a saturated sample); = -Delta sigma'_3
-    (q = sigma_z - (sigma_x + sigma_y) / 2, pendular.homogenize.invariants)."""
-    sigma = np.asarray(sigma, dtype=np.float64)
-    q, p = deviator_stress(sigma), mean_stress(sigma)
-    return (q - q[0]) / 3.0 - (p - p[0])
-
-
-def undrained_summary(history, peak):
-    """Results of an undrained (constant-volume) shear's ``history`` (column
-    ``excess_pore_pressure``, excess_pore_pressure), ``peak`` the row of the peak of q:
-    ``excess_pore_pressure_at_peak``, ``_final``, ``_max`` [Pa]; ``p_min`` [Pa], the least
-    mean effective stress, and ``axial_strain_at_p_min`` (where a contracting sample turns to
-    dilating, the phase transformation); ``max_volume_change``, max |V / V0 - 1| [-], the
-    volume held; ``effective_stress_path``, PATH_POINTS rows evenly spaced over the history:
-    axial strain, p' and q of the wall stresses, Delta u, and wet p' of Eq. 3.43, suction and
-    saturation Sr, which change at a constant water content."""
-    sigma = history["sigma_wall"]
-    change = history["excess_pore_pressure"]
-    p = mean_stress(sigma)
-    least = int(np.argmin(p))
-    summary = {
-        "drainage": "undrained",
-        "excess_pore_pressure_at_peak": float(change[peak]),
-        "excess_pore_pressure_final": float(change[-1]),
-        "excess_pore_pressure_max": float(change.max()),
-        "p_min": float(p[least]),
-        "axial_strain_at_p_min": float(history["axial_strain"][least]),
-        "max_volume_change": float(np.max(np.abs(history["volumetric_strain"]))),
-    }
-    rows = np.unique(np.linspace(0, len(p) - 1, PATH_POINTS).round().astype(int))
-    path = {"axial_strain": history["axial_strain"][rows], "p": p[rows],
-            "q": deviator_stress(sigma[rows]), "excess_pore_pressure": change[rows]}
-    effective = _effective(history)
-    if effective is not None:
-        path["p_effective"] = mean_stress(effective[rows])
-    for name in ("suction", "saturation"):
-        if name in history:
-            path[name] = history[name][rows]
-            summary[f"{name}_final"] = float(history[name][-1])
-    summary["effective_stress_path"] = {k: [float(v) for v in values]
-                                        for k, values in path.items()}
-    return summary
-
-
-def _stage_ends(history, count):
-    """Row of each stage's end (the last row of each stage index), for ``count`` stages."""
-    stage = history.get("stage")
-    if stage is None:
-        return [len(history["step"]) - 1]
-    return [int(np.flatnonzero(stage == k)[-1]) for k in range(count)
-            if np.any(stage == k)]
-
-
-def _index(e_high, e_low, stress_high, stress_low):
-    """Delta e per log10 of the stress over a stress change [-], None without one."""
-    span = math.log10(stress_high / stress_low) if stress_high > 0 and stress_low > 0 else 0.0
-    return (e_high - e_low) / span if span > 0.0 else None
-
-
-def _indices(void, stress):
-    """(compression index, swelling index) [-] of successive states (void ratio, stress [Pa]):
-    the total decrease of e over the total rise of log10 sigma over the steps that load, and
-    the total rise of e over the total fall of log10 sigma over those that unload (None
-    without such a step)."""
-    loading = [0.0, 0.0]
-    unloading = [0.0, 0.0]
-    for k in range(1, len(stress)):
-        if stress[k] <= 0.0 or stress[k - 1] <= 0.0:
-            continue
-        rise = math.log10(stress[k] / stress[k - 1])
-        change = void[k] - void[k - 1]
-        side = loading if rise > 0.0 else unloading
-        side[0] += -change if rise > 0.0 else change
-        side[1] += abs(rise)
-    return tuple(total / span if span > 0.0 else None for total, span in (loading, unloading))
-
-
-def _effective(history):
-    """Diagonal (n, 3) of the effective stress (Eq. 3.43) of a wet history, or None."""
-    if "sigma_effective" not in history:
-        return None
-    return np.diagonal(history["sigma_effective"], axis1=1, axis2=2)
-
-
-def oedometer_summary(history, axial_stress, unload_to=None):
-    """Results of an oedometric test's history (oedometer_stages; columns ``void_ratio`` and,
-    with unloading, ``stage``): at the end of the loading (the target ``axial_stress`` [Pa])
-    ``k0`` = sigma_lateral / sigma_axial, the axial and lateral stresses, axial strain and void
-    ratio; ``constrained_modulus`` [Pa] = (sigma_v - sigma_v0) / (eps_a - eps_a0) over the
-    loading (secant from the start) and ``constrained_modulus_tangent`` over its last fifth
-    of stress (least squares); ``compression_index`` = -Delta e / Delta log10 sigma_v over the
-    loading; with ``unload_to``: the same at the end of the unloading,
-    ``constrained_modulus_unloading`` (secant) and ``swelling_index``. A wet history adds
-    ``k0_effective`` and the indices against the effective vertical stress (Eq. 3.43)."""
-    sigma = history["sigma_wall"]
-    strain = history["axial_strain"]
-    void = history["void_ratio"]
-    ends = _stage_ends(history, 2 if unload_to is not None else 1)
-    loaded = ends[0]
-    axial, lateral = sigma[:, 2], lateral_stress(sigma)
-    summary = {
-        "k0": float(lateral[loaded] / axial[loaded]),
-        "axial_stress_target": float(axial_stress),
-        "axial_stress_at_load": float(axial[loaded]),
-        "lateral_stress_at_load": float(lateral[loaded]),
-        "axial_strain_at_load": float(strain[loaded]),
-        "initial_void_ratio": float(void[0]),
-        "void_ratio_at_load": float(void[loaded]),
-        "constrained_modulus": float((axial[loaded] - axial[0]) / (strain[loaded] - strain[0])),
-        "constrained_modulus_tangent": _tangent_modulus(strain[:loaded + 1],
-                                                        axial[:loaded + 1]),
-        "compression_index": _index(void[0], void[loaded], axial[loaded], axial[0]),
-    }
-    if summary["constrained_modulus_tangent"] is None:
-        summary["constrained_modulus_tangent_note"] = (
-            "not measured: fewer than 3 records, or no strain, in the top fifth of the "
-            "loading's stress")
-    effective = _effective(history)
-    if effective is not None:
-        summary["k0_effective"] = float(lateral_stress(effective[loaded])
-                                        / effective[loaded, 2])
-        summary["compression_index_effective"] = _index(void[0], void[loaded],
-                                                        effective[loaded, 2], effective[0, 2])
-    if unload_to is not None and len(ends) == 2:
-        final = ends[1]
-        summary.update({
-            "unload_to": float(unload_to),
-            "k0_final": float(lateral[final] / axial[final]),
-            "axial_stress_final": float(axial[final]),
-            "axial_strain_final": float(strain[final]),
-            "void_ratio_final": float(void[final]),
-            "constrained_modulus_unloading": float((axial[loaded] - axial[final])
-                                                   / (strain[loaded] - strain[final])),
-            "swelling_index": _index(void[final], void[loaded], axial[loaded], axial[final]),
-        })
-        if effective is not None:
-            summary["swelling_index_effective"] = _index(void[final], void[loaded],
-                                                         effective[loaded, 2],
-                                                         effective[final, 2])
-    return summary
-
-
-def _tangent_modulus(strain, stress, fraction=0.2):
-    """Slope d sigma / d eps [Pa] (least squares) over the rows whose stress lies in the top
-    ``fraction`` of the range of ``stress``; None with fewer than 3 such rows."""
-    top = stress >= stress.max() - fraction * (stress.max() - stress[0])
-    if np.count_nonzero(top) < 3 or np.ptp(strain[top]) == 0.0:
-        return None
-    return float(np.polyfit(strain[top], stress[top], 1)[0])
-
-
-def isotropic_summary(history, stresses):
-    """Results of an isotropic path's history (isotropic_stages to ``stresses`` [Pa]; columns
-    ``void_ratio`` and ``stage``): ``stages``, one row per stage end (target, p [Pa], void
-    ratio, volumetric strain, and wet p' of the effective stress, Eq. 3.43), and
-    ``compression_index`` / ``swelling_index`` = Delta e per log10 p over the steps between
-    successive listed stresses that load / unload (the stage from the confining stress to the
-    first listed one is the path's start, not a step of it); wet, the same against p'
-    (``*_effective``)."""
-    void = history["void_ratio"]
-    p = mean_stress(history["sigma_wall"])
-    effective = _effective(history)
-    ends = _stage_ends(history, len(stresses))
-    rows = []
-    for k, row in enumerate(ends):
-        entry = {"stage": k, "target": float(stresses[k]), "p": float(p[row]),
-                 "void_ratio": float(void[row]),
-                 "volumetric_strain": float(history["volumetric_strain"][row]),
-                 "step": int(history["step"][row])}
-        if effective is not None:
-            entry["p_effective"] = float(effective[row].mean())
-        rows.append(entry)
-    compression, swelling = _indices([r["void_ratio"] for r in rows], [r["p"] for r in rows])
-    summary = {"stages": rows, "initial_void_ratio": float(void[0]),
-               "final_void_ratio": float(void[-1]), "compression_index": compression,
-               "swelling_index": swelling}
-    if effective is not None:
-        compression, swelling = _indices([r["void_ratio"] for r in rows],
-                                         [r["p_effective"] for r in rows])
-        summary.update({"compression_index_effective": compression,
-                        "swelling_index_effective": swelling})
-    return summary

@@ -77,8 +77,8 @@ from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
 
 from pendular.procedures.config import config_to_dict, sample_made_with
-from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.triaxial import Interrupted
+from pendular.procedures.registry import config_from_options, options_of
+from pendular.procedures.laboratory import Interrupted
 from pendular.studies.run_kinds import PROCEDURES, RunConfig, procedure_of, run_options_of
 
 #: Seconds between updates of the campaign's progress bar.

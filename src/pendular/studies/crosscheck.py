@@ -62,15 +62,18 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.interop.yade.formats import read_spheres, write_spheres
 from pendular.homogenize.invariants import stress_ratio
 
-from pendular.procedures.config import (MAX_STAGE_STEPS, MIN_SAMPLE_PARTICLES, YADE_CHOICES,
-    BridgeConfig, ShearConfig, TriaxialConfig, config_to_dict)
-from pendular.procedures.options import SUCTION, axial_strain, sample_sizes, size_options
+from pendular.procedures.config import (BridgeConfig, MAX_STAGE_STEPS, MIN_SAMPLE_PARTICLES,
+    ShearConfig, YADE_CHOICES, config_to_dict)
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.options import SUCTION, sample_sizes, size_options
+from pendular.procedures.triaxial import axial_strain
 from pendular.utils.parameters import (Option, OptionError, Parameter, default_of, option_from,
     option_of)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
-from pendular.procedures.triaxial import NotStatic, TriaxialShear, equilibrate, summarize
+from pendular.procedures.equilibrium import NotStatic, equilibrate
+from pendular.procedures.triaxial import TriaxialShear, summarize
 from pendular.interop.yade.runner import (cached_sample, find_yade, run_yade_triaxial,
     yade_capillary_files, yade_history)
 

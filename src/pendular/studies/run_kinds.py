@@ -10,16 +10,25 @@ import os
 from dataclasses import dataclass
 from typing import Any, Callable, Union
 
-from pendular.procedures.config import (CyclicConfig, IsotropicConfig, OedometerConfig,
-    SimpleShearConfig, SwccConfig, TablePathConfig, TensionConfig, TriaxialConfig,
-    same_config, stored_config)
+from pendular.procedures.cyclic import CyclicConfig
+from pendular.procedures.isotropic import IsotropicConfig
+from pendular.procedures.oedometer import OedometerConfig
+from pendular.procedures.simple_shear import SimpleShearConfig
+from pendular.procedures.swcc import SwccConfig
+from pendular.procedures.path import TablePathConfig
+from pendular.procedures.tension import TensionConfig
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.config import same_config, stored_config
 from pendular.procedures.cyclic import CyclicTest
-from pendular.procedures.path_table import PathTest
+from pendular.procedures.path import PathTest
 from pendular.procedures.simple_shear import SimpleShearTest
 from pendular.procedures.swcc import SwccTest
 from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import (IsotropicTest, LaboratoryTest, OedometerTest,
-    TriaxialTest, parameters)
+from pendular.procedures.isotropic import IsotropicTest
+from pendular.procedures.laboratory import LaboratoryTest
+from pendular.procedures.triaxial import TriaxialTest
+from pendular.procedures.oedometer import OedometerTest
+from pendular.procedures.laboratory import parameters
 from pendular.utils.parameters import Option, flat_options
 
 #: What a campaign runs: the configuration of a laboratory command (PROCEDURES).

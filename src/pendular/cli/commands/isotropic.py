@@ -13,19 +13,6 @@ triaxial``. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.triaxial import IsotropicTest
-
 from pendular.cli.commands.triaxial import loading_command
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular isotropic --particles 1000 --stresses 1000,2000,4000,2000,1000 "
-           "--out runs/isotropic",
-           "e against log p at the end of each stage, with the compression and swelling indices; "
-           "isotropic.png")
-
-#: Summary keys printed at the end.
-SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "compression_index",
-         "swelling_index", "compression_index_effective", "swelling_index_effective",
-         "initial_porosity", "wall_time_s", "particle_steps_per_s")
-
-add_arguments, config_from, run = loading_command("isotropic", IsotropicTest, SHOWN)
+add_arguments, config_from, run, EXAMPLE = loading_command("isotropic")
