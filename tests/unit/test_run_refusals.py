@@ -217,3 +217,65 @@ def test_resuming_a_run_stopped_before_its_sample_says_so(tmp_path, capsys):
     line = refused(*run_in_process("oedometer", ["--resume", str(folder)], capsys),
                    "sample.h5 is missing", "before its sample existed", "run it again")
     assert "checkpoint_every" not in line
+
+
+# ---------------------------------------------------------------- direct tension's water
+def test_a_water_content_too_low_for_the_compared_packing_names_it_and_its_range(tmp_path,
+                                                                                capsys):
+    """Below the least water content whose bridges span the separation of the regular
+    packing a case is compared with, the refusal names --water-content and its range for the
+    sample, not the bridge solver's internal distance."""
+    line = refused_here(capsys, tmp_path, "tension",
+                        ["--particles", "100", "--void-ratio", "0.7", "--water-content", "0.001",
+                         "--quiet"],
+                        "--water-content = 0.001 % is outside the valid range [",
+                        "% of a sample of void ratio 0.7")
+    assert "distance_star" not in line
+
+
+def test_the_least_water_content_is_where_the_compared_packing_starts_to_hold_bridges():
+    """The bound of the refusal above, against pendular.homogenize.packing_state: the
+    prediction of the compared packing exists just above it, and not just below."""
+    from pendular.procedures.tension import TensionConfig, tension_sample
+    from pendular.procedures.tension_pull import prediction
+
+    config = TensionConfig(cases=[(0.7, 0.01)], sample=tension_sample(particles=100))
+    least = config.least_water_content(0.7)
+    assert 0.0 < least < config.pendular_limit(0.7)
+    assert prediction(config, 0.7, least * 1.01)[0] > 0.0
+    with pytest.raises(ValueError):
+        prediction(config, 0.7, least * 0.99)
+
+
+def test_too_much_water_for_a_graded_sample_names_the_options_typed(monkeypatch):
+    """A water content whose bridges would pass the pendular limit at the contacts of a
+    graded sample's smallest grains is refused naming --water-content and the size option
+    that made those grains (--radius-spread), not a suction and a radius the user never
+    typed. The wetting itself is replaced by what the bridges' check raises."""
+    import types
+
+    import numpy as np
+
+    from pendular.capillary.validation import NotPendular
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
+    from pendular.utils.parameters import ParameterError
+
+    def too_wet(*_, **__):
+        raise NotPendular("suction = 2676.82 Pa is outside the valid range [3748, inf) Pa",
+                          2676.82, 3748.0, 5.5e-5, 49.8)
+
+    monkeypatch.setattr(tension_pull, "wet_to_water_volume", too_wet)
+    monkeypatch.setattr(tension_pull.BridgeTable, "cached", lambda *_, **__: None)
+    particles = types.SimpleNamespace(radius=np.full(4, 1.1e-4), solid_volume=lambda: 1e-9)
+    contacts = types.SimpleNamespace(overlap=np.ones(2), pair_i=np.array([0, 1]),
+                                     pair_j=np.array([2, 3]))
+    dry = types.SimpleNamespace(particles=particles, contacts=contacts)
+    config = TensionConfig(cases=[(0.7, 0.01)], form_gap=0.0,
+                           sample=tension_sample(particles=100, radius_spread=0.5))
+    with pytest.raises(ParameterError) as error:
+        tension_pull.wet(dry, config, 0.01, progress=False)
+    line = error.value.on_command_line()
+    assert line.startswith("--water-content = 1 % is more than this sample "
+                           "(--radius-spread 0.5) holds in the pendular regime")
+    assert "lower --water-content or the size spread" in line

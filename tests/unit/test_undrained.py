@@ -1,6 +1,6 @@
 """Undrained (constant-volume) shear: the ConstantVolume control (pendular.dem.walls) against
 the volume it holds, step by step, between walls and in a periodic cell; the excess pore
-pressure against its definition (pendular.procedures.loading.excess_pore_pressure); the
+pressure against its definition (pendular.procedures.triaxial.excess_pore_pressure); the
 stage's and the configuration's refusals; the undrained summary of a hand-made history."""
 
 from types import SimpleNamespace

@@ -161,7 +161,7 @@ def start_executor_run(args):
 
 def add_declared_options(parser, options):
     """Add to ``parser`` the declared ``options`` (pendular.utils.parameters.Option; a
-    laboratory command's: pendular.procedures.options.options_of, a study's: its module's) in
+    laboratory command's: pendular.procedures.registry.options_of, a study's: its module's) in
     their order: flag and aliases, default (a list's as its comma text), type (an integer with
     a least value checked as it is parsed), choices, metavar, help; a flag stores true; the
     options of one group exclude each other. Each action of an option that sets a

@@ -7,7 +7,7 @@ column that is not, so a new column cannot be written without its units. Units a
 the second index of a 3x3 tensor), ``grip`` (z-, z+: the grips of direct tension).
 
 The commands that write each column: HISTORY_WRITERS (every loading path records
-pendular.procedures.loading.history_columns; wet, the capillary ones of
+pendular.procedures.columns.history_columns; wet, the capillary ones of
 pendular.homogenize.on_the_fly.CapillaryHomogenization; at a water content the closed
 liquid's; each test adds its own: an undrained triaxial excess_pore_pressure, a path with
 water-content stages water_content and liquid_total; an impact records every step of its
@@ -58,11 +58,11 @@ class Column:
         return np.dtype(self.dtype).kind in "iu"
 
 
-#: The laboratory tests (pendular.procedures.triaxial.LaboratoryTest): what every run writes.
+#: The laboratory tests (pendular.procedures.laboratory.LaboratoryTest): what every run writes.
 LABORATORY = ("triaxial", "oedometer", "isotropic", "simple-shear", "cyclic", "path")
 
 #: The commands whose history.h5 holds each column, by column: every loading path's
-#: (pendular.procedures.loading.history_columns) and the SWCC's; wet, the capillary ones; the
+#: (pendular.procedures.columns.history_columns) and the SWCC's; wet, the capillary ones; the
 #: closed liquid's; each test's own.
 HISTORY_WRITERS = {
     **dict.fromkeys(("porosity", "volumetric_strain", "sigma_contact", "fabric", "anisotropy"),
@@ -233,7 +233,7 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "sigma_wall": "Pa", "coordination": "1", "pendular_overlaps": "1",
                     "steps": "1"}
 
-#: Units of the run options in campaign rows (pendular.procedures.triaxial.parameters, TensionConfig) and
+#: Units of the run options in campaign rows (pendular.procedures.laboratory.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
 OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
@@ -256,7 +256,7 @@ OPTION_UNITS = {
 #: is taken from it, and the tests refuse a written key that is not here. Keys that are text
 #: or flags have units "1". Stresses compression positive; strains compression positive.
 SUMMARY_KEYS = {
-    # -- the peak of a shear (pendular.procedures.triaxial.summarize; path_table.path_summary)
+    # -- the peak of a shear (pendular.procedures.triaxial.summarize; path.path_summary)
     "peak_q": Key("Pa", "the peak of q: the largest in compression, the least (most "
                         "negative) in extension; q = sigma_z - (sigma_x + sigma_y)/2, the von "
                         "Mises deviatoric stress at b != 0; the '_at_peak' keys are of its "
@@ -313,14 +313,14 @@ SUMMARY_KEYS = {
                                     "tolerances)", _T),
     "phi_cs_effective_deg": Key("deg", "phi_cs_deg of the effective stress (Eq. 3.43)", _T),
     "M_cs_effective": Key("1", "M_cs of the effective stress (Eq. 3.43)", _T),
-    # -- how closely a shear held its path (loading.path_deviations)
+    # -- how closely a shear held its path (triaxial.path_deviations)
     "mean_stress_deviation": Key("1", "--constant-p: largest |p / confining - 1| over the "
                                       "records", _T),
     "b_deviation": Key("1", "--b: largest |b measured - b| over the records with sigma_z - "
                             "sigma_x of at least a tenth of the confining stress; null "
                             "without such records", _T),
     "b_deviation_note": Key("1", "why b_deviation is null", _T),
-    # -- an undrained triaxial (loading.undrained_summary; history excess_pore_pressure)
+    # -- an undrained triaxial (triaxial.undrained_summary; history excess_pore_pressure)
     "drainage": Key("1", "'undrained' when the shear held the volume (text)", _T),
     "excess_pore_pressure_at_peak": Key("Pa", "undrained: excess pore pressure Delta u of a "
                                               "saturated sample at the peak of q", _T),
@@ -337,7 +337,7 @@ SUMMARY_KEYS = {
                                   "excess_pore_pressure": "Pa", "p_effective": "Pa",
                                   "suction": "Pa", "saturation": "1"},
                                  "undrained: the stress path at points evenly spaced over "
-                                 "the history (loading.PATH_POINTS; each field a list): axial "
+                                 "the history (triaxial.PATH_POINTS; each field a list): axial "
                                  "strain, p and q of the wall stresses, Delta u and, wet, p' "
                                  "of Eq. 3.43, the suction and Sr", _T),
     # -- every laboratory run (TriaxialTest's run, pendular.procedures.triaxial)
@@ -414,7 +414,7 @@ SUMMARY_KEYS = {
                                      "initial| / initial over the records", LABORATORY),
     "liquid_lost_fraction": Key("1", "closed liquid: the fraction of the liquid lost by the "
                                      "end", LABORATORY),
-    # -- oedometer (loading.oedometer_summary)
+    # -- oedometer (oedometer_summary)
     "k0": Key("1", "K0 = sigma_lateral / sigma_axial of the wall stresses at the axial stress "
                    "target", ("oedometer",)),
     "k0_effective": Key("1", "K0 of the effective stress (Eq. 3.43) there", ("oedometer",)),
@@ -446,7 +446,7 @@ SUMMARY_KEYS = {
     "axial_stress_final": Key("Pa", "axial stress at the end of the path", ("oedometer",)),
     "axial_strain_final": Key("1", "axial strain at the end of the path", ("oedometer",)),
     "void_ratio_final": Key("1", "void ratio at the end of the path", ("oedometer",)),
-    # -- isotropic and path tables (loading.isotropic_summary, path_table.path_summary)
+    # -- isotropic and path tables (isotropic_summary, path.path_summary)
     "stages": Key({"target": "Pa", "p": "Pa", "p_effective": "Pa", "q": "Pa",
                    "q_effective": "Pa", "sigma_wall": "Pa", "void_ratio": "1",
                    "axial_strain": "1", "volumetric_strain": "1", "stage": "1", "step": "1",
@@ -462,7 +462,7 @@ SUMMARY_KEYS = {
                          "suction_after": "Pa", "water_content_before": "1",
                          "water_content_after": "1"},
                         "path: one row per stage that changes the water "
-                        "(path_table.wetting_strains): its index, the suction or the water "
+                        "(path.wetting_strains): its index, the suction or the water "
                         "content (a fraction) before and after it, its axial and volumetric "
                         "strain changes", ("path",)),
     "collapse_strain": Key("1", "path: volumetric strain over the stages that wet the sample "

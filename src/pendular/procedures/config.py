@@ -110,7 +110,7 @@ class ShearConfig:
     - servo_stiffness_every: refresh the walls' stiffness every this many steps (and at each of
       the first 100) instead of every step.
 
-    The path of the shear (pendular.procedures.loading.shear_stage): ``direction``
+    The path of the shear (pendular.procedures.triaxial.shear_stage): ``direction``
     (SHEAR_DIRECTIONS; in extension ``max_strain`` is the magnitude of the axial extension);
     ``b``: the intermediate principal stress ratio (sigma_2 - sigma_3) / (sigma_1 - sigma_3)
     held through a compression, sigma_1 on z, sigma_3 on x (None: sigma_x = sigma_y, a
@@ -296,7 +296,7 @@ class BridgeConfig:
 @dataclass
 class LaboratoryConfig:
     """What every laboratory test on a prepared sample shares (TriaxialConfig, OedometerConfig,
-    IsotropicConfig; pendular.procedures.triaxial.LaboratoryTest): sample, optional bridges,
+    IsotropicConfig; pendular.procedures.laboratory.LaboratoryTest): sample, optional bridges,
     outputs.
 
     sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its
@@ -311,7 +311,7 @@ class LaboratoryConfig:
     instead (None: from vtk_frames);
     checkpoint_every: steps between checkpoints of the loading (0: none); both at most
     MAX_STAGE_STEPS;
-    wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.triaxial.wet_sample):
+    wetting: how the bridges appear (WETTING_PROTOCOLS; pendular.procedures.equilibrium.wet_sample):
     'isotropic' (added to the static sample, re-equilibrated by the servo), 'at-shear'
     (switched on at the first loading step), 'constant-volume' (added with the walls fixed,
     equilibrated, then servoed to the confining stress).
@@ -366,10 +366,7 @@ class LaboratoryConfig:
                             f"{type(self.bridges).__name__}")
         check_particles(self.sample.particles, self.MIN_PARTICLES, MAX_PARTICLES, self.TEST,
                         self.FEWEST)
-        if self.sample.confining <= 0.0:
-            # the path's starting stress: the inertial number and the servo need it > 0
-            raise fail(self.sample, "confining", f"confining = {self.sample.confining:g} Pa is "
-                       f"outside the valid range (0, 1e+07] Pa for {self.TEST}")
+        check_loaded_confining(self.sample, self.TEST)
         validate(self)
         if self.wetting != "isotropic" and (self.bridges is None
                                             or self.bridges.water_content is not None):
@@ -483,6 +480,19 @@ class PathConfig(LaboratoryConfig):
 #: Density of water [kg/m^3]: the specific gravity of the grains is their density over it
 #: (Gs = rho_s / rho_w), which turns a water content by mass into a water volume.
 WATER_DENSITY = 1000.0
+
+
+#: The confining stress of a test that runs at it or loads from it: PrepareConfig's, 0 left out
+#: (the servo and the inertial number of the rate need a stress).
+LOADED_CONFINING = dataclasses.replace(spec_of(PrepareConfig, "confining"), low_inclusive=False)
+
+
+def check_loaded_confining(sample, test):
+    """ParameterError naming the confining stress of the PrepareConfig ``sample`` outside
+    LOADED_CONFINING's range, for ``test`` (e.g. 'a triaxial test')."""
+    if not sample.confining > LOADED_CONFINING.low:
+        raise fail(sample, "confining", f"confining = {sample.confining:g} Pa is outside the "
+                   f"valid range {LOADED_CONFINING.valid_range()} Pa for {test}")
 
 
 def check_particles(particles, low, high, test, why):

@@ -275,7 +275,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
     about the lateral stress ``confining`` [Pa], default the first record's) is None, with
     ``damping_ratio_measured``, ``damping_ratio_resolution`` and ``damping_ratio_note`` in its
     row (``damping_ratio_effective_*`` of q') and ``damping_ratio_note`` at the top naming the
-    cycles. ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
+    cycles. ``phi_peak_deg`` (columns.friction_angle of the wall stresses) only
     where a half-cycle has a failure peak (q falls after it by FAILURE_DROP or more). A wet
     history adds, per cycle and at the top, the modulus and damping ratio of the effective
     stress (Eq. 3.43; ``*_effective``)."""
@@ -341,7 +341,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
 # ---------------------------------------------------------------- the test
 
 class CyclicTest(LaboratoryTest):
-    """A cyclic triaxial test of ``config`` (pendular.procedures.config.CyclicConfig;
+    """A cyclic triaxial test of ``config`` (pendular.procedures.cyclic.CyclicConfig;
     cyclic_stages): history with ``void_ratio``, ``stage`` and ``cycle``, summary of
     cyclic_summary; figure cyclic.png (the q-eps_a loops, and the secant modulus and damping
     ratio against the cycle). Rows every ``record_strain`` of the path's rate and, under

@@ -21,6 +21,7 @@ from pendular.procedures.columns import COMPRESSION_COLUMNS
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
 from pendular.utils.parameters import fail, option_of, parameter
+from pendular.procedures.preparation import MAX_STRESS
 
 
 #: Fewest stresses of an isotropic path: a loading (or unloading) needs two.
@@ -30,14 +31,14 @@ MIN_ISOTROPIC_STAGES = 2
 @registered
 @dataclass
 class IsotropicConfig(PathConfig):
-    """Isotropic loading and unloading in stages (pendular.procedures.loading.isotropic_stages):
+    """Isotropic loading and unloading in stages (pendular.procedures.isotropic.isotropic_stages):
     the six walls servoed to each of ``stresses`` [Pa] (each > 0, in any order, at least
     MIN_ISOTROPIC_STAGES) in turn, each stage run until static; the walls move at most at the
     path's rate. ``stage_steps``: most steps of a stage."""
 
     stresses: list[float] = parameter(
         default_factory=lambda: [500.0, 1000.0, 2000.0, 5000.0, 2000.0, 500.0], many=True,
-        unit="Pa", low=0.0, high=1e7, low_inclusive=False, flag="--stresses",
+        unit="Pa", low=0.0, high=MAX_STRESS, low_inclusive=False, flag="--stresses",
         metavar="P1,P2,...", help="isotropic stresses of the stages, each > 0, in any order")
     stage_steps: int = stage_steps_parameter(2_000_000,
                                              "most steps of a stage to reach equilibrium")
@@ -111,8 +112,8 @@ def isotropic_summary(history, stresses):
 
 class IsotropicTest(LaboratoryTest):
     """Isotropic loading and unloading in stages of ``config``
-    (pendular.procedures.config.IsotropicConfig; loading.isotropic_stages): history with
-    ``void_ratio`` and ``stage``, summary of loading.isotropic_summary; figure isotropic.png
+    (pendular.procedures.isotropic.IsotropicConfig; isotropic_stages): history with
+    ``void_ratio`` and ``stage``, summary of isotropic_summary; figure isotropic.png
     (e-log p, net and effective, and the volumetric strain)."""
 
     NAME = "isotropic"

@@ -42,8 +42,9 @@ from pendular.procedures.equilibrium import (equilibrate, frame_period, frames_w
     prep_vtk_period, watched, wet_sample)
 from pendular.procedures.guards import AxialContactLost, SampleCrushed
 from pendular.procedures.loading import VTK_RECORDS, check_stages_device
-from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample, pwave_step,
-    servoed_simulation, timestep, timestep_description)
+from pendular.procedures.preparation import (MAX_STRESS, PREPARATION_PHASES, prepare_sample,
+    pwave_step, servoed_simulation, timestep, timestep_description)
+from pendular.procedures.run_options import RunOptions
 from pendular.procedures.progress import laboratory_plan
 from pendular.utils.atomic import write_json
 from pendular.utils.integrity import checksum, config_hash
@@ -191,7 +192,7 @@ def check_feasible(config, force=False):
         name = "confining" if pressure == sample.confining else "the path's lowest stress"
         raise ValueError(
             f"{name} = {pressure:g} Pa is outside the valid range "
-            f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, 1e+07] Pa for young = "
+            f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, {MAX_STRESS:g}] Pa for young = "
             f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
             "never hold the confining stress (the equilibrium would run to its step limit); "
             "raise confining or lower young (or --force)")
@@ -280,25 +281,30 @@ class LaboratoryTest:
                                                                   config.sample_path))
 
     # ------------------------------------------------------------ phases
-    def start(self, progress=True, threads=None, writers=(), device="cpu"):
+    def start(self, options=None, writers=()):
         """(static sample at the confining stress, preparation report, the host holding it);
         ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
-        vtk_prep VtkWriter); ``device``: where the preparation or the loaded sample's
-        equilibrium runs, and the returned simulation's runs (the wetting after it)."""
+        vtk_prep VtkWriter); ``options`` (RunOptions): its device is where the preparation or
+        the loaded sample's equilibrium runs, and the returned simulation's runs (the wetting
+        after it)."""
+        options = RunOptions.of(options)
         self.config = config = self._sized(self.config)
         if config.sample_path is not None:
-            return self.load_sample(config.sample_path, progress, threads, writers, device)
-        return prepare_sample(config.sample, progress=progress, threads=threads,
-                              writers=writers, device=device)
+            return self.load_sample(config.sample_path, options, writers)
+        return prepare_sample(config.sample, progress=options.progress, threads=options.threads,
+                              writers=writers, device=options.device)
 
-    def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
+    def load_sample(self, path, options=None, writers=()):
         """(sample saved at ``path`` servoed at the confining stress and run until static on
-        ``device``, its report; the simulation's runs go on there); ``writers`` watch the
-        equilibrium (phase "sample")."""
+        the device of ``options`` (RunOptions), its report; the simulation's runs go on
+        there); ``writers`` watch the equilibrium (phase "sample")."""
+        options = RunOptions.of(options)
+        progress = options.progress
         sample = self.config.sample
         particles, walls, report, _ = load_sample(path, expected=sample)
-        sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
-        sim.device = device
+        sim = servoed_simulation(particles, walls, sample, sample.confining,
+                                 threads=options.threads)
+        sim.device = options.device
         started = time.perf_counter()
         with watched(sim, writers, "sample"):
             steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
@@ -316,29 +322,31 @@ class LaboratoryTest:
         report.setdefault("timestep", timestep_description(sample))
         return sim, report
 
-    def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False,
-            plots=True, device="cpu"):
-        """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
-        shear after this many steps as an interruption would (raises Interrupted); ``plots``:
-        False leaves out triaxial.png and plots/ (a run timed for its physics, as the
-        trade-off study's: the figures' cost is not the physics').
+    def run(self, out, options=None, **settings):
+        """The whole test into the folder ``out`` (class docstring), run as ``options`` say
+        (pendular.procedures.run_options.RunOptions; ``settings``: its fields one by one):
+        ``stop_after``: stop the shear after this many steps as an interruption would (raises
+        Interrupted); ``plots``: False leaves out triaxial.png and plots/ (a run timed for its
+        physics, as the trade-off study's: the figures' cost is not the physics').
         ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
         (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
         many steps, False (default) or 0 none. Output only: the results are the same.
         ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
-        the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
-        the configuration."""
-        check_device(device)
-        check_stages_device(self.stages(), device)
+        the wetting, the loading), "cpu" or "gpu" (``check_device``)."""
+        options = RunOptions.of(options, **settings)
+        check_device(options.device)
+        check_stages_device(self.stages(), options.device)
+        vtk_prep = options.vtk_prep
         if vtk_prep is not True and vtk_prep is not False:
-            vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
+            options = RunOptions.of(options, vtk_prep=check_int("vtk_prep", vtk_prep, low=0))
         if self.config.sample_path is not None:       # checked before the folder is touched
             load_sample(self.config.sample_path, expected=self.config.sample)
         with OutputFolder(out, self.NAME) as folder:
             for name in self.outputs():
                 folder.claim(name)
-            with whole_run(laboratory_plan(self.config, self.PROGRESS), enabled=progress):
-                return self._run(folder, progress, threads, stop_after, vtk_prep, plots, device)
+            with whole_run(laboratory_plan(self.config, self.PROGRESS),
+                           enabled=options.progress):
+                return self._run(folder, options)
 
     def prep_writer(self, out, vtk_prep):
         """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
@@ -353,14 +361,14 @@ class LaboratoryTest:
                          field_data=lambda s: {"mean_wall_stress":
                                                float(np.mean(s.walls.stress()))})
 
-    def _run(self, folder, progress, threads, stop_after, vtk_prep, plots, device):
-        config, out = self.config, folder.path
+    def _run(self, folder, options):
+        config, out, progress = self.config, folder.path, options.progress
         started = time.perf_counter()
-        frames = self.prep_writer(out, vtk_prep)
+        frames = self.prep_writer(out, options.vtk_prep)
         writers = () if frames is None else (frames,)
         folder.phase = "prepare"
         pause_point(folder.phase)
-        sim, preparation = self.start(progress, threads, writers, device)   # runs on device
+        sim, preparation = self.start(options, writers)        # runs on the device
         prepared = time.perf_counter()
         wetting = {}
         if config.bridges is not None:
@@ -381,13 +389,16 @@ class LaboratoryTest:
         run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
-        return run.finish(progress, stop_after, plots)
+        return run.finish(progress, options.stop_after, options.plots)
 
     @classmethod
-    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
+    def resume(cls, out, options=None, **settings):
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration stored in its sample.h5, its loading on ``device`` (whichever device
+        configuration stored in its sample.h5, run as ``options`` say (RunOptions;
+        ``settings``: its fields one by one): its loading on their device (whichever device
         wrote the checkpoint); returns the summary."""
+        options = RunOptions.of(options, **settings)
+        device = options.device
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(sample_file):
@@ -408,7 +419,7 @@ class LaboratoryTest:
                                  f"({type(config).__name__}), not of pendular {cls.NAME}")
             check_device(device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
-                                     threads=threads)
+                                     threads=options.threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
                 sim.forces.append(config.bridges.build(
                     before_shear["wetting"].get("formation_suction_pa"), closed=True))
@@ -441,7 +452,7 @@ class LaboratoryTest:
                                  f"[{start}, {end}] of this run's loading (an edited checkpoint)")
             run.resumed(state)
             sim.device = device
-            return run.finish(progress, stop_after)
+            return run.finish(options.progress, options.stop_after, options.plots)
 
     # ------------------------------------------------------------ the path of the test
     def outputs(self):
@@ -625,7 +636,7 @@ class _PathRun:
                             "void_ratio_before_wetting": before / (1.0 - before),
                             "void_ratio_after_wetting": after / (1.0 - after)})
         if "liquid_bridges" in history:
-            # the closed amount, which water-content stages change (path_table.liquid_total)
+            # the closed amount, which water-content stages change (path.liquid_total)
             initial = np.asarray(history.get("liquid_total",
                                              self.before_shear["wetting"]["liquid_initial"]))
             total = history["liquid_bridges"] + history["liquid_film"] + history["liquid_lost"]

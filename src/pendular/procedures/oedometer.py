@@ -24,21 +24,23 @@ from pendular.procedures.loading import LoadingPath, Stage, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
 from pendular.utils.parameters import fail, option_of, parameter
+from pendular.procedures.preparation import MAX_STRESS
 
 
 @registered
 @dataclass
 class OedometerConfig(PathConfig):
-    """Oedometric (K0) compression (pendular.procedures.loading.oedometer_stages): the lateral
+    """Oedometric (K0) compression (pendular.procedures.oedometer.oedometer_stages): the lateral
     walls fixed, the axial ones pushed in at the path's rate until the axial stress is
     ``axial_stress`` [Pa] (above the confining stress the sample starts from), then, with
     ``unload_to`` [Pa] (below ``axial_stress``, above 0), pulled back until it is that."""
 
-    axial_stress: float = parameter(10000.0, unit="Pa", low=0.0, high=1e7,
+    axial_stress: float = parameter(10000.0, unit="Pa", low=0.0, high=MAX_STRESS,
                                     flag="--axial-stress",
                                     help="axial stress the compression ends at, above "
                                          "--confining")
-    unload_to: float | None = parameter(None, unit="Pa", low=0.0, high=1e7, low_inclusive=False,
+    unload_to: float | None = parameter(None, unit="Pa", low=0.0, high=MAX_STRESS,
+                                        low_inclusive=False,
                                         flag="--unload-to",
                                         help="then unload to this axial stress, below "
                                              "--axial-stress")
@@ -50,7 +52,7 @@ class OedometerConfig(PathConfig):
         confining = self.sample.confining
         if self.axial_stress <= confining:
             raise fail(self, "axial_stress", f"axial_stress = {self.axial_stress:g} Pa is "
-                       f"outside the valid range ({confining:g}, 1e+07] Pa: the compression "
+                       f"outside the valid range ({confining:g}, {MAX_STRESS:g}] Pa: the compression "
                        f"starts from the confining stress (--confining {confining:g} Pa)")
         check_soft(self, "axial_stress", self.axial_stress)
         if self.unload_to is not None and self.unload_to >= self.axial_stress:
@@ -136,9 +138,9 @@ def oedometer_summary(history, axial_stress, unload_to=None):
 
 
 class OedometerTest(LaboratoryTest):
-    """An oedometric (K0) test of ``config`` (pendular.procedures.config.OedometerConfig;
-    loading.oedometer_stages): history with ``void_ratio`` and ``k0`` (and ``stage`` with an
-    unloading), summary of loading.oedometer_summary; figure oedometer.png (e-log sigma_v and
+    """An oedometric (K0) test of ``config`` (pendular.procedures.oedometer.OedometerConfig;
+    oedometer_stages): history with ``void_ratio`` and ``k0`` (and ``stage`` with an
+    unloading), summary of oedometer_summary; figure oedometer.png (e-log sigma_v and
     K0), plots/ (stress path, and against axial strain as the triaxial's)."""
 
     NAME = "oedometer"

@@ -29,7 +29,7 @@ options (those of ``pendular triaxial``), so one table runs on any sample, dry o
 Every unknown key is refused with the file, the entry ("stage 2", "stage 3.1": the first
 entry of the group at entry 3) and the valid keys; a value Stage refuses, with its field,
 prefixed by the same. The parsed entries are stored as plain data in the configuration
-(pendular.procedures.config.TablePathConfig), so a run resumes without its table.
+(pendular.procedures.path.TablePathConfig), so a run resumes without its table.
 
 A stage's water key needs the sample wetted as it says (``check_water``), and a suction
 within the bridge tables for the sample's radii (``check_suctions``), both refused before
@@ -151,7 +151,7 @@ class TablePathConfig(PathConfig):
         return found
 
     def reference_pressure(self):
-        """The lowest stress of the path [Pa] (path_table.lowest_stress): the confining
+        """The lowest stress of the path [Pa] (path.lowest_stress): the confining
         stress or a lower target of a stage."""
 
         return lowest_stress(self.stages, self.source, self.sample.confining)
@@ -174,7 +174,7 @@ NAMES = {"stress": STRESS_NAMES, "mean_stress": STRESS_NAMES, "strain_rate": RAT
 AXIS_FIELDS = tuple(f.name for f in dataclasses.fields(Stage) if f.default_factory is dict)
 #: Keys of an entry that repeats a group of entries.
 GROUP_KEYS = ("repeat", "stages")
-#: History columns of a path beyond loading.history_columns.
+#: History columns of a path beyond columns.history_columns.
 PATH_COLUMNS = {"void_ratio": void_ratio, "k0": k0}
 
 
@@ -442,7 +442,7 @@ def lowest_stress(entries, source, confining):
 # ---------------------------------------------------------------- the test
 
 class PathTest(LaboratoryTest):
-    """The loading path of a table (``config``: pendular.procedures.config.TablePathConfig),
+    """The loading path of a table (``config``: pendular.procedures.path.TablePathConfig),
     on the sample and wetting of LaboratoryTest: history with ``void_ratio``, ``k0`` and
     ``stage`` (rows every ``record_strain``, or ``records`` rows over one stage ending at a
     strain as a triaxial's), summary of ``path_summary``; figure path.png (plot_path: the q-p
@@ -540,7 +540,7 @@ def path_summary(history, count=None, stages=None):
     one before did); ``initial_void_ratio`` and ``final_void_ratio``; ``has_peak``: whether
     the largest q of the path is a peak within a stage, past its first row and one that the
     stage went past (pendular.io.schema.peak_reached over its rows), and then ``peak_q``,
-    ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (loading.friction_angle),
+    ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (columns.friction_angle),
     ``peak_index``, ``peak_stage`` and, wet, ``peak_q_effective``, ``p_effective_at_peak``,
     ``phi_peak_effective_deg``. Each stage's entry also gives its ``axial_strain_change`` and
     ``volumetric_strain_change`` and, wet, the WATER_COLUMNS at its end; with the path's
@@ -620,9 +620,9 @@ def change_suction(sim, bridges, suction, *, stress, increments=4, max_velocity=
     ``stress`` ({axis: Pa}) servoed at it (at most at ``max_velocity`` [m/s]; None: the
     scene's servo speed), those of the other axes fixed (e.g. {'z': sigma_v}: drying at a
     constant vertical stress, no lateral strain). The suction changes in ``increments`` steps
-    of equal ratio, each run until static (triaxial.equilibrate with ``unbalanced``,
+    of equal ratio, each run until static (equilibrium.equilibrate with ``unbalanced``,
     ``tolerance``, ``max_steps``). Returns the history of the state before and after each
-    increment (loading.history_columns, strains from the start, with PATH_COLUMNS)."""
+    increment (columns.history_columns, strains from the start, with PATH_COLUMNS)."""
     if bridges.control != "suction":
         raise ValueError(f"control = {bridges.control!r}: change_suction needs "
                          "suction-controlled bridges (volume-controlled ones hold their liquid)")

@@ -6,7 +6,7 @@ normal stress with x and y held (a K0 consolidation, skipped when the normal str
 confining one), then the shear at the rate gamma_dot to the final shear strain, the normal
 stress held by the cell's servo (drained) or the cell's lengths held (constant volume: the
 volume is conserved exactly). ``SimpleShearTest(config).run(out)`` runs it as every
-laboratory test (pendular.procedures.triaxial.LaboratoryTest: sample, wetting, checkpoints,
+laboratory test (pendular.procedures.laboratory.LaboratoryTest: sample, wetting, checkpoints,
 resume) and writes history.h5 (the loading path's columns and ``shear_strain`` gamma,
 ``shear_stress`` tau, ``normal_stress`` sigma_zz), summary.json (``simple_shear_summary``),
 simple_shear.png (tau, sigma_n and the volumetric strain against gamma), vtk/.
@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.options import (SAMPLE, framed, laboratory_fields, laboratory_options,
     options_named)
-from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
 from pendular.utils.parameters import fail, fields_of, option_of, parameter
 
 
@@ -74,7 +74,7 @@ class SimpleShearConfig(PathConfig):
     record_strain: float = parameter(4e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
                                      flag="--record-strain",
                                      help="shear strain between history rows")
-    normal_stress: float | None = parameter(None, unit="Pa", low=0.0, high=1e7,
+    normal_stress: float | None = parameter(None, unit="Pa", low=0.0, high=MAX_STRESS,
                                             low_inclusive=False, flag="--normal-stress",
                                             help="normal stress sigma_zz of the shear "
                                                  "(default: --confining)")
@@ -282,7 +282,7 @@ def dilatancy(gamma, volumetric):
 
 
 class SimpleShearTest(LaboratoryTest):
-    """A simple shear test of ``config`` (pendular.procedures.config.SimpleShearConfig; module
+    """A simple shear test of ``config`` (pendular.procedures.simple_shear.SimpleShearConfig; module
     docstring): history with ``shear_strain``, ``shear_stress``, ``normal_stress`` (and
     ``stage`` with a consolidation), summary of ``simple_shear_summary``, figure
     simple_shear.png."""

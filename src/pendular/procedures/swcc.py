@@ -50,6 +50,7 @@ from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
     servoed_simulation, static)
+from pendular.procedures.run_options import RunOptions
 from pendular.procedures.progress import swcc_plan
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
@@ -63,7 +64,8 @@ from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
 
 from pendular.procedures.config import (AVERAGES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
-    check_particles, config_from_dict, config_to_dict, registered, stage_steps_parameter)
+    check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
+    stage_steps_parameter)
 from pendular.io.history import write_history
 from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
@@ -125,9 +127,7 @@ class SwccConfig:
                        f"{','.join(f'{s:g}' for s in self.suctions)}: at least two suctions "
                        "[Pa], ascending and distinct, expected (the drying path; wetting goes "
                        "back along it)")
-        if self.sample.confining <= 0.0:
-            raise fail(self.sample, "confining", f"confining = {self.sample.confining:g} Pa is "
-                       "outside the valid range (0, 1e+07] Pa for an SWCC at constant stress")
+        check_loaded_confining(self.sample, "an SWCC at constant stress")
 
 
 #: Files a SWCC run owns in its output folder.
@@ -151,6 +151,9 @@ class SwccTest:
     """The SWCC path of a ``SwccConfig`` (module docstring); ``run(out)`` returns the
     swcc.json content."""
 
+    #: The configuration's type.
+    CONFIG = SwccConfig
+
     def __init__(self, config: SwccConfig):
         if not isinstance(config, SwccConfig):
             raise TypeError(f"config must be a SwccConfig, got {type(config).__name__}")
@@ -165,15 +168,18 @@ class SwccTest:
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
 
-    def run(self, out, *, progress=True, threads=None, device="cpu", checkpoint_every=0,
-            stop_after=None):
-        """Run the path into ``out``; ``device``: where the preparation and the stages run,
-        "cpu" or "gpu" (``check_device``, before anything is made); ``checkpoint_every``:
-        steps between checkpoints ``out``/checkpoint.h5 of the path (0: none), from which
-        ``resume`` continues; ``stop_after``: stop the path after this many steps as an
-        interruption would (raises Interrupted)."""
+    def run(self, out, options=None, **settings):
+        """Run the path into ``out`` as ``options`` say (pendular.procedures.run_options
+        .RunOptions; ``settings``: its fields one by one): ``device``: where the preparation
+        and the stages run, "cpu" or "gpu" (``check_device``, before anything is made);
+        ``checkpoint_every``: steps between checkpoints ``out``/checkpoint.h5 of the path (0:
+        none), from which ``resume`` continues; ``stop_after``: stop the path after this many
+        steps as an interruption would (raises Interrupted)."""
+        options = RunOptions.of(options, **settings)
+        progress, threads, device = options.progress, options.threads, options.device
         check_device(device)
-        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
+        checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        stop_after = options.stop_after
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -198,10 +204,14 @@ class SwccTest:
         return path.finish(progress, stop_after)
 
     @classmethod
-    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
+    def resume(cls, out, options=None, **settings):
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration stored in its sample.h5, its path on ``device``; returns the swcc.json
+        configuration stored in its sample.h5, run as ``options`` say (RunOptions;
+        ``settings``: its fields one by one), its path on their device; returns the swcc.json
         content."""
+        options = RunOptions.of(options, **settings)
+        progress, threads, device = options.progress, options.threads, options.device
+        stop_after = options.stop_after
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(sample_file):

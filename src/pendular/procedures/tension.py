@@ -65,6 +65,7 @@ from pendular.homogenize import packing_state, regular_packing
 from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
     check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
+from pendular.procedures.run_options import RunOptions
 from pendular.procedures.progress import tension_plan
 from pendular.utils.progress import whole_run
 from pendular.io.outputs import OutputFolder
@@ -83,6 +84,7 @@ from pendular.utils.parameters import (OptionError, Parameter, ParameterError, d
 from pendular.procedures.command import LaboratoryCommand
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.tension_pull import case_name, prediction, prepare_void_ratio, run_case
+from pendular.capillary.volume_control import rupture_distance_for_volume
 
 
 #: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
@@ -92,7 +94,7 @@ MIN_TENSION_PARTICLES = 100
 
 
 #: Most spheres of a direct tension sample (each void ratio is tuned over up to
-#: pendular.procedures.tension.PREPARATIONS preparations of it).
+#: pendular.procedures.tension_pull.PREPARATIONS preparations of it).
 MAX_TENSION_PARTICLES = 1_000_000
 
 
@@ -317,6 +319,32 @@ class TensionConfig:
                              specific_gravity=self.specific_gravity).water_content
 
 
+    def least_water_content(self, void_ratio):
+        """Gravimetric water content [-] below which the regular packing compared with a
+        sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION) holds
+        no bridge: its bridges' rupture distance (capillary.rupture_distance_for_volume)
+        falls below the grains' separation. Bisection in ln w up to the pendular limit."""
+        packing = regular_packing(comparison_packing(void_ratio)[0], separation=KIM_SEPARATION)
+        pore_volume = packing.porosity * packing.cell_volume           # [R^3]
+
+        def holds(water):
+            volume_star = (water * self.specific_gravity / packing.void_ratio * pore_volume
+                           / packing.bridges_per_cell)
+            try:
+                reach = rupture_distance_for_volume(1.0, self.contact_angle, volume_star)
+            except ValueError:                   # a volume below the solver's bridges
+                return False
+            return reach >= KIM_SEPARATION
+
+        low, high = 1e-9, self.pendular_limit(void_ratio)
+        if holds(low):
+            return 0.0
+        for _ in range(40):
+            middle = math.sqrt(low * high)
+            low, high = (low, middle) if holds(middle) else (middle, high)
+        return high
+
+
 #: Files and folders a tension run owns in its output folder.
 OUTPUTS = ("tension.json", "report.md", "plots", "cases", "checkpoint.h5")
 
@@ -408,26 +436,42 @@ class TensionTest:
     """The direct-tension cases of ``config`` (TensionConfig): one sample per void ratio, each
     water content wetted and pulled from a copy of it (module docstring)."""
 
+    #: The configuration's type.
+    CONFIG = TensionConfig
+
     def __init__(self, config: TensionConfig) -> None:
         if not isinstance(config, TensionConfig):
             raise TypeError(f"config must be a TensionConfig, got {type(config).__name__}")
         self.config = config
+        for e, w in config.cases:         # each case is compared with its regular packing
+            least = config.least_water_content(e)
+            if w < least:
+                _, label = comparison_packing(e)
+                raise ParameterError("water_content", (
+                    f"water_content = {100.0 * w:g} % is outside the valid range "
+                    f"[{100.0 * least:.3g}, {100.0 * config.pendular_limit(e):.3g}] % of a sample "
+                    f"of void ratio {e:g}: less water holds no bridge across the grains' "
+                    f"separation (H/R = {KIM_SEPARATION:g}) of the {label} packing whose "
+                    "prediction the case is compared with"), "--water-content")
 
-    def run(self, out: str, *, progress: bool = True, arguments: dict | None = None,
-            device: str = "cpu", checkpoint_every: int = 0, stop_after: int | None = None
-            ) -> dict:
+    def run(self, out: str, options: RunOptions | None = None, **settings) -> dict:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
-        the tension.json content. ``arguments``: what tension.json records under 'arguments'
-        and the histories as attributes (the command: its options; default: the
-        configuration's, TensionConfig.options); the configuration itself is under 'config'.
-        ``device``: where the preparations, wettings and pulls run, "cpu" or "gpu"
-        (``check_device``, before anything is made); a run option, not part of the
-        configuration. ``checkpoint_every``: steps between checkpoints ``out``/checkpoint.h5
-        of the pulls (0: none), from which ``resume`` continues; ``stop_after``: stop after
-        this many steps of the pulls as an interruption would (raises Interrupted)."""
+        the tension.json content. Run as ``options`` say (pendular.procedures.run_options
+        .RunOptions; ``settings``: its fields one by one): ``arguments``: what tension.json
+        records under 'arguments' and the histories as attributes (the command: its options;
+        default: the configuration's, TensionConfig.options); the configuration itself is
+        under 'config'. ``device``: where the preparations, wettings and pulls run, "cpu" or
+        "gpu" (``check_device``, before anything is made). ``checkpoint_every``: steps
+        between checkpoints ``out``/checkpoint.h5 of the pulls (0: none), from which
+        ``resume`` continues; ``stop_after``: stop after this many steps of the pulls as an
+        interruption would (raises Interrupted). The pulls run on one thread, whatever
+        ``threads``."""
+        options = RunOptions.of(options, **settings)
+        progress, device, stop_after = options.progress, options.device, options.stop_after
         check_device(device)
-        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
-        arguments = self.config.options() if arguments is None else dict(arguments)
+        checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        arguments = (self.config.options() if options.arguments is None
+                     else dict(options.arguments))
         with OutputFolder(out, "tension") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -436,13 +480,15 @@ class TensionTest:
                 return self._run(out, progress, device, run)
 
     @classmethod
-    def resume(cls, out: str, *, progress: bool = True, stop_after: int | None = None,
-               device: str = "cpu") -> dict:
+    def resume(cls, out: str, options: RunOptions | None = None, **settings) -> dict:
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration and arguments stored there: the cases finished are kept, the sample
-        of the case being pulled is prepared and wetted again (the engine is deterministic:
-        the same state), and its pull goes on from the checkpoint; returns the tension.json
-        content, bit for bit that of an uninterrupted run (timings aside)."""
+        configuration and arguments stored there, run as ``options`` say (RunOptions;
+        ``settings``: its fields one by one): the cases finished are kept, the sample of the
+        case being pulled is prepared and wetted again (the engine is deterministic: the same
+        state), and its pull goes on from the checkpoint; returns the tension.json content,
+        bit for bit that of an uninterrupted run (timings aside)."""
+        options = RunOptions.of(options, **settings)
+        progress, device, stop_after = options.progress, options.device, options.stop_after
         path = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(path):
             raise ValueError(f"resume = {out!r}: {path} is missing: the run stopped before "

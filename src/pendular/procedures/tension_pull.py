@@ -40,9 +40,11 @@ from pendular.procedures.grips import core_void_ratio, grip_members, grip_reach,
 from pendular.procedures.columns import measured
 from pendular.procedures.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
 from pendular.procedures.progress import equilibrium_bar
-from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION,
-    comparison_packing)
+from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
+    KIM_SEPARATION, comparison_packing)
 from pendular.procedures.water_content import wet_to_water_volume
+from pendular.capillary.validation import NotPendular
+from pendular.utils.parameters import ParameterError
 
 
 #: Surface tension [N/m] of the Chapter 4 comparison (docs/physics.md 'Errata').
@@ -147,6 +149,21 @@ def prepare_void_ratio(config, target: float, progress: bool,
     return sim, report
 
 
+def sample_sizes_given(config) -> str:
+    """The size options of ``config``'s sample that differ from the direct tension's defaults,
+    as typed ('--radius-spread 0.5', '--psd', '--radius 0.0002'), comma separated; '' for
+    Kim's equal spheres."""
+    sample = config.sample
+    given = []
+    if sample.psd is not None:
+        given.append("--psd")
+    elif sample.radius_spread > 0.0:
+        given.append(f"--radius-spread {sample.radius_spread:g}")
+    if sample.psd is None and sample.radius != KIM_RADIUS:
+        given.append(f"--radius {sample.radius:g}")
+    return ", ".join(given)
+
+
 def wetted_pairs(sim: Simulation, max_gap: float) -> tuple[np.ndarray, np.ndarray,
                                                              np.ndarray | None]:
     """(pair_i, pair_j, gap [m] or None) of the pairs that take liquid at wetting: the
@@ -196,10 +213,20 @@ def wet(dry: Simulation, config, water_content: float,
                                                 config.sample.equilibrium_unbalanced,
                                                 config.sample.stress_tolerance))
 
-    sim, bridges, tries = wet_to_water_volume(
-        dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,
-        settle, surface_tension=config.surface_tension, roughness=config.roughness,
-        max_gap=max_gap)
+    try:
+        sim, bridges, tries = wet_to_water_volume(
+            dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap),
+            build, settle, surface_tension=config.surface_tension,
+            roughness=config.roughness, max_gap=max_gap)
+    except NotPendular as error:
+        sizes = sample_sizes_given(config)
+        raise ParameterError("water_content", (
+            f"water_content = {100.0 * water_content:g} % is more than this sample"
+            f"{f' ({sizes})' if sizes else ''} holds in the pendular regime: its bridges form "
+            f"at {error.suction:.4g} Pa, and below {error.lowest:.4g} Pa those at contact "
+            f"between its smallest grains (R = {error.radius:.3g} m) pass the pendular limit "
+            f"(filling angle {error.angle:.1f} deg, the menisci merge); lower --water-content"
+            + (" or the size spread" if sizes else "")), "--water-content") from None
     suction = tries[-1]["formation_suction_pa"]
     attempts = [{"formation_suction_pa": t["formation_suction_pa"], "steps": t["steps"],
                  "water_content": gravimetric_water_content(

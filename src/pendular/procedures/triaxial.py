@@ -246,7 +246,7 @@ class TriaxialShear:
 
 def shear_path(sim, shear, confining, rate, columns=None):
     """The LoadingPath of a triaxial shear of ``shear`` (ShearConfig) at the axial strain rate
-    ``rate`` [1/s] from the isotropic ``confining`` stress [Pa] (loading.shear_stage), with
+    ``rate`` [1/s] from the isotropic ``confining`` stress [Pa] (triaxial.shear_stage), with
     its servo options; ``columns``: history columns beyond ``history_columns``."""
     return LoadingPath(sim, [shear_stage(shear, confining, rate)], records=shear.records,
                        columns=columns, servo_max_velocity=shear.servo_max_velocity,
@@ -264,7 +264,7 @@ def summarize(history, direction="compression", b=None):
     there, all of that record; in compression ``peak_axial_stress`` (the largest axial
     stress), in extension ``min_axial_stress`` and ``axial_contact_lost``: whether the axial
     stress fell to 0 (the walls released a cohesive sample before it failed).
-    ``phi_peak_deg``: the mobilised friction angle at the peak (loading.friction_angle of the
+    ``phi_peak_deg``: the mobilised friction angle at the peak (columns.friction_angle of the
     net wall stresses), None with ``phi_peak_note`` when the axial contact was lost. A wet
     history adds ``peak_q_effective``, ``p_effective_at_peak`` and
     ``phi_peak_effective_deg``: q', p' and the friction angle of the effective stress (Eq.
@@ -328,9 +328,9 @@ def summarize(history, direction="compression", b=None):
 
 
 class TriaxialTest(LaboratoryTest):
-    """A drained triaxial test of ``config`` (pendular.procedures.config.TriaxialConfig): the
+    """A drained triaxial test of ``config`` (pendular.procedures.triaxial.TriaxialConfig): the
     shear of ``config.shear`` (compression, extension, at a constant b or mean stress;
-    loading.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
+    triaxial.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
     plots/ (q/p, volumetric strain, wet: saturation and capillary stresses; the stress path
     stress_path.png: q-p and, wet, q'-p' of the effective stress)."""
 
@@ -365,7 +365,7 @@ class TriaxialTest(LaboratoryTest):
         return summary
 
     def derived(self, history):
-        """Undrained, the history with ``excess_pore_pressure`` (loading.excess_pore_pressure
+        """Undrained, the history with ``excess_pore_pressure`` (excess_pore_pressure
         of the wall stresses)."""
         if self.config.undrained:
             history["excess_pore_pressure"] = excess_pore_pressure(history["sigma_wall"])

@@ -7,7 +7,7 @@
    stress; cached, pendular.interop.yade.runner.cached_sample, shared with the benchmarks), servoed on its six
    walls at the confining stress and, wet (``config.bridges``), given capillary bridges at
    every contact (suction control, exact tables); it is run until static
-   (pendular.procedures.triaxial.equilibrate, at most ``config.wet_steps`` steps).
+   (pendular.procedures.equilibrium.equilibrate, at most ``config.wet_steps`` steps).
 2. This static (wetted) packing is exported (DIR/packing.txt, pendular.interop.yade.formats.write_spheres:
    centres, radii, wall box). Both codes start the shear from it in the same state: velocities
    zero, contacts found afresh (no shear-spring history), every touching pair getting a bridge

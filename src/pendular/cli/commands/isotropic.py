@@ -1,7 +1,7 @@
 """Isotropic loading and unloading in stages, dry or wet: prepare (or load) a sample at
 --confining, wet it, then servo the six walls to each stress of --stresses in turn, each stage
 until static, the walls moving at most at the quasi-static rate
-(pendular.procedures.loading.isotropic_stages).
+(pendular.procedures.isotropic.isotropic_stages).
 
 Writes into --out: history.h5 (with void_ratio and stage at every row), summary.json (each
 stage's end: p, e, and wet p' of the effective stress; the compression and swelling indices,

@@ -1,7 +1,7 @@
 """Oedometric (K0) compression, dry or wet: prepare (or load) a sample at --confining, wet it,
 hold the lateral walls and push the axial ones in at the quasi-static rate until the axial
 stress is --axial-stress, then with --unload-to pull them back until it is that
-(pendular.procedures.loading.oedometer_stages).
+(pendular.procedures.oedometer.oedometer_stages).
 
 Writes into --out: history.h5 (with void_ratio and k0 = sigma_lateral / sigma_axial at every
 row), summary.json (k0 at the axial stress, the constrained modulus, the compression and

@@ -18,7 +18,7 @@ import sys
 
 from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
     add_run_options, command_config, declared_values, print_summary, set_threads)
-from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options, run_options
 from pendular.procedures.options import CHECKPOINT_EVERY
 from pendular.procedures.registry import COMMANDS
 from pendular.procedures.swcc import SwccTest
@@ -46,18 +46,15 @@ def config_from(args):
 
 def run(args):
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            result = SwccTest.resume(args.resume, progress=progress, threads=args.threads,
-                                     stop_after=args.stop_after, device=args.device)
+            result = SwccTest.resume(args.resume, run_options(args))
             args.out = args.resume
         else:
             every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
-            result = SwccTest(config_from(args)).run(
-                args.out, progress=progress, threads=args.threads, device=args.device,
-                checkpoint_every=every, stop_after=args.stop_after)
+            result = SwccTest(config_from(args)).run(args.out,
+                                                     run_options(args, checkpoint_every=every))
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED

@@ -17,7 +17,7 @@ import sys
 
 from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
     add_run_options, command_config, declared_values, print_summary, set_threads)
-from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options, run_options
 from pendular.procedures.tension import TensionConfig
 from pendular.procedures.options import CHECKPOINT_EVERY
 from pendular.procedures.registry import COMMANDS
@@ -48,21 +48,18 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
 
 def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            output = TensionTest.resume(args.resume, progress=progress,
-                                        stop_after=args.stop_after, device=args.device)
+            output = TensionTest.resume(args.resume, run_options(args))
             args.out = args.resume
         else:
             config = config_from(args)
             check_device(args.device)                   # before anything is made
             every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
             arguments = {k: v for k, v in vars(args).items() if k not in WATCHING}
-            output = TensionTest(config).run(args.out, progress=progress, arguments=arguments,
-                                             device=args.device, checkpoint_every=every,
-                                             stop_after=args.stop_after)
+            output = TensionTest(config).run(args.out, run_options(
+                args, checkpoint_every=every, arguments=arguments))
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED

@@ -11,7 +11,7 @@ the grains' mass, the liquid then conserved during the shear (--liquid) and the 
 output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
 extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
 axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises
-(pendular.procedures.loading.shear_stage). --drainage undrained holds the volume (the lateral
+(pendular.procedures.triaxial.shear_stage). --drainage undrained holds the volume (the lateral
 walls follow the axial ones): summary excess_pore_pressure_at_peak [Pa] of a saturated sample
 and effective_stress_path; wet, the water content is held too (volume-controlled bridges,
 closed liquid) and the suction and Sr change.
@@ -32,6 +32,7 @@ from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_devi
 from pendular.dem.simulation import check_device
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.registry import COMMANDS
+from pendular.procedures.run_options import RunOptions
 
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
@@ -107,19 +108,16 @@ def run_test(args, test, config_from, shown, add_arguments):
     their defaults); print the summary's ``shown`` keys (print_summary: JSON with --quiet);
     the exit status."""
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            summary = test.resume(args.resume, progress=progress, threads=args.threads,
-                                  stop_after=args.stop_after, device=args.device)
+            summary = test.resume(args.resume, run_options(args))
             out = args.resume
         else:
             config = config_from(args)
             check_device(args.device)               # before the test loads its tables
-            summary = test(config, force=args.force).run(
-                args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
-                vtk_prep=args.vtk_prep, device=args.device)
+            options = run_options(args, force=args.force, vtk_prep=args.vtk_prep)
+            summary = test(config, force=options.force).run(args.out, options)
             out = args.out
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
@@ -132,6 +130,13 @@ def run_test(args, test, config_from, shown, add_arguments):
     # with --quiet, stdout holds the JSON alone
     print(f"outputs in {out}", file=sys.stderr if args.quiet else sys.stdout)
     return 0
+
+
+def run_options(args, **more):
+    """The RunOptions of the parsed options ``args`` (--device, --threads, --quiet and the
+    hidden --stop-after), with ``more`` (a command's own: force, vtk_prep, ...)."""
+    return RunOptions(device=args.device, threads=args.threads, progress=not args.quiet,
+                      stop_after=args.stop_after, **more)
 
 
 def _defaults(add_arguments):
