@@ -25,7 +25,7 @@ from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.guards import (MAX_OVERLAP_OVER_RADIUS, MIN_POROSITY_EQUAL, SampleCrushed,
     SampleGuard)
-from pendular.procedures.tension import case_line
+from pendular.procedures.tension_report import case_line
 from pendular.procedures.triaxial import TriaxialShear, summarize
 
 #: A short triaxial (the audit's) and a tension command line; each test adds to them.

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from pendular.io.schema import HISTORY_COLUMNS, SUMMARY_KEYS, SUMMARY_UNITS, undeclared_keys
+from pendular.io.columns import HISTORY_COLUMNS
+from pendular.io.schema import SUMMARY_KEYS, SUMMARY_UNITS, undeclared_keys
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.cyclic import cyclic_summary
 from pendular.procedures.loading import Stage, Strain

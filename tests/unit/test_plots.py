@@ -9,7 +9,7 @@ import pytest
 
 from conftest import assert_drawn
 from pendular.io import plots
-from pendular.procedures import tension
+from pendular.procedures import tension_report
 from pendular.procedures.reference import KIM_2001
 from pendular.procedures.tension import TensionConfig, tension_sample
 
@@ -168,7 +168,7 @@ def test_the_tension_plots_are_titled_and_name_the_cases_in_words(saved, tmp_pat
                "tensile_stress": 600.0 * np.exp(-((extension - 0.01) / 0.01) ** 2)}
     plots.plot_curves([summary], {"e0.72_w1.00": history}, tmp_path, config)
     plots.plot_strength([summary], config, KIM_2001,
-                        tension.strength_predictions([summary], config),
+                        tension_report.strength_predictions([summary], config),
                         tmp_path / "strength_vs_water.png")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "strength_vs_water.png", "tension_all.png", "tension_e0.72_w1.00.png"]

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from pendular.io.history import read_history, read_summary, write_history
-from pendular.io.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION,
-    SUMMARY_UNITS, peak_reached)
+from pendular.io.columns import DIMENSIONS, DIMENSION_LABELS
+from pendular.io.columns import HISTORY_COLUMNS
+from pendular.io.schema import SCHEMA_VERSION, SUMMARY_UNITS, peak_reached
 
 DRY = ["step", "time", "axial_strain", "volumetric_strain", "sigma_wall", "sigma_contact",
        "porosity", "coordination", "fabric", "anisotropy", "unbalanced_force"]

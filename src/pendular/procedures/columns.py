@@ -8,8 +8,11 @@ positive [Pa].
 """
 
 from __future__ import annotations
+
 import math
+
 import numpy as np
+
 from pendular.dem.measure import porosity
 from pendular.homogenize.invariants import lateral_stress
 from pendular.homogenize.on_the_fly import homogenized

@@ -3,7 +3,9 @@ isotropic test's summaries (pendular.procedures.oedometer, pendular.procedures.i
 """
 
 from __future__ import annotations
+
 import math
+
 import numpy as np
 
 

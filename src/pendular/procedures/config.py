@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from pendular.dem.sample import load_sample
 from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.dem.sample import load_sample
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)

@@ -21,23 +21,22 @@ at the amplitudes. Stresses compression positive [Pa], strains compression posit
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from pendular.homogenize.invariants import deviator_stress, lateral_stress
 from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
+from pendular.procedures.columns import COMPRESSION_COLUMNS, friction_angle
+from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import MIN_AXIAL_STRAIN, PathConfig, check_soft, registered
 from pendular.procedures.guards import AxialStressGuard
-from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress
-from pendular.procedures.columns import friction_angle
-from pendular.procedures.columns import COMPRESSION_COLUMNS
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
-import dataclasses
-from dataclasses import dataclass
-from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
 from pendular.utils.parameters import OptionError, fail, option_of, parameter
@@ -414,5 +413,9 @@ SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio
 
 #: The cyclic command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "cyclic", "cyclic triaxial loading, stress- or strain-controlled",
-    CyclicTest, laboratory_options(CYCLIC_OWN, framed(path_command(CyclicConfig, CYCLIC_OWN, check=amplitude_given))), SHOWN, EXAMPLE, "runs/cyclic")
+    name="cyclic",
+    description="cyclic triaxial loading, stress- or strain-controlled",
+    test=CyclicTest,
+    declared=laboratory_options(
+        CYCLIC_OWN, framed(path_command(CyclicConfig, CYCLIC_OWN, check=amplitude_given))),
+    shown=SHOWN, example=EXAMPLE, out="runs/cyclic")

@@ -13,10 +13,13 @@ Stresses compression positive [Pa].
 """
 
 from __future__ import annotations
+
 import contextlib
-import numpy as np
 import os
 import time
+
+import numpy as np
+
 from pendular.dem.measure import porosity, unbalanced_force
 from pendular.dem.walls import StressServo
 from pendular.io.vtk import VtkWriter

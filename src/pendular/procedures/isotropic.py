@@ -8,20 +8,22 @@ indices; ``IsotropicTest``: the test (pendular.procedures.laboratory.LaboratoryT
 """
 
 from __future__ import annotations
+
 import os
 from dataclasses import dataclass
+
 from pendular.homogenize.invariants import mean_stress
 from pendular.io.plots import plot_compression, plot_stress_path
+from pendular.procedures.columns import COMPRESSION_COLUMNS
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.compression import compression_indices, effective_diagonal, stage_ends
 from pendular.procedures.config import PathConfig, check_soft, registered, stage_steps_parameter
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import AXIS_NAMES, LoadingPath, Stage, Static
-from pendular.procedures.columns import COMPRESSION_COLUMNS
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
-from pendular.utils.parameters import fail, option_of, parameter
 from pendular.procedures.preparation import MAX_STRESS
+from pendular.utils.parameters import fail, option_of, parameter
 
 
 #: Fewest stresses of an isotropic path: a loading (or unloading) needs two.
@@ -98,7 +100,8 @@ def isotropic_summary(history, stresses):
         if effective is not None:
             entry["p_effective"] = float(effective[row].mean())
         rows.append(entry)
-    compression, swelling = compression_indices([r["void_ratio"] for r in rows], [r["p"] for r in rows])
+    compression, swelling = compression_indices([r["void_ratio"] for r in rows],
+                                                [r["p"] for r in rows])
     summary = {"stages": rows, "initial_void_ratio": float(void[0]),
                "final_void_ratio": float(void[-1]), "compression_index": compression,
                "swelling_index": swelling}
@@ -157,5 +160,9 @@ SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "compression_index"
 
 #: The isotropic command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "isotropic", "isotropic loading and unloading in stages: e against log p",
-    IsotropicTest, laboratory_options(ISOTROPIC_OWN, framed(path_command(IsotropicConfig, ISOTROPIC_OWN))), SHOWN, EXAMPLE, "runs/isotropic")
+    name="isotropic",
+    description="isotropic loading and unloading in stages: e against log p",
+    test=IsotropicTest,
+    declared=laboratory_options(
+        ISOTROPIC_OWN, framed(path_command(IsotropicConfig, ISOTROPIC_OWN))),
+    shown=SHOWN, example=EXAMPLE, out="runs/isotropic")

@@ -16,14 +16,17 @@ compression positive, volumetric strain positive in contraction (docs/units.md).
 """
 
 from __future__ import annotations
+
 import dataclasses
 import json
 import math
-import numba
-import numpy as np
 import os
 import sys
 import time
+
+import numba
+import numpy as np
+
 from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.dem.measure import coordination, porosity
@@ -44,8 +47,8 @@ from pendular.procedures.guards import AxialContactLost, SampleCrushed
 from pendular.procedures.loading import VTK_RECORDS, check_stages_device
 from pendular.procedures.preparation import (MAX_STRESS, PREPARATION_PHASES, prepare_sample,
     pwave_step, servoed_simulation, timestep, timestep_description)
-from pendular.procedures.run_options import RunOptions
 from pendular.procedures.progress import laboratory_plan
+from pendular.procedures.run_options import RunOptions
 from pendular.utils.atomic import write_json
 from pendular.utils.integrity import checksum, config_hash
 from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at

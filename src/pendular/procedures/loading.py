@@ -51,13 +51,13 @@ from pendular.dem.mixed_stress import StageFailed
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.walls import AXES, ConstantStrainRate, ConstantVolume, StressServo
 from pendular.homogenize.invariants import deviator_stress, lateral_stress, mean_stress
+from pendular.procedures.columns import capillary_operation, history_columns
 from pendular.procedures.config import MAX_AXIAL_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.hydraulic import SuctionChange, WaterContentChange
 from pendular.procedures.preparation import servo_speed, static
 from pendular.procedures.progress import equilibrium_bar, stress_bar
 from pendular.utils.validate import check_int, check_positive, check_range
-from pendular.procedures.columns import capillary_operation, history_columns
 
 #: The axes by name, in order (x, y lateral; z axial).
 AXIS_NAMES = tuple(AXES)

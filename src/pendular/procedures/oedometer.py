@@ -9,22 +9,24 @@ the constrained modulus, the compression and swelling indices against the axial 
 """
 
 from __future__ import annotations
+
 import math
 import os
 from dataclasses import dataclass
+
 from pendular.homogenize.invariants import lateral_stress
 from pendular.io.plots import plot_compression, plot_stress_path, write_plots
+from pendular.procedures.columns import COMPRESSION_COLUMNS, k0
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.compression import (effective_diagonal, index_of_slope, stage_ends,
     tangent_modulus)
 from pendular.procedures.config import PathConfig, check_soft, registered
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
-from pendular.procedures.columns import COMPRESSION_COLUMNS, k0
 from pendular.procedures.loading import LoadingPath, Stage, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
-from pendular.utils.parameters import fail, option_of, parameter
 from pendular.procedures.preparation import MAX_STRESS
+from pendular.utils.parameters import fail, option_of, parameter
 
 
 @registered
@@ -52,7 +54,8 @@ class OedometerConfig(PathConfig):
         confining = self.sample.confining
         if self.axial_stress <= confining:
             raise fail(self, "axial_stress", f"axial_stress = {self.axial_stress:g} Pa is "
-                       f"outside the valid range ({confining:g}, {MAX_STRESS:g}] Pa: the compression "
+                       f"outside the valid range ({confining:g}, {MAX_STRESS:g}] Pa: the "
+                       "compression "
                        f"starts from the confining stress (--confining {confining:g} Pa)")
         check_soft(self, "axial_stress", self.axial_stress)
         if self.unload_to is not None and self.unload_to >= self.axial_stress:
@@ -128,7 +131,8 @@ def oedometer_summary(history, axial_stress, unload_to=None):
             "void_ratio_final": float(void[final]),
             "constrained_modulus_unloading": float((axial[loaded] - axial[final])
                                                    / (strain[loaded] - strain[final])),
-            "swelling_index": index_of_slope(void[final], void[loaded], axial[loaded], axial[final]),
+            "swelling_index": index_of_slope(void[final], void[loaded], axial[loaded],
+                                             axial[final]),
         })
         if effective is not None:
             summary["swelling_index_effective"] = index_of_slope(void[final], void[loaded],
@@ -189,5 +193,9 @@ SHOWN = ("k0", "k0_effective", "axial_stress_at_load", "lateral_stress_at_load",
 
 #: The oedometer command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "oedometer", "oedometric (K0) compression and unloading, dry or wet",
-    OedometerTest, laboratory_options(OEDOMETER_OWN, framed(path_command(OedometerConfig, OEDOMETER_OWN))), SHOWN, EXAMPLE, "runs/oedometer")
+    name="oedometer",
+    description="oedometric (K0) compression and unloading, dry or wet",
+    test=OedometerTest,
+    declared=laboratory_options(
+        OEDOMETER_OWN, framed(path_command(OedometerConfig, OEDOMETER_OWN))),
+    shown=SHOWN, example=EXAMPLE, out="runs/oedometer")

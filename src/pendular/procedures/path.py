@@ -46,7 +46,9 @@ and suction (examples/loading_path_api.py). Stresses compression positive [Pa].
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -56,22 +58,20 @@ from pendular.dem.walls import StressServo
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.plots import plot_path
 from pendular.io.schema import peak_reached
-from pendular.procedures.config import MAX_RECORDS, PathConfig, registered
-from pendular.procedures.hydraulic import water_content
-from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
-    Strain, Stress)
 from pendular.procedures.columns import (capillary_operation, friction_angle, history_columns, k0,
     void_ratio)
-from pendular.procedures.preparation import check_soft_contacts, servo_speed
-from pendular.procedures.laboratory import LaboratoryTest, stress_balance
+from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.config import MAX_RECORDS, PathConfig, registered
 from pendular.procedures.equilibrium import equilibrate
+from pendular.procedures.hydraulic import water_content
+from pendular.procedures.laboratory import LaboratoryTest, stress_balance
+from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
+    Strain, Stress)
+from pendular.procedures.options import framed, laboratory_fields, laboratory_options, rate_options
+from pendular.procedures.preparation import check_soft_contacts, servo_speed
+from pendular.utils.parameters import Option, fail, fields_of, option_of, parameter
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int, check_positive
-import math
-from dataclasses import dataclass
-from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.options import framed, laboratory_fields, laboratory_options, rate_options
-from pendular.utils.parameters import Option, fail, fields_of, option_of, parameter
 
 
 @registered
@@ -686,5 +686,8 @@ SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q
 
 #: The path command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "path", "any loading path from a TOML table of stages, dry or wet",
-    PathTest, laboratory_options(PATH_OWN, framed(table_path_config), first=(PATH_TABLE,)), SHOWN, EXAMPLE, "runs/path")
+    name="path",
+    description="any loading path from a TOML table of stages, dry or wet",
+    test=PathTest,
+    declared=laboratory_options(PATH_OWN, framed(table_path_config), first=(PATH_TABLE,)),
+    shown=SHOWN, example=EXAMPLE, out="runs/path")

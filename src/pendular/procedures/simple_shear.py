@@ -21,21 +21,21 @@ cell step for step as on the CPU).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from pendular.io.plots import plot_simple_shear
 from pendular.io.schema import peak_reached
 from pendular.io.vtk import shear_strain_fields
+from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_RECORD_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE,
     MIN_AXIAL_STRAIN, MIN_RECORD_STRAIN, PathConfig, check_soft, registered, stage_steps_parameter)
-from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
-import dataclasses
-from dataclasses import dataclass
-from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static
 from pendular.procedures.options import (SAMPLE, framed, laboratory_fields, laboratory_options,
     options_named)
 from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
@@ -355,5 +355,9 @@ SHOWN = ("peak_shear_stress", "shear_strain_at_peak_stress", "normal_stress_at_p
 
 #: The simple-shear command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "simple-shear", "simple shear (periodic cell), drained or constant volume",
-    SimpleShearTest, laboratory_options(SIMPLE_SHEAR_OWN, framed(simple_shear_config), sample=SIMPLE_SHEAR_SAMPLE), SHOWN, EXAMPLE, "runs/simple_shear")
+    name="simple-shear",
+    description="simple shear (periodic cell), drained or constant volume",
+    test=SimpleShearTest,
+    declared=laboratory_options(
+        SIMPLE_SHEAR_OWN, framed(simple_shear_config), sample=SIMPLE_SHEAR_SAMPLE),
+    shown=SHOWN, example=EXAMPLE, out="runs/simple_shear")

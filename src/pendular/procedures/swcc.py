@@ -36,51 +36,47 @@ wetting across gaps and the rows of swcc.json are computed on the host between t
 
 from __future__ import annotations
 
-from pendular.capillary import SURFACE_TENSION
-
 import math
 import os
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendular.capillary import CapillaryBridges, sample_radius_ratios
-from pendular.utils.atomic import write_json
+from pendular.capillary import CapillaryBridges, SURFACE_TENSION, sample_radius_ratios
+from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
-from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
-    servoed_simulation, static)
-from pendular.procedures.run_options import RunOptions
-from pendular.procedures.progress import swcc_plan
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
-from pendular.utils.progress import whole_run
-from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
-
+from pendular.io.history import write_history
+from pendular.io.outputs import OutputFolder
+from pendular.io.plots import plot_swcc
+from pendular.io.schema import SWCC_STAGE_UNITS
+from pendular.procedures.columns import history_columns
+from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (AVERAGES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
     check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
     stage_steps_parameter)
-from pendular.io.history import write_history
-from pendular.io.schema import SWCC_STAGE_UNITS
-from pendular.io.outputs import OutputFolder
-from pendular.procedures.reference import FIG_5_5
-from pendular.procedures.columns import history_columns
+from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.laboratory import (Interrupted, MIN_CONFINING_OVER_YOUNG, plain,
     run_identity)
-from pendular.procedures.equilibrium import NotStatic, equilibrium_status
-from dataclasses import dataclass
-from dataclasses import field
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
     sample_sizes, size_options)
+from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
+    servoed_simulation, static)
+from pendular.procedures.progress import swcc_plan
+from pendular.procedures.reference import FIG_5_5
+from pendular.procedures.run_options import RunOptions
+from pendular.utils.atomic import write_json
 from pendular.utils.parameters import fail, fields_of, option_of, parameter, validate
-from pendular.procedures.command import LaboratoryCommand
-from pendular.io.plots import plot_swcc
+from pendular.utils.progress import whole_run
+from pendular.utils.validate import check_int
 
 
 @registered
@@ -502,6 +498,9 @@ COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", 
 
 #: The swcc command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "swcc", "soil-water characteristic curve of a sample: drying then wetting",
-    SwccTest, CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL
-                   + (CHECKPOINT_EVERY,), swcc_config), SHOWN, EXAMPLE, "runs/swcc", COLUMNS)
+    name="swcc",
+    description="soil-water characteristic curve of a sample: drying then wetting",
+    test=SwccTest,
+    declared=CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL
+                            + (CHECKPOINT_EVERY,), swcc_config),
+    shown=SHOWN, example=EXAMPLE, out="runs/swcc", columns=COLUMNS)

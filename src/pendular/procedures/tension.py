@@ -48,43 +48,42 @@ bridges, water_content, saturation, unbalanced_force) and the ParaView series
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
 import time
+from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pendular.utils.atomic import write_json, write_text
-from pendular.procedures.preparation import PrepareConfig, pwave_step
+from pendular.capillary.volume_control import rupture_distance_for_volume
+from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
 from pendular.dem.simulation import check_device
 from pendular.homogenize import packing_state, regular_packing
-
-from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
+from pendular.io.outputs import OutputFolder
+from pendular.io.plots import plot_curves, plot_strength
+from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
     check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
-from pendular.procedures.run_options import RunOptions
-from pendular.procedures.progress import tension_plan
-from pendular.utils.progress import whole_run
-from pendular.io.outputs import OutputFolder
-from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
-    KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
 from pendular.procedures.laboratory import Interrupted
-from pendular.utils.integrity import config_hash
-from pendular.utils.validate import check_int
-import dataclasses
-from dataclasses import dataclass
-from dataclasses import field
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
     sample_sizes, size_options)
+from pendular.procedures.preparation import PrepareConfig, pwave_step
+from pendular.procedures.progress import tension_plan
+from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
+    KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
+from pendular.procedures.run_options import RunOptions
+from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
+from pendular.procedures.tension_report import case_line, strength_predictions, write_report
+from pendular.utils.atomic import write_json
+from pendular.utils.integrity import config_hash
 from pendular.utils.parameters import (OptionError, Parameter, ParameterError, default_of, fail,
     fields_of, option_from, option_of, parameter, spec_of, validate)
-from pendular.procedures.command import LaboratoryCommand
-from pendular.io.plots import plot_curves, plot_strength
-from pendular.procedures.tension_pull import case_name, prediction, prepare_void_ratio, run_case
-from pendular.capillary.volume_control import rupture_distance_for_volume
+from pendular.utils.progress import whole_run
+from pendular.utils.validate import check_int
 
 
 #: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
@@ -368,68 +367,6 @@ def cases_of(void_ratios: list[float] | None = None,
             waters = kim or [0.5, 1.0, 2.0]
         result += [(e, w / 100.0) for w in waters]
     return result
-
-
-def strength_predictions(summaries: list[dict], config: TensionConfig) -> dict:
-    """{void ratio: (water contents [-], tensile strengths [Pa], the packing in words)}: the
-    regular packing's prediction (``prediction``) over the water contents of the cases of each
-    void ratio, for plots/strength_vs_water.png."""
-    curves = {}
-    for e in {s["void_ratio_target"] for s in summaries}:
-        highest = max(s["water_content_target"] for s in summaries
-                      if s["void_ratio_target"] == e)
-        grid = np.linspace(0.002, highest * 1.15, 25)
-        curves[e] = (grid, [prediction(config, e, w)[0] for w in grid],
-                     comparison_packing(e)[1])
-    return curves
-
-
-def case_line(summary: dict) -> str:
-    """The progress line of a finished case (``run_case``'s summary): its strength beside
-    Kim's measurement, when he made one, and the regular packing's prediction."""
-    kim = summary["kim_measured_pa"]
-    measured = "no Kim measurement" if kim is None else f"Kim {kim:.1f} Pa"
-    return (f"  {summary['case']}: tensile strength {summary['tensile_strength_pa']:.1f} Pa "
-            f"({measured}, regular packing prediction {summary['packing_state_pa']:.1f} Pa)")
-
-
-def _percent(value):
-    return "" if value is None else f"{100 * value:+.0f} %"
-
-
-def report_lines(summaries: list[dict], config: TensionConfig) -> list[str]:
-    """The lines of report.md: one table row per case."""
-    sample = config.sample
-    lines = [f"# Direct tension, {sample.particles} spheres, R = {sample.radius * 1e3:g} mm, "
-             f"contact angle θ = {config.contact_angle:g}°, surface tension "
-             f"γ = {config.surface_tension:g} N/m, bridge roughness H/R = {config.roughness:g}",
-             "",
-             "Tensile strength [Pa] positive in tension. e: core void ratio (box less one "
-             "diameter along each wall); w: gravimetric water content (water mass over grain "
-             f"mass, Gs = {config.specific_gravity:g}); Sr: degree of saturation; prediction: "
-             "tensile strength psi_xx of the regular packing compared with this void ratio at "
-             f"the target w (thesis Ch. 4, exact bridges, H/R = {KIM_SEPARATION:g}).",
-             "",
-             "| e target | e reached (box) | w target [%] | w [%] | Sr | bridges | s_form [Pa] "
-             "| DEM | Kim | prediction | DEM/Kim | DEM/prediction |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for s in summaries:
-        kim = "" if s["kim_measured_pa"] is None else f"{s['kim_measured_pa']:.1f}"
-        lines.append(
-            f"| {s['void_ratio_target']:.2f} | {s['void_ratio']:.3f} ({s['void_ratio_box']:.3f}) "
-            f"| {100 * s['water_content_target']:.2f} | {100 * s['water_content']:.3f} "
-            f"| {s['saturation']:.3f} | {s['bridges']} | {s['formation_suction_pa']:.0f} "
-            f"| {s['tensile_strength_pa']:.1f} | {kim} | {s['packing_state_pa']:.1f} "
-            f"| {_percent(s['relative_difference_to_kim'])} "
-            f"| {_percent(s['relative_difference_to_packing_state'])} |")
-    return lines
-
-
-def write_report(summaries: list[dict], config: TensionConfig, path: str) -> list[str]:
-    """report.md at ``path``; returns its lines."""
-    lines = report_lines(summaries, config)
-    write_text(path, "\n".join(lines) + "\n")
-    return lines
 
 
 class TensionTest:
@@ -733,5 +670,8 @@ COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
 
 #: The tension command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "tension", "direct tension of wet sand at fixed water content (Kim 2001)",
-    TensionTest, CommandOptions(TENSION, tension_config), SHOWN, EXAMPLE, "runs/direct_tension", COLUMNS)
+    name="tension",
+    description="direct tension of wet sand at fixed water content (Kim 2001)",
+    test=TensionTest,
+    declared=CommandOptions(TENSION, tension_config),
+    shown=SHOWN, example=EXAMPLE, out="runs/direct_tension", columns=COLUMNS)

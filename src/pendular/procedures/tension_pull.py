@@ -22,6 +22,7 @@ from scipy.spatial import cKDTree
 
 from pendular.capillary.bridges import CapillaryBridges, sample_radius_ratios
 from pendular.capillary.table import BridgeTable
+from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import gravimetric_water_content
 from pendular.dem.grading import grading
 from pendular.dem.grips import Grip
@@ -34,16 +35,15 @@ from pendular.homogenize.packing_state import packing_state
 from pendular.homogenize.regular_packing import regular_packing
 from pendular.io.history import write_history
 from pendular.io.schema import TENSION_SUMMARY_UNITS
+from pendular.procedures.columns import measured
 from pendular.procedures.config import config_to_dict, inertial_number
 from pendular.procedures.equilibrium import frame_period, frames_writer
 from pendular.procedures.grips import core_void_ratio, grip_members, grip_reach, tensile_stress
-from pendular.procedures.columns import measured
 from pendular.procedures.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
     KIM_SEPARATION, comparison_packing)
 from pendular.procedures.water_content import wet_to_water_volume
-from pendular.capillary.validation import NotPendular
 from pendular.utils.parameters import ParameterError
 
 

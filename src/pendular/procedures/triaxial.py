@@ -19,29 +19,31 @@ positive, volumetric strain positive in contraction (docs/units.md).
 """
 
 from __future__ import annotations
+
 import dataclasses
-import numpy as np
 import os
-from dataclasses import dataclass
-from dataclasses import field
+from dataclasses import dataclass, field
+
+import numpy as np
+
 from pendular.dem.walls import ConstantStrainRate
 from pendular.homogenize.invariants import (deviator_stress, lateral_stress, mean_stress,
     principal_difference, shear_deviator)
 from pendular.io.plots import plot_history, plot_stress_path, write_plots
 from pendular.io.schema import peak_reached
+from pendular.procedures.columns import friction_angle
 from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.compression import effective_diagonal
 from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, LaboratoryConfig, MAX_AXIAL_STRAIN,
     MIN_AXIAL_STRAIN, ShearConfig, registered)
 from pendular.procedures.critical_state import critical_state
 from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, Stage, Strain
-from pendular.procedures.columns import friction_angle
 from pendular.procedures.options import (laboratory_fields, laboratory_options, options_named,
     rate_options, steps_count)
 from pendular.utils.parameters import (ParameterError, fail, fields_of, flat_options, option_of,
     spec_of)
-from pendular.procedures.compression import effective_diagonal
 
 
 @registered
@@ -438,5 +440,8 @@ SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_
 
 #: The triaxial command (pendular.procedures.registry).
 COMMAND = LaboratoryCommand(
-    "triaxial", "triaxial test (thesis Ch. 5), dry or wet, drained or undrained",
-    TriaxialTest, laboratory_options(SHEAR, triaxial_config, frames=True), SHOWN, EXAMPLE, "runs/triaxial")
+    name="triaxial",
+    description="triaxial test (thesis Ch. 5), dry or wet, drained or undrained",
+    test=TriaxialTest,
+    declared=laboratory_options(SHEAR, triaxial_config, frames=True),
+    shown=SHOWN, example=EXAMPLE, out="runs/triaxial")
