@@ -8,7 +8,9 @@ On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
   (pendular.io.schema.VTK_FIELDS) and the ParaView fields as declared in pendular.io.vtk's
   docstring;
 - ``commands.md``: ``pendular --help`` and, per command, its worked example (the command module's
-  ``EXAMPLE``) above its ``--help``, as the command prints it;
+  ``EXAMPLE``: a laboratory test's is that of its LaboratoryCommand in
+  pendular.procedures.registry, with its description and options) above its ``--help``, as
+  the command prints it;
 - ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
   sub-package, its docstring and every module in it.
 
