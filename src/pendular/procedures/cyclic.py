@@ -33,13 +33,17 @@ from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
 from pendular.procedures.columns import COMPRESSION_COLUMNS, friction_angle
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import MIN_AXIAL_STRAIN, PathConfig, check_soft, registered
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (BridgeConfig, MIN_AXIAL_STRAIN, PathConfig, check_soft,
+    registered)
 from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
 from pendular.utils.parameters import OptionError, fail, option_of, parameter
+from pendular.procedures.preparation import PrepareConfig
 
 
 #: Most cycles of a cyclic triaxial test: liquefaction tests run tens to hundreds of cycles,

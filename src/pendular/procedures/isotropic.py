@@ -17,12 +17,15 @@ from pendular.io.plots import plot_compression, plot_stress_path
 from pendular.procedures.columns import COMPRESSION_COLUMNS
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.compression import compression_indices, effective_diagonal, stage_ends
-from pendular.procedures.config import PathConfig, check_soft, registered, stage_steps_parameter
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (BridgeConfig, PathConfig, check_soft, registered,
+    stage_steps_parameter)
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import AXIS_NAMES, LoadingPath, Stage, Static
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
-from pendular.procedures.preparation import MAX_STRESS
+from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
 from pendular.utils.parameters import fail, option_of, parameter
 
 

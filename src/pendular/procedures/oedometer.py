@@ -20,12 +20,14 @@ from pendular.procedures.columns import COMPRESSION_COLUMNS, k0
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.compression import (effective_diagonal, index_of_slope, stage_ends,
     tangent_modulus)
-from pendular.procedures.config import PathConfig, check_soft, registered
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import BridgeConfig, PathConfig, check_soft, registered
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, Stage, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
     rate_options)
-from pendular.procedures.preparation import MAX_STRESS
+from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
 from pendular.utils.parameters import fail, option_of, parameter
 
 

@@ -61,14 +61,16 @@ from pendular.io.schema import peak_reached
 from pendular.procedures.columns import (capillary_operation, friction_angle, history_columns, k0,
     void_ratio)
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import MAX_RECORDS, PathConfig, registered
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import BridgeConfig, MAX_RECORDS, PathConfig, registered
 from pendular.procedures.equilibrium import equilibrate
 from pendular.procedures.hydraulic import water_content
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
     Strain, Stress)
 from pendular.procedures.options import framed, laboratory_fields, laboratory_options, rate_options
-from pendular.procedures.preparation import check_soft_contacts, servo_speed
+from pendular.procedures.preparation import PrepareConfig, check_soft_contacts, servo_speed
 from pendular.utils.parameters import Option, fail, fields_of, option_of, parameter
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int, check_positive

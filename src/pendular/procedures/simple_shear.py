@@ -32,8 +32,11 @@ from pendular.io.plots import plot_simple_shear
 from pendular.io.schema import peak_reached
 from pendular.io.vtk import shear_strain_fields
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import (MAX_RECORD_STRAIN, MAX_SHEAR_STRAIN, MAX_STRAIN_RATE,
-    MIN_AXIAL_STRAIN, MIN_RECORD_STRAIN, PathConfig, check_soft, registered, stage_steps_parameter)
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (BridgeConfig, MAX_RECORD_STRAIN, MAX_SHEAR_STRAIN,
+    MAX_STRAIN_RATE, MIN_AXIAL_STRAIN, MIN_RECORD_STRAIN, PathConfig, check_soft, registered,
+    stage_steps_parameter)
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static
 from pendular.procedures.options import (SAMPLE, framed, laboratory_fields, laboratory_options,

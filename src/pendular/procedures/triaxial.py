@@ -34,8 +34,10 @@ from pendular.io.schema import peak_reached
 from pendular.procedures.columns import friction_angle
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.compression import effective_diagonal
-from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, LaboratoryConfig, MAX_AXIAL_STRAIN,
-    MIN_AXIAL_STRAIN, ShearConfig, registered)
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, BridgeConfig, LaboratoryConfig,
+    MAX_AXIAL_STRAIN, MIN_AXIAL_STRAIN, ShearConfig, registered)
 from pendular.procedures.critical_state import critical_state
 from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
@@ -44,6 +46,7 @@ from pendular.procedures.options import (laboratory_fields, laboratory_options, 
     rate_options, steps_count)
 from pendular.utils.parameters import (ParameterError, fail, fields_of, flat_options, option_of,
     spec_of)
+from pendular.procedures.preparation import PrepareConfig
 
 
 @registered
