@@ -44,6 +44,11 @@ bridges, water_content, saturation, unbalanced_force) and the ParaView series
 ``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull); with
 ``run(out, checkpoint_every=N)`` checkpoint.h5 (TensionRun), from which
 ``TensionTest.resume(out)`` continues an interrupted run bit for bit.
+
+This module holds the configuration, its options and command (``COMMAND``), the run of the
+cases with its checkpoints; one case's sample, wetting and pull are in
+pendular.procedures.tension_pull, the report in pendular.procedures.tension_report, the
+figures in pendular.io.plots.
 """
 
 from __future__ import annotations
