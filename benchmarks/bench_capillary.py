@@ -11,7 +11,7 @@ at the start of the shear, as YADE's law is here). Both runs first take ``warmup
 sample compacts under the capillary forces), then are timed in alternating chunks so that a
 change of machine load hits both alike. YADE 2023 runs the same sample, time step and strain
 rate with and without its capillary law, reading capillary files M(r=1) ... M(r=10) written
-by pendular.capillary.write_yade (350 suctions x 80 distances, cached under .cache/). Prints
+by pendular.interop.yade.capillary_files.write_yade (350 suctions x 80 distances, cached under .cache/). Prints
 particle-steps/s, the wet/dry cost ratios of both codes and pendular / YADE (wet).
 """
 

@@ -14,6 +14,7 @@ import time
 import numba
 
 from pendular import capillary
+from pendular.interop.yade.capillary_files import write_table_files
 
 
 def main():
@@ -24,11 +25,11 @@ def main():
     numba.set_num_threads(arguments.threads)
     with tempfile.TemporaryDirectory() as folder:
         warm = capillary.BridgeTable.build(0.0, radius_ratios=(1.0,), n_suction=3, n_distance=3)
-        warm.write_yade(folder, n_distance=3)
+        write_table_files(warm, folder, n_distance=3)
         start = time.perf_counter()
         table = capillary.BridgeTable.build(0.0)
         built = time.perf_counter()
-        table.write_yade(folder)
+        write_table_files(table, folder)
         written = time.perf_counter()
     print(f"threads: {arguments.threads}")
     print(f"BridgeTable 10 x 350 x 80 (theta = 0): {built - start:.1f} s")

@@ -7,7 +7,7 @@ at constant σv, then unload it: each phase is one call on the same scene, so st
 suction paths compose in any order.
 
 - :func:`pendular.wet` adds the capillary bridges and equilibrates;
-- ``run_path`` (pendular.procedures.path_table) runs :class:`pendular.Stage` objects, the
+- ``run_path`` (pendular.procedures.path) runs :class:`pendular.Stage` objects, the
   same stages a path table (``pendular path PATH.toml``) holds, and returns their history;
 - ``change_suction`` brings suction-controlled bridges to a new suction at a held stress, in
   steps of equal ratio, each until static.
@@ -19,8 +19,8 @@ import matplotlib.pyplot as plt
 
 from pendular import BridgeConfig, PrepareConfig, Stage, Stress, prepare_sample, wet
 from pendular.procedures.config import quasi_static_rate
-from pendular.procedures.loading import oedometer_stages
-from pendular.procedures.path_table import change_suction, run_path
+from pendular.procedures.oedometer import oedometer_stages
+from pendular.procedures.path import change_suction, run_path
 
 sample = PrepareConfig(particles=150, confining=1000.0, seed=1)
 sim, _ = prepare_sample(sample, progress=False)

@@ -4,7 +4,7 @@
         [--suction PA] [--out DIR] ...
     python scenarios/isotropic.py --resume DIR
 
-The test itself is pendular.procedures.triaxial.IsotropicTest; the options are
+The test itself is pendular.procedures.isotropic.IsotropicTest; the options are
 pendular.cli.commands.isotropic.
 """
 

@@ -4,7 +4,7 @@
         [--unload-to PA] [--suction PA] [--out DIR] ...
     python scenarios/oedometer.py --resume DIR
 
-The test itself is pendular.procedures.triaxial.OedometerTest; the options are
+The test itself is pendular.procedures.oedometer.OedometerTest; the options are
 pendular.cli.commands.oedometer.
 """
 

@@ -2,13 +2,15 @@
 
 On ``builder-inited`` this writes, under ``docs/_generated/`` (not in git):
 
-- ``outputs_tables.md``: every history column (pendular.io.schema.HISTORY_COLUMNS), summary key
+- ``outputs_tables.md``: every history column (pendular.io.columns.HISTORY_COLUMNS), summary key
   with its meaning and the commands writing it (SUMMARY_KEYS), run option (OPTION_UNITS), sample and checkpoint dataset (pendular.dem.sample.DATASETS,
   pendular.dem.checkpoint.DATASETS) with its units, the ParaView frames' field data
   (pendular.io.schema.VTK_FIELDS) and the ParaView fields as declared in pendular.io.vtk's
   docstring;
 - ``commands.md``: ``pendular --help`` and, per command, its worked example (the command module's
-  ``EXAMPLE``) above its ``--help``, as the command prints it;
+  ``EXAMPLE``: a laboratory test's is that of its LaboratoryCommand in
+  pendular.procedures.registry, with its description and options) above its ``--help``, as
+  the command prints it;
 - ``api/pendular.md``: the public names of ``pendular``; ``api/<package>.md``: one page per
   sub-package, its docstring and every module in it.
 
@@ -56,14 +58,14 @@ def outputs_tables():
     """The Markdown of the outputs reference's tables."""
     from pendular.dem import checkpoint, sample
     from pendular.dem.grading import GRADING_UNITS
-    from pendular.io import schema, vtk
+    from pendular.io import columns, schema, vtk
 
     lines = ["## History datasets (`history.h5`, group `history`)", "",
              "One row per record; the dimensions after `record` are `axis` and `component` "
              "(x, y, z) or `grip` (z−, z+). `–`: dimensionless.", "",
              "| dataset | units | dimensions | dtype | written by | equation | description |",
              "|---|---|---|---|---|---|---|"]
-    for name, column in schema.HISTORY_COLUMNS.items():
+    for name, column in columns.HISTORY_COLUMNS.items():
         dims = ", ".join(("record", *column.dims))
         commands = ", ".join(f"`{command}`" for command in column.commands)
         lines.append(f"| `{name}` | {_units(column.units)} | {dims} | {column.dtype} | "

@@ -154,6 +154,6 @@ figure.tight_layout()
 # triaxial`` with the same options), ``oedometer_unload.toml`` and ``cyclic.toml``.
 #
 # A change of suction is not a table's stage yet; in Python it is one call,
-# ``pendular.procedures.path_table.change_suction``, between stages run by ``run_path``:
+# ``pendular.procedures.path.change_suction``, between stages run by ``run_path``:
 # the example :doc:`/auto_examples/loading_path_api` wets a sample at 30 kPa, loads it
 # oedometrically to 10 kPa, dries it to 300 kPa at constant σv and unloads it, in six lines.

@@ -22,8 +22,9 @@ from pendular.studies.campaign import (MAX_RUNS, Campaign, CampaignResult, Run, 
                                        executor, finished_summary, max_jobs, run_name,
                                        run_progress, sweep_from_table, table_rows,
                                        write_campaign_csv)
-from pendular.procedures.config import (ShearConfig, TensionConfig, TriaxialConfig, config_to_dict,
-    tension_sample)
+from pendular.procedures.config import ShearConfig, config_to_dict
+from pendular.procedures.tension import TensionConfig, tension_sample
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.io.outputs import OutputFolder
 from pendular.studies.run_kinds import PROCEDURES
 
@@ -543,7 +544,8 @@ def test_a_run_stored_before_a_defaulted_field_existed_is_the_same_run():
     """Reuse across versions: a configuration stored before ``wetting`` existed equals one with
     its default (the former behaviour), not one with another value."""
     from pendular.procedures.config import same_config
-    from pendular.procedures.config import BridgeConfig, TriaxialConfig, config_to_dict
+    from pendular.procedures.config import BridgeConfig, config_to_dict
+    from pendular.procedures.triaxial import TriaxialConfig
 
     config = TriaxialConfig(bridges=BridgeConfig(30000.0))
     stored = config_to_dict(config)

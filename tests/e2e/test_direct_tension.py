@@ -18,11 +18,11 @@ from pendular.procedures.preparation import prepare_sample
 from pendular.dem.state import Particles, Walls
 from pendular.dem.grips import Grip
 from pendular.procedures.grips import grip_members
-from pendular.procedures import tension as direct_tension
+from pendular.procedures import tension_pull as direct_tension
 from pendular.procedures.water_content import WATER_TOLERANCE
 from pendular.cli import command_parser
-from pendular.procedures.config import (CONFIG_TYPES, TensionConfig, config_from_dict,
-    config_to_dict, tension_sample)
+from pendular.procedures.config import CONFIG_TYPES, config_from_dict, config_to_dict
+from pendular.procedures.tension import TensionConfig, tension_sample
 from pendular.procedures.preparation import PrepareConfig
 
 from conftest import ROOT

@@ -437,7 +437,8 @@ def test_an_interrupt_while_numba_compiles_waits_for_the_kernel_to_be_whole(pyth
 
 # ---------------------------------------------------------------- stress bookkeeping
 def test_records_whose_wall_and_love_weber_stresses_drift_apart_are_flagged():
-    from pendular.procedures.triaxial import STRESS_BALANCE_BOUND, stress_balance_error, summarize
+    from pendular.procedures.laboratory import STRESS_BALANCE_BOUND, stress_balance_error
+    from pendular.procedures.triaxial import summarize
 
     records = 5
     wall = np.tile([1000.0, 1000.0, 3000.0], (records, 1))        # p = 5/3 kPa

@@ -11,7 +11,8 @@ import pytest
 
 from conftest import assert_drawn, history_of, summary_of
 from pendular.homogenize.invariants import deviator_stress
-from pendular.io.schema import HISTORY_COLUMNS, undeclared_keys
+from pendular.io.columns import HISTORY_COLUMNS
+from pendular.io.schema import undeclared_keys
 from pendular.procedures.critical_state import CRITICAL_STATE_KEYS, critical_state
 
 pytestmark = pytest.mark.slow

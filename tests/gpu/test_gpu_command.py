@@ -88,9 +88,9 @@ def assert_agrees(cpu, other, sensitivity):
 def one_ulp_off(sample):
     """Within the block, a run loading the sample file ``sample`` gets its first coordinate
     moved by one ulp (the CPU's sensitivity to round-off, module docstring)."""
-    from pendular.procedures import triaxial
+    from pendular.procedures import laboratory
 
-    load_sample = triaxial.load_sample
+    load_sample = laboratory.load_sample
 
     def moved(path, expected=None):
         particles, walls, report, extra = load_sample(path, expected=expected)
@@ -98,11 +98,11 @@ def one_ulp_off(sample):
             particles.position[0, 0] = np.nextafter(particles.position[0, 0], np.inf)
         return particles, walls, report, extra
 
-    triaxial.load_sample = moved
+    laboratory.load_sample = moved
     try:
         yield
     finally:
-        triaxial.load_sample = load_sample
+        laboratory.load_sample = load_sample
 
 
 def sensitivity(runs):

@@ -124,10 +124,10 @@ def wetted_and_pulled(device, folder):
     from dataclasses import replace
 
     from pendular.dem.walls import StressServo
-    from pendular.procedures import tension
-    from pendular.procedures.config import TensionConfig, tension_sample
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
 
-    tension.WET_STEPS = WET_STEPS
+    tension_pull.WET_STEPS = WET_STEPS
     dry = periodic_scene()
     dry.writers.clear()
     dry.controls = [StressServo("xyz", 1e4, 0.01)]
@@ -137,9 +137,9 @@ def wetted_and_pulled(device, folder):
                      periodic=True)
     config = TensionConfig(sample=sample, cases=[(0.7, WATER_CONTENT)], inertial_number=1e-2,
                            max_strain=0.01, vtk_frames=0)
-    sim, bridges, report = tension.wet(dry, config, WATER_CONTENT, progress=False)
+    sim, bridges, report = tension_pull.wet(dry, config, WATER_CONTENT, progress=False)
     position = sim.walls.unwrapped(sim.particles)
-    steps, history = tension.Pull(sim, bridges, config, folder, progress=False).run(None)
+    steps, history = tension_pull.Pull(sim, bridges, config, folder, progress=False).run(None)
     return report, position, steps, history
 
 

@@ -1,5 +1,5 @@
 """A loading path's history recorded from a GPU run without bringing the state back: every
-column a record needs (pendular.procedures.loading.history_columns, with the bridges' for a wet
+column a record needs (pendular.procedures.columns.history_columns, with the bridges' for a wet
 scene) and the crushed-sample guard read the device's homogenisation
 (pendular.homogenize.on_the_fly.homogenized, pendular.gpu.homogenize), so that a record step
 fetches the walls (a periodic cell's faces, rate, stress and stiffness) alone and the whole
@@ -50,7 +50,8 @@ def measure(check):
     from pendular.capillary.bridges import CapillaryBridges
     from pendular.dem.record import HistoryRecorder
     from pendular.procedures.guards import SampleGuard
-    from pendular.procedures.loading import AxisStrain, history_columns
+    from pendular.procedures.loading import AxisStrain
+    from pendular.procedures.columns import history_columns
     from pendular.procedures.preparation import static
 
     wet = check.endswith("wet")

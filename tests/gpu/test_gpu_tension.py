@@ -77,12 +77,12 @@ def wetted_and_pulled(device, folder):
     from dataclasses import replace
 
     from pendular.dem.walls import StressServo
-    from pendular.procedures import tension
-    from pendular.procedures.config import TensionConfig, tension_sample
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
     from simulated import RADIUS, scene
     from simulator import counted_copies
 
-    tension.WET_STEPS = WET_STEPS
+    tension_pull.WET_STEPS = WET_STEPS
     dry = scene(side=3)
     dry.writers.clear()
     dry.controls = [StressServo("xyz", 1e4, 0.01)]
@@ -91,10 +91,10 @@ def wetted_and_pulled(device, folder):
     sample = replace(tension_sample(), radius=RADIUS, density=2650.0, confining=1e4)
     config = TensionConfig(sample=sample, cases=[(0.7, 0.01)], inertial_number=1e-2,
                            max_strain=0.01, grip_depth=0.1, vtk_frames=0)
-    sim, bridges, report = tension.wet(dry, config, 0.01, progress=False)
+    sim, bridges, report = tension_pull.wet(dry, config, 0.01, progress=False)
     position = sim.particles.position.copy()
     with counted_copies() as copies:
-        pull = tension.Pull(sim, bridges, config, folder, progress=False)
+        pull = tension_pull.Pull(sim, bridges, config, folder, progress=False)
         steps, history = pull.run(None)
     return report, position, steps, history, pull, copies
 

@@ -29,7 +29,7 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.config import ShearConfig
-from pendular.procedures.cyclic import AxialStressGuard
+from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.guards import SampleGuard
 from pendular.procedures.loading import MixedStress, Stage, Strain
 from pendular.procedures.preparation import PrepareConfig, prepare_sample

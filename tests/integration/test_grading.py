@@ -14,8 +14,8 @@ from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grad
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
 from pendular.cli import run_command
 from pendular.io.history import read_history
-from pendular.procedures.config import (TriaxialConfig, config_from_dict, config_json,
-    config_to_dict)
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.config import config_from_dict, config_json, config_to_dict
 from pendular.procedures.triaxial import TriaxialTest
 
 CURVE = ((30e-6, 0.0), (40e-6, 20.0), (50e-6, 60.0), (80e-6, 100.0))

@@ -159,8 +159,9 @@ def test_custom_loading_path_in_a_few_lines():
 
 
 def test_configurations_round_trip_through_json():
-    from pendular.procedures.config import (BridgeConfig, ShearConfig, TriaxialConfig,
-        config_from_dict, config_json, config_to_dict)
+    from pendular.procedures.config import (BridgeConfig, ShearConfig, config_from_dict, config_json,
+        config_to_dict)
+    from pendular.procedures.triaxial import TriaxialConfig
     from pendular.procedures.preparation import PrepareConfig
 
     config = TriaxialConfig(sample=PrepareConfig(particles=500, confining=250.0),

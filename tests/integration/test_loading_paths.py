@@ -25,8 +25,11 @@ from pendular.dem.cell import PeriodicCell
 from pendular.dem.state import Particles, Walls
 from pendular.homogenize import regular_packing
 from pendular.procedures.config import ShearConfig
-from pendular.procedures.loading import (LoadingPath, isotropic_stages, isotropic_summary, k0,
-    measured_b, oedometer_stages, oedometer_summary, void_ratio)
+from pendular.procedures.loading import LoadingPath
+from pendular.procedures.columns import k0, void_ratio
+from pendular.procedures.isotropic import isotropic_stages, isotropic_summary
+from pendular.procedures.triaxial import measured_b
+from pendular.procedures.oedometer import oedometer_stages, oedometer_summary
 from pendular.procedures.preparation import PrepareConfig, dry_simulation
 from pendular.procedures.triaxial import TriaxialShear, summarize
 from pendular.homogenize.invariants import mean_stress

@@ -20,7 +20,7 @@ import pytest
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import normal_stiffness
 from pendular.dem.state import Particles
-from pendular.procedures.config import SimpleShearConfig
+from pendular.procedures.simple_shear import SimpleShearConfig
 from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static, Strain
 from pendular.procedures.preparation import PrepareConfig, dry_simulation, prepare_sample
 from pendular.procedures.simple_shear import (SHEAR_COLUMNS, simple_shear_stages,

@@ -14,7 +14,8 @@ from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.hydraulic import (SuctionChange, WaterContentChange,
     set_water_content, unit_water_volume, water_content)
-from pendular.procedures.loading import LoadingPath, excess_pore_pressure, shear_stage
+from pendular.procedures.loading import LoadingPath
+from pendular.procedures.triaxial import excess_pore_pressure, shear_stage
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from conftest import RADIUS, two_body_scene
 

@@ -243,7 +243,7 @@ def test_every_series_of_a_wet_run_reads_back_with_vtk(wet_triaxial_run, folder)
     the declared arrays, and field data step, time and axial_strain (shear: the .pvd time axis
     is the axial strain in %, field data axial_strain_percent) or phase (preparation: every
     phase of a wet run, in order)."""
-    from pendular.procedures.triaxial import PREP_PHASES
+    from pendular.procedures.laboratory import PREP_PHASES
 
     path = wet_triaxial_run / folder
     steps = None

@@ -81,7 +81,7 @@ def test_the_formation_suction_shares_the_water_over_contacts_and_gaps():
 
 def test_wetting_without_a_gap_wets_the_contacts_only(tmp_path):
     from pendular.procedures.preparation import PrepareConfig, prepare_sample
-    from pendular.procedures.tension import wetted_pairs
+    from pendular.procedures.tension_pull import wetted_pairs
 
     sim, _ = prepare_sample(PrepareConfig(particles=150, confining=750.0, unload_steps=400),
                             progress=False)
@@ -98,7 +98,7 @@ def test_wetting_without_a_gap_wets_the_contacts_only(tmp_path):
 
 
 def test_a_formation_gap_out_of_range_is_refused_naming_it():
-    from pendular.procedures.config import TensionConfig
+    from pendular.procedures.tension import TensionConfig
 
     with pytest.raises(ValueError, match="^form_gap = 1.5 is outside"):
         TensionConfig(form_gap=1.5)

@@ -14,16 +14,18 @@ import pytest
 
 from conftest import refused, run_in_process
 
-from pendular.procedures.config import (MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES,
-    MIN_TENSION_PARTICLES, ShearConfig, SwccConfig, TensionConfig, TriaxialConfig, case_name,
-    tension_sample)
+from pendular.procedures.config import MAX_AXIAL_STRAIN, MIN_SAMPLE_PARTICLES, ShearConfig
+from pendular.procedures.tension import MIN_TENSION_PARTICLES, TensionConfig, tension_sample
+from pendular.procedures.tension_pull import case_name
+from pendular.procedures.swcc import SwccConfig
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.dem.grading import read_grading_curve
 from pendular.dem.measure import largest_overlap, porosity
 from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.guards import (MAX_OVERLAP_OVER_RADIUS, MIN_POROSITY_EQUAL, SampleCrushed,
     SampleGuard)
-from pendular.procedures.tension import case_line
+from pendular.procedures.tension_report import case_line
 from pendular.procedures.triaxial import TriaxialShear, summarize
 
 #: A short triaxial (the audit's) and a tension command line; each test adds to them.

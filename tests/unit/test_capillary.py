@@ -14,6 +14,7 @@ from conftest import requires
 
 from pendular import capillary
 from pendular.capillary.verification import reference_bridge
+from pendular.interop.yade.capillary_files import read_yade, write_table_files
 
 # (radius_ratio, contact_angle, suction_star, filling_angle) spanning the solver's range
 CASES = [
@@ -195,12 +196,12 @@ def test_table_hdf5_round_trip_and_cache(tmp_path, monkeypatch, small_table):
 
 def test_yade_files_round_trip(tmp_path):
     table = capillary.BridgeTable.build(0.0, radius_ratios=(1.0, 2.0), n_suction=12, n_distance=4, suction_max=100.0)
-    paths = table.write_yade(tmp_path, n_distance=7)
+    paths = write_table_files(table, tmp_path, n_distance=7)
     assert sorted(p.name for p in paths) == ["M(r=1)", "M(r=2)"]
     lines = (tmp_path / "M(r=2)").read_text().splitlines()
     assert lines[0] == "2" and lines[1] == "7"
     assert lines[2].split()[1:] == ["0"] * 7  # block header: row count then seven zeros
-    files = capillary.read_yade(tmp_path)
+    files = read_yade(tmp_path)
     assert sorted(files) == [1.0, 2.0]
     for radius_ratio, capillary_file in files.items():
         distances = capillary_file.distances
@@ -310,7 +311,7 @@ print("RESULT" + json.dumps(out))
 def test_yade_reads_the_files_and_reproduces_the_exact_bridges(tmp_path):
     """YADE's Law2_ScGeom_CapillaryPhys_Capillarity, fed our M(r=...) files, gives back our bridges."""
     table = capillary.BridgeTable.build(0.0, n_suction=60, n_distance=4, suction_max=200.0)
-    table.write_yade(tmp_path, n_distance=60)
+    write_table_files(table, tmp_path, n_distance=60)
     (tmp_path / "two_spheres.py").write_text(YADE_TWO_SPHERES)
     environment = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
     run = subprocess.run(["yade", "-n", "-x", "two_spheres.py"], cwd=tmp_path, capture_output=True, text=True,

@@ -11,14 +11,16 @@ import pytest
 from conftest import StressScene
 
 from pendular.dem.state import Particles, Walls
-from pendular.procedures.config import (MIN_AXIAL_STRAIN, CyclicConfig, PrepareConfig,
-    config_from_dict, config_to_dict)
+from pendular.procedures.config import MIN_AXIAL_STRAIN, config_from_dict, config_to_dict
+from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.cyclic import CyclicConfig
 from pendular.procedures.cyclic import (CyclicPath, cycle_of, cyclic_stages, cyclic_summary,
     damping_resolution, loop_measures)
 from pendular.procedures.guards import AxialStressGuard
-from pendular.procedures.loading import StageFailed, Strain, Stress
+from pendular.dem.mixed_stress import StageFailed
+from pendular.procedures.loading import Strain, Stress
 from pendular.procedures.preparation import servoed_simulation
-from pendular.procedures.triaxial import equilibrate
+from pendular.procedures.equilibrium import equilibrate
 
 
 def test_a_cyclic_path_is_a_first_loading_then_unloadings_and_reloadings():

@@ -9,7 +9,7 @@ import pytest
 
 from conftest import RADIUS, two_body_scene
 from pendular.dem.measure import porosity
-from pendular.procedures.triaxial import frame_period, frames_writer, wetting_report
+from pendular.procedures.equilibrium import frame_period, frames_writer, wetting_report
 
 
 @pytest.mark.parametrize("vtk_every, vtk_frames, steps, unknown, period", [

@@ -10,11 +10,17 @@ import pytest
 from conftest import StressScene
 
 from pendular.dem.walls import ConstantStrainRate, StressServo
-from pendular.procedures.config import (IsotropicConfig, OedometerConfig, PrepareConfig,
-    ShearConfig, TriaxialConfig, config_from_dict, config_to_dict)
-from pendular.procedures.loading import (MixedStress, Stage, StageFailed, Static, Strain,
-    Stress, friction_angle, isotropic_stages, isotropic_summary, measured_b,
-    oedometer_stages, oedometer_summary, shear_stage)
+from pendular.procedures.isotropic import IsotropicConfig
+from pendular.procedures.oedometer import OedometerConfig
+from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.config import ShearConfig, config_from_dict, config_to_dict
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.loading import MixedStress, Stage, Static, Strain, Stress
+from pendular.dem.mixed_stress import StageFailed
+from pendular.procedures.columns import friction_angle
+from pendular.procedures.isotropic import isotropic_stages, isotropic_summary
+from pendular.procedures.triaxial import measured_b, shear_stage
+from pendular.procedures.oedometer import oedometer_stages, oedometer_summary
 
 
 def test_the_triaxial_shear_is_one_stage_of_per_axis_control():

@@ -11,14 +11,18 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
-from pendular.io.schema import HISTORY_COLUMNS, SUMMARY_KEYS, SUMMARY_UNITS, undeclared_keys
+from pendular.io.columns import HISTORY_COLUMNS
+from pendular.io.schema import SUMMARY_KEYS, SUMMARY_UNITS, undeclared_keys
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.cyclic import cyclic_summary
-from pendular.procedures.loading import (Stage, Strain, excess_pore_pressure,
-    isotropic_summary, oedometer_summary, path_deviations, undrained_summary)
-from pendular.procedures.path_table import path_summary
+from pendular.procedures.loading import Stage, Strain
+from pendular.procedures.triaxial import excess_pore_pressure, path_deviations, undrained_summary
+from pendular.procedures.isotropic import isotropic_summary
+from pendular.procedures.oedometer import oedometer_summary
+from pendular.procedures.path import path_summary
 from pendular.procedures.simple_shear import simple_shear_summary
-from pendular.procedures.triaxial import stress_balance, summarize
+from pendular.procedures.laboratory import stress_balance
+from pendular.procedures.triaxial import summarize
 
 ROWS = 200
 

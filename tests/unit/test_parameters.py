@@ -10,11 +10,17 @@ import pytest
 
 from pendular.cli import command_parser, main
 from pendular.io.schema import OPTION_UNITS
-from pendular.procedures.options import COMMANDS, config_from_options, options_of
+from pendular.procedures.registry import COMMANDS, config_from_options, options_of
 from pendular.studies.campaign import sweep_from_table
-from pendular.procedures.config import (BridgeConfig, CyclicConfig, IsotropicConfig,
-    LaboratoryConfig, OedometerConfig, PathConfig, ShearConfig, SimpleShearConfig, SwccConfig,
-    TablePathConfig, TensionConfig, TriaxialConfig, tension_sample)
+from pendular.procedures.config import BridgeConfig, LaboratoryConfig, PathConfig, ShearConfig
+from pendular.procedures.cyclic import CyclicConfig
+from pendular.procedures.isotropic import IsotropicConfig
+from pendular.procedures.oedometer import OedometerConfig
+from pendular.procedures.simple_shear import SimpleShearConfig
+from pendular.procedures.swcc import SwccConfig
+from pendular.procedures.path import TablePathConfig
+from pendular.procedures.tension import TensionConfig, tension_sample
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.procedures.preparation import MAX_PARTICLES, PrepareConfig
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError,
     default_of, option_from, option_values, parameters_of, spec_of, validate)

@@ -1,4 +1,4 @@
-"""Path tables (pendular.procedures.path_table): every key of a stage read into loading.Stage,
+"""Path tables (pendular.procedures.path): every key of a stage read into loading.Stage,
 named values, repeated groups, one error naming the file, the entry and the key, the
 configuration's JSON round trip, and the generic path summary against hand-made histories."""
 
@@ -7,10 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from pendular.procedures.config import (PrepareConfig, TablePathConfig, config_from_dict,
-    config_to_dict, quasi_static_rate, ShearConfig)
+from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.config import (ShearConfig, config_from_dict, config_to_dict,
+    quasi_static_rate)
+from pendular.procedures.path import TablePathConfig
 from pendular.procedures.loading import Stage, Static, Strain, Stress
-from pendular.procedures.path_table import (UNTIL_KINDS, build_stages, lowest_stress,
+from pendular.procedures.path import (UNTIL_KINDS, build_stages, lowest_stress,
     path_summary, read_table, stage_keys)
 
 SAMPLE = PrepareConfig(particles=100, confining=750.0)
@@ -340,7 +342,7 @@ def test_a_wet_summary_adds_the_effective_stress():
 
 def test_change_suction_refuses_volume_controlled_bridges_and_a_bad_suction():
     from pendular.procedures.config import BridgeConfig
-    from pendular.procedures.path_table import change_suction
+    from pendular.procedures.path import change_suction
 
     volume = BridgeConfig(suction=3e4, control="volume").build()
     with pytest.raises(ValueError, match="control = 'volume': change_suction needs "

@@ -9,8 +9,9 @@ import pytest
 
 from conftest import assert_drawn
 from pendular.io import plots
-from pendular.procedures import tension
-from pendular.procedures.config import TensionConfig, tension_sample
+from pendular.procedures import tension_report
+from pendular.procedures.reference import KIM_2001
+from pendular.procedures.tension import TensionConfig, tension_sample
 
 #: Code names that must not reach a legend or a label.
 CODE_NAMES = ("psi_interface", "sigma_capillary", "sigma_effective", "packing_state", "psi ",
@@ -63,8 +64,7 @@ def titles(figure):
 @pytest.fixture
 def saved(monkeypatch):
     """File name -> what the figure saved there shows (its y labels and their font sizes, legend
-    texts, titles), for every figure passed to save_figure (by plots and by the tension
-    procedure), each still saved."""
+    texts, titles), for every figure passed to save_figure, each still saved."""
     figures = {}
     original = plots.save_figure
 
@@ -76,7 +76,6 @@ def saved(monkeypatch):
         return original(figure, path, dpi=40)
 
     monkeypatch.setattr(plots, "save_figure", keep)
-    monkeypatch.setattr(tension, "save_figure", keep)
     return figures
 
 
@@ -167,8 +166,10 @@ def test_the_tension_plots_are_titled_and_name_the_cases_in_words(saved, tmp_pat
     extension = np.linspace(0.0, 0.05, 50)
     history = {"axial_strain": -extension,
                "tensile_stress": 600.0 * np.exp(-((extension - 0.01) / 0.01) ** 2)}
-    tension.plot_curves([summary], {"e0.72_w1.00": history}, tmp_path, config)
-    tension.plot_strength([summary], config, tmp_path / "strength_vs_water.png")
+    plots.plot_curves([summary], {"e0.72_w1.00": history}, tmp_path, config)
+    plots.plot_strength([summary], config, KIM_2001,
+                        tension_report.strength_predictions([summary], config),
+                        tmp_path / "strength_vs_water.png")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "strength_vs_water.png", "tension_all.png", "tension_e0.72_w1.00.png"]
     assert sorted(saved) == ["strength_vs_water.png", "tension_all.png",

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, static
-from pendular.procedures.config import SwccConfig, TensionConfig, TriaxialConfig
+from pendular.procedures.swcc import SwccConfig
+from pendular.procedures.tension import TensionConfig
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.procedures.progress import (OPEN_ENDED_STEPS, laboratory_plan, off_equilibrium,
                                           preparation_plan, swcc_plan, tension_plan)
 from pendular.utils import progress

@@ -68,7 +68,7 @@ def test_a_table_stage_at_a_strain_rate_that_never_ends_is_refused_naming_it(tmp
 
 
 def test_a_later_stage_counts_its_strain_from_where_the_earlier_one_ended(tmp_path):
-    from pendular.procedures.options import config_from_options
+    from pendular.procedures.registry import config_from_options
 
     quick = LATERAL + 'strain_rate = {z = 1.0}\nuntil = {strain = 0.01, axis = "z"}'
     slow = LATERAL + 'strain_rate = {z = 1e-3}\nuntil = {strain = 0.012, axis = "z"}'
@@ -158,17 +158,18 @@ def test_a_void_ratio_no_preparation_reaches_states_the_range_in_order(monkeypat
     range refused is the two preparations' void ratios in order, never an inverted one."""
     import types
 
-    from pendular.procedures import tension
-    from pendular.procedures.config import TensionConfig, tension_sample
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
 
     reached = {0.0: 0.477, 30.0: 0.429}                 # denser at the higher friction
-    monkeypatch.setattr(tension, "prepare_sample", lambda config, **_: (
+    monkeypatch.setattr(tension_pull, "prepare_sample", lambda config, **_: (
         types.SimpleNamespace(device="cpu", friction=config.prep_friction_deg),
         {"porosity": 0.3}))
-    monkeypatch.setattr(tension, "sample_void_ratio", lambda sim, radius: reached[sim.friction])
+    monkeypatch.setattr(tension_pull, "sample_void_ratio",
+                        lambda sim, radius: reached[sim.friction])
     config = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100))
     with pytest.raises(ValueError) as error:
-        tension.prepare_void_ratio(config, 0.72, progress=False)
+        tension_pull.prepare_void_ratio(config, 0.72, progress=False)
     assert "valid range of this sample, [0.429, 0.477]" in str(error.value)
     assert "growth friction 0 and 30 deg give e = 0.477 and 0.429" in str(error.value)
 
@@ -186,15 +187,15 @@ def test_a_repeat_given_as_text_is_refused_as_other_text_for_numbers_is(tmp_path
 def test_an_isotropic_stress_repeated_in_a_row_is_refused_not_merged(tmp_path, capsys):
     refused_here(capsys, tmp_path, "isotropic", [*SMALL, "--stresses", "1000,1000"],
                  "--stresses = 1000,1000", "stage 2 repeats the 1000 Pa of stage 1")
-    from pendular.procedures.options import config_from_options
+    from pendular.procedures.registry import config_from_options
 
     loop = config_from_options("isotropic", {"particles": 60, "stresses": "1000,2000,1000"})
     assert loop.stresses == [1000.0, 2000.0, 1000.0]      # a loading and unloading: valid
 
 
 def test_the_smallest_simple_shear_is_its_own_documented_minimum(tmp_path, capsys):
-    from pendular.procedures.config import MIN_SIMPLE_SHEAR_PARTICLES
-    from pendular.procedures.options import options_of
+    from pendular.procedures.simple_shear import MIN_SIMPLE_SHEAR_PARTICLES
+    from pendular.procedures.registry import options_of
 
     particles = next(o for o in options_of("simple-shear") if o.key == "particles")
     assert f"valid range [{MIN_SIMPLE_SHEAR_PARTICLES}, " in particles.help
@@ -216,3 +217,65 @@ def test_resuming_a_run_stopped_before_its_sample_says_so(tmp_path, capsys):
     line = refused(*run_in_process("oedometer", ["--resume", str(folder)], capsys),
                    "sample.h5 is missing", "before its sample existed", "run it again")
     assert "checkpoint_every" not in line
+
+
+# ---------------------------------------------------------------- direct tension's water
+def test_a_water_content_too_low_for_the_compared_packing_names_it_and_its_range(tmp_path,
+                                                                                capsys):
+    """Below the least water content whose bridges span the separation of the regular
+    packing a case is compared with, the refusal names --water-content and its range for the
+    sample, not the bridge solver's internal distance."""
+    line = refused_here(capsys, tmp_path, "tension",
+                        ["--particles", "100", "--void-ratio", "0.7", "--water-content", "0.001",
+                         "--quiet"],
+                        "--water-content = 0.001 % is outside the valid range [",
+                        "% of a sample of void ratio 0.7")
+    assert "distance_star" not in line
+
+
+def test_the_least_water_content_is_where_the_compared_packing_starts_to_hold_bridges():
+    """The bound of the refusal above, against pendular.homogenize.packing_state: the
+    prediction of the compared packing exists just above it, and not just below."""
+    from pendular.procedures.tension import TensionConfig, tension_sample
+    from pendular.procedures.tension_pull import prediction
+
+    config = TensionConfig(cases=[(0.7, 0.01)], sample=tension_sample(particles=100))
+    least = config.least_water_content(0.7)
+    assert 0.0 < least < config.pendular_limit(0.7)
+    assert prediction(config, 0.7, least * 1.01)[0] > 0.0
+    with pytest.raises(ValueError):
+        prediction(config, 0.7, least * 0.99)
+
+
+def test_too_much_water_for_a_graded_sample_names_the_options_typed(monkeypatch):
+    """A water content whose bridges would pass the pendular limit at the contacts of a
+    graded sample's smallest grains is refused naming --water-content and the size option
+    that made those grains (--radius-spread), not a suction and a radius the user never
+    typed. The wetting itself is replaced by what the bridges' check raises."""
+    import types
+
+    import numpy as np
+
+    from pendular.capillary.validation import NotPendular
+    from pendular.procedures import tension_pull
+    from pendular.procedures.tension import TensionConfig, tension_sample
+    from pendular.utils.parameters import ParameterError
+
+    def too_wet(*_, **__):
+        raise NotPendular("suction = 2676.82 Pa is outside the valid range [3748, inf) Pa",
+                          2676.82, 3748.0, 5.5e-5, 49.8)
+
+    monkeypatch.setattr(tension_pull, "wet_to_water_volume", too_wet)
+    monkeypatch.setattr(tension_pull.BridgeTable, "cached", lambda *_, **__: None)
+    particles = types.SimpleNamespace(radius=np.full(4, 1.1e-4), solid_volume=lambda: 1e-9)
+    contacts = types.SimpleNamespace(overlap=np.ones(2), pair_i=np.array([0, 1]),
+                                     pair_j=np.array([2, 3]))
+    dry = types.SimpleNamespace(particles=particles, contacts=contacts)
+    config = TensionConfig(cases=[(0.7, 0.01)], form_gap=0.0,
+                           sample=tension_sample(particles=100, radius_spread=0.5))
+    with pytest.raises(ParameterError) as error:
+        tension_pull.wet(dry, config, 0.01, progress=False)
+    line = error.value.on_command_line()
+    assert line.startswith("--water-content = 1 % is more than this sample "
+                           "(--radius-spread 0.5) holds in the pendular regime")
+    assert "lower --water-content or the size spread" in line

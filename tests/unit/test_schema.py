@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from pendular.io.history import read_history, read_summary, write_history
-from pendular.io.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION,
-    SUMMARY_UNITS, peak_reached)
+from pendular.io.columns import DIMENSIONS, DIMENSION_LABELS
+from pendular.io.columns import HISTORY_COLUMNS
+from pendular.io.schema import SCHEMA_VERSION, SUMMARY_UNITS, peak_reached
 
 DRY = ["step", "time", "axial_strain", "volumetric_strain", "sigma_wall", "sigma_contact",
        "porosity", "coordination", "fabric", "anisotropy", "unbalanced_force"]
@@ -93,7 +94,7 @@ def test_every_declared_column_has_units_a_description_and_known_dimensions():
 
 def test_the_columns_the_triaxial_records_are_all_declared():
     from pendular.homogenize.on_the_fly import CapillaryHomogenization
-    from pendular.procedures.loading import history_columns
+    from pendular.procedures.columns import history_columns
 
     bridges = SimpleNamespace(saturation=None, mean_suction=None, count=None,
                               pendular_overlaps=None, model="exact")

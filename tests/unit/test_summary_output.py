@@ -175,7 +175,7 @@ def test_the_terminal_summary_of_a_wet_run(tmp_path, capsys):
     line with its value to 4 significant figures and its unit, no JSON; the ParaView time axis
     in the unit of the frames' field data; the q-p' stress path in plots/."""
     import pendular
-    from pendular.cli.commands.triaxial import SHOWN
+    from pendular.procedures.triaxial import SHOWN
 
     out = tmp_path / "run"
     status = main(["triaxial", "--particles", "150", "--max-strain", "0.01",

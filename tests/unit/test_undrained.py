@@ -1,6 +1,6 @@
 """Undrained (constant-volume) shear: the ConstantVolume control (pendular.dem.walls) against
 the volume it holds, step by step, between walls and in a periodic cell; the excess pore
-pressure against its definition (pendular.procedures.loading.excess_pore_pressure); the
+pressure against its definition (pendular.procedures.triaxial.excess_pore_pressure); the
 stage's and the configuration's refusals; the undrained summary of a hand-made history."""
 
 from types import SimpleNamespace
@@ -11,9 +11,11 @@ import pytest
 from pendular.dem.cell import PeriodicCell
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, ConstantVolume
-from pendular.procedures.config import BridgeConfig, PrepareConfig, ShearConfig, TriaxialConfig
-from pendular.procedures.loading import (Stage, Strain, excess_pore_pressure, shear_stage,
-    undrained_summary)
+from pendular.procedures.config import BridgeConfig, ShearConfig
+from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.loading import Stage, Strain
+from pendular.procedures.triaxial import excess_pore_pressure, shear_stage, undrained_summary
 from pendular.utils.parameters import ParameterError
 
 

@@ -10,7 +10,7 @@ from pendular.capillary import CapillaryBridges
 from pendular.capillary.table import BridgeTable
 from pendular.capillary.toroidal_table import toroidal_table
 from pendular.capillary.validation import check_filling_angle, check_radius_ratio, check_suction
-from pendular.capillary.yade_files import read_capillary_file
+from pendular.interop.yade.capillary_files import read_capillary_file
 from conftest import two_body_scene
 from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.contact_law import ContactForces

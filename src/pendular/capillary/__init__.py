@@ -7,7 +7,6 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 - bridge_at_distance / rupture_distance / lowest_distance: suction-controlled (pendular.capillary.suction_control).
 - bridge_with_volume / rupture_distance_for_volume / volume_contour: volume-controlled (pendular.capillary.volume_control).
 - BridgeTable + lookup_suction, VolumeBridgeTable + lookup_volume: tables for Numba kernels.
-- write_yade / read_yade: YADE capillary files M(r=...) (pendular.capillary.yade_files).
 - toroidal_bridge: thesis Appendix A (pendular.capillary.toroidal).
 - CapillaryBridges: the bridge operations of wet DEM scenes (pendular.capillary.bridges), one per
   control, SuctionBridges and VolumeBridges (``CapillaryBridges(..., control=...)`` builds
@@ -35,7 +34,6 @@ from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, bridge_with_
     rupture_distance_for_volume, volume_contour)
 from pendular.capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume
 from pendular.capillary.wetting import formation_suction, gravimetric_water_content
-from pendular.capillary.yade_files import YadeCapillaryFile, read_yade, write_yade
 
 __all__ = [
     "BRIDGE_MODELS",
@@ -64,18 +62,15 @@ __all__ = [
     "VOLUME_FIELDS",
     "VolumeBridgeTable",
     "YADE_RADIUS_RATIOS",
-    "YadeCapillaryFile",
     "bridge_at_distance",
     "bridge_with_volume",
     "cache_directory",
     "lookup_suction",
     "lookup_volume",
     "lowest_distance",
-    "read_yade",
     "rupture_distance",
     "rupture_distance_for_volume",
     "solve_bridge",
     "toroidal_bridge",
     "volume_contour",
-    "write_yade",
 ]

@@ -583,9 +583,3 @@ class BridgeTable(TabulatedBridges):
         """Python-side lookup_interface: (exists, nn11*, nn33*)."""
         return lookup_interface(*self.arrays(), float(radius_ratio), float(suction_star),
                                 float(distance_star))
-
-    def write_yade(self, folder, n_distance=80):
-        """Write YADE capillary files M(r=...) for the table's radius ratios (pendular.capillary.yade_files)."""
-        from pendular.capillary.yade_files import write_yade
-
-        return write_yade(folder, self.contact_angle, self.radius_ratios, self.suction, n_distance)

@@ -70,10 +70,19 @@ def _widest_filling_angle(table, suction_star):
                for ratio in table.radius_ratios)
 
 
+class NotPendular(ValueError):
+    """A suction [Pa] below ``lowest`` [Pa], at which bridges at contact between spheres of
+    ``radius`` [m] would have a filling angle ``angle`` [deg] above the pendular limit."""
+
+    def __init__(self, message, suction, lowest, radius, angle):
+        super().__init__(message)
+        self.suction, self.lowest, self.radius, self.angle = suction, lowest, radius, angle
+
+
 def check_pendular_suction(table, suction, radius, surface_tension):
-    """ValueError naming ``suction`` [Pa] when a bridge at contact between spheres of radius
-    >= ``radius`` [m] (surface_tension [N/m]) would have a filling angle above
-    PENDULAR_FILLING_ANGLE; ``table``: the BridgeTable of the contact angle."""
+    """NotPendular (a ValueError) naming ``suction`` [Pa] when a bridge at contact between
+    spheres of radius >= ``radius`` [m] (surface_tension [N/m]) would have a filling angle
+    above PENDULAR_FILLING_ANGLE; ``table``: the BridgeTable of the contact angle."""
     scale = radius / surface_tension
     angle = _widest_filling_angle(table, suction * scale)
     if angle <= PENDULAR_FILLING_ANGLE:
@@ -88,11 +97,12 @@ def check_pendular_suction(table, suction, radius, surface_tension):
         middle = (low * high) ** 0.5
         low, high = (middle, high) if _widest_filling_angle(table, middle) > PENDULAR_FILLING_ANGLE \
             else (low, middle)
-    raise ValueError(
+    raise NotPendular(
         f"suction = {suction:g} Pa is outside the valid range [{high / scale:.4g}, inf) Pa of the "
         f"pendular regime for radius = {radius:g} m (contact angle {table.contact_angle:g} deg): a "
         f"bridge at contact would have a filling angle of {angle:.1f} deg, above the pendular "
-        f"limit of {PENDULAR_FILLING_ANGLE:g} deg where the menisci of neighbouring contacts merge")
+        f"limit of {PENDULAR_FILLING_ANGLE:g} deg where the menisci of neighbouring contacts merge",
+        suction, high / scale, radius, angle)
 
 
 def check_bridge_stiffness(young, radius, surface_tension):

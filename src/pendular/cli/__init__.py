@@ -16,16 +16,17 @@ import importlib
 import json
 import sys
 
-#: Command name -> (module under pendular.cli.commands, one-line description).
+#: Command name -> (module under pendular.cli.commands, one-line description); a laboratory
+#: test's line is its own (pendular.procedures.registry, read by ``descriptions``).
 COMMANDS = {
-    "triaxial": ("triaxial", "triaxial test (thesis Ch. 5), dry or wet, drained or undrained"),
-    "oedometer": ("oedometer", "oedometric (K0) compression and unloading, dry or wet"),
-    "isotropic": ("isotropic", "isotropic loading and unloading in stages: e against log p"),
-    "simple-shear": ("simple_shear", "simple shear (periodic cell), drained or constant volume"),
-    "cyclic": ("cyclic", "cyclic triaxial loading, stress- or strain-controlled"),
-    "path": ("path", "any loading path from a TOML table of stages, dry or wet"),
-    "tension": ("tension", "direct tension of wet sand at fixed water content (Kim 2001)"),
-    "swcc": ("swcc", "soil-water characteristic curve of a sample: drying then wetting"),
+    "triaxial": ("triaxial", None),
+    "oedometer": ("oedometer", None),
+    "isotropic": ("isotropic", None),
+    "simple-shear": ("simple_shear", None),
+    "cyclic": ("cyclic", None),
+    "path": ("path", None),
+    "tension": ("tension", None),
+    "swcc": ("swcc", None),
     "chapter4": ("chapter4", "regular packings of thesis Ch. 4: tables and figures"),
     "chapter5": ("chapter5", "thesis Table 5.3 campaign of triaxial tests"),
     "campaign": ("campaign", "sweep of a laboratory command's options from a TOML table"),
@@ -36,6 +37,16 @@ COMMANDS = {
     "crosscheck": ("crosscheck", "the same packing sheared by pendular and YADE"),
     "impact": ("impact", "one collision of a sphere with a sphere or a wall: the contact law"),
 }
+
+
+def descriptions():
+    """Command name -> its line in ``pendular --help`` (a laboratory test's from its
+    LaboratoryCommand)."""
+    from pendular.procedures.registry import COMMANDS as LABORATORY
+
+    return {name: text if text is not None else LABORATORY[name].description
+            for name, (_, text) in COMMANDS.items()}
+
 
 #: Exit status of a run stopped by Ctrl-C or --stop-after.
 INTERRUPTED = 130
@@ -150,7 +161,7 @@ def start_executor_run(args):
 
 def add_declared_options(parser, options):
     """Add to ``parser`` the declared ``options`` (pendular.utils.parameters.Option; a
-    laboratory command's: pendular.procedures.options.options_of, a study's: its module's) in
+    laboratory command's: pendular.procedures.registry.options_of, a study's: its module's) in
     their order: flag and aliases, default (a list's as its comma text), type (an integer with
     a least value checked as it is parsed), choices, metavar, help; a flag stores true; the
     options of one group exclude each other. Each action of an option that sets a
@@ -189,16 +200,16 @@ def add_declared_options(parser, options):
 def add_command_options(parser, command):
     """Add to ``parser`` the options of the configuration of ``command``
     (pendular.procedures.options)."""
-    from pendular.procedures.options import options_of
+    from pendular.procedures.registry import options_of
 
     add_declared_options(parser, options_of(command))
 
 
 def command_config(command, args):
     """The configuration of ``command`` from the parsed options ``args`` (those it declares:
-    pendular.procedures.options.config_from_options; its errors name the keys, and
+    pendular.procedures.registry.config_from_options; its errors name the keys, and
     ``on_command_line`` the flags)."""
-    from pendular.procedures.options import config_from_options, options_of
+    from pendular.procedures.registry import config_from_options, options_of
 
     keys = {option.key for option in options_of(command)}
     return config_from_options(command, {key: value for key, value in vars(args).items()
@@ -319,7 +330,7 @@ def _main(argv, prog):
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="DEM of wet granular media in the pendular regime (Khosravani 2014).",
         epilog="commands:\n" + "\n".join(f"  {name:<11} {text}"
-                                         for name, (_, text) in COMMANDS.items())
+                                         for name, text in descriptions().items())
         + "\n\n'pendular <command> --help' shows a command's options with their defaults.")
     parser.add_argument("-V", "--version", action="version",
                         version=f"pendular {software_version()}")

@@ -20,8 +20,8 @@ from pendular.utils.version import software_version
 
 from pendular.utils.atomic import replacing
 
-from pendular.io.schema import (DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS, SCHEMA_VERSION,
-    SUMMARY_UNITS)
+from pendular.io.columns import DIMENSION_LABELS, DIMENSIONS, HISTORY_COLUMNS
+from pendular.io.schema import SCHEMA_VERSION, SUMMARY_UNITS
 
 #: File attributes written by write_history itself (not overridable by ``attributes``).
 RESERVED_ATTRIBUTES = ("pendular_version", "schema_version", "config")

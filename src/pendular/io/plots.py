@@ -1,10 +1,11 @@
-"""Figures: matplotlib without a display, saved atomically, and the plots of the loading paths
-(triaxial, oedometer, isotropic).
+"""Figures: matplotlib without a display, saved atomically, and the plots of every laboratory
+test (triaxial, oedometer, isotropic, cyclic, simple shear, path, direct tension, SWCC).
 
 Every figure is written under a temporary name then renamed (a killed run never leaves a
 truncated PNG). Stresses compression positive.
 """
 
+import math
 import os
 
 import numpy as np
@@ -377,7 +378,7 @@ def plot_cyclic(history, cycles, path, title=""):
 
 
 def plot_path(history, path, title=""):
-    """A loading path of any stages (pendular.procedures.path_table): left, the stress path q
+    """A loading path of any stages (pendular.procedures.path): left, the stress path q
     against p [kPa] of the net wall stress and, wet, q' against p' of the effective stress
     (Eq. 3.43), each stage's end marked; right, the wall stresses sigma_x, sigma_y, sigma_z
     [kPa] (wet, the effective ones dashed) and the axial and volumetric strains [%] against
@@ -475,4 +476,103 @@ def plot_simple_shear(history, path, title="", summary=None):
         axes.grid(alpha=0.3)
     top.set_title(f"Simple shear (x with z, periodic cell)\n{title}", fontsize=9)
     figure.tight_layout()
+    return save_figure(figure, path)
+
+
+# ---------------------------------------------------------------- direct tension
+
+def plot_label(config) -> str:
+    """One line of the run's parameters for the figures' titles."""
+    sample = config.sample
+    return (f"N = {sample.particles}, R = {sample.radius * 1e3:g} mm, contact angle "
+            f"θ = {config.contact_angle:g}°, γ = {config.surface_tension:g} N/m")
+
+
+def case_label(summary: dict) -> str:
+    """A case in words: its target void ratio and water content."""
+    return (f"e = {summary['void_ratio_target']:g}, "
+            f"w = {100 * summary['water_content_target']:g} %")
+
+
+def plot_curves(summaries: list[dict], histories: dict, folder: str,
+                config) -> None:
+    """Tensile stress against axial extension, one figure per case (tension_<case>.png) and
+    one with all (tension_all.png)."""
+    plt = pyplot()
+    every, all_axes = plt.subplots(figsize=(6, 4))
+    for summary in summaries:
+        history = histories[summary["case"]]
+        figure, axes = plt.subplots(figsize=(6, 4))
+        for target in (axes, all_axes):
+            target.plot(-100.0 * history["axial_strain"], history["tensile_stress"],
+                        label=case_label(summary))
+        axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
+                 title=f"Direct tension, {case_label(summary)}\n{plot_label(config)}")
+        axes.title.set_fontsize(9)
+        axes.grid(alpha=0.3)
+        save_figure(figure, os.path.join(folder, f"tension_{summary['case']}.png"))
+    all_axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
+                 title=f"Direct tension, every case\n{plot_label(config)}")
+    all_axes.title.set_fontsize(9)
+    all_axes.grid(alpha=0.3)
+    all_axes.legend(fontsize=7)
+    save_figure(every, os.path.join(folder, "tension_all.png"))
+
+
+def plot_strength(summaries: list[dict], config, measured, predictions, path: str) -> None:
+    """Tensile strength against water content: DEM, the measurements ``measured``
+    [(void ratio, water content [-], tensile strength [Pa])] (Kim 2001) and ``predictions``
+    {void ratio: (water contents [-], tensile strengths [Pa], the packing in words)} of the
+    regular packing of the same void ratio (pendular.homogenize.packing_state, thesis Ch. 4);
+    ``config``: the run's TensionConfig, for the title."""
+    figure, axes = pyplot().subplots(figsize=(6, 4.5))
+    void_ratios = sorted({s["void_ratio_target"] for s in summaries}, reverse=True)
+    for colour, e in zip(("C0", "C3", "C2", "C1"), void_ratios):
+        mine = [s for s in summaries if s["void_ratio_target"] == e]
+        waters = [100 * s["water_content"] for s in mine]
+        axes.plot(waters, [s["tensile_strength_pa"] for s in mine], "o-", color=colour,
+                  label=f"DEM, e = {mine[0]['void_ratio']:.3f}")
+        kim = [(100 * w, t) for ke, w, t in measured if math.isclose(ke, e)]
+        if kim:
+            axes.plot(*zip(*kim), "s", mfc="none", color=colour, label=f"Kim (2001), e = {e}")
+        grid, curve, packing = predictions[e]
+        axes.plot(100 * np.asarray(grid), curve, "--", color=colour,
+                  label=f"regular packing prediction (Ch. 4), {packing}")
+    axes.set(xlabel="gravimetric water content w [%]", ylabel="tensile strength [Pa]",
+             xlim=(0, None), ylim=(0, None),
+             title=f"Tensile strength against water content\n{plot_label(config)}")
+    axes.title.set_fontsize(9)
+    axes.grid(alpha=0.3)
+    axes.legend(fontsize=7)
+    save_figure(figure, path)
+
+
+# ---------------------------------------------------------------- SWCC
+
+def plot_swcc(path, result):
+    """swcc.png: Sr [%] against suction [kPa] (log), both branches, thesis Fig. 5.5's points
+    and the regular packings' curves."""
+    plt = pyplot()
+    figure, axes = plt.subplots(figsize=(6.5, 4.5))
+    for branch, style in (("drying", "o-"), ("wetting", "s--")):
+        rows = result[branch]
+        axes.plot([r["suction"] / 1e3 for r in rows], [100 * r["saturation"] for r in rows],
+                  style, label=f"DEM, {branch}")
+    suctions = [r["suction"] for r in result["drying"]]
+    for kind, values in result["regular_packings"].items():
+        points = [(s / 1e3, 100 * v) for s, v in zip(suctions, values) if v is not None]
+        if points:
+            axes.plot(*zip(*points), ":", lw=1, label=f"{kind.upper()} packing (Ch. 4)")
+    thesis = sorted((float(s), v) for s, v in result["thesis_fig_5_5"].items())
+    axes.plot([s / 1e3 for s, _ in thesis], [100 * v for _, v in thesis], "k*", ms=10,
+              label="thesis Fig. 5.5 (its DEM samples)")
+    axes.set_xscale("log")
+    axes.set_yscale("log")
+    axes.set_xlabel("suction [kPa]")
+    axes.set_ylabel("degree of saturation Sr [%]")
+    sample = result["config"]["fields"]["sample"]["fields"]
+    axes.set_title(f"SWCC, {sample['particles']} spheres, confining {sample['confining']:g} Pa",
+                   fontsize=9)
+    axes.grid(alpha=0.3, which="both")
+    axes.legend(fontsize=7)
     return save_figure(figure, path)

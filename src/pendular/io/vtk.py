@@ -60,7 +60,7 @@ data ``stage`` and ``suction`` [Pa].
 A writer given ``phases`` (names) also writes a frame whenever its ``phase`` attribute changes
 (set by whoever drives the simulation, e.g. pendular.procedures.preparation.prepare_sample), and every frame's
 field data holds ``phase``: the index of the current phase in ``phases`` (the triaxial test's
-``vtk_prep/`` series: pendular.procedures.triaxial.PREP_PHASES).
+``vtk_prep/`` series: pendular.procedures.laboratory.PREP_PHASES).
 """
 
 import os

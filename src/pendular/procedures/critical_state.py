@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from pendular.homogenize.invariants import mean_stress
-from pendular.procedures.loading import friction_angle
+from pendular.procedures.columns import friction_angle
 
 #: Axial strain over which the critical state is judged and measured: the last 5 % [-].
 CRITICAL_STATE_WINDOW = 0.05

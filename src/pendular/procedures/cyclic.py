@@ -21,18 +21,116 @@ at the amplitudes. Stresses compression positive [Pa], strains compression posit
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from pendular.homogenize.invariants import deviator_stress, lateral_stress
 from pendular.io.plots import plot_cyclic, plot_stress_path
 from pendular.io.schema import peak_reached
-from pendular.procedures.config import CyclicConfig
+from pendular.procedures.columns import COMPRESSION_COLUMNS, friction_angle
+from pendular.procedures.command import LaboratoryCommand
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (BridgeConfig, MIN_AXIAL_STRAIN, PathConfig, check_soft,
+    registered)
 from pendular.procedures.guards import AxialStressGuard
-from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress, friction_angle
-from pendular.procedures.triaxial import COMPRESSION_COLUMNS, LaboratoryTest, stress_balance
+from pendular.procedures.laboratory import LaboratoryTest, stress_balance
+from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress
+from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
+    rate_options)
+from pendular.utils.parameters import OptionError, fail, option_of, parameter
+from pendular.procedures.preparation import PrepareConfig
+
+
+#: Most cycles of a cyclic triaxial test: liquefaction tests run tens to hundreds of cycles,
+#: resilient-modulus tests about 2,000 (AASHTO T 307: up to 1,000 to condition, then 15
+#: sequences of 100).
+MAX_CYCLES = 10_000
+
+
+#: Largest axial strain amplitude of a strain-controlled cyclic test [-]: cyclic triaxial tests
+#: measure modulus and damping from about 1e-5 to a few % (Kramer 1996, Ch. 6); beyond, the
+#: extension half of a cycle pulls the sample apart rather than cycling it.
+MAX_CYCLIC_STRAIN = 0.05
+
+
+@registered
+@dataclass
+class CyclicConfig(PathConfig):
+    """Cyclic triaxial loading (pendular.procedures.cyclic.cyclic_stages) from the isotropic
+    confining stress sigma_c, the lateral walls servoed at sigma_c, the axial walls driven at
+    the path's rate: a first loading to the amplitude, then ``cycles`` cycles (at most
+    MAX_CYCLES), each an unloading to minus the amplitude and a reloading back. Exactly one
+    amplitude: ``amplitude_q`` [Pa] (stress control: q = sigma_axial - sigma_lateral between
+    +A and -A, in (0, sigma_c): at -A the axial stress is sigma_c - A, and walls cannot pull)
+    or ``amplitude_strain`` [-] (strain control: the axial strain between +X and -X from the
+    start, in [MIN_AXIAL_STRAIN, MAX_CYCLIC_STRAIN]; a run whose axial stress falls to 0
+    stops with pendular.procedures.loading.StageFailed)."""
+
+    amplitude_q: float | None = parameter(None, unit="Pa", low=0.0, low_inclusive=False,
+                                          flag="--amplitude-q", metavar="PA",
+                                          help="stress control: q cycles between +PA and -PA, "
+                                               "below --confining (one of --amplitude-q and "
+                                               "--amplitude-strain is required)")
+    amplitude_strain: float | None = parameter(None, low=MIN_AXIAL_STRAIN,
+                                               high=MAX_CYCLIC_STRAIN,
+                                               flag="--amplitude-strain", metavar="X",
+                                               help="strain control: the axial strain cycles "
+                                                    "between +X and -X")
+    cycles: int = parameter(10, kind=int, low=1, high=MAX_CYCLES, flag="--cycles",
+                            help="cycles after the first loading")
+
+    TEST = "a cyclic triaxial test"
+    LENGTH = ("--cycles", "--amplitude-strain")
+
+    def __post_init__(self):
+        super().__post_init__()
+        if (self.amplitude_q is None) == (self.amplitude_strain is None):
+            raise ValueError("amplitude_q, amplitude_strain: give exactly one (stress control: "
+                             "q between +-A [Pa]; strain control: the axial strain between "
+                             "+-X)")
+        confining = self.sample.confining
+        if self.amplitude_q is not None:
+            if self.amplitude_q >= confining:
+                raise fail(self, "amplitude_q", f"amplitude_q = {self.amplitude_q!r} Pa is "
+                           f"outside the valid range (0, {confining:g}) Pa: at q = -A the axial "
+                           f"stress is --confining ({confining:g} Pa) - A, and walls cannot "
+                           "pull")
+            check_soft(self, "amplitude_q", confining + self.amplitude_q,
+                       "the largest axial stress (--confining + --amplitude-q)")
+
+    @property
+    def stress_controlled(self):
+        """Whether q (not the axial strain) cycles between the amplitudes."""
+        return self.amplitude_q is not None
+
+    def reference_pressure(self):
+        """The least mean stress of the path [Pa], where the inertial number is taken: sigma_c
+        - A / 3 at q = -A (stress control); 2 sigma_c / 3, its bound while the axial walls
+        touch, under strain control."""
+        confining = self.sample.confining
+        if self.stress_controlled:
+            return confining - self.amplitude_q / 3.0
+        return 2.0 * confining / 3.0
+
+    def estimated_steps(self):
+        """Steps of a strain-controlled path, (1 + 4 cycles) X over the strain of a step;
+        None under stress control (its stages end at a stress)."""
+        if self.stress_controlled:
+            return None
+        travel = (1 + 4 * self.cycles) * self.amplitude_strain
+        return travel / self.strain_per_step(self.rate())
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"amplitude_q": self.amplitude_q, "amplitude_strain": self.amplitude_strain,
+                "cycles": self.cycles}
+
 
 #: Least history rows of a half-cycle under strain control: a loop's area needs its shape.
 MIN_BRANCH_RECORDS = 20
@@ -180,7 +278,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
     about the lateral stress ``confining`` [Pa], default the first record's) is None, with
     ``damping_ratio_measured``, ``damping_ratio_resolution`` and ``damping_ratio_note`` in its
     row (``damping_ratio_effective_*`` of q') and ``damping_ratio_note`` at the top naming the
-    cycles. ``phi_peak_deg`` (loading.friction_angle of the wall stresses) only
+    cycles. ``phi_peak_deg`` (columns.friction_angle of the wall stresses) only
     where a half-cycle has a failure peak (q falls after it by FAILURE_DROP or more). A wet
     history adds, per cycle and at the top, the modulus and damping ratio of the effective
     stress (Eq. 3.43; ``*_effective``)."""
@@ -246,7 +344,7 @@ def cyclic_summary(history, cycles, complete=True, confining=None):
 # ---------------------------------------------------------------- the test
 
 class CyclicTest(LaboratoryTest):
-    """A cyclic triaxial test of ``config`` (pendular.procedures.config.CyclicConfig;
+    """A cyclic triaxial test of ``config`` (pendular.procedures.cyclic.CyclicConfig;
     cyclic_stages): history with ``void_ratio``, ``stage`` and ``cycle``, summary of
     cyclic_summary; figure cyclic.png (the q-eps_a loops, and the secant modulus and damping
     ratio against the cycle). Rows every ``record_strain`` of the path's rate and, under
@@ -286,3 +384,42 @@ class CyclicTest(LaboratoryTest):
         plot_cyclic(history, cyclic_summary(history, config.cycles)["cycles"],
                     os.path.join(out, self.FIGURE), label)
         plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), label)
+
+
+# ---------------------------------------------------------------- the command
+
+
+CYCLIC_OWN = (tuple(dataclasses.replace(option, group="amplitude") for option in options_named(
+                  CyclicConfig, ("amplitude_q", "amplitude_strain")))
+              + (option_of(CyclicConfig, "cycles"),) + rate_options(PathConfig)
+              + (option_of(PathConfig, "record_strain"),))
+
+
+def amplitude_given(values):
+    """OptionError unless one of the cyclic amplitudes is given."""
+    if values["amplitude_q"] is None and values["amplitude_strain"] is None:
+        raise OptionError(lambda name: f"give {name('amplitude_q')} PA (stress control) or "
+                                       f"{name('amplitude_strain')} X (strain control)")
+
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular cyclic --particles 1000 --amplitude-q 200 --cycles 10 --out runs/cyclic",
+           "ten cycles of q = +-200 Pa: the secant modulus and damping ratio of each loop (null "
+           "below its resolution) and the accumulated strains; cyclic.png")
+
+#: Summary keys printed at the end.
+SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
+         "damping_ratio_last", "secant_modulus_first_effective",
+         "secant_modulus_last_effective", "damping_ratio_first_effective",
+         "damping_ratio_last_effective", "axial_strain_accumulated",
+         "volumetric_strain_accumulated", "phi_peak_deg", "initial_porosity", "wall_time_s",
+         "particle_steps_per_s", "damping_ratio_note")
+
+#: The cyclic command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="cyclic",
+    description="cyclic triaxial loading, stress- or strain-controlled",
+    test=CyclicTest,
+    declared=laboratory_options(
+        CYCLIC_OWN, framed(path_command(CyclicConfig, CYCLIC_OWN, check=amplitude_given))),
+    shown=SHOWN, example=EXAMPLE, out="runs/cyclic")

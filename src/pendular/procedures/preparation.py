@@ -229,6 +229,8 @@ MAX_STRESS_OVER_YOUNG = 0.02
 #: Largest sample: about 1 kB of state per sphere and hours per 1e-3 of strain at 1e6 spheres
 #: on a few cores; beyond, memory and run time are out of reach.
 MAX_PARTICLES = 10_000_000
+#: Largest stress a test's options may set [Pa] (confining, axial, normal, stages' stresses).
+MAX_STRESS = 1e7
 #: Sphere radii a run accepts [m]: grains of a micron to a metre. Outside, the strain rate of
 #: an inertial number, the box and the masses leave the floating-point range a run needs.
 RADIUS_RANGE = (1e-6, 1.0)
@@ -329,7 +331,7 @@ class PrepareConfig:
                                         "estimate of the smallest sphere")
     prep_stress: float = parameter(5000.0, unit="Pa", low=0.0, low_inclusive=False,
                                    help="mean wall stress that ends the radius growth")
-    confining: float = parameter(750.0, unit="Pa", low=0.0, high=1e7, flag="--confining",
+    confining: float = parameter(750.0, unit="Pa", low=0.0, high=MAX_STRESS, flag="--confining",
                                  help="isotropic stress the loading starts from, the lateral "
                                       "stress of a triaxial")
     seed: int = parameter(0, kind=int, low=0, high=MAX_SEED, flag="--seed",

@@ -6,7 +6,7 @@ normal stress with x and y held (a K0 consolidation, skipped when the normal str
 confining one), then the shear at the rate gamma_dot to the final shear strain, the normal
 stress held by the cell's servo (drained) or the cell's lengths held (constant volume: the
 volume is conserved exactly). ``SimpleShearTest(config).run(out)`` runs it as every
-laboratory test (pendular.procedures.triaxial.LaboratoryTest: sample, wetting, checkpoints,
+laboratory test (pendular.procedures.laboratory.LaboratoryTest: sample, wetting, checkpoints,
 resume) and writes history.h5 (the loading path's columns and ``shear_strain`` gamma,
 ``shear_stress`` tau, ``normal_stress`` sigma_zz), summary.json (``simple_shear_summary``),
 simple_shear.png (tau, sigma_n and the volumetric strain against gamma), vtk/.
@@ -21,17 +21,110 @@ cell step for step as on the CPU).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
+from dataclasses import dataclass
 
 import numpy as np
 
 from pendular.io.plots import plot_simple_shear
 from pendular.io.schema import peak_reached
 from pendular.io.vtk import shear_strain_fields
-from pendular.procedures.config import SimpleShearConfig
+from pendular.procedures.command import LaboratoryCommand
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (BridgeConfig, MAX_RECORD_STRAIN, MAX_SHEAR_STRAIN,
+    MAX_STRAIN_RATE, MIN_AXIAL_STRAIN, MIN_RECORD_STRAIN, PathConfig, check_soft, registered,
+    stage_steps_parameter)
+from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, ShearStrain, Stage, Static
-from pendular.procedures.triaxial import LaboratoryTest, stress_balance
+from pendular.procedures.options import (SAMPLE, framed, laboratory_fields, laboratory_options,
+    options_named)
+from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
+from pendular.utils.parameters import fail, fields_of, option_of, parameter
+
+
+#: Fewest spheres of a simple shear: its periodic cell must be 3 diameters plus the neighbour
+#: reach across (pendular.dem.neighbors), which 50 spheres at the default porosity miss by a
+#: hair; 60 hold it with a margin.
+MIN_SIMPLE_SHEAR_PARTICLES = 60
+
+
+#: Why a simple shear needs MIN_SIMPLE_SHEAR_PARTICLES (the end of the error refusing fewer).
+NARROW_CELL = ("its periodic cell must span 3 diameters plus the neighbour reach, which fewer "
+               "spheres do not")
+
+
+@registered
+@dataclass
+class SimpleShearConfig(PathConfig):
+    """Simple shear, x with z, of a sample in a periodic cell (pendular.procedures.simple_shear;
+    Lees–Edwards, pendular.dem.cell): from the isotropic confining stress, z brought to
+    ``normal_stress`` [Pa] (None: the confining stress) with x and y held, then sheared to the
+    shear strain ``max_strain`` [-] (in [MIN_AXIAL_STRAIN, MAX_SHEAR_STRAIN]) at that normal
+    stress (drained), or with ``constant_volume`` with the cell's lengths held. The shear rate
+    gamma_dot [1/s] is ``strain_rate`` or the one giving ``inertial_number`` at the lower of
+    the confining and normal stresses (quasi_static_rate); ``record_strain``: shear strain
+    between two history rows; ``stage_steps``: most steps of the consolidation to the normal
+    stress. The sample must be periodic (walls cannot shear it)."""
+
+    # the shear rate gamma_dot [1/s]: PathConfig's strain rate, under the command's name
+    strain_rate: float | None = parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE,
+                                          low_inclusive=False, flag="--shear-rate",
+                                          help="shear rate gamma_dot (overrides "
+                                               "--inertial-number)")
+    record_strain: float = parameter(4e-4, low=MIN_RECORD_STRAIN, high=MAX_RECORD_STRAIN,
+                                     flag="--record-strain",
+                                     help="shear strain between history rows")
+    normal_stress: float | None = parameter(None, unit="Pa", low=0.0, high=MAX_STRESS,
+                                            low_inclusive=False, flag="--normal-stress",
+                                            help="normal stress sigma_zz of the shear "
+                                                 "(default: --confining)")
+    constant_volume: bool = parameter(False, kind=bool, flag="--constant-volume",
+                                      help="shear at constant volume (the cell's lengths held; "
+                                           "the normal stress an output) instead of at "
+                                           "--normal-stress")
+    max_strain: float = parameter(0.2, low=MIN_AXIAL_STRAIN, high=MAX_SHEAR_STRAIN,
+                                  flag="--max-strain", help="final shear strain gamma")
+    stage_steps: int = stage_steps_parameter(
+        2_000_000, "most steps of the consolidation to --normal-stress")
+
+    TEST = "a simple shear test"
+    LENGTH = ("--max-strain",)
+    MIN_PARTICLES, FEWEST = MIN_SIMPLE_SHEAR_PARTICLES, NARROW_CELL
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not self.sample.periodic:
+            raise fail(self.sample, "periodic", "periodic = False: a simple shear needs a "
+                       "periodic cell (--periodic; Lees–Edwards images), walls cannot shear a "
+                       "sample")
+        if self.normal_stress is None:
+            self.normal_stress = self.sample.confining
+        check_soft(self, "normal_stress", self.normal_stress)
+
+    @property
+    def consolidates(self):
+        """Whether z is first brought from the confining to the normal stress."""
+        return self.normal_stress != self.sample.confining
+
+    def reference_pressure(self):
+        """The lower of the confining and normal stresses [Pa], where the inertial number of
+        the shear rate is taken."""
+        return min(self.sample.confining, self.normal_stress)
+
+    def estimated_steps(self):
+        """Steps of the shear, max_strain over the shear strain of a step (the consolidation,
+        which ends at equilibrium, not counted)."""
+        return self.max_strain / self.strain_per_step(self.rate())
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"normal_stress": self.normal_stress, "constant_volume": self.constant_volume,
+                "max_strain": self.max_strain, "stage_steps": self.stage_steps}
+
 
 #: Records whose normal stress is below this fraction of the shear's initial one do not
 #: measure tau / sigma_n (a ratio of noise over nearly zero, e.g. a loose sample whose normal
@@ -192,7 +285,7 @@ def dilatancy(gamma, volumetric):
 
 
 class SimpleShearTest(LaboratoryTest):
-    """A simple shear test of ``config`` (pendular.procedures.config.SimpleShearConfig; module
+    """A simple shear test of ``config`` (pendular.procedures.simple_shear.SimpleShearConfig; module
     docstring): history with ``shear_strain``, ``shear_stress``, ``normal_stress`` (and
     ``stage`` with a consolidation), summary of ``simple_shear_summary``, figure
     simple_shear.png."""
@@ -223,3 +316,51 @@ class SimpleShearTest(LaboratoryTest):
         plot_simple_shear(shear, os.path.join(out, self.FIGURE),
                           f"{kind}, σn = {config.normal_stress / 1e3:g} kPa; {title}",
                           summary=simple_shear_summary(history, config.constant_volume))
+
+
+# ---------------------------------------------------------------- the command
+
+
+#: A simple shear's sample: always in a periodic cell, --periodic implied.
+SIMPLE_SHEAR_SAMPLE = tuple(
+    dataclasses.replace(option, default=True, help="a periodic cell, with Lees–Edwards images "
+                                                   "(implied: walls cannot shear a sample)")
+    if option.key == "periodic" else
+    option_of(PrepareConfig, "particles", low=MIN_SIMPLE_SHEAR_PARTICLES)
+    if option.key == "particles" else option for option in SAMPLE)
+
+SIMPLE_SHEAR_OWN = options_named(SimpleShearConfig, ("normal_stress", "constant_volume",
+                                                "max_strain", "inertial_number", "strain_rate",
+                                                "record_strain", "stage_steps"))
+
+
+def simple_shear_config(values, given):
+    """The SimpleShearConfig of ``values``: always in a periodic cell (walls cannot shear a
+    sample)."""
+    return SimpleShearConfig(**laboratory_fields({**values, "periodic": True}, given,
+                                                 lambda: fields_of(values, SIMPLE_SHEAR_OWN)))
+
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular simple-shear --particles 1000 --normal-stress 1000 "
+           "--constant-volume --max-strain 0.2 --out runs/simple_shear",
+           "a constant-volume simple shear to gamma 20 %: the peak of tau, the peak of "
+           "tau/sigma_n with its friction angle, each with its own record; simple_shear.png with "
+           "the tau-sigma_n stress path")
+
+#: Summary keys printed at the end.
+SHOWN = ("peak_shear_stress", "shear_strain_at_peak_stress", "normal_stress_at_peak_stress",
+         "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak", "normal_stress_at_peak",
+         "shear_stress_at_peak", "peak_reached", "residual_stress_ratio", "phi_residual_deg",
+         "phi_peak_effective_deg", "phi_residual_effective_deg", "normal_stress_final",
+         "max_dilatancy", "dilatancy_angle_deg", "max_volume_change", "liquid_balance_error",
+         "initial_porosity", "wall_time_s", "particle_steps_per_s")
+
+#: The simple-shear command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="simple-shear",
+    description="simple shear (periodic cell), drained or constant volume",
+    test=SimpleShearTest,
+    declared=laboratory_options(
+        SIMPLE_SHEAR_OWN, framed(simple_shear_config), sample=SIMPLE_SHEAR_SAMPLE),
+    shown=SHOWN, example=EXAMPLE, out="runs/simple_shear")

@@ -46,38 +46,100 @@ from __future__ import annotations
 import math
 import os
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from pendular.capillary import CapillaryBridges, sample_radius_ratios
+from pendular.capillary import CapillaryBridges, SURFACE_TENSION, sample_radius_ratios
 from pendular.capillary.liquid_clusters import LiquidClusters
-from pendular.utils.atomic import write_json
+from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.grading import GRADING_UNITS, grading
 from pendular.dem.measure import coordination, porosity
-from pendular.procedures.preparation import prepare_sample, servoed_simulation, static
-from pendular.procedures.progress import swcc_plan
 from pendular.dem.record import HistoryRecorder
-from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import check_device
 from pendular.dem.walls import ConstantStrainRate
-from pendular.utils.progress import whole_run
-from pendular.utils.validate import check_int
 from pendular.homogenize import packing_state, regular_packing
 from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
-
-from pendular.procedures.config import SwccConfig, config_from_dict, config_to_dict
 from pendular.io.history import write_history
 from pendular.io.vtk import pore_mesh, write_pvd, write_vtu
-from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.io.outputs import OutputFolder
-from pendular.io.plots import pyplot, save_figure
+from pendular.io.plots import plot_swcc
+from pendular.io.schema import SWCC_STAGE_UNITS
+from pendular.procedures.columns import history_columns
+from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
+    check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
+    stage_steps_parameter)
+from pendular.procedures.equilibrium import NotStatic, equilibrium_status
+from pendular.procedures.laboratory import (Interrupted, MIN_CONFINING_OVER_YOUNG, plain,
+    run_identity)
+from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
+    sample_sizes, size_options)
+from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
+    servoed_simulation, static)
+from pendular.procedures.progress import swcc_plan
 from pendular.procedures.reference import FIG_5_5
-from pendular.procedures.loading import history_columns
-from pendular.procedures.triaxial import (MIN_CONFINING_OVER_YOUNG, Interrupted, NotStatic,
-    equilibrium_status, plain, run_identity)
+from pendular.procedures.run_options import RunOptions
+from pendular.utils.atomic import write_json
+from pendular.utils.parameters import fail, fields_of, option_of, parameter, validate
+from pendular.utils.progress import whole_run
+from pendular.utils.validate import check_int
+
+
+@registered
+@dataclass
+class SwccConfig:
+    """The soil-water characteristic curve of a sample (pendular.procedures.swcc): drying through
+    ``suctions`` then wetting back, at the sample's confining stress.
+
+    sample: preparation and material (pendular.procedures.preparation.PrepareConfig; its ``confining`` [Pa]
+    holds during the path; at least MIN_SAMPLE_PARTICLES spheres); suctions [Pa]: the path's
+    stages, ascending and distinct, at least two; surface_tension [N/m]; contact_angle [deg];
+    form_gap: at wetting, bridges also form across gaps up to form_gap mean radii (0: at
+    contacts only); stage_steps: most steps per stage to reach equilibrium; record_every: steps
+    between history records; liquid: the liquid regime, "pendular" (bridges alone) or
+    "clusters" (filled pore units beside them: pendular.capillary.liquid_clusters).
+    """
+
+    sample: PrepareConfig = field(default_factory=PrepareConfig)
+    suctions: list[float] = parameter(
+        default_factory=lambda: [3000.0, 10000.0, 30000.0, 100000.0, 300000.0], many=True,
+        unit="Pa", low=0.0, low_inclusive=False, flag="--suctions", metavar="S1,S2,...",
+        help="suctions of the drying path, ascending; wetting goes back along them")
+    surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
+                                       high=MAX_SURFACE_TENSION, low_inclusive=False,
+                                       flag="--surface-tension", help="liquid surface tension")
+    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                     flag="--contact-angle", help="wetting angle")
+    form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
+                                help="at wetting, bridges also form across gaps up to this many "
+                                     "mean radii (0: at contacts only; 1: wherever a bridge of "
+                                     "the lowest suction can exist)")
+    stage_steps: int = stage_steps_parameter(200000, "most steps per stage to reach equilibrium")
+    record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
+                                  help="steps between history records")
+    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                            help="liquid regime: pendular bridges alone, or clusters of filled "
+                                 "pore units beside them (drying from saturation; "
+                                 "docs/liquid_clusters.md)")
+
+    def __post_init__(self):
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, "an SWCC",
+                        AVERAGES)
+        validate(self)
+        if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
+                                                                   self.suctions[1:])):
+            raise fail(self, "suctions", f"suctions = "
+                       f"{','.join(f'{s:g}' for s in self.suctions)}: at least two suctions "
+                       "[Pa], ascending and distinct, expected (the drying path; wetting goes "
+                       "back along it)")
+        check_loaded_confining(self.sample, "an SWCC at constant stress")
+
 
 #: Files a SWCC run owns in its output folder.
 OUTPUTS = ("swcc.json", "swcc.png", "history.h5", "sample.h5", "checkpoint.h5")
@@ -100,6 +162,9 @@ class SwccTest:
     """The SWCC path of a ``SwccConfig`` (module docstring); ``run(out)`` returns the
     swcc.json content."""
 
+    #: The configuration's type.
+    CONFIG = SwccConfig
+
     def __init__(self, config: SwccConfig):
         if not isinstance(config, SwccConfig):
             raise TypeError(f"config must be a SwccConfig, got {type(config).__name__}")
@@ -118,15 +183,18 @@ class SwccTest:
                              "(the clusters' forces would need their face terms in the cell's "
                              "stress)")
 
-    def run(self, out, *, progress=True, threads=None, device="cpu", checkpoint_every=0,
-            stop_after=None):
-        """Run the path into ``out``; ``device``: where the preparation and the stages run,
-        "cpu" or "gpu" (``check_device``, before anything is made); ``checkpoint_every``:
-        steps between checkpoints ``out``/checkpoint.h5 of the path (0: none), from which
-        ``resume`` continues; ``stop_after``: stop the path after this many steps as an
-        interruption would (raises Interrupted)."""
+    def run(self, out, options=None, **settings):
+        """Run the path into ``out`` as ``options`` say (pendular.procedures.run_options
+        .RunOptions; ``settings``: its fields one by one): ``device``: where the preparation
+        and the stages run, "cpu" or "gpu" (``check_device``, before anything is made);
+        ``checkpoint_every``: steps between checkpoints ``out``/checkpoint.h5 of the path (0:
+        none), from which ``resume`` continues; ``stop_after``: stop the path after this many
+        steps as an interruption would (raises Interrupted)."""
+        options = RunOptions.of(options, **settings)
+        progress, threads, device = options.progress, options.threads, options.device
         check_device(device)
-        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
+        checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        stop_after = options.stop_after
         if self.config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
             raise ValueError(f"liquid = 'clusters' runs on the CPU without checkpoints (its pore "
                              f"units are the host's and not yet checkpointed); got device = "
@@ -157,10 +225,14 @@ class SwccTest:
         return path.finish(progress, stop_after)
 
     @classmethod
-    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
+    def resume(cls, out, options=None, **settings):
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration stored in its sample.h5, its path on ``device``; returns the swcc.json
+        configuration stored in its sample.h5, run as ``options`` say (RunOptions;
+        ``settings``: its fields one by one), its path on their device; returns the swcc.json
         content."""
+        options = RunOptions.of(options, **settings)
+        progress, threads, device = options.progress, options.threads, options.device
+        stop_after = options.stop_after
         sample_file = os.path.join(out, "sample.h5")
         checkpoint = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(sample_file):
@@ -469,30 +541,41 @@ def regular_packing_curves(config, suctions):
     return curves
 
 
-def plot_swcc(path, result):
-    """swcc.png: Sr [%] against suction [kPa] (log), both branches, thesis Fig. 5.5's points
-    and the regular packings' curves."""
-    plt = pyplot()
-    figure, axes = plt.subplots(figsize=(6.5, 4.5))
-    for branch, style in (("drying", "o-"), ("wetting", "s--")):
-        rows = result[branch]
-        axes.plot([r["suction"] / 1e3 for r in rows], [100 * r["saturation"] for r in rows],
-                  style, label=f"DEM, {branch}")
-    suctions = [r["suction"] for r in result["drying"]]
-    for kind, values in result["regular_packings"].items():
-        points = [(s / 1e3, 100 * v) for s, v in zip(suctions, values) if v is not None]
-        if points:
-            axes.plot(*zip(*points), ":", lw=1, label=f"{kind.upper()} packing (Ch. 4)")
-    thesis = sorted((float(s), v) for s, v in result["thesis_fig_5_5"].items())
-    axes.plot([s / 1e3 for s, _ in thesis], [100 * v for _, v in thesis], "k*", ms=10,
-              label="thesis Fig. 5.5 (its DEM samples)")
-    axes.set_xscale("log")
-    axes.set_yscale("log")
-    axes.set_xlabel("suction [kPa]")
-    axes.set_ylabel("degree of saturation Sr [%]")
-    sample = result["config"]["fields"]["sample"]["fields"]
-    axes.set_title(f"SWCC, {sample['particles']} spheres, confining {sample['confining']:g} Pa",
-                   fontsize=9)
-    axes.grid(alpha=0.3, which="both")
-    axes.legend(fontsize=7)
-    return save_figure(figure, path)
+# ---------------------------------------------------------------- the command
+
+
+#: An SWCC's sample (1,000 spheres by default), own fields and material.
+SWCC_SAMPLE = (option_of(PrepareConfig, "particles", default=1000, low=MIN_SAMPLE_PARTICLES),
+               option_of(PrepareConfig, "confining"))
+
+SWCC_OWN = options_named(SwccConfig, ("suctions", "contact_angle", "surface_tension",
+                                       "form_gap", "stage_steps", "record_every", "liquid"))
+
+SWCC_MATERIAL = options_named(PrepareConfig, ("friction_deg", "prep_friction_deg", "seed"))
+
+
+def swcc_config(values, given):
+    """The SwccConfig of ``values``."""
+    sample = PrepareConfig(**fields_of(values, SWCC_SAMPLE + SWCC_MATERIAL),
+                           **sample_sizes(values))
+    return SwccConfig(sample=sample, **fields_of(values, SWCC_OWN))
+
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular swcc --particles 1000 --suctions 3000,10000,30000,100000 --out runs/swcc",
+           "Sr and chi along drying then wetting at these suctions, with the hysteresis; "
+           "swcc.json, swcc.png")
+
+#: Summary keys printed at the end, tables of COLUMNS.
+SHOWN = ("drying", "wetting")
+#: Columns of those tables.
+COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
+
+#: The swcc command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="swcc",
+    description="soil-water characteristic curve of a sample: drying then wetting",
+    test=SwccTest,
+    declared=CommandOptions(SWCC_SAMPLE + SWCC_OWN + size_options() + SWCC_MATERIAL
+                            + (CHECKPOINT_EVERY,), swcc_config),
+    shown=SHOWN, example=EXAMPLE, out="runs/swcc", columns=COLUMNS)

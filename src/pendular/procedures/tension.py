@@ -44,65 +44,311 @@ bridges, water_content, saturation, unbalanced_force) and the ParaView series
 ``cases/<case>/vtk/*.pvd`` (every --vtk-every steps, or --vtk-frames frames per pull); with
 ``run(out, checkpoint_every=N)`` checkpoint.h5 (TensionRun), from which
 ``TensionTest.resume(out)`` continues an interrupted run bit for bit.
+
+This module holds the configuration, its options and command (``COMMAND``), the run of the
+cases with its checkpoints; one case's sample, wetting and pull are in
+pendular.procedures.tension_pull, the report in pendular.procedures.tension_report, the
+figures in pendular.io.plots.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
 import time
-from dataclasses import replace
+from dataclasses import dataclass, field
 
 import h5py
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pendular.capillary import (BridgeTable, CapillaryBridges, gravimetric_water_content,
-    sample_radius_ratios)
-from pendular.utils.atomic import write_json, write_text
-from pendular.dem.grading import grading
-from pendular.dem.measure import coordination, unbalanced_force
-from pendular.procedures.preparation import (PrepareConfig, equilibrated, prepare_sample,
-    servo_speed)
-from pendular.dem.record import HistoryRecorder
-from pendular.dem.simulation import Simulation, check_device
-from pendular.dem.grips import Grip
-from pendular.procedures.grips import core_void_ratio, grip_members, grip_reach, tensile_stress
-from pendular.dem.walls import ConstantStrainRate, StressServo
-from pendular.homogenize import packing_state, regular_packing
-
+from pendular.capillary.volume_control import rupture_distance_for_volume
 from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
-from pendular.procedures.config import (TensionConfig, case_name, config_from_dict,
-    config_to_dict, inertial_number)
-from pendular.procedures.loading import measured
-from pendular.procedures.progress import equilibrium_bar, tension_plan
-from pendular.utils.progress import whole_run
-from pendular.homogenize.on_the_fly import homogenized
-from pendular.io.history import write_history
+from pendular.dem.simulation import check_device
+from pendular.homogenize import packing_state, regular_packing
 from pendular.io.outputs import OutputFolder
-from pendular.io.plots import pyplot, save_figure
-from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_SEPARATION,
-    comparison_packing)
-from pendular.procedures.triaxial import Interrupted, frame_period, frames_writer
-from pendular.io.schema import TENSION_SUMMARY_UNITS
+from pendular.io.plots import plot_curves, plot_strength
+from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
+    check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
+from pendular.procedures.laboratory import Interrupted
+from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
+    sample_sizes, size_options)
+from pendular.procedures.preparation import PrepareConfig, pwave_step
+from pendular.procedures.progress import tension_plan
+from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
+    KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
+from pendular.procedures.run_options import RunOptions
+from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
+from pendular.procedures.tension_report import case_line, strength_predictions, write_report
+from pendular.utils.atomic import write_json
 from pendular.utils.integrity import config_hash
+from pendular.utils.parameters import (OptionError, Parameter, ParameterError, default_of, fail,
+    fields_of, option_from, option_of, parameter, spec_of, validate)
+from pendular.utils.progress import whole_run
 from pendular.utils.validate import check_int
-from pendular.procedures.water_content import wet_to_water_volume
 
-#: Surface tension [N/m] of the Chapter 4 comparison (docs/physics.md 'Errata').
-SURFACE_TENSION = CHAPTER4_SURFACE_TENSION
-#: Preparation friction range searched for the void ratio [deg].
-PREP_FRICTION_RANGE = (0.0, 30.0)
-#: Largest number of preparations tried per void ratio.
-PREPARATIONS = 7
-#: Steps allowed to reach equilibrium after wetting; steps between convergence checks.
-WET_STEPS = 200000
-CHECK_EVERY = 200
-#: Extension past the peak over which the stress must stay below the residual to stop [-].
-POST_PEAK_STRAIN = 0.01
-#: History rows over --max-strain.
-RECORDS = 400
+
+#: Fewest spheres of a direct tension sample: the grips hold a layer at each z wall and the
+#: void ratio is the core's, the box less a diameter along each wall; at 100 spheres the box
+#: is about 4.5 diameters across and the core 2.5.
+MIN_TENSION_PARTICLES = 100
+
+
+#: Most spheres of a direct tension sample (each void ratio is tuned over up to
+#: pendular.procedures.tension_pull.PREPARATIONS preparations of it).
+MAX_TENSION_PARTICLES = 1_000_000
+
+
+#: Valid specific gravities Gs of a direct tension's grains [-] (--specific-gravity).
+SPECIFIC_GRAVITY_RANGE = (1.0, 10.0)
+
+#: The direct tension's sample where it differs from PrepareConfig's defaults: Kim's (2001)
+#: F-75 sand (R = 0.11 mm, Gs = 2.65), 2,000 spheres held at 100 Pa.
+TENSION_SAMPLE = {"particles": 2000, "radius": KIM_RADIUS,
+                  "density": SPECIFIC_GRAVITY * WATER_DENSITY, "confining": 100.0}
+
+
+#: The direct tension's ranges of its sample's fields, narrower than PrepareConfig's:
+#: field -> (low, high), the bounds' openness PrepareConfig's.
+TENSION_RANGES = {"radius": (1e-6, 1e-2), "confining": (1.0, 1e5), "young": (0.0, 1e12)}
+
+
+#: The specific gravity Gs = density / WATER_DENSITY of a direct tension's grains, as its
+#: command sets it.
+SPECIFIC_GRAVITY_PARAMETER = Parameter(
+    "1", f"specific gravity Gs of the grains: sets their density, Gs x {WATER_DENSITY:g} "
+    "kg/m^3, which gives their mass (time step, strain rate) and the water volume of a water "
+    "content by mass",
+    *SPECIFIC_GRAVITY_RANGE, flag="--specific-gravity")
+
+#: The core void ratio of a direct tension's case: denser than random close packing or looser
+#: than the loosest growth is unreachable.
+VOID_RATIO_PARAMETER = Parameter("1", "core void ratio", 0.5, 1.2, flag="--void-ratio")
+
+
+def check_tension_sample(fields):
+    """ParameterError naming the field (and its option) of ``fields`` (PrepareConfig's names;
+    those absent are not checked) outside the direct tension's range, narrower than
+    PrepareConfig's: particles in [MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES],
+    TENSION_RANGES, density [kg/m^3] as the specific gravity Gs = density / WATER_DENSITY
+    (--specific-gravity), friction_deg and seed in PrepareConfig's ranges."""
+    if "particles" in fields:
+        check_particles(fields["particles"], MIN_TENSION_PARTICLES, MAX_TENSION_PARTICLES,
+                        "direct tension", "the grips hold a layer at each z wall and the void "
+                        "ratio is the core's")
+    if "density" in fields:
+        SPECIFIC_GRAVITY_PARAMETER.check("specific_gravity", fields["density"] / WATER_DENSITY)
+    for name in ("radius", "confining", "friction_deg", "young", "seed"):
+        if name in fields:
+            spec = spec_of(PrepareConfig, name)
+            low, high = TENSION_RANGES.get(name, (spec.low, spec.high))
+            spec = dataclasses.replace(spec, low=low, high=high)
+            try:
+                spec.check(name, fields[name])
+            except ParameterError:
+                if name != "radius" or fields.get("psd") is None:
+                    raise
+                # the grading curve's sizes, not a --radius given
+                raise ParameterError("psd", f"psd: the grading curve's mean radius, "
+                                     f"{fields['radius']:.3g} m, is outside the valid range "
+                                     f"{spec.valid_range()} m of a direct tension's sphere",
+                                     "--psd") from None
+
+
+def tension_sample(**fields):
+    """The PrepareConfig of a direct tension's sample: TENSION_SAMPLE with ``fields``
+    (PrepareConfig's names) over it, e.g. ``tension_sample(particles=200)``; the tension's ranges
+    (check_tension_sample) checked before PrepareConfig's own."""
+    check_tension_sample(fields)
+    return PrepareConfig(**{**TENSION_SAMPLE, **fields})
+
+
+@registered
+@dataclass
+class TensionConfig:
+    """Direct tension of wet sand at fixed water content (pendular.procedures.tension; Kim 2001,
+    thesis §4.4.1.2 and Table 4.5). Validated on creation (ParameterError naming the field; its
+    Parameter's flag on the command line).
+
+    sample: the grains and their preparation (pendular.procedures.preparation.PrepareConfig,
+    default ``tension_sample()``): particles, sizes (radius [m], the mean radius;
+    radius_spread; psd), density [kg/m^3], the one grain density (its specific gravity Gs =
+    density / WATER_DENSITY turns water contents by mass into water volumes; the command's
+    --specific-gravity sets it), confining: isotropic stress of preparation and wetting [Pa],
+    friction_deg: contact friction of wetting and pull [deg], young: YADE young E [Pa], seed,
+    periodic: a periodic cell pulled along z at zero lateral stress (no walls, no grips: a
+    grip_depth other than the default is refused; the void ratio is the whole cell's). Its
+    prep_friction_deg is not used: the growth friction is tuned to each void ratio. Ranges
+    narrower than PrepareConfig's: check_tension_sample.
+
+    cases: [(core void ratio [-], gravimetric water content [-, a fraction])], one sample per
+    void ratio (default Kim's six), distinct by their folder names (``case_name``);
+    roughness: meniscus separation of touching grains H/R [-]; form_gap: at wetting, bridges
+    also form across gaps up to form_gap x radius [-] (0: at contacts only; the default 1
+    reaches past the rupture distance of Kim's bridges, so they form wherever they can;
+    pendular.capillary.wetting); contact_angle [deg], surface_tension [N/m];
+    inertial_number: I of the pull [-]; max_strain: largest axial extension [-]; residual:
+    fraction of the peak below which the pull has ruptured [-]; grip_depth: grip thickness
+    [diameters] (walls only); void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull
+    (0: none); vtk_every: steps between frames instead (None: from vtk_frames; 0: none), both
+    at most the pull's steps (``pull_steps``).
+    """
+
+    sample: PrepareConfig = field(default_factory=tension_sample)
+    cases: list[tuple[float, float]] = parameter(
+        default_factory=lambda: [(e, w) for e, w, _ in KIM_2001], kind=None, recorded=False,
+        help="(core void ratio, gravimetric water content as a fraction) of each case")
+    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=0.5, flag="--roughness",
+                                 help="meniscus separation of touching grains H/R (default "
+                                      "Kim's sand, as in the regular packing prediction; 0: "
+                                      "smooth spheres)")
+    form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
+                                help="at wetting, bridges also form across gaps up to this many "
+                                     "radii (0: at contacts only; 1: wherever a bridge of the "
+                                     "formation suction can exist, docs/direct_tension.md)")
+    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
+                                     flag="--contact-angle", help="wetting angle")
+    surface_tension: float = parameter(CHAPTER4_SURFACE_TENSION, unit="N/m", low=0.0,
+                                       high=MAX_SURFACE_TENSION, low_inclusive=False,
+                                       flag="--surface-tension",
+                                       help="surface tension (thesis Chapter 4's, which the "
+                                            "comparison with Kim and the regular packing "
+                                            "prediction uses; triaxial and swcc default to "
+                                            "Chapter 5's 0.073)")
+    inertial_number: float = parameter(1e-3, low=0.0, high=0.01, low_inclusive=False,
+                                       flag="--inertial-number",
+                                       help="I = strain rate x d x sqrt(rho / confining) of "
+                                            "the pull")
+    max_strain: float = parameter(0.1, low=0.0, high=0.5, low_inclusive=False,
+                                  flag="--max-strain", help="largest axial extension of the pull")
+    residual: float = parameter(0.2, low=0.0, high=1.0, low_inclusive=False,
+                                high_inclusive=False, flag="--residual",
+                                help="fraction of the peak below which the pull has ruptured")
+    grip_depth: float = parameter(1.0, low=0.0, high=3.0, flag="--grip-depth", unset=True,
+                                  help="grip thickness: particles whose surface is within this "
+                                       "many diameters of a z wall, in diameters (not with "
+                                       "--periodic, which has no grips)")
+    void_ratio_tolerance: float = parameter(0.01, low=0.001, high=0.1,
+                                            flag="--void-ratio-tolerance",
+                                            help="largest |e - target| accepted from the "
+                                                 "preparation")
+    vtk_frames: int = parameter(20, kind=int, low=0, high=1000, flag="--vtk-frames",
+                                help="ParaView frames per pull (0: none)")
+    vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
+                                      help="steps between ParaView frames of the pull, instead "
+                                           "of --vtk-frames (0: none)")
+
+    def __post_init__(self):
+        if not isinstance(self.sample, PrepareConfig):
+            raise TypeError(f"sample must be a PrepareConfig, got {type(self.sample).__name__}")
+        check_tension_sample(vars(self.sample))
+        validate(self)
+        self.cases = [(float(e), float(w)) for e, w in self.cases]
+        if not self.cases:
+            raise ValueError("cases = [] is empty: give at least one (void ratio, water "
+                             "content)")
+        for e, _ in self.cases:
+            # denser than random close packing or looser than the loosest growth: unreachable
+            VOID_RATIO_PARAMETER.check("void_ratio", e)
+        names = [case_name(e, w) for e, w in self.cases]
+        for k, name in enumerate(names):
+            if name in names[:k]:        # one folder, one sample per void ratio: run once
+                (e0, w0), (e1, w1) = self.cases[names.index(name)], self.cases[k]
+                raise ValueError(
+                    f"cases: (e {e0:g}, w {100 * w0:g} %) and (e {e1:g}, w {100 * w1:g} %) "
+                    f"share the folder {name}: give each case once, void ratios 0.01 or water "
+                    "contents 0.01 % apart")
+        if self.sample.periodic and self.grip_depth != default_of(TensionConfig, "grip_depth"):
+            raise fail(self, "grip_depth", f"grip_depth = {self.grip_depth:g} does not apply "
+                       "to --periodic: a periodic cell has no walls, so no grips")
+        steps = self.pull_steps()
+        for name in ("vtk_frames", "vtk_every"):
+            if getattr(self, name) is not None:
+                try:
+                    check_steps_count(name, getattr(self, name), steps,
+                                      f"the pull to --max-strain {self.max_strain:g}")
+                except ValueError as error:
+                    raise fail(self, name, str(error)) from None
+        for e, w in self.cases:
+            limit = self.pendular_limit(e)
+            if not 0.0 < w <= limit:
+                raise ParameterError("water_content", f"water_content = {100.0 * w:g} % is "
+                                     f"outside the valid range (0, {100.0 * limit:.3g}] %: the "
+                                     "pendular regime ends at the pendular limit of the "
+                                     f"{comparison_packing(e)[1]} packing", "--water-content")
+
+    @property
+    def specific_gravity(self):
+        """Specific gravity Gs of the grains [-]: the sample's density over WATER_DENSITY."""
+        return self.sample.density / WATER_DENSITY
+
+    def options(self):
+        """The run's options, flat and named as the command's (tension.json 'arguments' of a
+        library run, campaign rows): the sample's as --particles, --radius, ..., its density
+        as specific_gravity."""
+        sample = self.sample
+        return {"roughness": self.roughness, "form_gap": self.form_gap,
+                "particles": sample.particles, "radius": sample.radius,
+                "radius_spread": sample.radius_spread, "psd": sample.psd,
+                "contact_angle": self.contact_angle, "surface_tension": self.surface_tension,
+                "specific_gravity": self.specific_gravity, "confining": sample.confining,
+                "friction": sample.friction_deg, "young": sample.young,
+                "inertial_number": self.inertial_number, "max_strain": self.max_strain,
+                "residual": self.residual, "grip_depth": self.grip_depth,
+                "void_ratio_tolerance": self.void_ratio_tolerance,
+                "vtk_frames": self.vtk_frames, "vtk_every": self.vtk_every,
+                "seed": sample.seed, "periodic": sample.periodic}
+
+    def pull_steps(self):
+        """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
+        the strain rate times the P-wave step of the mean radius (pendular.procedures.preparation
+        .pwave_step; the pull runs at the 'stiffness' rule's step, 1.4-1.5 times longer on
+        prepared samples); a pull that ruptures stops sooner."""
+        sample = self.sample
+        rate = self.inertial_number / inertial_number(1.0, sample.radius, sample.density,
+                                                      sample.confining)
+        return self.max_strain / (rate * pwave_step(sample.radius, sample))
+
+    def pendular_limit(self, void_ratio):
+        """Gravimetric water content [-] at the pendular limit of the regular packing compared
+        with a sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION)."""
+        kind, _ = comparison_packing(void_ratio)
+        return packing_state(regular_packing(kind, separation=KIM_SEPARATION),
+                             radius=self.sample.radius, contact_angle=self.contact_angle,
+                             surface_tension=self.surface_tension,
+                             filling_angle=regular_packing(kind).max_filling_angle,
+                             specific_gravity=self.specific_gravity).water_content
+
+
+    def least_water_content(self, void_ratio):
+        """Gravimetric water content [-] below which the regular packing compared with a
+        sample of ``void_ratio`` (reference.comparison_packing, H/R = KIM_SEPARATION) holds
+        no bridge: its bridges' rupture distance (capillary.rupture_distance_for_volume)
+        falls below the grains' separation. Bisection in ln w up to the pendular limit."""
+        packing = regular_packing(comparison_packing(void_ratio)[0], separation=KIM_SEPARATION)
+        pore_volume = packing.porosity * packing.cell_volume           # [R^3]
+
+        def holds(water):
+            volume_star = (water * self.specific_gravity / packing.void_ratio * pore_volume
+                           / packing.bridges_per_cell)
+            try:
+                reach = rupture_distance_for_volume(1.0, self.contact_angle, volume_star)
+            except ValueError:                   # a volume below the solver's bridges
+                return False
+            return reach >= KIM_SEPARATION
+
+        low, high = 1e-9, self.pendular_limit(void_ratio)
+        if holds(low):
+            return 0.0
+        for _ in range(40):
+            middle = math.sqrt(low * high)
+            low, high = (low, middle) if holds(middle) else (middle, high)
+        return high
+
+
 #: Files and folders a tension run owns in its output folder.
 OUTPUTS = ("tension.json", "report.md", "plots", "cases", "checkpoint.h5")
 
@@ -128,488 +374,46 @@ def cases_of(void_ratios: list[float] | None = None,
     return result
 
 
-def prepare_config(config: TensionConfig, prep_friction: float) -> PrepareConfig:
-    """The sample's preparation (thesis Ch. 5.2.2) with growth friction ``prep_friction`` [deg]."""
-    return replace(config.sample, prep_friction_deg=prep_friction)
-
-
-def sample_void_ratio(sim: Simulation, radius: float) -> float:
-    """Void ratio of the core: the box less one diameter along each wall (a periodic cell,
-    which has no wall layers: the whole cell)."""
-    if sim.walls.periodic:
-        voids = sim.walls.volume() - sim.particles.solid_volume()
-        return voids / sim.particles.solid_volume()
-    return core_void_ratio(sim.particles, sim.walls, 2.0 * radius, radius / 8.0)
-
-
-def prepare_void_ratio(config: TensionConfig, target: float, progress: bool,
-                       device: str = "cpu") -> tuple[Simulation, dict]:
-    """(sim, preparation report) of the sample whose core void ratio is within tolerance of
-    ``target``: regula falsi on the growth friction over PREP_FRICTION_RANGE; the closest
-    preparation if none is within tolerance after PREPARATIONS tries. ValueError when the
-    target lies outside the void ratios of the range's two ends. The preparations run on
-    ``device`` ("cpu" or "gpu"), and so do the returned simulation's runs."""
-    tried = {}
-
-    def prepared(friction):
-        sim, report = prepare_sample(prepare_config(config, friction), progress=progress,
-                                     device=device)
-        report["void_ratio"] = sample_void_ratio(sim, config.sample.radius)
-        report["box_void_ratio"] = report["porosity"] / (1.0 - report["porosity"])
-        report["prep_friction_deg"] = friction
-        tried[friction] = (sim, report)
-        if progress:
-            print(f"  prepared: growth friction {friction:.2f} deg -> core e = "
-                  f"{report['void_ratio']:.4f} (box {report['box_void_ratio']:.4f})", flush=True)
-        return report["void_ratio"] - target
-
-    low, high = PREP_FRICTION_RANGE
-    error_low = prepared(low)
-    if error_low > config.void_ratio_tolerance:
-        raise ValueError(f"--void-ratio = {target:g} is outside the valid range of this "
-                         f"sample, [{target + error_low:.3f}, ...]: the densest preparation "
-                         f"(growth friction {low:g} deg) gives e = {target + error_low:.3f}")
-    if abs(error_low) > config.void_ratio_tolerance:
-        error_high = prepared(high)
-        if error_high < -config.void_ratio_tolerance:
-            # the ends of the friction range need not order the void ratios (small samples)
-            ends = sorted((target + error_low, target + error_high))
-            raise ValueError(f"--void-ratio = {target:g} is outside the valid range of this "
-                             f"sample, [{ends[0]:.3f}, {ends[1]:.3f}]: the preparations at "
-                             f"growth friction {low:g} and {high:g} deg give e = "
-                             f"{target + error_low:.3f} and {target + error_high:.3f}")
-    def closest():
-        return min(abs(report["void_ratio"] - target) for _, report in tried.values())
-
-    while len(tried) < PREPARATIONS and closest() > config.void_ratio_tolerance:
-        guess = round(low - error_low * (high - low) / (error_high - error_low), 2)
-        if guess in tried:                      # secant stalled: bisect the bracket
-            guess = round(0.5 * (low + high), 2)
-            if guess in tried:
-                break
-        error = prepared(guess)
-        if error < 0.0:
-            low, error_low = guess, error
-        else:
-            high, error_high = guess, error
-    sim, report = min(tried.values(), key=lambda item: abs(item[1]["void_ratio"] - target))
-    report["preparations"] = {f"{f:.3f}": r["void_ratio"] for f, (_, r) in sorted(tried.items())}
-    return sim, report
-
-
-def wetted_pairs(sim: Simulation, max_gap: float) -> tuple[np.ndarray, np.ndarray,
-                                                             np.ndarray | None]:
-    """(pair_i, pair_j, gap [m] or None) of the pairs that take liquid at wetting: the
-    touching pairs of ``sim``'s contacts, and with ``max_gap`` [m] > 0 every pair whose gap is
-    at most max_gap (found afresh over all spheres, gap 0 for touching ones)."""
-    particles = sim.particles
-    if max_gap <= 0.0:
-        touching = sim.contacts.overlap > 0.0
-        return sim.contacts.pair_i[touching], sim.contacts.pair_j[touching], None
-    radius = particles.radius
-    position, box = particles.position, None
-    if sim.walls.periodic:           # pairs through the faces, nearest image
-        box = sim.walls.lengths()
-        position = np.mod(position, box)
-    pairs = cKDTree(position, boxsize=box).query_pairs(2.0 * radius.max() + max_gap,
-                                                       output_type="ndarray")
-    i, j = pairs[:, 0], pairs[:, 1]
-    branch = position[j] - position[i]
-    if box is not None:
-        branch -= box * np.round(branch / box)
-    gap = np.linalg.norm(branch, axis=1) - radius[i] - radius[j]
-    near = gap <= max_gap
-    return i[near], j[near], np.maximum(gap[near], 0.0)
-
-
-def wet(dry: Simulation, config: TensionConfig, water_content: float,
-        progress: bool) -> tuple[Simulation, CapillaryBridges, dict]:
-    """(wetted sim, bridges, wetting report): volume-controlled bridges at every contact of a
-    copy of ``dry`` (and across every gap up to config.form_gap radii) holding water content
-    ``water_content`` (fraction) once static, the formation suction corrected for the contacts
-    the bridges add (the wetting law itself, formation suction at a water volume, is
-    pendular.capillary.formation_suction)."""
-    particles = dry.particles
-    target = water_content * config.specific_gravity * particles.solid_volume()
-    max_gap = config.form_gap * config.sample.radius
-    pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
-    table = BridgeTable.cached(config.contact_angle,
-                               radius_ratios=sample_radius_ratios(particles.radius))
-
-    def build(suction):
-        return CapillaryBridges(suction, config.surface_tension, config.contact_angle,
-                                control="volume", roughness=config.roughness)
-
-    def settle(sim):
-        return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
-                       progress=equilibrium_bar("wet" if progress else None,
-                                                config.sample.equilibrium_unbalanced,
-                                                config.sample.stress_tolerance))
-
-    sim, bridges, tries = wet_to_water_volume(
-        dry, target, table, (particles.radius[pair_i], particles.radius[pair_j], gap), build,
-        settle, surface_tension=config.surface_tension, roughness=config.roughness,
-        max_gap=max_gap)
-    suction = tries[-1]["formation_suction_pa"]
-    attempts = [{"formation_suction_pa": t["formation_suction_pa"], "steps": t["steps"],
-                 "water_content": gravimetric_water_content(
-                     t["water_volume"], particles.solid_volume(), config.specific_gravity)}
-                for t in tries]
-    report = {"formation_suction_pa": suction, "wetting_attempts": attempts,
-              "water_content": attempts[-1]["water_content"],
-              "saturation": bridges.saturation(sim), "bridges": bridges.count(sim),
-              "coordination_wet": coordination(sim.contacts, len(sim.particles)),
-              "void_ratio_wet": sample_void_ratio(sim, config.sample.radius),
-              "unbalanced_force_wet": unbalanced_force(sim.particles, sim.contacts)}
-    return sim, bridges, report
-
-
-class Pull:
-    """The pull of a sample held by its six walls' servo: z walls apart at constant strain
-    rate, grips, recorder (with the bridges' columns when ``bridges`` is given) and ParaView
-    writer (a frame every ``config.vtk_every`` steps, or ``config.vtk_frames`` frames over
-    --max-strain); ``run()`` pulls to rupture and returns (steps, history). In a periodic cell:
-    the cell stretched along z at the strain rate, its x and y stress servoed at zero, no
-    grips; the tensile stress is minus the cell's z stress."""
-
-    def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
-                 config: TensionConfig, folder: str, progress: bool):
-        self.sim, self.bridges, self.config, self.progress = sim, bridges, config, progress
-        sample = config.sample
-        self.rate = config.inertial_number / inertial_number(1.0, sample.radius,
-                                                           sim.particles.density, sample.confining)
-        self.extension = ConstantStrainRate("z", -self.rate, sim.walls.lengths()[2])
-        if sim.walls.periodic:
-            self.grips = []
-            lateral = StressServo("xy", 0.0, servo_speed(sim.walls, sim.dt))
-            sim.controls = [self.extension, lateral]
-        else:
-            depth = grip_reach(sample.radius, config.grip_depth, sim.particles.radius)
-            self.grips = [Grip(wall, grip_members(sim.particles.position, sim.particles.radius,
-                                                  sim.walls, wall, depth)) for wall in (4, 5)]
-            sim.controls = [self.extension, *self.grips]   # the x, y walls held where they are
-            for op in self.grips:            # the grips' pull of the current (wetted) state
-                op.apply(sim)
-        self.steps = int(math.ceil(config.max_strain / (self.rate * sim.dt)))
-        period = max(1, self.steps // RECORDS)
-        # the homogenised columns measured where the state is held (loading.measured): on a
-        # device a record then brings back the walls alone, with the grips' pulls
-        columns = {
-            "step": lambda s: s.step,
-            "time": lambda s: s.time,
-            "axial_strain": lambda s: self.extension.strain(s.walls),
-            "tensile_stress": self.tensile_stress,
-            "sigma_wall": lambda s: s.walls.stress(),
-            "coordination": measured("coordination"),
-            "unbalanced_force": measured("unbalanced_force"),
-        }
-        if self.grips:
-            columns["grip_pull"] = self.pulls
-        if bridges is not None:
-            solid = sim.particles.solid_volume()
-            water_volume = measured("water_volume")
-
-            def saturation(s):
-                return homogenized(s)["water_volume"] / (s.walls.volume() - solid)
-
-            columns.update({
-                "bridges": measured("bridges"),
-                "water_content": lambda s: gravimetric_water_content(
-                    water_volume(s), solid, config.specific_gravity),
-                "saturation": saturation})
-        self.start = sim.step
-        self.recorder = HistoryRecorder(period, columns, origin=sim.step, reads=("walls",))
-        self.recorder.record(sim)
-        sim.writers.append(self.recorder)
-        self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
-                                                           self.steps))
-
-    def pulls(self, sim: Simulation) -> list[float]:
-        """The grips' pulls [N] (z-, z+) of ``sim``'s state."""
-        sim.fetch("walls")  # on a device the pulls come back with the walls (dem.grips.Grip)
-        return [grip.pull for grip in self.grips]
-
-    def tensile_stress(self, sim: Simulation) -> float:
-        """Tensile stress of the specimen [Pa], positive in tension: the grips' mean pull over
-        the cross-section (pendular.procedures.grips.tensile_stress), or minus a periodic cell's
-        z stress."""
-        walls = sim.fetch("walls").walls   # on a device the pulls come back with the walls
-        if walls.periodic:
-            return -float(walls.stress()[2])
-        return tensile_stress(self.grips, walls)
-
-    def ruptured(self, sim: Simulation) -> bool:
-        """The stress has stayed below the residual fraction of its positive peak for
-        POST_PEAK_STRAIN of extension."""
-        stress = self.recorder.rows["tensile_stress"]
-        peak = int(np.argmax(stress))
-        strain = self.recorder.rows["axial_strain"]
-        return (stress[peak] > 0.0 and stress[-1] < self.config.residual * stress[peak]
-                and strain[peak] - strain[-1] >= POST_PEAK_STRAIN)
-
-    def _ended(self, sim: Simulation) -> bool:
-        """Whether the pull has ended: at its last step, or ruptured at one of its checks
-        (every recorder period of the pull, where an uninterrupted pull checks)."""
-        taken = sim.step - self.start
-        return taken >= self.steps or (taken > 0 and taken % self.recorder.period == 0
-                                       and self.ruptured(sim))
-
-    def advance(self, label: str | None, budget: float = math.inf) -> bool:
-        """Pull on from where the pull stands (a resumed one too: its checks fall where they
-        fell before) to rupture or --max-strain, at most ``budget`` steps; whether it ended."""
-        def status(s):
-            return {"ext": f"{-self.extension.strain(s.fetch('walls').walls):.4f}",
-                    "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
-
-        sim, period = self.sim, self.recorder.period
-        label = label if self.progress else None
-        taken = 0
-        while not self._ended(sim):
-            if taken >= budget:
-                return False
-            done = sim.step - self.start
-            steps = int(min(self.steps - done, budget - taken))
-            offset = done % period
-            if offset:
-                taken += sim.run(min(period - offset, steps), progress=label, status=status)
-                continue
-            taken += sim.run(steps, until=self._ended, check_every=period, progress=label,
-                             status=status)
-        if self.vtk is not None:
-            self.vtk.close(sim)
-        return True
-
-    def run(self, label: str | None) -> tuple[int, dict]:
-        """Pull to rupture; (steps, history)."""
-        self.advance(label)
-        return self.sim.step - self.start, self.recorder.arrays()
-
-
-def prediction(config: TensionConfig, void_ratio: float,
-               water_content: float) -> tuple[float, str, float]:
-    """(psi_xx [Pa], label, void ratio of the packing) of pendular.homogenize.packing_state for the
-    comparison packing at this water content (exact bridges, H/R = 0.09)."""
-    kind, label = comparison_packing(void_ratio)
-    packing = regular_packing(kind, separation=KIM_SEPARATION)
-    state = packing_state(packing, radius=config.sample.radius,
-                          contact_angle=config.contact_angle,
-                          surface_tension=config.surface_tension, water_content=water_content,
-                          specific_gravity=config.specific_gravity)
-    return float(state.psi[0, 0]), label, packing.void_ratio
-
-
-def kim_measured(void_ratio: float, water_content: float) -> float | None:
-    """Kim's (2001) tensile strength [Pa] of this case, or None."""
-    for e, w, strength in KIM_2001:
-        if math.isclose(e, void_ratio) and math.isclose(w, water_content):
-            return strength
-    return None
-
-
-def run_case(dry: Simulation, preparation: dict, config: TensionConfig, void_ratio: float,
-             water_content: float, out: str, progress: bool,
-             arguments: dict | None = None, run: TensionRun | None = None) -> tuple[dict, dict]:
-    """Wet, pull and summarise one case into ``out``/cases/<case>: history.h5 (and vtk/);
-    returns (summary, history). ``arguments``: history file attributes (default the
-    configuration's options, TensionConfig.options); ``run``: the TensionRun whose
-    checkpoints and interruptions watch the pull (None: pulled to its end)."""
-    name = case_name(void_ratio, water_content)
-    folder = os.path.join(out, "cases", name)
-    os.makedirs(folder, exist_ok=True)
-    started = time.perf_counter()
-    sim, bridges, wetting = wet(dry, config, water_content, progress)
-    wetted = time.perf_counter()
-    pull = Pull(sim, bridges, config, folder, progress)
-    earlier = 0.0
-    if run is None:
-        pull.advance(f"pull {name}")
-    else:
-        earlier = run.pull(pull, f"pull {name}")
-    steps, history = sim.step - pull.start, pull.recorder.arrays()
-    stress = history["tensile_stress"]
-    peak = int(np.argmax(stress))
-    strength = float(stress[peak])
-    predicted, packing_label, packing_e = prediction(config, void_ratio, water_content)
-    measured = kim_measured(void_ratio, water_content)
-    before_peak = history["unbalanced_force"][1:peak + 1]
-    summary = {
-        "case": name,
-        "void_ratio_target": void_ratio,
-        "void_ratio": preparation["void_ratio"],
-        "void_ratio_box": preparation["box_void_ratio"],
-        "void_ratio_wet": wetting["void_ratio_wet"],
-        "prep_friction_deg": preparation["prep_friction_deg"],
-        "water_content_target": water_content,
-        **wetting,
-        "grading": grading(sim.particles.radius),
-        "grip_particles": [len(grip.members) for grip in pull.grips],
-        "tensile_strength_pa": strength,
-        "axial_extension_at_peak": float(-history["axial_strain"][peak]),
-        "water_content_at_peak": float(history["water_content"][peak]),
-        "bridges_at_peak": int(history["bridges"][peak]),
-        "final_tensile_stress_pa": float(stress[-1]),
-        "final_axial_extension": float(-history["axial_strain"][-1]),
-        "ruptured": bool(stress[-1] < config.residual * strength),
-        "kim_measured_pa": measured,
-        "packing_state_pa": predicted,
-        "packing_state_packing": f"{packing_label}, e = {packing_e:.3f}, H/R = {KIM_SEPARATION}",
-        "relative_difference_to_kim": None if measured is None else strength / measured - 1.0,
-        "relative_difference_to_packing_state": strength / predicted - 1.0,
-        "strain_rate": pull.rate,
-        "inertial_number": config.inertial_number,
-        "mean_unbalanced_force_to_peak": float(np.mean(before_peak)) if len(before_peak) else None,
-        "unbalanced_force_at_peak": float(history["unbalanced_force"][peak]),
-        "pull_steps": steps,
-        "dt": sim.dt,
-        "wetting_time_s": wetted - started,
-        "pull_time_s": earlier + time.perf_counter() - wetted,
-    }
-    attributes = dict(arguments if arguments is not None else config.options())
-    attributes.update({key: value for key, value in summary.items()
-                       if isinstance(value, (int, float, str))})
-    write_history(os.path.join(folder, "history.h5"), history, config_to_dict(config),
-                  attributes=attributes)
-    summary["units"] = {key: unit for key, unit in TENSION_SUMMARY_UNITS.items()
-                        if key in summary}
-    return summary, history
-
-
-def plot_label(config: TensionConfig) -> str:
-    """One line of the run's parameters for the figures' titles."""
-    sample = config.sample
-    return (f"N = {sample.particles}, R = {sample.radius * 1e3:g} mm, contact angle "
-            f"θ = {config.contact_angle:g}°, γ = {config.surface_tension:g} N/m")
-
-
-def case_label(summary: dict) -> str:
-    """A case in words: its target void ratio and water content."""
-    return (f"e = {summary['void_ratio_target']:g}, "
-            f"w = {100 * summary['water_content_target']:g} %")
-
-
-def plot_curves(summaries: list[dict], histories: dict, folder: str,
-                config: TensionConfig) -> None:
-    """Tensile stress against axial extension, one figure per case (tension_<case>.png) and
-    one with all (tension_all.png)."""
-    plt = pyplot()
-    every, all_axes = plt.subplots(figsize=(6, 4))
-    for summary in summaries:
-        history = histories[summary["case"]]
-        figure, axes = plt.subplots(figsize=(6, 4))
-        for target in (axes, all_axes):
-            target.plot(-100.0 * history["axial_strain"], history["tensile_stress"],
-                        label=case_label(summary))
-        axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
-                 title=f"Direct tension, {case_label(summary)}\n{plot_label(config)}")
-        axes.title.set_fontsize(9)
-        axes.grid(alpha=0.3)
-        save_figure(figure, os.path.join(folder, f"tension_{summary['case']}.png"))
-    all_axes.set(xlabel="axial extension [%]", ylabel="tensile stress [Pa]",
-                 title=f"Direct tension, every case\n{plot_label(config)}")
-    all_axes.title.set_fontsize(9)
-    all_axes.grid(alpha=0.3)
-    all_axes.legend(fontsize=7)
-    save_figure(every, os.path.join(folder, "tension_all.png"))
-
-
-def plot_strength(summaries: list[dict], config: TensionConfig, path: str) -> None:
-    """Tensile strength against water content: DEM, Kim (2001) and the prediction of the
-    regular packing of the same void ratio (pendular.homogenize.packing_state, thesis Ch. 4)."""
-    figure, axes = pyplot().subplots(figsize=(6, 4.5))
-    void_ratios = sorted({s["void_ratio_target"] for s in summaries}, reverse=True)
-    for colour, e in zip(("C0", "C3", "C2", "C1"), void_ratios):
-        mine = [s for s in summaries if s["void_ratio_target"] == e]
-        waters = [100 * s["water_content"] for s in mine]
-        axes.plot(waters, [s["tensile_strength_pa"] for s in mine], "o-", color=colour,
-                  label=f"DEM, e = {mine[0]['void_ratio']:.3f}")
-        kim = [(100 * w, t) for ke, w, t in KIM_2001 if math.isclose(ke, e)]
-        if kim:
-            axes.plot(*zip(*kim), "s", mfc="none", color=colour, label=f"Kim (2001), e = {e}")
-        grid = np.linspace(0.002, max(s["water_content_target"] for s in mine) * 1.15, 25)
-        curve = [prediction(config, e, w)[0] for w in grid]
-        axes.plot(100 * grid, curve, "--", color=colour,
-                  label=f"regular packing prediction (Ch. 4), {comparison_packing(e)[1]}")
-    axes.set(xlabel="gravimetric water content w [%]", ylabel="tensile strength [Pa]",
-             xlim=(0, None), ylim=(0, None),
-             title=f"Tensile strength against water content\n{plot_label(config)}")
-    axes.title.set_fontsize(9)
-    axes.grid(alpha=0.3)
-    axes.legend(fontsize=7)
-    save_figure(figure, path)
-
-
-def case_line(summary: dict) -> str:
-    """The progress line of a finished case (``run_case``'s summary): its strength beside
-    Kim's measurement, when he made one, and the regular packing's prediction."""
-    kim = summary["kim_measured_pa"]
-    measured = "no Kim measurement" if kim is None else f"Kim {kim:.1f} Pa"
-    return (f"  {summary['case']}: tensile strength {summary['tensile_strength_pa']:.1f} Pa "
-            f"({measured}, regular packing prediction {summary['packing_state_pa']:.1f} Pa)")
-
-
-def _percent(value):
-    return "" if value is None else f"{100 * value:+.0f} %"
-
-
-def report_lines(summaries: list[dict], config: TensionConfig) -> list[str]:
-    """The lines of report.md: one table row per case."""
-    sample = config.sample
-    lines = [f"# Direct tension, {sample.particles} spheres, R = {sample.radius * 1e3:g} mm, "
-             f"contact angle θ = {config.contact_angle:g}°, surface tension "
-             f"γ = {config.surface_tension:g} N/m, bridge roughness H/R = {config.roughness:g}",
-             "",
-             "Tensile strength [Pa] positive in tension. e: core void ratio (box less one "
-             "diameter along each wall); w: gravimetric water content (water mass over grain "
-             f"mass, Gs = {config.specific_gravity:g}); Sr: degree of saturation; prediction: "
-             "tensile strength psi_xx of the regular packing compared with this void ratio at "
-             f"the target w (thesis Ch. 4, exact bridges, H/R = {KIM_SEPARATION:g}).",
-             "",
-             "| e target | e reached (box) | w target [%] | w [%] | Sr | bridges | s_form [Pa] "
-             "| DEM | Kim | prediction | DEM/Kim | DEM/prediction |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for s in summaries:
-        kim = "" if s["kim_measured_pa"] is None else f"{s['kim_measured_pa']:.1f}"
-        lines.append(
-            f"| {s['void_ratio_target']:.2f} | {s['void_ratio']:.3f} ({s['void_ratio_box']:.3f}) "
-            f"| {100 * s['water_content_target']:.2f} | {100 * s['water_content']:.3f} "
-            f"| {s['saturation']:.3f} | {s['bridges']} | {s['formation_suction_pa']:.0f} "
-            f"| {s['tensile_strength_pa']:.1f} | {kim} | {s['packing_state_pa']:.1f} "
-            f"| {_percent(s['relative_difference_to_kim'])} "
-            f"| {_percent(s['relative_difference_to_packing_state'])} |")
-    return lines
-
-
-def write_report(summaries: list[dict], config: TensionConfig, path: str) -> list[str]:
-    """report.md at ``path``; returns its lines."""
-    lines = report_lines(summaries, config)
-    write_text(path, "\n".join(lines) + "\n")
-    return lines
-
-
 class TensionTest:
     """The direct-tension cases of ``config`` (TensionConfig): one sample per void ratio, each
     water content wetted and pulled from a copy of it (module docstring)."""
+
+    #: The configuration's type.
+    CONFIG = TensionConfig
 
     def __init__(self, config: TensionConfig) -> None:
         if not isinstance(config, TensionConfig):
             raise TypeError(f"config must be a TensionConfig, got {type(config).__name__}")
         self.config = config
+        for e, w in config.cases:         # each case is compared with its regular packing
+            least = config.least_water_content(e)
+            if w < least:
+                _, label = comparison_packing(e)
+                raise ParameterError("water_content", (
+                    f"water_content = {100.0 * w:g} % is outside the valid range "
+                    f"[{100.0 * least:.3g}, {100.0 * config.pendular_limit(e):.3g}] % of a sample "
+                    f"of void ratio {e:g}: less water holds no bridge across the grains' "
+                    f"separation (H/R = {KIM_SEPARATION:g}) of the {label} packing whose "
+                    "prediction the case is compared with"), "--water-content")
 
-    def run(self, out: str, *, progress: bool = True, arguments: dict | None = None,
-            device: str = "cpu", checkpoint_every: int = 0, stop_after: int | None = None
-            ) -> dict:
+    def run(self, out: str, options: RunOptions | None = None, **settings) -> dict:
         """Every case into ``out``; writes tension.json, report.md, plots/ and cases/; returns
-        the tension.json content. ``arguments``: what tension.json records under 'arguments'
-        and the histories as attributes (the command: its options; default: the
-        configuration's, TensionConfig.options); the configuration itself is under 'config'.
-        ``device``: where the preparations, wettings and pulls run, "cpu" or "gpu"
-        (``check_device``, before anything is made); a run option, not part of the
-        configuration. ``checkpoint_every``: steps between checkpoints ``out``/checkpoint.h5
-        of the pulls (0: none), from which ``resume`` continues; ``stop_after``: stop after
-        this many steps of the pulls as an interruption would (raises Interrupted)."""
+        the tension.json content. Run as ``options`` say (pendular.procedures.run_options
+        .RunOptions; ``settings``: its fields one by one): ``arguments``: what tension.json
+        records under 'arguments' and the histories as attributes (the command: its options;
+        default: the configuration's, TensionConfig.options); the configuration itself is
+        under 'config'. ``device``: where the preparations, wettings and pulls run, "cpu" or
+        "gpu" (``check_device``, before anything is made). ``checkpoint_every``: steps
+        between checkpoints ``out``/checkpoint.h5 of the pulls (0: none), from which
+        ``resume`` continues; ``stop_after``: stop after this many steps of the pulls as an
+        interruption would (raises Interrupted). The pulls run on one thread, whatever
+        ``threads``."""
+        options = RunOptions.of(options, **settings)
+        progress, device, stop_after = options.progress, options.device, options.stop_after
         check_device(device)
-        checkpoint_every = check_int("checkpoint_every", checkpoint_every, low=0)
-        arguments = self.config.options() if arguments is None else dict(arguments)
+        checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        arguments = (self.config.options() if options.arguments is None
+                     else dict(options.arguments))
         with OutputFolder(out, "tension") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -618,13 +422,15 @@ class TensionTest:
                 return self._run(out, progress, device, run)
 
     @classmethod
-    def resume(cls, out: str, *, progress: bool = True, stop_after: int | None = None,
-               device: str = "cpu") -> dict:
+    def resume(cls, out: str, options: RunOptions | None = None, **settings) -> dict:
         """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration and arguments stored there: the cases finished are kept, the sample
-        of the case being pulled is prepared and wetted again (the engine is deterministic:
-        the same state), and its pull goes on from the checkpoint; returns the tension.json
-        content, bit for bit that of an uninterrupted run (timings aside)."""
+        configuration and arguments stored there, run as ``options`` say (RunOptions;
+        ``settings``: its fields one by one): the cases finished are kept, the sample of the
+        case being pulled is prepared and wetted again (the engine is deterministic: the same
+        state), and its pull goes on from the checkpoint; returns the tension.json content,
+        bit for bit that of an uninterrupted run (timings aside)."""
+        options = RunOptions.of(options, **settings)
+        progress, device, stop_after = options.progress, options.device, options.stop_after
         path = os.path.join(out, "checkpoint.h5")
         if not os.path.exists(path):
             raise ValueError(f"resume = {out!r}: {path} is missing: the run stopped before "
@@ -681,7 +487,8 @@ class TensionTest:
                   "wall_time_s": run.earlier_time + time.perf_counter() - started}
         write_json(os.path.join(out, "tension.json"), output, default=float)
         plot_curves(summaries, histories, os.path.join(out, "plots"), config)
-        plot_strength(summaries, config, os.path.join(out, "plots", "strength_vs_water.png"))
+        plot_strength(summaries, config, KIM_2001, strength_predictions(summaries, config),
+                      os.path.join(out, "plots", "strength_vs_water.png"))
         write_report(summaries, config, os.path.join(out, "report.md"))
         return output
 
@@ -775,3 +582,101 @@ class TensionRun:
                               + (f"; continue with --resume {self.out}"
                                  if writer is not None else ""))
         return self._pull_time
+
+
+# ---------------------------------------------------------------- the command
+
+
+#: A direct tension's sample: Kim's sand by default (TENSION_SAMPLE), the tension's ranges.
+TENSION_SAMPLE_OPTIONS = {
+    "particles": option_of(PrepareConfig, "particles", default=TENSION_SAMPLE["particles"],
+                           low=MIN_TENSION_PARTICLES, high=MAX_TENSION_PARTICLES),
+    "confining": option_of(PrepareConfig, "confining", default=TENSION_SAMPLE["confining"],
+                           low=TENSION_RANGES["confining"][0],
+                           high=TENSION_RANGES["confining"][1],
+                           help="isotropic stress of preparation and wetting"),
+    "friction": option_of(PrepareConfig, "friction_deg",
+                          help="contact friction during wetting and pull"),
+    "young": option_of(PrepareConfig, "young", high=TENSION_RANGES["young"][1]),
+    "seed": option_of(PrepareConfig, "seed", help="random seed of the samples"),
+    "periodic": option_of(PrepareConfig, "periodic",
+                          help="a periodic cell instead of six walls: no grips, the cell pulled "
+                               "along z at zero lateral stress; the void ratio is the whole "
+                               "cell's"),
+}
+
+
+#: A direct tension's sizes: Kim's radius by default, the tension's range.
+TENSION_SIZES = size_options(default=KIM_RADIUS, low=TENSION_RANGES["radius"][0],
+                             high=TENSION_RANGES["radius"][1])
+
+#: The cases of a direct tension: every water content [%] at every void ratio.
+TENSION_VOID_RATIO = option_from(dataclasses.replace(
+    VOID_RATIO_PARAMETER, help="void ratio(s) of the core, comma separated (default: Kim's "
+                               "0.72, 0.58)"), None, many=True, distinct=True)
+
+TENSION_WATER_CONTENT = option_from(dataclasses.replace(
+    WATER_CONTENT, low=None, high=None,
+    help="gravimetric water content(s), comma separated, each at most the pendular limit of "
+         "its void ratio's packing (default: Kim's for his void ratios, else 0.5,1,2)"),
+    None, many=True, distinct=True)
+
+#: A direct tension's own fields set by their options as they are.
+TENSION_OWN = {name: option_of(TensionConfig, name) for name in (
+    "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
+    "max_strain", "residual", "grip_depth", "void_ratio_tolerance")}
+
+
+TENSION_FRAMES = (dataclasses.replace(option_of(TensionConfig, "vtk_frames"), group="frames"),
+                  dataclasses.replace(option_of(TensionConfig, "vtk_every"), least=0,
+                                      group="frames"))
+
+#: A direct tension's options, in the order of its help.
+TENSION = ((TENSION_VOID_RATIO, TENSION_OWN["roughness"], TENSION_WATER_CONTENT,
+            TENSION_SAMPLE_OPTIONS["particles"], TENSION_OWN["form_gap"])
+           + TENSION_SIZES
+           + (TENSION_OWN["contact_angle"], TENSION_OWN["surface_tension"],
+              option_from(SPECIFIC_GRAVITY_PARAMETER, SPECIFIC_GRAVITY),
+              TENSION_SAMPLE_OPTIONS["confining"], TENSION_SAMPLE_OPTIONS["friction"],
+              TENSION_SAMPLE_OPTIONS["young"])
+           + tuple(TENSION_OWN[name] for name in ("inertial_number", "max_strain", "residual",
+                                                  "grip_depth", "void_ratio_tolerance"))
+           + TENSION_FRAMES + (CHECKPOINT_EVERY, TENSION_SAMPLE_OPTIONS["seed"],
+                               TENSION_SAMPLE_OPTIONS["periodic"]))
+
+
+def tension_config(values, given):
+    """The TensionConfig of ``values``: its cases every water content [%] at every void ratio
+    (pendular.procedures.tension.cases_of), the sample's density from the specific gravity."""
+
+    cases = cases_of(values["void_ratio"], values["water_content"])
+    depth = values["grip_depth"]
+    if values["periodic"] and depth is not None:
+        raise OptionError(lambda name: f"{name('grip_depth')} = {depth:g} does not apply to "
+                                       f"{name('periodic')}: a periodic cell has no walls, so "
+                                       "no grips")
+    sample = tension_sample(**fields_of(values, TENSION_SAMPLE_OPTIONS.values()),
+                            **sample_sizes(values),
+                            density=values["specific_gravity"] * WATER_DENSITY)
+    return TensionConfig(sample=sample, cases=cases,
+                         **fields_of(values, (*TENSION_OWN.values(), *TENSION_FRAMES)))
+
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tension",
+           "the direct tensile strength of one of Kim's (2001) cases against his measurement and "
+           "the packing-state prediction; tension.json, report.md")
+
+#: Summary keys printed at the end, tables of COLUMNS.
+SHOWN = ("cases",)
+#: Columns of those tables.
+COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
+                 "tensile_strength_pa", "kim_measured_pa", "packing_state_pa")
+
+#: The tension command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="tension",
+    description="direct tension of wet sand at fixed water content (Kim 2001)",
+    test=TensionTest,
+    declared=CommandOptions(TENSION, tension_config),
+    shown=SHOWN, example=EXAMPLE, out="runs/direct_tension", columns=COLUMNS)

@@ -1,22 +1,18 @@
-"""Drained triaxial test (thesis Ch. 5.2.3): prepare, wet, shear, record, resume.
+"""Drained or undrained triaxial test (thesis Ch. 5.2.3): its configuration, shear, summary
+and command.
 
-Building blocks, usable alone for a custom loading path (the tutorial
-docs/tutorials/plot_3_custom_loading_path.py):
-
-- ``equilibrate(sim, ...)``: run until static (unbalanced force and servoed stresses within
-  tolerance);
-- ``wet(sim, bridges, ...)``: add capillary bridges to a static sample and re-equilibrate;
+- ``TriaxialConfig``: the sample, bridges and outputs of every laboratory test
+  (pendular.procedures.config.LaboratoryConfig) and the shear (ShearConfig);
+- ``shear_stage``: the path of the shear (lateral walls at the confining stress, axial walls
+  at the rate of ShearConfig, to the final strain), in compression or extension, at a
+  constant b or a constant mean stress, or undrained (at constant volume);
 - ``TriaxialShear(sim, shear, ...)``: lateral walls servoed, axial walls at a constant strain
   rate, a history recorder; ``sim.run(shear.steps)`` shears to the final strain (one stage
   of a pendular.procedures.loading.LoadingPath, which runs any sequence of stages);
-- ``summarize(history)``: peak values.
-
-``TriaxialTest(config).run(out)`` chains them as the thesis does and writes the outputs
-(history.h5, summary.json, triaxial.png, plots/, vtk/, sample.h5, checkpoint.h5; with
-``vtk_prep``, vtk_prep/: ParaView frames of the preparation and wetting);
-``TriaxialTest.resume(out)`` continues an interrupted run from its checkpoint bit-identically.
-``OedometerTest`` and ``IsotropicTest`` are the same test (``LaboratoryTest``: sample, wetting,
-outputs, resume) along the oedometric and the isotropic paths.
+- ``summarize(history)``: peak values, ``undrained_summary``, ``path_deviations``;
+- ``TriaxialTest(config).run(out)``: the whole test (pendular.procedures.laboratory
+  .LaboratoryTest: sample, wetting, outputs, checkpoints, resume);
+- ``COMMAND``: the ``pendular triaxial`` command (its options, pendular.procedures.options).
 
 Stresses compression positive [Pa], q and p as pendular.homogenize.invariants; strains compression
 positive, volumetric strain positive in contraction (docs/units.md).
@@ -24,288 +20,207 @@ positive, volumetric strain positive in contraction (docs/units.md).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import json
-import math
 import os
-import sys
-import time
+from dataclasses import dataclass, field
 
-import numba
 import numpy as np
 
-from pendular.utils.atomic import write_json
-from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
-from pendular.dem.grading import grading
-from pendular.utils.integrity import checksum, config_hash
-from pendular.utils.interrupt import deferred_interrupts, pause_point, pausing_at
-from pendular.utils.progress import whole_run
-from pendular.utils.parameters import fail, flat_options, spec_of
-from pendular.dem.measure import coordination, porosity, unbalanced_force
-from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
-    pwave_step, servoed_simulation, static, timestep, timestep_description)
-from pendular.dem.sample import load_sample, save_sample
-from pendular.dem.simulation import check_device
-from pendular.utils.validate import check_int
-from pendular.dem.walls import ConstantStrainRate, StressServo
-from pendular.homogenize.invariants import (lateral_stress, mean_stress,
+from pendular.dem.walls import ConstantStrainRate
+from pendular.homogenize.invariants import (deviator_stress, lateral_stress, mean_stress,
     principal_difference, shear_deviator)
-
+from pendular.io.plots import plot_history, plot_stress_path, write_plots
+from pendular.io.schema import peak_reached
+from pendular.procedures.columns import friction_angle
+from pendular.procedures.command import LaboratoryCommand
+from pendular.procedures.compression import effective_diagonal
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import (AXIAL_STRAIN_LIMIT, BridgeConfig, LaboratoryConfig,
+    MAX_AXIAL_STRAIN, MIN_AXIAL_STRAIN, ShearConfig, registered)
 from pendular.procedures.critical_state import critical_state
-from pendular.procedures.progress import equilibrium_bar, laboratory_plan
-from pendular.procedures.guards import AxialContactLost, AxialStressGuard, SampleCrushed
-from pendular.procedures.config import (IsotropicConfig, LaboratoryConfig, OedometerConfig,
-    WATER_DENSITY, TriaxialConfig, config_from_dict, config_to_dict, inertial_number,
-    sized_as_sample)
-from pendular.procedures.loading import (VTK_RECORDS, LoadingPath, StageFailed,
-    check_stages_device, excess_pore_pressure, friction_angle, isotropic_stages,
-    isotropic_summary, k0, oedometer_stages, oedometer_summary, path_deviations, shear_stage,
-    undrained_summary, void_ratio)
-from pendular.io.history import write_history
-from pendular.io.outputs import OutputFolder
-from pendular.io.schema import SUMMARY_UNITS, peak_reached
-from pendular.io.plots import (plot_compression, plot_history, plot_stress_path, run_label,
-    write_plots)
-from pendular.io.vtk import VtkWriter, axial_strain_fields
-from pendular.procedures.water_content import wet_to_water_volume
-
-#: Largest inertial number of a quasi-static shear (GDR MiDi 2004: I < 1e-3 quasi-static,
-#: dense flow beyond; at 1e-2 the wall and Love–Weber stresses already differ by a few %).
-MAX_INERTIAL_NUMBER = 1e-2
-#: Most shear steps a run may ask for without --force (about 1 h at 1,000 spheres here).
-MAX_SHEAR_STEPS = 20_000_000
-#: Most particle-steps (spheres x steps) of a loading without --force: about 7 h at
-#: ESTIMATE_RATE, a night's run; MAX_SHEAR_STEPS bounds the steps of smaller samples.
-MAX_PARTICLE_STEPS = 1e11
-#: Smallest prep_stress / young of a preparation: the radius growth (1e-4 R per step) settles
-#: only when the overlaps at the target stress (about 8 prep_stress / young R) are well above
-#: its step (60 spheres: 1.7e-4 settles in 7,400 steps, 5e-5 not in 2,000,000).
-MIN_PREP_STRESS_OVER_YOUNG = 1e-4
-#: Smallest confining / young: below, the six servoed walls do not hold the confining stress
-#: within the 1 % tolerance (60 spheres, young 1e6 Pa: 5 Pa is static after 8,600 steps,
-#: 3 Pa not after 250,000; the walls hover at 10-30 Pa).
-MIN_CONFINING_OVER_YOUNG = 5e-6
-#: Largest difference between the wall stress and the Love–Weber stress of contacts and bridges
-#: (any axis, over the mean wall stress p) of a record in equilibrium: quasi-static runs stay
-#: below 2-4 % (60-1,000 spheres, max over 500 records), I = 0.05 reaches 100 %.
-STRESS_BALANCE_BOUND = 0.05
-#: Particle-steps per second assumed for run-time estimates (one core of the 2-core machine).
-ESTIMATE_RATE = 4e6
+from pendular.procedures.guards import AxialStressGuard
+from pendular.procedures.laboratory import LaboratoryTest, stress_balance
+from pendular.procedures.loading import LoadingPath, Stage, Strain
+from pendular.procedures.options import (laboratory_fields, laboratory_options, options_named,
+    rate_options, steps_count)
+from pendular.utils.parameters import (ParameterError, fail, fields_of, flat_options, option_of,
+    spec_of)
+from pendular.procedures.preparation import PrepareConfig
 
 
-#: Phases of the vtk_prep/ series, by the code in each frame's field data ``phase``: those of
-#: pendular.procedures.preparation.prepare_sample, then "sample" (a loaded sample equilibrated at the confining
-#: stress) and "wetting" (bridges added, equilibrated again).
-PREP_PHASES = (*PREPARATION_PHASES, "sample", "wetting")
+@registered
+@dataclass
+class TriaxialConfig(LaboratoryConfig):
+    """A drained triaxial test (thesis Ch. 5.2.3): LaboratoryConfig's sample, bridges and
+    outputs, and shear: ShearConfig (the confining stress is the lateral stress of the shear).
+    """
+
+    shear: ShearConfig = field(default_factory=ShearConfig)
+
+    TEST = "a triaxial test"
+    LENGTH = ("--max-strain",)
+    LOADING = "the shear"
+
+    def rate_settings(self):
+        """The shear, whose ``strain_rate`` sets the rate."""
+        return self.shear
+
+    def loading_parameters(self):
+        """The shear's options; a conventional run's rows stay as they were, without the
+        path's options."""
+        return flat_options(self.shear, () if not self.shear.conventional else
+                            ("direction", "b", "constant_p", "drainage"))
+
+    def __post_init__(self):
+        if not isinstance(self.shear, ShearConfig):
+            raise TypeError(f"shear must be a ShearConfig, got {type(self.shear).__name__}")
+        super().__post_init__()
+        bridges = self.bridges
+        if self.undrained and bridges is not None and bridges.control != "volume":
+            # the water cannot leave either: bridges of constant volume, formed at the suction
+            if bridges.model != "exact" or bridges.persist:
+                raise fail(self.shear, "drainage", "drainage = 'undrained' of a wet sample "
+                           "holds its water in volume-controlled exact bridges: --bridges "
+                           "toroidal and --persist-bridges do not apply")
+            self.bridges = dataclasses.replace(bridges, control="volume")
+
+    @property
+    def undrained(self):
+        """Whether the shear holds the volume (and, wet, the water content)."""
+        return self.shear.drainage == "undrained"
+
+    def rate(self):
+        """Axial strain rate of the shear [1/s] (ShearConfig.rate at the confining stress)."""
+        sample = self.sample
+        return self.shear.rate(sample.radius, sample.density, sample.confining)
+
+    def reference_pressure(self):
+        """Stress at which the inertial number of the rate is taken [Pa]: the confining."""
+        return self.sample.confining
+
+    def shear_steps(self):
+        """Steps of the shear estimated before anything runs [-]: max_strain over the strain
+        rate times the P-wave step of the mean radius (pendular.procedures.preparation.pwave_step). An
+        upper bound for equal spheres: the 'stiffness' rule's step is 1.4-1.5 times longer on
+        prepared samples, so the shear takes that much fewer."""
+        return self.shear.max_strain / self.strain_per_step(self.rate())
+
+    def estimated_steps(self):
+        """Steps of the loading estimated before anything runs (``shear_steps``)."""
+        return self.shear_steps()
 
 
-class NotStatic(ValueError):
-    """An equilibrium phase ended at its step limit without reaching equilibrium."""
+#: Records whose sigma_1 - sigma_3 is below this fraction of the mean stress do not measure b
+#: (its ratio is noise over nearly zero at the start of a true triaxial shear).
+B_MEASURE_FROM = 0.1
 
 
-class Interrupted(Exception):
-    """A run stopped before its end (Ctrl-C, or ``stop_after``); the checkpoint, if any, is
-    where ``TriaxialTest.resume`` starts."""
+def shear_stage(shear, confining, rate):
+    """The Stage of a triaxial shear of ``shear`` (pendular.procedures.config.ShearConfig)
+    from the isotropic ``confining`` stress [Pa] at the axial strain rate ``rate`` [1/s]: the
+    axial walls compressed (or, in extension, pulled apart) to ``shear.max_strain``; the lateral
+    walls at the confining stress, or with ``shear.b`` sigma_3 = confining on x and sigma_y =
+    sigma_3 + b (sigma_z - sigma_3), or with ``shear.constant_p`` at the stresses that keep
+    p = confining (and b, when given), or with ``shear.drainage`` "undrained" the lateral
+    walls moved so that the volume stays that of the start (the pore water of a saturated
+    sample, or the closed liquid of a wet one, cannot leave). b = 0 alone is the conventional
+    compression."""
+    sign = 1.0 if shear.direction == "compression" else -1.0
+    until = Strain(sign * shear.max_strain)
+    axial = {"z": sign * rate}
+    if shear.drainage == "undrained":
+        return Stage(strain_rate=axial, volume="constant", until=until)
+    if shear.constant_p:
+        return Stage(strain_rate=axial, mean_stress=confining, b=shear.b, until=until)
+    if shear.b is not None and shear.b > 0.0:
+        return Stage(stress={"x": confining}, strain_rate=axial, b=shear.b, until=until)
+    return Stage(stress={"x": confining, "y": confining}, strain_rate=axial, until=until)
 
 
-# ---------------------------------------------------------------- building blocks
-
-def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check_every=200,
-                progress=None, phase="equilibrium"):
-    """Run ``sim`` until static: unbalanced force below ``unbalanced`` and, if a StressServo
-    controls walls, their stresses within ``tolerance`` (relative) of its target; at most
-    ``max_steps`` steps; ``progress``: the label of its bar (procedures.progress
-    .equilibrium_bar). Returns the steps taken; NotStatic (naming ``phase`` and what it
-    reached) when the limit is hit first."""
-    done = static(unbalanced, tolerance)
-    steps = sim.run(max_steps, until=done, check_every=check_every,
-                    progress=equilibrium_bar(progress, unbalanced, tolerance),
-                    status=equilibrium_status(unbalanced))
-    if not done(sim):
-        reached = equilibrium_status(unbalanced)(sim)
-        raise NotStatic(f"{phase} not reached in {steps} steps (the step limit): "
-                        + ", ".join(f"{k} {v}" for k, v in reached.items())
-                        + "; raise the step limit (e.g. --wet-steps) or check the settings")
-    return steps
+def measured_b(sigma, mean):
+    """b = (sigma_y - sigma_x) / (sigma_z - sigma_x) of wall stresses ``sigma`` (n, 3) [Pa],
+    NaN where sigma_z - sigma_x is below B_MEASURE_FROM times ``mean`` [Pa]."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    span = sigma[:, 2] - sigma[:, 0]
+    measured = span > B_MEASURE_FROM * mean
+    return np.where(measured, (sigma[:, 1] - sigma[:, 0]) / np.where(measured, span, 1.0),
+                    np.nan)
 
 
-def equilibrium_status(unbalanced):
-    """Progress fields of an equilibrium phase: the unbalanced force against its target and
-    each servo's stress against its target."""
-
-    def status(sim):
-        sim.fetch()                 # all of a device run's state (Simulation.fetch)
-        fields = {"unbalanced": f"{unbalanced_force(sim.particles, sim.contacts):.3g}"
-                                f"/{unbalanced:g}"}
-        for servo in (op for op in sim.controls if isinstance(op, StressServo)):
-            stress = sim.walls.stress()[list(servo.axes)]
-            fields["stress"] = (f"{np.max(np.abs(stress - servo.target)):.3g}Pa off "
-                                f"{servo.target:g}Pa")
-        return fields
-
-    return status
-
-
-def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None):
-    """Add the capillary operation ``bridges`` to the forces of a static sample and run until
-    static again; returns the wetting report (steps, time, Sr, bridges, porosity)."""
-    sim.forces.append(bridges)
-    started = time.perf_counter()
-    steps = equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
-                        progress=progress, phase="equilibrium after wetting")
-    return wetting_report(sim, bridges, steps, started)
+def path_deviations(history, shear, confining):
+    """How closely a shear of ``shear`` (ShearConfig) held its mixed condition: with
+    ``constant_p``, ``mean_stress_deviation`` max over the records of |p / confining - 1|;
+    with ``b``, ``b_deviation`` max of |b measured - b| over the records with sigma_z - sigma_x
+    of at least B_MEASURE_FROM confining (measured_b), None with ``b_deviation_note`` without
+    such records. Both [-]; {} for neither."""
+    sigma = history["sigma_wall"]
+    found = {}
+    if shear.constant_p:
+        found["mean_stress_deviation"] = float(np.max(np.abs(mean_stress(sigma) / confining
+                                                             - 1.0)))
+    if shear.b is not None:
+        b = measured_b(sigma, confining)
+        found["b_deviation"] = (float(np.nanmax(np.abs(b - shear.b)))
+                                if np.isfinite(b).any() else None)
+        if found["b_deviation"] is None:
+            found["b_deviation_note"] = (
+                f"not measured: no record has sigma_z - sigma_x of at least {B_MEASURE_FROM:g} "
+                "of the confining stress, where b is more than noise")
+    return found
 
 
-def wetting_report(sim, bridges, steps, started, **details):
-    """The report of a wetting that took ``steps`` steps from ``started`` (time.perf_counter,
-    [s]): steps and time, ``details`` (what the protocol adds), then the wet state: Sr, the
-    bridges of the operation ``bridges`` and the porosity."""
-    return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
-            **details, "initial_saturation": bridges.saturation(sim),
-            "initial_bridges": bridges.count(sim),
-            "wet_porosity": porosity(sim.particles, sim.walls)}
+#: Rows of the effective stress path an undrained summary lists (undrained_summary).
+PATH_POINTS = 21
 
 
-def wet_sample(sim, config, *, progress=None):
-    """Wet the static sample ``sim`` as ``config`` (TriaxialConfig) says; returns (the wet
-    simulation, its bridge operation, the wetting report). Protocols (config.wetting):
-
-    - 'isotropic': bridges added, the servo re-equilibrates the sample (``wet``);
-    - 'at-shear': bridges added, formed at the sample's contacts now and shearing starts at
-      once (the servo meets them during the shear);
-    - 'constant-volume': bridges added with the walls fixed, run until the unbalanced force is
-      below the threshold, then the servo brings the walls to the confining stress.
-
-    Undrained (TriaxialConfig.undrained) at a suction, the bridges are volume-controlled,
-    formed at the suction from a reservoir, and the liquid is then closed
-    (CapillaryBridges.close_liquid), so that the shear holds the water content.
-
-    At a water content (config.bridges.water_content) the bridges are volume-controlled, their
-    formation suction found so that they hold w Gs V_s (Gs = density / 1000 kg/m^3;
-    pendular.procedures.water_content), the sample re-equilibrated; the liquid is then closed
-    (CapillaryBridges.close_liquid), so the shear conserves it.
-
-    The equilibria run on ``sim``'s device (Simulation.device; the wettings at a water content
-    from copies of ``sim``, which keep it); the bridges of 'at-shear' form on the host."""
-    sample = config.sample
-    thresholds = {"unbalanced": sample.equilibrium_unbalanced,
-                  "tolerance": sample.stress_tolerance, "max_steps": config.wet_steps}
-    if config.bridges.water_content is not None:
-        return _wet_at_water_content(sim, config, thresholds, progress)
-    bridges = config.bridges.build()
-    if config.wetting == "isotropic":
-        report = wet(sim, bridges, progress=progress, **thresholds)
-    else:
-        report = _wet_by_protocol(sim, config, bridges, thresholds, progress)
-    if config.undrained:                # the water cannot leave during the shear
-        bridges.close_liquid(sim, config.bridges.liquid)
-        report["liquid_initial"] = bridges.liquid_initial
-    return sim, bridges, report
+def excess_pore_pressure(sigma):
+    """Excess pore pressure Delta u [Pa] of each record of wall stresses ``sigma`` (n, 3) [Pa]
+    from the first: the pressure a saturating, incompressible pore fluid takes up in an
+    undrained shear along the conventional total stress path (the cell pressure sigma_3
+    held): Delta u = Delta p_total - Delta p', p_total = sigma_3 + q / 3 and p' the mean wall
+    stress, the skeleton's (the effective stress of a saturated sample); = -Delta sigma'_3
+    (q = sigma_z - (sigma_x + sigma_y) / 2, pendular.homogenize.invariants)."""
+    sigma = np.asarray(sigma, dtype=np.float64)
+    q, p = deviator_stress(sigma), mean_stress(sigma)
+    return (q - q[0]) / 3.0 - (p - p[0])
 
 
-def _wet_by_protocol(sim, config, bridges, thresholds, progress):
-    """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols."""
-    started = time.perf_counter()
-    sim.forces.append(bridges)
-    steps = 0
-    if config.wetting == "at-shear":
-        sim.evaluate_forces()               # the bridges form at the sample's contacts
-    else:
-        servo = sim.controls
-        sim.controls = []                   # walls fixed
-        steps = equilibrate(sim, phase="equilibrium of the wetted sample at constant volume",
-                            progress=progress, **thresholds)
-        fixed_stress = sim.walls.stress().tolist()
-        sim.controls = servo
-        steps += equilibrate(sim, phase="equilibrium after wetting at constant volume",
-                             progress=progress, **thresholds)
-    report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
-    if config.wetting == "constant-volume":
-        report["sigma_wall_at_constant_volume"] = fixed_stress
-    return report
-
-
-def _wet_at_water_content(dry, config, thresholds, progress):
-    """wet_sample at config.bridges.water_content (volume-controlled bridges at contacts)."""
-    from pendular.capillary import BridgeTable, gravimetric_water_content, sample_radius_ratios
-
-    bridges_config = config.bridges
-    particles = dry.particles
-    specific_gravity = particles.density / WATER_DENSITY
-    target = bridges_config.water_content * specific_gravity * particles.solid_volume()
-    if dry.contacts is None:
-        dry.evaluate_forces()
-    touching = dry.contacts.overlap > 0.0
-    pairs = (particles.radius[dry.contacts.pair_i[touching]],
-             particles.radius[dry.contacts.pair_j[touching]], None)
-    table = BridgeTable.cached(bridges_config.contact_angle,
-                               radius_ratios=sample_radius_ratios(particles.radius))
-    started = time.perf_counter()
-    try:
-        sim, bridges, tries = wet_to_water_volume(
-            dry, target, table, pairs, bridges_config.build,
-            lambda s: equilibrate(s, progress=progress, phase="equilibrium after wetting",
-                                  **thresholds),
-            surface_tension=bridges_config.surface_tension,
-            roughness=bridges_config.roughness)
-    except ValueError as error:
-        raise ValueError(f"--water-content = {100 * bridges_config.water_content:g} %: {error}") \
-            from None
-    bridges.close_liquid(sim, bridges_config.liquid)
-    water_content = gravimetric_water_content(bridges.liquid_initial,
-                                              particles.solid_volume(), specific_gravity)
-    return sim, bridges, {"wetting": "water-content", **wetting_report(
-        sim, bridges, sum(t["steps"] for t in tries), started,
-        formation_suction_pa=tries[-1]["formation_suction_pa"], water_content=water_content,
-        wetting_attempts=tries, liquid_initial=bridges.liquid_initial)}
-
-
-@contextlib.contextmanager
-def watched(sim, writers, phase):
-    """Within the block, ``writers`` (read-only operations, e.g. the vtk_prep VtkWriter) are
-    appended to ``sim.writers`` and those with a ``phase`` attribute have it set to ``phase``;
-    they are removed at its end."""
-    writers = list(writers)
-    for writer in writers:
-        if hasattr(writer, "phase"):
-            writer.phase = phase
-    sim.writers.extend(writers)
-    try:
-        yield
-    finally:
-        sim.writers = [op for op in sim.writers if not any(op is w for w in writers)]
-
-
-def prep_vtk_period(sample):
-    """Default steps between the frames of vtk_prep/: one per unload stage of the preparation
-    (``unload_steps`` / 20, 500 steps by default), so that a preparation (a radius growth of at
-    least 5,000 steps, the unload, the equilibria) gives a few tens of frames."""
-    return max(1, sample.unload_steps // 20)
-
-
-def frame_period(vtk_every, vtk_frames, steps, unknown_length_period=0):
-    """Steps between the ParaView frames of a loading of ``steps`` steps (0: no frames):
-    ``vtk_every`` when given, else ``vtk_frames`` frames over the loading (0: none), or, for a
-    loading whose length is not known before it runs (``steps`` None), one every
-    ``unknown_length_period`` steps."""
-    if vtk_every is not None:
-        return vtk_every
-    if not vtk_frames:
-        return 0
-    if steps is not None:
-        return max(1, int(steps // vtk_frames))
-    return unknown_length_period
-
-
-def frames_writer(sim, out, period, **options):
-    """The VtkWriter of ``out``/vtk/, a frame every ``period`` steps (``options``: VtkWriter's),
-    appended to ``sim.writers``; None when ``period`` is 0 (no frames)."""
-    if period <= 0:
-        return None
-    writer = VtkWriter(os.path.join(out, "vtk"), period, **options)
-    sim.writers.append(writer)
-    return writer
+def undrained_summary(history, peak):
+    """Results of an undrained (constant-volume) shear's ``history`` (column
+    ``excess_pore_pressure``, excess_pore_pressure), ``peak`` the row of the peak of q:
+    ``excess_pore_pressure_at_peak``, ``_final``, ``_max`` [Pa]; ``p_min`` [Pa], the least
+    mean effective stress, and ``axial_strain_at_p_min`` (where a contracting sample turns to
+    dilating, the phase transformation); ``max_volume_change``, max |V / V0 - 1| [-], the
+    volume held; ``effective_stress_path``, PATH_POINTS rows evenly spaced over the history:
+    axial strain, p' and q of the wall stresses, Delta u, and wet p' of Eq. 3.43, suction and
+    saturation Sr, which change at a constant water content."""
+    sigma = history["sigma_wall"]
+    change = history["excess_pore_pressure"]
+    p = mean_stress(sigma)
+    least = int(np.argmin(p))
+    summary = {
+        "drainage": "undrained",
+        "excess_pore_pressure_at_peak": float(change[peak]),
+        "excess_pore_pressure_final": float(change[-1]),
+        "excess_pore_pressure_max": float(change.max()),
+        "p_min": float(p[least]),
+        "axial_strain_at_p_min": float(history["axial_strain"][least]),
+        "max_volume_change": float(np.max(np.abs(history["volumetric_strain"]))),
+    }
+    rows = np.unique(np.linspace(0, len(p) - 1, PATH_POINTS).round().astype(int))
+    path = {"axial_strain": history["axial_strain"][rows], "p": p[rows],
+            "q": deviator_stress(sigma[rows]), "excess_pore_pressure": change[rows]}
+    effective = effective_diagonal(history)
+    if effective is not None:
+        path["p_effective"] = mean_stress(effective[rows])
+    for name in ("suction", "saturation"):
+        if name in history:
+            path[name] = history[name][rows]
+            summary[f"{name}_final"] = float(history[name][-1])
+    summary["effective_stress_path"] = {k: [float(v) for v in values]
+                                        for k, values in path.items()}
+    return summary
 
 
 class TriaxialShear:
@@ -336,7 +251,7 @@ class TriaxialShear:
 
 def shear_path(sim, shear, confining, rate, columns=None):
     """The LoadingPath of a triaxial shear of ``shear`` (ShearConfig) at the axial strain rate
-    ``rate`` [1/s] from the isotropic ``confining`` stress [Pa] (loading.shear_stage), with
+    ``rate`` [1/s] from the isotropic ``confining`` stress [Pa] (triaxial.shear_stage), with
     its servo options; ``columns``: history columns beyond ``history_columns``."""
     return LoadingPath(sim, [shear_stage(shear, confining, rate)], records=shear.records,
                        columns=columns, servo_max_velocity=shear.servo_max_velocity,
@@ -354,7 +269,7 @@ def summarize(history, direction="compression", b=None):
     there, all of that record; in compression ``peak_axial_stress`` (the largest axial
     stress), in extension ``min_axial_stress`` and ``axial_contact_lost``: whether the axial
     stress fell to 0 (the walls released a cohesive sample before it failed).
-    ``phi_peak_deg``: the mobilised friction angle at the peak (loading.friction_angle of the
+    ``phi_peak_deg``: the mobilised friction angle at the peak (columns.friction_angle of the
     net wall stresses), None with ``phi_peak_note`` when the axial contact was lost. A wet
     history adds ``peak_q_effective``, ``p_effective_at_peak`` and
     ``phi_peak_effective_deg``: q', p' and the friction angle of the effective stress (Eq.
@@ -414,396 +329,13 @@ def summarize(history, direction="compression", b=None):
     return summary
 
 
-def stress_balance(history):
-    """The balance of wall and Love–Weber stresses over a history with ``sigma_contact`` (else
-    {}): the largest ``stress_balance_error``, the bound and the records beyond it."""
-    if "sigma_contact" not in history:            # not in a YADE history
-        return {}
-    error = stress_balance_error(history)
-    return {"stress_balance_error": float(np.max(error)),
-            "stress_balance_bound": STRESS_BALANCE_BOUND,
-            "stress_balance_flagged": np.flatnonzero(error > STRESS_BALANCE_BOUND).tolist()}
-
-
-def stress_balance_error(history):
-    """Per record, max over the axes of |sigma_wall - diag(sigma_contact + sigma_capillary)| / p
-    (p the mean wall stress): how far the wall stress and the Love–Weber stress (Eq. 3.41) of
-    the contacts and bridges inside are from the balance that holds in equilibrium."""
-    inside = history["sigma_contact"]
-    if "sigma_capillary" in history:
-        inside = inside + history["sigma_capillary"]
-    wall = history["sigma_wall"]
-    return (np.abs(np.diagonal(inside, axis1=1, axis2=2) - wall).max(axis=1)
-            / np.abs(mean_stress(wall)))
-
-
 # ---------------------------------------------------------------- the whole test
-
-def quasi_static_number(rate, sample, pressure):
-    """The inertial number [-] of the strain rate ``rate`` [1/s] for the grains of ``sample``
-    (a PrepareConfig) at the stress ``pressure`` [Pa]."""
-    return inertial_number(rate, sample.radius, sample.density, pressure)
-
-
-def check_feasible(config, force=False):
-    """Refuse, before anything runs, a test that cannot be quasi-static (inertial number above
-    MAX_INERTIAL_NUMBER at the lowest stress of its path) or would not finish in reasonable
-    time (more than MAX_SHEAR_STEPS steps of a path whose length is known), with the estimate,
-    or whose equilibrium phases cannot settle (a stress of the path below
-    MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
-    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. A path
-    table's stages that name their own rates are held to the same bounds, each named by its
-    file and stage. Output periods must fit the loading. ValueError naming the setting."""
-    sample = config.sample
-    rate = config.rate()
-    # the option setting the rate: --strain-rate, or a simple shear's --shear-rate
-    flag = spec_of(config.shear if isinstance(config, TriaxialConfig) else config,
-                   "strain_rate").flag
-    rate_name = f"{flag[2:].replace('-', ' ')} {rate:.3g} 1/s"
-    pressure = config.reference_pressure()
-    number = quasi_static_number(rate, sample, pressure)
-    dt = pwave_step(sample.radius, sample)    # the stiffness rule's step is larger
-    steps = config.estimated_steps()
-    where = (f"confining = {pressure:g} Pa" if pressure == sample.confining
-             else f"{pressure:g} Pa, the lowest stress of the path")
-    # the most steps of a loading: MAX_SHEAR_STEPS, fewer for a large sample
-    most = min(MAX_SHEAR_STEPS, MAX_PARTICLE_STEPS / sample.particles)
-    large = ("--particles",) if most < MAX_SHEAR_STEPS else ()
-
-    def too_long(what, steps, rate_name, remedy):
-        hours = sample.particles * steps / ESTIMATE_RATE / 3600.0
-        return ValueError(
-            f"{what} would take {steps:.3g} steps (dt = {dt:.3g} s, {rate_name}; about "
-            f"{hours:.3g} h here at {sample.particles} spheres), outside the valid range "
-            f"[1, {most:.3g}]: {remedy} (or --force)")
-
-    if not force and number > MAX_INERTIAL_NUMBER:
-        raise ValueError(
-            f"{rate_name} gives the inertial number I = {number:.3g}, outside the quasi-static "
-            f"range (0, {MAX_INERTIAL_NUMBER:g}] at {where}: lower {flag} / --inertial-number "
-            "(or --force)")
-    if not force and steps is not None and steps > most:
-        raise too_long("the shear" if isinstance(config, TriaxialConfig) else "the loading",
-                       steps, rate_name, f"raise {flag} / --inertial-number, or lower "
-                       f"{', '.join(('--young', *large, *config.LENGTH))}")
-    for stage, stage_rate, stage_steps in config.stage_rates() if not force else ():
-        stage_number = quasi_static_number(stage_rate, sample, pressure)
-        if stage_number > MAX_INERTIAL_NUMBER:
-            raise ValueError(
-                f"{stage}: strain rate {stage_rate:.3g} 1/s gives the inertial number I = "
-                f"{stage_number:.3g}, outside the quasi-static range (0, "
-                f"{MAX_INERTIAL_NUMBER:g}] at {where}: lower it (or --force)")
-        if stage_steps is not None and stage_steps > most:
-            raise too_long(stage, stage_steps, f"strain rate {stage_rate:.3g} 1/s",
-                           "raise its strain rate")
-    if (not force and config.sample_path is None
-            and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
-        raise ValueError(
-            f"young = {sample.young:g} Pa is outside the valid range (0, "
-            f"{sample.prep_stress / MIN_PREP_STRESS_OVER_YOUNG:g}] Pa for the preparation at "
-            f"prep_stress = {sample.prep_stress:g} Pa: the radius growth cannot settle at "
-            f"overlaps below {MIN_PREP_STRESS_OVER_YOUNG:g} of the radius (it would run "
-            "2,000,000 steps and stop); lower young (or --force)")
-    if not force and pressure < MIN_CONFINING_OVER_YOUNG * sample.young:
-        name = "confining" if pressure == sample.confining else "the path's lowest stress"
-        raise ValueError(
-            f"{name} = {pressure:g} Pa is outside the valid range "
-            f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, 1e+07] Pa for young = "
-            f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
-            "never hold the confining stress (the equilibrium would run to its step limit); "
-            "raise confining or lower young (or --force)")
-    for name in ("vtk_every", "checkpoint_every"):
-        value = getattr(config, name)
-        if steps is not None and value is not None and value > max(steps, 1.0) + 1:
-            raise fail(config, name, f"{name} = {value} is outside the valid range "
-                       f"[0, {int(steps) + 1}]: the shear has about {int(steps)} steps")
-
-
-def parameters(config):
-    """Flat name -> value of a configuration (TriaxialConfig or a PathConfig), named as the command's options (history file attributes, campaign
-    tables): the sample's and the shear's from their fields' Parameters; the rest, values
-    derived from the fields (the suction, the water content in %), in the columns' order of
-    earlier campaign tables."""
-    bridges = config.bridges
-    flat = flat_options(config.sample)          # the recorded fields, keyed by their options
-    if isinstance(config, TriaxialConfig):
-        # a conventional run's rows stay as they were, without the path's options
-        flat.update(flat_options(config.shear, () if not config.shear.conventional else
-                                 ("direction", "b", "constant_p", "drainage")))
-    else:                           # a path (PathConfig) names its own options
-        flat.update(config.path_parameters())
-        flat.update({"inertial_number": config.inertial_number,
-                     "strain_rate": config.strain_rate, "record_strain": config.record_strain})
-    flat.update({"suction": config.suction, "wet_steps": config.wet_steps,
-                 "wetting": config.wetting,
-                 "vtk_every": config.vtk_every, "checkpoint_every": config.checkpoint_every,
-                 "sample": config.sample_path})
-    if bridges is not None:
-        flat.update({"contact_angle": bridges.contact_angle, "bridges": bridges.model,
-                     "surface_tension": bridges.surface_tension,
-                     "persist_bridges": bridges.persist, "control": bridges.control,
-                     "water_content_percent": (None if bridges.water_content is None
-                                               else 100.0 * bridges.water_content),
-                     "liquid": None if bridges.water_content is None else bridges.liquid,
-                     "table_resolution": (None if bridges.table_resolution is None else
-                                          ",".join(map(str, bridges.table_resolution)))})
-    return flat
-
-
-class LaboratoryTest:
-    """A laboratory test of ``config`` (a pendular.procedures.config.LaboratoryConfig of the
-    subclass's ``CONFIG``): the sample, its wetting and its outputs, and the loading path that
-    the subclass declares (``loading``: a pendular.procedures.loading.LoadingPath;
-    ``summarize``; ``plot``).
-
-    ``run(out)`` prepares the sample (or loads ``config.sample_path``), wets it at the confining
-    stress (bridges at every contact, six walls servoed until static), loads it along the path
-    and writes into ``out``: history.h5, summary.json, the test's figure (``FIGURE``), plots/,
-    vtk/ (ParaView), sample.h5 (the sample the loading starts from, with the configuration),
-    with checkpoint_every checkpoint.h5 and, with ``vtk_prep``, vtk_prep/ (ParaView frames of
-    the preparation and wetting). Returns the summary (dict). A run stopped before its end
-    (pendular.io.outputs) names in summary.json the phase it reached: "prepare", "wet",
-    "shear" (the loading) or "write".
-    """
-
-    #: The test's command name (output folder label), configuration type and figure.
-    NAME = "triaxial"
-    CONFIG = LaboratoryConfig
-    FIGURE = "triaxial.png"
-    #: Progress-bar label of the loading.
-    PROGRESS = "shear"
-    #: Whether the loading ends, its results written, when the axial walls leave the sample
-    #: (guards.AxialContactLost), rather than failing.
-    ENDS_AT_CONTACT_LOSS = False
-
-    def __init__(self, config, *, force=False):
-        if not isinstance(config, self.CONFIG):
-            raise TypeError(f"config must be a {self.CONFIG.__name__}, got "
-                            f"{type(config).__name__}")
-        config = self._sized(config)
-        self.config = config
-        check_feasible(config, force=force)
-        if config.bridges is not None and config.bridges.suction is not None:
-            # check the bridges against the sample's radii before any preparation
-            from pendular.capillary import sample_radius_ratios
-
-            radii = config.sample.radii()
-            config.bridges.build().load_tables(float(radii.min()), float(radii.max()),
-                                               radius_ratios=sample_radius_ratios(radii))
-
-    @staticmethod
-    def _sized(config):
-        """``config`` with the count and sizes of its prepared sample where not given
-        (sized_as_sample), once the sample exists: a campaign builds its tests before it
-        prepares their shared samples, and ``start`` sizes them then."""
-        if config.sample_path is None or not os.path.isfile(config.sample_path):
-            return config
-        return dataclasses.replace(config, sample=sized_as_sample(config.sample,
-                                                                  config.sample_path))
-
-    # ------------------------------------------------------------ phases
-    def start(self, progress=True, threads=None, writers=(), device="cpu"):
-        """(static sample at the confining stress, preparation report, the host holding it);
-        ``writers`` watch the preparation or the equilibrium of a loaded sample (e.g. the
-        vtk_prep VtkWriter); ``device``: where the preparation or the loaded sample's
-        equilibrium runs, and the returned simulation's runs (the wetting after it)."""
-        self.config = config = self._sized(self.config)
-        if config.sample_path is not None:
-            return self.load_sample(config.sample_path, progress, threads, writers, device)
-        return prepare_sample(config.sample, progress=progress, threads=threads,
-                              writers=writers, device=device)
-
-    def load_sample(self, path, progress=True, threads=None, writers=(), device="cpu"):
-        """(sample saved at ``path`` servoed at the confining stress and run until static on
-        ``device``, its report; the simulation's runs go on there); ``writers`` watch the
-        equilibrium (phase "sample")."""
-        sample = self.config.sample
-        particles, walls, report, _ = load_sample(path, expected=sample)
-        sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
-        sim.device = device
-        started = time.perf_counter()
-        with watched(sim, writers, "sample"):
-            steps = equilibrate(sim, unbalanced=sample.equilibrium_unbalanced,
-                                tolerance=sample.stress_tolerance,
-                                max_steps=self.config.wet_steps,
-                                progress="equilibrate sample" if progress else None,
-                                phase=f"equilibrium of sample {path!r} at the confining stress")
-        report = dict(report)
-        report.update({"sample": os.path.abspath(path), "sample_equilibration_steps": steps,
-                       "sample_equilibration_time_s": time.perf_counter() - started,
-                       "porosity": porosity(sim.particles, sim.walls),
-                       "coordination": coordination(sim.contacts, len(sim.particles)),
-                       "sigma_wall": sim.walls.stress().tolist()})
-        report.setdefault("steps", steps)
-        report.setdefault("timestep", timestep_description(sample))
-        return sim, report
-
-    def run(self, out, *, progress=True, threads=None, stop_after=None, vtk_prep=False,
-            plots=True, device="cpu"):
-        """The whole test into the folder ``out`` (class docstring); ``stop_after``: stop the
-        shear after this many steps as an interruption would (raises Interrupted); ``plots``:
-        False leaves out triaxial.png and plots/ (a run timed for its physics, as the
-        trade-off study's: the figures' cost is not the physics').
-        ``vtk_prep``: ParaView frames of the preparation and wetting into ``out``/vtk_prep/
-        (``prep_writer``): True every ``prep_vtk_period`` steps, a positive integer every that
-        many steps, False (default) or 0 none. Output only: the results are the same.
-        ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
-        the wetting, the loading), "cpu" or "gpu" (``check_device``); a run option, not part of
-        the configuration."""
-        check_device(device)
-        check_stages_device(self.stages(), device)
-        if vtk_prep is not True and vtk_prep is not False:
-            vtk_prep = check_int("vtk_prep", vtk_prep, low=0)
-        if self.config.sample_path is not None:       # checked before the folder is touched
-            load_sample(self.config.sample_path, expected=self.config.sample)
-        with OutputFolder(out, self.NAME) as folder:
-            for name in self.outputs():
-                folder.claim(name)
-            with whole_run(laboratory_plan(self.config, self.PROGRESS), enabled=progress):
-                return self._run(folder, progress, threads, stop_after, vtk_prep, plots, device)
-
-    def prep_writer(self, out, vtk_prep):
-        """The VtkWriter of ``out``/vtk_prep/ (None when ``vtk_prep`` is False or 0): the four
-        series of pendular.io.vtk, ParaView's time axis the simulated time [s], field data
-        ``phase`` (index in PREP_PHASES: 0 growth, 1 friction, 2 unload, 3 equilibrate, 4
-        sample, 5 wetting) and ``mean_wall_stress`` [Pa]; a frame every period steps and at
-        the first step of each phase."""
-        if vtk_prep is False or vtk_prep == 0:
-            return None
-        period = prep_vtk_period(self.config.sample) if vtk_prep is True else vtk_prep
-        return VtkWriter(os.path.join(out, "vtk_prep"), period, phases=PREP_PHASES,
-                         field_data=lambda s: {"mean_wall_stress":
-                                               float(np.mean(s.walls.stress()))})
-
-    def _run(self, folder, progress, threads, stop_after, vtk_prep, plots, device):
-        config, out = self.config, folder.path
-        started = time.perf_counter()
-        frames = self.prep_writer(out, vtk_prep)
-        writers = () if frames is None else (frames,)
-        folder.phase = "prepare"
-        pause_point(folder.phase)
-        sim, preparation = self.start(progress, threads, writers, device)   # runs on device
-        prepared = time.perf_counter()
-        wetting = {}
-        if config.bridges is not None:
-            folder.phase = "wet"
-            pause_point(folder.phase)
-            # the water-content wetting restarts from copies of the dry sample: no frames
-            with watched(sim, writers if config.bridges.suction is not None else (), "wetting"):
-                sim, _, wetting = wet_sample(sim, config, progress="wet" if progress else None)
-        if frames is not None:
-            frames.close(sim)           # the state the shear starts from
-        folder.phase = "shear"
-        before_shear = plain({"config": config_to_dict(config), "preparation": preparation,
-                               "wetting": wetting, "preparation_time_s": prepared - started,
-                               "pre_shear_time_s": time.perf_counter() - started})
-        sample_file = os.path.join(out, "sample.h5")
-        save_sample(sample_file, sim, preparation, before_shear,
-                    identity={"seed": config.sample.seed})
-        run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
-        if run.checkpoint is not None:
-            run.checkpoint.write(sim)
-        return run.finish(progress, stop_after, plots)
-
-    @classmethod
-    def resume(cls, out, *, progress=True, threads=None, stop_after=None, device="cpu"):
-        """Continue the interrupted run of folder ``out`` from its checkpoint.h5, with the
-        configuration stored in its sample.h5, its loading on ``device`` (whichever device
-        wrote the checkpoint); returns the summary."""
-        sample_file = os.path.join(out, "sample.h5")
-        checkpoint = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(sample_file):
-            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
-                             "before its sample existed (in the preparation or the wetting), "
-                             "so nothing can be resumed; run it again")
-        if not os.path.exists(checkpoint):
-            stored = config_from_dict(load_sample(sample_file)[3].get("config"), sample_file)
-            why = ("the run stopped before its first checkpoint" if
-                   getattr(stored, "checkpoint_every", 0) > 0 else
-                   "the run was started with --checkpoint-every 0, which writes none")
-            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: {why}; run it again")
-        with OutputFolder(out, f"{cls.NAME} --resume", keep=True) as folder:
-            particles, walls, _, before_shear = load_sample(sample_file)
-            config = config_from_dict(before_shear.get("config"), sample_file)
-            if not isinstance(config, cls.CONFIG):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular {cls.NAME}")
-            check_device(device)
-            sim = servoed_simulation(particles, walls, config.sample, config.confining,
-                                     threads=threads)
-            if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
-                sim.forces.append(config.bridges.build(
-                    before_shear["wetting"].get("formation_suction_pa"), closed=True))
-            identity = run_identity(config, sample_file)
-            test = cls.__new__(cls)          # the stored run, checked when it started
-            test.config = config
-            run = _PathRun(sim, test, folder, before_shear, identity)
-            dt = sim.dt                      # the loading's time step, set from its sample
-            state = load_checkpoint(checkpoint, sim, expected_identity=identity)
-            if sim.dt != dt:                 # a checksum can be forged
-                raise ValueError(f"{checkpoint}: dt = {sim.dt:g} s is not this run's time step, "
-                                 f"{dt:g} s (set from its sample.h5): an edited checkpoint")
-            position = sim.particles.position   # two centres at one point have no normal
-            order = np.lexsort(position.T[::-1])
-            same = np.flatnonzero(np.all(position[order[1:]] == position[order[:-1]], axis=1))
-            if len(same):
-                i, j = sorted((int(order[same[0]]), int(order[same[0] + 1])))
-                raise ValueError(f"{checkpoint}: particles {i} and {j} share the position "
-                                 f"{position[i].tolist()} m: an edited checkpoint")
-            if (not isinstance(state, dict) or state.get("phase") != "shear"
-                    or state.get("steps") != run.steps
-                    or not isinstance(state.get("start_step"), int)
-                    or not isinstance(state.get("shear_time_s"), (int, float))):
-                raise ValueError(f"{checkpoint} does not belong to this run's loading")
-            start = state["start_step"]
-            end = math.inf if run.steps is None else start + run.steps
-            if not start <= sim.step <= end:
-                # a checksum can be forged: the step must lie in this loading
-                raise ValueError(f"{checkpoint}: step = {sim.step} is outside the valid range "
-                                 f"[{start}, {end}] of this run's loading (an edited checkpoint)")
-            run.resumed(state)
-            sim.device = device
-            return run.finish(progress, stop_after)
-
-    # ------------------------------------------------------------ the path of the test
-    def outputs(self):
-        """Files and folders the test owns in its output folder (pendular.io.outputs)."""
-        return ("history.h5", "summary.json", self.FIGURE, "plots", "vtk", "sample.h5",
-                "checkpoint.h5", "vtk_prep")
-
-    def loading(self, sim):
-        """The LoadingPath of the test attached to the static sample ``sim`` (time step set)."""
-        raise NotImplementedError
-
-    def stages(self):
-        """The stages of the loading known before it runs, for the checks made then
-        (loading.check_stages_device); [] by default."""
-        return []
-
-    def summarize(self, history):
-        """The test's results from its ``history`` (dict of arrays)."""
-        raise NotImplementedError
-
-    def derived(self, history):
-        """The recorded ``history`` (dict of arrays) with the columns the test computes from
-        its rows (none here)."""
-        return history
-
-    def frame_fields(self, path):
-        """(field data function of sim, time axis name) of the ParaView frames of the loading
-        ``path`` (pendular.io.vtk.VtkWriter): the axial strain, in % on the time axis."""
-        axial = path.axial
-        return (lambda s: axial_strain_fields(axial.strain(s.walls))), "axial_strain_percent"
-
-    def plot(self, history, out, title):
-        """The test's figures into the folder ``out``, ``title`` the run's parameters."""
-        raise NotImplementedError
 
 
 class TriaxialTest(LaboratoryTest):
-    """A drained triaxial test of ``config`` (pendular.procedures.config.TriaxialConfig): the
+    """A drained triaxial test of ``config`` (pendular.procedures.triaxial.TriaxialConfig): the
     shear of ``config.shear`` (compression, extension, at a constant b or mean stress;
-    loading.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
+    triaxial.shear_stage); figure triaxial.png (q and volumetric strain against axial strain),
     plots/ (q/p, volumetric strain, wet: saturation and capillary stresses; the stress path
     stress_path.png: q-p and, wet, q'-p' of the effective stress)."""
 
@@ -838,7 +370,7 @@ class TriaxialTest(LaboratoryTest):
         return summary
 
     def derived(self, history):
-        """Undrained, the history with ``excess_pore_pressure`` (loading.excess_pore_pressure
+        """Undrained, the history with ``excess_pore_pressure`` (excess_pore_pressure
         of the wall stresses)."""
         if self.config.undrained:
             history["excess_pore_pressure"] = excess_pore_pressure(history["sigma_wall"])
@@ -854,263 +386,65 @@ class TriaxialTest(LaboratoryTest):
                          shear.direction, shear.b)
 
 
-#: History columns of the oedometric and isotropic paths beyond the triaxial's.
-COMPRESSION_COLUMNS = {"void_ratio": void_ratio}
+# ---------------------------------------------------------------- the command
 
 
-class OedometerTest(LaboratoryTest):
-    """An oedometric (K0) test of ``config`` (pendular.procedures.config.OedometerConfig;
-    loading.oedometer_stages): history with ``void_ratio`` and ``k0`` (and ``stage`` with an
-    unloading), summary of loading.oedometer_summary; figure oedometer.png (e-log sigma_v and
-    K0), plots/ (stress path, and against axial strain as the triaxial's)."""
-
-    NAME = "oedometer"
-    CONFIG = OedometerConfig
-    FIGURE = "oedometer.png"
-    PROGRESS = "oedometer"
-
-    def loading(self, sim):
-        config = self.config
-        rate = config.rate()
-        return LoadingPath(sim, oedometer_stages(config.axial_stress, rate, config.unload_to),
-                           record_every=config.record_every(sim.dt),
-                           columns={**COMPRESSION_COLUMNS, "k0": k0})
-
-    def summarize(self, history):
-        config = self.config
-        return {**oedometer_summary(history, config.axial_stress, config.unload_to),
-                **stress_balance(history)}
-
-    def plot(self, history, out, title):
-        plot_compression(history, os.path.join(out, self.FIGURE), title, stress="axial")
-        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
-        write_plots(history, os.path.join(out, "plots"), title, direction=None)
+#: A triaxial shear's own options.
+SHEAR = (options_named(ShearConfig, ("max_strain", "direction", "b", "constant_p", "drainage"))
+         + rate_options(ShearConfig) + (option_of(ShearConfig, "records"),))
 
 
-class IsotropicTest(LaboratoryTest):
-    """Isotropic loading and unloading in stages of ``config``
-    (pendular.procedures.config.IsotropicConfig; loading.isotropic_stages): history with
-    ``void_ratio`` and ``stage``, summary of loading.isotropic_summary; figure isotropic.png
-    (e-log p, net and effective, and the volumetric strain)."""
-
-    NAME = "isotropic"
-    CONFIG = IsotropicConfig
-    FIGURE = "isotropic.png"
-    PROGRESS = "stage"
-
-    def loading(self, sim):
-        config = self.config
-        sample = config.sample
-        stages = isotropic_stages(config.stresses, config.rate(), max_steps=config.stage_steps,
-                                  unbalanced=sample.equilibrium_unbalanced,
-                                  tolerance=sample.stress_tolerance)
-        return LoadingPath(sim, stages, record_every=config.record_every(sim.dt),
-                           columns=COMPRESSION_COLUMNS)
-
-    def summarize(self, history):
-        return {**isotropic_summary(history, self.config.stresses), **stress_balance(history)}
-
-    def plot(self, history, out, title):
-        plot_compression(history, os.path.join(out, self.FIGURE), title, stress="mean")
-        plot_stress_path(history, os.path.join(out, "plots", "stress_path.png"), title)
+def axial_strain(strain):
+    """The final axial strain ``strain`` of a triaxial shear (--max-strain); ParameterError
+    outside [MIN_AXIAL_STRAIN, MAX_AXIAL_STRAIN], saying why (AXIAL_STRAIN_LIMIT)."""
+    if not MIN_AXIAL_STRAIN <= strain <= MAX_AXIAL_STRAIN:              # NaN included
+        raise ParameterError("max_strain", f"max_strain = {strain:g} is outside the valid "
+                             f"range [{MIN_AXIAL_STRAIN:g}, {MAX_AXIAL_STRAIN:g}]: "
+                             f"{AXIAL_STRAIN_LIMIT}", "--max-strain")
+    return strain
 
 
-def run_identity(config, sample_file):
-    """What a checkpoint of this run must carry (pendular.utils.integrity): the configuration's hash, the
-    seed and the checksum of the sample the loading started from."""
-    return {"config_hash": config_hash(config_to_dict(config)), "seed": config.sample.seed,
-            "sample_checksum": checksum(sample_file)}
+def triaxial_config(values, given):
+    """The TriaxialConfig of ``values`` (its shear's steps bounding --vtk-frames and
+    --records)."""
+    axial_strain(values["max_strain"])
+    if values["records"] is not None:
+        spec_of(ShearConfig, "records").check("records", values["records"])
+    fields = laboratory_fields(values, given, lambda: ShearConfig(**fields_of(values, SHEAR)))
+    frames = values["vtk_frames"]
+    config = TriaxialConfig(**fields, **({} if frames is None else {"vtk_frames": frames}))
+    # counts given beyond the shear's steps would silently give one a step (the defaults may)
+    steps = config.shear_steps()
+    phase = f"the shear to --max-strain {config.shear.max_strain:g}"
+    if frames is not None:
+        steps_count("vtk_frames", frames, steps, phase)
+    if values["records"] is not None:
+        steps_count("records", values["records"], steps, phase, low=2)
+    return config
 
 
-class _PathRun:
-    """The loading of a LaboratoryTest with its writers in a fixed order (recorder, ParaView,
-    checkpoint), so that a resumed run builds the same simulation; ``finish`` runs the
-    rest of the path and writes the outputs."""
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular triaxial --particles 1000 --suction 30000 --confining 750 --out runs/wet",
+           "a wet drained triaxial compression at 30 kPa suction and 750 Pa confining stress: "
+           "the peak of q and its friction angles (net and effective), the critical state when "
+           "reached, in summary.json; q and the volumetric strain in triaxial.png")
 
-    def __init__(self, sim, test, folder, before_shear, identity):
-        self.sim, self.test, self.config, self.before_shear = sim, test, test.config, before_shear
-        self.folder, self.out = folder, folder.path
-        config = self.config
-        out = folder.path
-        sim.dt = timestep(sim, config.sample)   # from the state the loading starts from
-        self.path = test.loading(sim)
-        self.steps = self.path.steps           # None: known only as the path runs
-        self.start_step = sim.step
-        self.shear_time = 0.0        # seconds spent loading by earlier (interrupted) runs
-        # frames spread over the loading, or over its estimate when its stages end otherwise
-        self.vtk_period = frame_period(
-            config.vtk_every, config.vtk_frames,
-            self.steps if self.steps is not None else config.estimated_steps(),
-            self.path.recorder.period * VTK_RECORDS)
-        field_data, time_axis = test.frame_fields(self.path)
-        self.vtk = frames_writer(sim, out, self.vtk_period, field_data=field_data,
-                                 time_axis=time_axis)
-        self.checkpoint = None
-        if config.checkpoint_every > 0:
-            self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),
-                                               config.checkpoint_every, self.extra_state,
-                                               identity)
-            sim.writers.append(self.checkpoint)
-        self._clock = time.perf_counter()
+#: Summary keys printed at the end.
+SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
+         "principal_difference_at_peak", "phi_peak_deg", "peak_q_effective",
+         "p_effective_at_peak", "phi_peak_effective_deg", "peak_q_effective_complete",
+         "p_effective_complete_at_peak", "phi_cs_deg", "M_cs", "void_ratio_cs",
+         "critical_state_note", "phi_peak_note",
+         "mean_stress_deviation", "b_deviation", "axial_contact_lost", "initial_porosity",
+         "porosity_after_wetting", "saturation_at_peak", "suction_at_peak",
+         "excess_pore_pressure_at_peak", "excess_pore_pressure_final", "p_min",
+         "max_volume_change", "suction_final", "saturation_final",
+         "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
 
-    def extra_state(self, sim):
-        """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
-        return {"phase": "shear", "steps": self.steps, "start_step": self.start_step,
-                "shear_time_s": self.shear_time + time.perf_counter() - self._clock,
-                "config": self.before_shear["config"], "path": self.path.state()}
-
-    def resumed(self, state):
-        """Take the progress of the checkpoint loaded into the simulation."""
-        self.start_step = state["start_step"]
-        self.shear_time = state["shear_time_s"]
-        where = state.get("path")
-        if where is None and self.steps is not None:
-            # a checkpoint that holds no path: a shear's one stage
-            where = {"stage": 0, "stage_start": self.start_step, "stage_steps": self.steps}
-        if not isinstance(where, dict):
-            raise ValueError("the checkpoint does not say where its loading path stood")
-        self.path.resume(self.sim, where)
-        self._clock = time.perf_counter()
-
-    def finish(self, progress, stop_after, plots=True):
-        """Run the rest of the path (raising Interrupted at ``stop_after`` steps or on Ctrl-C)
-        and write the outputs (the figures if ``plots``); returns the summary. Interrupted, it
-        keeps the history so far (summary ``completed`` false), unless the folder holds the
-        finished results of an earlier run, which are then kept instead."""
-        sim, path = self.sim, self.path
-        label = self.test.PROGRESS if progress else None
-        budget = math.inf if stop_after is None else stop_after
-        self._clock = time.perf_counter()
-        try:
-            if pausing_at("shear"):          # tests: Ctrl-C halfway through the loading
-                half = int(min(path.steps_left(sim), budget)) // 2
-                budget -= path.run(sim, max_steps=half)
-                pause_point("shear")
-            path.run(sim, max_steps=None if budget == math.inf else budget, progress=label)
-        except KeyboardInterrupt:
-            pass
-        except AxialContactLost as error:
-            if not self.test.ENDS_AT_CONTACT_LOSS:
-                return self._failed(error)
-            path.recorder.record(sim)            # the record of the loss ends the history
-            self.shear_time += time.perf_counter() - self._clock
-            if self.vtk is not None:
-                self.vtk.close(sim)
-            return self.write_outputs(plots=plots, stopped=str(error))
-        except (SampleCrushed, StageFailed) as error:
-            return self._failed(error)
-        self.shear_time += time.perf_counter() - self._clock
-        if not path.done:
-            if self.folder.earlier_results:
-                raise Interrupted(f"interrupted at step {sim.step}; the earlier results in "
-                                  f"{self.out} are kept")
-            self.write_outputs(completed=False)
-            raise Interrupted(f"interrupted at step {sim.step}; history so far in {self.out}"
-                              + (f"; continue with --resume {self.out}"
-                                 if self.checkpoint is not None else ""))
-        if self.vtk is not None:
-            self.vtk.close(sim)
-        return self.write_outputs(plots=plots)
-
-    def _failed(self, error):
-        """Keep the history of a loading that ``error`` stopped (unless the folder holds the
-        finished results of an earlier run), then raise it."""
-        self.shear_time += time.perf_counter() - self._clock
-        if not self.folder.earlier_results:
-            self.write_outputs(completed=False, error=str(error))
-        raise error
-
-    def write_outputs(self, completed=True, plots=True, error=None, stopped=None):
-        """history.h5, summary.json (``completed``: whether the loading reached its end;
-        ``error``: what stopped it, if not an interruption; ``stopped``: why a completed
-        loading ended before its last stage's end) and, for a completed run, the plots unless
-        ``plots`` is False."""
-        sim, config, out = self.sim, self.config, self.out
-        sample = config.sample
-        preparation = self.before_shear["preparation"]
-        history = self.test.derived(self.path.recorder.arrays())
-        summary = self.test.summarize(history)
-        rate = config.rate()
-        sheared = sim.step - self.start_step
-        loaded = history["unbalanced_force"][1:]      # none when the first stage failed at once
-        summary.update({
-            "completed": completed,
-            "initial_porosity": preparation["porosity"],
-            "initial_coordination": preparation["coordination"],
-            "wall_time_s": self.before_shear["pre_shear_time_s"] + self.shear_time,
-            "preparation_time_s": self.before_shear["preparation_time_s"],
-            "shear_time_s": self.shear_time,
-            "steps": self.steps if self.steps is not None else sheared,
-            "preparation_steps": preparation["steps"],
-            "particle_steps_per_s": (len(sim.particles) * sheared / self.shear_time
-                                     if self.shear_time > 0.0 else None),
-            "dt": sim.dt,
-            "strain_rate": rate,
-            "inertial_number": inertial_number(rate, sample.radius, sample.density,
-                                               config.reference_pressure()),
-            "max_unbalanced_force": float(np.max(loaded)) if len(loaded) else None,
-            "mean_unbalanced_force": float(np.mean(loaded)) if len(loaded) else None,
-            "threads": numba.get_num_threads(),
-            "device": sim.device,
-            "grading": grading(sim.particles.radius),
-            **self.before_shear["wetting"],
-        })
-        wetting = self.before_shear["wetting"]
-        if "wet_porosity" in wetting:
-            before, after = preparation["porosity"], wetting["wet_porosity"]
-            summary.update({"porosity_before_wetting": before, "porosity_after_wetting": after,
-                            "void_ratio_before_wetting": before / (1.0 - before),
-                            "void_ratio_after_wetting": after / (1.0 - after)})
-        if "liquid_bridges" in history:
-            # the closed amount, which water-content stages change (path_table.liquid_total)
-            initial = np.asarray(history.get("liquid_total",
-                                             self.before_shear["wetting"]["liquid_initial"]))
-            total = history["liquid_bridges"] + history["liquid_film"] + history["liquid_lost"]
-            summary.update({
-                "liquid_balance_error": float(np.max(np.abs(total - initial) / initial)),
-                "liquid_lost_fraction": float(history["liquid_lost"][-1]
-                                              / np.ravel(initial)[-1])})
-        summary = plain(summary)              # NumPy scalars as plain floats and ints
-        summary["units"] = {k: v for k, v in SUMMARY_UNITS.items() if k in summary}
-        attributes = {k: v for k, v in parameters(config).items() if v is not None}
-        attributes.update({"timestep": preparation["timestep"], "dt": sim.dt,
-                           "strain_rate": rate, "vtk_every": self.vtk_period})
-        if not completed:
-            summary["phase"] = "shear"
-        if error is not None:
-            summary["error"] = error
-        if stopped is not None:
-            summary["stopped"] = stopped
-        self.folder.phase = "write"
-        with deferred_interrupts():       # history and summary are written whole, or not at all
-            write_history(os.path.join(out, "history.h5"), history,
-                          self.before_shear["config"], attributes=attributes)
-            pause_point("write")
-            write_json(os.path.join(out, "summary.json"), summary)
-            if completed:
-                self.folder.commit()
-        if not completed:
-            return summary
-        flagged = summary["stress_balance_flagged"]
-        if flagged:
-            print(f"warning: {len(flagged)} of {len(history['step'])} records have wall and "
-                  f"Love-Weber stresses apart by more than {STRESS_BALANCE_BOUND:.0%} of p (up "
-                  f"to {summary['stress_balance_error']:.1%}): the loading is not quasi-static "
-                  "there (summary.json stress_balance_flagged)", file=sys.stderr)
-        if summary.get("axial_contact_lost"):
-            print("warning: the axial stress fell to 0: the axial walls, which cannot pull, left "
-                  "the sample before it failed in extension, and the shear ended there; the "
-                  "peak is that of the walls' release, not of the sample, and phi_peak_deg is "
-                  "null (summary.json axial_contact_lost); raise --confining", file=sys.stderr)
-        if not plots:
-            return summary
-        self.test.plot(history, out, run_label(parameters(config),
-                                               float(history["porosity"][0])))
-        return summary
-
-
-def plain(data):
-    """``data`` with NumPy scalars and arrays as JSON values."""
-    return json.loads(json.dumps(data, default=lambda v: v.tolist() if hasattr(v, "tolist")
-                                 else str(v)))
-
+#: The triaxial command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="triaxial",
+    description="triaxial test (thesis Ch. 5), dry or wet, drained or undrained",
+    test=TriaxialTest,
+    declared=laboratory_options(SHEAR, triaxial_config, frames=True),
+    shown=SHOWN, example=EXAMPLE, out="runs/triaxial")

@@ -49,7 +49,7 @@ import numpy as np
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.history import read_history
 from pendular.io.schema import POSTERIOR_COLUMNS, summary_units
-from pendular.procedures.options import config_from_options, options_of
+from pendular.procedures.registry import config_from_options, options_of
 from pendular.studies.campaign import Campaign, Run
 from pendular.utils.atomic import replacing, write_json
 from pendular.utils.parameters import spec_of

@@ -39,7 +39,7 @@ SWCC (run_kinds.swcc_summary).
 
 Any option of the command's configuration can be fixed or swept, and ``force`` (Run.force) of a
 laboratory test; each run's configuration is built by
-pendular.procedures.options.config_from_options, as the command line builds it, so it is
+pendular.procedures.registry.config_from_options, as the command line builds it, so it is
 validated as there. Flags take true/false, a list option a list or its comma text
 (``table_resolution = [350, 80]``, ``stresses = "500,1000"``); relative ``sample``, ``psd``
 and ``table`` (a path table) paths are relative to the table's folder. A table must set at
@@ -77,8 +77,8 @@ from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int
 
 from pendular.procedures.config import config_to_dict, sample_made_with
-from pendular.procedures.options import config_from_options, options_of
-from pendular.procedures.triaxial import Interrupted
+from pendular.procedures.registry import config_from_options, options_of
+from pendular.procedures.laboratory import Interrupted
 from pendular.studies.run_kinds import PROCEDURES, RunConfig, procedure_of, run_options_of
 
 #: Seconds between updates of the campaign's progress bar.
@@ -98,7 +98,7 @@ JOBS_PER_CPU = 4
 class Run:
     """One run of a campaign: its folder name under ``out/runs`` and its configuration (of
     a command of PROCEDURES); ``force``: run a laboratory test refused as not quasi-static or
-    too long (pendular.procedures.triaxial.check_feasible)."""
+    too long (pendular.procedures.laboratory.check_feasible)."""
 
     name: str
     config: RunConfig
@@ -502,7 +502,7 @@ def _named(error: Exception, options: dict) -> list[str]:
 
 def sweep_from_table(path: str | os.PathLike) -> tuple[str, list[Run]]:
     """(command, [Run]) of the TOML table at ``path``; each run's configuration is built and
-    validated from its options by pendular.procedures.options.config_from_options (ValueError
+    validated from its options by pendular.procedures.registry.config_from_options (ValueError
     naming the table, the run and the table key with its section)."""
     source = f"table = {os.fspath(path)!r}"
     table = read_table(path)

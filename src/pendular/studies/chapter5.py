@@ -45,8 +45,8 @@ from pendular.procedures.preparation import PrepareConfig
 
 from pendular.studies.campaign import Campaign, Run, read_table, write_campaign_csv
 from pendular.studies.chapter5_figures import campaign_figures
-from pendular.procedures.config import (MIN_SAMPLE_PARTICLES, BridgeConfig, ShearConfig,
-    TriaxialConfig)
+from pendular.procedures.config import BridgeConfig, MIN_SAMPLE_PARTICLES, ShearConfig
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.procedures.options import SUCTION
 from pendular.utils.parameters import option_from, option_of, spec_of
 from pendular.studies.envelope import mohr_coulomb_fit

@@ -7,12 +7,12 @@
    stress; cached, pendular.interop.yade.runner.cached_sample, shared with the benchmarks), servoed on its six
    walls at the confining stress and, wet (``config.bridges``), given capillary bridges at
    every contact (suction control, exact tables); it is run until static
-   (pendular.procedures.triaxial.equilibrate, at most ``config.wet_steps`` steps).
+   (pendular.procedures.equilibrium.equilibrate, at most ``config.wet_steps`` steps).
 2. This static (wetted) packing is exported (DIR/packing.txt, pendular.interop.yade.formats.write_spheres:
    centres, radii, wall box). Both codes start the shear from it in the same state: velocities
    zero, contacts found afresh (no shear-spring history), every touching pair getting a bridge
    at the first step (YADE: Law2_ScGeom_CapillaryPhys_Capillarity with menisci created at
-   contact from the files of capillary.BridgeTable.write_yade, pendular.interop.yade.runner.
+   contact from the files of pendular.interop.yade.capillary_files, pendular.interop.yade.runner.
    yade_capillary_files). The wet state is thus identical in both codes at the start of the
    shear (same contacts, bridges, Sr, stresses), and only the shear's dynamics can differ.
    ``packing=FILE`` starts from a packing exported by an earlier cross-check of the same sample
@@ -62,15 +62,18 @@ from pendular.dem.walls import ConstantStrainRate, StressServo
 from pendular.interop.yade.formats import read_spheres, write_spheres
 from pendular.homogenize.invariants import stress_ratio
 
-from pendular.procedures.config import (MAX_STAGE_STEPS, MIN_SAMPLE_PARTICLES, YADE_CHOICES,
-    BridgeConfig, ShearConfig, TriaxialConfig, config_to_dict)
-from pendular.procedures.options import SUCTION, axial_strain, sample_sizes, size_options
+from pendular.procedures.config import (BridgeConfig, MAX_STAGE_STEPS, MIN_SAMPLE_PARTICLES,
+    ShearConfig, YADE_CHOICES, config_to_dict)
+from pendular.procedures.triaxial import TriaxialConfig
+from pendular.procedures.options import SUCTION, sample_sizes, size_options
+from pendular.procedures.triaxial import axial_strain
 from pendular.utils.parameters import (Option, OptionError, Parameter, default_of, option_from,
     option_of)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
-from pendular.procedures.triaxial import NotStatic, TriaxialShear, equilibrate, summarize
+from pendular.procedures.equilibrium import NotStatic, equilibrate
+from pendular.procedures.triaxial import TriaxialShear, summarize
 from pendular.interop.yade.runner import (cached_sample, find_yade, run_yade_triaxial,
     yade_capillary_files, yade_history)
 

@@ -28,7 +28,7 @@ import numpy as np
 
 from pendular.io.outputs import OutputFolder
 from pendular.io.schema import summary_units
-from pendular.procedures.options import config_from_options, options_of
+from pendular.procedures.registry import config_from_options, options_of
 from pendular.procedures.preparation import PrepareConfig
 from pendular.studies.campaign import Campaign, Run, run_name, write_campaign_csv
 from pendular.studies.envelope_figures import plot_mohr_circles, plot_peaks

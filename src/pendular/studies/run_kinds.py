@@ -1,6 +1,6 @@
 """What a campaign runs: each laboratory command's test, the file of its result, its summary
-and its options (``PROCEDURES``, a Procedure per command: triaxial, oedometer, isotropic, cyclic,
-simple-shear, path, tension, swcc), used by pendular.studies.campaign to run a configuration,
+and its options (``PROCEDURES``, a Procedure per command of pendular.procedures.registry:
+triaxial, oedometer, isotropic, cyclic, simple-shear, path, tension, swcc), used by pendular.studies.campaign to run a configuration,
 to reuse a finished run and to write its campaign.csv row."""
 
 from __future__ import annotations
@@ -10,16 +10,18 @@ import os
 from dataclasses import dataclass
 from typing import Any, Callable, Union
 
-from pendular.procedures.config import (CyclicConfig, IsotropicConfig, OedometerConfig,
-    SimpleShearConfig, SwccConfig, TablePathConfig, TensionConfig, TriaxialConfig,
-    same_config, stored_config)
-from pendular.procedures.cyclic import CyclicTest
-from pendular.procedures.path_table import PathTest
-from pendular.procedures.simple_shear import SimpleShearTest
-from pendular.procedures.swcc import SwccTest
-from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import (IsotropicTest, LaboratoryTest, OedometerTest,
-    TriaxialTest, parameters)
+from pendular.procedures.config import same_config, stored_config
+from pendular.procedures.cyclic import CyclicConfig
+from pendular.procedures.isotropic import IsotropicConfig
+from pendular.procedures.laboratory import LaboratoryTest, parameters
+from pendular.procedures.oedometer import OedometerConfig
+from pendular.procedures.path import TablePathConfig
+from pendular.procedures.registry import COMMANDS
+from pendular.procedures.run_options import RunOptions
+from pendular.procedures.simple_shear import SimpleShearConfig
+from pendular.procedures.swcc import SwccConfig
+from pendular.procedures.tension import TensionConfig
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.utils.parameters import Option, flat_options
 
 #: What a campaign runs: the configuration of a laboratory command (PROCEDURES).
@@ -80,7 +82,7 @@ class Procedure:
     summary (the scalars of which are its campaign.csv columns), ``options(config)`` its flat
     options (the other columns), ``keys`` the numbers a finished laboratory summary holds
     (else it is damaged and the run is done again). A laboratory test
-    (pendular.procedures.triaxial.LaboratoryTest) stores its configuration in its sample.h5,
+    (pendular.procedures.laboratory.LaboratoryTest) stores its configuration in its sample.h5,
     the others in their result."""
 
     test: type
@@ -103,8 +105,8 @@ class Procedure:
     def run(self, config: RunConfig, folder: str, threads: int = 1, force: bool = False,
             device: str = "cpu") -> dict:
         """Run the test of ``config`` into ``folder``; its summary."""
-        settings = {"threads": threads} if self.threaded else {}
-        return self.summary(self.start(config, force).run(folder, device=device, **settings))
+        options = RunOptions(device=device, threads=threads if self.threaded else None)
+        return self.summary(self.start(config, force).run(folder, options))
 
     def finished(self, config: RunConfig, folder: str) -> dict | None:
         """The summary of a run of ``folder`` that finished with an equal configuration, or
@@ -133,19 +135,16 @@ class Procedure:
             return None
 
 
-#: Each laboratory command a campaign runs, by its name.
-PROCEDURES = {
-    "triaxial": Procedure(TriaxialTest, TriaxialConfig, keys=SUMMARY_KEYS),
-    "oedometer": Procedure(OedometerTest, OedometerConfig),
-    "isotropic": Procedure(IsotropicTest, IsotropicConfig),
-    "cyclic": Procedure(CyclicTest, CyclicConfig),
-    "simple-shear": Procedure(SimpleShearTest, SimpleShearConfig),
-    "path": Procedure(PathTest, TablePathConfig),
-    "tension": Procedure(TensionTest, TensionConfig, "tension.json", tension_summary,
-                         tension_options, keys=(), threaded=False),
-    "swcc": Procedure(SwccTest, SwccConfig, "swcc.json", swcc_summary, swcc_options,
-                      keys=()),
-}
+#: What a campaign keeps of a command's run where it differs from a LaboratoryTest's
+#: (Procedure's fields by command).
+OWN = {"triaxial": {"keys": SUMMARY_KEYS},
+       "tension": {"result": "tension.json", "summary": tension_summary,
+                   "options": tension_options, "keys": (), "threaded": False},
+       "swcc": {"result": "swcc.json", "summary": swcc_summary, "options": swcc_options,
+                "keys": ()}}
+#: Each laboratory command a campaign runs, by its name: every test of the registry.
+PROCEDURES = {name: Procedure(command.test, command.config, **OWN.get(name, {}))
+              for name, command in COMMANDS.items()}
 
 
 def procedure_of(config: Any) -> Procedure:

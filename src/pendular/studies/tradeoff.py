@@ -63,8 +63,8 @@ from pendular.utils.validate import check_int
 
 from pendular.procedures.config import sample_made_with
 from pendular.studies.campaign import check_jobs, executor, prepare_one
-from pendular.procedures.config import (BridgeConfig, ShearConfig, TriaxialConfig, config_json,
-    config_to_dict)
+from pendular.procedures.config import BridgeConfig, ShearConfig, config_json, config_to_dict
+from pendular.procedures.triaxial import TriaxialConfig
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.triaxial import TriaxialTest

@@ -44,7 +44,7 @@ TESTS = ("triaxial", "oedometer", "isotropic", "cyclic", "simple-shear", "tensio
 
 def _test_options():
     """{key: Option} of every option of the TESTS, by key (the first declaration of a key)."""
-    from pendular.procedures.options import options_of
+    from pendular.procedures.registry import options_of
 
     return {option.key: option for test in TESTS for option in options_of(test)
             if not option.positional}
@@ -81,7 +81,7 @@ def _log(message):
 
 
 def run(args):
-    from pendular.procedures.options import options_of
+    from pendular.procedures.registry import options_of
     from pendular.studies.calibration import (Calibration, parse_fit, read_curve,
                                               write_posterior, write_summary, DATA_COLUMNS)
     from pendular.studies.calibration_figures import write_figures

@@ -20,21 +20,6 @@ and output options are those of ``pendular triaxial``. Stresses compression posi
 
 from __future__ import annotations
 
-from pendular.procedures.cyclic import CyclicTest
-
 from pendular.cli.commands.triaxial import loading_command
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular cyclic --particles 1000 --amplitude-q 200 --cycles 10 --out runs/cyclic",
-           "ten cycles of q = +-200 Pa: the secant modulus and damping ratio of each loop (null "
-           "below its resolution) and the accumulated strains; cyclic.png")
-
-#: Summary keys printed at the end.
-SHOWN = ("cycles", "secant_modulus_first", "secant_modulus_last", "damping_ratio_first",
-         "damping_ratio_last", "secant_modulus_first_effective",
-         "secant_modulus_last_effective", "damping_ratio_first_effective",
-         "damping_ratio_last_effective", "axial_strain_accumulated",
-         "volumetric_strain_accumulated", "phi_peak_deg", "initial_porosity", "wall_time_s",
-         "particle_steps_per_s", "damping_ratio_note")
-
-add_arguments, config_from, run = loading_command("cyclic", CyclicTest, SHOWN)
+add_arguments, config_from, run, EXAMPLE = loading_command("cyclic")

@@ -1,5 +1,5 @@
 """Any loading path from a table, dry or wet: prepare (or load) a sample at --confining, wet
-it, then run the stages of PATH.toml in turn (pendular.procedures.path_table).
+it, then run the stages of PATH.toml in turn (pendular.procedures.path).
 
 PATH.toml holds the path, a list of [[stage]] tables with the keys of the Python API's Stage:
 
@@ -38,19 +38,6 @@ run without its table. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.path_table import PathTest
-
 from pendular.cli.commands.triaxial import loading_command
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular path examples/paths/oedometer_unload.toml --particles 1000 --out runs/path",
-           "the stages of a TOML table run in turn: each stage's end state in summary.json, the "
-           "stress path in plots/")
-
-#: Summary keys printed at the end.
-SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
-         "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
-         "phi_peak_effective_deg", "water_stages", "collapse_strain", "collapse_axial_strain",
-         "initial_porosity", "wall_time_s", "particle_steps_per_s")
-
-add_arguments, config_from, run = loading_command("path", PathTest, SHOWN)
+add_arguments, config_from, run, EXAMPLE = loading_command("path")

@@ -17,23 +17,6 @@ options are those of ``pendular triaxial``. Stresses compression positive [Pa].
 
 from __future__ import annotations
 
-from pendular.procedures.simple_shear import SimpleShearTest
-
 from pendular.cli.commands.triaxial import loading_command
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular simple-shear --particles 1000 --normal-stress 1000 "
-           "--constant-volume --max-strain 0.2 --out runs/simple_shear",
-           "a constant-volume simple shear to gamma 20 %: the peak of tau, the peak of "
-           "tau/sigma_n with its friction angle, each with its own record; simple_shear.png with "
-           "the tau-sigma_n stress path")
-
-#: Summary keys printed at the end.
-SHOWN = ("peak_shear_stress", "shear_strain_at_peak_stress", "normal_stress_at_peak_stress",
-         "peak_stress_ratio", "phi_peak_deg", "shear_strain_at_peak", "normal_stress_at_peak",
-         "shear_stress_at_peak", "peak_reached", "residual_stress_ratio", "phi_residual_deg",
-         "phi_peak_effective_deg", "phi_residual_effective_deg", "normal_stress_final",
-         "max_dilatancy", "dilatancy_angle_deg", "max_volume_change", "liquid_balance_error",
-         "initial_porosity", "wall_time_s", "particle_steps_per_s")
-
-add_arguments, config_from, run = loading_command("simple-shear", SimpleShearTest, SHOWN)
+add_arguments, config_from, run, EXAMPLE = loading_command("simple-shear")

@@ -20,23 +20,21 @@ import sys
 
 from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
     add_run_options, command_config, declared_values, print_summary, set_threads)
-from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options, run_options
 from pendular.procedures.options import CHECKPOINT_EVERY
+from pendular.procedures.registry import COMMANDS
 from pendular.procedures.swcc import SwccTest
-from pendular.procedures.triaxial import Interrupted
+from pendular.procedures.laboratory import Interrupted
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular swcc --particles 1000 --suctions 3000,10000,30000,100000 --out runs/swcc",
-           "Sr and chi along drying then wetting at these suctions, with the hysteresis; "
-           "swcc.json, swcc.png")
+#: The command's declaration (pendular.procedures.registry).
+COMMAND = COMMANDS["swcc"]
+EXAMPLE = COMMAND.example
 
-#: Columns of the drying and wetting tables printed at the end (swcc.json's stage rows).
-SHOWN_COLUMNS = ("suction", "saturation", "bridges", "porosity", "volumetric_strain", "chi")
 
 
 def add_arguments(parser):
     add_command_options(parser, "swcc")
-    parser.add_argument("--out", default="runs/swcc", help="output folder")
+    parser.add_argument("--out", default=COMMAND.out, help="output folder")
     add_run_options(parser)
     add_device_option(parser, "the preparation and the path (the wetting across gaps stays on "
                               "the CPU)")
@@ -50,22 +48,19 @@ def config_from(args):
 
 def run(args):
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            result = SwccTest.resume(args.resume, progress=progress, threads=args.threads,
-                                     stop_after=args.stop_after, device=args.device)
+            result = SwccTest.resume(args.resume, run_options(args))
             args.out = args.resume
         else:
             every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
-            result = SwccTest(config_from(args)).run(
-                args.out, progress=progress, threads=args.threads, device=args.device,
-                checkpoint_every=every, stop_after=args.stop_after)
+            result = SwccTest(config_from(args)).run(args.out,
+                                                     run_options(args, checkpoint_every=every))
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED
-    print_summary(result, ("drying", "wetting"), args.quiet, columns=SHOWN_COLUMNS)
+    print_summary(result, COMMAND.shown, args.quiet, columns=COMMAND.columns)
     merged = sorted({row["suction"] for branch in ("drying", "wetting") for row in result[branch]
                      if row["pendular_overlaps"] > 0})
     if merged:

@@ -17,29 +17,25 @@ import sys
 
 from pendular.cli import (INTERRUPTED, add_command_options, add_device_option,
     add_run_options, command_config, declared_values, print_summary, set_threads)
-from pendular.cli.commands.triaxial import add_resume_options, check_resume_options
-from pendular.procedures.config import TensionConfig
+from pendular.cli.commands.triaxial import add_resume_options, check_resume_options, run_options
+from pendular.procedures.tension import TensionConfig
 from pendular.procedures.options import CHECKPOINT_EVERY
+from pendular.procedures.registry import COMMANDS
 from pendular.dem.simulation import check_device
 from pendular.procedures.tension import TensionTest
-from pendular.procedures.triaxial import Interrupted
+from pendular.procedures.laboratory import Interrupted
 
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular tension --void-ratio 0.65 --water-content 1 --out runs/tension",
-           "the direct tensile strength of one of Kim's (2001) cases against his measurement and "
-           "the packing-state prediction; tension.json, report.md")
-
-#: Columns of the cases' table printed at the end (--quiet: report.md's table).
 #: Options that watch a run rather than make it: not recorded in tension.json's arguments.
 WATCHING = ("checkpoint_every", "resume", "stop_after")
+#: The command's declaration (pendular.procedures.registry).
+COMMAND = COMMANDS["tension"]
+EXAMPLE = COMMAND.example
 
-SHOWN_COLUMNS = ("case", "void_ratio", "water_content", "saturation", "bridges",
-                 "tensile_strength_pa", "kim_measured_pa", "packing_state_pa")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_command_options(parser, "tension")
-    parser.add_argument("--out", default="runs/direct_tension", help="output folder")
+    parser.add_argument("--out", default=COMMAND.out, help="output folder")
     add_run_options(parser, threads_default=1)
     add_device_option(parser, "the preparations, the wettings and the pulls")
     add_resume_options(parser)
@@ -52,25 +48,22 @@ def config_from(args: argparse.Namespace) -> TensionConfig:
 
 def run(args: argparse.Namespace) -> int:
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            output = TensionTest.resume(args.resume, progress=progress,
-                                        stop_after=args.stop_after, device=args.device)
+            output = TensionTest.resume(args.resume, run_options(args))
             args.out = args.resume
         else:
             config = config_from(args)
             check_device(args.device)                   # before anything is made
             every = declared_values((CHECKPOINT_EVERY,), args)["checkpoint_every"]
             arguments = {k: v for k, v in vars(args).items() if k not in WATCHING}
-            output = TensionTest(config).run(args.out, progress=progress, arguments=arguments,
-                                             device=args.device, checkpoint_every=every,
-                                             stop_after=args.stop_after)
+            output = TensionTest(config).run(args.out, run_options(
+                args, checkpoint_every=every, arguments=arguments))
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
         return INTERRUPTED
-    print_summary(output, ("cases",), args.quiet, columns=SHOWN_COLUMNS)
+    print_summary(output, COMMAND.shown, args.quiet, columns=COMMAND.columns)
     # with --quiet, stdout holds the JSON alone
     print(f"done in {output['wall_time_s']:.0f} s; outputs in {args.out}",
           file=sys.stderr if args.quiet else sys.stdout)

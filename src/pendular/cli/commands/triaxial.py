@@ -11,15 +11,15 @@ the grains' mass, the liquid then conserved during the shear (--rupture-liquid) 
 output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
 extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
 axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises
-(pendular.procedures.loading.shear_stage). --drainage undrained holds the volume (the lateral
+(pendular.procedures.triaxial.shear_stage). --drainage undrained holds the volume (the lateral
 walls follow the axial ones): summary excess_pore_pressure_at_peak [Pa] of a saturated sample
 and effective_stress_path; wet, the water content is held too (volume-controlled bridges,
 closed liquid) and the suction and Sr change.
 
 The sample, wetting and output options are shared with every laboratory command (``pendular
 oedometer``, ``isotropic``, ``simple-shear``, ``cyclic``, ``path``): pendular.procedures.options
-declares them and builds the configuration; ``loading_command`` makes such a command and
-``run_test`` runs it.
+declares them, each test's module (pendular.procedures.registry) its own and how they build
+the configuration; ``loading_command`` makes such a command and ``run_test`` runs it.
 """
 
 from __future__ import annotations
@@ -30,45 +30,30 @@ import sys
 from pendular.cli import (INTERRUPTED, UsageError, add_command_options, add_device_option,
     add_run_options, command_config, positive_int, print_summary, set_threads)
 from pendular.dem.simulation import check_device
-from pendular.procedures.triaxial import Interrupted, TriaxialTest
-
-#: A worked example: the command line, and what it gives (--help and docs/commands.md).
-EXAMPLE = ("pendular triaxial --particles 1000 --suction 30000 --confining 750 --out runs/wet",
-           "a wet drained triaxial compression at 30 kPa suction and 750 Pa confining stress: "
-           "the peak of q and its friction angles (net and effective), the critical state when "
-           "reached, in summary.json; q and the volumetric strain in triaxial.png")
+from pendular.procedures.laboratory import Interrupted
+from pendular.procedures.registry import COMMANDS
+from pendular.procedures.run_options import RunOptions
 
 #: Options a resumed run takes from its own command line, not from the stored run.
 RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
-#: Summary keys printed at the end.
-SHOWN = ("peak_axial_stress", "min_axial_stress", "peak_q", "p_at_peak", "axial_strain_at_peak",
-         "principal_difference_at_peak", "phi_peak_deg", "peak_q_effective",
-         "p_effective_at_peak", "phi_peak_effective_deg", "peak_q_effective_complete",
-         "p_effective_complete_at_peak", "phi_cs_deg", "M_cs", "void_ratio_cs",
-         "critical_state_note", "phi_peak_note",
-         "mean_stress_deviation", "b_deviation", "axial_contact_lost", "initial_porosity",
-         "porosity_after_wetting", "saturation_at_peak", "suction_at_peak",
-         "excess_pore_pressure_at_peak", "excess_pore_pressure_final", "p_min",
-         "max_volume_change", "suction_final", "saturation_final",
-         "liquid_balance_error", "liquid_lost_fraction", "wall_time_s", "particle_steps_per_s")
+def loading_command(name):
+    """(add_arguments, config_from, run, EXAMPLE) of the laboratory command ``name`` (a key
+    of pendular.procedures.registry.COMMANDS): its declared options, its test, the summary
+    keys it prints, its worked example and its output folder."""
+    command = COMMANDS[name]
 
-
-def loading_command(name, test, shown):
-    """(add_arguments, config_from, run) of the laboratory command ``name`` (a key of
-    pendular.procedures.options.COMMANDS) running the LaboratoryTest subclass ``test`` and
-    printing the summary's ``shown`` keys; its output folder runs/<name>."""
     def add_arguments(parser):
         add_command_options(parser, name)
-        add_output_options(parser, "runs/" + name.replace("-", "_"))
+        add_output_options(parser, command.out)
 
     def config_from(args):
         """The configuration of parsed options (ValueError naming the option)."""
         return command_config(name, args)
 
     def run(args):
-        return run_test(args, test, config_from, shown, add_arguments)
+        return run_test(args, command.test, config_from, command.shown, add_arguments)
 
-    return add_arguments, config_from, run
+    return add_arguments, config_from, run, command.example
 
 
 def add_output_options(parser, out):
@@ -114,7 +99,7 @@ def check_resume_options(args, add_arguments):
                          "added)")
 
 
-add_arguments, config_from, run = loading_command("triaxial", TriaxialTest, SHOWN)
+add_arguments, config_from, run, EXAMPLE = loading_command("triaxial")
 
 
 def run_test(args, test, config_from, shown, add_arguments):
@@ -123,19 +108,16 @@ def run_test(args, test, config_from, shown, add_arguments):
     their defaults); print the summary's ``shown`` keys (print_summary: JSON with --quiet);
     the exit status."""
     set_threads(args.threads)
-    progress = not args.quiet
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            summary = test.resume(args.resume, progress=progress, threads=args.threads,
-                                  stop_after=args.stop_after, device=args.device)
+            summary = test.resume(args.resume, run_options(args))
             out = args.resume
         else:
             config = config_from(args)
             check_device(args.device)               # before the test loads its tables
-            summary = test(config, force=args.force).run(
-                args.out, progress=progress, threads=args.threads, stop_after=args.stop_after,
-                vtk_prep=args.vtk_prep, device=args.device)
+            options = run_options(args, force=args.force, vtk_prep=args.vtk_prep)
+            summary = test(config, force=options.force).run(args.out, options)
             out = args.out
     except Interrupted as stop:
         print(f"{stop}", file=sys.stderr)
@@ -148,6 +130,13 @@ def run_test(args, test, config_from, shown, add_arguments):
     # with --quiet, stdout holds the JSON alone
     print(f"outputs in {out}", file=sys.stderr if args.quiet else sys.stdout)
     return 0
+
+
+def run_options(args, **more):
+    """The RunOptions of the parsed options ``args`` (--device, --threads, --quiet and the
+    hidden --stop-after), with ``more`` (a command's own: force, vtk_prep, ...)."""
+    return RunOptions(device=args.device, threads=args.threads, progress=not args.quiet,
+                      stop_after=args.stop_after, **more)
 
 
 def _defaults(add_arguments):

@@ -12,7 +12,7 @@ Shared by the cross-check (pendular.studies.crosscheck) and the benchmarks (benc
   the cache folder (pendular.capillary.cache_directory: $PENDULAR_CACHE or ~/.cache/pendular) with its
   configuration and prepared again when the configuration differs;
 - ``yade_capillary_files(contact_angle)``: YADE's capillary files M(r=1) ... M(r=10) of the
-  exact bridge tables (capillary.BridgeTable.write_yade), written once into the cache folder;
+  exact bridge tables (pendular.interop.yade.capillary_files), written once into the cache folder;
 - ``yade_history(path, box_volume)``: the driver's history in the layout of pendular's;
 - ``random_packing``: a quick non-overlapping packing for driver checks.
 """
@@ -33,6 +33,7 @@ from pendular import capillary
 from pendular.utils.threads import OPENMP_DEFAULTS
 from pendular.procedures.preparation import PREPARATION_VERSION, PrepareConfig, prepare_sample
 from pendular.dem.sample import load_sample, save_sample
+from pendular.interop.yade.capillary_files import write_table_files
 from pendular.interop.yade.formats import read_plot_data
 
 from pendular.procedures.config import sample_made_with
@@ -159,12 +160,12 @@ def benchmark_sample(count, confining, progress=True):
 
 def yade_capillary_files(contact_angle=0.0):
     """Folder with YADE's ten capillary files M(r=1) ... M(r=10) of the exact bridge tables at
-    ``contact_angle`` [deg] (capillary.BridgeTable.write_yade; written once, cached)."""
+    ``contact_angle`` [deg] (capillary_files.write_table_files; written once, cached)."""
     folder = os.path.join(cache_folder(), f"yade_capillary_theta{contact_angle:g}")
     if not os.path.exists(os.path.join(folder, "M(r=10)")):
         os.makedirs(os.path.dirname(folder), exist_ok=True)
         partial = folder + f".partial{os.getpid()}"
-        capillary.BridgeTable.cached(contact_angle).write_yade(partial)
+        write_table_files(capillary.BridgeTable.cached(contact_angle), partial)
         try:
             os.replace(partial, folder)
         except OSError:           # another process put it there first

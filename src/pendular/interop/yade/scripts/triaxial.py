@@ -36,7 +36,7 @@
 #     globUpdate (YADE's default 5: steps between evaluations of the cell's stress and
 #     stiffness, predicted in between).
 #   capillary (optional, wet test): {"suction": s [Pa], "files": folder holding the capillary
-#     files M(r=1) ... M(r=10) (capillary.write_yade), "surface_tension": 0.073 N/m,
+#     files M(r=1) ... M(r=10) (pendular.interop.yade.capillary_files), "surface_tension": 0.073 N/m,
 #     "persist": false, "detection_factor": 1.0}. Adds YADE's capillary law
 #     (Law2_ScGeom_CapillaryPhys_Capillarity, Scholtes et al. 2009) after the InteractionLoop with
 #     Ip2_FrictMat_FrictMat_CapillaryPhys; menisci form at contact (createDistantMeniscii=False)

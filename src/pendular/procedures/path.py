@@ -29,7 +29,7 @@ options (those of ``pendular triaxial``), so one table runs on any sample, dry o
 Every unknown key is refused with the file, the entry ("stage 2", "stage 3.1": the first
 entry of the group at entry 3) and the valid keys; a value Stage refuses, with its field,
 prefixed by the same. The parsed entries are stored as plain data in the configuration
-(pendular.procedures.config.TablePathConfig), so a run resumes without its table.
+(pendular.procedures.path.TablePathConfig), so a run resumes without its table.
 
 A stage's water key needs the sample wetted as it says (``check_water``), and a suction
 within the bridge tables for the sample's radii (``check_suctions``), both refused before
@@ -46,7 +46,9 @@ and suction (examples/loading_path_api.py). Stresses compression positive [Pa].
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -56,14 +58,111 @@ from pendular.dem.walls import StressServo
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.plots import plot_path
 from pendular.io.schema import peak_reached
-from pendular.procedures.config import TablePathConfig
+from pendular.procedures.columns import (capillary_operation, friction_angle, history_columns, k0,
+    void_ratio)
+from pendular.procedures.command import LaboratoryCommand
+# BridgeConfig and PrepareConfig: the types of the inherited fields bridges and sample,
+# which the documentation reads here (typing.get_type_hints of the configuration)
+from pendular.procedures.config import BridgeConfig, MAX_RECORDS, PathConfig, registered
+from pendular.procedures.equilibrium import equilibrate
 from pendular.procedures.hydraulic import water_content
+from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
-    Strain, Stress, capillary_operation, friction_angle, history_columns, k0, void_ratio)
-from pendular.procedures.preparation import check_soft_contacts, servo_speed
-from pendular.procedures.triaxial import LaboratoryTest, equilibrate, stress_balance
+    Strain, Stress)
+from pendular.procedures.options import framed, laboratory_fields, laboratory_options, rate_options
+from pendular.procedures.preparation import PrepareConfig, check_soft_contacts, servo_speed
+from pendular.utils.parameters import Option, fail, fields_of, option_of, parameter
 from pendular.utils.toml_file import read_toml
 from pendular.utils.validate import check_int, check_positive
+
+
+@registered
+@dataclass
+class TablePathConfig(PathConfig):
+    """A loading path read from a table (pendular.procedures.path): PathConfig's sample,
+    bridges, outputs, rate (``inertial_number`` at the lowest stress of the path, or
+    ``strain_rate``: the value of the name 'quasi-static') and row spacing, and ``stages``:
+    the table's [[stage]] entries as plain data (numbers, the names 'confining' and
+    'quasi-static', groups repeated), built into pendular.procedures.loading.Stage objects by
+    ``loading_stages``; ``source``: the table's file, named in errors; ``records``: history
+    rows over a path of one stage ending at a strain, as ShearConfig.records (None: a row
+    every ``record_strain``)."""
+
+    stages: list = parameter(default_factory=list, kind=None, recorded=False,
+                             help="the table's [[stage]] entries, as plain data")
+    source: str = parameter("path table", kind=str, help="the table's file, named in errors")
+    records: int | None = parameter(None, kind=int, low=2, high=MAX_RECORDS, flag="--records",
+                                    help="history rows over a path of one stage ending at a "
+                                         "strain, as pendular triaxial's --records (default: a "
+                                         "row every --record-strain)")
+
+    TEST = "a loading path"
+
+    def __post_init__(self):
+        super().__post_init__()
+        stages = self.loading_stages()       # every entry checked, named by file and stage
+        if self.records is not None:
+            from pendular.procedures.loading import Strain
+
+            if len(stages) != 1 or not isinstance(stages[0].until, Strain):
+                raise fail(self, "records", f"records = {self.records} applies to a path of "
+                           f"one stage ending at a strain (a triaxial's); {self.source} has "
+                           f"{len(stages)} stage(s): leave it out (a row every "
+                           "--record-strain)")
+
+    def loading_stages(self):
+        """The pendular.procedures.loading.Stage list of the table (ValueError naming the
+        source, the entry and the key)."""
+
+
+        return build_stages(self.stages, self.source, confining=self.sample.confining,
+                            rate=self.rate(), young=self.sample.young,
+                            wetting=wetting_of(self.bridges))
+
+    def stage_rates(self):
+        """[(where, rate, steps)] of each stage of the table that moves an axis: 'FILE: stage
+        N', its fastest |strain rate| or |shear rate| [1/s] and, when it ends at a strain
+        whose start is known (the path's start, or the end of an earlier stage at a strain
+        of that axis, not moved since), its steps estimated before anything runs (the strain
+        to go over the strain of a step, ``strain_per_step``), else None."""
+        from pendular.procedures.loading import ShearStrain, Strain
+
+        start = {"x": 0.0, "y": 0.0, "z": 0.0, "shear": 0.0}      # None: not known
+        found = []
+        for label, stage in labelled_stages(self.stages, self.source,
+                                            confining=self.sample.confining, rate=self.rate()):
+            rates = {**stage.strain_rate, "shear": stage.shear_rate}
+            until = stage.until
+            ends = isinstance(until, (Strain, ShearStrain))
+            axis = "shear" if isinstance(until, ShearStrain) else getattr(until, "axis", None)
+            steps = None
+            if ends and start[axis] is not None:
+                try:
+                    steps = (abs(until.value - start[axis])
+                             / self.strain_per_step(abs(rates[axis])))
+                except ValueError:              # a strain per step that underflows
+                    steps = math.inf
+            for name in start:
+                if ends and name == axis:
+                    start[name] = until.value
+                elif rates.get(name, 0.0) != 0.0 or name in stage.stress or name in stage.free:
+                    start[name] = None
+            fastest = max(abs(value) for value in rates.values())
+            if fastest > 0.0:
+                found.append((f"{self.source}: {label}", fastest, steps))
+        return found
+
+    def reference_pressure(self):
+        """The lowest stress of the path [Pa] (path.lowest_stress): the confining
+        stress or a lower target of a stage."""
+
+        return lowest_stress(self.stages, self.source, self.sample.confining)
+
+    def path_parameters(self):
+        """The path's own options, named as the command's (pendular.procedures.triaxial
+        .parameters)."""
+        return {"path": self.source, "records": self.records}
+
 
 #: Most stages of a path once its groups are repeated.
 MAX_STAGES = 100_000
@@ -77,7 +176,7 @@ NAMES = {"stress": STRESS_NAMES, "mean_stress": STRESS_NAMES, "strain_rate": RAT
 AXIS_FIELDS = tuple(f.name for f in dataclasses.fields(Stage) if f.default_factory is dict)
 #: Keys of an entry that repeats a group of entries.
 GROUP_KEYS = ("repeat", "stages")
-#: History columns of a path beyond loading.history_columns.
+#: History columns of a path beyond columns.history_columns.
 PATH_COLUMNS = {"void_ratio": void_ratio, "k0": k0}
 
 
@@ -124,7 +223,7 @@ def parse_entries(entries, source):
     valid keys)."""
     if not isinstance(entries, list) or not entries:
         raise ValueError(f"{source}: no stage; valid: at least one [[stage]] table "
-                         "(pendular.procedures.path_table)")
+                         "(pendular.procedures.path)")
     stages = []
     _expand(entries, source, "stage ", stages)
     return stages
@@ -345,7 +444,7 @@ def lowest_stress(entries, source, confining):
 # ---------------------------------------------------------------- the test
 
 class PathTest(LaboratoryTest):
-    """The loading path of a table (``config``: pendular.procedures.config.TablePathConfig),
+    """The loading path of a table (``config``: pendular.procedures.path.TablePathConfig),
     on the sample and wetting of LaboratoryTest: history with ``void_ratio``, ``k0`` and
     ``stage`` (rows every ``record_strain``, or ``records`` rows over one stage ending at a
     strain as a triaxial's), summary of ``path_summary``; figure path.png (plot_path: the q-p
@@ -443,7 +542,7 @@ def path_summary(history, count=None, stages=None):
     one before did); ``initial_void_ratio`` and ``final_void_ratio``; ``has_peak``: whether
     the largest q of the path is a peak within a stage, past its first row and one that the
     stage went past (pendular.io.schema.peak_reached over its rows), and then ``peak_q``,
-    ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (loading.friction_angle),
+    ``p_at_peak``, ``axial_strain_at_peak``, ``phi_peak_deg`` (columns.friction_angle),
     ``peak_index``, ``peak_stage`` and, wet, ``peak_q_effective``, ``p_effective_at_peak``,
     ``phi_peak_effective_deg``. Each stage's entry also gives its ``axial_strain_change`` and
     ``volumetric_strain_change`` and, wet, the WATER_COLUMNS at its end; with the path's
@@ -523,9 +622,9 @@ def change_suction(sim, bridges, suction, *, stress, increments=4, max_velocity=
     ``stress`` ({axis: Pa}) servoed at it (at most at ``max_velocity`` [m/s]; None: the
     scene's servo speed), those of the other axes fixed (e.g. {'z': sigma_v}: drying at a
     constant vertical stress, no lateral strain). The suction changes in ``increments`` steps
-    of equal ratio, each run until static (triaxial.equilibrate with ``unbalanced``,
+    of equal ratio, each run until static (equilibrium.equilibrate with ``unbalanced``,
     ``tolerance``, ``max_steps``). Returns the history of the state before and after each
-    increment (loading.history_columns, strains from the start, with PATH_COLUMNS)."""
+    increment (columns.history_columns, strains from the start, with PATH_COLUMNS)."""
     if bridges.control != "suction":
         raise ValueError(f"control = {bridges.control!r}: change_suction needs "
                          "suction-controlled bridges (volume-controlled ones hold their liquid)")
@@ -553,3 +652,44 @@ def change_suction(sim, bridges, suction, *, stress, increments=4, max_velocity=
                     progress=progress, phase=f"equilibrium at suction {value:.4g} Pa")
         recorder.record(sim)
     return recorder.arrays()
+
+
+# ---------------------------------------------------------------- the command
+
+
+PATH_OWN = (rate_options(PathConfig) + (option_of(PathConfig, "record_strain"),
+                                        option_of(TablePathConfig, "records")))
+
+#: The path table of ``pendular path``.
+PATH_TABLE = Option("table", "the path table (not with --resume: the run keeps its own)",
+                    kind=str, metavar="PATH.toml", positional=True)
+
+
+def table_path_config(values, given):
+    """The TablePathConfig of ``values`` and the path table (ValueError naming its file,
+    entry and key)."""
+
+    if values["table"] is None:
+        raise ValueError("PATH.toml is missing: give the path table (or --resume DIR)")
+    return TablePathConfig(**laboratory_fields(values, given, lambda: {
+        **read_table(values["table"]), **fields_of(values, PATH_OWN)}))
+
+
+#: A worked example: the command line, and what it gives (--help and docs/commands.md).
+EXAMPLE = ("pendular path examples/paths/oedometer_unload.toml --particles 1000 --out runs/path",
+           "the stages of a TOML table run in turn: each stage's end state in summary.json, the "
+           "stress path in plots/")
+
+#: Summary keys printed at the end.
+SHOWN = ("stages", "initial_void_ratio", "final_void_ratio", "has_peak", "peak_q", "p_at_peak",
+         "axial_strain_at_peak", "phi_peak_deg", "peak_q_effective", "p_effective_at_peak",
+         "phi_peak_effective_deg", "water_stages", "collapse_strain", "collapse_axial_strain",
+         "initial_porosity", "wall_time_s", "particle_steps_per_s")
+
+#: The path command (pendular.procedures.registry).
+COMMAND = LaboratoryCommand(
+    name="path",
+    description="any loading path from a TOML table of stages, dry or wet",
+    test=PathTest,
+    declared=laboratory_options(PATH_OWN, framed(table_path_config), first=(PATH_TABLE,)),
+    shown=SHOWN, example=EXAMPLE, out="runs/path")

@@ -109,6 +109,13 @@ def write_yade(folder, contact_angle, radius_ratios, suction_values, n_distance=
     return paths
 
 
+def write_table_files(table, folder, n_distance=80):
+    """Write YADE capillary files M(r=...) for the radius ratios of ``table`` (a
+    pendular.capillary.BridgeTable) at its contact angle and suctions (write_yade)."""
+    return write_yade(folder, table.contact_angle, table.radius_ratios, table.suction,
+                      n_distance)
+
+
 def read_capillary_file(path):
     """Parse one capillary file as YADE does (whitespace-separated numbers); ValueError naming
     the path for a truncated or corrupt file."""
