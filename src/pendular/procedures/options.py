@@ -70,7 +70,7 @@ _SAMPLE_CELL = ((option_of(PrepareConfig, "particles", low=MIN_SAMPLE_PARTICLES)
                 + _options(PrepareConfig, ("confining", "seed", "periodic")))
 _MATERIAL = _options(PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg",
                                      "rolling_friction", "twisting_friction", "gravity",
-                                     "young", "contact", "poisson", "restitution", "damping",
+                                     "wall_friction", "young", "contact", "poisson", "restitution", "damping",
                                      "timestep_safety", "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL
