@@ -180,3 +180,8 @@ def test_a_wall_friction_out_of_range_is_refused_naming_it(value):
 def test_the_command_refuses_a_wall_friction_out_of_range_in_one_line(value, capsys):
     refused(*run_in_process("triaxial", ["--particles", "60", "--wall-friction", value],
                             capsys), "--wall-friction", "[0, 90)")
+
+
+def test_wall_friction_in_a_periodic_cell_is_refused(capsys):
+    refused(*run_in_process("triaxial", ["--particles", "60", "--wall-friction", "20",
+                                         "--periodic"], capsys), "--wall-friction", "--periodic")

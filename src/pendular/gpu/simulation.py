@@ -29,8 +29,8 @@ raises the CPU's StageFailed at its next check or, earlier, when anything fetche
 (``copy_back``), so that no writer records a state past the failure.
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces (or the damped
-and Hertz–Mindlin laws of pendular.dem.hertz_mindlin, whose walls the device does not run:
-ViscoelasticWallForces is refused), WallForces, RollingResistance (pendular.gpu.rolling),
+and Hertz–Mindlin laws of pendular.dem.hertz_mindlin), WallForces or a wall law with springs
+(ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance (pendular.gpu.rolling),
 Gravity (pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps
 (``persist``; a new suction between runs, as the CPU: GpuSimulation._follow_suction);
 controls StressServo, ConstantStrainRate, MixedStress (its servos among the controls),
@@ -52,7 +52,8 @@ from pendular.capillary.bridges import CapillaryBridges, SuctionBridges, VolumeB
 from pendular.dem.cell import ConstantShearRate, PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.gravity import Gravity
-from pendular.dem.hertz_mindlin import DampedLinearForces, HertzMindlinForces
+from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
+    ViscoelasticWallForces)
 from pendular.dem.grips import Grip
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.integrate import Integrator
@@ -60,6 +61,7 @@ from pendular.dem.mixed_stress import MixedStress
 from pendular.dem.neighbors import NeighborList, carry_pair_array, previous_pair_index
 from pendular.dem.rolling import RollingResistance
 from pendular.dem.state import Walls
+from pendular.dem.wall_friction import FrictionalWallForces
 from pendular.dem.walls import ConstantStrainRate, StressServo, WallForces
 from pendular.gpu import (cell as device_cell, forces, gravity as device_gravity, integrate,
     neighbors, rolling as device_rolling, walls as device_walls)
@@ -68,6 +70,7 @@ from pendular.gpu.grips import DeviceGrips, check_grips
 from pendular.gpu.growth import DeviceGrowth
 from pendular.gpu.homogenize import device_homogenization
 from pendular.gpu.state import DeviceState
+from pendular.gpu.wall_friction import DeviceSpringWalls
 from pendular.utils.validate import check_int
 
 
@@ -110,11 +113,12 @@ def check_scene(sim):
         raise ValueError("device='gpu' needs pendular's NeighborList and Integrator")
     for op in sim.forces:
         if type(op) not in (ContactForces, HertzMindlinForces, DampedLinearForces, WallForces,
+                            ViscoelasticWallForces, FrictionalWallForces,   # wall_friction
                             SuctionBridges, VolumeBridges, RollingResistance, Gravity):
             raise ValueError(f"device='gpu' does not run the force {type(op).__name__} yet "
                              "(valid: ContactForces, HertzMindlinForces, DampedLinearForces, "
-                             "WallForces, SuctionBridges, VolumeBridges, RollingResistance, "
-                             "Gravity)")
+                             "WallForces, ViscoelasticWallForces, FrictionalWallForces, "
+                             "SuctionBridges, VolumeBridges, RollingResistance, Gravity)")
     _one(sim, Gravity, required=False)             # at most one of each
     resistance = _one(sim, RollingResistance, required=False)
     if resistance is not None and sim.forces.index(resistance) < sim.forces.index(
@@ -171,7 +175,7 @@ def _check_periodic(sim, cell):
     cell, ConstantShearRate, MixedStress and a radius growth in a fixed cell run:
     pendular.gpu.cell)."""
     for op in sim.forces:
-        if type(op) in (WallForces, Gravity):
+        if isinstance(op, (WallForces, ViscoelasticWallForces, Gravity)):
             raise ValueError(f"device='gpu' runs a periodic cell without {type(op).__name__} "
                              "(it has no walls)")
     controls = sim.peek("controls")
@@ -232,6 +236,8 @@ class GpuSimulation:
         persist = bridges is not None and bridges.persist
         self._resistance = _one(sim, RollingResistance, required=False)
         resisting = self._resistance is not None
+        # wall_friction: a wall law with springs runs its own launches (pendular.gpu.wall_friction)
+        self._spring_walls = DeviceSpringWalls.of(sim.forces, len(sim.particles))
         self.state = (DeviceState(sim, sim.neighbors.skin, bridges is not None, reach, persist,
                                   film, resisting)
                       if self._growth is None else
@@ -448,6 +454,9 @@ class GpuSimulation:
                                 s.second_pair, s.pair_force, s.normal, s.overlap, joined,
                                 columns[2], walls_first, s.wall_position, wall_young,
                                 s.persist, s.bridge_pair_force, s.force, s.torque)),
+            # wall_friction: the walls' springs right after the gather, as the CPU's walls
+            *(self._spring_walls.launches(s, sim.dt) if self._spring_walls is not None
+              else ()),
             *(device_rolling.launches(self._resistance, s, sim.dt)
               if self._resistance is not None else ()),
             *(device_gravity.launches(gravity, s) if gravity is not None else ()),
@@ -525,13 +534,14 @@ class GpuSimulation:
     def _walled_steps(self):
         """(kernel, items, arguments) of a step inside walls (module docstring)."""
         sim = self.sim
-        wall_law = _one(sim, WallForces)
+        springs = self._spring_walls        # wall_friction: a wall law with springs, or None
+        wall_law = _one(sim, WallForces) if springs is None else springs.wall
         s = self.state
         n = s.count
         order = [type(op) for op in sim.forces]
         gatherer = (order.index(SuctionBridges) if s.wet and not s.persist
                     else sim.forces.index(_contact_law(sim)))
-        walls_first = order.index(WallForces) < gatherer
+        walls_first = order.index(type(wall_law)) < gatherer
         limit = 0.5 * s.skin
         bridges = s.bridges
         return [
@@ -548,9 +558,10 @@ class GpuSimulation:
                                        s.new_rolling, s.flags)),
             self._finish_step(),
             *self._force_steps(s.no_image, s.no_period, s.no_period, walls_first,
-                               wall_law.young),
-            (device_walls.wall_partials, s.partial.shape[0],
-             (s.position, s.radius, s.wall_position, wall_law.young, s.partial)),
+                               wall_law.young if springs is None else 0.0),
+            *(() if springs is not None else       # wall_friction: its own partial sums
+              ((device_walls.wall_partials, s.partial.shape[0],
+                (s.position, s.radius, s.wall_position, wall_law.young, s.partial)),)),
             (device_walls.wall_sums, 6 * device_walls.WALL_SUMS,
              (s.partial, s.wall_force, s.wall_stiffness, s.wall_moment)),
             (device_walls.wall_controls, 1,
@@ -659,6 +670,8 @@ class GpuSimulation:
             return
         self._holding = False
         self.state.to_host(sim)
+        if self._spring_walls is not None:      # wall_friction: the walls' springs
+            self._spring_walls.to_host()
         if self.state.periodic:
             device_cell.shear_to_host(self.state, sim.walls)
         if self._growth is not None:

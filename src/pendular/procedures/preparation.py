@@ -362,6 +362,10 @@ class PrepareConfig:
             raise fail(self, "gravity", f"gravity = {self.gravity:g} m/s^2 is outside the "
                        "valid range [0, 0] in a periodic cell (--periodic: no floor to carry "
                        "the weight); leave out gravity or the periodic cell")
+        if self.wall_friction > 0.0 and self.periodic:
+            raise fail(self, "wall_friction", f"wall_friction = {self.wall_friction:g} deg is "
+                       "outside the valid range [0, 0] in a periodic cell (--periodic: no "
+                       "walls); leave out the wall friction or the periodic cell")
         if self.psd is not None:
             if self.radius_spread > 0.0:
                 raise fail(self, "radius_spread",
