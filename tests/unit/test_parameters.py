@@ -37,7 +37,8 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "gravity", "wall_friction", "young", "contact", "poisson", "restitution", "damping",
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
-             "surface_tension", "liquid", "wetting", "persist_bridges", "wet_steps",
+             "surface_tension", "liquid", "wall_bridges", "wetting", "persist_bridges",
+             "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}

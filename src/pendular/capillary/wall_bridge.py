@@ -236,14 +236,9 @@ def wall_suction_nodes(suction_min, suction_max, n_suction):
 
 
 @numba.njit(cache=True)
-def lookup_wall(suction_axis, distance_low, log_distance_rupture, log_values, suction,
-                distance):
-    """Suction-controlled sphere–plane bridge from a WallBridgeTable's arrays(): u = s R /
-    gamma, D/R. Returns (exists, F*, V*, delta1 [deg], a/R); exists False beyond the rupture
-    distance (the other values 0); a gap below the smallest tabulated distance gets the values
-    there. Interpolation as pendular.capillary.table.lookup_suction (logarithms, linear in ln u
-    and in the distance coordinate relative to the interpolated rupture distance). Raises for u
-    outside [suction_min, suction_max] or non-finite input."""
+def _wall_cell(suction_axis, distance_low, log_distance_rupture, log_values, suction, distance):
+    """Checked table cell of (u, D/R): (exists, i_u, t_u, j, t_z); exists is False beyond
+    the rupture distance, the cell then the rupture node (z = 0)."""
     if not (math.isfinite(suction) and math.isfinite(distance)):
         raise ValueError("lookup_wall: non-finite suction or distance")
     suction_min, step, suction_max = suction_axis[0], suction_axis[1], suction_axis[2]
@@ -253,13 +248,40 @@ def lookup_wall(suction_axis, distance_low, log_distance_rupture, log_values, su
     i_u, t_u = grid_position(math.log(suction / suction_min), step, log_values.shape[1])
     d_rupture = math.exp(along_axis(log_distance_rupture, 0, i_u, t_u))
     if distance > d_rupture:
-        return False, 0.0, 0.0, 0.0, 0.0
+        return False, i_u, t_u, 0, 0.0
     d_low = along_axis(distance_low, 0, i_u, t_u)
     j, t_z = distance_cell(distance, d_low, d_rupture, log_values.shape[2])
+    return True, i_u, t_u, j, t_z
+
+
+@numba.njit(cache=True)
+def lookup_wall(suction_axis, distance_low, log_distance_rupture, log_values, suction,
+                distance):
+    """Suction-controlled sphere–plane bridge from a WallBridgeTable's arrays(): u = s R /
+    gamma, D/R. Returns (exists, F*, V*, delta1 [deg], a/R); exists False beyond the rupture
+    distance (the other values 0); a gap below the smallest tabulated distance gets the values
+    there. Interpolation as pendular.capillary.table.lookup_suction (logarithms, linear in ln u
+    and in the distance coordinate relative to the interpolated rupture distance). Raises for u
+    outside [suction_min, suction_max] or non-finite input."""
+    exists, i_u, t_u, j, t_z = _wall_cell(suction_axis, distance_low, log_distance_rupture,
+                                          log_values, suction, distance)
+    if not exists:
+        return False, 0.0, 0.0, 0.0, 0.0
     return (True, _interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 0),
             _interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 1),
             _interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 2),
             _interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 3))
+
+
+@numba.njit(cache=True)
+def lookup_wall_interface(suction_axis, distance_low, log_distance_rupture, log_values,
+                          suction, distance):
+    """(nn11, nn33) / R**2 of the liquid–gas interface of the bridge of lookup_wall's
+    arguments (beyond rupture: those at rupture)."""
+    _, i_u, t_u, j, t_z = _wall_cell(suction_axis, distance_low, log_distance_rupture,
+                                     log_values, suction, distance)
+    return (_interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 4),
+            _interpolate_log(log_values, 0, 0, 0.0, i_u, t_u, j, t_z, 5))
 
 
 class WallBridgeTable(TabulatedBridges):
@@ -296,7 +318,7 @@ class WallBridgeTable(TabulatedBridges):
                 "n_suction": int(n_suction), "n_distance": int(n_distance)}
 
     @classmethod
-    def build(cls, contact_angle=0.0, n_suction=200, n_distance=80, suction_min=0.01,
+    def build(cls, contact_angle=0.0, n_suction=120, n_distance=80, suction_min=0.01,
               suction_max=1500.0):
         """Solve every node exactly (parallel over the suctions): contact_angle in [0, 90) deg,
         0 < suction_min < suction_max (u units), n_suction, n_distance >= 2."""
@@ -313,7 +335,7 @@ class WallBridgeTable(TabulatedBridges):
         return cls(contact_angle, np.ones(1), suction_min, suction_max, low, rupture, values)
 
     @classmethod
-    def cached(cls, contact_angle=0.0, n_suction=200, n_distance=80, suction_min=0.01,
+    def cached(cls, contact_angle=0.0, n_suction=120, n_distance=80, suction_min=0.01,
                suction_max=1500.0, directory=None):
         """The table of these parameters from the cache directory, built and saved there when
         absent or failing its checks (pendular.capillary.table.cached_table)."""
@@ -357,3 +379,7 @@ class WallBridgeTable(TabulatedBridges):
     def lookup(self, suction, distance):
         """Python-side lookup_wall: (exists, F*, V*, delta1 [deg], a/R)."""
         return lookup_wall(*self.arrays(), float(suction), float(distance))
+
+    def interface(self, suction, distance):
+        """Python-side lookup_wall_interface: (nn11, nn33) / R**2."""
+        return lookup_wall_interface(*self.arrays(), float(suction), float(distance))

@@ -126,6 +126,9 @@ def check_scene(sim):
         raise ValueError("device='gpu' runs a RollingResistance listed after the contact law "
                          "only (it reads the contact law's pairs of the same step)")
     bridges = _bridges_of(sim)
+    if bridges is not None and bridges.walls is not None:     # wall_bridges: no device side
+        raise ValueError("device='gpu' does not run sphere-wall bridges (--wall-bridges) yet: "
+                         "run them with --device cpu")
     if bridges is not None and bridges.persist:
         _check_persist(sim, bridges)
     controls = sim.peek("controls")

@@ -78,6 +78,7 @@ from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stre
     effective_stress_parameter, interface_stress, surface_tension_stress, wetted_caps_sum)
 from pendular.homogenize.contact_stress import contact_stress, pair_stress_sum
 from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
+from pendular.homogenize.wall_bridge_stress import with_wall_bridges
 
 
 @dataclass(frozen=True)
@@ -312,7 +313,8 @@ class HostMeasures(Mapping):
     def bridge_stress(self):
         """The BridgeStress of the bridges over the box inside the walls (homogenize_bridges
         with the operation's suction, contact angle and surface tension; volume control:
-        each bridge's own suction; the exact model: its interfaces)."""
+        each bridge's own suction; the exact model: its interfaces), the sphere-wall bridges'
+        share added (pendular.homogenize.wall_bridge_stress)."""
         if self._bridge_stress is None:
             sim, op = self.sim, self.bridges
             suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
@@ -324,6 +326,10 @@ class HostMeasures(Mapping):
                 sim.particles, sim.contacts, sim.walls.volume(), suction=suction,
                 contact_angle=op.contact_angle, surface_tension=op.surface_tension,
                 interfaces=interfaces, period=sim.walls.period)
+            if op.walls is not None:        # sphere-wall bridges (--wall-bridges)
+                self._bridge_stress = with_wall_bridges(
+                    self._bridge_stress, sim, op.walls, op.suction, op.contact_angle,
+                    op.surface_tension, sim.walls.volume())
         return self._bridge_stress
 
 
