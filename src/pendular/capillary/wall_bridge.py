@@ -289,7 +289,8 @@ class WallBridgeTable(TabulatedBridges):
     out as a sphere–sphere table (pendular.capillary.table.TabulatedBridges) of one row
     (``radius_ratios`` (1,) holds 1: the sphere's radius is the unit), its suction axis
     geometric over [suction_min, suction_max]. Build with ``build`` or, cached on disk,
-    ``cached``; inside Numba code call lookup_wall(*table.arrays(), suction, distance)."""
+    ``cached``; inside Numba code call ``lookup_wall(*table.arrays(), suction,
+    distance)``."""
 
     kind = "wall_bridge_table"
     description = "sphere-wall bridge table"

@@ -30,9 +30,9 @@ raises the CPU's StageFailed at its next check or, earlier, when anything fetche
 
 What runs on the device so far: walled scenes (``Walls``) with ContactForces (or the damped
 and Hertz–Mindlin laws of pendular.dem.hertz_mindlin), WallForces or a wall law with springs
-(ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance (pendular.gpu.rolling),
-Gravity (pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps
-(``persist``; a new suction between runs, as the CPU: GpuSimulation._follow_suction);
+(ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance
+(pendular.gpu.rolling), Gravity (pendular.gpu.gravity) and, wet, SuctionBridges at contact or
+across gaps (``persist``; a new suction between runs, as the CPU: GpuSimulation._follow_suction);
 controls StressServo, ConstantStrainRate, MixedStress (its servos among the controls),
 RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips);
 the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
