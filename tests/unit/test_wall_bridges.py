@@ -148,3 +148,22 @@ def test_wall_bridges_need_suction_controlled_exact_bridges():
 ])
 def test_the_command_refuses_wall_bridges_it_cannot_run_in_one_line(argv, words, capsys):
     refused(*run_in_process("triaxial", ["--particles", "60", *argv], capsys), *words)
+
+
+def test_the_walls_stress_is_the_contacts_and_the_bridges_in_equilibrium():
+    """A sphere between the floor and the ceiling, pressed on both and wetting both: the wall
+    stress is sigma_contact + sigma_capillary, the bridges' l f on the capillary side."""
+    overlap = 2e-6
+    particles = Particles(np.array([[0.0, 0.0, RADIUS - overlap]]), np.array([RADIUS]), 2650.0)
+    walls = Walls.box([-0.01, -0.01, 0.0], [0.01, 0.01, 2.0 * (RADIUS - overlap)])
+    sim = Simulation(particles, walls, 1e-4, neighbors=NeighborList(0.5 * RADIUS),
+                     forces=[ContactForces(YOUNG), WallForces(YOUNG),
+                             CapillaryBridges(SUCTION, wall_bridges=True)],
+                     integrator=Kinematic())
+    sim.evaluate_forces()
+    assert sim.operation(CapillaryBridges).walls.count() == 2
+    assert abs(sim.particles.force[0, 2]) < 1e-12 * sim.walls.force[4]
+    measured = homogenized(sim)
+    total = measured["sigma_contact"] + measured["sigma_capillary"]
+    assert measured["sigma_capillary"][2, 2] < 0.0 < measured["sigma_contact"][2, 2]
+    assert total[2, 2] == pytest.approx(sim.walls.stress()[2], rel=1e-12)

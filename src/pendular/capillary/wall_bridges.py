@@ -11,7 +11,9 @@ the contact values, as the sphere–sphere bridges do):
   rupture distance at the suction, as the operation's sphere–sphere bridges;
 - force F = F* 2 pi gamma R, attractive along the wall's normal: -F n on the sphere (n into the
   box), +F n on the wall, so the wall's normal force (``Walls.force``, the servo's and the wall
-  stress's) loses F and its moment (r + D) F; the stiffness of the wall is its contacts' alone;
+  stress's) loses F; the stiffness of the wall is its contacts' alone, and its Love–Weber term
+  (R + D) F (``moment``, the capillary stress's share of the walls, as ``Walls.moment`` is the
+  contacts') is kept apart from the contacts';
 - the liquid V = V* R**3 and the filling angle delta1 on the sphere are kept per sphere and
   wall (``exists``, ``volume``, ``force``, ``filling`` (N, 6)) for the liquid balance, the
   saturation and the homogenised stresses (pendular.homogenize.wall_bridge_stress).
@@ -36,11 +38,13 @@ SUCTION_RANGE = (0.01, 1500.0)
 @numba.njit(cache=True)
 def wall_bridge_forces(position, radius, wall_position, suction, surface_tension, persist,
                        suction_axis, distance_low, log_distance_rupture, log_values, exists,
-                       volume, force_magnitude, filling, force, wall_force, wall_moment):
+                       volume, force_magnitude, filling, force, wall_force, moment):
     """Every sphere's bridges with the six walls (module docstring), in place: ``exists``
     (N, 6) int8, ``volume`` [m^3], ``force_magnitude`` [N] and ``filling`` [deg] (N, 6); the
-    forces added to ``force`` (N, 3) and to the walls' ``wall_force`` and ``wall_moment`` (6,).
+    forces added to ``force`` (N, 3) and subtracted from the walls' ``wall_force`` (6,);
+    ``moment`` (6,) [N m] set to each wall's sum of (centre-to-wall distance) * pull.
     suction [Pa], surface_tension [N/m]; the table's arrays (WallBridgeTable.arrays)."""
+    moment[:] = 0.0
     for p in range(len(radius)):
         r = radius[p]
         u = suction * r / surface_tension
@@ -70,14 +74,15 @@ def wall_bridge_forces(position, radius, wall_position, suction, surface_tension
             filling[p, w] = delta1
             force[p, axis] -= side * pull
             wall_force[w] -= pull
-            wall_moment[w] -= (r + gap) * pull
+            moment[w] += (r + gap) * pull
 
 
 class WallBridges:
     """The sphere–wall bridges of a suction-controlled bridge operation (module docstring):
     its suction, surface tension, contact angle and ``persist`` are the operation's
     (``bridges``), read at each step. ``apply(sim)`` after the wall forces, which set the walls'
-    totals this step."""
+    totals this step. ``moment`` (6,) [N m]: each wall's sum of (centre-to-wall distance) *
+    pull of the last step."""
 
     def __init__(self, bridges):
         self.bridges = bridges
@@ -86,6 +91,7 @@ class WallBridges:
         self.volume = np.zeros((0, 6))
         self.force = np.zeros((0, 6))
         self.filling = np.zeros((0, 6))
+        self.moment = np.zeros(6)
 
     #: The per-sphere, per-wall arrays a checkpoint keeps: name -> dtype.
     ARRAYS = {"exists": np.int8, "volume": np.float64, "force": np.float64,
@@ -129,7 +135,7 @@ class WallBridges:
         self.load_table(float(p.radius.min()), float(p.radius.max()))
         wall_bridge_forces(p.position, p.radius, box.position, b.suction, b.surface_tension,
                            b.persist, *self.table.arrays(), self.exists, self.volume,
-                           self.force, self.filling, p.force, box.force, box.moment)
+                           self.force, self.filling, p.force, box.force, self.moment)
 
     def count(self):
         """Number of sphere–wall bridges."""

@@ -218,11 +218,16 @@ def capillary_force_stress(sim, bridges):
     operation ``bridges`` (capillary.CapillaryBridges), V the box inside the walls, with the
     sign convention of pendular.homogenize.contact_stress (l = x_j - x_i, f on j from i, compression
     positive): attractive bridges give a negative (tensile) stress, and in static equilibrium
-    sigma_wall = sigma_contact + sigma_capillary."""
+    sigma_wall = sigma_contact + sigma_capillary. Sphere-wall bridges (``bridges.walls``) add
+    their l f, l from the sphere's centre to the wall, as the walls' contacts add theirs to
+    sigma_contact (Walls.moment)."""
     pair_force = bridges.pair_forces(sim)
     c = sim.contacts
     total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, c.image,
                             sim.walls.period, pair_force, BridgeState.of(c).mask())
+    if bridges.walls is not None:
+        moment = bridges.walls.moment
+        total[np.diag_indices(3)] -= moment[0::2] + moment[1::2]
     return total / sim.walls.volume()
 
 

@@ -10,9 +10,10 @@ grain of it) and holds liquid in V, so it adds
     psi  += chi_b s + B_b,                       I += (gamma / V) ∫_interface (I - n n) dS,
 
 with the bridge axis along the wall's normal; its force on the wall is a boundary force, which
-the wall stress sigma_wall (the walls' forces) measures, as the walls' contact forces. The
-Love–Weber sums over the pairs (sigma_contact, sigma_capillary) stay sums over sphere–sphere
-pairs: in static equilibrium they balance the boundary forces, the wall bridges' pull among them.
+the wall stress sigma_wall (the walls' forces) measures, as the walls' contact forces. In the
+Love–Weber stress of the capillary forces (on_the_fly.capillary_force_stress) a wall bridge adds
+its l f, l from the sphere's centre to the wall, as a wall contact adds its own to the contact
+stress: in static equilibrium sigma_wall = sigma_contact + sigma_capillary still holds.
 """
 
 import dataclasses
