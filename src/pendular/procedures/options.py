@@ -70,7 +70,7 @@ _SAMPLE_CELL = ((option_of(PrepareConfig, "particles", low=MIN_SAMPLE_PARTICLES)
                 + _options(PrepareConfig, ("confining", "seed", "periodic")))
 _MATERIAL = _options(PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg",
                                      "rolling_friction", "twisting_friction", "gravity",
-                                     "young", "contact", "poisson", "restitution", "damping",
+                                     "wall_friction", "young", "contact", "poisson", "restitution", "damping",
                                      "timestep_safety", "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL
@@ -91,10 +91,11 @@ WATER_CONTENT = Parameter("%", "gravimetric water content held by volume-control
                           "at constant liquid volume, instead of --suction", 0.0, 100.0,
                           low_inclusive=False, flag="--water-content")
 #: The bridges' own fields set by their options as they are, at a suction or a water content.
-BRIDGES = _options(BridgeConfig, ("contact_angle", "model", "surface_tension", "liquid"))
+BRIDGES = _options(BridgeConfig, ("contact_angle", "model", "surface_tension", "liquid",
+                                   "wall_bridges"))
 #: A wet laboratory test: at a suction or a water content.
 WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
-           + (option_from(WATER_CONTENT, None, checked=True), BRIDGES[3],
+           + (option_from(WATER_CONTENT, None, checked=True), *BRIDGES[3:],
               option_of(LaboratoryConfig, "wetting"), option_of(BridgeConfig, "persist"),
               option_of(LaboratoryConfig, "wet_steps"),
               option_of(BridgeConfig, "table_resolution", metavar="NS,ND",
@@ -102,7 +103,7 @@ WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
                              "350,80; toroidal 64,80)")))
 #: Wetting options, each refused without a wet test when given (not at its default).
 WET_ONLY = ("contact_angle", "table_resolution", "bridges", "surface_tension",
-            "persist_bridges", "wetting")
+            "persist_bridges", "wetting", "wall_bridges")
 
 
 def table_resolution(value):
