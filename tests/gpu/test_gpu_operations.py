@@ -89,6 +89,19 @@ def test_a_periodic_cell_refuses_what_has_walls_by_name():
         check_scene(sim)
 
 
+def test_walls_with_springs_take_the_walls_role(sim):
+    """A wall law with springs is the scene's walls, the gather adding no wall springs then
+    (its side's own launches run them)."""
+    from pendular.dem.wall_friction import FrictionalWallForces
+    from pendular.gpu.simulation import check_scene
+    from pendular.gpu.wall_friction import SpringWalls
+    from simulated import YOUNG
+
+    sim.forces[1] = FrictionalWallForces(YOUNG, 0.3, 25.0)
+    walls = check_scene(sim).force("walls")
+    assert isinstance(walls, SpringWalls) and walls.young == 0.0
+
+
 def test_no_gpu_module_tests_an_operations_type():
     """isinstance or type() only where the device compiles the CPU's functions (cuda.py) and
     where a side is found through the operation's classes (operations.py)."""

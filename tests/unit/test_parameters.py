@@ -40,10 +40,11 @@ BOUNDS = [
 #: The options of ``pendular triaxial`` made from their fields' metadata.
 GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spread",
              "porosity", "friction", "prep_friction", "rolling_friction", "twisting_friction",
-             "gravity", "young", "contact", "poisson", "restitution", "damping",
+             "gravity", "wall_friction", "young", "contact", "poisson", "restitution", "damping",
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
-             "surface_tension", "rupture_liquid", "wetting", "persist_bridges", "wet_steps",
+             "surface_tension", "rupture_liquid", "wall_bridges", "wetting", "persist_bridges",
+             "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
              "checkpoint_every"}

@@ -38,9 +38,9 @@ Coulomb cap |Fs| <= Fn tan(phi): in YADE, Law2_ScGeom_FrictPhys_CundallStrack ca
 force with ``phys->normalForce`` (the spring's force only), and
 Law2_ScGeom_CapillaryPhys_Capillarity adds fCap separately through ``scene->forces.addForce``
 (YADE 2023 sources, pkg/dem/ElasticContactLaw.cpp and
-pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). There are no sphere-wall bridges (YADE's
-capillary law skips pairs of different shapes), and ``contacts.force`` stays the mechanical
-force, so that pendular.homogenize.contact_stress is Eq. 3.41's contact stress.
+pkg/dem/Law2_ScGeom_CapillaryPhys_Capillarity.cpp). Sphere-wall bridges are optional
+(SuctionBridges' ``wall_bridges``, pendular.capillary.wall_bridges; YADE's capillary law skips
+pairs of different shapes), and ``contacts.force`` stays the mechanical force, so that pendular.homogenize.contact_stress is Eq. 3.41's contact stress.
 
 Lookups (the units of docs/units.md): r = R2/R1 with R2 the larger radius, u* = s R2 / gamma,
 d* = max(gap, 0) / R2 (overlaps read the table's contact values, as YADE does), F = F* 2 pi gamma
@@ -88,6 +88,7 @@ from pendular.capillary.table import YADE_RADIUS_RATIOS, BridgeTable
 from pendular.capillary.validation import (check_bridge_stiffness, check_contact_angle,
     check_pendular_suction)
 from pendular.capillary.volume_table import VolumeBridgeTable
+from pendular.capillary.wall_bridges import WallBridges
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.neighbors import gather_pair_forces, gather_pair_forces_virial
 from pendular.dem.protocols import state_array
@@ -227,6 +228,7 @@ class CapillaryBridges(metaclass=_ByControl):
         self._radius_bounds = None
         self._checked_stiffness = False
         self._state = None
+        self.walls = None                # sphere-wall bridges (SuctionBridges' wall_bridges)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
@@ -295,6 +297,8 @@ class CapillaryBridges(metaclass=_ByControl):
             options.setdefault("radius_ratios", radius_ratios)
             self.suction_table = BridgeTable.cached(self.contact_angle, **options)
         self._check_suction(self.suction, low, high)
+        if self.walls is not None:
+            self.walls.load_table(low, high)
         self._load_control_tables()
         self._lookup = self.suction_table.arrays()
         self._radius_bounds = (low, high, radius_ratios)
@@ -398,8 +402,10 @@ class CapillaryBridges(metaclass=_ByControl):
         return self.state(sim).count()
 
     def water_volume(self, contacts):
-        """Total liquid volume of the bridges of ``contacts`` [m^3]."""
-        return float(np.sum(BridgeState.of(contacts).volume))
+        """Total liquid volume of the bridges of ``contacts`` [m^3], the sphere-wall bridges'
+        included (``walls``)."""
+        walls = 0.0 if self.walls is None else self.walls.water_volume()
+        return float(np.sum(BridgeState.of(contacts).volume)) + walls
 
     def saturation(self, sim):
         """Degree of saturation Sr = sum(V_bridge) / V_voids, V_voids = box volume minus the
@@ -439,26 +445,41 @@ class SuctionBridges(CapillaryBridges):
         spheres touch, and the contact law's gather adds its force (``joins_contact_gather``);
         True: bridges live up to the rupture distance instead of breaking when contact is
         lost (thesis Table 5.1), gathered apart.
+    wall_bridges: bridges between the spheres and the walls too (``walls``, a
+        pendular.capillary.wall_bridges.WallBridges at this suction and ``persist``), applied
+        first each step (the scene lists the bridges after the wall forces).
     The other parameters are CapillaryBridges'.
     """
 
     control = "suction"
 
     def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
-                 model="exact", persist=False, table_options=None):
+                 model="exact", persist=False, table_options=None, wall_bridges=False):
         super().__init__(suction, surface_tension, contact_angle, model, table_options)
         self.persist = bool(persist)
         self._applied_suction = None
+        if wall_bridges:
+            if model != "exact":
+                raise ValueError("wall_bridges needs model='exact' (the sphere-plane bridges "
+                                 "are exact Young-Laplace solutions)")
+            self.walls = WallBridges(self)
 
     def state_dict(self):
         """CapillaryBridges' and ``applied_suction`` [Pa], the suction the bridges at contact
-        were last looked up at (None before the first step)."""
-        return {**super().state_dict(), "applied_suction": self._applied_suction}
+        were last looked up at (None before the first step); with wall bridges their state
+        (``walls``, WallBridges.state_dict)."""
+        walls = {} if self.walls is None else {"walls": self.walls.state_dict()}
+        return {**super().state_dict(), "applied_suction": self._applied_suction, **walls}
 
     def load_state(self, state):
         applied = state["applied_suction"]
         applied = None if applied is None else check_range("applied_suction", applied, 0.0,
                                                            unit="Pa")
+        if (self.walls is None) != ("walls" not in state):
+            raise ValueError("walls: the checkpoint's bridges and this scene's differ in their "
+                             "sphere-wall bridges (--wall-bridges)")
+        if self.walls is not None:
+            self.walls.load_state(state["walls"])
         super().load_state(state)
         self._applied_suction = applied
 
@@ -509,6 +530,8 @@ class SuctionBridges(CapillaryBridges):
 
     def apply(self, sim):
         self._sync(sim)
+        if self.walls is not None:
+            self.walls.apply(sim)
         pairs = pair_geometry(sim)
         state = self._state
         if self.take_new_suction():             # set_suction: bridges at contact
@@ -696,7 +719,7 @@ class VolumeBridges(CapillaryBridges):
 
 def bridges_by_control(suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
                        model="exact", control="suction", persist=False, table_options=None,
-                       roughness=0.0, liquid="reservoir"):
+                       roughness=0.0, liquid="reservoir", wall_bridges=False):
     """The bridge operation of ``control`` ("suction": SuctionBridges, "volume":
     VolumeBridges, which always persist) with these parameters (CapillaryBridges and the two
     classes); ValueError naming a parameter the control does not take: ``roughness`` > 0 and
@@ -705,6 +728,9 @@ def bridges_by_control(suction, surface_tension=SURFACE_TENSION, contact_angle=0
     if control not in CONTROLS:
         raise ValueError(f"control = {control!r} is not one of {CONTROLS}")
     if control == "volume":
+        if wall_bridges:
+            raise ValueError("wall_bridges needs control='suction' (volume-controlled "
+                             "sphere-wall bridges are not implemented)")
         if model != "exact":
             raise ValueError("volume-controlled bridges need model='exact'")
         return VolumeBridges(suction, surface_tension, contact_angle, roughness=roughness,
@@ -719,4 +745,4 @@ def bridges_by_control(suction, surface_tension=SURFACE_TENSION, contact_angle=0
         raise ValueError(f"liquid = {liquid!r} needs control='volume' (suction-controlled "
                          "bridges exchange liquid with a reservoir at the imposed suction)")
     return SuctionBridges(suction, surface_tension, contact_angle, model, persist=persist,
-                          table_options=table_options)
+                          table_options=table_options, wall_bridges=wall_bridges)

@@ -184,6 +184,60 @@ def viscoelastic_pair_forces(position, velocity, angular_velocity, radius, mass,
                               tangential, damping, tan_friction, dt)
 
 
+@numba.njit(cache=True, inline="always")
+def _sphere_on_walls(p, position, velocity, angular_velocity, radius, mass, wall_position,
+                     wall_velocity, hertz, modulus, tangential, damping, tan_friction, dt,
+                     wall_shear, force, torque, wall_force, wall_stiffness, wall_moment):
+    """Particle p's damped contacts with the six walls, walls in order (the body of
+    viscoelastic_wall_forces's loop and of the device's threads, pendular.gpu.wall_friction):
+    add to ``force[p]`` and ``torque[p]``, update ``wall_shear[p]``, add to the walls' totals
+    (6,); arguments as viscoelastic_wall_forces'."""
+    r = radius[p]
+    for w in range(6):
+        axis = w // 2
+        side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box: side e_axis
+        overlap = r - side * (position[p, axis] - wall_position[w])
+        if overlap <= 0.0:
+            wall_shear[p, w, 0] = 0.0
+            wall_shear[p, w, 1] = 0.0
+            wall_shear[p, w, 2] = 0.0
+            continue
+        n0 = side if axis == 0 else 0.0
+        n1 = side if axis == 1 else 0.0
+        n2 = side if axis == 2 else 0.0
+        # the sphere's velocity at its contact point x - r n relative to the wall, whose
+        # velocity is -wall_velocity[w] n (outward positive)
+        w0 = angular_velocity[p, 0]
+        w1 = angular_velocity[p, 1]
+        w2 = angular_velocity[p, 2]
+        speed = wall_velocity[w]
+        u0 = velocity[p, 0] - r * (w1 * n2 - w2 * n1) + speed * n0
+        u1 = velocity[p, 1] - r * (w2 * n0 - w0 * n2) + speed * n1
+        u2 = velocity[p, 2] - r * (w0 * n1 - w1 * n0) + speed * n2
+        un = u0 * n0 + u1 * n1 + u2 * n2
+        fe, kn, kt = _stiffnesses(hertz, modulus, tangential, r, overlap,
+                                  wall_contact_stiffness(modulus, r))
+        fn, s0, s1, s2, f0, f1, f2 = _damped_forces(
+            fe, kn, kt, mass[p], damping, un, u0 - un * n0, u1 - un * n1, u2 - un * n2,
+            wall_shear[p, w, 0], wall_shear[p, w, 1], wall_shear[p, w, 2], tan_friction, dt)
+        wall_shear[p, w, 0] = s0
+        wall_shear[p, w, 1] = s1
+        wall_shear[p, w, 2] = s2
+        f0 += fn * n0
+        f1 += fn * n1
+        f2 += fn * n2
+        force[p, 0] += f0
+        force[p, 1] += f1
+        force[p, 2] += f2
+        lever = overlap * 0.5 - r                   # the contact point at lever n
+        torque[p, 0] += lever * (n1 * f2 - n2 * f1)
+        torque[p, 1] += lever * (n2 * f0 - n0 * f2)
+        torque[p, 2] += lever * (n0 * f1 - n1 * f0)
+        wall_force[w] += fn
+        wall_stiffness[w] += kn
+        wall_moment[w] += (r - overlap) * fn
+
+
 @numba.njit(cache=True)
 def viscoelastic_wall_forces(position, velocity, angular_velocity, radius, mass, near_wall,
                              wall_position, wall_velocity, hertz, modulus, tangential, damping,
@@ -200,51 +254,9 @@ def viscoelastic_wall_forces(position, velocity, angular_velocity, radius, mass,
     wall_stiffness[:] = 0.0
     wall_moment[:] = 0.0
     for p in near_wall:
-        r = radius[p]
-        for w in range(6):
-            axis = w // 2
-            side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box: side e_axis
-            overlap = r - side * (position[p, axis] - wall_position[w])
-            if overlap <= 0.0:
-                wall_shear[p, w, 0] = 0.0
-                wall_shear[p, w, 1] = 0.0
-                wall_shear[p, w, 2] = 0.0
-                continue
-            n0 = side if axis == 0 else 0.0
-            n1 = side if axis == 1 else 0.0
-            n2 = side if axis == 2 else 0.0
-            # the sphere's velocity at its contact point x - r n relative to the wall, whose
-            # velocity is -wall_velocity[w] n (outward positive)
-            w0 = angular_velocity[p, 0]
-            w1 = angular_velocity[p, 1]
-            w2 = angular_velocity[p, 2]
-            speed = wall_velocity[w]
-            u0 = velocity[p, 0] - r * (w1 * n2 - w2 * n1) + speed * n0
-            u1 = velocity[p, 1] - r * (w2 * n0 - w0 * n2) + speed * n1
-            u2 = velocity[p, 2] - r * (w0 * n1 - w1 * n0) + speed * n2
-            un = u0 * n0 + u1 * n1 + u2 * n2
-            fe, kn, kt = _stiffnesses(hertz, modulus, tangential, r, overlap,
-                                      wall_contact_stiffness(modulus, r))
-            fn, s0, s1, s2, f0, f1, f2 = _damped_forces(
-                fe, kn, kt, mass[p], damping, un, u0 - un * n0, u1 - un * n1, u2 - un * n2,
-                wall_shear[p, w, 0], wall_shear[p, w, 1], wall_shear[p, w, 2], tan_friction,
-                dt)
-            wall_shear[p, w, 0] = s0
-            wall_shear[p, w, 1] = s1
-            wall_shear[p, w, 2] = s2
-            f0 += fn * n0
-            f1 += fn * n1
-            f2 += fn * n2
-            force[p, 0] += f0
-            force[p, 1] += f1
-            force[p, 2] += f2
-            lever = overlap * 0.5 - r                   # the contact point at lever n
-            torque[p, 0] += lever * (n1 * f2 - n2 * f1)
-            torque[p, 1] += lever * (n2 * f0 - n0 * f2)
-            torque[p, 2] += lever * (n0 * f1 - n1 * f0)
-            wall_force[w] += fn
-            wall_stiffness[w] += kn
-            wall_moment[w] += (r - overlap) * fn
+        _sphere_on_walls(p, position, velocity, angular_velocity, radius, mass, wall_position,
+                         wall_velocity, hertz, modulus, tangential, damping, tan_friction, dt,
+                         wall_shear, force, torque, wall_force, wall_stiffness, wall_moment)
 
 
 class _DampedContactForces(ContactForces):

@@ -78,7 +78,11 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
     def check(self, scene):
         """Bridges across gaps (``persist``) run listed after the contact law and the wall
         forces (the device adds their forces last, as the CPU's gather_pair_forces after
-        both), with radii that do not grow."""
+        both), with radii that do not grow; no sphere–wall bridges (``walls``: no device
+        side yet)."""
+        if self.op.walls is not None:
+            raise ValueError("device='gpu' does not run sphere-wall bridges (--wall-bridges) "
+                             "yet: run them with --device cpu")
         if not self.persist:
             return
         what = f"bridges across gaps ({self.name} with persist = True)"

@@ -26,7 +26,6 @@ from pendular.dem.contact_law import (ContactForces, _evaluate_pair, _first_memb
 from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
     _evaluate_damped_pair)
 from pendular.dem.neighbors import _sum_pair_forces
-from pendular.dem.walls import WallForces
 from pendular.gpu.cuda import cuda, device, device_twin
 from pendular.gpu.operations import DeviceSide, device_side
 
@@ -312,18 +311,3 @@ class DampedLaw(LinearLaw):
         return Law(op.modulus, op.tangential, tan_friction(op), True, op.hertz, op.damping,
                    dt)
 
-
-@device_side(WallForces)
-class WallSprings(DeviceSide):
-    """The frictionless walls' springs (WallForces, kn = E R): added in the gather, before
-    or after the pair forces as the scene lists them, and reduced on each wall
-    (pendular.gpu.walls)."""
-
-    family = "force"
-    role = "walls"
-    in_cell = False
-
-    @property
-    def young(self):
-        """E [Pa] of the springs now."""
-        return self.op.young

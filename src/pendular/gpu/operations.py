@@ -71,9 +71,10 @@ class DeviceSide:
         return []
 
     def pairs_to_host(self, sim, state, index):
-        """A force's per-pair state from ``state`` (a DeviceState) into its operation, carried
-        to the host list's pairs (``index``: pendular.dem.neighbors.previous_pair_index), when
-        the state comes back to ``sim``; nothing by default."""
+        """A force's own state from ``state`` (a DeviceState) into its operation when the
+        state comes back to ``sim``: per pair, carried to the host list's pairs (``index``:
+        pendular.dem.neighbors.previous_pair_index), or per particle (the walls' springs);
+        nothing by default."""
 
 
 class ControlSide(DeviceSide):

@@ -29,13 +29,14 @@ import numpy as np
 
 from pendular.dem.growth import GrowthTimeStep, RadiusGrowth
 from pendular.dem.mixed_stress import MixedStress
-from pendular.dem.walls import (ConstantStrainRate, StressServo, move_walls as cpu_move_walls,
-    servo_refreshes as cpu_servo_refreshes, servo_walls as cpu_servo_walls)
+from pendular.dem.walls import (ConstantStrainRate, StressServo, WallForces,
+    move_walls as cpu_move_walls, servo_refreshes as cpu_servo_refreshes,
+    servo_walls as cpu_servo_walls)
 from pendular.gpu.cuda import cuda, device, device_twin
 from pendular.dem.state import Walls
 from pendular.gpu import integrate, neighbors
 from pendular.gpu.forces import wall_push
-from pendular.gpu.operations import BoxSide, ControlSide, device_side
+from pendular.gpu.operations import BoxSide, ControlSide, DeviceSide, device_side
 
 servo_walls = device_twin(cpu_servo_walls)
 servo_refreshes = device_twin(cpu_servo_refreshes)
@@ -385,9 +386,34 @@ class GrowthTimeStepRow(ControlSide):
     single = True
 
 
+@device_side(WallForces)
+class WallSprings(DeviceSide):
+    """The frictionless walls' springs (WallForces, kn = E R): added in the gather, before
+    or after the pair forces as the scene lists them, and reduced on each wall
+    (``wall_partials``). A walls side gives ``young``, the stiffness of the springs the
+    gather adds, and ``partials(state)``, the launches that fill ``state.partial`` for
+    ``wall_sums``."""
+
+    family = "force"
+    role = "walls"
+    in_cell = False
+
+    @property
+    def young(self):
+        """E [Pa] of the springs now."""
+        return self.op.young
+
+    def partials(self, state):
+        """(kernel, items, arguments) of each block's sums on the walls (``wall_partials``)."""
+        s = state
+        return [(wall_partials, s.partial.shape[0],
+                 (s.position, s.radius, s.wall_position, self.young, s.partial))]
+
+
 @device_side(Walls)
 class WallBox(BoxSide):
-    """Six walls (Walls, with WallForces among the forces): a step's launches (module
+    """Six walls (Walls, with one walls operation among the forces: WallForces, or a wall law
+    with springs, pendular.gpu.wall_friction): a step's launches (module
     docstring of pendular.gpu.simulation), the walls' reduction and controls here."""
 
     def check(self, scene):
@@ -413,8 +439,7 @@ class WallBox(BoxSide):
                                        s.new_carried(), s.flags)),
             gpu.finish_step(),
             *gpu.force_steps(walls_first, springs.young),
-            (wall_partials, s.partial.shape[0],
-             (s.position, s.radius, s.wall_position, springs.young, s.partial)),
+            *springs.partials(s),
             (wall_sums, 6 * WALL_SUMS,
              (s.partial, s.wall_force, s.wall_stiffness, s.wall_moment)),
             (wall_controls, 1,

@@ -78,6 +78,7 @@ from pendular.homogenize.bridge_tensors import (capillary_stress, capillary_stre
     effective_stress_parameter, interface_stress, surface_tension_stress, wetted_caps_sum)
 from pendular.homogenize.contact_stress import contact_stress, pair_stress_sum
 from pendular.homogenize.fabric import fabric_tensor, principal_anisotropy
+from pendular.homogenize.wall_bridge_stress import with_wall_bridges
 
 
 @dataclass(frozen=True)
@@ -217,11 +218,16 @@ def capillary_force_stress(sim, bridges):
     operation ``bridges`` (capillary.CapillaryBridges), V the box inside the walls, with the
     sign convention of pendular.homogenize.contact_stress (l = x_j - x_i, f on j from i, compression
     positive): attractive bridges give a negative (tensile) stress, and in static equilibrium
-    sigma_wall = sigma_contact + sigma_capillary."""
+    sigma_wall = sigma_contact + sigma_capillary. Sphere-wall bridges (``bridges.walls``) add
+    their l f, l from the sphere's centre to the wall, as the walls' contacts add theirs to
+    sigma_contact (Walls.moment)."""
     pair_force = bridges.pair_forces(sim)
     c = sim.contacts
     total = pair_stress_sum(sim.particles.position, c.pair_i, c.pair_j, c.image,
                             sim.walls.period, pair_force, BridgeState.of(c).mask())
+    if bridges.walls is not None:
+        moment = bridges.walls.moment
+        total[np.diag_indices(3)] -= moment[0::2] + moment[1::2]
     return total / sim.walls.volume()
 
 
@@ -312,7 +318,8 @@ class HostMeasures(Mapping):
     def bridge_stress(self):
         """The BridgeStress of the bridges over the box inside the walls (homogenize_bridges
         with the operation's suction, contact angle and surface tension; volume control:
-        each bridge's own suction; the exact model: its interfaces)."""
+        each bridge's own suction; the exact model: its interfaces), the sphere-wall bridges'
+        share added (pendular.homogenize.wall_bridge_stress)."""
         if self._bridge_stress is None:
             sim, op = self.sim, self.bridges
             suction = (BridgeState.of(sim.contacts).suction if op.control == "volume"
@@ -324,6 +331,10 @@ class HostMeasures(Mapping):
                 sim.particles, sim.contacts, sim.walls.volume(), suction=suction,
                 contact_angle=op.contact_angle, surface_tension=op.surface_tension,
                 interfaces=interfaces, period=sim.walls.period)
+            if op.walls is not None:        # sphere-wall bridges (--wall-bridges)
+                self._bridge_stress = with_wall_bridges(
+                    self._bridge_stress, sim, op.walls, op.suction, op.contact_angle,
+                    op.surface_tension, sim.walls.volume())
         return self._bridge_stress
 
 

@@ -81,7 +81,7 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
 OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
     "friction": "deg", "prep_friction": "deg", "rolling_friction": "1",
-    "twisting_friction": "1", "gravity": "m/s^2", "contact": "1", "poisson": "1",
+    "twisting_friction": "1", "gravity": "m/s^2", "wall_friction": "deg", "contact": "1", "poisson": "1",
     "restitution": "1", "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",

@@ -215,7 +215,8 @@ class BridgeConfig:
     persist: suction-controlled bridges live to their rupture distance instead of breaking when
     contact is lost; roughness: meniscus separation at contact H/R2 (volume control);
     table_resolution: (nodes in suction, nodes in distance) of the tables, None for the model's
-    default.
+    default; wall_bridges: bridges between the spheres and the walls too (suction control,
+    pendular.capillary.wall_bridges).
     """
 
     suction: float | None = parameter(None, unit="Pa", low=0.0, low_inclusive=False,
@@ -243,6 +244,9 @@ class BridgeConfig:
         help="bridge table nodes in suction and in distance")
     water_content: float | None = parameter(None, low=0.0, high=1.0, low_inclusive=False,
                                             help="gravimetric water content (a fraction)")
+    wall_bridges: bool = parameter(False, kind=bool, flag="--wall-bridges",
+                                   help="liquid bridges between the spheres and the walls too "
+                                        "(exact sphere-plane solutions; suction control)")
     liquid: str = parameter("shared", kind=str, choices=LIQUID_MODELS[1:],
                             flag="--rupture-liquid",
                             unset=True,
@@ -257,6 +261,11 @@ class BridgeConfig:
                                                or self.model != "exact"):
             raise fail(self, "water_content", "water_content needs volume-controlled exact "
                        "bridges (control='volume', model='exact')")
+        if self.wall_bridges and (self.control != "suction" or self.model != "exact"):
+            raise fail(self, "wall_bridges", "wall_bridges needs suction-controlled exact "
+                       "bridges (--suction, not --water-content or an undrained test; not "
+                       "--bridges toroidal): volume-controlled sphere-wall bridges are not "
+                       "implemented")
         if self.table_resolution is not None:
             if len(self.table_resolution) != 2:
                 raise fail(self, "table_resolution", f"table_resolution = "
@@ -294,7 +303,7 @@ class BridgeConfig:
                                 contact_angle=self.contact_angle, model=self.model,
                                 control=self.control, persist=self.persist,
                                 roughness=self.roughness, table_options=table_options,
-                                liquid=liquid)
+                                liquid=liquid, wall_bridges=self.wall_bridges)
 
 
 @dataclass

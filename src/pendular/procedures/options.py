@@ -63,9 +63,10 @@ def sample_sizes(values):
 _SAMPLE_CELL = ((option_of(PrepareConfig, "particles", low=MIN_SAMPLE_PARTICLES),)
                 + options_named(PrepareConfig, ("confining", "seed", "periodic")))
 _MATERIAL = options_named(PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg",
-                                     "rolling_friction", "twisting_friction", "gravity",
-                                     "young", "contact", "poisson", "restitution", "damping",
-                                     "timestep_safety", "timestep_rule", "skin_factor"))
+                                          "rolling_friction", "twisting_friction", "gravity",
+                                          "wall_friction", "young", "contact", "poisson",
+                                          "restitution", "damping", "timestep_safety",
+                                          "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL
 #: A laboratory test's sample: its preparation, sizes and material, or a prepared --sample.
@@ -85,10 +86,11 @@ WATER_CONTENT = Parameter("%", "gravimetric water content held by volume-control
                           "at constant liquid volume, instead of --suction", 0.0, 100.0,
                           low_inclusive=False, flag="--water-content")
 #: The bridges' own fields set by their options as they are, at a suction or a water content.
-BRIDGES = options_named(BridgeConfig, ("contact_angle", "model", "surface_tension", "liquid"))
+BRIDGES = options_named(BridgeConfig, ("contact_angle", "model", "surface_tension", "liquid",
+                                       "wall_bridges"))
 #: A wet laboratory test: at a suction or a water content.
 WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
-           + (option_from(WATER_CONTENT, None, checked=True), BRIDGES[3],
+           + (option_from(WATER_CONTENT, None, checked=True), *BRIDGES[3:],
               option_of(LaboratoryConfig, "wetting"), option_of(BridgeConfig, "persist"),
               option_of(LaboratoryConfig, "wet_steps"),
               option_of(BridgeConfig, "table_resolution", metavar="NS,ND",
@@ -96,7 +98,7 @@ WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
                              "350,80; toroidal 64,80)")))
 #: Wetting options, each refused without a wet test when given (not at its default).
 WET_ONLY = ("contact_angle", "table_resolution", "bridges", "surface_tension",
-            "persist_bridges", "wetting")
+            "persist_bridges", "wetting", "wall_bridges")
 
 
 def table_resolution(value):

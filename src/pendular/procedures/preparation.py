@@ -32,7 +32,7 @@ from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.gravity import MAX_GRAVITY, Gravity
 from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinearForces,
-    HertzMindlinForces, ViscoelasticWallForces)
+    HertzMindlinForces)
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
@@ -46,7 +46,8 @@ from pendular.utils.parameters import ParameterError, fail, parameter, spec_of, 
 from pendular.utils.progress import PhaseBar
 from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int, check_positive
-from pendular.dem.walls import StressServo, WallForces
+from pendular.dem.wall_friction import WALL_FRICTION_RANGE, wall_law
+from pendular.dem.walls import StressServo
 from pendular.homogenize.on_the_fly import homogenized
 
 
@@ -315,6 +316,11 @@ class PrepareConfig:
              "(0: none)")
     density: float = parameter(2650.0, unit="kg/m^3", low=0.0, low_inclusive=False,
                                help="grain density")
+    wall_friction: float = parameter(
+        0.0, unit="deg", low=WALL_FRICTION_RANGE[0], high=WALL_FRICTION_RANGE[1],
+        high_inclusive=False, flag="--wall-friction",
+        help="friction angle between the spheres and the walls, in every phase (pendular.dem."
+             "wall_friction; 0: frictionless walls)")
     gravity: float = parameter(0.0, unit="m/s^2", low=0.0, high=MAX_GRAVITY, flag="--gravity",
                                help="gravitational acceleration along -z (0: none; walls "
                                     "only, not with --periodic)")
@@ -358,6 +364,10 @@ class PrepareConfig:
             raise fail(self, "gravity", f"gravity = {self.gravity:g} m/s^2 is outside the "
                        "valid range [0, 0] in a periodic cell (--periodic: no floor to carry "
                        "the weight); leave out gravity or the periodic cell")
+        if self.wall_friction > 0.0 and self.periodic:
+            raise fail(self, "wall_friction", f"wall_friction = {self.wall_friction:g} deg is "
+                       "outside the valid range [0, 0] in a periodic cell (--periodic: no "
+                       "walls); leave out the wall friction or the periodic cell")
         if self.psd is not None:
             if self.radius_spread > 0.0:
                 raise fail(self, "radius_spread",
@@ -471,16 +481,16 @@ def contact_forces(config, friction_deg):
 def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, threads=None,
                    device="cpu", resistance=True):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m],
-    contacts of ``config``'s law at ``friction_deg`` [deg] (contact_forces), frictionless
-    wall contacts of the same law (none in a periodic cell), the weight (``config.gravity``
+    contacts of ``config``'s law at ``friction_deg`` [deg] (contact_forces), wall contacts of
+    the same law at ``config.wall_friction`` (pendular.dem.wall_friction.wall_law; none in a
+    periodic cell), the weight (``config.gravity``
     > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
     coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its runs on
     ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
     resistance it holds the contacts and the walls alone."""
     forces = [contact_forces(config, friction_deg)]
     if not walls.periodic:
-        forces.append(WallForces(config.young) if type(forces[0]) is ContactForces
-                      else ViscoelasticWallForces(forces[0]))
+        forces.append(wall_law(forces[0], config.young, config.wall_friction))
     if config.gravity > 0.0:
         forces.append(Gravity(config.gravity))
     if resistance:

@@ -1,0 +1,49 @@
+"""Walls with tangential springs (pendular.gpu.wall_friction) on the GPU against the CPU under
+Numba's CUDA simulator: the scenes of wall_friction_checks.py (frictional linear walls under
+gravity, Hertz–Mindlin walls, with bridges at contact), whose checks run in one process of
+their own so that no other test meets the simulator. The simulator does not contract
+multiply-adds as the CPU's hot kernels do, hence round-off bounds."""
+
+import pytest
+
+from conftest import requires
+from simulator import simulated
+
+pytestmark = requires("numba_cuda")
+
+QUANTITIES = ("velocity", "angular_velocity", "force", "torque", "springs", "wall_force",
+              "wall_moment", "wall_stiffness", "wall_shear")
+
+
+@pytest.fixture(scope="module")
+def measured():
+    return simulated("wall_friction_checks.py", "linear", "hertz", "wet", "refusal",
+                     "wall_bridges")
+
+
+@pytest.mark.parametrize("name", ["linear", "hertz", "wet"])
+def test_the_walls_springs_on_the_gpu_agree_with_the_cpu_to_round_off(measured, name):
+    for case in ("agreement", "handed_over"):
+        agreement = measured[name][case]
+        assert agreement["touching_cpu"] == agreement["touching_gpu"] == \
+            agreement["touching_both"] > 10, case
+        cpu, gpu = agreement["springs_on_walls"]
+        assert cpu == gpu > 5, case
+        assert agreement["position"] < 1e-13 and agreement["wall_position"] < 1e-13, case
+        for quantity in QUANTITIES:
+            assert agreement[quantity] < 1e-10, (case, quantity)
+
+
+@pytest.mark.parametrize("name", ["linear", "hertz"])
+def test_the_wall_friction_matters(measured, name):
+    """What the comparison would miss if the device left the walls' springs out."""
+    without = measured[name]["without_friction"]
+    assert without["angular_velocity"] > 1e-3 and without["position"] > 1e-9
+
+
+def test_two_wall_operations_are_refused(measured):
+    assert "at most one walls operation" in (measured["refusal"] or "")
+
+
+def test_sphere_wall_bridges_are_refused_by_name(measured):
+    assert "does not run sphere-wall bridges" in (measured["wall_bridges"] or "")
