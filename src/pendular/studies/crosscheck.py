@@ -30,6 +30,11 @@
    reaches ``config.shear.max_strain``. Periodic: YADE drives the cell with PeriTriaxController
    (x, y stress goals, z at the true strain rate), its stress evaluated every step and its
    servo given pendular's gain (``cell_grow_damping``); pendular with its cell servo.
+   The contact law is ``config.sample.contact``'s: the linear law against YADE's
+   Ip2_FrictMat_FrictMat_FrictPhys / Law2_ScGeom_FrictPhys_CundallStrack, or (dry, six walls,
+   undamped) Hertz–Mindlin against Ip2_FrictMat_FrictMat_MindlinPhys /
+   Law2_ScGeom_MindlinPhys_Mindlin, YADE's wall contacts made pendular's rigid plane
+   (``yade_wall_poisson``).
 
 Writes DIR/crosscheck.json: ``pendular`` and ``yade`` summaries (peak q, p, axial and volumetric
 strain, Sr, bridges / menisci and porosity at the peak of q, the same at the start of the shear,
