@@ -123,7 +123,8 @@ def main(argv=None):
                    ("poisson", args.poisson), ("pressures", args.pressures),
                    ("max_strain", args.max_strain), ("seed", args.seed))),
               "date": time.strftime("%Y-%m-%d", time.gmtime()), "machine": args.machine,
-              "preparation_steps": report.get("steps"), "wall_time_s": time.perf_counter() - started,
+              "preparation_steps": report.get("steps"),
+              "wall_time_s": time.perf_counter() - started,
               "rows": rows, "exponents": fits}
     print(json.dumps(result["exponents"]))
     if args.json:

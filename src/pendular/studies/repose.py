@@ -13,9 +13,10 @@ speed below ``rest_speed`` sqrt(g R)) or ``max_time``.
 
 The angle is read from the heap's surface (``repose_angle``): the grains' tops z + R, binned
 by the distance r from the heap's axis (bins of one diameter) and by azimuth (``SECTORS``
-sectors); the highest top of each cell, averaged over the sectors of a bin, gives the
-surface height h(r) (over the sectors holding a grain); a straight line fitted to h(r) over the flank (from ``FLANK`` of the
-heap's radius, where h first falls below one radius above the floor) gives tan(theta).
+sectors); the highest top of each cell, averaged over the sectors of a bin that hold a
+grain, gives the surface height h(r); a straight line fitted to h(r) over the flank (from
+``FLANK`` of the heap's radius, where h first falls below one radius above the floor) gives
+tan(theta).
 
 Stresses and lengths SI; angles in degrees.
 """
