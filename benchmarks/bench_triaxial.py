@@ -147,7 +147,8 @@ def main(argv=None):
                        "cost_per_particle_step_ns": 1e9 * step_time / count,
                        "fixed_cost_per_step_us": 1e6 * fixed_cost,
                        "fixed_cost_share": fixed_cost / step_time,
-                       "dt": dt, "strain_rate": rate, "porosity": report["porosity"]}
+                       "dt": dt, "strain_rate": rate, "porosity": report["porosity"],
+                       "coordination": report.get("coordination")}
                 if use_yade:
                     yade_speeds = [yade["particle_steps_per_s"] for _, yade, _, _ in
                                    turns[contact]]
