@@ -9,8 +9,10 @@ E [Pa] and ``--poisson`` is prepared at the first pressure (thesis Ch. 5.2.2,
 pendular.procedures.preparation), then loaded isotropically to each pressure in turn
 (six walls servoed there until static); at each, a copy is sheared in drained triaxial
 compression (x, y held at the pressure, z at the inertial-number rate of the default
-ShearConfig) to ``--max-strain``, and the secant moduli q / eps_a at eps_a = 1e-5 and 1e-4
-are read from its history. Hertz's contacts stiffen as k_n ~ f^(1/3): at a fixed fabric
+ShearConfig) to ``--max-strain``, and the secant moduli q / eps_a at eps_a = 1e-5 and 1e-4,
+and where q first reaches 0.02 p and 0.05 p (the same mobilisation at every pressure: the
+elastic range of Hertz contacts shrinks as (p / E)^(2/3) towards low pressures, so a fixed
+strain lies further out of it there), are read from its history. Hertz's contacts stiffen as k_n ~ f^(1/3): at a fixed fabric
 (contacts, their directions and the coordination) a packing's moduli grow as p^(1/3); a
 packing that gains contacts as it is pressed grows faster (about p^(1/2) in sands). The
 script fits the exponent n of E ~ p^n over the pressures (least squares in log-log) and
@@ -36,14 +38,26 @@ from pendular.procedures.triaxial import TriaxialShear, equilibrate
 
 #: The axial strains [-] of the secant moduli.
 STRAINS = (1e-5, 1e-4)
+#: The stress ratios q / p [-] of the secant moduli at a fixed mobilisation.
+RATIOS = (0.02, 0.05)
 
 
-def secant_moduli(history):
-    """q / eps_a [Pa] at each of STRAINS (linear interpolation in the history)."""
+def secant_moduli(history, pressure):
+    """q / eps_a [Pa] at each of STRAINS, then at the first strain where q reaches each of
+    RATIOS times ``pressure`` [Pa] (linear interpolation in the history)."""
     sigma = np.asarray(history["sigma_wall"], dtype=np.float64)
     strain = np.asarray(history["axial_strain"], dtype=np.float64)
     q = sigma[:, 2] - 0.5 * (sigma[:, 0] + sigma[:, 1])
-    return [float(np.interp(at, strain, q) / at) for at in STRAINS]
+    moduli = [float(np.interp(at, strain, q) / at) for at in STRAINS]
+    for ratio in RATIOS:
+        target = ratio * pressure
+        k = int(np.argmax(q >= target))
+        if k == 0:
+            moduli.append(float("nan"))
+            continue
+        t = (target - q[k - 1]) / (q[k] - q[k - 1])
+        moduli.append(float(target / (strain[k - 1] + t * (strain[k] - strain[k - 1]))))
+    return moduli
 
 
 def at_pressure(particles, walls, config, pressure, max_strain, records):
@@ -61,10 +75,15 @@ def at_pressure(particles, walls, config, pressure, max_strain, records):
     shear = TriaxialShear(sim, ShearConfig(max_strain=max_strain, records=records), pressure,
                           sample.radius, sample.density)
     sim.run(shear.steps, status=shear.status)
-    moduli = secant_moduli(shear.recorder.arrays())
-    row.update({f"secant_modulus_{at:g}": value for at, value in zip(STRAINS, moduli)})
+    moduli = secant_moduli(shear.recorder.arrays(), pressure)
+    row.update({key: value for key, value in zip(MEASURES, moduli)})
     row["shear_steps"] = shear.steps
     return state, row
+
+
+#: The row's keys of the moduli of secant_moduli.
+MEASURES = (tuple(f"secant_modulus_{at:g}" for at in STRAINS)
+            + tuple(f"secant_modulus_q_over_p_{ratio:g}" for ratio in RATIOS))
 
 
 def exponent(pressures, moduli):
@@ -76,10 +95,10 @@ def figure(rows, fits, path):
     """Secant moduli against the pressure, log-log, with the fits and the 1/3 and 1/2 slopes."""
     fig, axes = pyplot().subplots(figsize=(5.5, 4.2))
     pressure = np.array([row["pressure"] for row in rows])
-    for at, marker in zip(STRAINS, "os"):
-        modulus = np.array([row[f"secant_modulus_{at:g}"] for row in rows])
-        axes.loglog(pressure, modulus, marker, label=f"q/ε_a at ε_a = {at:g}: "
-                                                       f"n = {fits[f'{at:g}']:.3f}")
+    labels = [f"ε_a = {at:g}" for at in STRAINS] + [f"q/p = {r:g}" for r in RATIOS]
+    for key, label, marker in zip(MEASURES, labels, "os^v"):
+        modulus = np.array([row[key] for row in rows])
+        axes.loglog(pressure, modulus, marker, label=f"q/ε_a at {label}: n = {fits[key]:.3f}")
         for slope, style in ((1.0 / 3.0, ":"), (0.5, "--")):
             axes.loglog(pressure, modulus[0] * (pressure / pressure[0]) ** slope, style,
                         color="grey", linewidth=0.8)
@@ -97,7 +116,7 @@ def main(argv=None):
     parser.add_argument("--poisson", type=float, default=0.3)
     parser.add_argument("--pressures", default="1000,3000,10000,30000,100000")
     parser.add_argument("--max-strain", type=float, default=0.0005)
-    parser.add_argument("--records", type=int, default=500)
+    parser.add_argument("--records", type=int, default=1000)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", default=None)
     parser.add_argument("--figure", default=None)
@@ -114,8 +133,7 @@ def main(argv=None):
         state, row = at_pressure(*state, config, pressure, args.max_strain, args.records)
         rows.append(row)
         print(json.dumps(row), flush=True)
-    fits = {f"{at:g}": exponent(pressures, [row[f"secant_modulus_{at:g}"] for row in rows])
-            for at in STRAINS}
+    fits = {key: exponent(pressures, [row[key] for row in rows]) for key in MEASURES}
     fits["coordination"] = exponent(pressures, [row["coordination"] for row in rows])
     result = {"command": "python benchmarks/bench_hm_stiffness.py " + " ".join(
                   f"--{key.replace('_', '-')} {value}" for key, value in
