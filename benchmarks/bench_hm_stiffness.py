@@ -1,19 +1,23 @@
 """Small-strain stiffness of a Hertz–Mindlin packing against the confining pressure.
 
     python benchmarks/bench_hm_stiffness.py [--particles 300] [--young 1e9] [--poisson 0.3]
-        [--pressures 1000,3000,10000,30000,100000] [--max-strain 0.0005] [--seed 0]
+        [--pressures 1000,3000,10000,30000,100000] [--max-strain 0.0001]
+        [--probe-steps 20000] [--seed 0]
         [--json docs/figures/hm_stiffness.json] [--figure docs/figures/hm_stiffness.png]
 
 One dry sample of ``--particles`` spheres with the Hertz–Mindlin law of the grains' ``--young``
 E [Pa] and ``--poisson`` is prepared at the first pressure (thesis Ch. 5.2.2,
 pendular.procedures.preparation), then loaded isotropically to each pressure in turn
 (six walls servoed there until static); at each, a copy is sheared in drained triaxial
-compression (x, y held at the pressure, z at the inertial-number rate of the default
-ShearConfig) to ``--max-strain``, and the secant moduli q / eps_a at eps_a = 1e-5 and 1e-4,
-and where q first reaches 0.02 p and 0.05 p (the same mobilisation at every pressure: the
-elastic range of Hertz contacts shrinks as (p / E)^(2/3) towards low pressures, so a fixed
-strain lies further out of it there), are read from its history. Hertz's contacts stiffen as k_n ~ f^(1/3): at a fixed fabric
-(contacts, their directions and the coordination) a packing's moduli grow as p^(1/3); a
+compression (x, y held at the pressure) to ``--max-strain`` in ``--probe-steps`` steps (a
+strain rate far below the inertial-number rate of a shear: a compression wave crosses the
+sample in some 100 steps, and 1e-5 of strain at the shear's rate would be read before the
+first crossing), and the secant moduli q / eps_a at eps_a = 1e-5 and 5e-5, and where q first
+reaches 0.01 p and 0.02 p (the same mobilisation at every pressure: the elastic range of
+Hertz contacts shrinks as (p / E)^(2/3) towards low pressures, so a fixed strain lies further
+out of it there), are read from its history. Hertz's contacts stiffen as k_n ~ f^(1/3): at a
+fixed fabric (contacts, their directions and the coordination) a packing's moduli grow as
+p^(1/3); a
 packing that gains contacts as it is pressed grows faster (about p^(1/2) in sands). The
 script fits the exponent n of E ~ p^n over the pressures (least squares in log-log) and
 writes the table, the fit and the coordination at each pressure to the JSON and a log-log
@@ -37,9 +41,9 @@ from pendular.procedures.preparation import PrepareConfig, prepare_sample, servo
 from pendular.procedures.triaxial import TriaxialShear, equilibrate
 
 #: The axial strains [-] of the secant moduli.
-STRAINS = (1e-5, 1e-4)
+STRAINS = (1e-5, 5e-5)
 #: The stress ratios q / p [-] of the secant moduli at a fixed mobilisation.
-RATIOS = (0.02, 0.05)
+RATIOS = (0.01, 0.02)
 
 
 def secant_moduli(history, pressure):
@@ -60,7 +64,7 @@ def secant_moduli(history, pressure):
     return moduli
 
 
-def at_pressure(particles, walls, config, pressure, max_strain, records):
+def at_pressure(particles, walls, config, pressure, max_strain, records, probe_steps):
     """(the static state at ``pressure`` [Pa] (Particles, Walls), its row: porosity,
     coordination, secant moduli of a triaxial from it, steps)."""
     sample = dataclasses.replace(config, confining=pressure)
@@ -72,12 +76,15 @@ def at_pressure(particles, walls, config, pressure, max_strain, records):
     row = {"pressure": pressure, "porosity": float(porosity(sim.particles, sim.walls)),
            "coordination": float(coordination(sim.contacts, len(sim.particles))),
            "loading_steps": steps, "dt": sim.dt}
-    shear = TriaxialShear(sim, ShearConfig(max_strain=max_strain, records=records), pressure,
-                          sample.radius, sample.density)
+    # slow enough that the strain of each modulus takes many wave crossings of the sample
+    rate = max_strain / (probe_steps * sim.dt)
+    shear = TriaxialShear(sim, ShearConfig(max_strain=max_strain, records=records,
+                                           strain_rate=rate), pressure, sample.radius,
+                          sample.density)
     sim.run(shear.steps, status=shear.status)
     moduli = secant_moduli(shear.recorder.arrays(), pressure)
     row.update({key: value for key, value in zip(MEASURES, moduli)})
-    row["shear_steps"] = shear.steps
+    row.update(shear_steps=shear.steps, strain_rate=rate)
     return state, row
 
 
@@ -115,8 +122,10 @@ def main(argv=None):
     parser.add_argument("--young", type=float, default=1e9)
     parser.add_argument("--poisson", type=float, default=0.3)
     parser.add_argument("--pressures", default="1000,3000,10000,30000,100000")
-    parser.add_argument("--max-strain", type=float, default=0.0005)
-    parser.add_argument("--records", type=int, default=1000)
+    parser.add_argument("--max-strain", type=float, default=0.0001)
+    parser.add_argument("--records", type=int, default=400)
+    parser.add_argument("--probe-steps", type=int, default=20000,
+                        help="steps of the triaxial probe to --max-strain")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--json", default=None)
     parser.add_argument("--figure", default=None)
@@ -130,7 +139,8 @@ def main(argv=None):
     state = sim.particles, sim.walls
     rows = []
     for pressure in pressures:
-        state, row = at_pressure(*state, config, pressure, args.max_strain, args.records)
+        state, row = at_pressure(*state, config, pressure, args.max_strain, args.records,
+                                 args.probe_steps)
         rows.append(row)
         print(json.dumps(row), flush=True)
     fits = {key: exponent(pressures, [row[key] for row in rows]) for key in MEASURES}
