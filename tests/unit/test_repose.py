@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from pendular.procedures.preparation import PrepareConfig
-from pendular.studies.repose import (HeldParticles, PileConfig, column_cloud, floor_lattice,
-    pile_scene, repose_angle)
+from pendular.studies.repose import (HeldParticles, PileConfig, column_cloud, flank_angle,
+    floor_lattice, pile_scene, repose_angle)
 
 RADIUS = 1e-3
 
@@ -31,8 +31,20 @@ def test_the_angle_of_a_cone_of_spheres_is_the_cones(angle):
     measured, centre, profile, edge = repose_angle(position, np.full(len(position), RADIUS),
                                                    axis, 2.0 * RADIUS)
     assert measured == pytest.approx(angle, abs=0.5)
-    assert edge == pytest.approx(base, abs=2.0 * RADIUS)
+    # the heap ends where the surface falls below a diameter
+    assert edge == pytest.approx(base - 2.0 * RADIUS / slope, abs=2.0 * RADIUS)
     assert profile[0] == pytest.approx(height, rel=0.05)
+
+
+def test_a_monolayer_on_the_floor_is_not_part_of_the_flank():
+    """A cone of 30 deg and, around it to twice its radius, grains lying in the floor's
+    hollows (tops 0.7 diameter high): the same angle as the cone alone."""
+    slope = math.tan(math.radians(30.0))
+    centre = (np.arange(40) + 0.5) * 2.0 * RADIUS
+    height = np.maximum(12.0 * RADIUS - slope * centre, 1.4 * RADIUS)
+    angle, edge = flank_angle(centre, height)
+    assert angle == pytest.approx(30.0, abs=0.5)
+    assert edge < 12.0 * RADIUS / slope
 
 
 def test_the_floor_and_the_column_hold_no_overlap():

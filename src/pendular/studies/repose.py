@@ -15,8 +15,8 @@ The angle is read from the heap's surface (``repose_angle``): the grains' tops z
 by the distance r from the heap's axis (bins of one diameter) and by azimuth (``SECTORS``
 sectors); the highest top of each cell, averaged over the sectors of a bin that hold a
 grain, gives the surface height h(r); a straight line fitted to h(r) over the flank (from
-``FLANK`` of the heap's radius, where h first falls below one radius above the floor) gives
-tan(theta).
+``FLANK`` of the heap's radius, where h first falls below one diameter above the floor)
+gives tan(theta).
 
 Stresses and lengths SI; angles in degrees.
 """
@@ -35,7 +35,7 @@ from pendular.utils.validate import check_int, check_range
 #: Azimuthal sectors of the surface profile.
 SECTORS = 8
 #: The flank over which the surface is fitted, as fractions of the heap's radius.
-FLANK = (0.2, 0.8)
+FLANK = (0.3, 0.9)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -133,32 +133,47 @@ def column_cloud(count, radius, column_radius, fraction, centre, base, rng):
     return placed
 
 
-def repose_angle(position, radius, axis, floor_top):
-    """(angle [deg], the profile: bin centres r [m] and surface heights h [m] above
-    ``floor_top``, the heap's radius [m]) of the heap of spheres at ``position`` (N, 3) [m]
-    of ``radius`` (N,) [m] about the vertical ``axis`` (x, y) [m] (module docstring)."""
+def surface_profile(position, radius, axis, floor_top):
+    """(bin centres r [m], surface heights h [m] above ``floor_top``) of the heap of spheres
+    at ``position`` (N, 3) [m] of ``radius`` (N,) [m] about the vertical ``axis`` (x, y) [m]:
+    bins of one mean diameter, h the mean over the sectors holding a grain of each sector's
+    highest top (module docstring; a bin without a grain: 0)."""
     top = position[:, 2] + radius - floor_top
     dx = position[:, 0] - axis[0]
     dy = position[:, 1] - axis[1]
-    distance = np.hypot(dx, dy)
     width = 2.0 * float(np.mean(radius))
-    radial = (distance // width).astype(int)
+    radial = (np.hypot(dx, dy) // width).astype(int)
     sector = ((np.arctan2(dy, dx) + math.pi) / (2.0 * math.pi) * SECTORS).astype(int) % SECTORS
-    bins = int(radial.max()) + 1
-    highest = np.full((bins, SECTORS), -np.inf)
+    highest = np.full((int(radial.max()) + 1, SECTORS), -np.inf)
     np.maximum.at(highest, (radial, sector), top)
     filled = np.isfinite(highest)
-    # the mean over the sectors that hold a grain (none: bare floor, height 0)
     height = np.where(filled, highest, 0.0).sum(axis=1) / np.maximum(filled.sum(axis=1), 1)
-    centre = (np.arange(bins) + 0.5) * width
-    low = np.flatnonzero(height < 0.5 * width)
+    return (np.arange(len(height)) + 0.5) * width, height
+
+
+def flank_angle(centre, height):
+    """(angle [deg], the heap's radius [m]) of the surface profile (surface_profile): the
+    heap ends where h first falls below one bin width (a grain's diameter: the grains that
+    roll out onto the floor lie in its hollows, a monolayer about 0.7 diameter high), and a
+    straight line fitted to h over the FLANK fractions of that radius gives tan(angle)."""
+    width = centre[1] - centre[0]
+    low = np.flatnonzero(height < width)
     edge = centre[low[0]] if len(low) else centre[-1]
     flank = (centre >= FLANK[0] * edge) & (centre <= FLANK[1] * edge)
     if np.count_nonzero(flank) < 3:
         raise ValueError(f"repose_angle: {np.count_nonzero(flank)} bins on the flank (heap "
                          f"radius {edge:g} m, bins of {width:g} m); valid: at least 3")
     slope = np.polyfit(centre[flank], height[flank], 1)[0]
-    return math.degrees(math.atan(-slope)), centre, height, edge
+    return math.degrees(math.atan(-slope)), float(edge)
+
+
+def repose_angle(position, radius, axis, floor_top):
+    """(angle [deg], the profile's bin centres r [m] and heights h [m] above ``floor_top``,
+    the heap's radius [m]) of the heap of spheres at ``position`` (N, 3) [m] of ``radius``
+    (N,) [m] about the vertical ``axis`` (x, y) [m] (surface_profile, flank_angle)."""
+    centre, height = surface_profile(position, radius, axis, floor_top)
+    angle, edge = flank_angle(centre, height)
+    return angle, centre, height, edge
 
 
 def pile_scene(config):
@@ -201,7 +216,7 @@ def pour_pile(config, progress=None):
     position = sim.particles.position[free]
     angle, centre, height, edge = repose_angle(position, sim.particles.radius[free], axis,
                                                floor_top)
-    return {"angle_deg": angle, "heap_radius": float(edge), "heap_height": float(height[0]),
+    return {"angle_deg": angle, "heap_radius": edge, "heap_height": float(height.max()),
             "profile_r": centre.tolist(), "profile_h": height.tolist(),
             "time": sim.time, "steps": steps, "dt": sim.dt, "at_rest": bool(at_rest(sim)),
             "max_speed": float(np.linalg.norm(sim.particles.velocity[free], axis=1).max()),
