@@ -3,12 +3,15 @@
     python benchmarks/bench_repose.py [--rolling 0,0.1,0.3] [--contacts linear]
         [--grains 800] [--seeds 0] [--json docs/figures/repose.json]
         [--figure docs/figures/repose.png]
+    python benchmarks/bench_repose.py --gather A.json B.json ... --json ALL.json --figure F.png
 
 Each run pours ``--grains`` spheres of R = 1 mm, 2650 kg/m^3, E = 1e7 Pa (nu 0.3 with
 Hertz–Mindlin), contact friction 30 deg, restitution 0.5, Cundall damping 0.2, g = 9.81 m/s^2
 onto a rough floor of fixed spheres, until at rest, and reads the angle of the heap's flank.
 The JSON holds each run's summary (angle, heap radius and height, profile, time, steps, wall
-time); the figure the surface profiles and the angle against mu_r.
+time); the figure the surface profiles and the angle against mu_r. ``--gather`` instead
+reads the runs of earlier JSON files (e.g. one per seed), fits their angles again from their
+profiles (pendular.studies.repose.flank_angle) and writes them together.
 """
 
 import argparse
@@ -19,7 +22,9 @@ import time
 
 from pendular.io.plots import pyplot, save_figure
 from pendular.procedures.preparation import PrepareConfig
-from pendular.studies.repose import PileConfig, pour_pile
+import numpy as np
+
+from pendular.studies.repose import PileConfig, flank_angle, pour_pile
 
 
 def material(contact, rolling):
@@ -49,6 +54,28 @@ def figure(rows, path):
     save_figure(fig, path)
 
 
+def gather(paths, json_path, figure_path):
+    """The runs of the JSON files ``paths``, each angle and heap radius fitted again from its
+    profile, into one JSON and its figure."""
+    rows, sources = [], []
+    for path in paths:
+        with open(path, encoding="utf-8") as handle:
+            data = json.load(handle)
+        sources.append({key: data[key] for key in ("command", "date", "machine")})
+        for row in data["runs"]:
+            angle, edge = flank_angle(np.array(row["profile_r"]), np.array(row["profile_h"]))
+            rows.append({**row, "angle_deg": angle, "heap_radius": edge,
+                         "heap_height": max(row["profile_h"])})
+    if json_path:
+        with open(json_path, "w") as handle:
+            json.dump({"sources": sources, "runs": rows}, handle, indent=1)
+    if figure_path:
+        figure(rows, figure_path)
+    for row in rows:
+        print(f"{row['contact']:>13} seed {row['seed']} mu_r {row['rolling_friction']:g}: "
+              f"{row['angle_deg']:.2f} deg, heap radius {row['heap_radius'] * 1e3:.0f} mm")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--rolling", default="0,0.1,0.3")
@@ -59,7 +86,12 @@ def main(argv=None):
     parser.add_argument("--json", default=None)
     parser.add_argument("--figure", default=None)
     parser.add_argument("--machine", default=f"{platform.machine()}, {os.cpu_count()} cores")
+    parser.add_argument("--gather", nargs="+", metavar="JSON",
+                        help="the runs of these JSON files, their angles fitted again")
     args = parser.parse_args(argv)
+    if args.gather:
+        gather(args.gather, args.json, args.figure)
+        return
     rows = []
     for contact in args.contacts.split(","):
         for seed in (int(s) for s in args.seeds.split(",")):
