@@ -12,8 +12,8 @@ pendular.procedures.preparation), then loaded isotropically to each pressure in 
 compression (x, y held at the pressure) to ``--max-strain`` in ``--probe-steps`` steps (a
 strain rate far below the inertial-number rate of a shear: a compression wave crosses the
 sample in some 100 steps, and 1e-5 of strain at the shear's rate would be read before the
-first crossing), and the secant moduli q / eps_a at eps_a = 1e-5 and 5e-5, and where q first
-reaches 0.01 p and 0.02 p (the same mobilisation at every pressure: the elastic range of
+first crossing), and the secant moduli (q - q_0) / eps_a at eps_a = 1e-5 and 5e-5, and where
+q - q_0 first reaches 0.01 p and 0.02 p (the same mobilisation at every pressure: the elastic range of
 Hertz contacts shrinks as (p / E)^(2/3) towards low pressures, so a fixed strain lies further
 out of it there), are read from its history. Hertz's contacts stiffen as k_n ~ f^(1/3): at a
 fixed fabric (contacts, their directions and the coordination) a packing's moduli grow as
@@ -47,11 +47,14 @@ RATIOS = (0.01, 0.02)
 
 
 def secant_moduli(history, pressure):
-    """q / eps_a [Pa] at each of STRAINS, then at the first strain where q reaches each of
-    RATIOS times ``pressure`` [Pa] (linear interpolation in the history)."""
+    """(q - q_0) / eps_a [Pa] at each of STRAINS, then at the first strain where q - q_0
+    reaches each of RATIOS times ``pressure`` [Pa] (linear interpolation in the history; q_0
+    the deviator at the start, the static sample's, which the servo holds within its 1 %
+    tolerance of the pressure: as large as the increments read at 1e-5)."""
     sigma = np.asarray(history["sigma_wall"], dtype=np.float64)
     strain = np.asarray(history["axial_strain"], dtype=np.float64)
     q = sigma[:, 2] - 0.5 * (sigma[:, 0] + sigma[:, 1])
+    q = q - q[0]
     moduli = [float(np.interp(at, strain, q) / at) for at in STRAINS]
     for ratio in RATIOS:
         target = ratio * pressure
