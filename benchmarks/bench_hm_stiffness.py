@@ -43,7 +43,7 @@ from pendular.procedures.triaxial import TriaxialShear, equilibrate
 #: The axial strains [-] of the secant moduli.
 STRAINS = (1e-5, 5e-5)
 #: The static state a probe starts from: unbalanced force and relative stress error [-].
-EQUILIBRIUM = (1e-4, 1e-4)
+EQUILIBRIUM = (2e-3, 2e-4)
 #: The stress ratios q / p [-] of the secant moduli at a fixed mobilisation.
 RATIOS = (0.01, 0.02)
 
