@@ -37,6 +37,10 @@ resistance's k_n, pendular.dem.rolling; a periodic cell's servo stiffness) thus 
 spring's secant stiffness, 2/3 of Hertz's tangent kn or the linear kn, at any damping, not a
 stiffness that swings with the normal velocity (above kn while the contact closes, 0 where
 the dashpot cancels the spring).
+
+On one thread the pairs are evaluated row by row and, unless a later force joins the gather,
+their forces scattered to the particles as they are evaluated: the linear law's one-thread
+scheme (pendular.dem.contact_law), the same sums in the same order as the gather's.
 """
 
 import math
