@@ -1,7 +1,8 @@
 """Shear-phase speed of the dry triaxial: pendular against YADE on the same sample, same run.
 
     python benchmarks/bench_triaxial.py [--sizes 1000,10000] [--threads 1,2] [--steps 3000]
-        [--repeats 1] [--no-yade] [--out benchmarks/results_triaxial.json]
+        [--repeats 1] [--contacts linear,hertz-mindlin] [--no-yade]
+        [--out benchmarks/results_triaxial.json]
 
 For each size, a sample is prepared with pendular (thesis Ch. 5.2.2, 750 Pa; cached under
 .cache/), sheared with x, y servoed and z strained, and timed in particle-steps per second after
@@ -13,7 +14,10 @@ the table gives the medians and the ratio's median and range over the R turns: o
 machine either code's speed drifts by tens of per cent within minutes), and the fixed cost
 of a step: the step time of a FIXED_COST_SPHERES scene with the same operations, which is
 nearly all Python, Numba dispatch and kernel launches (its share of a step at each size is the
-overhead outside the compiled work).
+overhead outside the compiled work). ``--contacts`` times each contact law on its own sample
+(prepared with that law), YADE with its FrictPhys or MindlinPhys law, the laws of one size in
+turn (with ``--repeats``, interleaved): the table then adds each law's cost over the first
+law's (pendular and YADE) in the same run.
 """
 
 import argparse
@@ -30,8 +34,16 @@ from pendular.procedures.preparation import servoed_simulation
 from pendular.interop.yade.formats import write_spheres
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.triaxial import TriaxialShear
-from pendular.interop.yade.runner import benchmark_sample as sample  # (config, particles, walls, report)
-from pendular.interop.yade.runner import find_yade, run_yade_triaxial
+from pendular.interop.yade.runner import cached_sample, find_yade, run_yade_triaxial
+from pendular.procedures.preparation import PrepareConfig
+from pendular.studies.crosscheck import yade_wall_poisson
+
+
+def sample(count, confining, contact="linear"):
+    """(PrepareConfig, Particles, Walls, report) of the thesis-default sample (Table 5.2) of
+    ``count`` spheres at ``confining`` [Pa] with the contact law ``contact`` (cached)."""
+    config = PrepareConfig(particles=count, confining=confining, contact=contact)
+    return (config, *cached_sample(config))
 
 
 def time_pendular(config, particles, walls, threads, steps, warmup, force_threads=False):
@@ -57,13 +69,16 @@ def time_yade(config, particles, walls, threads, steps, warmup, dt, rate):
     with tempfile.TemporaryDirectory() as folder:
         spheres = os.path.join(folder, "spheres.txt")
         write_spheres(spheres, particles.position, particles.radius, walls.lo, walls.hi)
-        result = run_yade_triaxial({
+        settings = {
             "spheres": spheres, "box_lo": walls.lo.tolist(), "box_hi": walls.hi.tolist(),
             "young": config.young, "poisson": config.shear_ratio,
             "friction_deg": config.friction_deg, "density": config.density,
             "damping": config.damping, "dt": dt, "confining": config.confining,
             "strain_rate": rate, "steps": steps, "warmup_steps": warmup,
-            "record_every": steps}, threads=threads)
+            "record_every": steps, "contact": config.contact}
+        if config.contact == "hertz-mindlin":
+            settings.update(poisson=config.poisson, wall_poisson=yade_wall_poisson(config.poisson))
+        result = run_yade_triaxial(settings, threads=threads)
     return result
 
 
@@ -87,6 +102,8 @@ def main(argv=None):
     parser.add_argument("--repeats", type=int, default=1,
                         help="turns of each code, alternately (medians reported)")
     parser.add_argument("--confining", type=float, default=750.0)
+    parser.add_argument("--contacts", default="linear",
+                        help="contact laws, comma separated (linear, hertz-mindlin)")
     parser.add_argument("--no-yade", action="store_true")
     parser.add_argument("--out", default=None, help="JSON file for the results")
     args = parser.parse_args(argv)
@@ -103,46 +120,68 @@ def main(argv=None):
         tiny, _, _ = time_pendular(config, particles, walls, thread_count, args.steps,
                                    args.warmup, force_threads=True)
         fixed[thread_count] = tiny["wall_time_s"] / args.steps
+    contacts = args.contacts.split(",")
     rows = []
     for count in sizes:
-        config, particles, walls, report = sample(count, args.confining)
+        samples = {contact: sample(count, args.confining, contact) for contact in contacts}
         for thread_count in threads:
-            turns = []
+            turns = {contact: [] for contact in contacts}
             for _ in range(args.repeats):
-                ours, dt, rate = time_pendular(config, particles, walls, thread_count,
-                                               args.steps, args.warmup)
-                yade = (time_yade(config, particles, walls, thread_count, args.steps,
-                                  args.warmup, dt, rate) if use_yade else None)
-                turns.append((ours, yade))
-            speeds = [ours["particle_steps_per_s"] for ours, _ in turns]
-            step_time = count / statistics.median(speeds)
-            fixed_cost = fixed.get(ours["threads_used"], fixed[thread_count])
-            row = {"particles": count, "threads": thread_count,
-                   "threads_used": ours["threads_used"],
-                   "pendular": statistics.median(speeds), "pendular_turns": speeds,
-                   "cost_per_particle_step_ns": 1e9 * step_time / count,
-                   "fixed_cost_per_step_us": 1e6 * fixed_cost,
-                   "fixed_cost_share": fixed_cost / step_time,
-                   "dt": dt, "strain_rate": rate, "porosity": report["porosity"]}
-            if use_yade:
-                yade_speeds = [yade["particle_steps_per_s"] for _, yade in turns]
-                ratios = [a / b for a, b in zip(speeds, yade_speeds)]
-                row.update(yade=statistics.median(yade_speeds), yade_turns=yade_speeds,
-                           ratio=statistics.median(ratios), ratio_range=[min(ratios),
-                                                                         max(ratios)])
-            rows.append(row)
-            print(json.dumps(row), flush=True)
-    print(f"\n{'particles':>9} {'threads':>7} {'used':>4} {'pendular [Mps/s]':>17} "
+                for contact in contacts:       # the laws in turn: the same load on each
+                    config, particles, walls, _ = samples[contact]
+                    ours, dt, rate = time_pendular(config, particles, walls, thread_count,
+                                                   args.steps, args.warmup)
+                    yade = (time_yade(config, particles, walls, thread_count, args.steps,
+                                      args.warmup, dt, rate) if use_yade else None)
+                    turns[contact].append((ours, yade, dt, rate))
+            first = None
+            for contact in contacts:
+                report = samples[contact][3]
+                speeds = [ours["particle_steps_per_s"] for ours, _, _, _ in turns[contact]]
+                ours, _, dt, rate = turns[contact][-1]
+                step_time = count / statistics.median(speeds)
+                fixed_cost = fixed.get(ours["threads_used"], fixed[thread_count])
+                row = {"particles": count, "threads": thread_count, "contact": contact,
+                       "threads_used": ours["threads_used"],
+                       "pendular": statistics.median(speeds), "pendular_turns": speeds,
+                       "cost_per_particle_step_ns": 1e9 * step_time / count,
+                       "fixed_cost_per_step_us": 1e6 * fixed_cost,
+                       "fixed_cost_share": fixed_cost / step_time,
+                       "dt": dt, "strain_rate": rate, "porosity": report["porosity"],
+                       "coordination": report.get("coordination")}
+                if use_yade:
+                    yade_speeds = [yade["particle_steps_per_s"] for _, yade, _, _ in
+                                   turns[contact]]
+                    ratios = [a / b for a, b in zip(speeds, yade_speeds)]
+                    row.update(yade=statistics.median(yade_speeds), yade_turns=yade_speeds,
+                               ratio=statistics.median(ratios), ratio_range=[min(ratios),
+                                                                             max(ratios)])
+                if first is None:
+                    first = row
+                else:   # this law's cost per particle-step over the first law's, turn by turn
+                    costs = [a / b for a, b in zip(first["pendular_turns"], speeds)]
+                    row["cost_over_first"] = statistics.median(costs)
+                    row["cost_over_first_turns"] = costs
+                    if use_yade:
+                        row["yade_cost_over_first"] = statistics.median(
+                            [a / b for a, b in zip(first["yade_turns"], row["yade_turns"])])
+                rows.append(row)
+                print(json.dumps(row), flush=True)
+    print(f"\n{'particles':>9} {'contact':>13} {'threads':>7} {'used':>4} {'pendular [Mps/s]':>17} "
           f"{'[ns/particle-step]':>19} {'fixed cost share':>16} {'YADE [Mps/s]':>13} "
-          f"{'ratio':>6} {'ratio range':>12}")
+          f"{'ratio':>6} {'ratio range':>12} {'cost/first':>10} {'YADE cost/first':>15}")
     for row in rows:
         yade = f"{row['yade'] / 1e6:13.2f}" if "yade" in row else f"{'-':>13}"
         ratio = f"{row['ratio']:6.2f}" if "ratio" in row else f"{'-':>6}"
         spread = (f"{row['ratio_range'][0]:5.2f}-{row['ratio_range'][1]:<6.2f}"
                   if "ratio" in row and args.repeats > 1 else "")
-        print(f"{row['particles']:9d} {row['threads']:7d} {row['threads_used']:4d} "
-              f"{row['pendular'] / 1e6:17.2f} {row['cost_per_particle_step_ns']:19.0f} "
-              f"{row['fixed_cost_share']:16.1%} {yade} {ratio} {spread}")
+        over = f"{row['cost_over_first']:10.2f}" if "cost_over_first" in row else f"{'-':>10}"
+        yade_over = (f"{row['yade_cost_over_first']:15.2f}" if "yade_cost_over_first" in row
+                     else f"{'-':>15}")
+        print(f"{row['particles']:9d} {row['contact']:>13} {row['threads']:7d} "
+              f"{row['threads_used']:4d} {row['pendular'] / 1e6:17.2f} "
+              f"{row['cost_per_particle_step_ns']:19.0f} {row['fixed_cost_share']:16.1%} "
+              f"{yade} {ratio} {spread:12} {over} {yade_over}")
     print("fixed cost per step [us] (a " + str(FIXED_COST_SPHERES) + "-sphere scene): "
           + ", ".join(f"{t} thread(s) {1e6 * v:.1f}" for t, v in fixed.items()))
     if args.out:

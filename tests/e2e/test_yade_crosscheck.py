@@ -182,6 +182,52 @@ def test_periodic_pendular_half_against_itself(tmp_path, monkeypatch):
         crosscheck.run_crosscheck(config, tmp_path / "again", packing=walled, progress=False)
 
 
+@requires("yade")
+def test_hertz_mindlin_crosscheck_agrees(tmp_path):
+    """YADE's Ip2_FrictMat_FrictMat_MindlinPhys / Law2_ScGeom_MindlinPhys_Mindlin against
+    pendular's Hertz–Mindlin law on the same packing: the walls' Hertz contacts made alike
+    (yade_wall_poisson), the wall stresses at the start agree to round-off (YADE's own wall
+    contacts, a sphere on a twin sphere, would be 2 sqrt(2) times softer), and the peak
+    within 5 %."""
+    config = crosscheck.crosscheck_config(particles=300, max_strain=0.01, records=30,
+                                          contact="hertz-mindlin", mimic_yade=True)
+    result = crosscheck.run_crosscheck(config, tmp_path, progress=False)
+    check_result(result, 0.01)
+    assert json.loads((tmp_path / "yade_result.json").read_text())["contact"] == "hertz-mindlin"
+    assert result["start_sigma_rel_diff"] < START_TOLERANCE
+    assert abs(result["peak_q_rel_diff"]) < PEAK_TOLERANCE
+
+
+def test_yades_wall_contact_is_made_pendulars_rigid_plane():
+    """Ip2_FrictMat_FrictMat_MindlinPhys's mixing (E* = Ea Eb / ((1 - va^2) Eb + (1 - vb^2) Ea),
+    R* = Ra Rb / (Ra + Rb), a box taking the sphere's radius) with the wall material's
+    Poisson ratio of yade_wall_poisson gives Hertz's coefficient 4/3 E* sqrt(R*) of a sphere on
+    pendular's rigid plane, E / (1 - nu^2) with R* = R."""
+    from pendular.dem.hertz_mindlin import effective_modulus
+
+    for young, poisson, radius in ((1e6, 0.3, 2.4e-5), (7e10, 0.22, 1e-3), (1e9, 0.0, 1e-4)):
+        wall = crosscheck.yade_wall_poisson(poisson)
+        mixed = young * young / ((1.0 - poisson ** 2) * young + (1.0 - wall ** 2) * young)
+        yade = 4.0 / 3.0 * mixed * math.sqrt(radius * radius / (2.0 * radius))
+        rigid = 4.0 / 3.0 * effective_modulus(young, poisson) * math.sqrt(radius)
+        assert yade == pytest.approx(rigid, rel=1e-12)
+
+
+def test_command_refuses_a_wet_or_periodic_hertz_mindlin_crosscheck():
+    from pendular.cli import UsageError, command_parser
+    from pendular.cli.commands.crosscheck import check, config_from
+
+    parser, _ = command_parser("crosscheck")
+    config = config_from(parser.parse_args(["--contact", "hertz-mindlin", "--poisson", "0.25"]))
+    assert (config.sample.contact, config.sample.poisson) == ("hertz-mindlin", 0.25)
+    for extra, flag in ((["--suction", "1e4"], "--suction"), (["--periodic"], "--periodic")):
+        with pytest.raises(UsageError, match=f"{flag} with --contact hertz-mindlin"):
+            check(parser.parse_args(["--contact", "hertz-mindlin", *extra]))
+    with pytest.raises(ValueError, match="contact = 'hertz-mindlin' with bridges"):
+        crosscheck.check_mirrored(crosscheck.crosscheck_config(suction=1e4,
+                                                               contact="hertz-mindlin"))
+
+
 def test_configuration_and_refusals():
     assert crosscheck.mimics_yade(crosscheck.crosscheck_config(mimic_yade=True).shear)
     assert not crosscheck.mimics_yade(crosscheck.crosscheck_config().shear)

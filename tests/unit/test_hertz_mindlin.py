@@ -329,3 +329,53 @@ def test_the_per_pair_normal_force_is_the_springs_whatever_the_damping(law):
         _, _, overlaps, normal_force, force = arrays
         assert normal_force[0] / overlaps[0] == pytest.approx(stiffness, rel=1e-9)
         assert (force[0, 0] > normal_force[0]) == (speed < 0.0)     # the dashpot's sign
+
+
+@pytest.mark.parametrize("law", [HertzMindlinForces(1e6, 0.3), HertzMindlinForces(1e6, 0.3, 0.4),
+                                 DampedLinearForces(1e6, 0.3, 0.4)])
+def test_the_one_thread_kernels_give_the_parallel_kernels_forces_bit_for_bit(law):
+    """Row by row (serial_viscoelastic_pair_forces) and scattered to the particles as the
+    pairs are evaluated (scattered_viscoelastic_pair_forces): the per-pair arrays and the
+    particles' sums of viscoelastic_pair_forces and the gather, step after step."""
+    from pendular.dem.contact_law import gather_contact_forces
+    from pendular.dem.hertz_mindlin import (scattered_viscoelastic_pair_forces,
+        serial_viscoelastic_pair_forces)
+
+    rng = np.random.default_rng(7)
+    count, radius = 200, 1e-3
+    position = rng.random((count, 3)) * 0.012
+    radii = np.full(count, radius) * rng.uniform(0.8, 1.2, count)
+    contacts = build_contacts(position, radii, 1e-4)
+    velocity = rng.normal(size=(count, 3)) * 1e-2
+    spin = rng.normal(size=(count, 3))
+    mass = 2650.0 * 4.0 / 3.0 * math.pi * radii ** 3
+    pairs = len(contacts.pair_i)
+    runs = {name: [np.zeros((pairs, 3)), np.zeros((pairs, 3)), np.zeros(pairs), np.zeros(pairs),
+                   np.zeros((pairs, 3))] for name in ("parallel", "serial", "scattered")}
+    sums = {name: (np.zeros((count, 3)), np.zeros((count, 3))) for name in ("parallel",
+                                                                            "scattered")}
+    material = (law.hertz, law.modulus, law.tangential, law.damping, law._tan_friction, 1e-6)
+    box = (contacts.image, np.zeros(3), np.zeros(3))
+    kinematics = (position, velocity, spin, radii, mass)
+    for _ in range(5):
+        for force, torque in sums.values():
+            force[:] = 0.0
+            torque[:] = 0.0
+        viscoelastic_pair_forces(*kinematics, contacts.pair_i, contacts.pair_j, *box,
+                                 *runs["parallel"], *material)
+        gather_contact_forces(runs["parallel"][4], None, runs["parallel"][1],
+                              runs["parallel"][2], radii, contacts.row_start,
+                              contacts.second_start, contacts.second_pair, *sums["parallel"])
+        serial_viscoelastic_pair_forces(*kinematics, contacts.row_start, contacts.pair_j,
+                                        *box, *runs["serial"], *material, 4)
+        scattered_viscoelastic_pair_forces(*kinematics, contacts.row_start, contacts.pair_j,
+                                           *box, *runs["scattered"], *material, 0,
+                                           *sums["scattered"])
+        position += velocity * 1e-6
+    assert np.count_nonzero(runs["parallel"][3]) > 50
+    for name in ("serial", "scattered"):
+        for got, want in zip(runs[name], runs["parallel"]):
+            np.testing.assert_array_equal(got, want)
+    for got, want in zip(sums["scattered"], sums["parallel"]):
+        np.testing.assert_array_equal(got, want)
+    assert np.abs(sums["parallel"][1]).max() > 0.0

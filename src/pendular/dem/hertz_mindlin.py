@@ -37,6 +37,10 @@ resistance's k_n, pendular.dem.rolling; a periodic cell's servo stiffness) thus 
 spring's secant stiffness, 2/3 of Hertz's tangent kn or the linear kn, at any damping, not a
 stiffness that swings with the normal velocity (above kn while the contact closes, 0 where
 the dashpot cancels the spring).
+
+On one thread the pairs are evaluated row by row and, unless a later force joins the gather,
+their forces scattered to the particles as they are evaluated: the linear law's one-thread
+scheme (pendular.dem.contact_law), the same sums in the same order as the gather's.
 """
 
 import math
@@ -45,8 +49,10 @@ import numba
 import numpy as np
 
 from pendular.dem import HOT_KERNEL_FASTMATH
-from pendular.dem.contact_law import (ContactForces, _contact_gap, _first_member, _stretched,
+from pendular.dem.contact_law import (ContactForces, _contact_gap, _first_member,
+    _prefetch_second, _row_sums, _scatter_to_both, _store_row_sums, _stretched,
     _turned_contact, normal_stiffness, wall_contact_stiffness)
+from pendular.dem.prefetch import prefetch_distance
 from pendular.dem.protocols import state_array
 from pendular.dem.restitution import damping_ratio
 from pendular.utils.validate import check_positive, check_range
@@ -107,11 +113,14 @@ def _damped_forces(fe, kn, kt, mass_star, damping, un, t0, t1, t2, s0, s1, s2, t
     (turned with the contact): Fn = max(0, fe - 2 gamma sqrt(m* kn) un); spring s - kt t dt;
     tangential force spring - 2 gamma sqrt(m* kt) t, capped at Fn tan(phi), a sliding
     contact's spring set to the capped force."""
-    fn = max(fe - 2.0 * damping * math.sqrt(mass_star * kn) * un, 0.0)
+    # undamped (the default), the dashpots are exact zeros without their square roots
+    normal_dashpot = 2.0 * damping * math.sqrt(mass_star * kn) if damping != 0.0 else 0.0
+    fn = max(fe - normal_dashpot * un, 0.0)
     s0 -= kt * t0 * dt
     s1 -= kt * t1 * dt
     s2 -= kt * t2 * dt
-    dashpot = 2.0 * damping * math.sqrt(TANGENTIAL_MASS * mass_star * kt)
+    dashpot = (2.0 * damping * math.sqrt(TANGENTIAL_MASS * mass_star * kt) if damping != 0.0
+               else 0.0)
     f0 = s0 - dashpot * t0
     f1 = s1 - dashpot * t1
     f2 = s2 - dashpot * t2
@@ -133,12 +142,13 @@ def _evaluate_damped_pair(k, first, mass_i, j, position, velocity, angular_veloc
                           damping, tan_friction, dt):
     """Pair k of first member ``first`` (pendular.dem.contact_law._first_member) of mass
     ``mass_i`` [kg] and second member j, fill its per-pair arrays (module docstring); the
-    arguments as viscoelastic_pair_forces'."""
+    arguments as viscoelastic_pair_forces'. Returns as pendular.dem.contact_law._evaluate_pair:
+    (touching, the force on j from i [N], the normal, the overlap [m])."""
     d0, d1, d2, distance, gap_overlap = _contact_gap(k, first, j, position, radius, image,
                                                      period, periodic, overlap, shear_force,
                                                      normal_force, force)
     if gap_overlap <= 0.0:
-        return
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, gap_overlap
     n0, n1, n2, s0, s1, s2, v0, v1, v2 = _turned_contact(
         k, first, j, d0, d1, d2, distance, velocity, angular_velocity, radius, affine_rate,
         stretched, shear_force, normal, dt)
@@ -158,9 +168,13 @@ def _evaluate_damped_pair(k, first, mass_i, j, position, velocity, angular_veloc
     normal[k, 1] = n1
     normal[k, 2] = n2
     normal_force[k] = fe            # the spring's: F_n / delta is its secant stiffness
-    force[k, 0] = fn * n0 + f0
-    force[k, 1] = fn * n1 + f1
-    force[k, 2] = fn * n2 + f2
+    a0 = fn * n0 + f0
+    a1 = fn * n1 + f1
+    a2 = fn * n2 + f2
+    force[k, 0] = a0
+    force[k, 1] = a1
+    force[k, 2] = a2
+    return True, a0, a1, a2, n0, n1, n2, gap_overlap
 
 
 @numba.njit(cache=True, parallel=True, fastmath=HOT_KERNEL_FASTMATH)
@@ -182,6 +196,62 @@ def viscoelastic_pair_forces(position, velocity, angular_velocity, radius, mass,
                               mass, image, period, periodic, affine_rate, stretched,
                               shear_force, normal, overlap, normal_force, force, hertz, modulus,
                               tangential, damping, tan_friction, dt)
+
+
+@numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
+def serial_viscoelastic_pair_forces(position, velocity, angular_velocity, radius, mass,
+                                    row_start, pair_j, image, period, affine_rate, shear_force,
+                                    normal, overlap, normal_force, force, hertz, modulus,
+                                    tangential, damping, tan_friction, dt, prefetch_ahead):
+    """viscoelastic_pair_forces on one thread, row by row (particle i's state read once for
+    its row), without the parallel launch and reference counting (the same results; the
+    pairs' rows from ``row_start``; ``prefetch_ahead`` as pendular.dem.contact_law.
+    pair_forces')."""
+    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+    stretched = _stretched(affine_rate)
+    for i in range(len(row_start) - 1):
+        first = _first_member(i, position, velocity, angular_velocity, radius)
+        for k in range(row_start[i], row_start[i + 1]):
+            _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity),
+                             radius)
+            _evaluate_damped_pair(k, first, mass[i], pair_j[k], position, velocity,
+                                  angular_velocity, radius, mass, image, period, periodic,
+                                  affine_rate, stretched, shear_force, normal, overlap,
+                                  normal_force, force, hertz, modulus, tangential, damping,
+                                  tan_friction, dt)
+
+
+@numba.njit(cache=True, fastmath=HOT_KERNEL_FASTMATH, _nrt=False)
+def scattered_viscoelastic_pair_forces(position, velocity, angular_velocity, radius, mass,
+                                       row_start, pair_j, image, period, affine_rate,
+                                       shear_force, normal, overlap, normal_force, force, hertz,
+                                       modulus, tangential, damping, tan_friction, dt,
+                                       prefetch_ahead, particle_force, particle_torque):
+    """serial_viscoelastic_pair_forces with each touching pair's force and torques added to
+    its particles' ``particle_force`` [N] and ``particle_torque`` [N m] as it is evaluated: the
+    sums of the gather in its order, in one pass over the rows (pendular.dem.contact_law.
+    scattered_pair_forces)."""
+    periodic = period[0] != 0.0 or period[1] != 0.0 or period[2] != 0.0
+    stretched = _stretched(affine_rate)
+    for i in range(len(row_start) - 1):
+        start = row_start[i]
+        stop = row_start[i + 1]
+        if start == stop:
+            continue
+        first = _first_member(i, position, velocity, angular_velocity, radius)
+        sums = _row_sums(i, particle_force, particle_torque)
+        for k in range(start, stop):
+            _prefetch_second(k, pair_j, prefetch_ahead, (position, velocity, angular_velocity,
+                                                         particle_force, particle_torque), radius)
+            j = pair_j[k]
+            touching, a0, a1, a2, n0, n1, n2, overlap_k = _evaluate_damped_pair(
+                k, first, mass[i], j, position, velocity, angular_velocity, radius, mass, image,
+                period, periodic, affine_rate, stretched, shear_force, normal, overlap,
+                normal_force, force, hertz, modulus, tangential, damping, tan_friction, dt)
+            if touching:
+                sums = _scatter_to_both(sums, j, a0, a1, a2, a0, a1, a2, n0, n1, n2, overlap_k,
+                                        first[9], radius, particle_force, particle_torque)
+        _store_row_sums(i, sums, particle_force, particle_torque)
 
 
 @numba.njit(cache=True, inline="always")
@@ -278,17 +348,28 @@ class _DampedContactForces(ContactForces):
 
     def apply(self, sim):
         """This step's pair forces, gathered onto the particles unless a later force
-        operation joins the gather (ContactForces.joined_by)."""
+        operation joins the gather (ContactForces.joined_by); on one thread, as the linear
+        law's (ContactForces.apply), row by row and scattered to the particles as they are
+        evaluated (the same sums)."""
         p = sim.particles
         c = sim.contacts
         box = sim.walls
-        viscoelastic_pair_forces(p.position, p.velocity, p.angular_velocity, p.radius, p.mass,
-                                 c.pair_i, c.pair_j, c.image, box.period, box.affine_rate,
-                                 c.shear_force, c.normal, c.overlap, c.normal_force, c.force,
-                                 self.hertz, self.modulus, self.tangential, self.damping,
-                                 self._tan_friction, sim.dt)
-        if self.joined_by(sim) is None:
-            self.gather(sim)
+        per_pair = (c.image, box.period, box.affine_rate, c.shear_force, c.normal, c.overlap,
+                    c.normal_force, c.force, self.hertz, self.modulus, self.tangential,
+                    self.damping, self._tan_friction, sim.dt)
+        kinematics = (p.position, p.velocity, p.angular_velocity, p.radius, p.mass)
+        joined = self.joined_by(sim) is not None
+        if numba.get_num_threads() > 1:
+            viscoelastic_pair_forces(*kinematics, c.pair_i, c.pair_j, *per_pair)
+            if not joined:
+                self.gather(sim)
+        elif joined:
+            serial_viscoelastic_pair_forces(*kinematics, c.row_start, c.pair_j, *per_pair,
+                                            prefetch_distance(len(c)))
+        else:
+            scattered_viscoelastic_pair_forces(*kinematics, c.row_start, c.pair_j, *per_pair,
+                                               prefetch_distance(len(c)), p.force, p.torque)
+            self._add_face_terms(sim, None)
 
 
 class HertzMindlinForces(_DampedContactForces):

@@ -30,6 +30,11 @@
    reaches ``config.shear.max_strain``. Periodic: YADE drives the cell with PeriTriaxController
    (x, y stress goals, z at the true strain rate), its stress evaluated every step and its
    servo given pendular's gain (``cell_grow_damping``); pendular with its cell servo.
+   The contact law is ``config.sample.contact``'s: the linear law against YADE's
+   Ip2_FrictMat_FrictMat_FrictPhys / Law2_ScGeom_FrictPhys_CundallStrack, or (dry, six walls,
+   undamped) Hertz–Mindlin against Ip2_FrictMat_FrictMat_MindlinPhys /
+   Law2_ScGeom_MindlinPhys_Mindlin, YADE's wall contacts made pendular's rigid plane
+   (``yade_wall_poisson``).
 
 Writes DIR/crosscheck.json: ``pendular`` and ``yade`` summaries (peak q, p, axial and volumetric
 strain, Sr, bridges / menisci and porosity at the peak of q, the same at the start of the shear,
@@ -46,6 +51,7 @@ both codes); DIR/yade_history.txt and DIR/pendular_history.h5. Stresses compress
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import shutil
 import time
@@ -103,7 +109,7 @@ def crosscheck_config(particles=PARTICLES, suction=0.0,
                       confining=default_of(PrepareConfig, "confining"),
                       max_strain=default_of(ShearConfig, "max_strain"), records=RECORDS,
                       mimic_yade=False, settle_steps=SETTLE_STEPS, seed=0, periodic=False,
-                      **sizes):
+                      contact="linear", poisson=default_of(PrepareConfig, "poisson"), **sizes):
     """The TriaxialConfig of a cross-check: the thesis-default sample (Table 5.2) of
     ``particles`` spheres at ``confining`` [Pa] from ``seed``, of the ``sizes`` given
     (PrepareConfig's radius, radius_spread, psd), in a periodic cell if ``periodic`` (YADE:
@@ -112,10 +118,11 @@ def crosscheck_config(particles=PARTICLES, suction=0.0,
     angle 0);
     the shear to ``max_strain`` with ``records`` rows, with YADE's wall-control choices if
     ``mimic_yade``; at most ``settle_steps`` steps (wet_steps) to bring the (wetted) sample to
-    rest before the export."""
+    rest before the export; ``contact`` the contact law ("linear" against YADE's FrictPhys,
+    "hertz-mindlin" of Poisson ratio ``poisson`` against its MindlinPhys)."""
     return TriaxialConfig(
         sample=PrepareConfig(particles=particles, confining=confining, seed=seed,
-                             periodic=periodic, **sizes),
+                             periodic=periodic, contact=contact, poisson=poisson, **sizes),
         shear=ShearConfig(max_strain=max_strain, records=records,
                           **(YADE_CHOICES if mimic_yade else {})),
         bridges=BridgeConfig(suction) if suction else None,
@@ -136,6 +143,12 @@ OPTIONS = (option_of(PrepareConfig, "particles", default=PARTICLES, low=MIN_SAMP
            option_of(PrepareConfig, "periodic",
                      help="a periodic cell instead of six walls: pendular's cell servo against "
                           "YADE's PeriTriaxController"),
+           option_of(PrepareConfig, "contact",
+                     help="contact law: linear springs (YADE's Ip2_FrictMat_FrictMat_FrictPhys, "
+                          "Law2_ScGeom_FrictPhys_CundallStrack) or Hertz-Mindlin (YADE's "
+                          "Ip2_FrictMat_FrictMat_MindlinPhys, Law2_ScGeom_MindlinPhys_Mindlin); "
+                          "six walls, dry"),
+           option_of(PrepareConfig, "poisson"),
            Option("mimic_yade", "pendular takes YADE's wall-control choices "
                                 "(pendular.procedures.config.YADE_CHOICES)",
                   default=False, kind=bool),
@@ -163,11 +176,18 @@ def crosscheck_from_options(values):
                                        "YADE's PeriTriaxController servoes the stress of the "
                                        "contact forces alone (without the capillary forces); "
                                        f"valid: 0 with {name('periodic')}")
+    contact = values["contact"]
+    if contact == "hertz-mindlin" and (suction > 0.0 or values["periodic"]):
+        what = "suction" if suction > 0.0 else "periodic"
+        raise OptionError(lambda name: f"{name(what)} with {name('contact')} hertz-mindlin: the "
+                                       "Hertz-Mindlin cross-check is dry, in six walls; valid: "
+                                       f"{name('contact')} linear, or a dry walled test")
     return crosscheck_config(particles=values["particles"], suction=suction,
                              confining=values["confining"], max_strain=values["max_strain"],
                              records=values["records"], mimic_yade=values["mimic_yade"],
                              settle_steps=max(values["settle_steps"], 1), seed=values["seed"],
-                             periodic=values["periodic"], **sample_sizes(values))
+                             periodic=values["periodic"], contact=contact,
+                             poisson=values["poisson"], **sample_sizes(values))
 
 
 def mimics_yade(shear):
@@ -185,6 +205,15 @@ def check_mirrored(config):
     if not config.confining > 0.0:
         raise ValueError(f"confining = {config.confining:g} Pa is outside the valid range "
                          "(0, inf)")
+    sample = config.sample
+    if sample.contact == "hertz-mindlin" and (config.bridges is not None or sample.periodic):
+        raise ValueError("contact = 'hertz-mindlin' with "
+                         f"{'bridges' if config.bridges is not None else 'a periodic cell'}: "
+                         "the Hertz-Mindlin cross-check is dry, in six walls; valid: contact "
+                         "'linear', or a dry walled test")
+    if sample.contact == "hertz-mindlin" and sample.restitution != 1.0:
+        raise ValueError(f"restitution = {sample.restitution:g} with contact 'hertz-mindlin': "
+                         "the cross-check mirrors YADE's undamped MindlinPhys; valid: 1")
     bridges = config.bridges
     if bridges is None:
         return
@@ -295,6 +324,17 @@ def cell_grow_damping(sim, gain, sample):
     return float(1.0 - gain * np.mean(mean_stiffness / (sim.walls.stiffness[:2] * area)))
 
 
+def yade_wall_poisson(poisson):
+    """The Poisson ratio [-] of YADE's wall material that gives its Hertz wall contacts
+    pendular's, a sphere on a rigid plane of E* = E / (1 - nu^2), R* = R
+    (pendular.dem.hertz_mindlin). Ig2_Box_Sphere_ScGeom gives the wall the sphere's radius,
+    so YADE's R* is R / 2, and Ip2_FrictMat_FrictMat_MindlinPhys mixes E* = E_a E_b /
+    ((1 - nu_a^2) E_b + (1 - nu_b^2) E_a): of the wall's E = E_a and this nu_b,
+    E* sqrt(R / 2) = E / (1 - nu^2) sqrt(R). Above 1, no real material's: only that formula
+    reads it (the walls are frictionless, so their shear stiffness never acts)."""
+    return math.sqrt(1.0 + (1.0 - poisson ** 2) * (1.0 - 1.0 / math.sqrt(2.0)))
+
+
 def yade_settings(config, packing, sim, shear, folder):
     """The YADE driver's configuration for the same shear (pendular/interop/yade/scripts/triaxial.py)."""
     sample = config.sample
@@ -312,7 +352,11 @@ def yade_settings(config, packing, sim, shear, folder):
         "stress_damping": 1.0 - lateral.gain, "strain_damping": 0.0,
         "max_vel": lateral.max_velocity,
         "history": os.path.join(folder, "yade_history.txt"),
-        "output": os.path.join(folder, "yade_result.json")}
+        "output": os.path.join(folder, "yade_result.json"),
+        "contact": sample.contact}
+    if sample.contact == "hertz-mindlin":
+        settings["poisson"] = sample.poisson
+        settings["wall_poisson"] = yade_wall_poisson(sample.poisson)
     if sample.periodic:
         # PeriTriaxController's stress and stiffness from the contacts every step: between
         # evaluations it predicts the stress by a formula whose units do not balance, which at

@@ -12,7 +12,8 @@
 #   spheres       sphere file, yade.export.textExt 'x_y_z_r' layout (dem.yade_io.write_spheres)
 #   box_lo/box_hi inner faces of the six walls [m] (default: the '# box_lo ... box_hi ...' line)
 #   young         FrictMat.young E [Pa]: kn = 2 E R1 R2 / (R1 + R2), E R against a wall
-#   poisson       FrictMat.poisson, read by Ip2_FrictMat_FrictMat_FrictPhys as ks / kn (0.3)
+#   poisson       FrictMat.poisson, read by Ip2_FrictMat_FrictMat_FrictPhys as ks / kn (0.3);
+#                 with contact "hertz-mindlin" the grains' Poisson ratio
 #   friction_deg  sphere friction angle (walls: 0, frictionless)
 #   density       [kg/m^3];  damping: NewtonIntegrator.damping (Cundall local damping)
 #   dt            fixed time step [s]
@@ -24,6 +25,13 @@
 #   stress_damping 0.25 (TriaxialStressController.stressDamping, YADE's default),
 #   strain_damping 0.0 (TriaxialStressController.strainDamping; YADE's default 0.99 ramps the
 #   axial rate up geometrically, 0 imposes it at once as pendular does),
+#   contact "linear" (Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack) or
+#   "hertz-mindlin" (Ip2_FrictMat_FrictMat_MindlinPhys, Law2_ScGeom_MindlinPhys_Mindlin: Hertz
+#   normal force 4/3 E* sqrt(R*) delta^1.5, shear stiffness 4 G sqrt(R* delta) / (2 - nu),
+#   undamped; dry, six walls only),
+#   wall_poisson (the walls' FrictMat.poisson; default poisson: with Hertz-Mindlin the value
+#   that makes YADE's wall contact pendular's rigid plane,
+#   pendular.studies.crosscheck.yade_wall_poisson),
 #   max_vel 1.0 m/s (TriaxialStressController.max_vel, YADE's default; YADE scales it per axis
 #   by 3 L_a / (L_x + L_y + L_z)), stiffness_update_interval 10
 #   (TriaxialStressController.stiffnessUpdateInterval, YADE's default; the wall stiffness is
@@ -48,7 +56,7 @@
 #
 # Engine list, one step (YADE order, as pendular's shear phase):
 #   ForceResetter -> InsertionSortCollider -> InteractionLoop(Ig2 sphere-sphere & box-sphere ScGeom,
-#   Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack)
+#   Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack, or the Mindlin pair)
 #   [-> Law2_ScGeom_CapillaryPhys_Capillarity (wet test)]
 #   -> TriaxialStressController (x, y servoed at -confining, z at strain rate -strain_rate)
 #   -> NewtonIntegrator(damping) [-> PyRunner recording the history]
@@ -83,7 +91,8 @@ from yade import O, plot, utils, ymport
 from yade import (Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
                   Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop,
                   Ip2_FrictMat_FrictMat_CapillaryPhys, Ip2_FrictMat_FrictMat_FrictPhys,
-                  Law2_ScGeom_CapillaryPhys_Capillarity, Law2_ScGeom_FrictPhys_CundallStrack,
+                  Ip2_FrictMat_FrictMat_MindlinPhys, Law2_ScGeom_CapillaryPhys_Capillarity,
+                  Law2_ScGeom_FrictPhys_CundallStrack, Law2_ScGeom_MindlinPhys_Mindlin,
                   NewtonIntegrator, PeriTriaxController, PyRunner, TriaxialStressController)
 import yade.config
 
@@ -111,6 +120,11 @@ def load_config(path):
         fail(f"damping = {config['damping']!r} must lie in [0, 1)")
     if config["confining"] < 0:
         fail(f"confining = {config['confining']!r} Pa must be >= 0")
+    contact = config.setdefault("contact", "linear")
+    if contact not in ("linear", "hertz-mindlin"):
+        fail(f"contact = {contact!r} must be 'linear' or 'hertz-mindlin'")
+    if contact == "hertz-mindlin" and (config.get("capillary") or config.get("periodic")):
+        fail("contact 'hertz-mindlin' is dry, in six walls (no capillary, not periodic)")
     return config
 
 
@@ -164,7 +178,8 @@ def build_scene(config):
     # kn_wall = E R (docs/physics.md 'The contact law'); friction angle 0 makes the walls
     # frictionless (Ip2 takes the min).
     wall_mat = O.materials.append(FrictMat(
-        young=E, poisson=float(config["poisson"]), density=float(config["density"]),
+        young=E, poisson=float(config.get("wall_poisson", config["poisson"])),
+        density=float(config["density"]),
         frictionAngle=0.0, label="walls"))
 
     if config.get("periodic"):
@@ -266,12 +281,14 @@ def main(config_path):
             NewtonIntegrator(damping=float(config["damping"])),
         ]
     else:
+        if config["contact"] == "hertz-mindlin":   # undamped: betan = betas = 0, en, es unset
+            physics, law = Ip2_FrictMat_FrictMat_MindlinPhys(), Law2_ScGeom_MindlinPhys_Mindlin()
+        else:
+            physics, law = Ip2_FrictMat_FrictMat_FrictPhys(), Law2_ScGeom_FrictPhys_CundallStrack()
         O.engines = [
             ForceResetter(),
             InsertionSortCollider([Bo1_Sphere_Aabb()] + box_bound, verletDist=0.5 * skin),
-            InteractionLoop([Ig2_Sphere_Sphere_ScGeom()] + box_geometry,
-                            [Ip2_FrictMat_FrictMat_FrictPhys()],
-                            [Law2_ScGeom_FrictPhys_CundallStrack()]),
+            InteractionLoop([Ig2_Sphere_Sphere_ScGeom()] + box_geometry, [physics], [law]),
             triax,
             NewtonIntegrator(damping=float(config["damping"])),
         ]
@@ -354,6 +371,7 @@ def main(config_path):
         "time": O.time,
         "dt": O.dt,
         "verlet_dist": 0.5 * skin,
+        "contact": config["contact"],
         **controller_settings(triax, periodic),
         "engines": [type(e).__name__ for e in O.engines],
     }
