@@ -347,9 +347,9 @@ def build_stages(entries, source, *, confining, rate, sample=None, wetting=None)
     """The loading.Stage list of a table's ``entries`` (read_table), groups repeated;
     ``confining`` [Pa] and ``rate`` [1/s] are the values of the names 'confining' and
     'quasi-static'; with ``sample`` (a PrepareConfig), every stress is checked against its
-    contacts (preparation.check_soft_contacts); with ``wetting`` (WETTINGS: how the sample is wetted),
-    every stage's water keys against it (check_water). ValueError naming ``source`` and the
-    entry."""
+    contacts (preparation.check_soft_contacts); with ``wetting`` (WETTINGS: how the sample
+    is wetted), every stage's water keys against it (check_water). ValueError naming
+    ``source`` and the entry."""
     return [stage for _, stage in labelled_stages(entries, source, confining=confining,
                                                   rate=rate, sample=sample, wetting=wetting)]
 
