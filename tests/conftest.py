@@ -142,10 +142,13 @@ def small_sample():
 
 
 def pytest_collection_modifyitems(items):
-    """Mark the end-to-end tests ``slow``."""
+    """Mark the end-to-end tests ``slow``, and put the GPU tests first: each module of them
+    waits on one long process under the simulator, which pytest-xdist (whole files, in this
+    order) then starts while the other workers take the shorter files, instead of last."""
     for item in items:
         if f"{os.sep}e2e{os.sep}" in str(item.path):
             item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: f"{os.sep}gpu{os.sep}" not in str(item.path))
 
 
 class SpringEnergyProbe:
