@@ -10,7 +10,8 @@ import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
 from pendular.dem.contact_law import pair_forces
-from pendular.dem.neighbors import ROW_CAPACITY, build_contacts, near_wall_particles, spatial_order
+from pendular.dem.cell_list import ROW_CAPACITY, spatial_order
+from pendular.dem.neighbors import build_contacts, near_wall_particles
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo

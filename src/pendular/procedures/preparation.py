@@ -36,7 +36,8 @@ from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinea
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
-from pendular.dem.neighbors import NeighborList, spatial_order
+from pendular.dem.cell_list import spatial_order
+from pendular.dem.neighbors import NeighborList
 from pendular.dem.rolling import MAX_RESISTANCE, RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls

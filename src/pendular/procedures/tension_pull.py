@@ -20,7 +20,8 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pendular.capillary.bridges import CapillaryBridges, sample_radius_ratios
+from pendular.capillary.bridges import CapillaryBridges
+from pendular.capillary.radius_ratios import sample_radius_ratios
 from pendular.capillary.table import BridgeTable
 from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import gravimetric_water_content
