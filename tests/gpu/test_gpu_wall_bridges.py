@@ -18,12 +18,13 @@ QUANTITIES = ("velocity", "angular_velocity", "force", "torque", "springs", "wal
 
 @pytest.fixture(scope="module")
 def measured():
-    return simulated("wall_bridges_checks.py", "agreement", "refusal")
+    return simulated("wall_bridges_checks.py", "agreement", "persist", "refusal")
 
 
+@pytest.mark.parametrize("name", ["agreement", "persist"])
 @pytest.mark.parametrize("case", ["agreement", "handed_over"])
-def test_the_wall_bridges_on_the_gpu_agree_with_the_cpu_to_round_off(measured, case):
-    agreement = measured["agreement"][case]
+def test_the_wall_bridges_on_the_gpu_agree_with_the_cpu_to_round_off(measured, name, case):
+    agreement = measured[name][case]
     cpu, gpu = agreement["wall_bridges"]
     assert cpu == gpu > 5
     assert agreement["bridges_exists"] == 0.0

@@ -1,7 +1,7 @@
 """Sphere–wall bridges (pendular.gpu.wall_bridges) on the GPU against the CPU, the checks of
 tests/gpu/test_gpu_wall_bridges.py run under Numba's CUDA simulator in a process of their own
-(``NUMBA_ENABLE_CUDASIM=1 python wall_bridges_checks.py agreement refusal`` prints one JSON
-object of measurements, simulator.run_checks):
+(``NUMBA_ENABLE_CUDASIM=1 python wall_bridges_checks.py agreement persist refusal`` prints
+one JSON object of measurements, simulator.run_checks):
 
 - "agreement": the 27-sphere scene of simulated.py (a triaxial's shear in miniature) wet,
   its suction-controlled bridges at contact with sphere–wall bridges, over STEPS: the plain
@@ -16,13 +16,15 @@ from simulator import run_checks
 STEPS = 200
 
 
-def scene(wall_bridges=True):
-    """simulated.py's wet scene, its bridges with sphere–wall bridges."""
+def scene(wall_bridges=True, persist=False):
+    """simulated.py's wet scene, its bridges with sphere–wall bridges (``persist``: across
+    gaps)."""
     from pendular.capillary.bridges import CapillaryBridges
     from simulated import scene as plain
 
     sim = plain(wet=True)
-    sim.forces[-1] = CapillaryBridges(30000.0, wall_bridges=wall_bridges)
+    sim.forces[-1] = CapillaryBridges(30000.0, persist=persist,
+                                     wall_bridges=wall_bridges)
     return sim
 
 
@@ -49,26 +51,28 @@ def compare(cpu, gpu):
     return out
 
 
-def agreement():
+def agreement(persist=False):
     """The scene on both devices (module docstring)."""
     from pendular.gpu import GpuSimulation
     from simulated import compare as plain_compare, snapshot as plain_snapshot
 
-    cpu = scene()
+    cpu = scene(persist=persist)
     cpu.run(STEPS)
-    gpu = GpuSimulation(scene())
+    gpu = GpuSimulation(scene(persist=persist))
     gpu.run(STEPS)
     gpu.to_host()
-    handed = scene()
+    handed = scene(persist=persist)
     handed.run(STEPS // 2)
     handed_gpu = GpuSimulation(handed)
     handed_gpu.run(STEPS - STEPS // 2)
     handed_gpu.to_host()
-    without = scene(wall_bridges=False)
-    without.run(STEPS)
-    return {"agreement": compare(snapshot(cpu), snapshot(gpu.sim)),
-            "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim)),
-            "without": plain_compare(plain_snapshot(cpu), plain_snapshot(without))}
+    out = {"agreement": compare(snapshot(cpu), snapshot(gpu.sim)),
+           "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim))}
+    if not persist:
+        without = scene(wall_bridges=False)
+        without.run(STEPS)
+        out["without"] = plain_compare(plain_snapshot(cpu), plain_snapshot(without))
+    return out
 
 
 def refusal():
@@ -86,4 +90,5 @@ def refusal():
 
 
 if __name__ == "__main__":
-    run_checks({"agreement": agreement, "refusal": refusal})
+    run_checks({"agreement": agreement, "persist": lambda: agreement(persist=True),
+                "refusal": refusal})
