@@ -18,7 +18,8 @@ QUANTITIES = ("velocity", "angular_velocity", "force", "torque", "springs", "wal
 
 @pytest.fixture(scope="module")
 def measured():
-    return simulated("wall_bridges_checks.py", "agreement", "persist", "refusal")
+    return simulated("wall_bridges_checks.py", "agreement", "persist", "refusal",
+                     "order")
 
 
 @pytest.mark.parametrize("name", ["agreement", "persist"])
@@ -42,3 +43,7 @@ def test_the_wall_bridges_matter(measured):
 def test_wall_bridges_while_radii_grow_are_refused_by_name(measured):
     assert "does not run sphere-wall bridges" in (measured["refusal"] or "")
     assert "RadiusGrowth" in measured["refusal"]
+
+
+def test_wall_bridges_listed_before_the_wall_forces_are_refused_by_name(measured):
+    assert "listed after the wall forces only" in (measured["order"] or "")

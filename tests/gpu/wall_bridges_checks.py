@@ -1,14 +1,18 @@
 """Sphere–wall bridges (pendular.gpu.wall_bridges) on the GPU against the CPU, the checks of
 tests/gpu/test_gpu_wall_bridges.py run under Numba's CUDA simulator in a process of their own
-(``NUMBA_ENABLE_CUDASIM=1 python wall_bridges_checks.py agreement persist refusal`` prints
-one JSON object of measurements, simulator.run_checks):
+(``NUMBA_ENABLE_CUDASIM=1 python wall_bridges_checks.py agreement persist refusal order``
+prints one JSON object of measurements, simulator.run_checks):
 
 - "agreement": the 27-sphere scene of simulated.py (a triaxial's shear in miniature) wet,
   its suction-controlled bridges at contact with sphere–wall bridges, over STEPS: the plain
   run, one handed from the CPU to the device halfway (the wall bridges' state goes up and
   comes back), and the CPU's run without wall bridges (what the comparison would miss);
+- "persist": the same with bridges that persist across gaps (``persist``: a wall bridge lives
+  on from step to step, and its state goes up to the device when handed over);
 - "refusal": the same scene with a radius growth (the wall bridges' table is checked for the
-  radii once a run).
+  radii once a run);
+- "order": the same scene, its bridges listed before the wall forces (whose sums on the CPU
+  then overwrite the pulls).
 """
 
 from simulator import run_checks
@@ -89,6 +93,19 @@ def refusal():
     return None
 
 
+def order():
+    """The error of the scene with its bridges listed before the wall forces."""
+    from pendular.gpu import GpuSimulation
+
+    reordered = scene()
+    reordered.forces.insert(1, reordered.forces.pop())
+    try:
+        GpuSimulation(reordered)
+    except ValueError as error:
+        return str(error)
+    return None
+
+
 if __name__ == "__main__":
     run_checks({"agreement": agreement, "persist": lambda: agreement(persist=True),
-                "refusal": refusal})
+                "refusal": refusal, "order": order})

@@ -82,11 +82,16 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
         """Bridges across gaps (``persist``) run listed after the contact law and the wall
         forces (the device adds their forces last, as the CPU's gather_pair_forces after
         both), with radii that do not grow; sphere–wall bridges (``walls``) inside walls,
-        with radii that do not grow (their table is checked for the radii at each run)."""
+        listed after the wall forces (the CPU's pulls enter the walls' sums the wall forces
+        have set), with radii that do not grow (their table is checked for the radii at each
+        run)."""
         if self.walls is not None:
             if scene.periodic:
                 raise ValueError("device='gpu' runs sphere-wall bridges (--wall-bridges) "
                                  "inside walls only, not in a periodic cell")
+            if scene.index(self) < scene.index(scene.force("walls", required=True)):
+                raise ValueError("device='gpu' runs sphere-wall bridges (--wall-bridges) "
+                                 "listed after the wall forces only")
             if any(side.grows_radii for side in scene.controls):
                 raise ValueError("device='gpu' does not run sphere-wall bridges "
                                  "(--wall-bridges) while radii grow (RadiusGrowth)")
