@@ -20,6 +20,9 @@ from pendular.gpu.walls import REDUCE_CHUNK
 
 sphere_on_walls = device_twin(_sphere_on_walls)
 
+#: Quantities summed on each wall: the pulls [N], their moments [N m].
+BRIDGE_SUMS = 2
+
 
 @cuda.jit
 def wall_bridges(position, radius, wall_position, suction, surface_tension, persist,
@@ -57,13 +60,13 @@ def wall_bridge_sums(partial, wall_force, bridge_moment):
     """One thread per wall and quantity: the blocks' pulls subtracted from the wall's force
     [N], their moments added in order into the bridges' ``bridge_moment`` (6,) [N m]."""
     t = cuda.grid(1)
-    if t >= 12:
+    if t >= 6 * BRIDGE_SUMS:
         return
-    w = t // 2
+    w = t // BRIDGE_SUMS
     total = 0.0
     for b in range(partial.shape[0]):
-        total += partial[b, w, t % 2]
-    if t % 2 == 0:
+        total += partial[b, w, t % BRIDGE_SUMS]
+    if t % BRIDGE_SUMS == 0:
         wall_force[w] -= total
     else:
         bridge_moment[w] = total
@@ -77,7 +80,8 @@ class DeviceWallBridges:
         self.walls = walls
         self.table = None
         self._table_of = None
-        self.state = None
+        self.state = None           # exists, volume, force, filling (N, 6)
+        self.moment = self.partial = self.bridge_moment = None
 
     def _upload(self, count, blocks):
         """The host's state (zeros when it has none for these ``count`` spheres), the moment
@@ -91,7 +95,7 @@ class DeviceWallBridges:
             arrays.append(cuda.to_device(np.ascontiguousarray(array, dtype=dtype)))
         self.state = tuple(arrays)
         self.moment = cuda.to_device(np.zeros((count, 6)))
-        self.partial = cuda.to_device(np.zeros((blocks, 6, 2)))
+        self.partial = cuda.to_device(np.zeros((blocks, 6, BRIDGE_SUMS)))
         self.bridge_moment = cuda.to_device(np.ascontiguousarray(walls.moment, np.float64))
 
     def launches(self, state, op):
@@ -114,7 +118,8 @@ class DeviceWallBridges:
         """(kernel, items, arguments) of the pulls' sums on the walls, after the walls' own."""
         return [(wall_bridge_partials, self.partial.shape[0],
                  (self.state[2], self.moment, self.partial)),
-                (wall_bridge_sums, 12, (self.partial, state.wall_force, self.bridge_moment))]
+                (wall_bridge_sums, 6 * BRIDGE_SUMS,
+                 (self.partial, state.wall_force, self.bridge_moment))]
 
     def to_host(self):
         """The device's state and the bridges' moments into the host's WallBridges."""
