@@ -60,7 +60,10 @@ autodoc_typehints = "signature"
 autodoc_default_options = {"undoc-members": False}
 
 # sphinx-gallery: every script of docs/tutorials and examples/ runs at each build, at the
-# small sizes they set (a few seconds to half a minute each on the 2-core machine)
+# small sizes they set (a few seconds to half a minute each on the 2-core machine), one per
+# core side by side (their samples are small enough to run on one Numba thread); the first
+# tutorial runs alone before the others, as the second reads its run folder
+# (``sphinx_gallery_parallel = False`` in it)
 sphinx_gallery_conf = {
     "examples_dirs": ["tutorials", os.path.join("..", "examples")],
     "gallery_dirs": ["auto_tutorials", "auto_examples"],
@@ -75,6 +78,7 @@ sphinx_gallery_conf = {
     "show_memory": False,
     "show_signature": False,
     "plot_gallery": "True",
+    "parallel": max(1, min(4, len(os.sched_getaffinity(0)))),
 }
 
 html_theme = "furo"

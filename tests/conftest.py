@@ -4,6 +4,7 @@ The tests are split by reach: tests/unit (one function or kernel against a close
 independent computation), tests/integration (simulations through the library), tests/e2e (the
 commands as a user runs them, marked ``slow``: ``pytest -m "not slow"`` leaves them out)."""
 
+import importlib.metadata
 import importlib.util
 import json
 import os
@@ -42,11 +43,27 @@ INSTALL = {"numba_cuda": "pip install -e '.[gpu]'", "vtk": "pip install -e '.[te
 def requires(need):
     """The skip mark of a test that needs what a machine may lack (the tests' one way to
     skip): ``need`` an importable module ("numba_cuda", "vtk", "meshio", "dask.distributed",
-    "grainlearning"), "yade" (its executable on PATH) or "threads" (two Numba threads). Use
-    it as a decorator, or as ``pytestmark = requires(...)`` for a whole module."""
+    "grainlearning"), "yade" (its executable on PATH), "threads" (two Numba threads), "cuda
+    compiler" (the gpu extra's NVVM and NVRTC wheels) or "no gpu" (no CUDA GPU visible, for
+    what a machine without one does). Use it as a decorator, or as ``pytestmark =
+    requires(...)`` for a whole module."""
     if need == "yade":
         have, missing = any(shutil.which(name) for name in ("yade", "yadedaily")), \
             "YADE (yade or yadedaily on PATH) is not installed"
+    elif need == "cuda compiler":
+        have, missing = True, ""
+        for wheel in ("nvidia-nvvm", "nvidia-cuda-nvrtc"):
+            try:
+                importlib.metadata.distribution(wheel)
+            except importlib.metadata.PackageNotFoundError:
+                have, missing = False, (f"the gpu extra's CUDA compiler ({wheel}) is not "
+                                        f"installed ({INSTALL['numba_cuda']})")
+    elif need == "no gpu":
+        have, missing = True, "a CUDA GPU is visible"
+        if importlib.util.find_spec("numba_cuda") is not None:
+            from numba import cuda
+
+            have = not cuda.is_available()
     elif need == "threads":
         have, missing = numba.config.NUMBA_NUM_THREADS >= 2, "needs two Numba threads"
     else:
@@ -125,10 +142,13 @@ def small_sample():
 
 
 def pytest_collection_modifyitems(items):
-    """Mark the end-to-end tests ``slow``."""
+    """Mark the end-to-end tests ``slow``, and put the GPU tests first: each module of them
+    waits on one long process under the simulator, which pytest-xdist (whole files, in this
+    order) then starts while the other workers take the shorter files, instead of last."""
     for item in items:
         if f"{os.sep}e2e{os.sep}" in str(item.path):
             item.add_marker(pytest.mark.slow)
+    items.sort(key=lambda item: f"{os.sep}gpu{os.sep}" not in str(item.path))
 
 
 class SpringEnergyProbe:

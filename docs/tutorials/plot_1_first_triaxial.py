@@ -24,6 +24,7 @@ two cores).
 # shell would, and print what it prints on its standard output (the progress bars go to the
 # standard error; ``--quiet`` leaves them out and prints the summary as JSON, for scripts).
 
+# sphinx_gallery_parallel = False
 # sphinx_gallery_start_ignore
 import shutil
 

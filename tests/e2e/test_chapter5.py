@@ -134,7 +134,7 @@ def test_report_sets_every_cell_beside_the_thesis(tmp_path):
 def campaign(tmp_path_factory):
     out = tmp_path_factory.mktemp("chapter5") / "campaign"
     subprocess.run([sys.executable, SCENARIO, *SMALL, "--out", str(out)],
-                   check=True, capture_output=True, text=True, timeout=300)
+                   check=True, capture_output=True, text=True, timeout=900)
     with open(out / "campaign.json") as handle:
         return out, json.load(handle)
 
@@ -216,7 +216,7 @@ def test_rerun_reuses_finished_runs(campaign):
     samples = {p: p.stat().st_mtime_ns for p in (out / "samples").glob("*.h5")}
     result = subprocess.run([sys.executable, SCENARIO, *SMALL, "--suction", "0,30000",
                              "--out", str(out)],
-                            check=True, capture_output=True, text=True, timeout=120)
+                            check=True, capture_output=True, text=True, timeout=900)
     assert "4 finished runs" in result.stdout and "0 run" in result.stdout
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps        # nothing re-run
     assert {p: p.stat().st_mtime_ns for p in samples} == samples      # nor prepared

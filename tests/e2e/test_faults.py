@@ -43,7 +43,10 @@ def command(argv, capsys):
     return run_in_process("triaxial", argv, capsys, prog="triaxial.py")
 
 
-def script(argv, cwd, timeout=120, **options):
+def script(argv, cwd, timeout=900, **options):
+    """``triaxial.py ARGV`` run in a process of its own (``timeout`` [s]: a bound on a hung
+    run, far beyond a run's time in a fresh clone, whose first runs compile the kernels, on a
+    loaded machine)."""
     return subprocess.run([sys.executable, SCRIPT, *argv], cwd=cwd, capture_output=True,
                           text=True, timeout=timeout, **options)
 

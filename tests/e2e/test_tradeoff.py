@@ -96,8 +96,8 @@ def test_a_finished_run_is_reused_only_with_an_equal_configuration(tmp_path, mon
 @pytest.fixture(scope="module")
 def quick_grid(tmp_path_factory):
     out = tmp_path_factory.mktemp("tradeoff")
-    subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--quick", "--particles", "200",
-                    "--max-strain", "0.01"], check=True, capture_output=True, text=True,
+    subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--quick", "--particles", "60",
+                    "--max-strain", "0.005"], check=True, capture_output=True, text=True,
                    timeout=900)
     with open(out / "tradeoff.json") as handle:
         return out, json.load(handle)

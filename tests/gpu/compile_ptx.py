@@ -95,19 +95,20 @@ def compile_step_kernels(cuda, capability):
     # dry and a wet step in a periodic cell (periodic_checks.py's), of a simple shear
     # (shear_checks.py's), the grips' (grips_checks.py's), volume-controlled bridges'
     # liquid exchange (volume_checks.py's), the rolling resistance and gravity
-    # (rolling_checks.py's)
+    # (rolling_checks.py's), the sphere-wall bridges (wall_bridges_checks.py's)
     from grips_checks import scene as grips_scene
     from growth_checks import scene as growth_scene
     from periodic_checks import scene as periodic_scene
     from rolling_checks import scene as rolling_scene
     from shear_checks import scene as shear_scene
     from volume_checks import scene as volume_scene
+    from wall_bridges_checks import scene as wall_bridges_scene
 
     for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
                        (periodic_scene(wet=True), " periodic wet"),
                        (shear_scene(), " sheared"),
                        (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume"),
-                       (rolling_scene(), "")):
+                       (rolling_scene(), ""), (wall_bridges_scene(), "")):
         gpu = GpuSimulation(sim)
         gpu.configure()
         for kernel, _, args in gpu.steps:

@@ -159,12 +159,8 @@ def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
     assert_agrees(history(runs / "cpu"), again, sensitivity(runs))
 
 
+@requires("no gpu")
 def test_a_gpu_run_without_a_gpu_says_how_to_get_one(tmp_path, capsys):
-    if HAVE_NUMBA_CUDA:
-        from numba import cuda
-
-        if cuda.is_available():
-            pytest.skip("a GPU (or the simulator) is here")
     out = tmp_path / "out"
     status, err = run_in_process("triaxial", ["--device", "gpu", "--particles", "60",
                                               "--out", out], capsys)

@@ -15,7 +15,6 @@ import sys
 
 import pytest
 
-from compile_ptx import extra_compiler_folder
 from conftest import requires
 from simulator import ROOT, simulated
 
@@ -117,26 +116,26 @@ def compile_ptx(*arguments):
                           cwd=os.path.join(ROOT, "tests", "gpu"), timeout=600)
 
 
+@requires("cuda compiler")
 def test_every_kernel_compiles_for_a_gpu():
     """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic, with
-    the rolling resistance and gravity (tests/gpu/compile_ptx.py),
-    where a CUDA compiler is installed (the gpu extra installs one): the simulator would run
-    code that the CUDA target rejects."""
+    the rolling resistance, gravity and the sphere-wall bridges (tests/gpu/compile_ptx.py),
+    where the gpu extra's CUDA compiler is installed: the simulator would run code that the
+    CUDA target rejects."""
     done = compile_ptx()
     assert done.returncode == 0, done.stderr[-3000:]
     compiled = json.loads(done.stdout.strip().splitlines()[-1])
-    if "skip" in compiled:
-        pytest.skip(f"no CUDA compiler here: {compiled['skip']}")
     kernels = ("bin_particles", "find_pairs", "finish_rebuild", "pair_forces", "gather",
                "wall_partials", "wall_sums", "wall_controls", "leapfrog",
                "homogenize_partials", "sum_columns")
     growth = ("grow", "mark_rebuild", "grown_beyond")
     grips = ("grip_partials", "grip_hold")
     resisting = ("pair_moments", "gather_moments", "add_weight")
+    wall_bridges = ("wall_bridges", "wall_bridge_partials", "wall_bridge_sums")
     periodic = ("bin_periodic", "find_periodic_pairs", "cell_partials", "cell_controls",
                 "cell_leapfrog")
     assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth,
-                                        *grips, *resisting,
+                                        *grips, *resisting, *wall_bridges,
                                         *(f"{name} periodic" for name in periodic),
                                         *(f"{name} periodic wet" for name in periodic),
                                         *(f"{name} sheared" for name in (*periodic,
@@ -145,13 +144,11 @@ def test_every_kernel_compiles_for_a_gpu():
     assert all(lines > 0 for lines in compiled["kernels"].values())
 
 
+@requires("cuda compiler")
 def test_a_compile_failure_fails_where_the_gpu_extra_installed_the_compiler():
     """With the gpu extra's NVVM and NVRTC installed, code the compiler rejects (here every
     kernel, for compute capability 5.0, which CUDA 13 no longer targets) fails the check: it
     does not skip."""
-    if extra_compiler_folder() is None:
-        pytest.skip("the gpu extra's CUDA compiler (nvidia-nvvm, nvidia-cuda-nvrtc) is not "
-                    "installed")
     done = compile_ptx("5.0")
     assert done.returncode != 0
     assert "skip" not in done.stdout and "compute capability 5.0" in done.stderr

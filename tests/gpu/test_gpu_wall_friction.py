@@ -17,8 +17,7 @@ QUANTITIES = ("velocity", "angular_velocity", "force", "torque", "springs", "wal
 
 @pytest.fixture(scope="module")
 def measured():
-    return simulated("wall_friction_checks.py", "linear", "hertz", "wet", "refusal",
-                     "wall_bridges")
+    return simulated("wall_friction_checks.py", "linear", "hertz", "wet", "refusal")
 
 
 @pytest.mark.parametrize("name", ["linear", "hertz", "wet"])
@@ -44,6 +43,3 @@ def test_the_wall_friction_matters(measured, name):
 def test_two_wall_operations_are_refused(measured):
     assert "at most one walls operation" in (measured["refusal"] or "")
 
-
-def test_sphere_wall_bridges_are_refused_by_name(measured):
-    assert "does not run sphere-wall bridges" in (measured["wall_bridges"] or "")

@@ -1,8 +1,6 @@
 """Walls with tangential springs (pendular.gpu.wall_friction) on the GPU against the CPU, the
 checks of tests/gpu/test_gpu_wall_friction.py run under Numba's CUDA simulator in a process of
-their own (``NUMBA_ENABLE_CUDASIM=1 python wall_friction_checks.py linear hertz wet refusal
-wall_bridges``
-prints one JSON object of measurements, simulator.run_checks):
+their own (``NUMBA_ENABLE_CUDASIM=1 python wall_friction_checks.py linear hertz wet refusal`` prints one JSON object of measurements, simulator.run_checks):
 
 - "linear": the 27-sphere scene of simulated.py (a triaxial's shear in miniature) with its
   walls frictional (FrictionalWallForces, FRICTION) and the weight: the plain run, one handed
@@ -12,8 +10,7 @@ prints one JSON object of measurements, simulator.run_checks):
   (ViscoelasticWallForces at FRICTION), over periodic_checks.HERTZ_STEPS (a damped scene's
   runs part from round-off within a hundred steps on the CPU alone);
 - "wet": the linear scene with bridges at contact, which gather the pairs after the walls;
-- "refusal": a scene with two wall operations (one role "walls" at most);
-- "wall_bridges": a wet scene with sphere-wall bridges (no device side yet).
+- "refusal": a scene with two wall operations (one role "walls" at most).
 """
 
 from periodic_checks import HERTZ_STEPS
@@ -105,21 +102,6 @@ def refusal():
     return None
 
 
-def wall_bridges():
-    """The error of a scene with sphere-wall bridges."""
-    from pendular.capillary.bridges import CapillaryBridges
-    from pendular.gpu import GpuSimulation
-
-    wet = scene()
-    wet.forces.append(CapillaryBridges(30000.0, wall_bridges=True))
-    try:
-        GpuSimulation(wet)
-    except ValueError as error:
-        return str(error)
-    return None
-
-
 if __name__ == "__main__":
     run_checks({"linear": agreement, "hertz": lambda: agreement(hertz=True, steps=HERTZ_STEPS),
-                "wet": lambda: agreement(wet=True), "refusal": refusal,
-                "wall_bridges": wall_bridges})
+                "wet": lambda: agreement(wet=True), "refusal": refusal})

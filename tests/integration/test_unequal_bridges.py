@@ -24,8 +24,7 @@ SMALL = 1e-3                      # R1 [m]
 RATIOS = (1.5, 3.0, 8.0)          # 8 lies between YADE's nodes 5 and 10
 #: u* = s R2 / gamma near the pendular limit (filling angle about 40 deg on the smaller sphere)
 WET = {1.5: 3.0, 3.0: 12.0, 8.0: 40.0}
-#: Table force and volume against the exact solver at the pair's own ratio node (measured:
-#: < 0.03 % up to 0.99 of the rupture distance, rupture distance within 0.01 %).
+#: Table force and volume against the exact solver at the pair's own ratio node.
 FORCE_TOLERANCE = 2e-3
 
 

@@ -1,6 +1,7 @@
 """Loading paths (pendular.procedures.loading): a stage's per-axis control and its checks, the
 mixed conditions' targets, the laboratory paths as stages, and the results' closed forms
-(friction angle, b, compression indices)."""
+(friction angle, b, compression indices), and the run of a stage (run_stage) that every
+procedure's stages share."""
 
 import math
 
@@ -15,7 +16,8 @@ from pendular.procedures.oedometer import OedometerConfig
 from pendular.procedures.preparation import PrepareConfig
 from pendular.procedures.config import ShearConfig, config_from_dict, config_to_dict
 from pendular.procedures.triaxial import TriaxialConfig
-from pendular.procedures.loading import MixedStress, Stage, Static, Strain, Stress
+from pendular.dem.simulation import Simulation
+from pendular.procedures.loading import MixedStress, Stage, Static, Strain, Stress, run_stage
 from pendular.dem.mixed_stress import StageFailed
 from pendular.procedures.columns import friction_angle
 from pendular.procedures.isotropic import isotropic_stages, isotropic_summary
@@ -186,3 +188,51 @@ def test_path_configurations_round_trip_through_json():
                    IsotropicConfig(sample=PrepareConfig(particles=100),
                                    stresses=[500.0, 2000.0, 300.0])):
         assert config_from_dict(config_to_dict(config)) == config
+
+
+# ---------------------------------------------------------------- the run of a stage
+
+class Clock:
+    """A scene whose steps change nothing but the step count, run by Simulation's own loop
+    (run_chunks), that notes the steps at which a stage's end was asked."""
+
+    def __init__(self, end):
+        self.step, self.end, self.asked = 0, end, []
+
+    def run(self, steps, *, until=None, check_every=100, progress=None, status=None):
+        def advance():
+            self.step += 1
+        return Simulation.run_chunks(self, steps, advance, until=until,
+                                     check_every=check_every)
+
+    def ended(self, start, every):
+        """The stage's end: reached from step ``end`` on, seen at its checks only."""
+        def ended(sim):
+            self.asked.append(sim.step)
+            taken = sim.step - start
+            return taken > 0 and taken % every == 0 and sim.step >= self.end
+        return ended
+
+
+def test_a_stage_ends_at_its_first_check_past_its_end():
+    clock = Clock(end=700)
+    assert run_stage(clock, clock.ended(0, 200), start=0, limit=10000, every=200) == 800
+    assert clock.step == 800 and clock.asked[1:] == [200, 400, 600, 800, 800]
+
+
+def test_a_stage_stopped_between_checks_checks_where_an_uninterrupted_one_did():
+    clock = Clock(end=800)
+    ended = clock.ended(100, 200)       # the stage started at step 100
+    clock.step = 100
+    assert run_stage(clock, ended, start=100, limit=10000, every=200, budget=350) == 350
+    assert clock.step == 450
+    clock.asked.clear()                 # resumed from step 450: next check at 500, not 650
+    assert run_stage(clock, ended, start=100, limit=10000, every=200) == 450
+    assert clock.step == 900 and [s for s in clock.asked if s > 450] == [500, 700, 900, 900]
+
+
+def test_a_stage_stops_at_its_limit_and_leaves_the_verdict_to_its_caller():
+    clock = Clock(end=math.inf)
+    assert run_stage(clock, clock.ended(0, 200), start=0, limit=500, every=200) == 500
+    assert clock.step == 500 and clock.asked[1:] == [200, 400, 500, 500]
+    assert run_stage(clock, clock.ended(0, 200), start=0, limit=500, every=200) == 0

@@ -10,7 +10,8 @@ import pytest
 
 from conftest import RADIUS, YOUNG, two_body_scene
 from pendular.dem.contact_law import pair_forces
-from pendular.dem.neighbors import ROW_CAPACITY, build_contacts, near_wall_particles, spatial_order
+from pendular.dem.cell_list import ROW_CAPACITY, spatial_order
+from pendular.dem.neighbors import build_contacts, near_wall_particles
 from pendular.procedures.preparation import PrepareConfig, prepare_sample, servoed_simulation
 from pendular.dem.state import Walls
 from pendular.dem.walls import ConstantStrainRate, StressServo
@@ -202,7 +203,7 @@ def test_spatial_order_walks_the_cells_along_the_z_curve():
 
 def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory():
     """The preparation numbers particles along the curve: the pairs' mean index distance is
-    under 40 % of the same packing's numbered at random (about 28 % at 1,000 spheres)."""
+    under 40 % of the same packing's numbered at random."""
     config = PrepareConfig(particles=1000, confining=750.0)
     sim, _ = prepare_sample(config, progress=False)
     i, j = sim.contacts.pair_i, sim.contacts.pair_j

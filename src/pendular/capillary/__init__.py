@@ -12,6 +12,8 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
   control, SuctionBridges and VolumeBridges (``CapillaryBridges(..., control=...)`` builds
   either), their per-pair BridgeState (pendular.capillary.bridge_state) and kernels
   (pendular.capillary.bridge_kernels).
+- sample_radius_ratios, table_radius_ratios: the radius-ratio nodes of a sample's bridge tables
+  (pendular.capillary.radius_ratios).
 - formation_suction, gravimetric_water_content: wetting at a water content (pendular.capillary.wetting).
 - decompose -> PoreUnits, entry_suction: the Delaunay pore units of a packing and their throats
   (pendular.capillary.pores); find_clusters -> Clusters: clusters of filled units
@@ -21,9 +23,10 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 from pendular.capillary.bridge_state import BridgeState
 from pendular.capillary.clusters import Clusters, find_clusters
 from pendular.capillary.bridges import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION,
-    CapillaryBridges, SuctionBridges, VolumeBridges, sample_radius_ratios, table_radius_ratios)
+    CapillaryBridges, SuctionBridges, VolumeBridges)
 from pendular.capillary.meniscus import Bridge, solve_bridge
 from pendular.capillary.pores import PoreUnits, decompose, entry_suction
+from pendular.capillary.radius_ratios import sample_radius_ratios, table_radius_ratios
 from pendular.capillary.suction_control import (bridge_at_distance, lowest_distance,
     rupture_distance)
 from pendular.capillary.table import (FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory,

@@ -36,6 +36,42 @@ SUCTION_RANGE = (0.01, 1500.0)
 
 
 @numba.njit(cache=True)
+def _sphere_on_walls(p, position, radius, wall_position, suction, surface_tension, persist,
+                     suction_axis, distance_low, log_distance_rupture, log_values, exists,
+                     volume, force_magnitude, filling, force, moment):
+    """Sphere p's bridges with the six walls (wall_bridge_forces' arguments; the GPU runs this
+    body too, pendular.gpu.wall_bridges): row p of ``exists``, ``volume``,
+    ``force_magnitude`` (its pull on each wall [N], 0 without a bridge) and ``filling`` set,
+    its pulls added to ``force[p]``, ``moment`` (6,) set to (centre-to-wall distance) * pull
+    [N m] per wall."""
+    r = radius[p]
+    u = suction * r / surface_tension
+    for w in range(6):
+        moment[w] = 0.0
+        axis = w // 2
+        side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box
+        gap = side * (position[p, axis] - wall_position[w]) - r
+        found = gap <= 0.0 or (persist and exists[p, w] != 0)
+        if found:
+            found, force_star, volume_star, delta1, _ = lookup_wall(
+                suction_axis, distance_low, log_distance_rupture, log_values, u,
+                max(gap, 0.0) / r)
+        if not found:
+            exists[p, w] = 0
+            volume[p, w] = 0.0
+            force_magnitude[p, w] = 0.0
+            filling[p, w] = 0.0
+            continue
+        pull = force_star * 2.0 * math.pi * surface_tension * r
+        exists[p, w] = 1
+        volume[p, w] = volume_star * r * r * r
+        force_magnitude[p, w] = pull
+        filling[p, w] = delta1
+        force[p, axis] -= side * pull
+        moment[w] = (r + gap) * pull
+
+
+@numba.njit(cache=True)
 def wall_bridge_forces(position, radius, wall_position, suction, surface_tension, persist,
                        suction_axis, distance_low, log_distance_rupture, log_values, exists,
                        volume, force_magnitude, filling, force, wall_force, moment):
@@ -45,36 +81,14 @@ def wall_bridge_forces(position, radius, wall_position, suction, surface_tension
     ``moment`` (6,) [N m] set to each wall's sum of (centre-to-wall distance) * pull.
     suction [Pa], surface_tension [N/m]; the table's arrays (WallBridgeTable.arrays)."""
     moment[:] = 0.0
+    sphere_moment = np.zeros(6)
     for p in range(len(radius)):
-        r = radius[p]
-        u = suction * r / surface_tension
+        _sphere_on_walls(p, position, radius, wall_position, suction, surface_tension, persist,
+                         suction_axis, distance_low, log_distance_rupture, log_values, exists,
+                         volume, force_magnitude, filling, force, sphere_moment)
         for w in range(6):
-            axis = w // 2
-            side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box
-            gap = side * (position[p, axis] - wall_position[w]) - r
-            if not (gap <= 0.0 or (persist and exists[p, w] != 0)):
-                exists[p, w] = 0
-                volume[p, w] = 0.0
-                force_magnitude[p, w] = 0.0
-                filling[p, w] = 0.0
-                continue
-            found, force_star, volume_star, delta1, _ = lookup_wall(
-                suction_axis, distance_low, log_distance_rupture, log_values, u,
-                max(gap, 0.0) / r)
-            if not found:
-                exists[p, w] = 0
-                volume[p, w] = 0.0
-                force_magnitude[p, w] = 0.0
-                filling[p, w] = 0.0
-                continue
-            pull = force_star * 2.0 * math.pi * surface_tension * r
-            exists[p, w] = 1
-            volume[p, w] = volume_star * r * r * r
-            force_magnitude[p, w] = pull
-            filling[p, w] = delta1
-            force[p, axis] -= side * pull
-            wall_force[w] -= pull
-            moment[w] += (r + gap) * pull
+            wall_force[w] -= force_magnitude[p, w]
+            moment[w] += sphere_moment[w]
 
 
 class WallBridges:

@@ -1,6 +1,7 @@
 """Capillary bridges' device side (pendular.capillary.bridges: SuctionBridges, VolumeBridges):
 their tables in device memory, the suction the pair forces' lookups read, the liquid of volume
-control, and what comes back to the host. Their kernels are pendular.gpu.forces's
+control, the sphere–wall bridges (pendular.gpu.wall_bridges), and what comes back to the
+host. Their kernels are pendular.gpu.forces's
 (pair_forces, exchange_liquid, refresh_bridges); their per-pair state is
 pendular.gpu.state's ``bridges``.
 
@@ -15,6 +16,7 @@ from pendular.dem.neighbors import carry_pair_array
 from pendular.gpu import forces
 from pendular.gpu.cuda import configured, cuda
 from pendular.gpu.operations import DeviceSide, device_side
+from pendular.gpu.wall_bridges import DeviceWallBridges
 
 #: Shapes of the stand-ins of a BridgeTable's and a VolumeBridgeTable's arrays().
 TABLE_SHAPES = ((1,), (3,), (1, 1), (1, 1), (1, 1, 1, 1))
@@ -64,6 +66,7 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
     def __init__(self, op):
         DeviceSide.__init__(self, op)
         NoBridges.__init__(self)
+        self.walls = None if op.walls is None else DeviceWallBridges(op.walls)
 
     @property
     def persist(self):
@@ -78,11 +81,20 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
     def check(self, scene):
         """Bridges across gaps (``persist``) run listed after the contact law and the wall
         forces (the device adds their forces last, as the CPU's gather_pair_forces after
-        both), with radii that do not grow; no sphere–wall bridges (``walls``: no device
-        side yet)."""
-        if self.op.walls is not None:
-            raise ValueError("device='gpu' does not run sphere-wall bridges (--wall-bridges) "
-                             "yet: run them with --device cpu")
+        both), with radii that do not grow; sphere–wall bridges (``walls``) inside walls,
+        listed after the wall forces (the CPU's pulls enter the walls' sums the wall forces
+        have set), with radii that do not grow (their table is checked for the radii at each
+        run)."""
+        if self.walls is not None:
+            if scene.periodic:
+                raise ValueError("device='gpu' runs sphere-wall bridges (--wall-bridges) "
+                                 "inside walls only, not in a periodic cell")
+            if scene.index(self) < scene.index(scene.force("walls", required=True)):
+                raise ValueError("device='gpu' runs sphere-wall bridges (--wall-bridges) "
+                                 "listed after the wall forces only")
+            if any(side.grows_radii for side in scene.controls):
+                raise ValueError("device='gpu' does not run sphere-wall bridges "
+                                 "(--wall-bridges) while radii grow (RadiusGrowth)")
         if not self.persist:
             return
         what = f"bridges across gaps ({self.name} with persist = True)"
@@ -118,6 +130,14 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
             kernel, items, args = self.refresh_step(state)
             configured(kernel, items)(*args)
 
+    def launches(self, state, dt):
+        """The sphere–wall bridges' step (pendular.gpu.wall_bridges), none without them."""
+        return [] if self.walls is None else self.walls.launches(state, self.op)
+
+    def wall_launches(self, state):
+        """The sphere–wall bridges' pulls on the walls, after the walls' own sums."""
+        return [] if self.walls is None else self.walls.wall_launches(state)
+
     def _check_reach(self, state):
         if self.op.required_range != state.reach:
             raise ValueError(f"the bridges' reach {self.op.required_range:g} m changed since "
@@ -138,7 +158,10 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
         device's, previous_pair_index): their count, which the CPU's next list must carry
         (CapillaryBridges._attach), and their forces on j from i at the last step, carried to
         the same pairs (CapillaryBridges.pair_forces reads them). Nothing for bridges at
-        contact (the list's per-pair state holds them)."""
+        contact (the list's per-pair state holds them). The sphere–wall bridges' state and
+        moments per sphere and wall (``walls``)."""
+        if self.walls is not None:
+            self.walls.to_host()
         if not self.persist:
             return
         self.op.adopt(sim)

@@ -23,8 +23,8 @@ checks (pendular.gpu.simulation).
 import math
 from collections import namedtuple
 
-from pendular.dem.neighbors import (NeighborList, _cell_coordinates, _sheared_cell,
-    _within_reach, _wrap_cell)
+from pendular.dem.cell_list import _cell_coordinates, _sheared_cell, _within_reach, _wrap_cell
+from pendular.dem.neighbors import NeighborList
 from pendular.gpu.cuda import cuda, device, device_twin
 from pendular.gpu.operations import DeviceSide, device_side
 
@@ -259,7 +259,7 @@ def finish_rebuild(position, rows, new, second_count, second_pair, carried, norm
 # ---------------------------------------------------------------- a periodic cell
 # The cells tile the periodic cell [0, L) (pendular.dem.cell.PeriodicCell; its faces in
 # ``cell_position``, as a Walls' position), int(L / cell_size) a side as the CPU's grid
-# (pendular.dem.neighbors._periodic_grid, at most the grid allocated); a pair's image (K, 3)
+# (pendular.dem.cell_list._periodic_grid, at most the grid allocated); a pair's image (K, 3)
 # int8 is stored with it (Contacts.image). A cell narrower than 3 cells a side sets NARROW_CELL
 # (the CPU refuses to build such a list: a pair would have more than one image in reach).
 # A sheared cell (``period`` (4,), its offset delta last: pendular.gpu.cell) wraps its

@@ -70,6 +70,12 @@ class DeviceSide:
         springs and the bridges run in the pair forces' kernel and the gather)."""
         return []
 
+    def wall_launches(self, state):
+        """A force's (kernel, items, arguments) after the walls' sums and before their
+        controls, its own share of the walls' sums (``state`` a DeviceState, inside walls);
+        none by default."""
+        return []
+
     def pairs_to_host(self, sim, state, index):
         """A force's own state from ``state`` (a DeviceState) into its operation when the
         state comes back to ``sim``: per pair, carried to the host list's pairs (``index``:

@@ -24,7 +24,8 @@ import math
 import numpy as np
 
 from pendular.capillary.bridge_state import FIELDS, OWNER
-from pendular.dem.neighbors import Contacts, build_pairs, build_periodic_pairs, second_index
+from pendular.dem.cell_list import build_pairs, build_periodic_pairs
+from pendular.dem.neighbors import Contacts, second_index
 from pendular.dem.protocols import pair_key
 from pendular.gpu.cell import CELL_SUMS
 from pendular.gpu import rolling as device_rolling

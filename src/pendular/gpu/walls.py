@@ -422,7 +422,8 @@ class WallBox(BoxSide):
     def steps(self, gpu):
         """(kernel, items, arguments) of a step inside walls: the rebuild, the forces (the
         walls' springs before or after the pairs' gather as the forces are listed), the
-        walls' sums and controls, the grips, the leapfrog."""
+        walls' sums (the forces' own shares after them: ``wall_launches``) and controls, the
+        grips, the leapfrog."""
         sim = gpu.sim
         scene = gpu.scene
         s = gpu.state
@@ -442,6 +443,7 @@ class WallBox(BoxSide):
             *springs.partials(s),
             (wall_sums, 6 * WALL_SUMS,
              (s.partial, s.wall_force, s.wall_stiffness, s.wall_moment)),
+            *(launch for side in scene.forces for launch in side.wall_launches(s)),
             (wall_controls, 1,
              (s.wall_force, s.wall_stiffness, s.program(), s.wall_position, s.wall_velocity,
               s.reference_walls, limit, sim.dt, s.flags)),

@@ -524,7 +524,8 @@ def check_soft(config, name, stress, label=None):
     (the field's value, or the stress called ``label`` made from it) is too large for its
     sample's contacts (pendular.procedures.preparation.check_soft_contacts)."""
     try:
-        check_soft_contacts(label or name, stress, config.sample.young)
+        sample = config.sample
+        check_soft_contacts(label or name, stress, sample.young, sample.contact, sample.poisson)
     except ValueError as error:
         message = str(error) if label is None else \
             f"{name} = {getattr(config, name):g} Pa: {error}"

@@ -24,6 +24,7 @@ from pendular.dem.measure import porosity, unbalanced_force
 from pendular.dem.walls import StressServo
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.config import WATER_DENSITY
+from pendular.procedures.loading import run_stage
 from pendular.procedures.preparation import static
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.water_content import wet_to_water_volume
@@ -39,11 +40,14 @@ def equilibrate(sim, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, check
     controls walls, their stresses within ``tolerance`` (relative) of its target; at most
     ``max_steps`` steps; ``progress``: the label of its bar (procedures.progress
     .equilibrium_bar). Returns the steps taken; NotStatic (naming ``phase`` and what it
-    reached) when the limit is hit first."""
-    done = static(unbalanced, tolerance)
-    steps = sim.run(max_steps, until=done, check_every=check_every,
-                    progress=equilibrium_bar(progress, unbalanced, tolerance),
-                    status=equilibrium_status(unbalanced))
+    reached) when the limit is hit first. A stage on the scene's own controls, run by the
+    stages' loop (pendular.procedures.loading.run_stage): checked every ``check_every`` steps
+    and at its limit, the first check after ``check_every`` steps (a sample static at the
+    start still runs them, where a LoadingPath's Static stage ends at once)."""
+    done, start = static(unbalanced, tolerance), sim.step
+    steps = run_stage(sim, lambda s: s.step > start and done(s), start=start, limit=max_steps,
+                      every=check_every, progress=equilibrium_bar(progress, unbalanced, tolerance),
+                      status=equilibrium_status(unbalanced))
     if not done(sim):
         reached = equilibrium_status(unbalanced)(sim)
         raise NotStatic(f"{phase} not reached in {steps} steps (the step limit): "

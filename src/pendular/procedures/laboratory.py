@@ -45,8 +45,9 @@ from pendular.procedures.equilibrium import (equilibrate, frame_period, frames_w
     prep_vtk_period, watched, wet_sample)
 from pendular.procedures.guards import AxialContactLost, SampleCrushed
 from pendular.procedures.loading import VTK_RECORDS, check_stages_device
-from pendular.procedures.preparation import (MAX_STRESS, PREPARATION_PHASES, prepare_sample,
-    pwave_step, servoed_simulation, timestep, timestep_description)
+from pendular.procedures.preparation import (MAX_STRESS, PEAK_FORCE_OVER_STRESS,
+    PREPARATION_PHASES, hertz_overlap, hertz_stress_over_young, prepare_sample, pwave_step,
+    servoed_simulation, timestep, timestep_description)
 from pendular.procedures.progress import laboratory_plan
 from pendular.procedures.run_options import RunOptions
 from pendular.utils.atomic import write_json
@@ -139,7 +140,8 @@ def check_feasible(config, force=False):
     time (more than MAX_SHEAR_STEPS steps of a path whose length is known), with the estimate,
     or whose equilibrium phases cannot settle (a stress of the path below
     MIN_CONFINING_OVER_YOUNG young; a preparation with prep_stress below
-    MIN_PREP_STRESS_OVER_YOUNG young); ``force`` lets an expert run it anyway. A path
+    MIN_PREP_STRESS_OVER_YOUNG young; with Hertz–Mindlin contacts the overlaps these set,
+    check_hertz_equilibria); ``force`` lets an expert run it anyway. A path
     table's stages that name their own rates are held to the same bounds, each named by its
     file and stage. Output periods must fit the loading. ValueError naming the setting."""
     sample = config.sample
@@ -183,27 +185,68 @@ def check_feasible(config, force=False):
         if stage_steps is not None and stage_steps > most:
             raise too_long(stage, stage_steps, f"strain rate {stage_rate:.3g} 1/s",
                            "raise its strain rate")
-    if (not force and config.sample_path is None
-            and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
-        raise ValueError(
-            f"young = {sample.young:g} Pa is outside the valid range (0, "
-            f"{sample.prep_stress / MIN_PREP_STRESS_OVER_YOUNG:g}] Pa for the preparation at "
-            f"prep_stress = {sample.prep_stress:g} Pa: the radius growth cannot settle at "
-            f"overlaps below {MIN_PREP_STRESS_OVER_YOUNG:g} of the radius (it would run "
-            "2,000,000 steps and stop); lower young (or --force)")
-    if not force and pressure < MIN_CONFINING_OVER_YOUNG * sample.young:
-        name = "confining" if pressure == sample.confining else "the path's lowest stress"
-        raise ValueError(
-            f"{name} = {pressure:g} Pa is outside the valid range "
-            f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, {MAX_STRESS:g}] Pa for young = "
-            f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
-            "never hold the confining stress (the equilibrium would run to its step limit); "
-            "raise confining or lower young (or --force)")
+    if sample.contact == "hertz-mindlin":
+        if not force:
+            check_hertz_equilibria(config, pressure)
+    else:
+        if (not force and config.sample_path is None
+                and sample.prep_stress < MIN_PREP_STRESS_OVER_YOUNG * sample.young):
+            raise ValueError(
+                f"young = {sample.young:g} Pa is outside the valid range (0, "
+                f"{sample.prep_stress / MIN_PREP_STRESS_OVER_YOUNG:g}] Pa for the preparation at "
+                f"prep_stress = {sample.prep_stress:g} Pa: the radius growth cannot settle at "
+                f"overlaps below {MIN_PREP_STRESS_OVER_YOUNG:g} of the radius (it would run "
+                "2,000,000 steps and stop); lower young (or --force)")
+        if not force and pressure < MIN_CONFINING_OVER_YOUNG * sample.young:
+            name = "confining" if pressure == sample.confining else "the path's lowest stress"
+            raise ValueError(
+                f"{name} = {pressure:g} Pa is outside the valid range "
+                f"[{MIN_CONFINING_OVER_YOUNG * sample.young:g}, {MAX_STRESS:g}] Pa for young = "
+                f"{sample.young:g} Pa: below {MIN_CONFINING_OVER_YOUNG:g} young the servoed walls "
+                "never hold the confining stress (the equilibrium would run to its step limit); "
+                "raise confining or lower young (or --force)")
     for name in ("vtk_every", "checkpoint_every"):
         value = getattr(config, name)
         if steps is not None and value is not None and value > max(steps, 1.0) + 1:
             raise fail(config, name, f"{name} = {value} is outside the valid range "
                        f"[0, {int(steps) + 1}]: the shear has about {int(steps)} steps")
+
+
+def check_hertz_equilibria(config, pressure):
+    """check_feasible's bounds on the equilibria of a test with Hertz–Mindlin contacts, the
+    linear law's MIN_PREP_STRESS_OVER_YOUNG and MIN_CONFINING_OVER_YOUNG turned into the
+    overlaps they set (PEAK_FORCE_OVER_STRESS times them, of the radius, at the most loaded
+    contact) and back into stresses by Hertz's law (preparation.hertz_overlap): at a stress
+    p a Hertz contact overlaps by about (15 p / E)^(2/3) R, far more than a linear spring's
+    8 p / E R, so it admits a far stiffer E. ``pressure``: the lowest stress of the path [Pa].
+    ValueError naming --young and its valid range."""
+    sample = config.sample
+    young, poisson = sample.young, sample.poisson
+
+    def stiffest(stress, overlap):
+        return stress / hertz_stress_over_young(overlap, poisson)
+
+    grown = PEAK_FORCE_OVER_STRESS * MIN_PREP_STRESS_OVER_YOUNG
+    if config.sample_path is None and young > stiffest(sample.prep_stress, grown):
+        raise ValueError(
+            f"--young = {young:g} Pa is outside the valid range (0, "
+            f"{stiffest(sample.prep_stress, grown):g}] Pa of Hertz–Mindlin grains (poisson = "
+            f"{poisson:g}) for the preparation at prep_stress = {sample.prep_stress:g} Pa: the "
+            f"most loaded contact would overlap by "
+            f"{hertz_overlap(sample.prep_stress, young, poisson):.3g} of the radius, below the "
+            f"{grown:g} the radius growth needs to settle (it would run 2,000,000 steps and "
+            "stop); lower --young, or prepare at a larger prep_stress and pass --sample (or "
+            "--force)")
+    held = PEAK_FORCE_OVER_STRESS * MIN_CONFINING_OVER_YOUNG
+    if young > stiffest(pressure, held):
+        name = "confining" if pressure == sample.confining else "the path's lowest stress"
+        raise ValueError(
+            f"--young = {young:g} Pa is outside the valid range (0, "
+            f"{stiffest(pressure, held):g}] Pa of Hertz–Mindlin grains (poisson = {poisson:g}) "
+            f"at {name} = {pressure:g} Pa: the most loaded contact would overlap by "
+            f"{hertz_overlap(pressure, young, poisson):.3g} of the radius, below the {held:g} "
+            "at which the servoed walls hold the stress (the equilibrium would run to its step "
+            f"limit); lower --young or raise {name} (or --force)")
 
 
 def parameters(config):

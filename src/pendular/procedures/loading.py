@@ -363,6 +363,36 @@ class MixedStress(mixed_stress.MixedStress):
                          stress=stage.stress)
 
 
+# ---------------------------------------------------------------- the run of a stage
+
+def run_stage(sim, ended, *, start, limit, every, budget=math.inf, progress=None, bar=None,
+              status=None):
+    """Run one stage of ``sim`` until ``ended(sim)``, the stage's end, checked every ``every``
+    steps counted from its first step ``start``, and at most to its step limit ``start +
+    limit``, taking at most ``budget`` steps; returns the steps taken. A stage resumed from a
+    checkpoint written between two checks first runs to the next one, so that its checks fall
+    on the steps where an uninterrupted run checked: a resumed run is the same run, bit for
+    bit. It stops at the limit without judging: what a stage that has not ended by then means
+    (StageFailed, NotStatic, the end of a pull) is its caller's. ``progress``: the progress
+    label, ``bar`` the bar of the checked run (None: ``progress``), ``status`` its fields
+    (Simulation.run). Every procedure runs its stages so: LoadingPath.run, the equilibria
+    (pendular.procedures.equilibrium.equilibrate), the SWCC's suction steps and the tension's
+    pull."""
+    bar = progress if bar is None else bar
+    taken = 0
+    while not ended(sim):
+        done = sim.step - start
+        if done >= limit or taken >= budget:
+            break
+        steps = int(min(limit - done, budget - taken))
+        offset = done % every
+        if offset:                  # a resumed stage: its checks fall where they fell before
+            taken += sim.run(min(every - offset, steps), progress=progress, status=status)
+            continue
+        taken += sim.run(steps, until=ended, check_every=every, progress=bar, status=status)
+    return taken
+
+
 # ---------------------------------------------------------------- a path
 
 class AxisStrain:
@@ -594,19 +624,17 @@ class LoadingPath:
             if taken >= budget:
                 break
             until = self.stages[self.stage].until
-            steps = int(min(self.steps_left(sim), budget - taken))
             label = progress if progress is None or len(self.stages) == 1 else (
                 f"{progress} {self.stage + 1}/{len(self.stages)}")
             if isinstance(until, (Strain, ShearStrain)):
-                taken += sim.run(steps, progress=label, status=status)
+                taken += sim.run(int(min(self.steps_left(sim), budget - taken)),
+                                 progress=label, status=status)
                 continue
-            every = 1 if isinstance(until, Stress) else until.check_every
-            offset = (sim.step - self.stage_start) % every
-            if offset:              # a resumed stage: its checks fall where they fell before
-                taken += sim.run(min(every - offset, steps), progress=label, status=status)
-                continue
-            taken += sim.run(steps, until=self._reached, check_every=every,
-                             progress=self._bar(label, until), status=status)
+            taken += run_stage(sim, self._reached, start=self.stage_start,
+                               limit=self.stage_steps,
+                               every=1 if isinstance(until, Stress) else until.check_every,
+                               budget=budget - taken, progress=label,
+                               bar=self._bar(label, until), status=status)
             if not self._reached(sim) and sim.step >= self.stage_start + self.stage_steps:
                 raise StageFailed(self._failure(sim))
         return taken

@@ -116,7 +116,7 @@ class TablePathConfig(PathConfig):
 
 
         return build_stages(self.stages, self.source, confining=self.sample.confining,
-                            rate=self.rate(), young=self.sample.young,
+                            rate=self.rate(), sample=self.sample,
                             wetting=wetting_of(self.bridges))
 
     def stage_rates(self):
@@ -343,26 +343,26 @@ def _stage(entry, values):
     return Stage(**fields)
 
 
-def build_stages(entries, source, *, confining, rate, young=None, wetting=None):
+def build_stages(entries, source, *, confining, rate, sample=None, wetting=None):
     """The loading.Stage list of a table's ``entries`` (read_table), groups repeated;
     ``confining`` [Pa] and ``rate`` [1/s] are the values of the names 'confining' and
-    'quasi-static'; with ``young`` [Pa], every stress is checked against it
-    (preparation.check_soft_contacts); with ``wetting`` (WETTINGS: how the sample is wetted),
-    every stage's water keys against it (check_water). ValueError naming ``source`` and the
-    entry."""
+    'quasi-static'; with ``sample`` (a PrepareConfig), every stress is checked against its
+    contacts (preparation.check_soft_contacts); with ``wetting`` (WETTINGS: how the sample
+    is wetted), every stage's water keys against it (check_water). ValueError naming
+    ``source`` and the entry."""
     return [stage for _, stage in labelled_stages(entries, source, confining=confining,
-                                                  rate=rate, young=young, wetting=wetting)]
+                                                  rate=rate, sample=sample, wetting=wetting)]
 
 
-def labelled_stages(entries, source, *, confining, rate, young=None, wetting=None):
+def labelled_stages(entries, source, *, confining, rate, sample=None, wetting=None):
     """[(label, loading.Stage)] of build_stages, each with its entry's label ('stage 3.1')."""
     values = {"confining": confining, "quasi-static": rate, "-quasi-static": -rate}
     stages = []
     for label, entry in parse_entries(entries, source):
         try:
             stage = _stage(entry, values)
-            for name, value in stage_stresses(stage) if young is not None else ():
-                check_soft_contacts(name, value, young)
+            for name, value in stage_stresses(stage) if sample is not None else ():
+                check_soft_contacts(name, value, sample.young, sample.contact, sample.poisson)
             if wetting is not None:
                 check_water(stage, wetting)
         except (ValueError, TypeError) as error:

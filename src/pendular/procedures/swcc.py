@@ -76,6 +76,7 @@ from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TE
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.laboratory import (Interrupted, MIN_CONFINING_OVER_YOUNG, plain,
     run_identity)
+from pendular.procedures.loading import run_stage
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
     sample_sizes, size_options)
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
@@ -436,23 +437,13 @@ class SwccPath:
         """Run the stage in progress until static, at most ``budget`` steps; the steps taken.
         NotStatic (SwccTest.stage_failed) at its --stage-steps limit."""
         sim, limit = self.sim, self.test.config.stage_steps
-        status = equilibrium_status(self.test.config.sample.equilibrium_unbalanced)
-        taken = 0
-        while not self._ended(sim):
-            done = sim.step - self.stage_start
-            if done >= limit:
-                branch, suction = self.path[self.index]
-                raise self.test.stage_failed(sim, suction, branch)
-            if taken >= budget:
-                break
-            steps = int(min(limit - done, budget - taken))
-            offset = done % self.CHECK_EVERY
-            if offset:              # a resumed stage: its checks fall where they fell before
-                taken += sim.run(min(self.CHECK_EVERY - offset, steps), progress=label,
-                                 status=status)
-                continue
-            taken += sim.run(steps, until=self._ended, check_every=self.CHECK_EVERY,
-                             progress=label, status=status)
+        taken = run_stage(sim, self._ended, start=self.stage_start, limit=limit,
+                          every=self.CHECK_EVERY, budget=budget, progress=label,
+                          status=equilibrium_status(self.test.config.sample
+                                                    .equilibrium_unbalanced))
+        if not self._ended(sim) and sim.step - self.stage_start >= limit:
+            branch, suction = self.path[self.index]
+            raise self.test.stage_failed(sim, suction, branch)
         return taken
 
     def write_pores(self, suction):

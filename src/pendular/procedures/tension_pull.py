@@ -20,7 +20,8 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pendular.capillary.bridges import CapillaryBridges, sample_radius_ratios
+from pendular.capillary.bridges import CapillaryBridges
+from pendular.capillary.radius_ratios import sample_radius_ratios
 from pendular.capillary.table import BridgeTable
 from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import gravimetric_water_content
@@ -39,6 +40,7 @@ from pendular.procedures.columns import measured
 from pendular.procedures.config import config_to_dict, inertial_number
 from pendular.procedures.equilibrium import frame_period, frames_writer
 from pendular.procedures.grips import core_void_ratio, grip_members, grip_reach, tensile_stress
+from pendular.procedures.loading import run_stage
 from pendular.procedures.preparation import PrepareConfig, equilibrated, prepare_sample, servo_speed
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
@@ -208,10 +210,12 @@ def wet(dry: Simulation, config, water_content: float,
                                 control="volume", roughness=config.roughness)
 
     def settle(sim):
-        return sim.run(WET_STEPS, until=equilibrated(config.sample), check_every=CHECK_EVERY,
-                       progress=equilibrium_bar("wet" if progress else None,
-                                                config.sample.equilibrium_unbalanced,
-                                                config.sample.stress_tolerance))
+        done, start = equilibrated(config.sample), sim.step
+        return run_stage(sim, lambda s: s.step > start and done(s), start=start,
+                         limit=WET_STEPS, every=CHECK_EVERY,
+                         progress=equilibrium_bar("wet" if progress else None,
+                                                  config.sample.equilibrium_unbalanced,
+                                                  config.sample.stress_tolerance))
 
     try:
         sim, bridges, tries = wet_to_water_volume(
@@ -338,20 +342,12 @@ class Pull:
             return {"ext": f"{-self.extension.strain(s.fetch('walls').walls):.4f}",
                     "tension": f"{self.recorder.last('tensile_stress'):.0f}Pa"}
 
-        sim, period = self.sim, self.recorder.period
-        label = label if self.progress else None
-        taken = 0
-        while not self._ended(sim):
-            if taken >= budget:
-                return False
-            done = sim.step - self.start
-            steps = int(min(self.steps - done, budget - taken))
-            offset = done % period
-            if offset:
-                taken += sim.run(min(period - offset, steps), progress=label, status=status)
-                continue
-            taken += sim.run(steps, until=self._ended, check_every=period, progress=label,
-                             status=status)
+        sim = self.sim
+        run_stage(sim, self._ended, start=self.start, limit=self.steps,
+                  every=self.recorder.period, budget=budget,
+                  progress=label if self.progress else None, status=status)
+        if not self._ended(sim):
+            return False
         if self.vtk is not None:
             self.vtk.close(sim)
         return True

@@ -10,8 +10,8 @@ knob of the preparation the samples prepared with each setting), --jobs runs at 
 
 import sys
 
-from pendular.studies.tradeoff import (OPTIONS, SeedStudy, study_of, write_seed_study,
-    write_study)
+from pendular.studies.tradeoff import OPTIONS, SeedStudy, study_of
+from pendular.studies.tradeoff_report import write_seed_study, write_study
 
 from pendular.cli import add_declared_options, declared_values
 
