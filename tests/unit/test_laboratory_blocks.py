@@ -56,3 +56,30 @@ def test_a_wetting_report_gives_steps_details_then_the_wet_state():
     assert report["initial_saturation"] == 0.25 and report["initial_bridges"] == 3
     assert report["wet_porosity"] == porosity(sim.particles, sim.walls)
     assert 0.0 <= report["wetting_time_s"] <= time.perf_counter() - started
+
+
+def test_a_campaign_sample_sizes_a_test_with_the_radius_it_was_prepared_with(tmp_path):
+    """The preparation rescales grown spheres to the radius asked, which can leave them an ulp
+    off it: the PrepareConfig a campaign stores with its sample sizes the test, so that a
+    finished run is recognised as the same configuration when the campaign runs again."""
+    import types
+
+    from pendular.dem.sample import save_sample
+    from pendular.dem.state import Particles, Walls
+    from pendular.procedures.config import config_to_dict, sized_as_sample
+    from pendular.procedures.preparation import PrepareConfig
+
+    prepared = PrepareConfig(particles=60, radius=2.4e-5)
+    off = np.nextafter(2.4e-5, 1.0)                     # the grown spheres' radius
+    centres = np.array([[i, j, k] for i in range(3) for j in range(4) for k in range(5)],
+                       float) * 3 * off + 2 * off
+    particles = Particles(centres, np.full(60, off), 2650.0)
+    walls = Walls.box(np.zeros(3), centres.max(axis=0) + 2 * off)
+    path = str(tmp_path / "c500.h5")
+    save_sample(path, types.SimpleNamespace(particles=particles, walls=walls), {"steps": 1},
+                {"sample": config_to_dict(prepared)})
+    sized = sized_as_sample(PrepareConfig(particles=60), path)
+    assert sized.radius == 2.4e-5 and sized.particles == 60
+    # without a stored configuration, the spheres' own radius
+    save_sample(path, types.SimpleNamespace(particles=particles, walls=walls), {"steps": 1})
+    assert sized_as_sample(PrepareConfig(particles=60), path).radius == off

@@ -424,21 +424,27 @@ SAMPLE_FIELDS = ("particles", "radius", "radius_spread", "psd", "seed")
 def sized_as_sample(sample, path):
     """``sample`` (a PrepareConfig) with the count and sizes (SAMPLE_FIELDS) of the prepared
     sample at ``path`` for the fields at their defaults (not given), read from the
-    configuration the sample was prepared with, else from its spheres (count and mean
-    radius). A field given keeps its value, which pendular.dem.sample.load_sample then
-    refuses when the sample contradicts it. ValueError naming the path for an unreadable
-    sample."""
+    configuration the sample was prepared with (a test's ``config``, or the ``sample`` a
+    campaign stores with its samples), else from its spheres (count and mean radius). The
+    spheres alone may be an ulp off the radius asked (the preparation rescales them to it), so
+    a stored configuration comes first. A field given keeps its value, which
+    pendular.dem.sample.load_sample then refuses when the sample contradicts it. ValueError
+    naming the path for an unreadable sample."""
     particles, _, _, stored = load_sample(path)
     radius = particles.radius      # equal spheres: their radius exactly, not a rounded mean
     made = {"particles": len(particles),
             "radius": float(radius[0] if np.all(radius == radius[0]) else np.mean(radius))}
-    if isinstance(stored.get("config"), dict):
+    for key in ("config", "sample"):
+        if not isinstance(stored.get(key), dict):
+            continue
         try:
-            prepared = config_from_dict(stored["config"], f"sample = {path!r}").sample
+            prepared = config_from_dict(stored[key], f"sample = {path!r}")
+            prepared = prepared.sample if key == "config" else prepared
         except (AttributeError, TypeError, ValueError):
             prepared = None            # written by another tool: its spheres say enough
         if isinstance(prepared, PrepareConfig):
             made = {name: getattr(prepared, name) for name in SAMPLE_FIELDS}
+            break
     return dataclasses.replace(sample, **{
         name: value for name, value in made.items()
         if getattr(sample, name) == default_of(PrepareConfig, name)})
