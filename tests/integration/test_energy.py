@@ -3,7 +3,7 @@
 import numpy as np
 
 from pendular.dem.measure import kinetic_energy
-from pendular.procedures.preparation import random_cloud
+from pendular.dem.cloud import random_cloud
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.contact_law import ContactForces, normal_stiffness

@@ -11,7 +11,8 @@ from conftest import refused, run_in_process
 
 from pendular.dem.grading import (MAX_RADIUS_SPREAD, grading, passing, read_grading_curve,
     sample_radii, size_at_passing)
-from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.cloud import random_cloud
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.cli import run_command
 from pendular.io.history import read_history
 from pendular.procedures.triaxial import TriaxialConfig

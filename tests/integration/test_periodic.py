@@ -14,7 +14,8 @@ from pendular.dem.cell import PeriodicCell, pair_virial
 from pendular.dem.contact_law import ContactForces, gather_contact_forces, normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList, build_contacts, gather_pair_forces
-from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.cloud import random_cloud
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.sample import load_sample, save_sample
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles

@@ -12,7 +12,7 @@ from pendular.capillary import CapillaryBridges
 from pendular.dem.contact_law import ContactForces, normal_stiffness
 from pendular.dem.integrate import Integrator
 from pendular.dem.neighbors import NeighborList
-from pendular.procedures.preparation import random_cloud
+from pendular.dem.cloud import random_cloud
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces

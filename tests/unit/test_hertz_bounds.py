@@ -10,7 +10,7 @@ import pytest
 import scipy.optimize
 
 from pendular.dem.hertz_mindlin import effective_modulus
-from pendular.procedures.laboratory import check_feasible
+from pendular.procedures.feasibility import check_feasible
 from pendular.procedures.preparation import (PEAK_FORCE_OVER_STRESS, hertz_overlap,
     hertz_stress_over_young)
 from pendular.procedures.registry import config_from_options

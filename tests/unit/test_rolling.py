@@ -19,7 +19,8 @@ from pendular.dem.state import Particles, Walls
 from pendular.dem.walls import WallForces
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.gravity import Gravity
-from pendular.procedures.preparation import PrepareConfig, random_cloud, servoed_simulation
+from pendular.dem.cloud import random_cloud
+from pendular.procedures.preparation import PrepareConfig, servoed_simulation
 
 OVERLAP = 1e-5                                  # [m], 0.01 R
 REDUCED = 0.5 * RADIUS                          # R* of two equal spheres [m]

@@ -17,7 +17,8 @@ from pendular.dem.contact_law import ContactForces
 from pendular.dem.integrate import Integrator
 from pendular.dem.timestep import pwave_timestep
 from pendular.dem.neighbors import NeighborList
-from pendular.procedures.preparation import PrepareConfig, prepare_sample, random_cloud
+from pendular.dem.cloud import random_cloud
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 from pendular.dem.record import HistoryRecorder
 from pendular.dem.sample import load_sample
 from pendular.dem.simulation import Simulation

@@ -74,8 +74,8 @@ from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TE
     check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
     stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
-from pendular.procedures.laboratory import (Interrupted, MIN_CONFINING_OVER_YOUNG, plain,
-    run_identity)
+from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG
+from pendular.procedures.laboratory import Interrupted, plain, run_identity
 from pendular.procedures.loading import run_stage
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
     sample_sizes, size_options)

@@ -98,7 +98,7 @@ JOBS_PER_CPU = 4
 class Run:
     """One run of a campaign: its folder name under ``out/runs`` and its configuration (of
     a command of PROCEDURES); ``force``: run a laboratory test refused as not quasi-static or
-    too long (pendular.procedures.laboratory.check_feasible)."""
+    too long (pendular.procedures.feasibility.check_feasible)."""
 
     name: str
     config: RunConfig

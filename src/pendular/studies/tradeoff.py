@@ -55,7 +55,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from pendular.utils.atomic import write_json
-from pendular.procedures.preparation import MAX_SEED, PrepareConfig
+from pendular.dem.cloud import MAX_SEED
+from pendular.procedures.preparation import PrepareConfig
 from pendular.dem.sample import load_sample
 from pendular.utils.parameters import (Option, OptionError, default_of, fail, option_field,
     option_of, parameter, validate)
