@@ -78,3 +78,22 @@ def test_too_soft_grains_are_refused_naming_young_and_its_range():
                        r"\[0, 2000\] Pa for Hertz–Mindlin grains of --young 100000 Pa: .* give "
                        r"--young in \[250000, inf\) Pa"):
         feasible("triaxial", young=1e5, **HM)
+
+
+def test_an_swcc_checks_hertz_mindlin_grains_by_their_overlaps():
+    """The SWCC's servoed walls hold its confining stress by the same rule as the laboratory
+    tests (its command fixes the material; the Python API sets it): a linear law's bound on
+    young, Hertz's overlaps for Hertz–Mindlin grains."""
+    from pendular.procedures.preparation import PrepareConfig
+    from pendular.procedures.swcc import SwccConfig, SwccTest
+
+    def swcc(**sample):
+        return SwccTest(SwccConfig(sample=PrepareConfig(young=1e9, **sample)))
+
+    with pytest.raises(ValueError, match="--confining = 750 Pa is below its valid minimum"):
+        swcc()
+    swcc(**HM)
+    with pytest.raises(ValueError, match=r"--young = 1e\+09 Pa is outside the valid range \(0, "
+                                         r".*\] Pa of Hertz–Mindlin grains .* at confining = "
+                                         r"10 Pa"):
+        swcc(confining=10.0, **HM)

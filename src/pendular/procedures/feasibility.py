@@ -132,15 +132,17 @@ def check_hertz_equilibria(config, pressure):
     contact) and back into stresses by Hertz's law (preparation.hertz_overlap): at a stress
     p a Hertz contact overlaps by about (15 p / E)^(2/3) R, far more than a linear spring's
     8 p / E R, so it admits a far stiffer E. ``pressure``: the lowest stress of the path [Pa].
-    ValueError naming --young and its valid range."""
+    ValueError naming --young and its valid range. A configuration without ``sample_path``
+    (an SWCC) prepares its own sample."""
     sample = config.sample
     young, poisson = sample.young, sample.poisson
+    sample_path = getattr(config, "sample_path", None)
 
     def stiffest(stress, overlap):
         return stress / hertz_stress_over_young(overlap, poisson)
 
     grown = PEAK_FORCE_OVER_STRESS * MIN_PREP_STRESS_OVER_YOUNG
-    if config.sample_path is None and young > stiffest(sample.prep_stress, grown):
+    if sample_path is None and young > stiffest(sample.prep_stress, grown):
         raise ValueError(
             f"--young = {young:g} Pa is outside the valid range (0, "
             f"{stiffest(sample.prep_stress, grown):g}] Pa of Hertz–Mindlin grains (poisson = "

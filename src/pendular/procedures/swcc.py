@@ -74,7 +74,7 @@ from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TE
     check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
     stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
-from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG
+from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
 from pendular.procedures.loading import run_stage
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
@@ -172,7 +172,9 @@ class SwccTest:
         self.config = config
         sample = config.sample
         lowest = MIN_CONFINING_OVER_YOUNG * sample.young
-        if sample.confining < lowest:
+        if sample.contact == "hertz-mindlin":       # Hertz's overlaps, not a spring's
+            check_hertz_equilibria(config, sample.confining)
+        elif sample.confining < lowest:
             raise ValueError(
                 f"--confining = {sample.confining:g} Pa is below its valid minimum {lowest:g} Pa "
                 f"({MIN_CONFINING_OVER_YOUNG:g} young, young = {sample.young:g} Pa): the "
