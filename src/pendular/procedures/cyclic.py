@@ -41,7 +41,7 @@ from pendular.procedures.guards import AxialStressGuard
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, Stage, Strain, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
-    rate_options)
+    path_rate_options)
 from pendular.utils.parameters import OptionError, fail, option_of, parameter
 from pendular.procedures.preparation import PrepareConfig
 
@@ -391,8 +391,7 @@ class CyclicTest(LaboratoryTest):
 
 CYCLIC_OWN = (tuple(dataclasses.replace(option, group="amplitude") for option in options_named(
                   CyclicConfig, ("amplitude_q", "amplitude_strain")))
-              + (option_of(CyclicConfig, "cycles"),) + rate_options(PathConfig)
-              + (option_of(PathConfig, "record_strain"),))
+              + (option_of(CyclicConfig, "cycles"),) + path_rate_options())
 
 
 def amplitude_given(values):

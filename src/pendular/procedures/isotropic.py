@@ -24,9 +24,9 @@ from pendular.procedures.config import (BridgeConfig, PathConfig, check_soft, re
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import AXIS_NAMES, LoadingPath, Stage, Static
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
-    rate_options)
+    path_rate_options)
 from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
-from pendular.utils.parameters import fail, option_of, parameter
+from pendular.utils.parameters import fail, parameter
 
 
 #: Fewest stresses of an isotropic path: a loading (or unloading) needs two.
@@ -148,7 +148,7 @@ class IsotropicTest(LaboratoryTest):
 
 
 ISOTROPIC_OWN = (options_named(IsotropicConfig, ("stresses", "stage_steps"))
-                 + rate_options(PathConfig) + (option_of(PathConfig, "record_strain"),))
+                 + path_rate_options())
 
 #: A worked example: the command line, and what it gives (--help and docs/commands.md).
 EXAMPLE = ("pendular isotropic --particles 1000 --stresses 1000,2000,4000,2000,1000 "

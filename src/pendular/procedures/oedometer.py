@@ -26,9 +26,9 @@ from pendular.procedures.config import BridgeConfig, PathConfig, check_soft, reg
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import LoadingPath, Stage, Stress
 from pendular.procedures.options import (framed, laboratory_options, options_named, path_command,
-    rate_options)
+    path_rate_options)
 from pendular.procedures.preparation import MAX_STRESS, PrepareConfig
-from pendular.utils.parameters import fail, option_of, parameter
+from pendular.utils.parameters import fail, parameter
 
 
 @registered
@@ -177,7 +177,7 @@ class OedometerTest(LaboratoryTest):
 
 #: Each loading path's own options (its fields set by them as they are).
 OEDOMETER_OWN = (options_named(OedometerConfig, ("axial_stress", "unload_to"))
-                 + rate_options(PathConfig) + (option_of(PathConfig, "record_strain"),))
+                 + path_rate_options())
 
 #: A worked example: the command line, and what it gives (--help and docs/commands.md).
 EXAMPLE = ("pendular oedometer --particles 1000 --axial-stress 10000 --unload-to 2000 "

@@ -21,7 +21,7 @@ from typing import Callable
 
 from pendular.dem.grading import MAX_RADIUS_RATIO, read_grading_curve
 from pendular.procedures.config import (BridgeConfig, LaboratoryConfig, MIN_SAMPLE_PARTICLES,
-    ShearConfig, check_steps_count)
+    PathConfig, ShearConfig, check_steps_count)
 from pendular.procedures.preparation import PrepareConfig
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError, fields_of,
     flag_of, option_from, option_of, spec_of)
@@ -122,6 +122,12 @@ def rate_options(config):
     """The loading rate of ``config`` (ShearConfig or PathConfig): an inertial number or a
     strain rate."""
     return options_named(config, ("inertial_number", "strain_rate"))
+
+
+def path_rate_options():
+    """What every loading path command sets of its PathConfig: its rate (rate_options) and
+    the strain between its history records (record_strain)."""
+    return rate_options(PathConfig) + (option_of(PathConfig, "record_strain"),)
 
 
 #: Steps between checkpoints of a run (every command that resumes: the laboratory tests,

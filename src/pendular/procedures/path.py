@@ -69,7 +69,8 @@ from pendular.procedures.hydraulic import water_content
 from pendular.procedures.laboratory import LaboratoryTest, stress_balance
 from pendular.procedures.loading import (AXIS_NAMES, AxisStrain, LoadingPath, Stage, Static,
     Strain, Stress)
-from pendular.procedures.options import framed, laboratory_fields, laboratory_options, rate_options
+from pendular.procedures.options import (framed, laboratory_fields, laboratory_options,
+    path_rate_options)
 from pendular.procedures.preparation import PrepareConfig, check_soft_contacts, servo_speed
 from pendular.utils.parameters import Option, fail, fields_of, option_of, parameter
 from pendular.utils.toml_file import read_toml
@@ -657,8 +658,7 @@ def change_suction(sim, bridges, suction, *, stress, increments=4, max_velocity=
 # ---------------------------------------------------------------- the command
 
 
-PATH_OWN = (rate_options(PathConfig) + (option_of(PathConfig, "record_strain"),
-                                        option_of(TablePathConfig, "records")))
+PATH_OWN = path_rate_options() + (option_of(TablePathConfig, "records"),)
 
 #: The path table of ``pendular path``.
 PATH_TABLE = Option("table", "the path table (not with --resume: the run keeps its own)",
