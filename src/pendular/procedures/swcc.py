@@ -83,6 +83,7 @@ from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepa
     servoed_simulation, static)
 from pendular.procedures.progress import swcc_plan
 from pendular.procedures.reference import FIG_5_5
+from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
 from pendular.utils.atomic import write_json
 from pendular.utils.parameters import fail, fields_of, option_of, parameter, validate
@@ -236,25 +237,13 @@ class SwccTest:
         options = RunOptions.of(options, **settings)
         progress, threads, device = options.progress, options.threads, options.device
         stop_after = options.stop_after
-        sample_file = os.path.join(out, "sample.h5")
-        checkpoint = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(sample_file):
-            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
-                             "before its sample existed (in the preparation), so nothing can "
-                             "be resumed; run it again")
-        if not os.path.exists(checkpoint):
-            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: the run stopped "
-                             "before its first checkpoint, or was started with "
-                             "--checkpoint-every 0, which writes none; run it again")
+        sample_file, checkpoint = resume_files(out, "in the preparation")
         with OutputFolder(out, "swcc --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)
             particles, walls, preparation, stored = load_sample(sample_file)
-            config = config_from_dict(stored.get("config"), sample_file)
-            if not isinstance(config, SwccConfig):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular swcc")
-            check_device(device)
+            config = stored_run(config_from_dict(stored.get("config"), sample_file), out, cls,
+                                "swcc", device)
             sim = servoed_simulation(particles, walls, config.sample, config.sample.confining,
                                      threads=threads)
             test = cls.__new__(cls)          # the stored run, checked when it started

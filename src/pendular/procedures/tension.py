@@ -80,6 +80,7 @@ from pendular.procedures.preparation import PrepareConfig, pwave_step
 from pendular.procedures.progress import tension_plan
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
     KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
+from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
 from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
 from pendular.procedures.tension_report import case_line, strength_predictions, write_report
@@ -431,21 +432,13 @@ class TensionTest:
         bit for bit that of an uninterrupted run (timings aside)."""
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
-        path = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(path):
-            raise ValueError(f"resume = {out!r}: {path} is missing: the run stopped before "
-                             "its first checkpoint, or was started with --checkpoint-every 0, "
-                             "which writes none; run it again")
+        path = resume_files(out)[1]
         with OutputFolder(out, "tension --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)
             state = checkpoint_extra_state(path)
-            config = config_from_dict(state.get("config") if isinstance(state, dict)
-                                      else None, path)
-            if not isinstance(config, TensionConfig):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular tension")
-            check_device(device)
+            config = stored_run(config_from_dict(state.get("config") if isinstance(state, dict)
+                                                 else None, path), out, cls, "tension", device)
             run = TensionRun(out, config, state.get("arguments"), 1, stop_after, state)
             return cls(config)._run(out, progress, device, run)
 
