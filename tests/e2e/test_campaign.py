@@ -450,7 +450,7 @@ def test_a_campaign_into_a_folder_in_use_is_refused(tmp_path, capsys, monkeypatc
     assert not (out / "campaign.csv").exists() and not (out / "runs").exists()
 
     # a campaign holds its folder while its runs go (no run needed to see it)
-    def run(self, where, **options):
+    def run(self, where, options=None, **settings):
         with pytest.raises(ValueError, match="in use by another pendular run .*campaign"):
             with OutputFolder(out, "a second campaign"):
                 pass
