@@ -71,8 +71,8 @@ from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.procedures.columns import history_columns
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
-    check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
-    stage_steps_parameter)
+    check_loaded_confining, check_particles, config_from_dict, config_to_dict,
+    contact_angle_parameter, registered, stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
@@ -114,8 +114,7 @@ class SwccConfig:
     surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
                                        flag="--surface-tension", help="liquid surface tension")
-    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                     flag="--contact-angle", help="wetting angle")
+    contact_angle: float = contact_angle_parameter()
     form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
                                 help="at wetting, bridges also form across gaps up to this many "
                                      "mean radii (0: at contacts only; 1: wherever a bridge of "

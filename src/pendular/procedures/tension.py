@@ -64,6 +64,7 @@ import h5py
 import numpy as np
 from scipy.spatial import cKDTree
 
+from pendular.capillary import MAX_ROUGHNESS
 from pendular.capillary.volume_control import rupture_distance_for_volume
 from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
 from pendular.dem.simulation import check_device
@@ -72,7 +73,9 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
-    check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
+    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
+    inertial_number, registered)
+from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
     sample_sizes, size_options)
@@ -202,16 +205,15 @@ class TensionConfig:
     cases: list[tuple[float, float]] = parameter(
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001], kind=None, recorded=False,
         help="(core void ratio, gravimetric water content as a fraction) of each case")
-    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=0.5, flag="--roughness",
-                                 help="meniscus separation of touching grains H/R (default "
+    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=MAX_ROUGHNESS,
+                                 flag="--roughness", help="meniscus separation of touching grains H/R (default "
                                       "Kim's sand, as in the regular packing prediction; 0: "
                                       "smooth spheres)")
     form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
                                 help="at wetting, bridges also form across gaps up to this many "
                                      "radii (0: at contacts only; 1: wherever a bridge of the "
                                      "formation suction can exist, docs/direct_tension.md)")
-    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                     flag="--contact-angle", help="wetting angle")
+    contact_angle: float = contact_angle_parameter()
     surface_tension: float = parameter(CHAPTER4_SURFACE_TENSION, unit="N/m", low=0.0,
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
                                        flag="--surface-tension",
@@ -219,7 +221,8 @@ class TensionConfig:
                                             "comparison with Kim and the regular packing "
                                             "prediction uses; triaxial and swcc default to "
                                             "Chapter 5's 0.073)")
-    inertial_number: float = parameter(1e-3, low=0.0, high=0.01, low_inclusive=False,
+    inertial_number: float = parameter(1e-3, low=0.0, high=MAX_INERTIAL_NUMBER,
+                                       low_inclusive=False,
                                        flag="--inertial-number",
                                        help="I = strain rate x d x sqrt(rho / confining) of "
                                             "the pull")
