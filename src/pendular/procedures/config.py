@@ -31,6 +31,8 @@ from pendular.utils.validate import check_int
 #: Most nodes (suction x distance) of a bridge table: about 1 kB of memory per node over the
 #: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
 MAX_TABLE_NODES = 200_000
+#: Fewest nodes of a bridge table along each of its axes (suction, distance).
+MIN_TABLE_NODES = 4
 
 #: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them
 #: (pendular.capillary.liquid_clusters).
@@ -279,7 +281,8 @@ class BridgeConfig:
                            "distance) expected")
             try:
                 self.table_resolution = tuple(
-                    check_int(f"table_resolution[{k}]", value, low=4, high=MAX_TABLE_NODES // 4)
+                    check_int(f"table_resolution[{k}]", value, low=MIN_TABLE_NODES,
+                              high=MAX_TABLE_NODES // MIN_TABLE_NODES)
                     for k, value in enumerate(self.table_resolution))
             except ValueError as error:
                 raise fail(self, "table_resolution", str(error)) from None
@@ -287,7 +290,8 @@ class BridgeConfig:
             if nodes > MAX_TABLE_NODES:
                 raise fail(self, "table_resolution", f"table_resolution = "
                            f"{self.table_resolution!r} has {nodes} nodes, outside the valid range "
-                           f"[16, {MAX_TABLE_NODES}] (suction nodes x distance nodes)")
+                           f"[{MIN_TABLE_NODES ** 2}, {MAX_TABLE_NODES}] (suction nodes x "
+                           "distance nodes)")
 
     def build(self, suction=None, closed=False):
         """The capillary operation (capillary.CapillaryBridges) of this configuration; with a
