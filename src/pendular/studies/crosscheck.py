@@ -251,16 +251,17 @@ def check_packing(config, packing):
                          "cell's corner 0; valid: DIR/packing.txt of a periodic cross-check")
 
 
-def static_packing(config, path, *, settle=True, threads=1, progress=True, device="cpu"):
+def static_packing(config, path, options, settle=True):
     """Load (or prepare, on the CPU: the cache is shared) the cached sample of ``config``,
-    bring it to rest at the confining stress on ``device`` (wetted if ``config.bridges``;
-    ``settle=False``: as loaded), write it to ``path``
-    (pendular.interop.yade.formats.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
-    return the settle report (steps, time, wall or cell stresses and, wet, Sr and bridges)."""
-    sample = config.sample
+    bring it to rest at the confining stress as the RunOptions ``options`` say (its device,
+    threads and progress bars; wetted if ``config.bridges``; ``settle=False``: as loaded),
+    write it to ``path`` (pendular.interop.yade.formats.write_spheres; a periodic cell's box
+    is [0, L], the centres wrapped into it); return the settle report (steps, time, wall or
+    cell stresses and, wet, Sr and bridges)."""
+    sample, progress, threads = config.sample, options.progress, options.threads
     particles, walls, _ = cached_sample(sample, progress=progress, threads=threads)
     sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
-    sim.device = device
+    sim.device = options.device
     bridges = None
     if config.bridges is not None:
         bridges = config.bridges.build()
@@ -480,9 +481,7 @@ class CrossCheck:
                 folder.claim(name)
             exported = os.path.join(out, "packing.txt")
             if packing is None:
-                settled = static_packing(config, exported, settle=self.settle,
-                                         threads=options.threads, progress=options.progress,
-                                         device=options.device)
+                settled = static_packing(config, exported, options, self.settle)
             else:
                 if os.path.abspath(packing) != exported:
                     shutil.copyfile(packing, exported)
