@@ -61,8 +61,6 @@ import time
 from dataclasses import dataclass, field
 
 import h5py
-import numpy as np
-from scipy.spatial import cKDTree
 
 from pendular.capillary import MAX_ROUGHNESS
 from pendular.capillary.volume_control import rupture_distance_for_volume
@@ -206,7 +204,8 @@ class TensionConfig:
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001], kind=None, recorded=False,
         help="(core void ratio, gravimetric water content as a fraction) of each case")
     roughness: float = parameter(KIM_SEPARATION, low=0.0, high=MAX_ROUGHNESS,
-                                 flag="--roughness", help="meniscus separation of touching grains H/R (default "
+                                 flag="--roughness",
+                                 help="meniscus separation of touching grains H/R (default "
                                       "Kim's sand, as in the regular packing prediction; 0: "
                                       "smooth spheres)")
     form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",

@@ -11,18 +11,18 @@ path, tension, swcc), built e.g. with ``dataclasses.replace``::
 ``Campaign.run(out, options)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt
 with its progress bars) with its command's test (run_kinds.Procedure), as the
 pendular.procedures.run_options.RunOptions ``options`` say (or their fields one by one, as
-above): ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned processes (at
-most JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``, on ``device``. It does not lock ``out``: a command holds it as its
-pendular.io.outputs.OutputFolder around the campaign, so that a second campaign into it is
-refused. A run whose folder holds a finished result of an equal configuration
-(``pendular.procedures.config.same_config`` of the configuration stored with it: in sample.h5
-of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted campaign goes
-on where it stopped; so is a shared sample (``samples``) saved with an equal PrepareConfig. The
-campaign's progress bar shows each running run's own progress. A run that fails does not stop
-the others: ``CampaignResult.failed`` names it with its error. A run's summary is the scalars
-of its result (run_kinds.Procedure.summary): a laboratory test's summary.json, the first case
-of a tension run (give each run one void ratio and one water content), the key figures of an
-SWCC (run_kinds.swcc_summary).
+above): ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned processes (at most
+JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``, on ``device``. It does not lock
+``out``: a command holds it as its pendular.io.outputs.OutputFolder around the campaign, so that
+a second campaign into it is refused. A run whose folder holds a finished result of an equal
+configuration (``pendular.procedures.config.same_config`` of the configuration stored with it:
+in sample.h5 of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted
+campaign goes on where it stopped; so is a shared sample (``samples``) saved with an equal
+PrepareConfig. The campaign's progress bar shows each running run's own progress. A run that
+fails does not stop the others: ``CampaignResult.failed`` names it with its error. A run's
+summary is the scalars of its result (run_kinds.Procedure.summary): a laboratory test's
+summary.json, the first case of a tension run (give each run one void ratio and one water
+content), the key figures of an SWCC (run_kinds.swcc_summary).
 
 ``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 

@@ -2,7 +2,8 @@
 
 ``CrossCheck(crosscheck_config(...)).run(out, options)`` (options: a
 pendular.procedures.run_options.RunOptions, or its fields one by one); command ``pendular
-crosscheck``. Needs ``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md lists the differences by design.
+crosscheck``. Needs ``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md
+lists the differences by design.
 
 1. The sample of ``config.sample`` is prepared by pendular (thesis Ch. 5.2.2 at the confining
    stress; cached, pendular.interop.yade.runner.cached_sample, shared with the benchmarks), servoed on its six

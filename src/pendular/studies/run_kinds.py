@@ -75,13 +75,13 @@ def tension_options(config: TensionConfig) -> dict:
 
 @dataclass(frozen=True)
 class Procedure:
-    """How a campaign runs the tests of one command: ``test`` its class (``test(config)``,
-    a laboratory test's with ``force``, checks the configuration; ``.run(folder, options)``
-    runs it, with the options' ``threads`` where ``threaded``), ``config`` its
-    configuration's class, ``result`` the file a finished run leaves with its result, ``summary(result)`` the run's
+    """How a campaign runs the tests of one command: ``test`` its class (``test(config)``, a
+    laboratory test's with ``force``, checks the configuration; ``.run(folder, options)`` runs
+    it, with the options' ``threads`` where ``threaded``), ``config`` its configuration's class,
+    ``result`` the file a finished run leaves with its result, ``summary(result)`` the run's
     summary (the scalars of which are its campaign.csv columns), ``options(config)`` its flat
-    options (the other columns), ``keys`` the numbers a finished laboratory summary holds
-    (else it is damaged and the run is done again). A laboratory test
+    options (the other columns), ``keys`` the numbers a finished laboratory summary holds (else
+    it is damaged and the run is done again). A laboratory test
     (pendular.procedures.laboratory.LaboratoryTest) stores its configuration in its sample.h5,
     the others in their result."""
 
