@@ -7,8 +7,9 @@ q = M p + q0 with M = 6 sin(phi) / (3 - sin(phi)) and q0 = c 6 cos(phi) / (3 - s
 standard errors of phi and c: those of M and q0 from the residual scatter (n - 2 degrees of
 freedom), carried to phi and c to first order (the delta method).
 
-``envelope(runs, out)`` runs drained triaxial compressions at several confining stresses as
-one campaign (pendular.studies.campaign: local processes or a Dask cluster) and fits the
+``envelope(runs, out, options)`` runs drained triaxial compressions at several confining
+stresses as one campaign, as the pendular.procedures.run_options.RunOptions ``options`` say
+(pendular.studies.campaign: local processes or a Dask cluster) and fits the
 envelope to their peaks in net stresses and in the effective stresses of Eq. 3.43 (the wet
 summaries' p' and q' at the peak of q; a dry test's effective stress is its net stress).
 It writes into ``out``: summary.json (its keys declared in pendular.io.schema.SUMMARY_KEYS),
