@@ -94,7 +94,7 @@ def test_library_campaign_of_replaced_configs_keeps_going_past_a_failed_run(tmp_
                           vtk_frames=0)
     runs = [("dry", base),
             Run("broken", dataclasses.replace(base, sample_path=str(tmp_path / "nothing.h5")))]
-    result = Campaign(runs).run(tmp_path / "c", quiet=True)
+    result = Campaign(runs).run(tmp_path / "c", progress=False)
     assert result.reused == [] and list(result.summaries) == ["dry"]
     assert "nothing.h5" in result.failed["broken"] and "log.txt" in result.failed["broken"]
     assert "Traceback" in (tmp_path / "c" / "runs" / "broken" / "log.txt").read_text()
@@ -107,22 +107,22 @@ def test_library_campaign_of_replaced_configs_keeps_going_past_a_failed_run(tmp_
     assert "nothing.h5" in rows["broken"]["error"] and rows["broken"]["peak_q"] == ""
 
     # again: the finished run is reused (equal configuration), a changed one runs again
-    again = Campaign([("dry", base)]).run(tmp_path / "c", quiet=True)
+    again = Campaign([("dry", base)]).run(tmp_path / "c", progress=False)
     assert again.reused == ["dry"]
     assert again.summaries["dry"]["peak_q"] == result.summaries["dry"]["peak_q"]
     changed = dataclasses.replace(base, shear=dataclasses.replace(base.shear, records=50))
-    assert Campaign([("dry", changed)]).run(tmp_path / "c", quiet=True).reused == []
+    assert Campaign([("dry", changed)]).run(tmp_path / "c", progress=False).reused == []
 
 
 def test_a_tension_run_in_a_campaign_is_summarised_and_reused(tmp_path):
     config = TensionConfig(cases=[(0.72, 0.01)], sample=tension_sample(particles=100),
                            max_strain=0.02, vtk_frames=0)
-    result = Campaign([("w1", config)]).run(tmp_path / "t", quiet=True)
+    result = Campaign([("w1", config)]).run(tmp_path / "t", progress=False)
     assert not result.failed
     summary = result.summaries["w1"]
     assert summary["case"] == "e0.72_w1.00" and summary["tensile_strength_pa"] > 0
     assert (tmp_path / "t" / "runs" / "w1" / "tension.json").exists()
-    again = Campaign([("w1", config)]).run(tmp_path / "t", quiet=True)
+    again = Campaign([("w1", config)]).run(tmp_path / "t", progress=False)
     assert again.reused == ["w1"] and again.summaries["w1"] == summary
 
 
@@ -255,7 +255,7 @@ def test_campaign_refuses_bad_runs_before_running(tmp_path):
         Run("a", config_to_dict(config))
     fast = dataclasses.replace(config, shear=ShearConfig(inertial_number=0.5))
     with pytest.raises(ValueError, match="run fast: strain rate .* quasi-static"):
-        Campaign([("fast", fast)]).run(tmp_path / "c", quiet=True)
+        Campaign([("fast", fast)]).run(tmp_path / "c", progress=False)
     assert not (tmp_path / "c" / "runs").exists()
 
 
@@ -450,7 +450,7 @@ def test_a_campaign_into_a_folder_in_use_is_refused(tmp_path, capsys, monkeypatc
     assert not (out / "campaign.csv").exists() and not (out / "runs").exists()
 
     # a campaign holds its folder while its runs go (no run needed to see it)
-    def run(self, where, **options):
+    def run(self, where, options=None, **settings):
         with pytest.raises(ValueError, match="in use by another pendular run .*campaign"):
             with OutputFolder(out, "a second campaign"):
                 pass

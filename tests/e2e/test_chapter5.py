@@ -13,7 +13,7 @@ import sys
 import numpy as np
 import pytest
 
-from pendular.studies.chapter5 import Chapter5Grid, chapter5_campaign, envelopes, write_report
+from pendular.studies.chapter5 import Chapter5Campaign, Chapter5Grid, envelopes, write_report
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.reference import FIG_5_5, TABLE_5_3
 
@@ -45,8 +45,8 @@ def test_grid_from_the_shipped_table_with_overrides():
 
 
 @pytest.mark.parametrize("values, message", [
-    ({"suctions": [-1.0]}, "--suctions [-1.0]: every value must be in [0, inf)"),
-    ({"confining": [0.0]}, "--confining [0.0]: every value must be in (0, inf)"),
+    ({"suctions": [-1.0]}, "suctions = -1.0 Pa is outside the valid range [0, inf] Pa"),
+    ({"confining": [0.0]}, "confining = 0.0 Pa is outside the valid range (0, 1e+07] Pa"),
     ({"confining": [500, 500]}, "must not repeat a value"),
     ({"suctions": []}, "--suctions: at least one value expected"),
 ])
@@ -244,10 +244,10 @@ def test_campaign_on_a_dask_cluster(tmp_path):
                         max_strain=0.01, inertial_number=3e-3)
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
-        campaign, reused = chapter5_campaign(grid, out, scheduler=cluster.scheduler_address,
-                                             quiet=True)
+        campaign = Chapter5Campaign(grid).run(out, scheduler=cluster.scheduler_address,
+                                              progress=False)
     runs = campaign["runs"]
-    assert reused == 0 and sorted(r["confining"] for r in runs) == [500, 1000]
+    assert campaign["reused"] == 0 and sorted(r["confining"] for r in runs) == [500, 1000]
     for run in runs:
         assert run["peak_axial_stress"] > run["confining"]
         assert 0.0 < run["saturation_at_peak"] < 1.0

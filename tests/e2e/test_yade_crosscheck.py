@@ -65,7 +65,7 @@ def check_result(result, max_strain, tolerance=0.01):
 def test_wet_crosscheck_agrees(tmp_path):
     config = crosscheck.crosscheck_config(particles=300, suction=30000.0, max_strain=0.01,
                                           records=50, mimic_yade=True)
-    result = crosscheck.run_crosscheck(config, tmp_path, progress=False)
+    result = crosscheck.CrossCheck(config).run(tmp_path, progress=False)
     assert json.loads((tmp_path / "crosscheck.json").read_text())["peak_q_rel_diff"] == \
         result["peak_q_rel_diff"]
     assert_drawn(tmp_path / "crosscheck.png")
@@ -84,7 +84,7 @@ def test_wet_crosscheck_agrees(tmp_path):
 def test_periodic_crosscheck_agrees(tmp_path):
     config = crosscheck.crosscheck_config(particles=300, max_strain=0.03, records=30,
                                           periodic=True)
-    result = crosscheck.run_crosscheck(config, tmp_path, progress=False)
+    result = crosscheck.CrossCheck(config).run(tmp_path, progress=False)
     check_result(result, 0.03)
     assert result["periodic"] and result["yade"]["controller"]["controller"] == \
         "PeriTriaxController"
@@ -121,7 +121,7 @@ def test_pendular_half_against_itself(tmp_path, monkeypatch):
     monkeypatch.setattr(crosscheck, "yade_capillary_files", fake_files)
     monkeypatch.setattr(crosscheck, "run_yade_triaxial", fake_run)
     out = tmp_path / "out"
-    result = crosscheck.run_crosscheck(config, out, progress=False)
+    result = crosscheck.CrossCheck(config).run(out, progress=False)
 
     check_result(result, 0.004, tolerance=1.0 / 8 + 0.01)
     for key in DIFFERENCES:
@@ -144,8 +144,8 @@ def test_pendular_half_against_itself(tmp_path, monkeypatch):
     assert settings["stress_damping"] == pytest.approx(1.0 - result["servo"]["gain"])
     assert settings["max_vel"] == result["servo"]["max_velocity"]
     # a second cross-check shears the exported packing again without settling
-    again = crosscheck.run_crosscheck(config, tmp_path / "again", packing=out / "packing.txt",
-                                      progress=False)
+    again = crosscheck.CrossCheck(config, packing=out / "packing.txt").run(tmp_path / "again",
+                                                                          progress=False)
     assert again["settle"] == {"from": str(out / "packing.txt")}
     assert again["pendular"]["peak_q"] == result["pendular"]["peak_q"]
 
@@ -165,7 +165,7 @@ def test_periodic_pendular_half_against_itself(tmp_path, monkeypatch):
     monkeypatch.setattr(crosscheck, "find_yade", lambda: "yade")
     monkeypatch.setattr(crosscheck, "run_yade_triaxial", fake_run)
     out = tmp_path / "out"
-    result = crosscheck.run_crosscheck(config, out, progress=False)
+    result = crosscheck.CrossCheck(config).run(out, progress=False)
     check_result(result, 0.004, tolerance=1.0 / 8 + 0.01)
     assert result["peak_q_rel_diff"] == result["start_sigma_rel_diff"] == 0.0
     assert result["periodic"] and result["pendular"]["lateral_stress_max_rel_error"] < 0.05
@@ -179,7 +179,7 @@ def test_periodic_pendular_half_against_itself(tmp_path, monkeypatch):
     write_spheres(walled, position + 1e-6, np.full(len(position), 2.4e-5), lo + 1e-6,
                   hi + 1e-6)
     with pytest.raises(ValueError, match="packing = .*box_lo"):
-        crosscheck.run_crosscheck(config, tmp_path / "again", packing=walled, progress=False)
+        crosscheck.CrossCheck(config, packing=walled)
 
 
 @requires("yade")
@@ -191,7 +191,7 @@ def test_hertz_mindlin_crosscheck_agrees(tmp_path):
     within 5 %."""
     config = crosscheck.crosscheck_config(particles=300, max_strain=0.01, records=30,
                                           contact="hertz-mindlin", mimic_yade=True)
-    result = crosscheck.run_crosscheck(config, tmp_path, progress=False)
+    result = crosscheck.CrossCheck(config).run(tmp_path, progress=False)
     check_result(result, 0.01)
     assert json.loads((tmp_path / "yade_result.json").read_text())["contact"] == "hertz-mindlin"
     assert result["start_sigma_rel_diff"] < START_TOLERANCE

@@ -31,10 +31,10 @@ def measure(folder):
     crosscheck.find_yade = lambda: "yade"
     crosscheck.yade_capillary_files = lambda contact_angle: folder
     crosscheck.run_yade_triaxial = stand_in
-    cpu = crosscheck.run_crosscheck(config, os.path.join(folder, "cpu"), progress=False)
+    cpu = crosscheck.CrossCheck(config).run(os.path.join(folder, "cpu"), progress=False)
     packing = os.path.join(folder, "cpu", "packing.txt")
-    gpu = crosscheck.run_crosscheck(config, os.path.join(folder, "gpu"), packing=packing,
-                                    progress=False, device="gpu")
+    gpu = crosscheck.CrossCheck(config, packing=packing).run(os.path.join(folder, "gpu"),
+                                                             progress=False, device="gpu")
 
     def history(run):
         path = os.path.join(folder, run, "pendular_history.h5")

@@ -1,6 +1,6 @@
-"""The YADE cross-check with pendular's shear on the GPU (``run_crosscheck(device="gpu")``,
-``pendular crosscheck --device gpu``), under Numba's CUDA simulator in a process of its own
-(tests/gpu/crosscheck_checks.py).
+"""The YADE cross-check with pendular's shear on the GPU (``CrossCheck(config).run(out,
+device="gpu")``, ``pendular crosscheck --device gpu``), under Numba's CUDA simulator in a
+process of its own (tests/gpu/crosscheck_checks.py).
 
 YADE is replaced by pendular on the CPU (as tests/e2e/test_yade_crosscheck.py does without
 YADE): a 60-sphere wet packing (30 kPa) settled and exported by a CPU cross-check is sheared

@@ -205,7 +205,7 @@ def test_the_inference_recovers_a_parameter_and_reports_one_it_cannot_see(tmp_pa
         def __init__(self, runs):
             self.runs = runs
 
-        def run(self, out, **settings):
+        def run(self, out, options=None, **settings):
             for run in self.runs:
                 configs[os.path.join(out, "runs", run.name)] = run.config
             return CampaignResult(self.runs, summaries={run.name: {} for run in self.runs})

@@ -64,7 +64,8 @@ CASES = {
     "swcc contact angle 2**64": ("swcc", ["--contact-angle", BIG], ["--contact-angle",
                                                                      "[0, 90) deg"]),
     "chapter5 particles 2**64": ("chapter5", ["--particles", BIG], ["particles", "10000000"]),
-    "chapter5 suctions nan": ("chapter5", ["--suctions", "nan"], ["--suctions", "[0, inf)"]),
+    "chapter5 suctions nan": ("chapter5", ["--suctions", "nan"], ["--suctions", "[0, inf]"]),
+    "chapter5 confining 0": ("chapter5", ["--confining", "0"], ["--confining", "(0, 1e+07]"]),
     "chapter5 max strain nan": ("chapter5", ["--max-strain", "nan"], ["--max-strain",
                                                                        "not finite"]),
 }

@@ -219,6 +219,20 @@ def test_resuming_a_run_stopped_before_its_sample_says_so(tmp_path, capsys):
     assert "checkpoint_every" not in line
 
 
+@pytest.mark.parametrize("command, missing, words", [
+    ("swcc", "sample.h5", ["before its sample existed (in the preparation)"]),
+    ("tension", "checkpoint.h5", ["before its first checkpoint", "--checkpoint-every 0"]),
+])
+def test_every_resume_refuses_a_folder_without_its_files_as_the_tests_do(command, missing, words,
+                                                                       tmp_path, capsys):
+    """The SWCC and the direct tension check the folder of a resume as the laboratory tests
+    do (pendular.procedures.resume): one line naming the folder and the missing file."""
+    folder = tmp_path / "stopped"
+    folder.mkdir()
+    refused(*run_in_process(command, ["--resume", str(folder)], capsys),
+            f"resume = {str(folder)!r}", f"{missing} is missing", *words, "run it again")
+
+
 # ---------------------------------------------------------------- direct tension's water
 def test_a_water_content_too_low_for_the_compared_packing_names_it_and_its_range(tmp_path,
                                                                                 capsys):

@@ -22,8 +22,8 @@ F* = F/(2 pi gamma R2), nn_ii = (1/R2**2) ∫ n_i n_i dS; angles in degrees.
 
 from pendular.capillary.bridge_state import BridgeState
 from pendular.capillary.clusters import Clusters, find_clusters
-from pendular.capillary.bridges import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION,
-    CapillaryBridges, SuctionBridges, VolumeBridges)
+from pendular.capillary.bridges import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_ROUGHNESS,
+    SURFACE_TENSION, CapillaryBridges, SuctionBridges, VolumeBridges)
 from pendular.capillary.meniscus import Bridge, solve_bridge
 from pendular.capillary.pores import PoreUnits, decompose, entry_suction
 from pendular.capillary.radius_ratios import sample_radius_ratios, table_radius_ratios
@@ -32,7 +32,7 @@ from pendular.capillary.suction_control import (bridge_at_distance, lowest_dista
 from pendular.capillary.table import (FIELDS, YADE_RADIUS_RATIOS, BridgeTable, cache_directory,
     lookup_suction)
 from pendular.capillary.toroidal import ToroidalBridge, toroidal_bridge
-from pendular.capillary.validation import MAX_SOLVER_RADIUS_RATIO
+from pendular.capillary.validation import MAX_CONTACT_ANGLE, MAX_SOLVER_RADIUS_RATIO
 from pendular.capillary.volume_control import (CONTACT_SUCTION_MAX, bridge_with_volume,
     rupture_distance_for_volume, volume_contour)
 from pendular.capillary.volume_table import VOLUME_FIELDS, VolumeBridgeTable, lookup_volume

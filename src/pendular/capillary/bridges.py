@@ -105,6 +105,9 @@ CONTROLS = ("suction", "volume")
 #: Where the liquid of volume-controlled bridges comes from and goes (``liquid``): an outside
 #: reservoir, or a closed amount shared among the grains' bridges on rupture, or lost on rupture.
 LIQUID_MODELS = ("reservoir", "shared", "lost")
+#: Largest meniscus separation of touching spheres H / R2 (a rough grain's, thesis Ch. 4) that
+#: volume-controlled bridges take: ``roughness`` in [0, MAX_ROUGHNESS].
+MAX_ROUGHNESS = 0.5
 
 
 class _ByControl(type):
@@ -531,8 +534,8 @@ class VolumeBridges(CapillaryBridges):
     from its volume and gap, and it persists across gaps up to its volume-controlled rupture
     distance (capillary.VolumeBridgeTable). Exact tables only.
 
-    roughness: meniscus separation of touching spheres H / R2 in [0, 0.5] (rough grains,
-        thesis Ch. 4's H/R; 0: smooth spheres, the default);
+    roughness: meniscus separation of touching spheres H / R2 in [0, MAX_ROUGHNESS] (rough
+        grains, thesis Ch. 4's H/R; 0: smooth spheres, the default);
     liquid: "reservoir" (default), "shared" or "lost" (LIQUID_MODELS, module docstring);
         ``close_liquid`` closes a reservoir-wetted sample's liquid later.
     The other parameters are CapillaryBridges'.
@@ -544,7 +547,7 @@ class VolumeBridges(CapillaryBridges):
     def __init__(self, suction, surface_tension=SURFACE_TENSION, contact_angle=0.0,
                  roughness=0.0, liquid="reservoir", table_options=None):
         super().__init__(suction, surface_tension, contact_angle, "exact", table_options)
-        self.roughness = check_range("roughness", roughness, 0.0, 0.5)
+        self.roughness = check_range("roughness", roughness, 0.0, MAX_ROUGHNESS)
         self.volume_table = None
         self.liquid_initial = None       # [m^3] at closing (None: open liquid)
         self.liquid_lost = 0.0           # [m^3] since closing
@@ -680,7 +683,7 @@ def bridges_by_control(suction, surface_tension=SURFACE_TENSION, contact_angle=0
             raise ValueError("volume-controlled bridges need model='exact'")
         return VolumeBridges(suction, surface_tension, contact_angle, roughness=roughness,
                              liquid=liquid, table_options=table_options)
-    roughness = check_range("roughness", roughness, 0.0, 0.5)
+    roughness = check_range("roughness", roughness, 0.0, MAX_ROUGHNESS)
     if roughness > 0.0:
         raise ValueError(f"roughness = {roughness:g} needs control='volume' (suction-"
                          "controlled bridges are between smooth spheres: roughness 0)")

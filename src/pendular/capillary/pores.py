@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
+from pendular.capillary.validation import check_contact_angle
 from pendular.utils.validate import check_array, check_range
 
 #: The six edges of a tetrahedron as vertex pairs (a, b), and the other two vertices (c, d).
@@ -195,8 +196,7 @@ def entry_suction(throat_radius, surface_tension, contact_angle=0.0):
     (``surface_tension`` gamma [N/m], ``contact_angle`` theta [deg]); inf for a closed throat."""
     gamma = check_range("surface_tension", surface_tension, 0.0, math.inf, low_inclusive=False,
                         unit="N/m")
-    theta = check_range("contact_angle", contact_angle, 0.0, 90.0, high_inclusive=False,
-                        unit="deg")
+    theta = check_contact_angle(contact_angle)
     r = np.asarray(throat_radius, dtype=float)
     with np.errstate(divide="ignore"):
         return np.where(r > 0, 2.0 * gamma * math.cos(math.radians(theta)) / r, np.inf)

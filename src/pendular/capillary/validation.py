@@ -3,10 +3,13 @@
 import math
 
 from pendular.dem.contact_law import normal_stiffness
-from pendular.utils.validate import check_positive, finite_number  # noqa: F401  (shared checks)
+from pendular.utils.validate import check_positive, check_range, finite_number  # noqa: F401
 
 MAX_SOLVER_RADIUS_RATIO = 20.0
 """Largest R2/R1 the exact solver accepts (its accuracy is verified up to this value)."""
+MAX_CONTACT_ANGLE = 90.0
+"""Wetting angles theta [deg] of a pendular bridge: [0, MAX_CONTACT_ANGLE) (a meniscus that
+wets the grains: its filling angle lies in (0, 90 - theta])."""
 
 
 def check_radius_ratio(radius_ratio, largest=MAX_SOLVER_RADIUS_RATIO):
@@ -20,11 +23,9 @@ def check_radius_ratio(radius_ratio, largest=MAX_SOLVER_RADIUS_RATIO):
 
 
 def check_contact_angle(contact_angle):
-    """theta in [0, 90) degrees."""
-    contact_angle = finite_number("contact_angle", contact_angle, "[0, 90) deg")
-    if not 0.0 <= contact_angle < 90.0:
-        raise ValueError(f"contact_angle = {contact_angle} deg is outside the valid range [0, 90) deg")
-    return contact_angle
+    """theta in [0, MAX_CONTACT_ANGLE) degrees."""
+    return check_range("contact_angle", contact_angle, 0.0, MAX_CONTACT_ANGLE,
+                       high_inclusive=False, unit="deg")
 
 
 def check_suction(suction_star):

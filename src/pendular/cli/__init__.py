@@ -148,8 +148,10 @@ def add_executor_options(parser):
 
 def start_executor_run(args):
     """Check the options of add_executor_options and --out before anything is made (errors
-    naming the option; --device: that it can run here), and apply --threads."""
+    naming the option; --device: that it can run here), and apply --threads; the
+    pendular.procedures.run_options.RunOptions of them, passed once to the command's run."""
     from pendular.dem.simulation import check_device
+    from pendular.procedures.run_options import RunOptions
     from pendular.studies.campaign import check_jobs
 
     if args.out == "":
@@ -157,6 +159,8 @@ def start_executor_run(args):
     set_threads(args.threads)
     check_jobs(args.jobs)
     check_device(args.device)
+    return RunOptions(device=args.device, threads=args.threads, progress=not args.quiet,
+                      jobs=args.jobs, scheduler=args.scheduler)
 
 
 def add_declared_options(parser, options):

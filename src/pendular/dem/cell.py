@@ -44,6 +44,10 @@ from pendular.utils.validate import check_array, check_range
 from pendular.dem.virial import (SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds,
     sum_blocks)
 
+#: Largest rate a boundary is driven at [1/s]: the walls' strain rate
+#: (pendular.dem.walls.ConstantStrainRate), the cell's shear rate (ConstantShearRate).
+MAX_STRAIN_RATE = 1e6
+
 
 @numba.njit(cache=True, parallel=True)
 def pair_virial(position, row_start, pair_j, image, period, pair_force):
@@ -345,8 +349,8 @@ class ConstantShearRate:
     step (the cell's rate returns to zero after the forces). Walls cannot shear a sample:
     ValueError on a walled scene."""
 
-    #: Largest shear rate [1/s] (ConstantStrainRate's bound on a strain rate).
-    MAX_RATE = 1e6
+    #: Largest shear rate [1/s].
+    MAX_RATE = MAX_STRAIN_RATE
 
     def __init__(self, rate):
         self.rate = check_range("shear_rate", rate, -self.MAX_RATE, self.MAX_RATE, unit="1/s")

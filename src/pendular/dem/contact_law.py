@@ -30,6 +30,12 @@ from pendular.utils.validate import check_positive, check_range
 from pendular.dem.virial import (SUM_BLOCKS, add_face_block, block_bounds,
     pair_force_with_attraction)
 
+#: Largest ratio ks / kn of the tangential to the normal stiffness of a contact [-]
+#: (``shear_ratio`` in [0, MAX_SHEAR_RATIO]).
+MAX_SHEAR_RATIO = 10.0
+#: Coulomb friction angles of a contact [deg]: [0, MAX_FRICTION_DEG) (a finite tan).
+MAX_FRICTION_DEG = 90.0
+
 
 @numba.njit(cache=True, inline="always")
 def normal_stiffness(young, radius_i, radius_j):
@@ -521,7 +527,7 @@ class ContactForces:
 
     def __init__(self, young, shear_ratio=0.3, friction_deg=18.0):
         self.young = check_positive("young", young, "Pa")
-        self.shear_ratio = check_range("shear_ratio", shear_ratio, 0.0, 10.0)
+        self.shear_ratio = check_range("shear_ratio", shear_ratio, 0.0, MAX_SHEAR_RATIO)
         self.friction_deg = friction_deg
 
     @property
@@ -530,8 +536,8 @@ class ContactForces:
 
     @friction_deg.setter
     def friction_deg(self, value):
-        self._friction_deg = check_range("friction_deg", value, 0.0, 90.0, high_inclusive=False,
-                                         unit="deg")
+        self._friction_deg = check_range("friction_deg", value, 0.0, MAX_FRICTION_DEG,
+                                         high_inclusive=False, unit="deg")
         self._tan_friction = float(np.tan(np.radians(self._friction_deg)))
 
     def state_dict(self):

@@ -49,8 +49,8 @@ import numba
 import numpy as np
 
 from pendular.dem import HOT_KERNEL_FASTMATH
-from pendular.dem.contact_law import (ContactForces, _contact_gap, _first_member,
-    _prefetch_second, _row_sums, _scatter_to_both, _store_row_sums, _stretched,
+from pendular.dem.contact_law import (MAX_SHEAR_RATIO, ContactForces, _contact_gap,
+    _first_member, _prefetch_second, _row_sums, _scatter_to_both, _store_row_sums, _stretched,
     _turned_contact, normal_stiffness, wall_contact_stiffness)
 from pendular.dem.prefetch import prefetch_distance
 from pendular.dem.protocols import state_array
@@ -396,7 +396,8 @@ class DampedLinearForces(_DampedContactForces):
 
     def __init__(self, young, shear_ratio=0.3, restitution=1.0, friction_deg=18.0):
         self.young = self.modulus = check_positive("young", young, "Pa")
-        self.shear_ratio = self.tangential = check_range("shear_ratio", shear_ratio, 0.0, 10.0)
+        self.shear_ratio = self.tangential = check_range("shear_ratio", shear_ratio, 0.0,
+                                                         MAX_SHEAR_RATIO)
         self.restitution = restitution
         self.friction_deg = friction_deg
 

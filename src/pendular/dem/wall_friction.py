@@ -26,13 +26,14 @@ law for every sphere–wall contact. With phi_w = 0 a scene keeps the frictionle
 pendular.dem.walls.WallForces (``wall_law``), bit for bit as before.
 """
 
+from pendular.dem.contact_law import MAX_FRICTION_DEG
 from pendular.dem.hertz_mindlin import (DampedLinearForces, ViscoelasticWallForces,
     _DampedContactForces)
 from pendular.dem.walls import WallForces
 from pendular.utils.validate import check_range
 
-#: Valid wall friction angles [deg]: [0, 90).
-WALL_FRICTION_RANGE = (0.0, 90.0)
+#: Valid wall friction angles [deg]: [0, 90), a contact's (MAX_FRICTION_DEG).
+WALL_FRICTION_RANGE = (0.0, MAX_FRICTION_DEG)
 
 
 def check_wall_friction(friction_deg):

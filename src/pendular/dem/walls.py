@@ -9,7 +9,7 @@ import math
 import numba
 import numpy as np
 
-from pendular.dem.cell import servo_cell
+from pendular.dem.cell import MAX_STRAIN_RATE, servo_cell
 from pendular.dem.contact_law import wall_forces
 from pendular.dem.protocols import state_array
 from pendular.utils.validate import check_int, check_positive, check_range
@@ -204,7 +204,7 @@ class ConstantStrainRate:
     """
 
     #: Largest strain rate [1/s].
-    MAX_RATE = 1e6
+    MAX_RATE = MAX_STRAIN_RATE
 
     def __init__(self, axis, rate, reference_length, on_current_length=False):
         (self.axis,) = _axes(axis)

@@ -18,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from pendular.capillary import BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, SURFACE_TENSION
+from pendular.capillary import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_CONTACT_ANGLE,
+    MAX_ROUGHNESS, SURFACE_TENSION)
 from pendular.dem.sample import load_sample
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
@@ -30,6 +31,8 @@ from pendular.utils.validate import check_int
 #: Most nodes (suction x distance) of a bridge table: about 1 kB of memory per node over the
 #: ten radius ratios, 7 times the exact default (350 x 80); beyond, building takes hours.
 MAX_TABLE_NODES = 200_000
+#: Fewest nodes of a bridge table along each of its axes (suction, distance).
+MIN_TABLE_NODES = 4
 
 #: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them
 #: (pendular.capillary.liquid_clusters).
@@ -88,6 +91,13 @@ def stage_steps_parameter(default, help):
     which stage)."""
     return parameter(default, kind=int, low=1, high=MAX_STAGE_STEPS, flag="--stage-steps",
                      help=help)
+
+
+def contact_angle_parameter(help="wetting angle", **changes):
+    """The field of a wet test's wetting angle [deg], in [0, MAX_CONTACT_ANGLE) (``help``;
+    ``changes``: e.g. ``unset``)."""
+    return parameter(0.0, unit="deg", low=0.0, high=MAX_CONTACT_ANGLE, high_inclusive=False,
+                     flag="--contact-angle", help=help, **changes)
 
 
 def strain_rate_parameter():
@@ -225,9 +235,7 @@ class BridgeConfig:
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
                                        flag="--surface-tension", unset=True,
                                        help="liquid surface tension (wet test)")
-    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                     flag="--contact-angle", unset=True,
-                                     help="wetting angle (wet test)")
+    contact_angle: float = contact_angle_parameter("wetting angle (wet test)", unset=True)
     model: str = parameter("exact", kind=str, choices=BRIDGE_MODELS, flag="--bridges",
                            unset=True,
                            help="bridge model of the wet test: exact Young-Laplace tables "
@@ -237,7 +245,7 @@ class BridgeConfig:
     persist: bool = parameter(False, kind=bool, flag="--persist-bridges",
                               help="bridges live up to their rupture distance instead of "
                                    "breaking when contact is lost")
-    roughness: float = parameter(0.0, low=0.0, high=0.5,
+    roughness: float = parameter(0.0, low=0.0, high=MAX_ROUGHNESS,
                                  help="meniscus separation of touching spheres H / R2")
     table_resolution: tuple[int, int] | None = parameter(
         None, kind=None, flag="--table-resolution",
@@ -273,7 +281,8 @@ class BridgeConfig:
                            "distance) expected")
             try:
                 self.table_resolution = tuple(
-                    check_int(f"table_resolution[{k}]", value, low=4, high=MAX_TABLE_NODES // 4)
+                    check_int(f"table_resolution[{k}]", value, low=MIN_TABLE_NODES,
+                              high=MAX_TABLE_NODES // MIN_TABLE_NODES)
                     for k, value in enumerate(self.table_resolution))
             except ValueError as error:
                 raise fail(self, "table_resolution", str(error)) from None
@@ -281,7 +290,8 @@ class BridgeConfig:
             if nodes > MAX_TABLE_NODES:
                 raise fail(self, "table_resolution", f"table_resolution = "
                            f"{self.table_resolution!r} has {nodes} nodes, outside the valid range "
-                           f"[16, {MAX_TABLE_NODES}] (suction nodes x distance nodes)")
+                           f"[{MIN_TABLE_NODES ** 2}, {MAX_TABLE_NODES}] (suction nodes x "
+                           "distance nodes)")
 
     def build(self, suction=None, closed=False):
         """The capillary operation (capillary.CapillaryBridges) of this configuration; with a

@@ -49,6 +49,7 @@ from pendular.procedures.feasibility import check_feasible
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
     servoed_simulation, timestep, timestep_description)
 from pendular.procedures.progress import laboratory_plan
+from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
 from pendular.utils.atomic import write_json
 from pendular.utils.integrity import checksum, config_hash
@@ -295,25 +296,19 @@ class LaboratoryTest:
         wrote the checkpoint); returns the summary."""
         options = RunOptions.of(options, **settings)
         device = options.device
-        sample_file = os.path.join(out, "sample.h5")
-        checkpoint = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(sample_file):
-            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
-                             "before its sample existed (in the preparation or the wetting), "
-                             "so nothing can be resumed; run it again")
-        if not os.path.exists(checkpoint):
+
+        def no_checkpoint(sample_file):
             stored = config_from_dict(load_sample(sample_file)[3].get("config"), sample_file)
-            why = ("the run stopped before its first checkpoint" if
-                   getattr(stored, "checkpoint_every", 0) > 0 else
-                   "the run was started with --checkpoint-every 0, which writes none")
-            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: {why}; run it again")
+            return ("the run stopped before its first checkpoint" if
+                    getattr(stored, "checkpoint_every", 0) > 0 else
+                    "the run was started with --checkpoint-every 0, which writes none")
+
+        sample_file, checkpoint = resume_files(out, "in the preparation or the wetting",
+                                               no_checkpoint)
         with OutputFolder(out, f"{cls.NAME} --resume", keep=True) as folder:
             particles, walls, _, before_shear = load_sample(sample_file)
-            config = config_from_dict(before_shear.get("config"), sample_file)
-            if not isinstance(config, cls.CONFIG):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular {cls.NAME}")
-            check_device(device)
+            config = stored_run(config_from_dict(before_shear.get("config"), sample_file), out,
+                                cls, cls.NAME, device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=options.threads)
             if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint

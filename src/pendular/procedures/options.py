@@ -21,7 +21,7 @@ from typing import Callable
 
 from pendular.dem.grading import MAX_RADIUS_RATIO, read_grading_curve
 from pendular.procedures.config import (BridgeConfig, LaboratoryConfig, MIN_SAMPLE_PARTICLES,
-    PathConfig, ShearConfig, check_steps_count)
+    MIN_TABLE_NODES, PathConfig, ShearConfig, check_steps_count)
 from pendular.procedures.preparation import PrepareConfig
 from pendular.utils.parameters import (Option, OptionError, Parameter, ParameterError, fields_of,
     flag_of, option_from, option_of, spec_of)
@@ -110,9 +110,9 @@ def table_resolution(value):
         nodes = tuple(int(v) for v in (value.split(",") if isinstance(value, str) else value))
     except (TypeError, ValueError):
         nodes = ()
-    if len(nodes) != 2 or min(nodes) < 4:
+    if len(nodes) != 2 or min(nodes) < MIN_TABLE_NODES:
         raise OptionError(lambda name: f"{name('table_resolution')} {value!r}: two integers "
-                                       "NS,ND, each in [4, inf), expected")
+                                       f"NS,ND, each in [{MIN_TABLE_NODES}, inf), expected")
     return nodes
 
 

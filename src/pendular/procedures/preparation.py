@@ -27,7 +27,7 @@ import numpy as np
 
 from pendular.dem import growth
 from pendular.dem.cell import PeriodicCell
-from pendular.dem.contact_law import ContactForces
+from pendular.dem.contact_law import MAX_FRICTION_DEG, MAX_SHEAR_RATIO, ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.gravity import MAX_GRAVITY, Gravity
 from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinearForces,
@@ -165,8 +165,8 @@ class PrepareConfig:
                                 help="porosity of the initial cloud box (not with --sample)")
     young: float = parameter(1e6, unit="Pa", low=0.0, low_inclusive=False, flag="--young",
                              help="YADE young E, kn = E R")
-    shear_ratio: float = parameter(0.3, low=0.0, high=10.0, help="contact stiffness ratio "
-                                   "ks / kn")
+    shear_ratio: float = parameter(0.3, low=0.0, high=MAX_SHEAR_RATIO,
+                                   help="contact stiffness ratio ks / kn")
     contact: str = parameter("linear", kind=str, choices=CONTACT_LAWS, flag="--contact",
                              help="contact law: linear springs (kn = E R, ks = 0.3 kn), or "
                                   "Hertz-Mindlin from the grains' E and --poisson, its time "
@@ -178,10 +178,12 @@ class PrepareConfig:
                                    flag="--restitution",
                                    help="coefficient of restitution of a contact, normal and "
                                         "tangential: viscous damping, 1 none")
-    friction_deg: float = parameter(18.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                    flag="--friction", help="contact friction")
+    friction_deg: float = parameter(18.0, unit="deg", low=0.0, high=MAX_FRICTION_DEG,
+                                    high_inclusive=False, flag="--friction",
+                                    help="contact friction")
     prep_friction_deg: float = parameter(
-        0.5, unit="deg", low=0.0, high=90.0, high_inclusive=False, flag="--prep-friction",
+        0.5, unit="deg", low=0.0, high=MAX_FRICTION_DEG, high_inclusive=False,
+        flag="--prep-friction",
         help="contact friction during the radius growth (thesis 0.5; higher gives a looser "
              "sample; not with --sample)")
     rolling_friction: float = parameter(

@@ -6,10 +6,15 @@ direct tension's TensionTest, the SWCC's SwccTest), a RunOptions holding what is
 the configuration: the device, the Numba threads, the progress bars, the checkpoints of a
 run whose configuration does not hold them (tension, swcc), a stop after some steps (as an
 interruption would), the expert override of the feasibility checks, the ParaView frames of
-the preparation and the figures. The results depend on none of them: a run on 1 or 2
-threads, with or without bars or frames, is the same bit for bit; a checkpoint resumes on
-either device. A run's keyword arguments, e.g. ``run(out, progress=False, threads=1)``, are
-the same options given one by one (``RunOptions.of``).
+the preparation and the figures. The commands that run many tests or another code run so
+too, with the same options and their own: a campaign (pendular.studies.campaign.Campaign,
+``pendular campaign``), the Chapter 5 campaign (pendular.studies.chapter5.Chapter5Campaign)
+with their local processes or Dask cluster, the YADE cross-check
+(pendular.studies.crosscheck.CrossCheck) with YADE run beside pendular's shear. The results
+depend on none of them: a run on 1 or 2 threads, with or without bars or frames, in one
+process or several, is the same bit for bit; a checkpoint resumes on either device. A run's
+keyword arguments, e.g. ``run(out, progress=False, threads=1)``, are the same options given
+one by one (``RunOptions.of``).
 """
 
 from __future__ import annotations
@@ -28,7 +33,10 @@ class RunOptions:
     as not quasi-static or too long (experts; checked when the test is made); vtk_prep:
     ParaView frames of the preparation and wetting (True, a period in steps, or False);
     plots: write the figures; arguments: the command line's options, recorded by a direct
-    tension in its tension.json."""
+    tension in its tension.json; jobs: local processes of a campaign's runs
+    (pendular.studies.campaign.check_jobs); scheduler: the address of the Dask cluster that
+    runs them instead (None: local processes); concurrent: a cross-check runs YADE while
+    pendular shears (each code's timing then shares the machine with the other)."""
 
     device: str = "cpu"
     threads: int | None = None
@@ -39,6 +47,9 @@ class RunOptions:
     vtk_prep: bool | int = False
     plots: bool = True
     arguments: dict | None = None
+    jobs: int = 1
+    scheduler: str | None = None
+    concurrent: bool = False
 
     @classmethod
     def of(cls, options=None, **settings):

@@ -71,8 +71,8 @@ from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.procedures.columns import history_columns
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
-    check_loaded_confining, check_particles, config_from_dict, config_to_dict, registered,
-    stage_steps_parameter)
+    check_loaded_confining, check_particles, config_from_dict, config_to_dict,
+    contact_angle_parameter, registered, stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
@@ -83,6 +83,7 @@ from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepa
     servoed_simulation, static)
 from pendular.procedures.progress import swcc_plan
 from pendular.procedures.reference import FIG_5_5
+from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
 from pendular.utils.atomic import write_json
 from pendular.utils.parameters import fail, fields_of, option_of, parameter, validate
@@ -113,8 +114,7 @@ class SwccConfig:
     surface_tension: float = parameter(SURFACE_TENSION, unit="N/m", low=0.0,
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
                                        flag="--surface-tension", help="liquid surface tension")
-    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                     flag="--contact-angle", help="wetting angle")
+    contact_angle: float = contact_angle_parameter()
     form_gap: float = parameter(1.0, low=0.0, high=1.0, flag="--form-gap",
                                 help="at wetting, bridges also form across gaps up to this many "
                                      "mean radii (0: at contacts only; 1: wherever a bridge of "
@@ -236,25 +236,13 @@ class SwccTest:
         options = RunOptions.of(options, **settings)
         progress, threads, device = options.progress, options.threads, options.device
         stop_after = options.stop_after
-        sample_file = os.path.join(out, "sample.h5")
-        checkpoint = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(sample_file):
-            raise ValueError(f"resume = {out!r}: {sample_file} is missing: the run stopped "
-                             "before its sample existed (in the preparation), so nothing can "
-                             "be resumed; run it again")
-        if not os.path.exists(checkpoint):
-            raise ValueError(f"resume = {out!r}: {checkpoint} is missing: the run stopped "
-                             "before its first checkpoint, or was started with "
-                             "--checkpoint-every 0, which writes none; run it again")
+        sample_file, checkpoint = resume_files(out, "in the preparation")
         with OutputFolder(out, "swcc --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)
             particles, walls, preparation, stored = load_sample(sample_file)
-            config = config_from_dict(stored.get("config"), sample_file)
-            if not isinstance(config, SwccConfig):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular swcc")
-            check_device(device)
+            config = stored_run(config_from_dict(stored.get("config"), sample_file), out, cls,
+                                "swcc", device)
             sim = servoed_simulation(particles, walls, config.sample, config.sample.confining,
                                      threads=threads)
             test = cls.__new__(cls)          # the stored run, checked when it started

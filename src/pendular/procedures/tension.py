@@ -61,9 +61,8 @@ import time
 from dataclasses import dataclass, field
 
 import h5py
-import numpy as np
-from scipy.spatial import cKDTree
 
+from pendular.capillary import MAX_ROUGHNESS
 from pendular.capillary.volume_control import rupture_distance_for_volume
 from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
 from pendular.dem.simulation import check_device
@@ -72,7 +71,9 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
-    check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
+    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
+    inertial_number, registered)
+from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
     sample_sizes, size_options)
@@ -80,6 +81,7 @@ from pendular.procedures.preparation import PrepareConfig, pwave_step
 from pendular.procedures.progress import tension_plan
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
     KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
+from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
 from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
 from pendular.procedures.tension_report import case_line, strength_predictions, write_report
@@ -201,7 +203,8 @@ class TensionConfig:
     cases: list[tuple[float, float]] = parameter(
         default_factory=lambda: [(e, w) for e, w, _ in KIM_2001], kind=None, recorded=False,
         help="(core void ratio, gravimetric water content as a fraction) of each case")
-    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=0.5, flag="--roughness",
+    roughness: float = parameter(KIM_SEPARATION, low=0.0, high=MAX_ROUGHNESS,
+                                 flag="--roughness",
                                  help="meniscus separation of touching grains H/R (default "
                                       "Kim's sand, as in the regular packing prediction; 0: "
                                       "smooth spheres)")
@@ -209,8 +212,7 @@ class TensionConfig:
                                 help="at wetting, bridges also form across gaps up to this many "
                                      "radii (0: at contacts only; 1: wherever a bridge of the "
                                      "formation suction can exist, docs/direct_tension.md)")
-    contact_angle: float = parameter(0.0, unit="deg", low=0.0, high=90.0, high_inclusive=False,
-                                     flag="--contact-angle", help="wetting angle")
+    contact_angle: float = contact_angle_parameter()
     surface_tension: float = parameter(CHAPTER4_SURFACE_TENSION, unit="N/m", low=0.0,
                                        high=MAX_SURFACE_TENSION, low_inclusive=False,
                                        flag="--surface-tension",
@@ -218,7 +220,8 @@ class TensionConfig:
                                             "comparison with Kim and the regular packing "
                                             "prediction uses; triaxial and swcc default to "
                                             "Chapter 5's 0.073)")
-    inertial_number: float = parameter(1e-3, low=0.0, high=0.01, low_inclusive=False,
+    inertial_number: float = parameter(1e-3, low=0.0, high=MAX_INERTIAL_NUMBER,
+                                       low_inclusive=False,
                                        flag="--inertial-number",
                                        help="I = strain rate x d x sqrt(rho / confining) of "
                                             "the pull")
@@ -431,21 +434,13 @@ class TensionTest:
         bit for bit that of an uninterrupted run (timings aside)."""
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
-        path = os.path.join(out, "checkpoint.h5")
-        if not os.path.exists(path):
-            raise ValueError(f"resume = {out!r}: {path} is missing: the run stopped before "
-                             "its first checkpoint, or was started with --checkpoint-every 0, "
-                             "which writes none; run it again")
+        path = resume_files(out)[1]
         with OutputFolder(out, "tension --resume", keep=True) as folder:
             for name in OUTPUTS:
                 folder.claim(name)
             state = checkpoint_extra_state(path)
-            config = config_from_dict(state.get("config") if isinstance(state, dict)
-                                      else None, path)
-            if not isinstance(config, TensionConfig):
-                raise ValueError(f"resume = {out!r} holds a run of another test "
-                                 f"({type(config).__name__}), not of pendular tension")
-            check_device(device)
+            config = stored_run(config_from_dict(state.get("config") if isinstance(state, dict)
+                                                 else None, path), out, cls, "tension", device)
             run = TensionRun(out, config, state.get("arguments"), 1, stop_after, state)
             return cls(config)._run(out, progress, device, run)
 

@@ -50,6 +50,7 @@ from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.history import read_history
 from pendular.io.schema import POSTERIOR_COLUMNS, summary_units
 from pendular.procedures.registry import config_from_options, options_of
+from pendular.procedures.run_options import RunOptions
 from pendular.studies.campaign import Campaign, Run
 from pendular.utils.atomic import replacing, write_json
 from pendular.utils.parameters import spec_of
@@ -478,14 +479,15 @@ class Calibration:
 
     # ------------------------------------------------------------ the loop
 
-    def run(self, out, *, jobs=1, scheduler=None, threads=1, device="cpu", quiet=False,
-            log=print):
+    def run(self, out, options=None, *, log=print, **settings):
         """Run the calibration into ``out`` (its runs in ``out``/runs/, each iteration a
-        Campaign.run with ``jobs``, ``scheduler``, ``threads``, ``device``); the result dict of
+        Campaign.run as the RunOptions ``options`` say, ``settings`` its fields one by one:
+        local processes or a Dask cluster, threads, device); the result dict of
         summary.json. ``out`` is held by the caller (an OutputFolder)."""
         from grainlearning import (SMC, DynamicSystem, GaussianMixtureModel,
                                    IterativeBayesianFilter)
 
+        options = RunOptions.of(options, **settings)
         observed = self.observed()
         system = DynamicSystem(obs_data=observed, ctrl_data=self.curve.control,
                                num_samples=self.samples,
@@ -506,10 +508,8 @@ class Calibration:
                                 for sample in ibf.param_data_list[-1]], dtype=float)
             runs = [Run(_sample_name(iteration, index), self.config(self.sample_values(sample)))
                     for index, sample in enumerate(samples)]
-            settings = dict(jobs=jobs, scheduler=scheduler, threads=threads, device=device,
-                            quiet=quiet)
             log(f"iteration {iteration + 1} of {self.iterations}: {len(runs)} runs")
-            curves = self.campaign_curves(runs, out, log, **settings)
+            curves = self.campaign_curves(runs, out, log, options)
             kept = [i for i in range(len(samples)) if _sample_name(iteration, i) in curves]
             if len(kept) < 2:
                 raise ValueError(f"iteration {iteration + 1}: fewer than two of its runs "
@@ -520,7 +520,7 @@ class Calibration:
                 best = kept[int(np.argmin(errors))]
                 seeds = self.seed_runs(self.sample_values(samples[best]))
                 log(f"seed noise: {len(seeds)} runs of {_sample_name(0, best)} at other seeds")
-                replicates = self.campaign_curves(seeds, out, log, **settings)
+                replicates = self.campaign_curves(seeds, out, log, options)
                 noise = self.seed_noise([curves[_sample_name(0, best)],
                                          *(replicates[run.name] for run in seeds
                                            if run.name in replicates)])
@@ -552,11 +552,11 @@ class Calibration:
                             zip(self.fits, self.moments(samples[kept], weights))))
         return self.summary(rows, history, noise)
 
-    def campaign_curves(self, runs, out, log, **settings):
-        """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out``
-        (Campaign.run's ``settings``); a run that failed or whose history does not span the
-        data is left out, and said so through ``log``."""
-        result = Campaign(runs).run(out, **settings)
+    def campaign_curves(self, runs, out, log, options):
+        """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out`` as
+        the RunOptions ``options`` say (Campaign.run); a run that failed or whose history does
+        not span the data is left out, and said so through ``log``."""
+        result = Campaign(runs).run(out, options)
         curves = {}
         for run in runs:
             if run.name not in result.summaries:

@@ -8,20 +8,21 @@ path, tension, swcc), built e.g. with ``dataclasses.replace``::
     runs = [Run(f"s{s:g}", dataclasses.replace(base, bridges=BridgeConfig(s))) for s in (1e4, 3e4)]
     result = Campaign(runs).run("runs/mine", jobs=2)      # result.summaries["s10000"] ...
 
-``Campaign.run(out)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt with its
-progress bars) with its command's test (run_kinds.Procedure), with ``threads`` Numba threads per
-run (1 by default), in ``jobs`` spawned processes (at most JOBS_PER_CPU per CPU) or on the
-Dask cluster of ``scheduler``. It does not lock ``out``: a command holds it as its
-pendular.io.outputs.OutputFolder around the campaign, so that a second campaign into it is
-refused. A run whose folder holds a finished result of an equal configuration
-(``pendular.procedures.config.same_config`` of the configuration stored with it: in sample.h5
-of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted campaign goes
-on where it stopped; so is a shared sample (``samples``) saved with an equal PrepareConfig. The
-campaign's progress bar shows each running run's own progress. A run that fails does not stop
-the others: ``CampaignResult.failed`` names it with its error. A run's summary is the scalars
-of its result (run_kinds.Procedure.summary): a laboratory test's summary.json, the first case
-of a tension run (give each run one void ratio and one water content), the key figures of an
-SWCC (run_kinds.swcc_summary).
+``Campaign.run(out, options)`` runs each into ``out/runs/<name>/`` (its outputs, and log.txt
+with its progress bars) with its command's test (run_kinds.Procedure), as the
+pendular.procedures.run_options.RunOptions ``options`` say (or their fields one by one, as
+above): ``threads`` Numba threads per run (1 by default), in ``jobs`` spawned processes (at most
+JOBS_PER_CPU per CPU) or on the Dask cluster of ``scheduler``, on ``device``. It does not lock
+``out``: a command holds it as its pendular.io.outputs.OutputFolder around the campaign, so that
+a second campaign into it is refused. A run whose folder holds a finished result of an equal
+configuration (``pendular.procedures.config.same_config`` of the configuration stored with it:
+in sample.h5 of a laboratory test, in tension.json or swcc.json) is reused, so an interrupted
+campaign goes on where it stopped; so is a shared sample (``samples``) saved with an equal
+PrepareConfig. The campaign's progress bar shows each running run's own progress. A run that
+fails does not stop the others: ``CampaignResult.failed`` names it with its error. A run's
+summary is the scalars of its result (run_kinds.Procedure.summary): a laboratory test's
+summary.json, the first case of a tension run (give each run one void ratio and one water
+content), the key figures of an SWCC (run_kinds.swcc_summary).
 
 ``sweep_from_table(path)`` reads a TOML parameter table (``pendular campaign TABLE.toml``)::
 
@@ -79,6 +80,7 @@ from pendular.utils.validate import check_int
 from pendular.procedures.config import config_to_dict, sample_made_with
 from pendular.procedures.registry import config_from_options, options_of
 from pendular.procedures.laboratory import Interrupted
+from pendular.procedures.run_options import RunOptions
 from pendular.studies.run_kinds import PROCEDURES, RunConfig, procedure_of, run_options_of
 
 #: Seconds between updates of the campaign's progress bar.
@@ -136,27 +138,32 @@ class CampaignResult:
 
 # ---------------------------------------------------------------- workers (top level: picklable)
 
-def run_one(config: RunConfig, folder: str, threads: int = 1, force: bool = False,
-            device: str = "cpu") -> dict:
-    """Worker: the test of ``config`` into ``folder`` with ``threads`` Numba threads on
-    ``device``, its output and progress bars in ``folder``/log.txt (with the traceback if it
+def run_one(config: RunConfig, folder: str, options: RunOptions, force: bool = False) -> dict:
+    """Worker: the test of ``config`` into ``folder`` as ``options`` say (its Numba threads and
+    device), its output and progress bars in ``folder``/log.txt (with the traceback if it
     fails); its summary (Procedure.run)."""
-    use_threads(threads)
+    use_threads(options.threads)
     os.makedirs(folder, exist_ok=True)
     with open(os.path.join(folder, "log.txt"), "w", encoding="utf-8") as log, \
             contextlib.redirect_stdout(log), contextlib.redirect_stderr(log):
         try:
-            return procedure_of(config).run(config, folder, threads, force, device)
+            return procedure_of(config).run(config, folder, options, force)
         except BaseException:
             traceback.print_exc()
             raise
 
 
-def prepare_one(sample: PrepareConfig, path: str, threads: int = 1, device: str = "cpu") -> str:
-    """Worker: prepare the sample of ``sample`` (a PrepareConfig) on ``device`` and save it at
-    ``path`` with its configuration (``{"sample": config_to_dict(sample)}``)."""
-    use_threads(threads)
-    sim, report = prepare_sample(sample, progress=False, threads=threads, device=device)
+#: A campaign's run by default: one Numba thread, on the CPU.
+ONE_THREAD = RunOptions(threads=1)
+
+
+def prepare_one(sample: PrepareConfig, path: str, options: RunOptions = ONE_THREAD) -> str:
+    """Worker: prepare the sample of ``sample`` (a PrepareConfig) with the Numba threads and on
+    the device of ``options`` and save it at ``path`` with its configuration (``{"sample":
+    config_to_dict(sample)}``)."""
+    use_threads(options.threads)
+    sim, report = prepare_sample(sample, progress=False, threads=options.threads,
+                                 device=options.device)
     save_sample(path, sim, report, {"sample": config_to_dict(sample)},
                 identity={"seed": sample.seed})
     return path
@@ -345,18 +352,23 @@ class Campaign:
         """The folder of run ``name``."""
         return os.path.join(out, "runs", name)
 
-    def run(self, out: str, *, jobs: int = 1, scheduler: str | None = None, threads: int = 1,
-            quiet: bool = False, device: str = "cpu") -> CampaignResult:
-        """Run every run into ``out``/runs/<name> (reusing finished ones) with ``threads``
-        Numba threads each, in ``jobs`` local processes (check_jobs) or on the Dask cluster
-        at ``scheduler`` (its workers must see ``out`` at the same path), the preparations
-        and the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's
-        identity, so a finished run is reused whichever device ran it). Every configuration
-        still to run is checked here first (its test: quasi-static, duration, bridge
-        tables), and the device, so a bad one is refused before anything runs. The
+    def run(self, out: str, options: RunOptions | None = None, **settings) -> CampaignResult:
+        """Run every run into ``out``/runs/<name> (reusing finished ones) as ``options`` say
+        (RunOptions; ``settings``: its fields one by one): ``threads`` Numba threads each
+        (None: 1), in ``jobs`` local processes (check_jobs) or on the Dask cluster at
+        ``scheduler`` (its workers must see ``out`` at the same path), the preparations and
+        the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's identity,
+        so a finished run is reused whichever device ran it), the campaign's progress bar
+        unless ``progress`` is False (each run's bars go to its log.txt). Every
+        configuration still to run is checked here first (its test: quasi-static, duration,
+        bridge tables), and the device, so a bad one is refused before anything runs. The
         caller holds ``out`` (an OutputFolder, module docstring)."""
-        jobs = check_jobs(jobs)
-        threads = check_int("threads", threads, low=1)
+        options = RunOptions.of(options, **settings)
+        jobs, scheduler, device = check_jobs(options.jobs), options.scheduler, options.device
+        threads = check_int("threads", 1 if options.threads is None else options.threads,
+                            low=1)
+        quiet = not options.progress
+        each = RunOptions(device=device, threads=threads)      # a run's, bars into its log
         out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
         result = CampaignResult(self.runs)
         todo = []
@@ -379,8 +391,7 @@ class Campaign:
             os.makedirs(os.path.dirname(path), exist_ok=True)
         with executor(jobs, scheduler) as pool:
             _, errors = map_tasks(pool, prepare_one,
-                                  [(sample, path, threads, device)
-                                   for sample, path in preparations],
+                                  [(sample, path, each) for sample, path in preparations],
                                   description="prepare", quiet=quiet)
             unprepared = {os.path.abspath(preparations[i][1]): text
                           for i, text in errors.items()}
@@ -392,7 +403,7 @@ class Campaign:
                                                f"{unprepared[os.path.abspath(path)]}")
             folders = [self.folder(out, run.name) for run in todo]
             results, errors = map_tasks(
-                pool, run_one, [(run.config, folder, threads, run.force, device)
+                pool, run_one, [(run.config, folder, each, run.force)
                                 for run, folder in zip(todo, folders)],
                 description="runs", folders=folders, quiet=quiet)
         for index, (run, summary) in enumerate(zip(todo, results)):

@@ -1,7 +1,9 @@
 """Thesis Chapter 5 campaign: drained triaxial tests at every (suction, confining stress).
 
-``chapter5_campaign(Chapter5Grid(...), out, jobs=..., scheduler=...)``; command
-``pendular chapter5`` (its default grid is the table pendular/campaigns/chapter5.toml).
+``Chapter5Campaign(Chapter5Grid(...)).run(out, options)`` (options: a
+pendular.procedures.run_options.RunOptions, or its fields one by one: ``jobs=...``,
+``scheduler=...``); command ``pendular chapter5`` (its default grid is the table
+pendular/campaigns/chapter5.toml).
 
 One sample is prepared per confining stress (pendular.procedures.preparation.prepare_sample: radius growth to
 5 kPa, then unloaded to the test value, the same seed for all) and saved as
@@ -33,7 +35,6 @@ DIR/campaign.csv: one row per run, its options and its whole summary (pendular.s
 from __future__ import annotations
 
 import dataclasses
-import math
 import os
 from dataclasses import dataclass
 
@@ -52,6 +53,7 @@ from pendular.utils.parameters import option_from, option_of, spec_of
 from pendular.studies.envelope import mohr_coulomb_fit
 from pendular.io.outputs import OutputFolder
 from pendular.procedures.reference import DRY_FRICTION_DEG, FIG_5_5, TABLE_5_3
+from pendular.procedures.run_options import RunOptions
 
 #: Strain at which Sr is also reported (Fig. 5.5's horizontal axis ends there).
 LATE_STRAIN = 0.20
@@ -60,6 +62,11 @@ LATE_STRAIN = 0.20
 OUTPUTS = ("campaign.json", "campaign.csv", "report.md", "plots")
 #: The Chapter 5 grid shipped with pendular (a campaign table).
 TABLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "campaigns", "chapter5.toml")
+#: The grid's suctions and confining stresses [Pa]: lists of the fields they set, each value in
+#: that field's range (a confining stress above 0).
+SUCTIONS = dataclasses.replace(SUCTION, flag="--suctions", many=True)
+CONFINING = dataclasses.replace(spec_of(PrepareConfig, "confining"), low_inclusive=False,
+                                many=True)
 
 
 @dataclass
@@ -76,15 +83,10 @@ class Chapter5Grid:
     prep_friction: float = 0.5
 
     def __post_init__(self):
-        for name, low in (("suctions", 0.0), ("confining", 0.0)):
-            values = [float(v) for v in getattr(self, name)]
+        for name, spec in (("suctions", SUCTIONS), ("confining", CONFINING)):
+            values = spec.check(name, getattr(self, name))
             if not values:
                 raise ValueError(f"--{name}: at least one value expected")
-            for value in values:
-                if not math.isfinite(value) or value < low or (name == "confining"
-                                                               and value == 0.0):
-                    raise ValueError(f"--{name} {values}: every value must be in "
-                                     f"{'[0' if name == 'suctions' else '(0'}, inf)")
             if len(set(values)) != len(values):
                 raise ValueError("--suctions and --confining must not repeat a value")
             setattr(self, name, values)
@@ -139,15 +141,14 @@ def grid_options(path: str = TABLE) -> tuple:
     def listed(values):
         return ",".join(f"{value:g}" for value in values)
 
-    suctions = dataclasses.replace(SUCTION, help="matric suctions, comma-separated, 0: dry "
-                                                 f"(table: {listed(table.suctions)})")
+    suctions = dataclasses.replace(SUCTIONS, help="matric suctions, comma-separated, 0: dry "
+                                                  f"(table: {listed(table.suctions)})")
     confining = dataclasses.replace(
-        spec_of(PrepareConfig, "confining"), low_inclusive=False,
-        help=f"lateral stresses, comma-separated (table: {listed(table.confining)})")
+        CONFINING, help=f"lateral stresses, comma-separated (table: {listed(table.confining)})")
     return (option_of(PrepareConfig, "particles", default=None, low=MIN_SAMPLE_PARTICLES,
                       help=f"number of spheres (table: {table.particles})"),
-            option_from(suctions, None, key="suctions", aliases=("--suction",), many=True),
-            option_from(confining, None, many=True),
+            option_from(suctions, None, aliases=("--suction",)),
+            option_from(confining, None),
             option_of(PrepareConfig, "seed", default=None,
                       help=f"random seed of every sample (table: {table.seed})"),
             option_of(ShearConfig, "max_strain", default=None,
@@ -350,45 +351,61 @@ def run_row(suction, lateral, summary, folder, out):
             "folder": os.path.relpath(folder, out)}
 
 
-def chapter5_campaign(grid: Chapter5Grid, out: str, *, jobs: int = 1,
-                      scheduler: str | None = None, threads: int = 1,
-                      quiet: bool = False, device: str = "cpu") -> tuple[dict, int]:
-    """Run the campaign of ``grid`` (Chapter5Grid) into ``out`` (``jobs`` local processes or
-    the Dask cluster at ``scheduler``, ``threads`` Numba threads per run, on ``device``:
-    Campaign.run); writes
-    campaign.json, campaign.csv, report.md and plots/ (module docstring); returns (campaign
-    dict, runs reused). ValueError naming the runs that failed (the others are kept and
-    reused when started again)."""
-    given_out = out
-    out = os.path.abspath(out)          # workers elsewhere see the same paths
-    tests = [(s, c) for s in grid.suctions for c in grid.confining]
-    runs = [Run(os.path.basename(run_folder(out, s, c)), grid.run(s, c, out)) for s, c in tests]
-    samples = [(grid.sample(c), sample_path(out, c)) for c in grid.confining]
-    # keep: the samples and finished runs of an earlier campaign there are reused
-    with OutputFolder(given_out, "chapter5", keep=True) as folder:
-        for name in OUTPUTS:
-            folder.claim(name)
-        result = Campaign(runs, samples).run(out, jobs=jobs, scheduler=scheduler,
-                                             threads=threads, quiet=quiet, device=device)
-        write_campaign_csv(os.path.join(out, "campaign.csv"), result)
-        result.check()
-        for s, c in tests:                  # reused runs too: the figures read them all
-            check_history(run_folder(out, s, c))
-        rows = [run_row(s, c, result.summaries[run.name], run_folder(out, s, c), out)
-                for (s, c), run in zip(tests, runs)]
-        fits = envelopes(rows)
-        arguments = {"particles": grid.particles, "suctions": grid.suctions,
-                     "confining": grid.confining, "jobs": jobs, "out": os.fspath(given_out),
-                     "seed": grid.seed, "max_strain": grid.max_strain,
-                     "inertial_number": grid.inertial_number,
-                     "prep_friction": grid.prep_friction, "scheduler": scheduler}
-        campaign = {"arguments": arguments, "runs": rows, "envelopes": fits,
-                    "thesis": {"table_5_3": [{"suction": s, "confining": c,
-                                              "peak_axial_stress": v}
-                                             for (s, c), v in TABLE_5_3.items()],
-                               "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
-                               "dry_friction_deg": DRY_FRICTION_DEG}}
-        write_json(os.path.join(out, "campaign.json"), campaign)
-        figures = campaign_figures(out, rows, fits, label, LATE_STRAIN)
-        write_report(os.path.join(out, "report.md"), rows, fits, grid, figures, out)
-    return campaign, len(result.reused)
+@dataclass(frozen=True)
+class Chapter5Campaign:
+    """The Chapter 5 campaign of ``grid`` (Chapter5Grid), run as every command runs:
+    ``run(out, options) -> summary``."""
+
+    grid: Chapter5Grid
+
+    def run(self, out: str, options: RunOptions | None = None, **settings) -> dict:
+        """Run the campaign into ``out`` as ``options`` say (RunOptions; ``settings``: its
+        fields one by one): ``jobs`` local processes or the Dask cluster at ``scheduler``,
+        ``threads`` Numba threads per run (None: 1), on ``device``, progress bars unless
+        ``progress`` is False (Campaign.run); writes campaign.json, campaign.csv, report.md
+        and plots/ (module docstring); returns the campaign.json content with ``reused``,
+        the number of finished runs reused. ValueError naming the runs that failed (the
+        others are kept and reused when started again)."""
+        options = RunOptions.of(options, **settings)
+        grid, given_out = self.grid, out
+        out = os.path.abspath(out)          # workers elsewhere see the same paths
+        tests = [(s, c) for s in grid.suctions for c in grid.confining]
+        runs = [Run(os.path.basename(run_folder(out, s, c)), grid.run(s, c, out))
+                for s, c in tests]
+        samples = [(grid.sample(c), sample_path(out, c)) for c in grid.confining]
+        # keep: the samples and finished runs of an earlier campaign there are reused
+        with OutputFolder(given_out, "chapter5", keep=True) as folder:
+            for name in OUTPUTS:
+                folder.claim(name)
+            result = Campaign(runs, samples).run(out, options)
+            campaign = write_campaign(out, given_out, grid, options, tests, runs, result)
+        return {**campaign, "reused": len(result.reused)}
+
+
+def write_campaign(out, given_out, grid, options, tests, runs, result):
+    """campaign.csv, campaign.json, plots/ and report.md of the finished campaign ``result``
+    (CampaignResult of ``runs``, one per (suction, confining) of ``tests``) in ``out``
+    (``given_out`` as the command was given it), run as ``options`` say; the campaign.json
+    content. ValueError naming the runs that failed or a reused run's damaged history."""
+    write_campaign_csv(os.path.join(out, "campaign.csv"), result)
+    result.check()
+    for s, c in tests:                  # reused runs too: the figures read them all
+        check_history(run_folder(out, s, c))
+    rows = [run_row(s, c, result.summaries[run.name], run_folder(out, s, c), out)
+            for (s, c), run in zip(tests, runs)]
+    fits = envelopes(rows)
+    arguments = {"particles": grid.particles, "suctions": grid.suctions,
+                 "confining": grid.confining, "jobs": options.jobs,
+                 "out": os.fspath(given_out), "seed": grid.seed,
+                 "max_strain": grid.max_strain, "inertial_number": grid.inertial_number,
+                 "prep_friction": grid.prep_friction, "scheduler": options.scheduler}
+    campaign = {"arguments": arguments, "runs": rows, "envelopes": fits,
+                "thesis": {"table_5_3": [{"suction": s, "confining": c,
+                                          "peak_axial_stress": v}
+                                         for (s, c), v in TABLE_5_3.items()],
+                           "fig_5_5_saturation": {label(s): v for s, v in FIG_5_5.items()},
+                           "dry_friction_deg": DRY_FRICTION_DEG}}
+    write_json(os.path.join(out, "campaign.json"), campaign)
+    figures = campaign_figures(out, rows, fits, label, LATE_STRAIN)
+    write_report(os.path.join(out, "report.md"), rows, fits, grid, figures, out)
+    return campaign

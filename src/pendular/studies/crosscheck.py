@@ -1,7 +1,9 @@
 """Cross-check of pendular's drained triaxial shear against YADE's on the same packing.
 
-``run_crosscheck(crosscheck_config(...), out)``; command ``pendular crosscheck``. Needs
-``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md lists the differences by design.
+``CrossCheck(crosscheck_config(...)).run(out, options)`` (options: a
+pendular.procedures.run_options.RunOptions, or its fields one by one); command ``pendular
+crosscheck``. Needs ``yade`` on PATH (pendular.interop.yade.runner); docs/yade_crosscheck.md
+lists the differences by design.
 
 1. The sample of ``config.sample`` is prepared by pendular (thesis Ch. 5.2.2 at the confining
    stress; cached, pendular.interop.yade.runner.cached_sample, shared with the benchmarks), servoed on its six
@@ -72,9 +74,10 @@ from pendular.procedures.config import (BridgeConfig, MAX_STAGE_STEPS, MIN_SAMPL
     ShearConfig, YADE_CHOICES, config_to_dict)
 from pendular.procedures.triaxial import TriaxialConfig
 from pendular.procedures.options import SUCTION, sample_sizes, size_options
+from pendular.procedures.run_options import RunOptions
 from pendular.procedures.triaxial import axial_strain
 from pendular.utils.parameters import (Option, OptionError, Parameter, default_of, option_from,
-    option_of)
+    option_of, spec_of)
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -129,14 +132,17 @@ def crosscheck_config(particles=PARTICLES, suction=0.0,
         wet_steps=settle_steps, vtk_frames=0)
 
 
+#: The lateral stress of a cross-check [Pa]: the sample's confining stress, above 0.
+CONFINING = dataclasses.replace(spec_of(PrepareConfig, "confining"), low_inclusive=False,
+                                high=None, high_inclusive=False, help="lateral stress")
 #: The options of ``pendular crosscheck`` (how it runs apart: folder, threads, concurrency):
 #: the sample's and the shear's from their fields, at the cross-check's defaults (the
 #: suction and confining stress checked as they are read: the ranges the cross-check takes),
 #: YADE's choices, the settling and a packing to start from.
 OPTIONS = (option_of(PrepareConfig, "particles", default=PARTICLES, low=MIN_SAMPLE_PARTICLES),
            option_from(dataclasses.replace(SUCTION, high_inclusive=False), 0.0, checked=True),
-           option_of(PrepareConfig, "confining", checked=True, low_inclusive=False, high=None,
-                     high_inclusive=False, help="lateral stress"),
+           option_from(CONFINING, default_of(PrepareConfig, "confining"),
+                       field=(PrepareConfig, "confining"), checked=True),
            option_of(ShearConfig, "max_strain", help="final axial strain"),
            *size_options(),
            option_of(PrepareConfig, "seed"),
@@ -202,9 +208,7 @@ def check_mirrored(config):
     if config.sample_path is not None:
         raise ValueError(f"sample_path = {config.sample_path!r}: the cross-check prepares its "
                          "own (cached) sample; valid: None")
-    if not config.confining > 0.0:
-        raise ValueError(f"confining = {config.confining:g} Pa is outside the valid range "
-                         "(0, inf)")
+    CONFINING.check("confining", config.confining)
     sample = config.sample
     if sample.contact == "hertz-mindlin" and (config.bridges is not None or sample.periodic):
         raise ValueError("contact = 'hertz-mindlin' with "
@@ -248,16 +252,17 @@ def check_packing(config, packing):
                          "cell's corner 0; valid: DIR/packing.txt of a periodic cross-check")
 
 
-def static_packing(config, path, *, settle=True, threads=1, progress=True, device="cpu"):
+def static_packing(config, path, options, settle=True):
     """Load (or prepare, on the CPU: the cache is shared) the cached sample of ``config``,
-    bring it to rest at the confining stress on ``device`` (wetted if ``config.bridges``;
-    ``settle=False``: as loaded), write it to ``path``
-    (pendular.interop.yade.formats.write_spheres; a periodic cell's box is [0, L], the centres wrapped into it);
-    return the settle report (steps, time, wall or cell stresses and, wet, Sr and bridges)."""
-    sample = config.sample
+    bring it to rest at the confining stress as the RunOptions ``options`` say (its device,
+    threads and progress bars; wetted if ``config.bridges``; ``settle=False``: as loaded),
+    write it to ``path`` (pendular.interop.yade.formats.write_spheres; a periodic cell's box
+    is [0, L], the centres wrapped into it); return the settle report (steps, time, wall or
+    cell stresses and, wet, Sr and bridges)."""
+    sample, progress, threads = config.sample, options.progress, options.threads
     particles, walls, _ = cached_sample(sample, progress=progress, threads=threads)
     sim = servoed_simulation(particles, walls, sample, sample.confining, threads=threads)
-    sim.device = device
+    sim.device = options.device
     bridges = None
     if config.bridges is not None:
         bridges = config.bridges.build()
@@ -442,43 +447,53 @@ def plot(histories, path):
     save_figure(figure, path)
 
 
-def run_crosscheck(config, out, *, settle=True, packing=None, concurrent=False, threads=1,
-                   progress=True, device="cpu"):
-    """The cross-check of ``config`` (a TriaxialConfig, e.g. ``crosscheck_config``) into the
-    folder ``out`` (module docstring); returns the crosscheck.json content.
+class CrossCheck:
+    """The cross-check of ``config`` (a TriaxialConfig, e.g. ``crosscheck_config``), checked
+    when it is made (check_mirrored, check_packing); ``settle``: bring the (wetted) sample to
+    rest before the export (False: export it as loaded); ``packing``: shear this exported
+    packing instead of settling one. Run as every command runs: ``run(out, options) ->
+    summary``."""
 
-    settle: bring the (wetted) sample to rest before the export (False: export it as loaded);
-    packing: shear this exported packing instead of settling one; concurrent: run YADE while
-    pendular shears (halves the wall time; each code's timing then shares the machine with the
-    other); threads: Numba threads of pendular and OpenMP threads of YADE; device: where
-    pendular settles and shears ("cpu" or "gpu"). RuntimeError when YADE is missing or
-    fails."""
-    if not isinstance(config, TriaxialConfig):
-        raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
-    check_mirrored(config)
-    out = os.path.abspath(out)
-    if packing is not None:
-        packing = os.fspath(packing)
-        check_packing(config, packing)
-    find_yade()
-    with OutputFolder(out, "crosscheck") as folder:
-        for name in OUTPUTS:
-            folder.claim(name)
-        exported = os.path.join(out, "packing.txt")
-        if packing is None:
-            settled = static_packing(config, exported, settle=settle, threads=threads,
-                                     progress=progress, device=device)
-        else:
-            if os.path.abspath(packing) != exported:
-                shutil.copyfile(packing, exported)
-            settled = {"from": packing}
-        return _shear_both(config, out, exported, settled, concurrent, threads, progress,
-                           device)
+    def __init__(self, config, *, settle=True, packing=None):
+        if not isinstance(config, TriaxialConfig):
+            raise TypeError(f"config must be a TriaxialConfig, got {type(config).__name__}")
+        check_mirrored(config)
+        if packing is not None:
+            packing = os.fspath(packing)
+            check_packing(config, packing)
+        self.config, self.settle, self.packing = config, settle, packing
+
+    def run(self, out, options=None, **settings):
+        """The cross-check into the folder ``out`` (module docstring), run as ``options`` say
+        (RunOptions; ``settings``: its fields one by one): ``threads`` Numba threads of
+        pendular and OpenMP threads of YADE (None: 1), ``device`` where pendular settles and
+        shears ("cpu" or "gpu"), ``progress`` its bars, ``concurrent``: run YADE while
+        pendular shears (halves the wall time; each code's timing then shares the machine
+        with the other). Returns the crosscheck.json content; RuntimeError when YADE is
+        missing or fails."""
+        options = RunOptions.of(options, **settings)
+        if options.threads is None:
+            options = RunOptions.of(options, threads=1)
+        config, packing = self.config, self.packing
+        out = os.path.abspath(out)
+        find_yade()
+        with OutputFolder(out, "crosscheck") as folder:
+            for name in OUTPUTS:
+                folder.claim(name)
+            exported = os.path.join(out, "packing.txt")
+            if packing is None:
+                settled = static_packing(config, exported, options, self.settle)
+            else:
+                if os.path.abspath(packing) != exported:
+                    shutil.copyfile(packing, exported)
+                settled = {"from": packing}
+            return _shear_both(config, out, exported, settled, options)
 
 
-def _shear_both(config, out, packing, settled, concurrent, threads, progress, device):
-    """Shear ``packing`` with both codes (pendular on ``device``), compare, write the
-    outputs."""
+def _shear_both(config, out, packing, settled, options):
+    """Shear ``packing`` with both codes (pendular on the device of ``options``), compare,
+    write the outputs."""
+    concurrent, threads, device = options.concurrent, options.threads, options.device
     sim, shear = pendular_shear(config, packing, threads, device)
     settings = yade_settings(config, packing, sim, shear, out)
     box_volume = sim.walls.volume()
@@ -488,7 +503,7 @@ def _shear_both(config, out, packing, settled, concurrent, threads, progress, de
                                      env={"OMP_WAIT_POLICY": "PASSIVE"})
         yade_run = pool.submit(run_yade) if concurrent else None
         started = time.perf_counter()
-        sim.run(shear.steps, progress="pendular shear" if progress else None,
+        sim.run(shear.steps, progress="pendular shear" if options.progress else None,
                 status=shear.status)
         pendular_seconds = time.perf_counter() - started
         yade_result = (yade_run or pool.submit(run_yade)).result()

@@ -7,8 +7,9 @@ q = M p + q0 with M = 6 sin(phi) / (3 - sin(phi)) and q0 = c 6 cos(phi) / (3 - s
 standard errors of phi and c: those of M and q0 from the residual scatter (n - 2 degrees of
 freedom), carried to phi and c to first order (the delta method).
 
-``envelope(runs, out)`` runs drained triaxial compressions at several confining stresses as
-one campaign (pendular.studies.campaign: local processes or a Dask cluster) and fits the
+``envelope(runs, out, options)`` runs drained triaxial compressions at several confining
+stresses as one campaign, as the pendular.procedures.run_options.RunOptions ``options`` say
+(pendular.studies.campaign: local processes or a Dask cluster) and fits the
 envelope to their peaks in net stresses and in the effective stresses of Eq. 3.43 (the wet
 summaries' p' and q' at the peak of q; a dry test's effective stress is its net stress).
 It writes into ``out``: summary.json (its keys declared in pendular.io.schema.SUMMARY_KEYS),
@@ -30,6 +31,7 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.schema import summary_units
 from pendular.procedures.registry import config_from_options, options_of
 from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.run_options import RunOptions
 from pendular.studies.campaign import Campaign, Run, run_name, write_campaign_csv
 from pendular.studies.envelope_figures import plot_mohr_circles, plot_peaks
 from pendular.utils.atomic import write_json
@@ -224,12 +226,14 @@ def envelope_summary(rows, config):
     return summary
 
 
-def envelope(runs, out, *, jobs=1, scheduler=None, threads=1, quiet=False, device="cpu"):
-    """Run the triaxials ``runs`` (envelope_runs) as one campaign into ``out`` (``jobs``
-    local processes or the Dask cluster at ``scheduler``, ``threads`` Numba threads per run,
-    on ``device``: pendular.studies.campaign.Campaign.run), reusing finished ones, and write
+def envelope(runs, out, options=None, **settings):
+    """Run the triaxials ``runs`` (envelope_runs) as one campaign into ``out`` as the
+    RunOptions ``options`` say (``settings``: its fields one by one; local processes or a
+    Dask cluster, Numba threads per run, device: pendular.studies.campaign.Campaign.run),
+    reusing finished ones, and write
     summary.json, campaign.csv and the figures (module docstring); returns (summary, runs
     reused). ValueError naming the runs that failed (the others are kept and reused)."""
+    options = RunOptions.of(options, **settings)
     given_out = out
     out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
     campaign = Campaign(runs)
@@ -238,8 +242,7 @@ def envelope(runs, out, *, jobs=1, scheduler=None, threads=1, quiet=False, devic
     with OutputFolder(given_out, "envelope", keep=True) as folder:
         for name in OUTPUTS:
             folder.claim(name)
-        result = campaign.run(out, jobs=jobs, scheduler=scheduler, threads=threads,
-                              quiet=quiet, device=device)
+        result = campaign.run(out, options)
         write_campaign_csv(os.path.join(out, "campaign.csv"), result)
         result.check()
         rows = []
@@ -252,7 +255,7 @@ def envelope(runs, out, *, jobs=1, scheduler=None, threads=1, quiet=False, devic
         write_json(os.path.join(out, "summary.json"), summary)
         plot_mohr_circles(os.path.join(out, "mohr_circles.png"), summary)
         plot_peaks(os.path.join(out, "peaks_pq.png"), summary)
-    if summary["peak_not_reached"] and not quiet:
+    if summary["peak_not_reached"] and options.progress:
         print("note: q still rises at the end of the test at confining "
               f"{', '.join(f'{c:g}' for c in summary['peak_not_reached'])} Pa (peak_reached "
               "false): their peaks are the highest records; a larger --max-strain reaches them",

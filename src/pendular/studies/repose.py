@@ -30,7 +30,11 @@ import numpy as np
 
 from pendular.dem.state import Particles, Walls
 from pendular.procedures.preparation import PrepareConfig, dry_simulation, pwave_step
+from pendular.utils.parameters import spec_of
 from pendular.utils.validate import check_int, check_range
+
+#: The gravity of a pile [m/s^2]: the sample's, above 0 (a pile needs its weight).
+PILE_GRAVITY = dataclasses.replace(spec_of(PrepareConfig, "gravity"), low_inclusive=False)
 
 #: Azimuthal sectors of the surface profile.
 SECTORS = 8
@@ -63,7 +67,7 @@ class PileConfig:
         check_range("floor_spacing", self.floor_spacing, 1.0, 1.5)
         if not self.material.gravity > 0.0:
             raise ValueError(f"gravity = {self.material.gravity:g} m/s^2: a pile needs its "
-                             "weight; valid range (0, 1000]")
+                             f"weight; valid range {PILE_GRAVITY.valid_range()}")
         if self.column_radius < 2.0 or self.floor_side < 2.0 * self.column_radius + 4.0:
             raise ValueError(f"column_radius = {self.column_radius:g}, floor_side = "
                              f"{self.floor_side:g} radii: valid: column_radius >= 2 and "

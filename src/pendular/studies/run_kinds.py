@@ -75,13 +75,13 @@ def tension_options(config: TensionConfig) -> dict:
 
 @dataclass(frozen=True)
 class Procedure:
-    """How a campaign runs the tests of one command: ``test`` its class (``test(config)``,
-    a laboratory test's with ``force``, checks the configuration; ``.run(folder, device=...)``
-    runs it, with ``threads`` where ``threaded``), ``config`` its configuration's class,
+    """How a campaign runs the tests of one command: ``test`` its class (``test(config)``, a
+    laboratory test's with ``force``, checks the configuration; ``.run(folder, options)`` runs
+    it, with the options' ``threads`` where ``threaded``), ``config`` its configuration's class,
     ``result`` the file a finished run leaves with its result, ``summary(result)`` the run's
     summary (the scalars of which are its campaign.csv columns), ``options(config)`` its flat
-    options (the other columns), ``keys`` the numbers a finished laboratory summary holds
-    (else it is damaged and the run is done again). A laboratory test
+    options (the other columns), ``keys`` the numbers a finished laboratory summary holds (else
+    it is damaged and the run is done again). A laboratory test
     (pendular.procedures.laboratory.LaboratoryTest) stores its configuration in its sample.h5,
     the others in their result."""
 
@@ -102,10 +102,12 @@ class Procedure:
         """The test of ``config``, checked before anything runs (ValueError)."""
         return self.test(config, force=force) if self.laboratory else self.test(config)
 
-    def run(self, config: RunConfig, folder: str, threads: int = 1, force: bool = False,
-            device: str = "cpu") -> dict:
-        """Run the test of ``config`` into ``folder``; its summary."""
-        options = RunOptions(device=device, threads=threads if self.threaded else None)
+    def run(self, config: RunConfig, folder: str, options: RunOptions | None = None,
+            force: bool = False) -> dict:
+        """Run the test of ``config`` into ``folder`` as ``options`` say (RunOptions; their
+        threads only where ``threaded``); its summary."""
+        if not self.threaded:
+            options = RunOptions.of(options, threads=None)
         return self.summary(self.start(config, force).run(folder, options))
 
     def finished(self, config: RunConfig, folder: str) -> dict | None:

@@ -64,7 +64,8 @@ from pendular.utils.validate import check_int
 
 from pendular.procedures.config import sample_made_with
 from pendular.studies.campaign import check_jobs, executor, prepare_one
-from pendular.procedures.config import BridgeConfig, ShearConfig, config_json, config_to_dict
+from pendular.procedures.config import (MAX_AXIAL_STRAIN, BridgeConfig, ShearConfig,
+    config_json, config_to_dict)
 from pendular.procedures.triaxial import TriaxialConfig
 from pendular.procedures.triaxial import TriaxialTest
 
@@ -142,7 +143,7 @@ class Study:
     out: str
     particles: int = parameter(2000, kind=int, low=MIN_PARTICLES, flag="--particles",
                                help="spheres of the reference sample")
-    max_strain: float = parameter(0.15, low=0.0, high=0.5, low_inclusive=False,
+    max_strain: float = parameter(0.15, low=0.0, high=MAX_AXIAL_STRAIN, low_inclusive=False,
                                   flag="--max-strain", help="final axial strain")
     seed: int = parameter(0, kind=int, low=0, high=MAX_SEED - NOISE_SEEDS, flag="--seed",
                           help="random seed of the samples")

@@ -86,7 +86,7 @@ def run(args):
                                               write_posterior, write_summary, DATA_COLUMNS)
     from pendular.studies.calibration_figures import write_figures
 
-    start_executor_run(args)
+    options = start_executor_run(args)
     if args.test not in DATA_COLUMNS:
         raise UsageError(f"--test {args.test}: calibrate compares curves of "
                          f"{', '.join(DATA_COLUMNS)} (no measured curve of {args.test} yet)")
@@ -110,9 +110,7 @@ def run(args):
         paths = {name: folder.claim(name) for name in
                  ("posterior.csv", "summary.json", "calibration.png", "posterior.png",
                   "errors.png")}
-        summary = calibration.run(os.path.abspath(args.out), jobs=args.jobs,
-                                  scheduler=args.scheduler, threads=args.threads,
-                                  device=args.device, quiet=args.quiet, log=_log)
+        summary = calibration.run(os.path.abspath(args.out), options, log=_log)
         write_posterior(paths["posterior.csv"], summary["rows"], fits)
         write_figures(calibration, summary, os.path.abspath(args.out), paths)
         data = write_summary(paths["summary.json"], summary, fits)

@@ -43,16 +43,13 @@ def add_arguments(parser):
 
 
 def run(args):
-    start_executor_run(args)             # before the output folder is made
+    options = start_executor_run(args)   # before the output folder is made
     command, runs = sweep_from_table(args.table)
     # keep: the finished runs of an earlier campaign there are reused; runs/ is never owned
     with OutputFolder(args.out, ["campaign", args.table], keep=True) as folder:
         csv_path = folder.claim("campaign.csv")
         try:
-            result = Campaign(runs).run(os.path.abspath(args.out), jobs=args.jobs,
-                                        scheduler=args.scheduler, threads=args.threads,
-                                        device=args.device,
-                                        quiet=args.quiet)
+            result = Campaign(runs).run(os.path.abspath(args.out), options)
         except RunRefused as error:
             raise UsageError(f"table = {args.table!r}: {error}") from None
         write_campaign_csv(csv_path, result)

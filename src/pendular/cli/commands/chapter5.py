@@ -5,7 +5,7 @@ and Sr beside the thesis's, Mohr–Coulomb envelopes in net and effective stress
 override it. Finished runs with equal configurations are reused. Each run has --threads Numba
 threads (one by default) and its own log.txt with its progress."""
 
-from pendular.studies.chapter5 import chapter5_campaign, grid_from_options, grid_options
+from pendular.studies.chapter5 import Chapter5Campaign, grid_from_options, grid_options
 from pendular.cli import (add_declared_options, add_executor_options, declared_values,
     print_result, start_executor_run)
 
@@ -23,13 +23,10 @@ def add_arguments(parser):
 
 
 def run(args):
-    start_executor_run(args)             # before the output folder is made
+    options = start_executor_run(args)   # before the output folder is made
     grid = grid_from_options(declared_values(grid_options(), args))
-    campaign, reused = chapter5_campaign(grid, args.out, jobs=args.jobs,
-                                         scheduler=args.scheduler, threads=args.threads,
-                                         device=args.device,
-                                         quiet=args.quiet)
-    runs = len(campaign["runs"])
+    summary = Chapter5Campaign(grid).run(args.out, options)
+    runs, reused = len(summary["runs"]), summary["reused"]
     print_result(args.quiet, (f"chapter5: {reused} finished runs in {args.out} reused, "
                               f"{runs - reused} run\n" if reused else "")
                  + f"chapter5: {runs} runs; outputs in {args.out} (campaign.json, report.md, "

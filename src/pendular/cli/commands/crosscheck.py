@@ -17,8 +17,8 @@ import sys
 from pendular.cli import (UsageError, add_declared_options, add_device_option, declared_values,
     positive_int, print_summary, set_threads)
 from pendular.dem.simulation import check_device
-from pendular.studies.crosscheck import (OPTIONS, SHOWN, check_mirrored, check_packing,
-    crosscheck_from_options, run_crosscheck)
+from pendular.procedures.run_options import RunOptions
+from pendular.studies.crosscheck import OPTIONS, SHOWN, CrossCheck, crosscheck_from_options
 from pendular.interop.yade.runner import find_yade
 from pendular.utils.parameters import OptionError, ParameterError
 
@@ -60,16 +60,14 @@ def run(args):
     config = check(args)                # every option checked before YADE is looked for
     set_threads(args.threads)
     check_device(args.device)
-    check_mirrored(config)
-    if args.packing is not None:
-        check_packing(config, args.packing)
+    crosscheck = CrossCheck(config, settle=args.settle_steps > 0, packing=args.packing)
     try:
         find_yade()
     except RuntimeError as error:
         raise UsageError(str(error)) from None
-    result = run_crosscheck(config, args.out, settle=args.settle_steps > 0,
-                            packing=args.packing, concurrent=args.concurrent,
-                            threads=args.threads, progress=not args.quiet, device=args.device)
+    options = RunOptions(device=args.device, threads=args.threads, progress=not args.quiet,
+                         concurrent=args.concurrent)
+    result = crosscheck.run(args.out, options)
     print_summary(result, SHOWN, args.quiet)
     # with --quiet, stdout holds the JSON alone
     print(f"outputs in {args.out} (crosscheck.json, crosscheck.png)",

@@ -45,13 +45,12 @@ def add_arguments(parser):
 
 
 def run(args):
-    start_executor_run(args)             # before the output folder is made
+    run_options = start_executor_run(args)       # before the output folder is made
     options = envelope_options()
     declared_values(options, args)       # every option read and checked before anything runs
     runs = envelope_runs({option.key: getattr(args, option.key) for option in options},
                          force=args.force)
-    summary, reused = envelope(runs, args.out, jobs=args.jobs, scheduler=args.scheduler,
-                               threads=args.threads, quiet=args.quiet, device=args.device)
+    summary, reused = envelope(runs, args.out, run_options)
     print_summary(summary, SHOWN + ("tests",), args.quiet, columns=COLUMNS)
     if not args.quiet:                   # --quiet: the JSON alone, for scripts
         print(f"envelope: {len(runs)} triaxial tests ({reused} reused); outputs in {args.out} "
