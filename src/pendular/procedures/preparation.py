@@ -21,6 +21,7 @@ friction, 4), "unload" (4), "equilibrate" (at the confining stress, 4). Writers 
 ``prepare_sample`` watch all of them (e.g. ParaView frames, pendular.io.vtk.VtkWriter).
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,8 +31,8 @@ from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.gravity import MAX_GRAVITY, Gravity
-from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinearForces,
-    HertzMindlinForces)
+from pendular.dem.hertz_mindlin import CONTACT_LAWS, DampedLinearForces, HertzMindlinForces
+from pendular.dem.material import POISSON_RANGE, Material
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
@@ -199,6 +200,19 @@ class PrepareConfig:
         high_inclusive=False, flag="--wall-friction",
         help="friction angle between the spheres and the walls, in every phase (pendular.dem."
              "wall_friction; 0: frictionless walls)")
+    wall_young: float | None = parameter(
+        None, unit="Pa", low=0.0, high=math.inf, low_inclusive=False, high_inclusive=False,
+        flag="--wall-young",
+        help="Young's modulus of the walls (Hertz-Mindlin; default: rigid walls, E = inf; "
+             "pendular.dem.material)")
+    wall_poisson: float | None = parameter(
+        None, low=POISSON_RANGE[0], high=POISSON_RANGE[1], low_inclusive=False,
+        high_inclusive=False, flag="--wall-poisson",
+        help="Poisson ratio of the walls, with --wall-young (default: the grains' --poisson)")
+    wall_restitution: float | None = parameter(
+        None, low=0.0, high=1.0, low_inclusive=False, flag="--wall-restitution",
+        help="coefficient of restitution of the walls; a sphere-wall contact's is the mean of "
+             "the grains' and the walls' (default: the grains' --restitution)")
     gravity: float = parameter(0.0, unit="m/s^2", low=0.0, high=MAX_GRAVITY, flag="--gravity",
                                help="gravitational acceleration along -z (0: none; walls "
                                     "only, not with --periodic)")
@@ -246,6 +260,7 @@ class PrepareConfig:
             raise fail(self, "wall_friction", f"wall_friction = {self.wall_friction:g} deg is "
                        "outside the valid range [0, 0] in a periodic cell (--periodic: no "
                        "walls); leave out the wall friction or the periodic cell")
+        self._check_wall_material()
         if self.psd is not None:
             if self.radius_spread > 0.0:
                 raise fail(self, "radius_spread",
@@ -266,6 +281,50 @@ class PrepareConfig:
                                     self.poisson)
             except ValueError as error:
                 raise fail(self, name, str(error)) from None
+
+    def _check_wall_material(self):
+        """ParameterError naming a wall material field given in a periodic cell (no walls),
+        --wall-young with the linear law (its wall is a sphere of the grains' springs),
+        --wall-poisson without --wall-young (a rigid wall's plays no part), or walls less
+        stiff in contact than two grains (their overlaps, then larger than the grains', would
+        escape the bounds the sample's stresses are checked against)."""
+        given = [name for name in ("wall_young", "wall_poisson", "wall_restitution")
+                 if getattr(self, name) is not None]
+        if given and self.periodic:
+            raise fail(self, given[0], f"{given[0]} = {getattr(self, given[0]):g} applies to "
+                       "walls; valid: none in a periodic cell (--periodic: no walls)")
+        if self.wall_poisson is not None and self.wall_young is None:
+            raise fail(self, "wall_poisson", f"wall_poisson = {self.wall_poisson:g} needs "
+                       "wall_young: a rigid wall's Poisson ratio plays no part")
+        if self.wall_young is None:
+            return
+        if self.contact != "hertz-mindlin":
+            raise fail(self, "wall_young", f"wall_young = {self.wall_young:g} Pa applies to "
+                       "Hertz-Mindlin contacts; valid: none with the linear law (its wall is a "
+                       "sphere of the grains' springs, kn = E R)")
+        wall = self.wall_material()
+        least = self.young * (1.0 - wall.poisson ** 2) / (1.0 - self.poisson ** 2)
+        if self.wall_young < least:
+            raise fail(self, "wall_young", f"wall_young = {self.wall_young:g} Pa is outside "
+                       f"the valid range [{least:g}, inf) Pa: walls at least as stiff in "
+                       "contact as two grains (young (1 - wall_poisson^2) / (1 - poisson^2)), "
+                       "whose overlaps the sample's stress bounds hold")
+
+    def grain_material(self):
+        """The grains' Material (pendular.dem.material) at the test friction."""
+        return Material(self.young, self.poisson, self.density, self.friction_deg,
+                        self.rolling_friction, self.restitution)
+
+    def wall_material(self):
+        """The walls' Material: rigid unless wall_young, of wall_poisson (the grains' Poisson
+        ratio unless given), wall_friction, and wall_restitution (the grains' unless given),
+        driven (infinite density), without rolling friction (a sphere–wall contact carries no
+        moment, pendular.dem.rolling)."""
+        return Material(math.inf if self.wall_young is None else self.wall_young,
+                        self.poisson if self.wall_poisson is None else self.wall_poisson,
+                        math.inf, self.wall_friction, 0.0,
+                        self.restitution if self.wall_restitution is None
+                        else self.wall_restitution)
 
     @property
     def graded(self):
@@ -361,15 +420,15 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
                    device="cpu", resistance=True):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m],
     contacts of ``config``'s law at ``friction_deg`` [deg] (contact_forces), wall contacts of
-    the same law at ``config.wall_friction`` (pendular.dem.wall_friction.wall_law; none in a
-    periodic cell), the weight (``config.gravity``
+    the same law with the walls' material, ``config.wall_material()``
+    (pendular.dem.wall_friction.wall_law; none in a periodic cell), the weight (``config.gravity``
     > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
     coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its runs on
     ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
     resistance it holds the contacts and the walls alone."""
     forces = [contact_forces(config, friction_deg)]
     if not walls.periodic:
-        forces.append(wall_law(forces[0], config.young, config.wall_friction))
+        forces.append(wall_law(forces[0], config.young, config.wall_material()))
     if config.gravity > 0.0:
         forces.append(Gravity(config.gravity))
     if resistance:
