@@ -1,6 +1,6 @@
 """Walls with tangential springs (pendular.gpu.wall_friction) on the GPU against the CPU under
 Numba's CUDA simulator: the scenes of wall_friction_checks.py (frictional linear walls under
-gravity, Hertz–Mindlin walls, with bridges at contact), whose checks run in one process of
+gravity, Hertz–Mindlin walls of their own material, with bridges at contact), whose checks run in one process of
 their own so that no other test meets the simulator. The simulator does not contract
 multiply-adds as the CPU's hot kernels do, hence round-off bounds."""
 
@@ -38,6 +38,13 @@ def test_the_wall_friction_matters(measured, name):
     """What the comparison would miss if the device left the walls' springs out."""
     without = measured[name]["without_friction"]
     assert without["angular_velocity"] > 1e-3 and without["position"] > 1e-9
+
+
+def test_the_walls_material_matters(measured):
+    """What the comparison would miss if the device took the grains' rigid walls instead of
+    the walls' own material."""
+    rigid = measured["hertz"]["rigid_wall"]
+    assert rigid["wall_force"] > 1e-3 and rigid["velocity"] > 1e-6
 
 
 def test_two_wall_operations_are_refused(measured):

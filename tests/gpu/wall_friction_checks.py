@@ -6,9 +6,10 @@ their own (``NUMBA_ENABLE_CUDASIM=1 python wall_friction_checks.py linear hertz 
   walls frictional (FrictionalWallForces, FRICTION) and the weight: the plain run, one handed
   from the CPU to the device halfway (the springs go up and come back), and the CPU's run
   with frictionless walls (what the comparison would miss);
-- "hertz": the same on Hertz–Mindlin contacts damped to e = 0.5 with Hertz–Mindlin walls
-  (ViscoelasticWallForces at FRICTION), over periodic_checks.HERTZ_STEPS (a damped scene's
-  runs part from round-off within a hundred steps on the CPU alone);
+- "hertz": the same on Hertz–Mindlin contacts damped to e = 0.5 with Hertz–Mindlin walls of
+  a material of their own (ViscoelasticWallForces on WALL at FRICTION: the unlike pair's E*,
+  G* and restitution, pendular.dem.material), over periodic_checks.HERTZ_STEPS (a damped
+  scene's runs part from round-off within a hundred steps on the CPU alone);
 - "wet": the linear scene with bridges at contact, which gather the pairs after the walls;
 - "refusal": a scene with two wall operations (one role "walls" at most).
 """
@@ -20,12 +21,18 @@ STEPS = 200
 FRICTION = 25.0
 #: Hertz–Mindlin material of the "hertz" scene: E [Pa], nu, e.
 HERTZ = (1e7, 0.3, 0.5)
+#: Its walls' material: E [Pa], nu, e (the contacts' e the mean with the grains', 0.7).
+WALL = (3e7, 0.25, 0.9)
 
 
-def scene(friction=FRICTION, hertz=False, wet=False):
-    """simulated.py's scene (module docstring) with frictional walls and the weight."""
+def scene(friction=FRICTION, hertz=False, wet=False, wall=WALL):
+    """simulated.py's scene (module docstring) with frictional walls and the weight; with
+    ``hertz`` the walls of ``wall`` (E [Pa], nu, e; None: rigid, of the grains' e)."""
     from pendular.dem.gravity import Gravity
+    import math
+
     from pendular.dem.hertz_mindlin import HertzMindlinForces, ViscoelasticWallForces
+    from pendular.dem.material import Material
     from pendular.dem.wall_friction import FrictionalWallForces
     from simulated import YOUNG, scene as plain
 
@@ -33,7 +40,9 @@ def scene(friction=FRICTION, hertz=False, wet=False):
     if hertz:
         contact = HertzMindlinForces(*HERTZ, friction_deg=30.0)
         sim.forces[0] = contact
-        sim.forces[1] = ViscoelasticWallForces(contact, friction)
+        young, poisson, restitution = (math.inf, 0.0, HERTZ[2]) if wall is None else wall
+        sim.forces[1] = ViscoelasticWallForces(
+            contact, Material(young, poisson, math.inf, friction, 0.0, restitution))
     else:
         sim.forces[1] = FrictionalWallForces(YOUNG, 0.3, friction)
     sim.forces.insert(2, Gravity(9.81))
@@ -66,7 +75,7 @@ def compare(cpu, gpu):
 
 def agreement(hertz=False, wet=False, steps=STEPS):
     """The scene on both devices over ``steps``: plain, handed over halfway, and the CPU
-    without friction."""
+    without friction (and, ``hertz``, on rigid walls of the grains' restitution)."""
     from pendular.gpu import GpuSimulation
     from simulated import compare as plain_compare, snapshot as plain_snapshot
 
@@ -82,9 +91,14 @@ def agreement(hertz=False, wet=False, steps=STEPS):
     handed_gpu.to_host()
     frictionless = scene(friction=0.0, hertz=hertz, wet=wet)
     frictionless.run(steps)
-    return {"agreement": compare(snapshot(cpu), snapshot(gpu.sim)),
-            "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim)),
-            "without_friction": plain_compare(plain_snapshot(cpu), plain_snapshot(frictionless))}
+    out = {"agreement": compare(snapshot(cpu), snapshot(gpu.sim)),
+           "handed_over": compare(snapshot(cpu), snapshot(handed_gpu.sim)),
+           "without_friction": plain_compare(plain_snapshot(cpu), plain_snapshot(frictionless))}
+    if hertz:
+        rigid = scene(hertz=True, wall=None)
+        rigid.run(steps)
+        out["rigid_wall"] = plain_compare(plain_snapshot(cpu), plain_snapshot(rigid))
+    return out
 
 
 def refusal():
