@@ -1,8 +1,8 @@
 """Walls with tangential springs (pendular.gpu.wall_friction) on the GPU against the CPU under
 Numba's CUDA simulator: the scenes of wall_friction_checks.py (frictional linear walls under
-gravity, Hertz–Mindlin walls of their own material, with bridges at contact), whose checks run in one process of
-their own so that no other test meets the simulator. The simulator does not contract
-multiply-adds as the CPU's hot kernels do, hence round-off bounds."""
+gravity, Hertz–Mindlin walls of their own material, with bridges at contact), whose checks
+run in one process of their own so that no other test meets the simulator. The simulator
+does not contract multiply-adds as the CPU's hot kernels do, hence round-off bounds."""
 
 import pytest
 

@@ -16,9 +16,10 @@ Simulation runs it with the chosen contact law, without local damping or gravity
 impact whose closed-form peak overlap exceeds MAX_OVERLAP of the radius is refused.
 
 The summary holds the contact's E* (Hertz–Mindlin) and restitution, the peak normal force
-and overlap, the contact's duration (while the normal force is positive), the restitution of the sphere's centre velocity along the initial normal
-and along the incident tangent (signed; None at normal incidence), its angular velocity after
-the contact and its rebound angle from the normal.
+and overlap, the contact's duration (while the normal force is positive), the restitution
+of the sphere's centre velocity along the initial normal and along the incident tangent
+(signed; None at normal incidence), its angular velocity after the contact and its rebound
+angle from the normal.
 """
 
 import math

@@ -29,9 +29,9 @@ EXAMPLE = ("pendular impact --target wall --contact hertz-mindlin --radius 0.01 
            "in summary.json; force against time and overlap in impact.png")
 
 #: Summary keys printed at the end.
-SHOWN = ("effective_modulus", "contact_restitution", "max_normal_force", "max_overlap", "contact_duration", "normal_restitution",
-         "tangential_restitution", "rebound_angular_velocity", "rebound_angle_deg", "dt",
-         "rayleigh_timestep")
+SHOWN = ("effective_modulus", "contact_restitution", "max_normal_force", "max_overlap",
+         "contact_duration", "normal_restitution", "tangential_restitution",
+         "rebound_angular_velocity", "rebound_angle_deg", "dt", "rayleigh_timestep")
 
 
 def add_arguments(parser):
