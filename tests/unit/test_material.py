@@ -16,11 +16,12 @@ from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
 from pendular.dem.material import (Material, effective_modulus, effective_shear_modulus,
     pair_restitution)
 from pendular.dem.restitution import damping_ratio
+from pendular.dem.state import Particles, Walls
 from pendular.dem.wall_friction import FrictionalWallForces, wall_law
 from pendular.dem.walls import WallForces
 from pendular.procedures import impact
 from pendular.procedures.config import config_from_dict, config_to_dict
-from pendular.procedures.preparation import PrepareConfig
+from pendular.procedures.preparation import PrepareConfig, dry_simulation
 from pendular.procedures.registry import config_from_options
 from pendular.utils.parameters import flat_options, option_values
 
@@ -89,6 +90,26 @@ def test_the_laboratory_walls_by_default_are_the_former_walls():
     contact = HertzMindlinForces(7e10, 0.3, 0.7)
     wall = wall_law(contact, 7e10, config.wall_material())
     assert (wall.modulus, wall.damping) == (effective_modulus(7e10, 0.3), contact.damping)
+
+
+def test_a_laboratory_scene_walls_take_the_configurations_wall_material():
+    """dry_simulation's walls: the pair's E*, G*, mean restitution and the wall's friction;
+    elastic linear grains on walls of restitution 0.6 get a dashpot of e = 0.8."""
+    particles = Particles(np.array([[0.5, 0.5, 0.5]]), np.array([0.1]), 2650.0)
+    walls = Walls.box((0, 0, 0), (1, 1, 1))
+    config = PrepareConfig(contact="hertz-mindlin", young=7e10, poisson=0.3, restitution=0.5,
+                           wall_young=2e11, wall_poisson=0.25, wall_restitution=0.9,
+                           wall_friction=10.0)
+    wall = dry_simulation(particles, walls, config, 1e-6, 0.01, 18.0, []).forces[1]
+    assert wall.modulus == effective_modulus(7e10, 0.3, 2e11, 0.25)
+    assert wall.tangential == effective_shear_modulus(7e10, 0.3, 2e11, 0.25)
+    assert wall.restitution == pytest.approx(0.7, rel=1e-15)
+    assert wall.damping == damping_ratio(wall.restitution, "hertz-mindlin")
+    assert wall.friction_deg == 10.0
+    linear = dry_simulation(particles, walls, PrepareConfig(wall_restitution=0.6), 1e-6, 0.01,
+                            18.0, []).forces[1]
+    assert type(linear) is FrictionalWallForces and linear.friction_deg == 0.0
+    assert linear.damping == damping_ratio(0.8, "linear") > 0.0
 
 
 def test_an_impact_on_a_rigid_wall_given_as_the_spheres_material_is_the_default_bit_for_bit():
