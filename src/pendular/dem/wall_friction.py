@@ -47,8 +47,8 @@ def check_wall_friction(friction_deg):
 class FrictionalWallForces(ViscoelasticWallForces):
     """Linear sphere–wall springs, kn = E R and kt = ``shear_ratio`` kn, with Coulomb friction
     of ``friction_deg`` [deg] in [0, 90) (module docstring); ``young`` E [Pa] of the grains,
-    whose contacts are elastic; walls of ``restitution`` (the contact's the mean of it and
-    the grains' 1, pendular.dem.material). Each particle's spring on each wall,
+    whose contacts are elastic; walls of ``restitution`` (a contact rebounds at its mean
+    with the grains' 1, pendular.dem.material). Each particle's spring on each wall,
     ``wall_shear`` (N, 6, 3) [N], is kept across steps and checkpoints."""
 
     def __init__(self, young, shear_ratio=0.3, friction_deg=30.0, restitution=1.0):
