@@ -2,7 +2,7 @@
 contact's parameters (docs/physics.md 'Materials and mixing rules').
 
 A ``Material`` holds young E [Pa], poisson nu, density [kg/m^3], friction_deg phi [deg],
-rolling_friction mu_r and restitution e. A wall is driven, never moved by its contacts: its
+rolling_friction mu_r, restitution e and twisting_friction mu_t. A wall is driven, never moved by its contacts: its
 density is infinite, and its E is infinite for a rigid wall (the default: the limit of an
 infinitely stiff wall). A sphere–wall contact takes:
 
@@ -13,7 +13,8 @@ infinitely stiff wall). A sphere–wall contact takes:
   (LIGGGHTS's ``coefficientFriction`` is a matrix over the pairs of atom types, its
   grain–wall entry the wall's); YADE's min(phi1, phi2) would make frictional walls under
   frictionless grains frictionless, and a wall's friction (a rough platen, a lubricated one)
-  is a property of the wall's surface. Rolling friction likewise, the wall's own;
+  is a property of the wall's surface. Rolling and twisting friction likewise, the wall's
+  own (pendular.dem.wall_rolling: the EPSD springs of the pairs on a sphere and a plane);
 - restitution: the arithmetic mean (e1 + e2) / 2, YADE's rule for two materials' values when
   no value is given for their pair (its MatchMaker's default algorithm, 'avg'): exact where
   the two are equal, as the mean of two equal doubles is that double.
@@ -55,8 +56,8 @@ def _positive_or_infinite(name, value, unit):
 class Material:
     """A body's material (module docstring): ``young`` [Pa] in (0, inf] (inf: rigid),
     ``poisson`` in (-1, 0.5), ``density`` [kg/m^3] in (0, inf] (inf: a driven wall),
-    ``friction_deg`` [deg] in [0, 90), ``rolling_friction`` >= 0, ``restitution`` in (0, 1].
-    ValueError naming the field outside its range."""
+    ``friction_deg`` [deg] in [0, 90), ``rolling_friction`` >= 0, ``restitution`` in (0, 1],
+    ``twisting_friction`` >= 0. ValueError naming the field outside its range."""
 
     young: float
     poisson: float = 0.3
@@ -64,6 +65,7 @@ class Material:
     friction_deg: float = 0.0
     rolling_friction: float = 0.0
     restitution: float = 1.0
+    twisting_friction: float = 0.0
 
     def __post_init__(self):
         checked = {
@@ -73,7 +75,8 @@ class Material:
             "friction_deg": check_range("friction_deg", self.friction_deg, 0.0, 90.0,
                                         high_inclusive=False, unit="deg"),
             "rolling_friction": check_range("rolling_friction", self.rolling_friction, 0.0),
-            "restitution": check_restitution(self.restitution)}
+            "restitution": check_restitution(self.restitution),
+            "twisting_friction": check_range("twisting_friction", self.twisting_friction, 0.0)}
         for name, value in checked.items():
             object.__setattr__(self, name, value)
 

@@ -83,6 +83,7 @@ OPTION_UNITS = {
     "friction": "deg", "prep_friction": "deg", "rolling_friction": "1",
     "twisting_friction": "1", "gravity": "m/s^2", "wall_friction": "deg", "contact": "1", "poisson": "1",
     "restitution": "1", "wall_young": "Pa", "wall_poisson": "1", "wall_restitution": "1",
+    "wall_rolling_friction": "1", "wall_twisting_friction": "1",
     "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",

@@ -7,7 +7,9 @@ other way (its position and velocity the mirror image through the contact point)
 other way (-spin: at normal incidence the two roll on each other without sliding, their
 relative rotation the rolling resistance's, ``rolling_friction`` and ``twisting_friction``,
 pendular.dem.rolling), with "wall" a flat wall of its own material (``wall_material``:
-``wall_young``, ``wall_poisson``, ``wall_friction``, ``wall_restitution``), mixed with the
+``wall_young``, ``wall_poisson``, ``wall_friction``, ``wall_restitution``,
+``wall_rolling_friction`` and ``wall_twisting_friction``: the rolling resistance of
+pendular.dem.wall_rolling, R* = R), mixed with the
 sphere's by pendular.dem.material's rules; rigid by default, the limit of an infinitely stiff
 wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R, m* = m
 (pendular.dem.hertz_mindlin.ViscoelasticWallForces; linear: kn = E R). The engine's own
@@ -37,6 +39,7 @@ from pendular.dem.rolling import RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import rayleigh_timestep
+from pendular.dem.wall_rolling import wall_resistance
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -78,11 +81,12 @@ OPTIONS = (
                 0.0, checked=True),
     option_of(PrepareConfig, "contact", checked=True),
     option_of(PrepareConfig, "rolling_friction", checked=True,
-              help="rolling resistance coefficient mu_r between the spheres (target sphere): "
-                   "limit moment mu_r R* Fn (pendular.dem.rolling; 0: none)"),
+              help="rolling resistance coefficient mu_r: limit moment mu_r R* Fn "
+                   "(pendular.dem.rolling; with the wall too, unless --wall-rolling-friction; "
+                   "0: none)"),
     option_of(PrepareConfig, "twisting_friction", checked=True,
-              help="twisting resistance coefficient mu_t between the spheres (target sphere): "
-                   "limit moment mu_t R* Fn about the normal (0: none)"),
+              help="twisting resistance coefficient mu_t: limit moment mu_t R* Fn about the "
+                   "normal (with the wall too, unless --wall-twisting-friction; 0: none)"),
     option_of(PrepareConfig, "wall_young", checked=True,
               help="Young's modulus of the wall (target wall, Hertz-Mindlin; default: rigid, "
                    "E = inf)"),
@@ -94,20 +98,30 @@ OPTIONS = (
     option_of(PrepareConfig, "wall_restitution", checked=True,
               help="coefficient of restitution of the wall (target wall): the contact's is the "
                    "mean of the sphere's and the wall's (default: the sphere's)"),
+    option_of(PrepareConfig, "wall_rolling_friction", default=None, checked=True,
+              help="rolling resistance coefficient of the wall (target wall; limit moment "
+                   "mu_r R Fn, pendular.dem.wall_rolling; default: the sphere's "
+                   "--rolling-friction)"),
+    option_of(PrepareConfig, "wall_twisting_friction", default=None, checked=True,
+              help="twisting resistance coefficient of the wall (target wall; default: the "
+                   "sphere's --twisting-friction)"),
 )
 #: The options that set the wall's material.
-WALL_OPTIONS = ("wall_young", "wall_poisson", "wall_friction", "wall_restitution")
+WALL_OPTIONS = ("wall_young", "wall_poisson", "wall_friction", "wall_restitution",
+                "wall_rolling_friction", "wall_twisting_friction")
 
 
 def wall_material(values):
     """The wall's Material (pendular.dem.material) of ``values`` (OPTIONS, read): rigid
-    unless ``wall_young``, the sphere's Poisson ratio, friction and restitution where no wall
-    value is given."""
+    unless ``wall_young``, the sphere's Poisson ratio, friction, rolling and twisting friction
+    and restitution where no wall value is given."""
     def given(key, otherwise):
         return otherwise if values[key] is None else values[key]
     return Material(given("wall_young", math.inf), given("wall_poisson", values["poisson"]),
-                    math.inf, given("wall_friction", values["friction"]), 0.0,
-                    given("wall_restitution", values["restitution"]))
+                    math.inf, given("wall_friction", values["friction"]),
+                    given("wall_rolling_friction", values["rolling_friction"]),
+                    given("wall_restitution", values["restitution"]),
+                    given("wall_twisting_friction", values["twisting_friction"]))
 
 
 def contact_restitution(values):
@@ -151,10 +165,8 @@ def elastic_impact(values):
 
 def check_impact(values):
     """OptionError naming --velocity and --young when the impact of ``values`` would overlap
-    the spheres by more than MAX_OVERLAP of their radius (elastic_impact), naming
-    --rolling-friction or --twisting-friction above 0 with a wall target (sphere–wall contacts
-    carry no rolling or twisting moment: pendular.dem.rolling), a wall's material with a
-    sphere target, --wall-young with the linear law (its wall is a sphere of the grains'
+    the spheres by more than MAX_OVERLAP of their radius (elastic_impact), naming a wall's
+    material with a sphere target, --wall-young with the linear law (its wall is a sphere of the grains'
     springs, kn = E R) and --wall-poisson without it."""
     walled = [key for key in WALL_OPTIONS if values[key] is not None]
     if walled and values["target"] == "sphere":
@@ -170,13 +182,6 @@ def check_impact(values):
         raise OptionError(lambda name: (
             f"{name('wall_poisson')} = {values['wall_poisson']:g} needs "
             f"{name('wall_young')}: a rigid wall's Poisson ratio plays no part"))
-    for option in ("rolling_friction", "twisting_friction"):
-        if values[option] > 0.0 and values["target"] == "wall":
-            raise OptionError(lambda name, option=option: (
-                f"{name(option)} = {values[option]:g} acts between spheres only (a wall "
-                f"carries no rolling or twisting moment); valid: 0 with {name('target')} "
-                f"wall, or "
-                f"{name('target')} sphere"))
     overlap = elastic_impact(values)[1] / values["radius"]
     if overlap > MAX_OVERLAP:
         stiffer = "young" if values["wall_young"] is None else "wall_young"
@@ -267,6 +272,7 @@ def impact_scene(values):
     forces = [contact]
     if wall:
         forces.append(ViscoelasticWallForces(contact, wall_material(values)))
+        forces.extend(wall_resistance(contact, wall_material(values)))
     elif values["rolling_friction"] > 0.0 or values["twisting_friction"] > 0.0:
         forces.append(RollingResistance(values["rolling_friction"],
                                         values["twisting_friction"]))

@@ -66,7 +66,9 @@ _MATERIAL = options_named(PrepareConfig, ("porosity", "friction_deg", "prep_fric
                                           "rolling_friction", "twisting_friction", "gravity",
                                           "wall_friction", "young", "contact", "poisson",
                                           "restitution", "wall_young", "wall_poisson",
-                                          "wall_restitution", "damping", "timestep_safety",
+                                          "wall_restitution", "wall_rolling_friction",
+                                          "wall_twisting_friction", "damping",
+                                          "timestep_safety",
                                           "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL

@@ -49,6 +49,7 @@ from pendular.utils.progress import PhaseBar
 from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int
 from pendular.dem.wall_friction import WALL_FRICTION_RANGE, wall_law
+from pendular.dem.wall_rolling import wall_resistance
 from pendular.dem.walls import StressServo
 from pendular.homogenize.on_the_fly import homogenized
 
@@ -213,6 +214,14 @@ class PrepareConfig:
         None, low=0.0, high=1.0, low_inclusive=False, flag="--wall-restitution",
         help="coefficient of restitution of the walls; a sphere-wall contact's is the mean of "
              "the grains' and the walls' (default: the grains' --restitution)")
+    wall_rolling_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--wall-rolling-friction",
+        help="rolling resistance coefficient mu_r of the walls: limit moment mu_r R Fn on a "
+             "sphere of radius R (pendular.dem.wall_rolling; 0: none; with the test friction)")
+    wall_twisting_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--wall-twisting-friction",
+        help="twisting resistance coefficient mu_t of the walls: limit moment mu_t R Fn about "
+             "the wall's normal (0: none)")
     gravity: float = parameter(0.0, unit="m/s^2", low=0.0, high=MAX_GRAVITY, flag="--gravity",
                                help="gravitational acceleration along -z (0: none; walls "
                                     "only, not with --periodic)")
@@ -290,6 +299,8 @@ class PrepareConfig:
         escape the bounds the sample's stresses are checked against)."""
         given = [name for name in ("wall_young", "wall_poisson", "wall_restitution")
                  if getattr(self, name) is not None]
+        given += [name for name in ("wall_rolling_friction", "wall_twisting_friction")
+                  if getattr(self, name) > 0.0]
         if given and self.periodic:
             raise fail(self, given[0], f"{given[0]} = {getattr(self, given[0]):g} applies to "
                        "walls; valid: none in a periodic cell (--periodic: no walls)")
@@ -317,14 +328,14 @@ class PrepareConfig:
 
     def wall_material(self):
         """The walls' Material: rigid unless wall_young, of wall_poisson (the grains' Poisson
-        ratio unless given), wall_friction, and wall_restitution (the grains' unless given),
-        driven (infinite density), without rolling friction (a sphere–wall contact carries no
-        moment, pendular.dem.rolling)."""
+        ratio unless given), wall_friction, wall_restitution (the grains' unless given),
+        wall_rolling_friction and wall_twisting_friction (pendular.dem.wall_rolling; 0 by
+        default: no moment on the walls), driven (infinite density)."""
         return Material(math.inf if self.wall_young is None else self.wall_young,
                         self.poisson if self.wall_poisson is None else self.wall_poisson,
-                        math.inf, self.wall_friction, 0.0,
+                        math.inf, self.wall_friction, self.wall_rolling_friction,
                         self.restitution if self.wall_restitution is None
-                        else self.wall_restitution)
+                        else self.wall_restitution, self.wall_twisting_friction)
 
     @property
     def graded(self):
@@ -423,7 +434,8 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
     the same law with the walls' material, ``config.wall_material()``
     (pendular.dem.wall_friction.wall_law; none in a periodic cell), the weight (``config.gravity``
     > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
-    coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its runs on
+    coefficients > 0: ``resisting``; on the walls, one of the walls' > 0:
+    pendular.dem.wall_rolling.wall_resistance), the given wall ``controls``, leapfrog; its runs on
     ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
     resistance it holds the contacts and the walls alone."""
     forces = [contact_forces(config, friction_deg)]
@@ -432,7 +444,7 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
     if config.gravity > 0.0:
         forces.append(Gravity(config.gravity))
     if resistance:
-        forces.extend(resisting(config))
+        forces.extend(resisting(config, forces[0], walls))
     return Simulation(particles, walls, dt,
                       neighbors=NeighborList(skin),
                       forces=forces,
@@ -441,12 +453,18 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
                       threads=threads, device=device)
 
 
-def resisting(config):
+def resisting(config, contact, walls):
     """The rolling and twisting resistance of ``config`` as a list of forces: one
-    RollingResistance when its rolling_friction or twisting_friction is above 0, else none."""
+    RollingResistance when its rolling_friction or twisting_friction is above 0, and inside
+    ``walls`` (not a periodic cell) one WallRollingResistance of the contact law ``contact``
+    when its wall_rolling_friction or wall_twisting_friction is above 0
+    (pendular.dem.wall_rolling.wall_resistance); else none."""
+    forces = []
     if config.rolling_friction > 0.0 or config.twisting_friction > 0.0:
-        return [RollingResistance(config.rolling_friction, config.twisting_friction)]
-    return []
+        forces.append(RollingResistance(config.rolling_friction, config.twisting_friction))
+    if not walls.periodic:
+        forces.extend(wall_resistance(contact, config.wall_material()))
+    return forces
 
 
 def servoed_simulation(particles, walls, config, target, threads=None):
@@ -548,7 +566,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     sim.controls = [servo]
     sim.dt = timestep(sim, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
-    sim.forces.extend(resisting(config))        # with the test friction, as in a loaded sample
+    # with the test friction, as in a loaded sample
+    sim.forces.extend(resisting(config, sim.forces[0], sim.walls))
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=equilibrium_bar(label and "set friction",
