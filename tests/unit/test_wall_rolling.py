@@ -86,7 +86,7 @@ def test_below_the_limit_the_moment_is_an_elastic_spring():
         moments.append(sim.particles.torque[0, 0])
         assert moments[-1] == pytest.approx(-stiffness * angle, rel=1e-9)
     spins, moments = np.array(spins), np.array(moments)
-    assert abs(int(np.argmax(spins < 0.0)) - quarter) <= 0.01 * quarter
+    assert abs(int(np.argmax(spins < 0.0)) - quarter) <= 1
     peak = w0 * math.sqrt(stiffness * INERTIA)
     assert np.abs(moments).max() == pytest.approx(peak, rel=1e-3)
     assert peak < mu * RADIUS * kn * overlap
@@ -143,7 +143,7 @@ def test_a_sphere_rolling_without_slip_slows_at_the_epsd_rate():
     rate = (p.velocity[0, 0] - v1) / (sim.time - t0)
     lever = RADIUS - 0.5 * overlap
     expected = -mu_r * RADIUS * MASS * G * RADIUS / (INERTIA + MASS * RADIUS * lever)
-    assert rate == pytest.approx(expected, rel=1e-3)
+    assert rate == pytest.approx(expected, rel=1e-6)
     assert expected == pytest.approx(-5.0 / 7.0 * mu_r * G, rel=1e-3)
     assert p.angular_velocity[0, 1] * RADIUS == pytest.approx(p.velocity[0, 0], rel=1e-4)
 

@@ -5,11 +5,12 @@ contact law: its peak force and overlap, contact duration, restitution and rebou
 With --target sphere two identical spheres approach each other, each at --velocity; with
 --target wall one sphere hits a flat wall at --velocity, rigid by default: the limit of an
 infinitely stiff wall (Hertz: E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R; linear:
-kn = E R); --wall-young, --wall-poisson, --wall-friction and --wall-restitution give the wall
-a material of its own, mixed with the sphere's (docs/physics.md 'Materials and mixing rules').
---angle tilts the velocity from the normal, --spin turns the sphere about the axis normal to
-the plane of incidence (a target sphere the other way); --rolling-friction and
---twisting-friction resist the spheres' relative rotation (target sphere only). The engine's
+kn = E R); --wall-young, --wall-poisson, --wall-friction, --wall-restitution,
+--wall-rolling-friction and --wall-twisting-friction give the wall a material of its own,
+mixed with the sphere's (docs/physics.md 'Materials and mixing rules'). --angle tilts the
+velocity from the normal, --spin turns the sphere about the axis normal to the plane of
+incidence (a target sphere the other way); --rolling-friction and --twisting-friction resist
+the relative rotation of the spheres, or of the sphere on the wall (R* = R). The engine's
 own simulation runs it with the chosen --contact law, at 2,000 steps per closed-form contact
 duration. Writes DIR/summary.json, DIR/history.h5 (time,
 overlap, normal_force, tangential_force, angular_velocity) and DIR/impact.png (force against
