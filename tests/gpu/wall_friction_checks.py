@@ -1,7 +1,7 @@
 """Walls with tangential springs (pendular.gpu.wall_friction) on the GPU against the CPU, the
 checks of tests/gpu/test_gpu_wall_friction.py run under Numba's CUDA simulator in a process of
-their own (``NUMBA_ENABLE_CUDASIM=1 python wall_friction_checks.py linear hertz wet rolling refusal``
-prints one JSON object of measurements, simulator.run_checks):
+their own (``NUMBA_ENABLE_CUDASIM=1 python wall_friction_checks.py linear hertz wet rolling
+refusal`` prints one JSON object of measurements, simulator.run_checks):
 
 - "linear": the 27-sphere scene of simulated.py (a triaxial's shear in miniature) with its
   walls frictional (FrictionalWallForces, FRICTION) and the weight: the plain run, one handed

@@ -47,11 +47,12 @@ class Spinning:
 
 
 def floor_scene(overlap, spin, wall, integrator, contact=None, wall_forces=None, extra=(),
-                velocity=(0.0, 0.0, 0.0), dt=5e-7):
+                velocity=(0.0, 0.0, 0.0), dt=5e-7, damping_ratio=0.0):
     """One sphere of RADIUS on the floor z = 0 of a box [-1, 1]^2 x [0, 1] at ``overlap`` [m],
     spinning at ``spin`` (3,) [rad/s] and moving at ``velocity``: ``contact`` (the linear
     law by default), ``wall_forces`` (its frictionless walls by default), the walls' rolling
-    resistance of the Material ``wall``, then ``extra`` forces."""
+    resistance of the Material ``wall`` (its dashpots' ``damping_ratio``), then ``extra``
+    forces."""
     contact = ContactForces(YOUNG, SHEAR_RATIO, 30.0) if contact is None else contact
     particles = Particles(np.array([[0.0, 0.0, RADIUS - overlap]]), np.array([RADIUS]),
                           DENSITY, velocity=np.array([velocity], float),
@@ -59,8 +60,8 @@ def floor_scene(overlap, spin, wall, integrator, contact=None, wall_forces=None,
     walls = Walls.box([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0])
     wall_forces = WallForces(YOUNG) if wall_forces is None else wall_forces
     return Simulation(particles, walls, dt, neighbors=NeighborList(0.2 * RADIUS),
-                      forces=[contact, wall_forces, WallRollingResistance(contact, wall),
-                              *extra],
+                      forces=[contact, wall_forces,
+                              WallRollingResistance(contact, wall, damping_ratio), *extra],
                       integrator=integrator)
 
 
@@ -91,6 +92,26 @@ def test_below_the_limit_the_moment_is_an_elastic_spring():
     assert np.abs(moments).max() == pytest.approx(peak, rel=1e-3)
     assert peak < mu * RADIUS * kn * overlap
     np.testing.assert_array_equal(sim.particles.torque[0, 1:], 0.0)
+
+
+def test_below_the_limit_the_twisting_dashpot_damps_at_its_ratio():
+    """Slow spin w0 about the floor's normal, damping ratio eta: the twisting spring and
+    dashpot (-eta 2 sqrt(I k_t) w) make a damped oscillator, whose successive spin maxima fall
+    by exp(-2 pi eta / sqrt(1 - eta^2))."""
+    mu, overlap, w0, eta = 0.3, 1e-5, 0.05, 0.1
+    sim = floor_scene(overlap, [0.0, 0.0, w0], rolling_wall(0.0, mu), Spinning(),
+                      damping_ratio=eta)
+    spins = []
+    for _ in range(800):
+        sim.run(1)
+        spins.append(sim.particles.angular_velocity[0, 2])
+    spins = np.array(spins)
+    peaks = [k for k in range(1, len(spins) - 1) if spins[k - 1] < spins[k] >= spins[k + 1]]
+    assert len(peaks) >= 3
+    decrement = spins[peaks[1]] / spins[peaks[0]]
+    expected = math.exp(-2.0 * math.pi * eta / math.sqrt(1.0 - eta ** 2))
+    assert decrement == pytest.approx(expected, rel=1e-2)
+    assert spins[peaks[2]] / spins[peaks[1]] == pytest.approx(decrement, rel=1e-3)
 
 
 @pytest.mark.parametrize("contact", ["linear", "hertz-mindlin"])
