@@ -2,9 +2,9 @@
 contact's parameters (docs/physics.md 'Materials and mixing rules').
 
 A ``Material`` holds young E [Pa], poisson nu, density [kg/m^3], friction_deg phi [deg],
-rolling_friction mu_r, restitution e and twisting_friction mu_t. A wall is driven, never moved by its contacts: its
-density is infinite, and its E is infinite for a rigid wall (the default: the limit of an
-infinitely stiff wall). A sphere–wall contact takes:
+rolling_friction mu_r, restitution e and twisting_friction mu_t. A wall is driven, never moved
+by its contacts: its density is infinite, and its E is infinite for a rigid wall (the default:
+the limit of an infinitely stiff wall). A sphere–wall contact takes:
 
 - elastic moduli: Hertz's E*, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Johnson 1985,
   Eq. 4.22), and Mindlin's G*, 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2 (Mindlin 1949), a rigid

@@ -166,8 +166,8 @@ def elastic_impact(values):
 def check_impact(values):
     """OptionError naming --velocity and --young when the impact of ``values`` would overlap
     the spheres by more than MAX_OVERLAP of their radius (elastic_impact), naming a wall's
-    material with a sphere target, --wall-young with the linear law (its wall is a sphere of the grains'
-    springs, kn = E R) and --wall-poisson without it."""
+    material with a sphere target, --wall-young with the linear law (its wall is a sphere of
+    the grains' springs, kn = E R) and --wall-poisson without it."""
     walled = [key for key in WALL_OPTIONS if values[key] is not None]
     if walled and values["target"] == "sphere":
         raise OptionError(lambda name: (

@@ -435,8 +435,8 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
     (pendular.dem.wall_friction.wall_law; none in a periodic cell), the weight (``config.gravity``
     > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
     coefficients > 0: ``resisting``; on the walls, one of the walls' > 0:
-    pendular.dem.wall_rolling.wall_resistance), the given wall ``controls``, leapfrog; its runs on
-    ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
+    pendular.dem.wall_rolling.wall_resistance), the given wall ``controls``, leapfrog; its runs
+    on ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
     resistance it holds the contacts and the walls alone."""
     forces = [contact_forces(config, friction_deg)]
     if not walls.periodic:
