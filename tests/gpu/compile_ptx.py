@@ -1,5 +1,6 @@
 """Compile every kernel of a dry and a wet step (and a radius growth's, a periodic cell's
-dry and wet, a simple shear's, the grips', the rolling resistance's and gravity's) for a real GPU (PTX,
+dry and wet, a simple shear's, the grips', the rolling resistance's and gravity's, the walls'
+springs and rolling resistance) for a real GPU (PTX,
 by default for compute capability 9.0, an H100) without one, as a script in its own process:
 the simulator runs kernels as Python and would not see code that the CUDA target cannot
 compile (a NumPy ufunc, a global it cannot type).
@@ -95,7 +96,8 @@ def compile_step_kernels(cuda, capability):
     # dry and a wet step in a periodic cell (periodic_checks.py's), of a simple shear
     # (shear_checks.py's), the grips' (grips_checks.py's), volume-controlled bridges'
     # liquid exchange (volume_checks.py's), the rolling resistance and gravity
-    # (rolling_checks.py's), the sphere-wall bridges (wall_bridges_checks.py's)
+    # (rolling_checks.py's), the sphere-wall bridges (wall_bridges_checks.py's), the walls'
+    # springs and rolling resistance (wall_friction_checks.py's)
     from grips_checks import scene as grips_scene
     from growth_checks import scene as growth_scene
     from periodic_checks import scene as periodic_scene
@@ -103,12 +105,14 @@ def compile_step_kernels(cuda, capability):
     from shear_checks import scene as shear_scene
     from volume_checks import scene as volume_scene
     from wall_bridges_checks import scene as wall_bridges_scene
+    from wall_friction_checks import scene as wall_friction_scene
 
     for sim, label in ((growth_scene(), ""), (periodic_scene(), " periodic"),
                        (periodic_scene(wet=True), " periodic wet"),
                        (shear_scene(), " sheared"),
                        (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume"),
-                       (rolling_scene(), ""), (wall_bridges_scene(), "")):
+                       (rolling_scene(), ""), (wall_bridges_scene(), ""),
+                       (wall_friction_scene(rolling=True), "")):
         gpu = GpuSimulation(sim)
         gpu.configure()
         for kernel, _, args in gpu.steps:

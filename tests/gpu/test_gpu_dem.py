@@ -119,7 +119,8 @@ def compile_ptx(*arguments):
 @requires("cuda compiler")
 def test_every_kernel_compiles_for_a_gpu():
     """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic, with
-    the rolling resistance, gravity and the sphere-wall bridges (tests/gpu/compile_ptx.py),
+    the rolling resistance, gravity, the sphere-wall bridges, the walls' springs and rolling
+    resistance (tests/gpu/compile_ptx.py),
     where the gpu extra's CUDA compiler is installed: the simulator would run code that the
     CUDA target rejects."""
     done = compile_ptx()
@@ -132,10 +133,11 @@ def test_every_kernel_compiles_for_a_gpu():
     grips = ("grip_partials", "grip_hold")
     resisting = ("pair_moments", "gather_moments", "add_weight")
     wall_bridges = ("wall_bridges", "wall_bridge_partials", "wall_bridge_sums")
+    wall_springs = ("wall_contacts", "wall_moments")
     periodic = ("bin_periodic", "find_periodic_pairs", "cell_partials", "cell_controls",
                 "cell_leapfrog")
     assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth,
-                                        *grips, *resisting, *wall_bridges,
+                                        *grips, *resisting, *wall_bridges, *wall_springs,
                                         *(f"{name} periodic" for name in periodic),
                                         *(f"{name} periodic wet" for name in periodic),
                                         *(f"{name} sheared" for name in (*periodic,

@@ -15,6 +15,7 @@ from pendular.dem.contact_law import pair_forces
 from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
     ViscoelasticWallForces, effective_modulus, effective_shear_modulus,
     viscoelastic_pair_forces, viscoelastic_wall_forces)
+from pendular.dem.material import rigid_wall
 from pendular.dem.neighbors import build_contacts
 from pendular.dem.restitution import damping_ratio
 from pendular.dem.timestep import rayleigh_timestep
@@ -170,7 +171,8 @@ def test_the_wall_has_mindlins_stiffness_of_a_rigid_body():
     radius, young, poisson, density = (STEEL[k] for k in ("radius", "young", "poisson",
                                                           "density"))
     overlap = 1e-6
-    wall = ViscoelasticWallForces(HertzMindlinForces(young, poisson), friction_deg=30.0)
+    wall = ViscoelasticWallForces(HertzMindlinForces(young, poisson),
+                                  rigid_wall(friction_deg=30.0))
     position = np.array([[0.0, 0.0, radius - overlap]])
     velocity = np.array([[1e-3, 0.0, 0.0]])
     mass = np.array([density * 4.0 / 3.0 * math.pi * radius ** 3])

@@ -40,7 +40,9 @@ BOUNDS = [
 #: The options of ``pendular triaxial`` made from their fields' metadata.
 GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spread",
              "porosity", "friction", "prep_friction", "rolling_friction", "twisting_friction",
-             "gravity", "wall_friction", "young", "contact", "poisson", "restitution", "damping",
+             "gravity", "wall_friction", "young", "contact", "poisson", "restitution", "wall_young",
+             "wall_poisson", "wall_restitution", "wall_rolling_friction",
+             "wall_twisting_friction", "damping",
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
              "surface_tension", "rupture_liquid", "wall_bridges", "wetting", "persist_bridges",

@@ -288,6 +288,6 @@ def test_spheres_rolling_on_each_other_in_an_impact_lose_the_limit_moments_impul
     assert rolled["normal_restitution"] == pytest.approx(free["normal_restitution"], rel=1e-9)
 
 
-def test_rolling_friction_with_a_wall_target_is_refused_naming_the_option(capsys):
-    refused(*run_in_process("impact", ["--target", "wall", "--rolling-friction", "0.2"],
-                            capsys), "--rolling-friction", "--target")
+def test_a_walls_rolling_friction_with_a_sphere_target_is_refused_naming_the_option(capsys):
+    refused(*run_in_process("impact", ["--target", "sphere", "--wall-rolling-friction", "0.2"],
+                            capsys), "--wall-rolling-friction", "--target")

@@ -24,10 +24,13 @@ The same damping on the linear law (``DampedLinearForces``: kn of
 pendular.dem.contact_law.normal_stiffness, ks = shear_ratio kn) gives a linear contact a
 restitution; the linear law without damping stays pendular.dem.contact_law.ContactForces.
 
-Sphere–wall (``ViscoelasticWallForces``): the wall is rigid, the limit of an infinitely stiff
-wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R and m* = m (the linear law's wall: a
-virtual sphere of the same radius, kn = E R); its tangential spring lies in the wall's fixed
-plane, capped at Fn tan(wall friction): frictionless walls by default.
+Sphere–wall (``ViscoelasticWallForces``): the wall is a body of its own material
+(pendular.dem.material: E* and G* of the grain and the wall, the mean of their restitutions,
+the wall's friction), rigid by default, the limit of an infinitely stiff wall,
+E* = E / (1 - nu^2), G* = G / (2 - nu); R* = R and m* = m (a wall does not move under its
+contacts; the linear law's wall: a virtual sphere of the same radius and springs, kn = E R);
+its tangential spring lies in the wall's fixed plane, capped at Fn tan(wall friction):
+frictionless walls by default.
 
 The per-pair arrays are the contacts' (shear_force: the spring, normal, overlap,
 normal_force: the elastic spring's force, without the dashpot, as pendular.dem.neighbors.Contacts
@@ -52,6 +55,8 @@ from pendular.dem import HOT_KERNEL_FASTMATH
 from pendular.dem.contact_law import (MAX_SHEAR_RATIO, ContactForces, _contact_gap,
     _first_member, _prefetch_second, _row_sums, _scatter_to_both, _store_row_sums, _stretched,
     _turned_contact, normal_stiffness, wall_contact_stiffness)
+from pendular.dem.material import (check_poisson, check_restitution, effective_modulus,
+    effective_shear_modulus, rigid_wall, wall_contact)
 from pendular.dem.prefetch import prefetch_distance
 from pendular.dem.protocols import state_array
 from pendular.dem.restitution import damping_ratio
@@ -62,35 +67,6 @@ from pendular.utils.validate import check_positive, check_range
 TANGENTIAL_MASS = 2.0 / 7.0
 #: The contact laws a scene may use: linear springs (the default), Hertz–Mindlin.
 CONTACT_LAWS = ("linear", "hertz-mindlin")
-#: The valid Poisson ratios: (-1, 0.5), open at both ends (an incompressible 0.5 has no shear
-#: stiffness to spare: G* and the Rayleigh step stay finite, but the law is meant for solids).
-POISSON_RANGE = (-1.0, 0.5)
-
-
-def check_poisson(poisson):
-    """``poisson`` as float, ValueError outside (-1, 0.5)."""
-    return check_range("poisson", poisson, *POISSON_RANGE, low_inclusive=False,
-                       high_inclusive=False)
-
-
-def shear_modulus(young, poisson):
-    """G = E / (2 (1 + nu)) [Pa]."""
-    return young / (2.0 * (1.0 + poisson))
-
-
-def effective_modulus(young_1, poisson_1, young_2=math.inf, poisson_2=0.0):
-    """Hertz's effective modulus E* [Pa], 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2 (Johnson
-    1985, Eq. 4.22); a second body of infinite E (the default) is rigid."""
-    return 1.0 / ((1.0 - poisson_1 ** 2) / young_1 + (1.0 - poisson_2 ** 2) / young_2)
-
-
-def effective_shear_modulus(young_1, poisson_1, young_2=math.inf, poisson_2=0.0):
-    """Mindlin's effective shear modulus G* [Pa], 1/G* = (2 - nu1)/G1 + (2 - nu2)/G2 (Mindlin
-    1949; kt = 8 G* a); a second body of infinite E is rigid."""
-    return 1.0 / ((2.0 - poisson_1) / shear_modulus(young_1, poisson_1)
-                  + (2.0 - poisson_2) / shear_modulus(young_2, poisson_2))
-
-
 @numba.njit(cache=True, inline="always")
 def _stiffnesses(hertz, modulus, tangential, radius_star, overlap, linear_kn):
     """(elastic normal force [N], normal tangent stiffness kn [N/m], tangential stiffness kt
@@ -343,7 +319,7 @@ class _DampedContactForces(ContactForces):
     @restitution.setter
     def restitution(self, value):
         law = "hertz-mindlin" if self.hertz else "linear"
-        self._restitution = check_range("restitution", value, 0.0, 1.0, low_inclusive=False)
+        self._restitution = check_restitution(value)
         self.damping = damping_ratio(self._restitution, law)
 
     def apply(self, sim):
@@ -404,23 +380,32 @@ class DampedLinearForces(_DampedContactForces):
 
 class ViscoelasticWallForces:
     """Damped sphere–wall contacts of the law of ``contact`` (a HertzMindlinForces or
-    DampedLinearForces: its material and damping) on rigid walls of friction
-    ``friction_deg`` [deg] (0: frictionless, the laboratory tests' walls), module docstring.
-    Each particle's spring on each wall is kept across steps and checkpoints."""
+    DampedLinearForces: the grains' material) on walls of the material ``wall``
+    (pendular.dem.material.Material; None: rigid_wall, rigid and frictionless, of the grains'
+    restitution), module docstring. The contact's E*, G*, restitution and friction follow
+    pendular.dem.material.wall_contact; the linear law's wall is its virtual sphere of the
+    grains' springs (kn = E R), which takes no Young's modulus of its own. Each particle's
+    spring on each wall is kept across steps and checkpoints."""
 
-    def __init__(self, contact, friction_deg=0.0):
+    def __init__(self, contact, wall=None):
         if not isinstance(contact, _DampedContactForces):
             raise TypeError(f"contact must be a HertzMindlinForces or DampedLinearForces, got "
                             f"{type(contact).__name__}")
+        self.wall = rigid_wall(contact.restitution) if wall is None else wall
         self.hertz = contact.hertz
+        poisson = contact.poisson if self.hertz else 0.0
+        modulus, tangential, self.restitution, self.friction_deg = wall_contact(
+            contact.young, poisson, contact.restitution, self.wall)
         if self.hertz:
-            self.modulus = effective_modulus(contact.young, contact.poisson)
-            self.tangential = effective_shear_modulus(contact.young, contact.poisson)
+            self.modulus, self.tangential = modulus, tangential
+        elif not self.wall.rigid:
+            raise ValueError(f"wall_young = {self.wall.young:g} Pa applies to Hertz-Mindlin "
+                             "contacts; valid: a rigid wall (none given) with the linear law, "
+                             "whose wall is a sphere of the grains' springs (kn = E R)")
         else:
             self.modulus, self.tangential = contact.young, contact.shear_ratio
-        self.damping = contact.damping
-        self.friction_deg = check_range("friction_deg", friction_deg, 0.0, 90.0,
-                                        high_inclusive=False, unit="deg")
+        self.damping = damping_ratio(self.restitution,
+                                     "hertz-mindlin" if self.hertz else "linear")
         self._tan_friction = float(np.tan(np.radians(self.friction_deg)))
         self.wall_shear = np.zeros((0, 6, 3))
 

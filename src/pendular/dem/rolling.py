@@ -23,8 +23,8 @@ fills (``Contacts.normal_force``, ``overlap``, ``normal``): the linear law's k_n
 a Hertz law 4/3 E* sqrt(R* δ), the k_n LIGGGHTS's ``rolling_friction epsd`` takes from its
 Hertz law. F_n is the contact law's elastic spring force alone: a capillary bridge's attraction
 does not raise the limit, as it does not raise the Coulomb cap, and a damped law's dashpot
-(pendular.dem.hertz_mindlin) is left out of both k_n and the limit. Sphere–wall contacts are
-frictionless and carry no moment.
+(pendular.dem.hertz_mindlin) is left out of both k_n and the limit. Sphere–wall contacts take
+the same springs with the walls' own coefficients (pendular.dem.wall_rolling).
 """
 
 import math

@@ -37,11 +37,11 @@ operation's type.
 What runs on the device so far: walled scenes (``Walls``) with ContactForces (or the damped
 and Hertz–Mindlin laws of pendular.dem.hertz_mindlin), WallForces or a wall law with springs
 (ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance
-(pendular.gpu.rolling), Gravity (pendular.gpu.gravity) and, wet, SuctionBridges at contact or
-across gaps (``persist``; a new suction between runs, as the CPU: pendular.gpu.bridges);
-controls StressServo, ConstantStrainRate, MixedStress (its servos among the controls),
-RadiusGrowth and GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips);
-the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
+(pendular.gpu.rolling), WallRollingResistance (pendular.gpu.wall_rolling), Gravity
+(pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps (``persist``; a
+new suction between runs, as the CPU: pendular.gpu.bridges); controls StressServo,
+ConstantStrainRate, MixedStress (its servos among the controls), RadiusGrowth and
+GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
 damped or Hertz–Mindlin law), RollingResistance and, wet, SuctionBridges at contact or across
 gaps or VolumeBridges, under StressServo, ConstantStrainRate, ConstantShearRate (simple
 shear, Lees–Edwards) and MixedStress (pendular.gpu.cell): its step wraps the particles and
@@ -58,7 +58,7 @@ import numpy as np
 from pendular.dem.neighbors import carry_pair_array, previous_pair_index
 # the modules that declare the operations' device sides (pendular.gpu.operations)
 from pendular.gpu import (cell, gravity, grips, integrate, rolling,  # noqa: F401
-    wall_friction)
+    wall_friction, wall_rolling)
 from pendular.gpu import bridges as device_bridges, forces, neighbors, walls as device_walls
 from pendular.gpu.cuda import configured, cuda, simulated
 from pendular.gpu.grips import DeviceGrips

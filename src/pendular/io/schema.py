@@ -82,7 +82,9 @@ OPTION_UNITS = {
     "particles": "1", "radius": "m", "radius_spread": "1", "porosity": "1", "young": "Pa", "shear_ratio": "1",
     "friction": "deg", "prep_friction": "deg", "rolling_friction": "1",
     "twisting_friction": "1", "gravity": "m/s^2", "wall_friction": "deg", "contact": "1", "poisson": "1",
-    "restitution": "1", "density": "kg/m^3", "damping": "1",
+    "restitution": "1", "wall_young": "Pa", "wall_poisson": "1", "wall_restitution": "1",
+    "wall_rolling_friction": "1", "wall_twisting_friction": "1",
+    "density": "kg/m^3", "damping": "1",
     "timestep_safety": "1", "prep_stress": "Pa", "confining": "Pa", "seed": "1",
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
@@ -471,6 +473,12 @@ SUMMARY_KEYS = {
                  "principal stresses there, sigma_1 = p + 2q/3 and sigma_3 = p - q/3, net and "
                  "effective", _E),
     # -- one collision, summary.json of ``pendular impact`` (pendular.procedures.impact)
+    "effective_modulus": Key("Pa", "impact: Hertz's E* of the contact, the sphere's and its "
+                                   "target's (pendular.dem.material); null with the linear "
+                                   "law", _I),
+    "contact_restitution": Key("1", "impact: the coefficient of restitution the contact is "
+                                    "damped for: the sphere's, or with a wall the mean of "
+                                    "the sphere's and the wall's", _I),
     "max_normal_force": Key("N", "impact: the peak normal contact force on the sphere", _I),
     "max_overlap": Key("m", "impact: the peak overlap of the sphere with its target", _I),
     "contact_duration": Key("s", "impact: how long the normal force was positive", _I),

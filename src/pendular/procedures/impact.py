@@ -6,17 +6,22 @@ incidence (positive: rolling forward); with target "sphere" an identical sphere 
 other way (its position and velocity the mirror image through the contact point) spinning the
 other way (-spin: at normal incidence the two roll on each other without sliding, their
 relative rotation the rolling resistance's, ``rolling_friction`` and ``twisting_friction``,
-pendular.dem.rolling), with "wall" a rigid flat wall:
-the limit of an infinitely stiff wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R, m* = m
+pendular.dem.rolling), with "wall" a flat wall of its own material (``wall_material``:
+``wall_young``, ``wall_poisson``, ``wall_friction``, ``wall_restitution``,
+``wall_rolling_friction`` and ``wall_twisting_friction``: the rolling resistance of
+pendular.dem.wall_rolling, R* = R), mixed with the
+sphere's by pendular.dem.material's rules; rigid by default, the limit of an infinitely stiff
+wall, E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R, m* = m
 (pendular.dem.hertz_mindlin.ViscoelasticWallForces; linear: kn = E R). The engine's own
 Simulation runs it with the chosen contact law, without local damping or gravity, at a step of
 1/STEPS_PER_CONTACT of the contact's closed-form duration (Hertz's, or pi sqrt(m* / kn)); an
 impact whose closed-form peak overlap exceeds MAX_OVERLAP of the radius is refused.
 
-The summary holds the peak normal force and overlap, the contact's duration (while the normal
-force is positive), the restitution of the sphere's centre velocity along the initial normal
-and along the incident tangent (signed; None at normal incidence), its angular velocity after
-the contact and its rebound angle from the normal.
+The summary holds the contact's E* (Hertz–Mindlin) and restitution, the peak normal force
+and overlap, the contact's duration (while the normal force is positive), the restitution
+of the sphere's centre velocity along the initial normal and along the incident tangent
+(signed; None at normal incidence), its angular velocity after the contact and its rebound
+angle from the normal.
 """
 
 import math
@@ -25,14 +30,16 @@ import os
 import numpy as np
 
 from pendular.dem.hertz_mindlin import (DampedLinearForces, HertzMindlinForces,
-    ViscoelasticWallForces, effective_modulus)
+    ViscoelasticWallForces)
 from pendular.dem.integrate import Integrator
+from pendular.dem.material import Material, effective_modulus, pair_restitution
 from pendular.dem.neighbors import NeighborList
 from pendular.dem.protocols import state_array
 from pendular.dem.rolling import RollingResistance
 from pendular.dem.simulation import Simulation
 from pendular.dem.state import Particles, Walls
 from pendular.dem.timestep import rayleigh_timestep
+from pendular.dem.wall_rolling import wall_resistance
 from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import pyplot, save_figure
@@ -55,14 +62,15 @@ OUTPUTS = ("summary.json", "history.h5", "impact.png")
 #: (declared once there; steel's values by default), the collision's own.
 OPTIONS = (
     Option("target", "what the sphere hits: an identical sphere coming the other way, or a "
-                     "rigid flat wall", default="wall", kind=str, choices=("sphere", "wall")),
+                     "flat wall (rigid unless --wall-young)", default="wall", kind=str,
+           choices=("sphere", "wall")),
     option_of(PrepareConfig, "radius", default=0.01, checked=True, help="sphere radius"),
     option_of(PrepareConfig, "young", default=2e11, checked=True,
               help="Young's modulus E of the spheres (linear: kn = E R)"),
     option_of(PrepareConfig, "poisson", checked=True),
     option_of(PrepareConfig, "density", default=7800.0, checked=True, flag="--density"),
     option_of(PrepareConfig, "friction_deg", checked=True,
-              help="contact friction (with the wall too)"),
+              help="contact friction (with the wall too, unless --wall-friction)"),
     option_of(PrepareConfig, "restitution", checked=True),
     option_from(Parameter("m/s", "impact speed of the sphere (with target sphere: of each)",
                           low=0.0, low_inclusive=False, flag="--velocity"), 1.0, checked=True),
@@ -73,12 +81,65 @@ OPTIONS = (
                 0.0, checked=True),
     option_of(PrepareConfig, "contact", checked=True),
     option_of(PrepareConfig, "rolling_friction", checked=True,
-              help="rolling resistance coefficient mu_r between the spheres (target sphere): "
-                   "limit moment mu_r R* Fn (pendular.dem.rolling; 0: none)"),
+              help="rolling resistance coefficient mu_r: limit moment mu_r R* Fn "
+                   "(pendular.dem.rolling; with the wall too, unless --wall-rolling-friction; "
+                   "0: none)"),
     option_of(PrepareConfig, "twisting_friction", checked=True,
-              help="twisting resistance coefficient mu_t between the spheres (target sphere): "
-                   "limit moment mu_t R* Fn about the normal (0: none)"),
+              help="twisting resistance coefficient mu_t: limit moment mu_t R* Fn about the "
+                   "normal (with the wall too, unless --wall-twisting-friction; 0: none)"),
+    option_of(PrepareConfig, "wall_young", checked=True,
+              help="Young's modulus of the wall (target wall, Hertz-Mindlin; default: rigid, "
+                   "E = inf)"),
+    option_of(PrepareConfig, "wall_poisson", checked=True,
+              help="Poisson ratio of the wall, with --wall-young (default: the sphere's)"),
+    option_of(PrepareConfig, "wall_friction", default=None, checked=True,
+              help="friction angle of the wall (target wall; default: the sphere's "
+                   "--friction)"),
+    option_of(PrepareConfig, "wall_restitution", checked=True,
+              help="coefficient of restitution of the wall (target wall): the contact's is the "
+                   "mean of the sphere's and the wall's (default: the sphere's)"),
+    option_of(PrepareConfig, "wall_rolling_friction", default=None, checked=True,
+              help="rolling resistance coefficient of the wall (target wall; limit moment "
+                   "mu_r R Fn, pendular.dem.wall_rolling; default: the sphere's "
+                   "--rolling-friction)"),
+    option_of(PrepareConfig, "wall_twisting_friction", default=None, checked=True,
+              help="twisting resistance coefficient of the wall (target wall; default: the "
+                   "sphere's --twisting-friction)"),
 )
+#: The options that set the wall's material.
+WALL_OPTIONS = ("wall_young", "wall_poisson", "wall_friction", "wall_restitution",
+                "wall_rolling_friction", "wall_twisting_friction")
+
+
+def wall_material(values):
+    """The wall's Material (pendular.dem.material) of ``values`` (OPTIONS, read): rigid
+    unless ``wall_young``, the sphere's Poisson ratio, friction, rolling and twisting friction
+    and restitution where no wall value is given."""
+    def given(key, otherwise):
+        return otherwise if values[key] is None else values[key]
+    return Material(given("wall_young", math.inf), given("wall_poisson", values["poisson"]),
+                    math.inf, given("wall_friction", values["friction"]),
+                    given("wall_rolling_friction", values["rolling_friction"]),
+                    given("wall_restitution", values["restitution"]),
+                    given("wall_twisting_friction", values["twisting_friction"]))
+
+
+def contact_restitution(values):
+    """The coefficient of restitution of the contact of ``values`` (OPTIONS, read): the
+    spheres', or the mean of the sphere's and the wall's (pendular.dem.material)."""
+    if values["target"] == "sphere":
+        return values["restitution"]
+    return pair_restitution(values["restitution"], wall_material(values).restitution)
+
+
+def contact_modulus(values):
+    """Hertz's E* [Pa] of the contact of ``values`` (OPTIONS, read): two spheres, or the
+    sphere and the wall (rigid unless ``wall_young``)."""
+    young, poisson = values["young"], values["poisson"]
+    if values["target"] == "sphere":
+        return effective_modulus(young, poisson, young, poisson)
+    wall = wall_material(values)
+    return effective_modulus(young, poisson, wall.young, wall.poisson)
 
 
 def elastic_impact(values):
@@ -87,7 +148,7 @@ def elastic_impact(values):
     2.868 (m*^2 / (R* E*^2 v))^(1/5) and (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) (Johnson 1985,
     Eqs. 11.23-11.24), v the approach speed, or a linear spring's pi sqrt(m* / kn) and
     v sqrt(m* / kn)."""
-    radius, young, poisson = values["radius"], values["young"], values["poisson"]
+    radius, young = values["radius"], values["young"]
     mass = values["density"] * 4.0 / 3.0 * math.pi * radius ** 3
     pair = values["target"] == "sphere"
     mass_star = mass / 2.0 if pair else mass
@@ -95,8 +156,7 @@ def elastic_impact(values):
     if values["contact"] == "linear":
         period = math.sqrt(mass_star / (young * radius))
         return math.pi * period, approach * period
-    modulus = (effective_modulus(young, poisson, young, poisson) if pair
-               else effective_modulus(young, poisson))
+    modulus = contact_modulus(values)
     radius_star = radius / 2.0 if pair else radius
     return (2.868 * (mass_star ** 2 / (radius_star * modulus ** 2 * approach)) ** 0.2,
             (15.0 * mass_star * approach ** 2 / (16.0 * modulus * math.sqrt(radius_star)))
@@ -105,23 +165,31 @@ def elastic_impact(values):
 
 def check_impact(values):
     """OptionError naming --velocity and --young when the impact of ``values`` would overlap
-    the spheres by more than MAX_OVERLAP of their radius (elastic_impact), and naming
-    --rolling-friction or --twisting-friction above 0 with a wall target (sphere–wall contacts
-    carry no rolling or twisting moment: pendular.dem.rolling)."""
-    for option in ("rolling_friction", "twisting_friction"):
-        if values[option] > 0.0 and values["target"] == "wall":
-            raise OptionError(lambda name, option=option: (
-                f"{name(option)} = {values[option]:g} acts between spheres only (a wall "
-                f"carries no rolling or twisting moment); valid: 0 with {name('target')} "
-                f"wall, or "
-                f"{name('target')} sphere"))
+    the spheres by more than MAX_OVERLAP of their radius (elastic_impact), naming a wall's
+    material with a sphere target, --wall-young with the linear law (its wall is a sphere of
+    the grains' springs, kn = E R) and --wall-poisson without it."""
+    walled = [key for key in WALL_OPTIONS if values[key] is not None]
+    if walled and values["target"] == "sphere":
+        raise OptionError(lambda name: (
+            f"{', '.join(map(name, walled))} set(s) the wall's material; valid with "
+            f"{name('target')} wall only"))
+    if values["wall_young"] is not None and values["contact"] != "hertz-mindlin":
+        raise OptionError(lambda name: (
+            f"{name('wall_young')} = {values['wall_young']:g} Pa applies to Hertz-Mindlin "
+            f"contacts; valid: none with {name('contact')} linear (its wall is a sphere of "
+            "the grains' springs, kn = E R)"))
+    if values["wall_poisson"] is not None and values["wall_young"] is None:
+        raise OptionError(lambda name: (
+            f"{name('wall_poisson')} = {values['wall_poisson']:g} needs "
+            f"{name('wall_young')}: a rigid wall's Poisson ratio plays no part"))
     overlap = elastic_impact(values)[1] / values["radius"]
     if overlap > MAX_OVERLAP:
+        stiffer = "young" if values["wall_young"] is None else "wall_young"
         raise OptionError(lambda name: (
-            f"{name('velocity')} = {values['velocity']:g} m/s with {name('young')} = "
-            f"{values['young']:g} Pa overlaps the spheres by {overlap:.3g} of their radius at "
+            f"{name('velocity')} = {values['velocity']:g} m/s with {name(stiffer)} = "
+            f"{values[stiffer]:g} Pa overlaps the spheres by {overlap:.3g} of their radius at "
             f"the peak; valid: at most {MAX_OVERLAP:g} (the contact laws hold for small "
-            f"overlaps): lower {name('velocity')} or raise {name('young')}"))
+            f"overlaps): lower {name('velocity')} or raise {name(stiffer)}"))
 
 
 class ImpactRecorder:
@@ -203,7 +271,8 @@ def impact_scene(values):
                                      friction_deg=values["friction"])
     forces = [contact]
     if wall:
-        forces.append(ViscoelasticWallForces(contact, values["friction"]))
+        forces.append(ViscoelasticWallForces(contact, wall_material(values)))
+        forces.extend(wall_resistance(contact, wall_material(values)))
     elif values["rolling_friction"] > 0.0 or values["twisting_friction"] > 0.0:
         forces.append(RollingResistance(values["rolling_friction"],
                                         values["twisting_friction"]))
@@ -227,6 +296,9 @@ def impact_summary(sim, recorder, values):
     tangent_out = float(velocity[0])
     touching = history["normal_force"] > 0.0
     return {
+        "effective_modulus": (contact_modulus(values) if values["contact"] == "hertz-mindlin"
+                              else None),
+        "contact_restitution": contact_restitution(values),
         "max_normal_force": float(history["normal_force"].max()),
         "max_overlap": float(history["overlap"].max()),
         "contact_duration": float(np.count_nonzero(touching) * sim.dt),

@@ -65,7 +65,10 @@ _SAMPLE_CELL = ((option_of(PrepareConfig, "particles", low=MIN_SAMPLE_PARTICLES)
 _MATERIAL = options_named(PrepareConfig, ("porosity", "friction_deg", "prep_friction_deg",
                                           "rolling_friction", "twisting_friction", "gravity",
                                           "wall_friction", "young", "contact", "poisson",
-                                          "restitution", "damping", "timestep_safety",
+                                          "restitution", "wall_young", "wall_poisson",
+                                          "wall_restitution", "wall_rolling_friction",
+                                          "wall_twisting_friction", "damping",
+                                          "timestep_safety",
                                           "timestep_rule", "skin_factor"))
 #: A laboratory test's PrepareConfig fields set by their options as they are (sizes apart).
 PREPARATION = _SAMPLE_CELL + _MATERIAL

@@ -21,6 +21,7 @@ friction, 4), "unload" (4), "equilibrate" (at the confining stress, 4). Writers 
 ``prepare_sample`` watch all of them (e.g. ParaView frames, pendular.io.vtk.VtkWriter).
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,8 +31,8 @@ from pendular.dem.cell import PeriodicCell
 from pendular.dem.contact_law import MAX_FRICTION_DEG, MAX_SHEAR_RATIO, ContactForces
 from pendular.dem.grading import MAX_RADIUS_SPREAD, check_grading_curve, grading, sample_radii
 from pendular.dem.gravity import MAX_GRAVITY, Gravity
-from pendular.dem.hertz_mindlin import (CONTACT_LAWS, POISSON_RANGE, DampedLinearForces,
-    HertzMindlinForces)
+from pendular.dem.hertz_mindlin import CONTACT_LAWS, DampedLinearForces, HertzMindlinForces
+from pendular.dem.material import POISSON_RANGE, Material
 from pendular.dem.growth import RadiusGrowth
 from pendular.dem.integrate import Integrator
 from pendular.dem.measure import coordination, porosity, unbalanced_force
@@ -48,6 +49,7 @@ from pendular.utils.progress import PhaseBar
 from pendular.procedures.progress import equilibrium_bar, growth_bar
 from pendular.utils.validate import check_int
 from pendular.dem.wall_friction import WALL_FRICTION_RANGE, wall_law
+from pendular.dem.wall_rolling import wall_resistance
 from pendular.dem.walls import StressServo
 from pendular.homogenize.on_the_fly import homogenized
 
@@ -201,6 +203,27 @@ class PrepareConfig:
         high_inclusive=False, flag="--wall-friction",
         help="friction angle between the spheres and the walls, in every phase (pendular.dem."
              "wall_friction; 0: frictionless walls)")
+    wall_young: float | None = parameter(
+        None, unit="Pa", low=0.0, high=math.inf, low_inclusive=False, high_inclusive=False,
+        flag="--wall-young",
+        help="Young's modulus of the walls (Hertz-Mindlin; default: rigid walls, E = inf; "
+             "pendular.dem.material)")
+    wall_poisson: float | None = parameter(
+        None, low=POISSON_RANGE[0], high=POISSON_RANGE[1], low_inclusive=False,
+        high_inclusive=False, flag="--wall-poisson",
+        help="Poisson ratio of the walls, with --wall-young (default: the grains' --poisson)")
+    wall_restitution: float | None = parameter(
+        None, low=0.0, high=1.0, low_inclusive=False, flag="--wall-restitution",
+        help="coefficient of restitution of the walls; a sphere-wall contact's is the mean of "
+             "the grains' and the walls' (default: the grains' --restitution)")
+    wall_rolling_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--wall-rolling-friction",
+        help="rolling resistance coefficient mu_r of the walls: limit moment mu_r R Fn on a "
+             "sphere of radius R (pendular.dem.wall_rolling; 0: none; with the test friction)")
+    wall_twisting_friction: float = parameter(
+        0.0, low=0.0, high=MAX_RESISTANCE, flag="--wall-twisting-friction",
+        help="twisting resistance coefficient mu_t of the walls: limit moment mu_t R Fn about "
+             "the wall's normal (0: none)")
     gravity: float = parameter(0.0, unit="m/s^2", low=0.0, high=MAX_GRAVITY, flag="--gravity",
                                help="gravitational acceleration along -z (0: none; walls "
                                     "only, not with --periodic)")
@@ -248,6 +271,7 @@ class PrepareConfig:
             raise fail(self, "wall_friction", f"wall_friction = {self.wall_friction:g} deg is "
                        "outside the valid range [0, 0] in a periodic cell (--periodic: no "
                        "walls); leave out the wall friction or the periodic cell")
+        self._check_wall_material()
         if self.psd is not None:
             if self.radius_spread > 0.0:
                 raise fail(self, "radius_spread",
@@ -268,6 +292,52 @@ class PrepareConfig:
                                     self.poisson)
             except ValueError as error:
                 raise fail(self, name, str(error)) from None
+
+    def _check_wall_material(self):
+        """ParameterError naming a wall material field given in a periodic cell (no walls),
+        --wall-young with the linear law (its wall is a sphere of the grains' springs),
+        --wall-poisson without --wall-young (a rigid wall's plays no part), or walls less
+        stiff in contact than two grains (their overlaps, then larger than the grains', would
+        escape the bounds the sample's stresses are checked against)."""
+        given = [name for name in ("wall_young", "wall_poisson", "wall_restitution")
+                 if getattr(self, name) is not None]
+        given += [name for name in ("wall_rolling_friction", "wall_twisting_friction")
+                  if getattr(self, name) > 0.0]
+        if given and self.periodic:
+            raise fail(self, given[0], f"{given[0]} = {getattr(self, given[0]):g} applies to "
+                       "walls; valid: none in a periodic cell (--periodic: no walls)")
+        if self.wall_poisson is not None and self.wall_young is None:
+            raise fail(self, "wall_poisson", f"wall_poisson = {self.wall_poisson:g} needs "
+                       "wall_young: a rigid wall's Poisson ratio plays no part")
+        if self.wall_young is None:
+            return
+        if self.contact != "hertz-mindlin":
+            raise fail(self, "wall_young", f"wall_young = {self.wall_young:g} Pa applies to "
+                       "Hertz-Mindlin contacts; valid: none with the linear law (its wall is a "
+                       "sphere of the grains' springs, kn = E R)")
+        wall = self.wall_material()
+        least = self.young * (1.0 - wall.poisson ** 2) / (1.0 - self.poisson ** 2)
+        if self.wall_young < least:
+            raise fail(self, "wall_young", f"wall_young = {self.wall_young:g} Pa is outside "
+                       f"the valid range [{least:g}, inf) Pa: walls at least as stiff in "
+                       "contact as two grains (young (1 - wall_poisson^2) / (1 - poisson^2)), "
+                       "whose overlaps the sample's stress bounds hold")
+
+    def grain_material(self):
+        """The grains' Material (pendular.dem.material) at the test friction."""
+        return Material(self.young, self.poisson, self.density, self.friction_deg,
+                        self.rolling_friction, self.restitution)
+
+    def wall_material(self):
+        """The walls' Material: rigid unless wall_young, of wall_poisson (the grains' Poisson
+        ratio unless given), wall_friction, wall_restitution (the grains' unless given),
+        wall_rolling_friction and wall_twisting_friction (pendular.dem.wall_rolling; 0 by
+        default: no moment on the walls), driven (infinite density)."""
+        return Material(math.inf if self.wall_young is None else self.wall_young,
+                        self.poisson if self.wall_poisson is None else self.wall_poisson,
+                        math.inf, self.wall_friction, self.wall_rolling_friction,
+                        self.restitution if self.wall_restitution is None
+                        else self.wall_restitution, self.wall_twisting_friction)
 
     @property
     def graded(self):
@@ -363,19 +433,20 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
                    device="cpu", resistance=True):
     """The scene of a dry sample, time step ``dt`` [s]: neighbour list of ``skin`` [m],
     contacts of ``config``'s law at ``friction_deg`` [deg] (contact_forces), wall contacts of
-    the same law at ``config.wall_friction`` (pendular.dem.wall_friction.wall_law; none in a
-    periodic cell), the weight (``config.gravity``
+    the same law with the walls' material, ``config.wall_material()``
+    (pendular.dem.wall_friction.wall_law; none in a periodic cell), the weight (``config.gravity``
     > 0), the rolling and twisting resistance (``resistance`` and one of ``config``'s
-    coefficients > 0: ``resisting``), the given wall ``controls``, leapfrog; its runs on
-    ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
+    coefficients > 0: ``resisting``; on the walls, one of the walls' > 0:
+    pendular.dem.wall_rolling.wall_resistance), the given wall ``controls``, leapfrog; its runs
+    on ``device`` ("cpu" or "gpu"). A scene pays only for what it uses: without gravity and
     resistance it holds the contacts and the walls alone."""
     forces = [contact_forces(config, friction_deg)]
     if not walls.periodic:
-        forces.append(wall_law(forces[0], config.young, config.wall_friction))
+        forces.append(wall_law(forces[0], config.young, config.wall_material()))
     if config.gravity > 0.0:
         forces.append(Gravity(config.gravity))
     if resistance:
-        forces.extend(resisting(config))
+        forces.extend(resisting(config, forces[0], walls))
     return Simulation(particles, walls, dt,
                       neighbors=NeighborList(skin),
                       forces=forces,
@@ -384,12 +455,18 @@ def dry_simulation(particles, walls, config, dt, skin, friction_deg, controls, t
                       threads=threads, device=device)
 
 
-def resisting(config):
+def resisting(config, contact, walls):
     """The rolling and twisting resistance of ``config`` as a list of forces: one
-    RollingResistance when its rolling_friction or twisting_friction is above 0, else none."""
+    RollingResistance when its rolling_friction or twisting_friction is above 0, and inside
+    ``walls`` (not a periodic cell) one WallRollingResistance of the contact law ``contact``
+    when its wall_rolling_friction or wall_twisting_friction is above 0
+    (pendular.dem.wall_rolling.wall_resistance); else none."""
+    forces = []
     if config.rolling_friction > 0.0 or config.twisting_friction > 0.0:
-        return [RollingResistance(config.rolling_friction, config.twisting_friction)]
-    return []
+        forces.append(RollingResistance(config.rolling_friction, config.twisting_friction))
+    if not walls.periodic:
+        forces.extend(wall_resistance(contact, config.wall_material()))
+    return forces
 
 
 def servoed_simulation(particles, walls, config, target, threads=None):
@@ -491,7 +568,8 @@ def prepare_sample(config, *, progress=True, max_steps=2_000_000, threads=None, 
     sim.controls = [servo]
     sim.dt = timestep(sim, config)
     sim.operation(ContactForces).friction_deg = config.friction_deg
-    sim.forces.extend(resisting(config))        # with the test friction, as in a loaded sample
+    # with the test friction, as in a loaded sample
+    sim.forces.extend(resisting(config, sim.forces[0], sim.walls))
     _enter(writers, "friction")
     steps["friction"] = sim.run(max_steps, until=done, check_every=200,
                                 progress=equilibrium_bar(label and "set friction",

@@ -3,11 +3,14 @@ contact law: its peak force and overlap, contact duration, restitution and rebou
 (pendular.procedures.impact, docs/impact.md).
 
 With --target sphere two identical spheres approach each other, each at --velocity; with
---target wall one sphere hits a rigid flat wall at --velocity: the limit of an infinitely
-stiff wall (Hertz: E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R; linear: kn = E R).
---angle tilts the velocity from the normal, --spin turns the sphere about the axis normal to
-the plane of incidence (a target sphere the other way); --rolling-friction and
---twisting-friction resist the spheres' relative rotation (target sphere only). The engine's
+--target wall one sphere hits a flat wall at --velocity, rigid by default: the limit of an
+infinitely stiff wall (Hertz: E* = E / (1 - nu^2), G* = G / (2 - nu), R* = R; linear:
+kn = E R); --wall-young, --wall-poisson, --wall-friction, --wall-restitution,
+--wall-rolling-friction and --wall-twisting-friction give the wall a material of its own,
+mixed with the sphere's (docs/physics.md 'Materials and mixing rules'). --angle tilts the
+velocity from the normal, --spin turns the sphere about the axis normal to the plane of
+incidence (a target sphere the other way); --rolling-friction and --twisting-friction resist
+the relative rotation of the spheres, or of the sphere on the wall (R* = R). The engine's
 own simulation runs it with the chosen --contact law, at 2,000 steps per closed-form contact
 duration. Writes DIR/summary.json, DIR/history.h5 (time,
 overlap, normal_force, tangential_force, angular_velocity) and DIR/impact.png (force against
@@ -27,9 +30,9 @@ EXAMPLE = ("pendular impact --target wall --contact hertz-mindlin --radius 0.01 
            "in summary.json; force against time and overlap in impact.png")
 
 #: Summary keys printed at the end.
-SHOWN = ("max_normal_force", "max_overlap", "contact_duration", "normal_restitution",
-         "tangential_restitution", "rebound_angular_velocity", "rebound_angle_deg", "dt",
-         "rayleigh_timestep")
+SHOWN = ("effective_modulus", "contact_restitution", "max_normal_force", "max_overlap",
+         "contact_duration", "normal_restitution", "tangential_restitution",
+         "rebound_angular_velocity", "rebound_angle_deg", "dt", "rayleigh_timestep")
 
 
 def add_arguments(parser):
