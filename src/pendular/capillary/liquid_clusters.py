@@ -95,7 +95,9 @@ class LiquidClusters:
         after a step (or sim.evaluate_forces()), whose neighbour list and bridges it reads."""
         units, thresholds, carried = self._decompose(sim)
         contacts, radius = sim.contacts, sim.particles.radius
-        gap = -contacts.overlap
+        position = sim.particles.position     # the gaps the next step's bridges will see
+        gap = (np.linalg.norm(position[contacts.pair_j] - position[contacts.pair_i], axis=1)
+               - radius[contacts.pair_i] - radius[contacts.pair_j])
         held = self.bridges.state(sim).mask() | (gap < 0.0)
         if max_gap > 0.0:
             held |= gap <= max_gap

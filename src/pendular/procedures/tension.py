@@ -71,8 +71,9 @@ from pendular.homogenize import packing_state, regular_packing
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
-    check_steps_count, config_from_dict, config_to_dict, inertial_number, registered)
+from pendular.procedures.config import (LIQUID_REGIMES, MAX_SURFACE_TENSION, WATER_DENSITY,
+    check_particles, check_steps_count, config_from_dict, config_to_dict, inertial_number,
+    registered)
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
     sample_sizes, size_options)
@@ -81,6 +82,7 @@ from pendular.procedures.progress import tension_plan
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
     KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
 from pendular.procedures.run_options import RunOptions
+from pendular.procedures.tension_clusters import refuse_clusters, refuse_clusters_run
 from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
 from pendular.procedures.tension_report import case_line, strength_predictions, write_report
 from pendular.utils.atomic import write_json
@@ -194,7 +196,9 @@ class TensionConfig:
     fraction of the peak below which the pull has ruptured [-]; grip_depth: grip thickness
     [diameters] (walls only); void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull
     (0: none); vtk_every: steps between frames instead (None: from vtk_frames; 0: none), both
-    at most the pull's steps (``pull_steps``).
+    at most the pull's steps (``pull_steps``); liquid: "pendular" (volume-controlled bridges)
+    or "clusters" (filled pore units beside suction-controlled bridges, the liquid's volume
+    held at the suction found: pendular.procedures.tension_clusters).
     """
 
     sample: PrepareConfig = field(default_factory=tension_sample)
@@ -240,6 +244,10 @@ class TensionConfig:
     vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
                                       help="steps between ParaView frames of the pull, instead "
                                            "of --vtk-frames (0: none)")
+    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                            help="liquid regime: pendular bridges alone, or clusters of filled "
+                                 "pore units beside them at the suction that holds the water "
+                                 "(--roughness 0; docs/liquid_clusters.md)")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -264,6 +272,8 @@ class TensionConfig:
         if self.sample.periodic and self.grip_depth != default_of(TensionConfig, "grip_depth"):
             raise fail(self, "grip_depth", f"grip_depth = {self.grip_depth:g} does not apply "
                        "to --periodic: a periodic cell has no walls, so no grips")
+        if refuse_clusters(self) is not None:
+            raise fail(self, "liquid", refuse_clusters(self))
         steps = self.pull_steps()
         for name in ("vtk_frames", "vtk_every"):
             if getattr(self, name) is not None:
@@ -300,7 +310,7 @@ class TensionConfig:
                 "residual": self.residual, "grip_depth": self.grip_depth,
                 "void_ratio_tolerance": self.void_ratio_tolerance,
                 "vtk_frames": self.vtk_frames, "vtk_every": self.vtk_every,
-                "seed": sample.seed, "periodic": sample.periodic}
+                "seed": sample.seed, "periodic": sample.periodic, "liquid": self.liquid}
 
     def pull_steps(self):
         """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
@@ -410,8 +420,9 @@ class TensionTest:
         ``threads``."""
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
-        check_device(device)
         checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        refuse_clusters_run(self.config, device, checkpoint_every)
+        check_device(device)
         arguments = (self.config.options() if options.arguments is None
                      else dict(options.arguments))
         with OutputFolder(out, "tension") as folder:
@@ -624,7 +635,7 @@ TENSION_WATER_CONTENT = option_from(dataclasses.replace(
 #: A direct tension's own fields set by their options as they are.
 TENSION_OWN = {name: option_of(TensionConfig, name) for name in (
     "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
-    "max_strain", "residual", "grip_depth", "void_ratio_tolerance")}
+    "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "liquid")}
 
 
 TENSION_FRAMES = (dataclasses.replace(option_of(TensionConfig, "vtk_frames"), group="frames"),
@@ -640,7 +651,8 @@ TENSION = ((TENSION_VOID_RATIO, TENSION_OWN["roughness"], TENSION_WATER_CONTENT,
               TENSION_SAMPLE_OPTIONS["confining"], TENSION_SAMPLE_OPTIONS["friction"],
               TENSION_SAMPLE_OPTIONS["young"])
            + tuple(TENSION_OWN[name] for name in ("inertial_number", "max_strain", "residual",
-                                                  "grip_depth", "void_ratio_tolerance"))
+                                                  "grip_depth", "void_ratio_tolerance",
+                                                  "liquid"))
            + TENSION_FRAMES + (CHECKPOINT_EVERY, TENSION_SAMPLE_OPTIONS["seed"],
                                TENSION_SAMPLE_OPTIONS["periodic"]))
 
