@@ -5,9 +5,10 @@
 and those of its sample, a PrepareConfig, dashes for underscores; --specific-gravity sets the
 grains' density). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``, a sample
 by ``tension_sample(particles=200)``; ``run(out, device="gpu")`` (--device) runs every phase
-on the GPU. By default Kim's six cases: F-75 sand, R = 0.11 mm,
-e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
-Gs = 2.65, the grains' density over the water's). Each case:
+on the GPU; ``liquid="clusters"`` (--liquid clusters) holds the water in bridges and liquid
+clusters at the suction found (pendular.procedures.tension_clusters). By default Kim's six
+cases: F-75 sand, R = 0.11 mm, e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43,
+1.04, 2.01 % (gravimetric, Gs = 2.65, the grains' density over the water's). Each case:
 
 1. Sample (one per void ratio, shared by its water contents): equal spheres prepared as thesis
    Ch. 5.2.2 (pendular.procedures.preparation, radius growth to 5 kPa, friction set, walls servoed at
