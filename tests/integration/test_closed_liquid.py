@@ -10,6 +10,8 @@ import pytest
 
 from pendular.capillary import CapillaryBridges, formation_suction
 from pendular.capillary.closed_liquid import HeldLiquid, solve_closed_liquid
+from pendular.capillary.cluster_forces import (UnitForces, cluster_forces, cluster_stress,
+                                               partial_forces)
 from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.capillary.pore_filling import FillingThresholds, filling_thresholds, unit_edges
 from pendular.capillary.pores import decompose
@@ -101,3 +103,28 @@ def test_hold_volume_conserves_the_liquid_in_the_dem_account(small_sample):
     assert clusters.filled.any()
     force = clusters._force
     assert np.abs(force.sum(axis=0)).max() < 1e-10 * np.abs(force).max()
+
+
+def test_a_front_unit_filled_in_full_is_a_filled_unit(small_sample):
+    """The front's forces, stress and absorbed shares in fraction f: at f = 1 those of the
+    unit filled (superposition of the units' self-equilibrated sets)."""
+    _, sim, _ = small_sample
+    particles = sim.particles
+    units = decompose(particles.position, particles.radius)
+    forces = UnitForces(units.vertices, particles.radius[units.grains])
+    filled = np.random.default_rng(3).random(units.count) < 0.4
+    front = np.flatnonzero(~filled)[:5]
+    more = filled.copy()
+    more[front] = True
+    suction, count = 20000.0, len(particles)
+    assert np.allclose(cluster_forces(units, forces, filled, suction, count)
+                       + partial_forces(units, forces, front, 1.0, suction, count),
+                       cluster_forces(units, forces, more, suction, count),
+                       rtol=0, atol=1e-12 * suction * particles.radius.max() ** 2)
+    weight = filled + 0.3 * ~filled
+    half = cluster_stress(units, forces, weight > 0, suction, 1.0, weight)
+    assert np.allclose(half, 0.7 * cluster_stress(units, forces, filled, suction, 1.0)
+                       + 0.3 * cluster_stress(units, forces, np.ones(units.count, bool),
+                                              suction, 1.0), rtol=1e-12, atol=0)
+    edges = unit_edges(units)
+    assert np.array_equal(edges.share(filled.astype(float)), edges.filled_share(filled))

@@ -67,7 +67,7 @@ def refuse_clusters_run(config, device: str, checkpoint_every: int) -> None:
                          f"--checkpoint-every {checkpoint_every}")
 
 
-def wet_clusters(dry, config, water_content: float, progress: bool, pairs, settle):
+def wet_clusters(dry, config, water_content: float, pairs, settle):
     """(wetted sim, bridges, clusters, wetting report): a copy of ``dry`` holding the water
     content ``water_content`` (fraction) in bridges and clusters (module docstring);
     ``pairs``: (pair_i, pair_j, gap or None) of the pairs wetted

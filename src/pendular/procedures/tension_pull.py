@@ -223,7 +223,7 @@ def wet(dry: Simulation, config, water_content: float,
     pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
     settle = settler(config, progress)
     if config.liquid == "clusters":
-        sim, bridges, _, report = wet_clusters(dry, config, water_content, progress,
+        sim, bridges, _, report = wet_clusters(dry, config, water_content,
                                                (pair_i, pair_j, gap), settle)
         report["void_ratio_wet"] = sample_void_ratio(sim, config.sample.radius)
         return sim, bridges, report
