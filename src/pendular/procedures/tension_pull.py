@@ -268,7 +268,9 @@ class Pull:
     writer (a frame every ``config.vtk_every`` steps, or ``config.vtk_frames`` frames over
     --max-strain); ``run()`` pulls to rupture and returns (steps, history). In a periodic cell:
     the cell stretched along z at the strain rate, its x and y stress servoed at zero, no
-    grips; the tensile stress is minus the cell's z stress."""
+    grips; the tensile stress is minus the cell's z stress. With LiquidClusters among the
+    sim's forces (--liquid clusters), their columns too, and their closed liquid solved again
+    CLUSTER_UPDATES times over --max-strain (tension_clusters.ClosedLiquidUpdates)."""
 
     def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
                  config, folder: str, progress: bool):
