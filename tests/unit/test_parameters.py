@@ -69,7 +69,7 @@ OWN_GENERATED = {
     "tension": {"roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
                 "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
                 "vtk_every", "checkpoint_every", "particles", "confining", "friction",
-                "young", "seed", "periodic"} | SIZES,
+                "young", "seed", "periodic", "liquid"} | SIZES,
     "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
              "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
              "seed", "checkpoint_every", "liquid"} | SIZES,

@@ -105,18 +105,44 @@ def cluster_forces(pore_units, unit_forces, filled, suction, grain_count):
     return suction * force
 
 
-def cluster_stress(pore_units, unit_forces, filled, suction, volume):
-    """(3, 3) [Pa] the stress of the clusters' forces, compression positive, over ``volume``
-    [m^3]: -(1/V) sum x (x) F, taken unit by unit over each filled unit's self-equilibrated
-    set (its cone pressures and the menisci of all its four faces; the menisci of faces shared
-    by two filled units cancel in the grains' forces), at the positions the unit sees (a
-    periodic image's, unwrapped). It is the clusters' share of the complete capillary stress
-    psi + I (docs/capillary.md), as -(1/V) sum x (x) F of the bridges' forces is theirs."""
-    units = np.flatnonzero(filled)
+def equilibrated_sets(unit_forces, units):
+    """(U, 4, 3) [m^2] the forces at unit suction of each of ``units`` filled alone on its
+    four grains: its cone pressures and the menisci of all its four faces, a set that sums
+    to zero. A unit's share in a cluster's forces is its set: the menisci of a face shared
+    by two filled units cancel."""
     force = unit_forces.cone[units].copy()                 # (U, 4, 3)
     for f in range(4):
         for j in range(3):
             force[:, FACES[f, j]] += unit_forces.meniscus[units, f, j]
+    return force
+
+
+def partial_forces(pore_units, unit_forces, units, fraction, suction, grain_count):
+    """(grain_count, 3) [N] the forces at ``suction`` [Pa] of ``units`` partly filled, each
+    holding ``fraction`` [-] of its pore volume (the closed liquid's front,
+    pendular.capillary.closed_liquid): that fraction of its equilibrated set (equilibrated_sets),
+    added to the clusters' forces of the filled units around it."""
+    force = np.zeros((grain_count, 3))
+    units = np.asarray(units, np.int64)
+    sets = equilibrated_sets(unit_forces, units)
+    for axis in range(3):
+        force[:, axis] = np.bincount(pore_units.grains[units].ravel(), sets[..., axis].ravel(),
+                                     minlength=grain_count)
+    return fraction * suction * force
+
+
+def cluster_stress(pore_units, unit_forces, filled, suction, volume, weight=None):
+    """(3, 3) [Pa] the stress of the clusters' forces, compression positive, over ``volume``
+    [m^3]: -(1/V) sum x (x) F, taken unit by unit over each filled unit's self-equilibrated
+    set (equilibrated_sets; the menisci of faces shared by two filled units cancel in the
+    grains' forces), at the positions the unit sees (a periodic image's, unwrapped); with
+    ``weight`` (M,) [-], each unit's set in that share (a partly filled unit), ``filled`` then
+    the units with a share. It is the clusters' share of the complete capillary stress
+    psi + I (docs/capillary.md), as -(1/V) sum x (x) F of the bridges' forces is theirs."""
+    units = np.flatnonzero(filled)
+    force = equilibrated_sets(unit_forces, units)
+    if weight is not None:
+        force *= np.asarray(weight, float)[units, None, None]
     centred = pore_units.vertices[units] - pore_units.vertices[units].mean(axis=1,
                                                                            keepdims=True)
     return -suction / volume * np.einsum("uki,ukj->ij", centred, force)

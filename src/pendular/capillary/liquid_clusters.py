@@ -12,12 +12,20 @@ those of the packing at that moment (pendular.capillary.cluster_forces), added t
 each step, and a bridge on an edge of filled units keeps only the share of its force and
 liquid that lies in empty units (its force is taken off in the share the filled units hold:
 the cluster's pressure and menisci replace it there). Between walls only; on the CPU.
+
+With the liquid closed (a water content), ``hold_volume(sim, V)`` is the model's step instead:
+the suction is the one at which the bridges and the filled units hold V
+(pendular.capillary.closed_liquid), imposed on the bridges; the units at the front of a jump
+hold a fraction of their pore volume (their forces and absorbed shares in that fraction), and
+what a bridge broken at that suction leaves stays on the grains as film.
 """
 
 import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
-from pendular.capillary.cluster_forces import UnitForces, cluster_forces, cluster_stress
+from pendular.capillary.closed_liquid import HeldLiquid, solve_closed_liquid
+from pendular.capillary.cluster_forces import (UnitForces, cluster_forces, cluster_stress,
+    partial_forces)
 from pendular.capillary.clusters import find_clusters
 from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
     liquid_account, unit_edges)
@@ -47,6 +55,7 @@ class LiquidClusters:
         self._contacts = None
         self._share = None
         self._carried = None          # filled units of a checkpoint, until set_suction
+        self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
@@ -72,6 +81,43 @@ class LiquidClusters:
     def set_suction(self, sim, suction):
         """Impose ``suction`` [Pa] on the clusters of ``sim``'s packing now (module docstring):
         decompose, carry, fill, drain; the forces of the stage that follows."""
+        units, thresholds, carried = self._decompose(sim)
+        filled = drain(units, thresholds, imbibe(thresholds, carried, suction), suction)
+        self.liquid = None
+        self._set_state(sim, units, filled, suction)
+
+    def hold_volume(self, sim, volume, max_gap=0.0):
+        """Hold the closed liquid ``volume`` [m^3] in ``sim``'s packing now (module docstring):
+        decompose, carry, find the suction at which the bridges there (and those that form at
+        contact; with ``max_gap`` [m] > 0, at the wetting, those that form across every gap
+        of the neighbour list up to it) and the filled units hold it, impose it on the
+        bridges; the forces of the stage that follows. Returns the ClosedLiquid. Call it
+        after a step (or sim.evaluate_forces()), whose neighbour list and bridges it reads."""
+        units, thresholds, carried = self._decompose(sim)
+        contacts, radius = sim.contacts, sim.particles.radius
+        position = sim.particles.position     # the gaps the next step's bridges will see
+        gap = (np.linalg.norm(position[contacts.pair_j] - position[contacts.pair_i], axis=1)
+               - radius[contacts.pair_i] - radius[contacts.pair_j])
+        held = self.bridges.state(sim).mask() | (gap < 0.0)
+        if max_gap > 0.0:
+            held |= gap <= max_gap
+        pair_i, pair_j = contacts.pair_i[held], contacts.pair_j[held]
+        larger = np.maximum(radius[pair_i], radius[pair_j])
+        pairs = (larger, larger / np.minimum(radius[pair_i], radius[pair_j]),
+                 np.maximum(gap[held], 0.0) / larger)
+        edges = unit_edges(units)
+        liquid = solve_closed_liquid(volume, HeldLiquid(
+            pairs, edges.of_pairs(pair_i, pair_j), edges, units, thresholds, carried,
+            self.bridges.suction_table, self.bridges.surface_tension))
+        self.bridges.set_suction(liquid.suction)
+        if max_gap > 0.0:
+            self.bridges.form_across_gaps(sim, max_gap)
+        self.liquid = liquid
+        self._set_state(sim, units, liquid.filled, liquid.suction, edges)
+        return liquid
+
+    def _decompose(self, sim):
+        """(pore units, thresholds, the filled state carried over) of ``sim``'s packing."""
         if sim.walls.periodic:
             raise ValueError("liquid = 'clusters' runs between walls (a periodic cell's "
                              "cluster forces would need their face terms in the cell's stress)")
@@ -80,18 +126,28 @@ class LiquidClusters:
         previous = self._filled_grains()
         units = decompose(particles.position, particles.radius)
         if previous is None:
-            filled = np.full(units.count, self.saturated)
+            carried = np.full(units.count, self.saturated)
         else:
-            filled = _carry(units.grains, previous)
+            carried = _carry(units.grains, previous)
         thresholds = filling_thresholds(units, particles.radius, self.bridges.surface_tension,
                                         self.bridges.contact_angle)
-        filled = drain(units, thresholds, imbibe(thresholds, filled, suction), suction)
+        return units, thresholds, carried
+
+    def _set_state(self, sim, units, filled, suction, edges=None):
+        """Take ``filled`` at ``suction`` [Pa] (and the closed liquid's front, ``liquid``):
+        clusters, forces."""
+        particles = sim.particles
         self.units, self.filled, self.suction = units, filled, float(suction)
         self._unit_forces = UnitForces(units.vertices, particles.radius[units.grains])
-        self._edges = unit_edges(units)
+        self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
         self._force = cluster_forces(units, self._unit_forces, filled, self.suction,
                                      len(particles))
+        if self.liquid is not None and self.liquid.front_fraction > 0.0:
+            self._force += partial_forces(units, self._unit_forces,
+                                          np.flatnonzero(self.liquid.front),
+                                          self.liquid.front_fraction, self.suction,
+                                          len(particles))
         self._contacts = None
         self._carried = None
 
@@ -105,7 +161,7 @@ class LiquidClusters:
 
     # ---------------------------------------------------------------- every step
     def apply(self, sim):
-        if self._force is None or not self.filled.any():
+        if self._force is None or not (self.filled.any() or self._front_held()):
             return
         particles, contacts = sim.particles, sim.contacts
         particles.force += self._force
@@ -118,10 +174,18 @@ class LiquidClusters:
                                contacts.second_start, contacts.second_pair, particles.force)
 
     def pair_share(self, contacts):
-        """(K,) the share of each pair's bridge that the filled units hold."""
+        """(K,) the share of each pair's bridge that the filled units hold (and the closed
+        liquid's front, in its fraction)."""
         edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
-        share = self._edges.filled_share(self.filled)
+        if self._front_held():
+            share = self._edges.share(self.liquid.weight)
+        else:
+            share = self._edges.filled_share(self.filled)
         return np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+
+    def _front_held(self):
+        """Whether the closed liquid's front holds liquid."""
+        return self.liquid is not None and self.liquid.front_fraction > 0.0
 
     # ---------------------------------------------------------------- measures
     def account(self, sim):
@@ -130,7 +194,10 @@ class LiquidClusters:
         contacts = sim.contacts
         volume = BridgeState.of(contacts).volume
         edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
-        return liquid_account(self.units, self._edges, self.found, volume, edge)
+        if self.liquid is None:
+            return liquid_account(self.units, self._edges, self.found, volume, edge)
+        return liquid_account(self.units, self._edges, self.found, volume, edge,
+                              weight=self.liquid.weight, film=self.liquid.film)
 
     def _units_liquid(self, sim, account):
         """[m^3] the liquid inside the pore units: the filled units, and the bridges' shares in
@@ -151,6 +218,10 @@ class LiquidClusters:
     def stress(self, sim):
         """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box
         (cluster_forces.cluster_stress)."""
+        if self._front_held():
+            weight = self.liquid.weight
+            return cluster_stress(self.units, self._unit_forces, weight > 0.0, self.suction,
+                                  sim.walls.volume(), weight)
         return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
                               sim.walls.volume())
 

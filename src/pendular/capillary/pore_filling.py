@@ -157,6 +157,14 @@ class UnitEdges:
                             minlength=len(self.pair)) / (2.0 * math.pi)
         return np.minimum(share, 1.0)
 
+    def share(self, weight):
+        """(E,) the share of the space around each edge that the units' liquid holds, each
+        unit counted with ``weight`` (M,) [-] (1 filled, a fraction partly filled, 0 empty):
+        the weighted dihedral angles / 2 pi, at most 1."""
+        share = np.bincount(self.unit_edge.ravel(), (self.dihedral * weight[:, None]).ravel(),
+                            minlength=len(self.pair)) / (2.0 * math.pi)
+        return np.minimum(share, 1.0)
+
     def of_pairs(self, pair_i, pair_j):
         """(K,) the edge of each pair of grains (pair_i < pair_j), -1 for a pair that is not
         an edge."""
@@ -185,18 +193,21 @@ def unit_edges(pore_units):
 @dataclass(frozen=True)
 class LiquidAccount:
     """Where the liquid is [m^3]: ``bridges`` (the shares of bridges in empty units and
-    outside the units), ``clusters`` (filled units), ``largest`` (the largest cluster);
-    ``absorbed`` the bridges' shares inside filled units (counted in ``clusters``)."""
+    outside the units), ``clusters`` (filled units, and a closed liquid's partly filled
+    front), ``largest`` (the largest cluster); ``absorbed`` the bridges' shares inside filled
+    units (counted in ``clusters``); ``film`` a closed liquid's liquid on the grains
+    (pendular.capillary.closed_liquid)."""
 
     bridges: float
     clusters: float
     largest: float
     absorbed: float
+    film: float = 0.0
 
     @property
     def total(self):
         """The liquid held [m^3]."""
-        return self.bridges + self.clusters
+        return self.bridges + self.clusters + self.film
 
     def fractions(self):
         """{bridges, clusters, largest}: fractions of the liquid held (0 without liquid)."""
@@ -205,15 +216,22 @@ class LiquidAccount:
                 for name in ("bridges", "clusters", "largest")}
 
 
-def liquid_account(pore_units, edges, clusters, bridge_volume, pair_edge):
+def liquid_account(pore_units, edges, clusters, bridge_volume, pair_edge, weight=None,
+                   film=0.0):
     """LiquidAccount of the filled units (``clusters``, pendular.capillary.clusters.Clusters)
     and of the bridges of volume ``bridge_volume`` (K,) [m^3] on the edges ``pair_edge`` (K,)
-    (UnitEdges.of_pairs, -1: not an edge, the bridge all in empty space)."""
+    (UnitEdges.of_pairs, -1: not an edge, the bridge all in empty space); a closed liquid's
+    ``weight`` (M,) [-] (its partly filled front's liquid counted with the clusters') and
+    ``film`` [m^3]."""
     filled = clusters.label >= 0
-    share = edges.filled_share(filled)
+    if weight is None:
+        share, front = edges.filled_share(filled), 0.0
+    else:
+        share = edges.share(weight)
+        front = float(np.dot(np.where(filled, 0.0, weight), pore_units.pore_volume))
     absorbed_share = np.where(pair_edge >= 0, share[np.maximum(pair_edge, 0)], 0.0)
     absorbed = float(np.sum(bridge_volume * absorbed_share))
     largest = float(clusters.volume[clusters.largest]) if clusters.largest >= 0 else 0.0
     return LiquidAccount(bridges=float(np.sum(bridge_volume)) - absorbed,
-                         clusters=float(np.sum(clusters.volume)), largest=largest,
-                         absorbed=absorbed)
+                         clusters=float(np.sum(clusters.volume)) + front, largest=largest,
+                         absorbed=absorbed, film=float(film))

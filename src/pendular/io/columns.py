@@ -59,14 +59,15 @@ HISTORY_WRITERS = {
     **dict.fromkeys(("step", "axial_strain", "sigma_wall", "coordination", "unbalanced_force",
                      "bridges", "saturation"), (*LABORATORY, "swcc", "tension")),
     "time": (*LABORATORY, "swcc", "tension", "impact"),
-    **dict.fromkeys(("suction", "sigma_capillary", "pendular_overlaps", "chi", "B", "psi",
+    **dict.fromkeys(("sigma_capillary", "pendular_overlaps", "chi", "B", "psi",
                      "sigma_effective", "psi_interface", "sigma_effective_complete",
                      "fabric_bridges", "anisotropy_bridges", "a_psi"), (*LABORATORY, "swcc")),
+    "suction": (*LABORATORY, "swcc", "tension"),
     **dict.fromkeys(("liquid_bridges", "liquid_film", "liquid_lost"), LABORATORY),
     **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
     **dict.fromkeys(("clusters", "liquid_in_bridges", "liquid_in_clusters",
                      "liquid_in_largest_cluster", "largest_cluster_percolates",
-                     "saturation_pore_units"), ("swcc",)),
+                     "saturation_pore_units"), ("swcc", "tension")),
     "water_content": ("tension", "path"),
     "liquid_total": ("path",),
     "excess_pore_pressure": ("triaxial",),
@@ -105,7 +106,8 @@ HISTORY_COLUMNS = {
     "unbalanced_force": Column("1", "mean resultant force on particles / mean contact force"),
     "saturation": Column("1", "degree of saturation Sr = liquid volume / void volume"),
     "suction": Column("Pa", "matric suction s = u_a - u_w (imposed, or the bridges' mean "
-                            "under volume control)"),
+                            "under volume control, or a direct tension's with --liquid "
+                            "clusters: the suction that holds the water)"),
     "sigma_capillary": Column("Pa", "Love-Weber stress of the capillary forces (tension "
                                     "negative); sigma_wall = sigma_contact + sigma_capillary "
                                     "in equilibrium", _TENSOR),

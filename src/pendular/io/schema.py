@@ -76,6 +76,12 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "psi_clusters": "Pa", "saturation_pore_units": "1",
                     "chi_with_clusters": "1"}
 
+#: The clusters' figures of a direct tension's case (--liquid clusters,
+#: pendular.procedures.tension_clusters).
+TENSION_CLUSTER_UNITS = {"suction": "Pa", "clusters": "1", "liquid_in_bridges": "1",
+                         "liquid_in_clusters": "1", "liquid_in_largest_cluster": "1",
+                         "largest_cluster_percolates": "1", "saturation_pore_units": "1"}
+
 #: Units of the run options in campaign rows (pendular.procedures.laboratory.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
 OPTION_UNITS = {
@@ -89,7 +95,7 @@ OPTION_UNITS = {
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
     "checkpoint_every": "1", "contact_angle": "deg", "surface_tension": "N/m",
-    "roughness": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
+    "roughness": "1", "liquid": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
     "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",
@@ -409,6 +415,12 @@ SUMMARY_KEYS = {
     "pull_time_s": Key("s", "wall-clock time of the pull", _TEN),
     "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
     "case": Key("1", "the case's name: e<void ratio>_w<water content %>", _TEN),
+    "clusters_wet": Key(TENSION_CLUSTER_UNITS, "--liquid clusters: the suction that holds the "
+                        "water once wetted and the clusters then (their number, the liquid's "
+                        "fractions in bridges, clusters and the largest, its percolation along "
+                        "x, y, z, the saturation of the pore units)", _TEN),
+    "clusters_at_peak": Key(TENSION_CLUSTER_UNITS, "--liquid clusters: the same at the peak "
+                            "(the history's row)", _TEN),
     # -- the soil-water characteristic curve, swcc.json (pendular.procedures.swcc)
     "drying": Key(SWCC_STAGE_UNITS, "one row per suction of the drying branch, each stage's "
                                "equilibrium: suction, Sr, bridges (and across gaps), "

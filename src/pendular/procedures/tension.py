@@ -5,9 +5,10 @@
 and those of its sample, a PrepareConfig, dashes for underscores; --specific-gravity sets the
 grains' density). Variants: ``dataclasses.replace(config, cases=[(0.65, 0.01)])``, a sample
 by ``tension_sample(particles=200)``; ``run(out, device="gpu")`` (--device) runs every phase
-on the GPU. By default Kim's six cases: F-75 sand, R = 0.11 mm,
-e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43, 1.04, 2.01 % (gravimetric,
-Gs = 2.65, the grains' density over the water's). Each case:
+on the GPU; ``liquid="clusters"`` (--liquid clusters) holds the water in bridges and liquid
+clusters at the suction found (pendular.procedures.tension_clusters). By default Kim's six
+cases: F-75 sand, R = 0.11 mm, e = 0.72 at w = 0.47, 1.04, 2.11 % and e = 0.58 at w = 0.43,
+1.04, 2.01 % (gravimetric, Gs = 2.65, the grains' density over the water's). Each case:
 
 1. Sample (one per void ratio, shared by its water contents): equal spheres prepared as thesis
    Ch. 5.2.2 (pendular.procedures.preparation, radius growth to 5 kPa, friction set, walls servoed at
@@ -70,9 +71,9 @@ from pendular.homogenize import packing_state, regular_packing
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
-    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
-    inertial_number, registered)
+from pendular.procedures.config import (LIQUID_REGIMES, MAX_SURFACE_TENSION, WATER_DENSITY,
+    check_particles, check_steps_count, config_from_dict, config_to_dict,
+    contact_angle_parameter, inertial_number, registered)
 from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
@@ -83,6 +84,7 @@ from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, K
     KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
 from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
+from pendular.procedures.tension_clusters import refuse_clusters, refuse_clusters_run
 from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
 from pendular.procedures.tension_report import case_line, strength_predictions, write_report
 from pendular.utils.atomic import write_json
@@ -196,7 +198,9 @@ class TensionConfig:
     fraction of the peak below which the pull has ruptured [-]; grip_depth: grip thickness
     [diameters] (walls only); void_ratio_tolerance [-]; vtk_frames: ParaView frames per pull
     (0: none); vtk_every: steps between frames instead (None: from vtk_frames; 0: none), both
-    at most the pull's steps (``pull_steps``).
+    at most the pull's steps (``pull_steps``); liquid: "pendular" (volume-controlled bridges)
+    or "clusters" (filled pore units beside suction-controlled bridges, the liquid's volume
+    held at the suction found: pendular.procedures.tension_clusters).
     """
 
     sample: PrepareConfig = field(default_factory=tension_sample)
@@ -243,6 +247,10 @@ class TensionConfig:
     vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
                                       help="steps between ParaView frames of the pull, instead "
                                            "of --vtk-frames (0: none)")
+    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                            help="liquid regime: pendular bridges alone, or clusters of filled "
+                                 "pore units beside them at the suction that holds the water "
+                                 "(--roughness 0; docs/liquid_clusters.md)")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -267,6 +275,8 @@ class TensionConfig:
         if self.sample.periodic and self.grip_depth != default_of(TensionConfig, "grip_depth"):
             raise fail(self, "grip_depth", f"grip_depth = {self.grip_depth:g} does not apply "
                        "to --periodic: a periodic cell has no walls, so no grips")
+        if refuse_clusters(self) is not None:
+            raise fail(self, "liquid", refuse_clusters(self))
         steps = self.pull_steps()
         for name in ("vtk_frames", "vtk_every"):
             if getattr(self, name) is not None:
@@ -303,7 +313,7 @@ class TensionConfig:
                 "residual": self.residual, "grip_depth": self.grip_depth,
                 "void_ratio_tolerance": self.void_ratio_tolerance,
                 "vtk_frames": self.vtk_frames, "vtk_every": self.vtk_every,
-                "seed": sample.seed, "periodic": sample.periodic}
+                "seed": sample.seed, "periodic": sample.periodic, "liquid": self.liquid}
 
     def pull_steps(self):
         """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
@@ -413,8 +423,9 @@ class TensionTest:
         ``threads``."""
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
-        check_device(device)
         checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
+        refuse_clusters_run(self.config, device, checkpoint_every)
+        check_device(device)
         arguments = (self.config.options() if options.arguments is None
                      else dict(options.arguments))
         with OutputFolder(out, "tension") as folder:
@@ -619,7 +630,7 @@ TENSION_WATER_CONTENT = option_from(dataclasses.replace(
 #: A direct tension's own fields set by their options as they are.
 TENSION_OWN = {name: option_of(TensionConfig, name) for name in (
     "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
-    "max_strain", "residual", "grip_depth", "void_ratio_tolerance")}
+    "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "liquid")}
 
 
 TENSION_FRAMES = (dataclasses.replace(option_of(TensionConfig, "vtk_frames"), group="frames"),
@@ -635,7 +646,8 @@ TENSION = ((TENSION_VOID_RATIO, TENSION_OWN["roughness"], TENSION_WATER_CONTENT,
               TENSION_SAMPLE_OPTIONS["confining"], TENSION_SAMPLE_OPTIONS["friction"],
               TENSION_SAMPLE_OPTIONS["young"])
            + tuple(TENSION_OWN[name] for name in ("inertial_number", "max_strain", "residual",
-                                                  "grip_depth", "void_ratio_tolerance"))
+                                                  "grip_depth", "void_ratio_tolerance",
+                                                  "liquid"))
            + TENSION_FRAMES + (CHECKPOINT_EVERY, TENSION_SAMPLE_OPTIONS["seed"],
                                TENSION_SAMPLE_OPTIONS["periodic"]))
 

@@ -21,6 +21,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pendular.capillary.bridges import CapillaryBridges
+from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.capillary.radius_ratios import sample_radius_ratios
 from pendular.capillary.table import BridgeTable
 from pendular.capillary.validation import NotPendular
@@ -45,6 +46,8 @@ from pendular.procedures.preparation import PrepareConfig, equilibrated, prepare
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, KIM_RADIUS,
     KIM_SEPARATION, comparison_packing)
+from pendular.procedures.tension_clusters import (ClosedLiquidUpdates, cluster_columns,
+    cluster_summary, update_period, wet_clusters)
 from pendular.procedures.water_content import wet_to_water_volume
 from pendular.utils.parameters import ParameterError
 
@@ -191,23 +194,9 @@ def wetted_pairs(sim: Simulation, max_gap: float) -> tuple[np.ndarray, np.ndarra
     return i[near], j[near], np.maximum(gap[near], 0.0)
 
 
-def wet(dry: Simulation, config, water_content: float,
-        progress: bool) -> tuple[Simulation, CapillaryBridges, dict]:
-    """(wetted sim, bridges, wetting report): volume-controlled bridges at every contact of a
-    copy of ``dry`` (and across every gap up to config.form_gap radii) holding water content
-    ``water_content`` (fraction) once static, the formation suction corrected for the contacts
-    the bridges add (the wetting law itself, formation suction at a water volume, is
-    pendular.capillary.formation_suction)."""
-    particles = dry.particles
-    target = water_content * config.specific_gravity * particles.solid_volume()
-    max_gap = config.form_gap * config.sample.radius
-    pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
-    table = BridgeTable.cached(config.contact_angle,
-                               radius_ratios=sample_radius_ratios(particles.radius))
-
-    def build(suction):
-        return CapillaryBridges(suction, config.surface_tension, config.contact_angle,
-                                control="volume", roughness=config.roughness)
+def settler(config, progress: bool):
+    """settle(sim): run a wetted sample to equilibrium under its walls' servo (at most
+    WET_STEPS steps); returns the steps taken."""
 
     def settle(sim):
         done, start = equilibrated(config.sample), sim.step
@@ -216,6 +205,34 @@ def wet(dry: Simulation, config, water_content: float,
                          progress=equilibrium_bar("wet" if progress else None,
                                                   config.sample.equilibrium_unbalanced,
                                                   config.sample.stress_tolerance))
+    return settle
+
+
+def wet(dry: Simulation, config, water_content: float,
+        progress: bool) -> tuple[Simulation, CapillaryBridges, dict]:
+    """(wetted sim, bridges, wetting report): volume-controlled bridges at every contact of a
+    copy of ``dry`` (and across every gap up to config.form_gap radii) holding water content
+    ``water_content`` (fraction) once static, the formation suction corrected for the contacts
+    the bridges add (the wetting law itself, formation suction at a water volume, is
+    pendular.capillary.formation_suction). With liquid clusters
+    (pendular.procedures.tension_clusters.wet_clusters) the bridges are the persisting
+    suction-controlled ones, the sim's LiquidClusters beside them."""
+    particles = dry.particles
+    target = water_content * config.specific_gravity * particles.solid_volume()
+    max_gap = config.form_gap * config.sample.radius
+    pair_i, pair_j, gap = wetted_pairs(dry, max_gap)
+    settle = settler(config, progress)
+    if config.liquid == "clusters":
+        sim, bridges, _, report = wet_clusters(dry, config, water_content,
+                                               (pair_i, pair_j, gap), settle)
+        report["void_ratio_wet"] = sample_void_ratio(sim, config.sample.radius)
+        return sim, bridges, report
+    table = BridgeTable.cached(config.contact_angle,
+                               radius_ratios=sample_radius_ratios(particles.radius))
+
+    def build(suction):
+        return CapillaryBridges(suction, config.surface_tension, config.contact_angle,
+                                control="volume", roughness=config.roughness)
 
     try:
         sim, bridges, tries = wet_to_water_volume(
@@ -251,11 +268,14 @@ class Pull:
     writer (a frame every ``config.vtk_every`` steps, or ``config.vtk_frames`` frames over
     --max-strain); ``run()`` pulls to rupture and returns (steps, history). In a periodic cell:
     the cell stretched along z at the strain rate, its x and y stress servoed at zero, no
-    grips; the tensile stress is minus the cell's z stress."""
+    grips; the tensile stress is minus the cell's z stress. With LiquidClusters among the
+    sim's forces (--liquid clusters), their columns too, and their closed liquid solved again
+    CLUSTER_UPDATES times over --max-strain (tension_clusters.ClosedLiquidUpdates)."""
 
     def __init__(self, sim: Simulation, bridges: CapillaryBridges | None,
                  config, folder: str, progress: bool):
         self.sim, self.bridges, self.config, self.progress = sim, bridges, config, progress
+        self.clusters = liquid_clusters(sim)
         sample = config.sample
         self.rate = config.inertial_number / inertial_number(1.0, sample.radius,
                                                            sim.particles.density, sample.confining)
@@ -298,10 +318,17 @@ class Pull:
                 "water_content": lambda s: gravimetric_water_content(
                     water_volume(s), solid, config.specific_gravity),
                 "saturation": saturation})
+        if self.clusters is not None:
+            columns.update(cluster_columns(self.clusters, sim.particles.solid_volume(),
+                                           config.specific_gravity))
         self.start = sim.step
         self.recorder = HistoryRecorder(period, columns, origin=sim.step, reads=("walls",))
         self.recorder.record(sim)
         sim.writers.append(self.recorder)
+        if self.clusters is not None:       # after the recorder: rows show the held suction
+            sim.writers.append(ClosedLiquidUpdates(
+                self.clusters, self.clusters.liquid.total, update_period(self.steps),
+                sim.step))
         self.vtk = frames_writer(sim, folder, frame_period(config.vtk_every, config.vtk_frames,
                                                            self.steps))
 
@@ -356,6 +383,12 @@ class Pull:
         """Pull to rupture; (steps, history)."""
         self.advance(label)
         return self.sim.step - self.start, self.recorder.arrays()
+
+
+def liquid_clusters(sim: Simulation):
+    """The LiquidClusters among ``sim``'s forces, or None."""
+    found = [op for op in sim.forces if isinstance(op, LiquidClusters)]
+    return found[0] if found else None
 
 
 def prediction(config, void_ratio: float,
@@ -437,6 +470,8 @@ def run_case(dry: Simulation, preparation: dict, config, void_ratio: float,
         "wetting_time_s": wetted - started,
         "pull_time_s": earlier + time.perf_counter() - wetted,
     }
+    if pull.clusters is not None:
+        summary.update(cluster_summary(history, peak))
     attributes = dict(arguments if arguments is not None else config.options())
     attributes.update({key: value for key, value in summary.items()
                        if isinstance(value, (int, float, str))})
