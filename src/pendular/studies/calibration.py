@@ -26,10 +26,11 @@ Honest uncertainty:
   a curve fitted closer than two samples repeat each other gives no narrower posterior. Every
   run uses the same sample seed (the test's --seed), so the runs differ by their parameters
   alone; the seed noise says how far that sample may stand from the data's;
-- each iteration's weights are corrected by the density its samples were drawn from (the
-  library's ``proposal``), so that each estimates the same posterior, the prior times the
-  likelihood, however many iterations ran; the reported moments pool every iteration's
-  weighted ensemble (Calibration.pooled);
+- the filter's weights (corrected by the density its samples were drawn from, the library's
+  ``proposal``) train the next iteration's mixture; the posterior reported is the prior times
+  the likelihood at the seed noise itself, not at the filter's tempered ``sigma``, from every
+  iteration's samples together, each divided by the mixture of all the iterations' densities
+  (Calibration.posterior, pendular.studies.calibration_posterior);
 - a parameter whose posterior standard deviation is above UNCONSTRAINED_FRACTION of the
   prior's is reported ``constrained`` false: the data do not pin it.
 """
@@ -50,6 +51,7 @@ from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.history import read_history
 from pendular.io.schema import POSTERIOR_COLUMNS, summary_units
 from pendular.procedures.registry import config_from_options, options_of
+from pendular.studies.calibration_posterior import Proposal, mixture_density, moments
 from pendular.studies.campaign import Campaign, Run
 from pendular.utils.atomic import replacing, write_json
 from pendular.utils.parameters import spec_of
@@ -483,23 +485,17 @@ class Calibration:
         """Run the calibration into ``out`` (its runs in ``out``/runs/, each iteration a
         Campaign.run with ``jobs``, ``scheduler``, ``threads``, ``device``); the result dict of
         summary.json. ``out`` is held by the caller (an OutputFolder)."""
-        from grainlearning import (SMC, DynamicSystem, GaussianMixtureModel,
-                                   IterativeBayesianFilter)
+        from grainlearning import GaussianMixtureModel, IterativeBayesianFilter
 
         observed = self.observed()
-        system = DynamicSystem(obs_data=observed, ctrl_data=self.curve.control,
-                               num_samples=self.samples,
-                               param_min=[fit.low for fit in self.fits],
-                               param_max=[fit.high for fit in self.fits],
-                               param_names=[fit.key for fit in self.fits],
-                               obs_names=self.curve.columns)
+        system = self.system(self.samples)
         sampling = GaussianMixtureModel(max_num_components=MIXTURE_COMPONENTS,
                                         random_state=SAMPLING_SEED)
-        # the covariance scaled by each column's largest value: 1 in units of its range
-        ibf = IterativeBayesianFilter(SMC(ess_target=ESS_TARGET, scale_cov_with_max=True),
-                                      sampling)
+        ibf = IterativeBayesianFilter(self.filter(), sampling)
         ibf.initialize(system)
-        rows, history, noise = [], [], None
+        low, high = [fit.low for fit in self.fits], [fit.high for fit in self.fits]
+        proposals = [Proposal.uniform(low, high)]   # each iteration's, a Halton design first
+        rows, history, noise, simulated_all, drawn = [], [], None, [], []
         for iteration in range(self.iterations):
             # an integer option's samples run, and are weighed, at their rounded values
             samples = np.array([[fit.value(v) for fit, v in zip(self.fits, sample)]
@@ -537,20 +533,63 @@ class Calibration:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ibf.solve(system)
+            if iteration + 1 < self.iterations:       # the density the next one draws from
+                proposals.append(Proposal.of_sampling(sampling, low, high))
+            drawn.append(len(samples))
+            simulated_all.append(simulated)
             weights = np.asarray(ibf.posterior, dtype=float)
-            for index, weight, error in zip(kept, weights, errors):
+            for index, error in zip(kept, errors):
                 rows.append({"iteration": iteration, "sample": index,
                              "run": _sample_name(iteration, index),
-                             **self.sample_values(samples[index]),
-                             "weight": float(weight), "error": float(error)})
+                             **self.sample_values(samples[index]), "error": float(error)})
             history.append({"iteration": iteration, "runs": len(kept),
                             "sigma": float(np.atleast_1d(system.sigma_max)[0]),
                             "best_error": float(errors.min()),
                             "weighted_error": float(np.dot(weights, errors))})
-            log(f"iteration {iteration + 1}: best error {errors.min():.3g}, "
+            log(f"iteration {iteration + 1}: best error {errors.min():.3g}, the filter's "
                 + ", ".join(f"{fit.name} {m:.4g} ± {s:.2g}" for fit, (m, s) in
-                            zip(self.fits, self.moments(samples[kept], weights))))
+                            zip(self.fits, moments(samples[kept], weights))))
+        pooled = self.posterior(self.row_samples(rows), np.concatenate(simulated_all), noise,
+                                proposals, drawn)
+        for row, weight in zip(rows, pooled):
+            row["weight"] = float(weight)
         return self.summary(rows, history, noise)
+
+    def system(self, num_samples):
+        """GrainLearning's DynamicSystem of the data for ``num_samples`` samples."""
+        from grainlearning import DynamicSystem
+
+        return DynamicSystem(obs_data=self.observed(), ctrl_data=self.curve.control,
+                             num_samples=num_samples,
+                             param_min=[fit.low for fit in self.fits],
+                             param_max=[fit.high for fit in self.fits],
+                             param_names=[fit.key for fit in self.fits],
+                             obs_names=self.curve.columns)
+
+    @staticmethod
+    def filter():
+        """GrainLearning's sequential Monte Carlo filter, its covariance scaled by each
+        column's largest value: ``sigma`` in units of the data's range squared."""
+        from grainlearning import SMC
+
+        return SMC(ess_target=ESS_TARGET, scale_cov_with_max=True)
+
+    def row_samples(self, rows):
+        """The fitted values of ``rows`` (one row each, the fits' order)."""
+        return np.array([[row[fit.key] for fit in self.fits] for row in rows], dtype=float)
+
+    def posterior(self, samples, simulated, noise, proposals, drawn):
+        """The posterior weights of every iteration's ``samples`` (their ``simulated`` curves)
+        together: GrainLearning's likelihood at the seed ``noise``, divided by the mixture of
+        the iterations' ``proposals`` (calibration_posterior), each weighed by the samples
+        it ``drawn``."""
+        system = self.system(len(samples))
+        system.param_data = samples
+        system.set_sim_data(simulated)
+        density = mixture_density(proposals, drawn, samples)
+        inference = self.filter()
+        inference.data_assimilation_loop(noise, system, density / density.sum())
+        return np.asarray(inference.get_posterior_at_time(-1), dtype=float)
 
     def campaign_curves(self, runs, out, log, **settings):
         """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out``
@@ -596,29 +635,11 @@ class Calibration:
         density = np.exp(sampling.gmm.score_samples(sampling.normalize(samples)))
         return density / density.sum()
 
-    @staticmethod
-    def moments(samples, weights):
-        """[(mean, standard deviation)] of each column of ``samples`` under ``weights``."""
-        mean = weights @ samples
-        std = np.sqrt(weights @ (samples - mean) ** 2)
-        return list(zip(mean, std))
-
-    def pooled(self, rows):
-        """(samples, weights) of every iteration together: each iteration's weights (an
-        estimate of the same posterior, its proposal divided out) times its share of the
-        effective sample sizes (1 / sum w^2)."""
-        samples = np.array([[row[fit.key] for fit in self.fits] for row in rows], dtype=float)
-        weights = np.array([row["weight"] for row in rows], dtype=float)
-        iterations = np.array([row["iteration"] for row in rows])
-        for iteration in np.unique(iterations):
-            mine = iterations == iteration
-            weights[mine] *= 1.0 / np.sum(weights[mine] ** 2)
-        return samples, weights / weights.sum()
-
     def summary(self, rows, history, noise):
         best = min(rows, key=lambda row: row["error"])
         parameters = {}
-        for fit, (mean, std) in zip(self.fits, self.moments(*self.pooled(rows))):
+        weights = np.array([row["weight"] for row in rows])
+        for fit, (mean, std) in zip(self.fits, moments(self.row_samples(rows), weights)):
             prior_std = (fit.high - fit.low) / math.sqrt(12.0)
             parameters[fit.name] = {"mean": float(mean), "std": float(std),
                                     "best": best[fit.key], "unit": fit.unit,
