@@ -71,8 +71,9 @@ def test_weighted_moments():
 
 @requires("grainlearning")
 def test_every_iterations_samples_together_give_the_likelihoods_posterior(tmp_path):
-    """A curve linear in the friction, so that the likelihood at the seed noise is a Gaussian
-    of the friction: N(20, 3) well inside the prior [5, 40]. A uniform design of 12 samples,
+    """A curve linear in the friction, so that the likelihood at the seed noise (q's ten
+    times the volumetric strain's) is a Gaussian of the friction: N(20, 3) well inside the
+    prior [5, 40]. A uniform design of 12 samples,
     then 24 from a proposal narrower than the posterior and off its centre, N(23, 1.5) (whose
     own importance weights let its few tail samples set the spread): together, weighed by the
     mixture of both densities, they give the posterior's mean and standard deviation."""
@@ -82,8 +83,9 @@ def test_every_iterations_samples_together_give_the_likelihoods_posterior(tmp_pa
                               [parse_fit("friction=5:40", "triaxial")],
                               read_curve(path, "triaxial"))
     observed = calibration.observed()                   # 2 columns, 3 points
-    noise, std, truth = 0.5, 3.0, 20.0
-    slope = np.sqrt(noise / (observed.size * std ** 2))  # log L = -(f - 20)^2 / (2 std^2)
+    noise, std, truth = np.array([0.1, 1.0]), 3.0, 20.0
+    # each column's log-likelihood -3 slope^2 (f - 20)^2 / (2 noise): together std 3
+    slope = 1.0 / (std * np.sqrt(3.0 * np.sum(1.0 / noise)))
     design = np.linspace(5.0, 40.0, 12)
     rng = np.random.default_rng(1)
     narrow = 23.0 + 1.5 * rng.standard_normal(24)

@@ -503,9 +503,9 @@ SUMMARY_KEYS = {
                     _CAL),
     "best_error": Key("1", "calibrate: RMS difference of the best run's curve from the data, "
                            "in units of each data column's range", _CAL),
-    "seed_noise": Key("1", "calibrate: the filter's least variance, the scatter between "
-                           "samples of different seeds at the first iteration's best sample "
-                           "(each column's range squared)", _CAL),
+    "seed_noise": Key("1", "calibrate: per data column, the likelihood's variance, the "
+                           "scatter between samples of different seeds at the first "
+                           "iteration's best sample (the column's range squared)", _CAL),
     "iterations": Key({"iteration": "1", "runs": "1", "sigma": "1", "best_error": "1",
                        "weighted_error": "1"},
                       "calibrate: one row per iteration of the filter: its index, the runs "

@@ -20,10 +20,12 @@ Honest uncertainty:
   SEED_REPLICATES other seeds: the scatter between samples of different seeds at equal
   parameters, where the data are (the scatter grows with the friction, so a prior's centre far
   from the data would overstate it, or understate it). The data are one sample and
-  each run another, so their curves differ by twice that variance at equal parameters. The
-  filter's ``sigma`` is held at or above this seed noise (the library's lower bound), counted
-  once per curve, not once per point, since the scatter of neighbouring points is correlated:
-  a curve fitted closer than two samples repeat each other gives no narrower posterior. Every
+  each run another, so their curves differ by twice that variance at equal parameters. Each
+  column has its own (q scatters less than the volumetric strain), which weighs it in the
+  likelihood (the library's observation weights), and the filter's ``sigma`` is held at or
+  above it (the library's lower bound), counted once per curve, not once per point, since the
+  scatter of neighbouring points is correlated: a curve fitted closer than two samples repeat
+  each other gives no narrower posterior. Every
   run uses the same sample seed (the test's --seed), so the runs differ by their parameters
   alone; the seed noise says how far that sample may stand from the data's;
 - the filter's weights (corrected by the density its samples were drawn from, the library's
@@ -67,14 +69,16 @@ SEED_REPLICATES = 7
 ESS_TARGET = 0.3
 #: Components of the Gaussian mixture the next samples are drawn from.
 MIXTURE_COMPONENTS = 2
-#: Seed of the mixture's draws (a calibration started again draws the same samples).
+#: Seed of the mixture's draws, plus the iteration: each iteration draws fresh deviates (one
+#: seed for all would give every iteration the same standard normals, its errors repeated
+#: rather than averaged), and a calibration started again draws the same samples.
 SAMPLING_SEED = 0
 #: A posterior standard deviation above this fraction of the prior's: unconstrained.
 UNCONSTRAINED_FRACTION = 0.7
 #: How far above the seed noise the filter's upper bound stays (a bounded search needs room).
 NOISE_MARGIN = 1e-3
-#: The smallest seed noise [variance, in units of the data's range squared]: the filter needs a
-#: positive lower bound where the seeds give identical curves (a prepared --sample).
+#: The smallest seed noise of a column [variance, in units of its range squared]: the filter
+#: needs a positive lower bound where the seeds give identical curves (a prepared --sample).
 MIN_NOISE = 1e-8
 #: Options --fit cannot name: the runs' outputs, which calibrate turns off, and the sample's
 #: seed, which is no property of the material (the seed runs vary it).
@@ -520,16 +524,20 @@ class Calibration:
                 noise = self.seed_noise([curves[_sample_name(0, best)],
                                          *(replicates[run.name] for run in seeds
                                            if run.name in replicates)])
+                system.inv_obs_weight = list(noise)
+                system.compute_inv_normalized_sigma()
             system.param_data = samples[kept]
             system.num_samples = len(kept)
             system.set_sim_data(simulated)
-            system.sigma_lower_bound = noise
-            system.sigma_tol = noise
+            system.sigma_lower_bound = system.sigma_tol = _noise_sigma(noise)
             # the library anneals its upper bound from one iteration to the next: never
             # below the seed noise
             system.sigma_max = max(float(np.atleast_1d(system.sigma_max)[0]),
-                                   noise * (1.0 + NOISE_MARGIN))
-            ibf.proposal = self.proposal_density(sampling, samples[kept], iteration)
+                                   _noise_sigma(noise) * (1.0 + NOISE_MARGIN))
+            if iteration > 0:                   # the first's: a uniform design
+                density = proposals[iteration].density(samples[kept])
+                ibf.proposal = density / density.sum()
+            sampling.random_state = SAMPLING_SEED + iteration      # the next one's draws
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ibf.solve(system)
@@ -555,8 +563,9 @@ class Calibration:
             row["weight"] = float(weight)
         return self.summary(rows, history, noise)
 
-    def system(self, num_samples):
-        """GrainLearning's DynamicSystem of the data for ``num_samples`` samples."""
+    def system(self, num_samples, noise=None):
+        """GrainLearning's DynamicSystem of the data for ``num_samples`` samples, each column
+        weighed by its seed ``noise`` where given (seed_noise)."""
         from grainlearning import DynamicSystem
 
         return DynamicSystem(obs_data=self.observed(), ctrl_data=self.curve.control,
@@ -564,7 +573,8 @@ class Calibration:
                              param_min=[fit.low for fit in self.fits],
                              param_max=[fit.high for fit in self.fits],
                              param_names=[fit.key for fit in self.fits],
-                             obs_names=self.curve.columns)
+                             obs_names=self.curve.columns,
+                             inv_obs_weight=None if noise is None else list(noise))
 
     @staticmethod
     def filter():
@@ -580,15 +590,15 @@ class Calibration:
 
     def posterior(self, samples, simulated, noise, proposals, drawn):
         """The posterior weights of every iteration's ``samples`` (their ``simulated`` curves)
-        together: GrainLearning's likelihood at the seed ``noise``, divided by the mixture of
-        the iterations' ``proposals`` (calibration_posterior), each weighed by the samples
-        it ``drawn``."""
-        system = self.system(len(samples))
+        together: GrainLearning's likelihood at the seed ``noise`` (each column's), divided by
+        the mixture of the iterations' ``proposals`` (calibration_posterior), each weighed by
+        the samples it ``drawn``."""
+        system = self.system(len(samples), noise)
         system.param_data = samples
         system.set_sim_data(simulated)
         density = mixture_density(proposals, drawn, samples)
         inference = self.filter()
-        inference.data_assimilation_loop(noise, system, density / density.sum())
+        inference.data_assimilation_loop(_noise_sigma(noise), system, density / density.sum())
         return np.asarray(inference.get_posterior_at_time(-1), dtype=float)
 
     def campaign_curves(self, runs, out, log, **settings):
@@ -617,23 +627,15 @@ class Calibration:
                 for offset in range(1, SEED_REPLICATES + 1)]
 
     def seed_noise(self, curves):
-        """The filter's least uncertainty: the variance of the difference between two
-        samples' curves (twice the variance between the seeds' curves: the data are one
-        sample, a run another), in units of the data's range squared, averaged over the
-        points and counted once per curve (times the points: neighbouring points scatter
-        together)."""
+        """Each column's least uncertainty (an array, the data's columns): the variance of the
+        difference between two samples' curves (twice the variance between the seeds'
+        curves: the data are one sample, a run another), in units of the column's range
+        squared, averaged over the points and counted once per curve (times the points:
+        neighbouring points scatter together)."""
         if len(curves) < 2:
-            return MIN_NOISE
+            return np.full(len(self.curve.columns), MIN_NOISE)
         spread = 2.0 * np.var(np.array(curves), axis=0, ddof=1)
-        return max(float(np.mean(spread)) * spread.shape[-1], MIN_NOISE)
-
-    def proposal_density(self, sampling, samples, iteration):
-        """The density the samples of ``iteration`` were drawn from (None: the first's, a
-        uniform design), normalised over them: the filter divides their weights by it."""
-        if iteration == 0 or sampling.gmm is None:
-            return None
-        density = np.exp(sampling.gmm.score_samples(sampling.normalize(samples)))
-        return density / density.sum()
+        return np.maximum(np.mean(spread, axis=-1) * spread.shape[-1], MIN_NOISE)
 
     def summary(self, rows, history, noise):
         best = min(rows, key=lambda row: row["error"])
@@ -650,8 +652,15 @@ class Calibration:
         return {"test": self.test, "data": os.path.abspath(self.curve.path),
                 "columns": self.curve.columns, "parameters": parameters,
                 "best_run": os.path.join("runs", best["run"]), "best_error": best["error"],
-                "seed_noise": noise, "iterations": history,
+                "seed_noise": dict(zip(self.curve.columns, map(float, noise))),
+                "iterations": history,
                 "runs": len(rows) + SEED_REPLICATES, "rows": rows}
+
+
+def _noise_sigma(noise):
+    """The filter's ``sigma`` at which each column's variance is its seed ``noise``: their
+    geometric mean (the library scales the columns' weights to a unit determinant)."""
+    return float(np.exp(np.mean(np.log(noise))))
 
 
 def _seed_of(config):
