@@ -25,9 +25,9 @@ Honest uncertainty:
   likelihood (the library's observation weights), and the filter's ``sigma`` is held at or
   above it (the library's lower bound), counted once per curve, not once per point, since the
   scatter of neighbouring points is correlated: a curve fitted closer than two samples repeat
-  each other gives no narrower posterior. Every
-  run uses the same sample seed (the test's --seed), so the runs differ by their parameters
-  alone; the seed noise says how far that sample may stand from the data's;
+  each other gives no narrower posterior. Every run uses the same sample seed (the test's
+  --seed), so the runs differ by their parameters alone; the seed noise says how far that
+  sample may stand from the data's;
 - the filter's weights (corrected by the density its samples were drawn from, the library's
   ``proposal``) train the next iteration's mixture; the posterior reported is the prior times
   the likelihood at the seed noise itself, not at the filter's tempered ``sigma``, from every
