@@ -77,11 +77,11 @@ print(f"the truth, 15°, is {abs(friction['mean'] - 15.0) / friction['std']:.2f}
       "standard deviations from the posterior mean")
 
 # %%
-# ``posterior.csv`` holds every run: its friction, its weight in its iteration and its error to
-# the data (the RMS difference, each column in units of its range in the data). Each weight is
-# divided by the density its sample was drawn from, so that every iteration estimates the same
-# posterior; where the seed noise makes the likelihood nearly flat, as here, a sample drawn
-# where the proposal was thin weighs most:
+# ``posterior.csv`` holds every run: its friction, its weight in the posterior and its error to
+# the data (the RMS difference, each column in units of its range in the data). The weights are
+# those of every iteration's samples together: each sample's likelihood at the seed noise,
+# divided by the mixture of the densities the iterations drew from; where the seed noise makes
+# the likelihood nearly flat, as here, a sample drawn where the samples are sparse weighs most:
 
 import matplotlib.pyplot as plt
 import pandas as pd

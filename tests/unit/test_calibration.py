@@ -148,10 +148,11 @@ def test_the_seed_noise_is_counted_once_per_curve(tmp_path):
     calibration = Calibration("triaxial", {"particles": 60, "max_strain": 0.05},
                               [parse_fit("friction=5:40", "triaxial")], curve)
     base = np.zeros((2, 3))
-    curves = [base + 0.1, base - 0.1]          # variance 0.02 at each of 3 points
-    # the data and a run: two samples, whose difference has twice that variance
-    assert calibration.seed_noise(curves) == pytest.approx(2 * 0.02 * 3)
-    assert calibration.seed_noise([base, base]) > 0.0       # a positive bound for the filter
+    scatter = np.array([[0.1], [0.2]])
+    curves = [base + scatter, base - scatter]  # variances 0.02 and 0.08 at each of 3 points
+    # the data and a run: two samples, whose difference has twice that variance, per column
+    assert calibration.seed_noise(curves) == pytest.approx([2 * 0.02 * 3, 2 * 0.08 * 3])
+    assert np.all(calibration.seed_noise([base, base]) > 0.0)  # a positive bound for the filter
 
 
 @pytest.mark.parametrize("argv, words", [
@@ -227,7 +228,7 @@ def test_the_inference_recovers_a_parameter_and_reports_one_it_cannot_see(tmp_pa
     assert abs(friction["mean"] - 20.0) < max(2.0 * friction["std"], 0.5), friction
     assert friction["constrained"] and friction["std"] < 0.3 * friction["prior_std"]
     assert not young["constrained"], young
-    assert summary["seed_noise"] > 0.0
+    assert set(summary["seed_noise"]) == {"q"} and summary["seed_noise"]["q"] > 0.0
     assert len(summary["rows"]) == 3 * 16
 
 

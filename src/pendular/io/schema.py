@@ -513,8 +513,8 @@ SUMMARY_KEYS = {
     "test": Key("1", "calibrate: the laboratory command calibrated (text)", _CAL),
     "data": Key("1", "calibrate: the measured curve's CSV (absolute path)", _CAL),
     "columns": Key("1", "calibrate: the data's columns compared, the control first", _CAL),
-    "parameters": Key("1", "calibrate: per fitted option, its posterior mean and std (pooled "
-                           "over the iterations), the best run's value, the prior's low, "
+    "parameters": Key("1", "calibrate: per fitted option, its posterior mean and std (every "
+                           "iteration's samples together), the best run's value, the prior's low, "
                            "high and std, all in the option's own unit (its field 'unit'), "
                            "and 'constrained': whether the std is at most 0.7 of the prior's "
                            "(calibration.UNCONSTRAINED_FRACTION)",
@@ -523,13 +523,13 @@ SUMMARY_KEYS = {
                     _CAL),
     "best_error": Key("1", "calibrate: RMS difference of the best run's curve from the data, "
                            "in units of each data column's range", _CAL),
-    "seed_noise": Key("1", "calibrate: the filter's least variance, the scatter between "
-                           "samples of different seeds at the first iteration's best sample "
-                           "(each column's range squared)", _CAL),
+    "seed_noise": Key("1", "calibrate: per data column, the likelihood's variance, the "
+                           "scatter between samples of different seeds at the first "
+                           "iteration's best sample (the column's range squared)", _CAL),
     "iterations": Key({"iteration": "1", "runs": "1", "sigma": "1", "best_error": "1",
                        "weighted_error": "1"},
                       "calibrate: one row per iteration of the filter: its index, the runs "
-                      "that finished, the filter's sigma, the least and the posterior-weighted "
+                      "that finished, the filter's sigma, the least and the filter's weighted "
                       "RMS error", _CAL),
     "runs": Key("1", "calibrate: runs of every iteration together, the seed runs included",
                 _CAL),
@@ -542,7 +542,8 @@ POSTERIOR_COLUMNS = {
     "iteration": Key("1", "the filter's iteration, from 0", _CAL),
     "sample": Key("1", "the sample's index in its iteration", _CAL),
     "run": Key("1", "its run folder under runs/ (text)", _CAL),
-    "weight": Key("1", "its posterior weight in its iteration", _CAL),
+    "weight": Key("1", "its weight in the posterior, every iteration's samples together "
+                       "(summing to 1 over the file)", _CAL),
     "error": Key("1", "RMS difference of its curve from the data, in units of each data "
                       "column's range", _CAL),
 }

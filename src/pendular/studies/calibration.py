@@ -20,16 +20,19 @@ Honest uncertainty:
   SEED_REPLICATES other seeds: the scatter between samples of different seeds at equal
   parameters, where the data are (the scatter grows with the friction, so a prior's centre far
   from the data would overstate it, or understate it). The data are one sample and
-  each run another, so their curves differ by twice that variance at equal parameters. The
-  filter's ``sigma`` is held at or above this seed noise (the library's lower bound), counted
-  once per curve, not once per point, since the scatter of neighbouring points is correlated:
-  a curve fitted closer than two samples repeat each other gives no narrower posterior. Every
-  run uses the same sample seed (the test's --seed), so the runs differ by their parameters
-  alone; the seed noise says how far that sample may stand from the data's;
-- each iteration's weights are corrected by the density its samples were drawn from (the
-  library's ``proposal``), so that each estimates the same posterior, the prior times the
-  likelihood, however many iterations ran; the reported moments pool every iteration's
-  weighted ensemble (Calibration.pooled);
+  each run another, so their curves differ by twice that variance at equal parameters. Each
+  column has its own (q scatters less than the volumetric strain), which weighs it in the
+  likelihood (the library's observation weights), and the filter's ``sigma`` is held at or
+  above it (the library's lower bound), counted once per curve, not once per point, since the
+  scatter of neighbouring points is correlated: a curve fitted closer than two samples repeat
+  each other gives no narrower posterior. Every run uses the same sample seed (the test's
+  --seed), so the runs differ by their parameters alone; the seed noise says how far that
+  sample may stand from the data's;
+- the filter's weights (corrected by the density its samples were drawn from, the library's
+  ``proposal``) train the next iteration's mixture; the posterior reported is the prior times
+  the likelihood at the seed noise itself, not at the filter's tempered ``sigma``, from every
+  iteration's samples together, each divided by the mixture of all the iterations' densities
+  (Calibration.posterior, pendular.studies.calibration_posterior);
 - a parameter whose posterior standard deviation is above UNCONSTRAINED_FRACTION of the
   prior's is reported ``constrained`` false: the data do not pin it.
 """
@@ -51,6 +54,7 @@ from pendular.io.history import read_history
 from pendular.io.schema import POSTERIOR_COLUMNS, summary_units
 from pendular.procedures.registry import config_from_options, options_of
 from pendular.procedures.run_options import RunOptions
+from pendular.studies.calibration_posterior import Proposal, mixture_density, moments
 from pendular.studies.campaign import Campaign, Run
 from pendular.utils.atomic import replacing, write_json
 from pendular.utils.parameters import spec_of
@@ -66,14 +70,16 @@ SEED_REPLICATES = 7
 ESS_TARGET = 0.3
 #: Components of the Gaussian mixture the next samples are drawn from.
 MIXTURE_COMPONENTS = 2
-#: Seed of the mixture's draws (a calibration started again draws the same samples).
+#: Seed of the mixture's draws, plus the iteration: each iteration draws fresh deviates (one
+#: seed for all would give every iteration the same standard normals, its errors repeated
+#: rather than averaged), and a calibration started again draws the same samples.
 SAMPLING_SEED = 0
 #: A posterior standard deviation above this fraction of the prior's: unconstrained.
 UNCONSTRAINED_FRACTION = 0.7
 #: How far above the seed noise the filter's upper bound stays (a bounded search needs room).
 NOISE_MARGIN = 1e-3
-#: The smallest seed noise [variance, in units of the data's range squared]: the filter needs a
-#: positive lower bound where the seeds give identical curves (a prepared --sample).
+#: The smallest seed noise of a column [variance, in units of its range squared]: the filter
+#: needs a positive lower bound where the seeds give identical curves (a prepared --sample).
 MIN_NOISE = 1e-8
 #: Options --fit cannot name: the runs' outputs, which calibrate turns off, and the sample's
 #: seed, which is no property of the material (the seed runs vary it).
@@ -484,24 +490,18 @@ class Calibration:
         Campaign.run as the RunOptions ``options`` say, ``settings`` its fields one by one:
         local processes or a Dask cluster, threads, device); the result dict of
         summary.json. ``out`` is held by the caller (an OutputFolder)."""
-        from grainlearning import (SMC, DynamicSystem, GaussianMixtureModel,
-                                   IterativeBayesianFilter)
+        from grainlearning import GaussianMixtureModel, IterativeBayesianFilter
 
         options = RunOptions.of(options, **settings)
         observed = self.observed()
-        system = DynamicSystem(obs_data=observed, ctrl_data=self.curve.control,
-                               num_samples=self.samples,
-                               param_min=[fit.low for fit in self.fits],
-                               param_max=[fit.high for fit in self.fits],
-                               param_names=[fit.key for fit in self.fits],
-                               obs_names=self.curve.columns)
+        system = self.system(self.samples)
         sampling = GaussianMixtureModel(max_num_components=MIXTURE_COMPONENTS,
                                         random_state=SAMPLING_SEED)
-        # the covariance scaled by each column's largest value: 1 in units of its range
-        ibf = IterativeBayesianFilter(SMC(ess_target=ESS_TARGET, scale_cov_with_max=True),
-                                      sampling)
+        ibf = IterativeBayesianFilter(self.filter(), sampling)
         ibf.initialize(system)
-        rows, history, noise = [], [], None
+        low, high = [fit.low for fit in self.fits], [fit.high for fit in self.fits]
+        proposals = [Proposal.uniform(low, high)]   # each iteration's, a Halton design first
+        rows, history, noise, simulated_all, drawn = [], [], None, [], []
         for iteration in range(self.iterations):
             # an integer option's samples run, and are weighed, at their rounded values
             samples = np.array([[fit.value(v) for fit, v in zip(self.fits, sample)]
@@ -524,33 +524,82 @@ class Calibration:
                 noise = self.seed_noise([curves[_sample_name(0, best)],
                                          *(replicates[run.name] for run in seeds
                                            if run.name in replicates)])
+                system.inv_obs_weight = list(noise)
+                system.compute_inv_normalized_sigma()
             system.param_data = samples[kept]
             system.num_samples = len(kept)
             system.set_sim_data(simulated)
-            system.sigma_lower_bound = noise
-            system.sigma_tol = noise
+            system.sigma_lower_bound = system.sigma_tol = _noise_sigma(noise)
             # the library anneals its upper bound from one iteration to the next: never
             # below the seed noise
             system.sigma_max = max(float(np.atleast_1d(system.sigma_max)[0]),
-                                   noise * (1.0 + NOISE_MARGIN))
-            ibf.proposal = self.proposal_density(sampling, samples[kept], iteration)
+                                   _noise_sigma(noise) * (1.0 + NOISE_MARGIN))
+            if iteration > 0:                   # the first's: a uniform design
+                density = proposals[iteration].density(samples[kept])
+                ibf.proposal = density / density.sum()
+            sampling.random_state = SAMPLING_SEED + iteration      # the next one's draws
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ibf.solve(system)
+            if iteration + 1 < self.iterations:       # the density the next one draws from
+                proposals.append(Proposal.of_sampling(sampling, low, high))
+            drawn.append(len(samples))
+            simulated_all.append(simulated)
             weights = np.asarray(ibf.posterior, dtype=float)
-            for index, weight, error in zip(kept, weights, errors):
+            for index, error in zip(kept, errors):
                 rows.append({"iteration": iteration, "sample": index,
                              "run": _sample_name(iteration, index),
-                             **self.sample_values(samples[index]),
-                             "weight": float(weight), "error": float(error)})
+                             **self.sample_values(samples[index]), "error": float(error)})
             history.append({"iteration": iteration, "runs": len(kept),
                             "sigma": float(np.atleast_1d(system.sigma_max)[0]),
                             "best_error": float(errors.min()),
                             "weighted_error": float(np.dot(weights, errors))})
-            log(f"iteration {iteration + 1}: best error {errors.min():.3g}, "
+            log(f"iteration {iteration + 1}: best error {errors.min():.3g}, the filter's "
                 + ", ".join(f"{fit.name} {m:.4g} ± {s:.2g}" for fit, (m, s) in
-                            zip(self.fits, self.moments(samples[kept], weights))))
+                            zip(self.fits, moments(samples[kept], weights))))
+        pooled = self.posterior(self.row_samples(rows), np.concatenate(simulated_all), noise,
+                                proposals, drawn)
+        for row, weight in zip(rows, pooled):
+            row["weight"] = float(weight)
         return self.summary(rows, history, noise)
+
+    def system(self, num_samples, noise=None):
+        """GrainLearning's DynamicSystem of the data for ``num_samples`` samples, each column
+        weighed by its seed ``noise`` where given (seed_noise)."""
+        from grainlearning import DynamicSystem
+
+        return DynamicSystem(obs_data=self.observed(), ctrl_data=self.curve.control,
+                             num_samples=num_samples,
+                             param_min=[fit.low for fit in self.fits],
+                             param_max=[fit.high for fit in self.fits],
+                             param_names=[fit.key for fit in self.fits],
+                             obs_names=self.curve.columns,
+                             inv_obs_weight=None if noise is None else list(noise))
+
+    @staticmethod
+    def filter():
+        """GrainLearning's sequential Monte Carlo filter, its covariance scaled by each
+        column's largest value: ``sigma`` in units of the data's range squared."""
+        from grainlearning import SMC
+
+        return SMC(ess_target=ESS_TARGET, scale_cov_with_max=True)
+
+    def row_samples(self, rows):
+        """The fitted values of ``rows`` (one row each, the fits' order)."""
+        return np.array([[row[fit.key] for fit in self.fits] for row in rows], dtype=float)
+
+    def posterior(self, samples, simulated, noise, proposals, drawn):
+        """The posterior weights of every iteration's ``samples`` (their ``simulated`` curves)
+        together: GrainLearning's likelihood at the seed ``noise`` (each column's), divided by
+        the mixture of the iterations' ``proposals`` (calibration_posterior), each weighed by
+        the samples it ``drawn``."""
+        system = self.system(len(samples), noise)
+        system.param_data = samples
+        system.set_sim_data(simulated)
+        density = mixture_density(proposals, drawn, samples)
+        inference = self.filter()
+        inference.data_assimilation_loop(_noise_sigma(noise), system, density / density.sum())
+        return np.asarray(inference.get_posterior_at_time(-1), dtype=float)
 
     def campaign_curves(self, runs, out, log, options):
         """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out`` as
@@ -578,47 +627,21 @@ class Calibration:
                 for offset in range(1, SEED_REPLICATES + 1)]
 
     def seed_noise(self, curves):
-        """The filter's least uncertainty: the variance of the difference between two
-        samples' curves (twice the variance between the seeds' curves: the data are one
-        sample, a run another), in units of the data's range squared, averaged over the
-        points and counted once per curve (times the points: neighbouring points scatter
-        together)."""
+        """Each column's least uncertainty (an array, the data's columns): the variance of the
+        difference between two samples' curves (twice the variance between the seeds'
+        curves: the data are one sample, a run another), in units of the column's range
+        squared, averaged over the points and counted once per curve (times the points:
+        neighbouring points scatter together)."""
         if len(curves) < 2:
-            return MIN_NOISE
+            return np.full(len(self.curve.columns), MIN_NOISE)
         spread = 2.0 * np.var(np.array(curves), axis=0, ddof=1)
-        return max(float(np.mean(spread)) * spread.shape[-1], MIN_NOISE)
-
-    def proposal_density(self, sampling, samples, iteration):
-        """The density the samples of ``iteration`` were drawn from (None: the first's, a
-        uniform design), normalised over them: the filter divides their weights by it."""
-        if iteration == 0 or sampling.gmm is None:
-            return None
-        density = np.exp(sampling.gmm.score_samples(sampling.normalize(samples)))
-        return density / density.sum()
-
-    @staticmethod
-    def moments(samples, weights):
-        """[(mean, standard deviation)] of each column of ``samples`` under ``weights``."""
-        mean = weights @ samples
-        std = np.sqrt(weights @ (samples - mean) ** 2)
-        return list(zip(mean, std))
-
-    def pooled(self, rows):
-        """(samples, weights) of every iteration together: each iteration's weights (an
-        estimate of the same posterior, its proposal divided out) times its share of the
-        effective sample sizes (1 / sum w^2)."""
-        samples = np.array([[row[fit.key] for fit in self.fits] for row in rows], dtype=float)
-        weights = np.array([row["weight"] for row in rows], dtype=float)
-        iterations = np.array([row["iteration"] for row in rows])
-        for iteration in np.unique(iterations):
-            mine = iterations == iteration
-            weights[mine] *= 1.0 / np.sum(weights[mine] ** 2)
-        return samples, weights / weights.sum()
+        return np.maximum(np.mean(spread, axis=-1) * spread.shape[-1], MIN_NOISE)
 
     def summary(self, rows, history, noise):
         best = min(rows, key=lambda row: row["error"])
         parameters = {}
-        for fit, (mean, std) in zip(self.fits, self.moments(*self.pooled(rows))):
+        weights = np.array([row["weight"] for row in rows])
+        for fit, (mean, std) in zip(self.fits, moments(self.row_samples(rows), weights)):
             prior_std = (fit.high - fit.low) / math.sqrt(12.0)
             parameters[fit.name] = {"mean": float(mean), "std": float(std),
                                     "best": best[fit.key], "unit": fit.unit,
@@ -629,8 +652,15 @@ class Calibration:
         return {"test": self.test, "data": os.path.abspath(self.curve.path),
                 "columns": self.curve.columns, "parameters": parameters,
                 "best_run": os.path.join("runs", best["run"]), "best_error": best["error"],
-                "seed_noise": noise, "iterations": history,
+                "seed_noise": dict(zip(self.curve.columns, map(float, noise))),
+                "iterations": history,
                 "runs": len(rows) + SEED_REPLICATES, "rows": rows}
+
+
+def _noise_sigma(noise):
+    """The filter's ``sigma`` at which each column's variance is its seed ``noise``: their
+    geometric mean (the library scales the columns' weights to a unit determinant)."""
+    return float(np.exp(np.mean(np.log(noise))))
 
 
 def _seed_of(config):

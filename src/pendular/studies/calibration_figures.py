@@ -55,10 +55,11 @@ def curves_figure(calibration, summary, out):
 
 def posterior_figure(calibration, summary):
     """Each parameter's posterior on its prior range: the weighted histogram of every
-    iteration's samples pooled (Calibration.pooled), each sample a tick; below the diagonal
-    the pairs, each sample sized by its weight."""
+    iteration's samples together (their posterior weights, Calibration.posterior), each sample
+    a tick; below the diagonal the pairs, each sample sized by its weight."""
     fits = calibration.fits
-    samples, weights = calibration.pooled(summary["rows"])
+    samples = calibration.row_samples(summary["rows"])
+    weights = np.array([row["weight"] for row in summary["rows"]])
     size = len(fits)
     figure, axes = pyplot().subplots(size, size, figsize=(3.2 * size + 1, 3.0 * size + 0.5),
                                      squeeze=False)
@@ -98,7 +99,7 @@ def errors_figure(summary):
     axis.plot([s["iteration"] + 1 for s in steps], [s["best_error"] for s in steps], "-o",
               color="C3", label="best")
     axis.plot([s["iteration"] + 1 for s in steps], [s["weighted_error"] for s in steps], "-s",
-              color="C0", label="mean under the posterior weights")
+              color="C0", label="mean under the filter's weights")
     axis.set_yscale("log")
     axis.set_xlabel("iteration")
     axis.set_ylabel("RMS error (fraction of the data's range)")
