@@ -46,7 +46,9 @@ def pendular(*arguments, check=True):
                           capture_output=True, text=True, check=check, timeout=600)
 
 
-def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
+def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path, capsys):
+    """``pendular campaign`` in its own interpreter, then again in-process
+    (pendular.cli.run_command) over the finished runs."""
     table = tmp_path / "sweep.toml"
     table.write_text(TABLE)
     out = tmp_path / "out"
@@ -78,9 +80,10 @@ def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path):
 
     stamps = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/*")}
     started = time.perf_counter()
-    again = pendular("campaign", str(table), "--out", str(out), "--quiet")
+    status, err = run_in_process("campaign", [table, "--out", out, "--quiet"], capsys)
     assert time.perf_counter() - started < 60
-    assert "4 triaxial runs (4 reused, 0 failed)" in again.stderr
+    assert status == 0, err
+    assert "4 triaxial runs (4 reused, 0 failed)" in err
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps          # no run touched
     with open(out / "campaign.csv") as handle:
         reread = list(csv.DictReader(handle))

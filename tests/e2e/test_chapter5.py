@@ -13,6 +13,7 @@ import sys
 import numpy as np
 import pytest
 
+from pendular.cli import run_command
 from pendular.studies.chapter5 import Chapter5Campaign, Chapter5Grid, envelopes, write_report
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.reference import FIG_5_5, TABLE_5_3
@@ -210,14 +211,17 @@ def test_directional_value_of_a_tensor_is_its_quadratic_form():
     assert directional(tensor, np.array([0.0]))[0] == 3.0          # axial direction: T_zz
 
 
-def test_rerun_reuses_finished_runs(campaign):
+def test_rerun_reuses_finished_runs(campaign, capsys):
+    """The scenario's command started again in-process (pendular.cli.run_command, as
+    scenarios/chapter5.py runs it)."""
     out, data = campaign
     stamps = {p: p.stat().st_mtime_ns for p in (out / "runs").glob("*/history.h5")}
     samples = {p: p.stat().st_mtime_ns for p in (out / "samples").glob("*.h5")}
-    result = subprocess.run([sys.executable, SCENARIO, *SMALL, "--suction", "0,30000",
-                             "--out", str(out)],
-                            check=True, capture_output=True, text=True, timeout=900)
-    assert "4 finished runs" in result.stdout and "0 run" in result.stdout
+    capsys.readouterr()
+    assert run_command("chapter5", [*SMALL, "--suction", "0,30000", "--out", str(out)],
+                       prog="chapter5.py") == 0
+    printed = capsys.readouterr().out
+    assert "4 finished runs" in printed and "0 run" in printed
     assert {p: p.stat().st_mtime_ns for p in stamps} == stamps        # nothing re-run
     assert {p: p.stat().st_mtime_ns for p in samples} == samples      # nor prepared
     with open(out / "campaign.json") as handle:

@@ -25,7 +25,7 @@ from pendular.procedures.config import CONFIG_TYPES, config_from_dict, config_to
 from pendular.procedures.tension import TensionConfig, tension_sample
 from pendular.procedures.preparation import PrepareConfig
 
-from conftest import ROOT
+from conftest import ROOT, run_in_process
 from pendular.io.schema import undeclared_keys
 
 GAMMA = 0.074
@@ -151,13 +151,14 @@ def test_dry_sample_has_no_strength_and_wet_one_a_rumpf_order_strength(dry, wett
     (["--friction", "95"], "--friction = 95.0 deg is outside"),
     (["--void-ratio", "0.7,x"], "--void-ratio = '0.7,x' is not a comma-separated list"),
 ])
-def test_bad_inputs_are_refused_by_name(arguments, message):
-    result = subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
-                             *TINY, *arguments, "--out", os.devnull], capture_output=True,
-                            text=True)
-    assert result.returncode == 2
-    assert message in result.stderr and "Traceback" not in result.stderr
-    assert result.stderr.count("error:") == 1
+def test_bad_inputs_are_refused_by_name(arguments, message, capsys):
+    """scenarios/direct_tension.py's command, run in-process (its own interpreter in
+    test_command_runs_one_case_and_writes_its_outputs)."""
+    status, err = run_in_process("tension", [*TINY, *arguments, "--out", os.devnull], capsys,
+                                 prog="direct_tension.py")
+    assert status == 2
+    assert message in err and "Traceback" not in err
+    assert err.count("error:") == 1
 
 
 def test_config_is_validated_and_saved_as_json(args):

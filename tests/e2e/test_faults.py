@@ -8,8 +8,9 @@ concurrent runs on one folder, a run into a used folder, SIGINT during a shear. 
 identities and the physical checks of samples at the library level, and tampered table caches,
 are in tests/unit/test_integrity.py (not repeated here).
 
-Option cases run in-process through pendular.cli.run_command (they are refused before anything
-runs); runs and signals are subprocesses of 60 spheres.
+Option cases, and runs whose ending the test reads from their exit status and stderr, run
+in-process through pendular.cli.run_command; the runs a signal stops, and the runs those leave
+behind, are subprocesses; all of 60 spheres.
 """
 
 import json
@@ -212,7 +213,7 @@ def test_a_second_run_on_a_folder_in_use_is_refused(tmp_path, capsys):
         refused(*command(TINY + ["--out", str(out)], capsys), str(out), "in use")
 
 
-def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp_path):
+def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp_path, capsys):
     """A dry run into an old wet run's folder: its ParaView frames and wet-only plots go, the
     user's own files stay."""
     out = copy_run(interrupted, tmp_path)
@@ -224,9 +225,9 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
     manifest = json.loads((out / ".pendular-outputs.json").read_text())
     manifest["files"] = sorted(set(manifest["files"]) | {"vtk", "plots"})
     (out / ".pendular-outputs.json").write_text(json.dumps(manifest))
-    done = script(TINY + ["--sample", str(interrupted / "sample.h5"), "--out", str(out)],
-                  cwd=tmp_path)
-    assert done.returncode == 0, done.stderr
+    status, err = command(TINY + ["--sample", str(interrupted / "sample.h5"), "--out", str(out)],
+                          capsys)
+    assert status == 0, err
     assert not (out / "vtk").exists() and not (out / "checkpoint.h5").exists()
     assert not (out / "plots" / "saturation.png").exists()
     assert (out / "notes.txt").read_text() == "mine"
@@ -336,21 +337,21 @@ def test_ctrl_c_in_a_used_folder_keeps_the_earlier_results(phase, finished, tmp_
 
 
 def test_a_run_that_fails_keeps_the_earlier_results_or_says_where_it_stopped(finished,
-                                                                             tmp_path):
+                                                                             tmp_path, capsys):
     """--wet-steps 1: the equilibrium after wetting is not reached (exit 2, one line)."""
     out = tmp_path / "run"
     shutil.copytree(finished, out)
     before = outputs(out)
     failing = TINY + WET + ["--wet-steps", "1"]
-    done = script(failing + ["--out", str(out)], cwd=tmp_path)
-    said, error = done.stderr.strip().splitlines()
+    status, err = command(failing + ["--out", str(out)], capsys)
+    said, error = err.strip().splitlines()
     assert said.endswith("holds the results of an earlier run; this run replaces them when it "
                          "ends (they stay if it fails)")
-    refused(done.returncode, error, "equilibrium after wetting", "--wet-steps")
+    refused(status, error, "equilibrium after wetting", "--wet-steps")
     assert outputs(out) == before and not (out / ".pendular-earlier").exists()
     fresh = tmp_path / "fresh"
-    done = script(failing + ["--out", str(fresh)], cwd=tmp_path)
-    assert done.returncode == 2, done.stderr
+    status, err = command(failing + ["--out", str(fresh)], capsys)
+    assert status == 2, err
     summary = json.loads((fresh / "summary.json").read_text())
     assert summary["completed"] is False and summary["phase"] == "wet"
     assert "equilibrium after wetting" in summary["error"]
@@ -457,16 +458,16 @@ def test_records_whose_wall_and_love_weber_stresses_drift_apart_are_flagged():
     assert summary["stress_balance_bound"] == STRESS_BALANCE_BOUND < 0.1
 
 
-def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path):
+def test_a_forced_fast_shear_is_flagged_in_its_summary(tmp_path, capsys):
     out = tmp_path / "out"
     argv = ["--particles", "60", "--max-strain", "0.01", "--inertial-number", "0.05", "--force",
             "--vtk-frames", "0", "--quiet", "--out", str(out)]
-    result = script(argv, tmp_path)
-    assert result.returncode == 0, result.stderr
+    status, err = command(argv, capsys)
+    assert status == 0, err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["stress_balance_error"] > summary["stress_balance_bound"]
     assert summary["stress_balance_flagged"]
-    assert "not quasi-static" in result.stderr and "Traceback" not in result.stderr
+    assert "not quasi-static" in err and "Traceback" not in err
 
 
 def test_an_interrupt_wrapped_by_numba_is_an_interrupt(capsys, monkeypatch):

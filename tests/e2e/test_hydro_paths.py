@@ -1,6 +1,7 @@
 """Hydro-mechanical paths (issue 14): the SWCC of a sample (drying then wetting), the triaxial at
 constant water content (liquid conserved, suction an output) and the wetting protocols, run as
-a user runs them (scenarios/*.py), and their bad input refused in one line."""
+a user runs them (scenarios/*.py; the runs beside the first of each scenario run its command
+in-process, pendular.cli.run_command), and their bad input refused in one line."""
 
 import json
 import os
@@ -14,15 +15,22 @@ from pendular import read_history
 from pendular.cli import run_command
 from pendular.io.schema import undeclared_keys
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, run_in_process
 
 SMALL = ["--particles", "150", "--quiet"]
-SHEAR = ["--max-strain", "0.03", "--inertial-number", "2e-3", "--vtk-frames", "0"]
+RATE = ["--inertial-number", "2e-3", "--vtk-frames", "0"]
+SHEAR = ["--max-strain", "0.03", *RATE]
 
 
 def scenario(name, *argv):
     subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", name), *argv],
                    check=True, capture_output=True, text=True, timeout=600)
+
+
+def in_process(capsys, name, *argv):
+    """Scenario ``name``'s command run in-process, as the scenario runs it."""
+    status, err = run_in_process(name.removesuffix(".py"), argv, capsys, prog=name)
+    assert status == 0, err
 
 
 @pytest.fixture(scope="module")
@@ -59,10 +67,10 @@ def test_swcc_has_both_branches_and_their_hysteresis(swcc_run):
     assert sorted(set(history["suction"].values)) == [3000.0, 30000.0, 300000.0]
 
 
-def test_swcc_at_contacts_only_has_no_broken_gap_bridges(tmp_path):
+def test_swcc_at_contacts_only_has_no_broken_gap_bridges(tmp_path, capsys):
     """--form-gap 0: every bridge formed at a contact, so the wetting branch differs from the
     drying one only by the contacts the path opened."""
-    scenario("swcc.py", *SMALL, "--suctions", "10000,100000", "--form-gap", "0",
+    in_process(capsys, "swcc.py", *SMALL, "--suctions", "10000,100000", "--form-gap", "0",
              "--out", str(tmp_path))
     result = json.loads((tmp_path / "swcc.json").read_text())
     assert result["bridges_formed_across_gaps"] == 0
@@ -92,11 +100,12 @@ def test_constant_water_content_conserves_the_liquid(water_run):
     assert np.all(np.isfinite(history["suction"].values)) and history["suction"].values.std() > 0
 
 
-def test_wetting_protocols_run_and_report(tmp_path):
+def test_wetting_protocols_run_and_report(tmp_path, capsys):
+    """The wetting before the shear, its steps and wall stresses: a shear to 0.5 %."""
     summaries = {}
     for protocol in ("at-shear", "constant-volume"):
-        scenario("triaxial.py", *SMALL, *SHEAR, "--suction", "30000", "--wetting", protocol,
-                 "--out", str(tmp_path / protocol))
+        in_process(capsys, "triaxial.py", *SMALL, "--max-strain", "0.005", *RATE, "--suction",
+                   "30000", "--wetting", protocol, "--out", str(tmp_path / protocol))
         summaries[protocol] = json.loads((tmp_path / protocol / "summary.json").read_text())
     assert summaries["at-shear"]["wetting_steps"] == 0
     assert summaries["at-shear"]["initial_bridges"] > 0

@@ -10,6 +10,7 @@ import sys
 import pytest
 
 from conftest import assert_drawn, history_of, summary_of
+from pendular.cli import run_command
 
 STEEL = ["--target", "wall", "--contact", "hertz-mindlin", "--radius", "0.01", "--young", "2e11",
          "--poisson", "0.3", "--density", "7800", "--velocity", "1"]
@@ -17,13 +18,19 @@ KEYS = ("max_normal_force", "max_overlap", "contact_duration", "normal_restituti
         "tangential_restitution", "rebound_angular_velocity", "rebound_angle_deg")
 
 
-def impact(tmp_path, *options):
-    """(summary, run folder) of ``pendular impact`` with the steel sphere and ``options``."""
+def impact(tmp_path, *options, capsys=None):
+    """(summary, run folder) of ``pendular impact`` with the steel sphere and ``options``: in
+    its own interpreter, or with ``capsys`` in-process (pendular.cli.run_command)."""
     out = tmp_path / "impact"
-    done = subprocess.run([sys.executable, "-m", "pendular", "impact", *STEEL, *options,
-                           "--quiet", "--out", str(out)],
-                          check=True, capture_output=True, text=True, timeout=300)
-    assert json.loads(done.stdout)["max_overlap"] == summary_of(out)["max_overlap"]
+    argv = [*STEEL, *options, "--quiet", "--out", str(out)]
+    if capsys is None:
+        stdout = subprocess.run([sys.executable, "-m", "pendular", "impact", *argv], check=True,
+                                capture_output=True, text=True, timeout=300).stdout
+    else:
+        capsys.readouterr()
+        assert run_command("impact", argv) == 0
+        stdout = capsys.readouterr().out
+    assert json.loads(stdout)["max_overlap"] == summary_of(out)["max_overlap"]
     return summary_of(out), out
 
 
@@ -45,7 +52,7 @@ def test_a_steel_sphere_on_a_wall_has_hertzs_peak_force_overlap_and_duration(tmp
     assert_drawn(out / "impact.png")
 
 
-def test_a_steel_sphere_rebounds_at_the_restitution_asked(tmp_path):
-    summary, _ = impact(tmp_path, "--restitution", "0.5", "--angle", "30")
+def test_a_steel_sphere_rebounds_at_the_restitution_asked(tmp_path, capsys):
+    summary, _ = impact(tmp_path, "--restitution", "0.5", "--angle", "30", capsys=capsys)
     assert summary["normal_restitution"] == pytest.approx(0.5, abs=0.01)
     assert -1.0 < summary["tangential_restitution"] < 1.0

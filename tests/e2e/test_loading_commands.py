@@ -18,7 +18,8 @@ SMALL = ["--particles", "150", "--confining", "500", "--seed", "2", "--quiet"]
 def oedometer_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("oedometer") / "run"
     subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "oedometer.py"), *SMALL,
-                    "--axial-stress", "5000", "--unload-to", "1000", "--out", str(out)],
+                    "--axial-stress", "5000", "--unload-to", "1000", "--checkpoint-every", "500",
+                    "--out", str(out)],
                    check=True, capture_output=True, text=True, timeout=600)
     return out
 
@@ -110,20 +111,18 @@ def test_true_triaxial_at_constant_mean_stress_holds_both_targets(tmp_path, caps
 
 def test_a_resumed_oedometer_has_the_history_of_an_uninterrupted_one(oedometer_run, tmp_path,
                                                                        capsys):
+    """Stopped and resumed, the run of the module's oedometer (the same options and
+    checkpoints) gives its history."""
     out = tmp_path / "stopped"
     argv = [*SMALL, "--axial-stress", "5000", "--unload-to", "1000", "--out", out,
             "--checkpoint-every", "500"]
-    whole = tmp_path / "whole"
-    status, err = run_in_process("oedometer", [*argv[:-4], "--out", whole,
-                                               "--checkpoint-every", "500"], capsys)
-    assert status == 0, err
-    steps = summary_of(whole)["steps"]
+    steps = summary_of(oedometer_run)["steps"]
     status, _ = run_in_process("oedometer", [*argv, "--stop-after", str(int(0.7 * steps))],
                                capsys)
     assert status == 130 and summary_of(out)["completed"] is False
     status, err = run_in_process("oedometer", ["--resume", out, "--quiet"], capsys)
     assert status == 0, err
-    expected, got = history_of(whole), history_of(out)
+    expected, got = history_of(oedometer_run), history_of(out)
     for name in expected:
         assert np.array_equal(got[name], expected[name], equal_nan=True), name
 

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from conftest import assert_drawn, history_of, summary_of
+from pendular.cli import run_command
 from pendular.homogenize.invariants import deviator_stress
 from pendular.io.columns import HISTORY_COLUMNS
 from pendular.io.schema import undeclared_keys
@@ -56,11 +57,14 @@ def test_a_wet_extension_stops_when_the_axial_walls_leave_the_sample(tmp_path):
     assert_drawn(out / "triaxial.png")
 
 
-def test_a_real_run_reports_its_critical_state_by_the_stated_rule(tmp_path):
+def test_a_real_run_reports_its_critical_state_by_the_stated_rule(tmp_path, capsys):
+    """``pendular triaxial`` run in-process (pendular.cli.run_command; its own interpreter in
+    the test above)."""
     out = tmp_path / "compression"
-    stdout, _ = pendular("triaxial", "--particles", "300", "--max-strain", "0.15",
-                         "--vtk-frames", "0", "--quiet", "--out", out)
-    assert set(CRITICAL_STATE_KEYS) <= set(json.loads(stdout))
+    capsys.readouterr()
+    assert run_command("triaxial", ["--particles", "300", "--max-strain", "0.15",
+                                    "--vtk-frames", "0", "--quiet", "--out", str(out)]) == 0
+    assert set(CRITICAL_STATE_KEYS) <= set(json.loads(capsys.readouterr().out))
     summary, history = summary_of(out), history_of(out)
     expected = critical_state(history["axial_strain"], history["volumetric_strain"],
                               history["sigma_wall"], deviator_stress(history["sigma_wall"]),

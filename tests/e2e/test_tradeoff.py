@@ -14,7 +14,7 @@ import pytest
 from pendular.studies import tradeoff
 from pendular.procedures.config import config_to_dict
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, run_in_process
 
 SCENARIO = os.path.join(ROOT, "scenarios", "tradeoff.py")
 
@@ -245,19 +245,22 @@ def test_seed_rows_read_each_run_against_its_own_samples_reference(tmp_path):
     assert not any(r["within_scatter"] for r in prepared)    # 20 % off, sd 6.7 %
 
 
-def test_a_seed_study_from_the_command_line(tmp_path):
+def test_a_seed_study_from_the_command_line(tmp_path, capsys):
+    """scenarios/tradeoff.py's command run in-process (the quick grid runs the scenario in its
+    own interpreter)."""
     out = tmp_path / "seeds"
-    done = subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--knob",
-                           "timestep_rule", "--seeds", "2", "--particles", "200",
-                           "--max-strain", "0.01"], capture_output=True, text=True, timeout=900)
-    assert done.returncode == 0, done.stderr
+    status, err = run_in_process("tradeoff", ["--out", out, "--knob", "timestep_rule",
+                                              "--seeds", "2", "--particles", "60",
+                                              "--max-strain", "0.005"], capsys,
+                                 prog="tradeoff.py")
+    assert status == 0, err
     data = json.loads((out / "seeds_timestep_rule.json").read_text())
     assert len(data["runs"]) == 2 * 4 and len(data["rows"]) == 3
     for row in data["rows"]:
         assert 0.3 < row["porosity"] < 0.5 and row["cpu_time_s"] > 0
     text = (out / "seeds_timestep_rule.md").read_text()
     assert "Scatter between samples" in text and "prepared with it" in text
-    refused = subprocess.run([sys.executable, SCENARIO, "--out", str(out), "--seeds", "3"],
-                             capture_output=True, text=True, timeout=300)
-    assert refused.returncode != 0
-    assert "error: --seeds" in refused.stderr.strip().splitlines()[-1]
+    status, err = run_in_process("tradeoff", ["--out", out, "--seeds", "3"], capsys,
+                                 prog="tradeoff.py")
+    assert status != 0
+    assert "error: --seeds" in err.strip().splitlines()[-1]

@@ -16,7 +16,7 @@ from pendular.homogenize import contact_stress
 from pendular.procedures.config import ShearConfig
 from pendular.procedures.triaxial import TriaxialShear, summarize
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, run_in_process
 
 
 
@@ -141,9 +141,10 @@ def test_triaxial_scenario_writes_its_outputs(tmp_path):
     (["--suction", "-5"], "suction"),
     (["--bogus"], "unrecognized arguments"),
 ])
-def test_triaxial_scenario_refuses_bad_input(arguments, message):
-    command = [sys.executable, os.path.join(ROOT, "scenarios", "triaxial.py"), *arguments,
-               "--out", os.devnull]
-    result = subprocess.run(command, capture_output=True, text=True)
-    assert result.returncode != 0
-    assert message in result.stderr
+def test_triaxial_scenario_refuses_bad_input(arguments, message, capsys):
+    """scenarios/triaxial.py's command, run in-process (its own interpreter in
+    test_triaxial_scenario_writes_its_outputs)."""
+    status, err = run_in_process("triaxial", [*arguments, "--out", os.devnull], capsys,
+                                 prog="triaxial.py")
+    assert status != 0
+    assert message in err

@@ -1,4 +1,6 @@
-"""Outputs of the triaxial scenario: ParaView series, plots, checkpoints and --resume."""
+"""Outputs of the triaxial scenario: ParaView series, plots, checkpoints and --resume. The
+uninterrupted runs go through scenarios/triaxial.py; the stopped and resumed ones run its
+command in-process (the same pendular.cli.run_command, without a new interpreter)."""
 
 import json
 import os
@@ -11,7 +13,7 @@ import meshio
 import numpy as np
 import pytest
 
-from conftest import ROOT, assert_drawn
+from conftest import ROOT, assert_drawn, run_in_process
 
 SCENARIO = os.path.join(ROOT, "scenarios", "triaxial.py")
 PARTICLES = 150
@@ -23,6 +25,11 @@ KINDS = {"dry": [], "wet": ["--suction", "30000"]}
 def triaxial(*arguments, check=True):
     return subprocess.run([sys.executable, SCENARIO, *arguments], capture_output=True,
                           text=True, check=check)
+
+
+def in_process(capsys, *arguments):
+    """(exit status, stderr) of scenarios/triaxial.py's command run in-process."""
+    return run_in_process("triaxial", arguments, capsys, prog="triaxial.py")
 
 
 @pytest.fixture(scope="module", params=sorted(KINDS))
@@ -99,18 +106,18 @@ def test_plots_are_written(finished):
     assert_drawn(out / "triaxial.png")
 
 
-def test_resumed_run_has_the_history_of_an_uninterrupted_one(finished, tmp_path):
+def test_resumed_run_has_the_history_of_an_uninterrupted_one(finished, tmp_path, capsys):
     kind, out = finished
     run = tmp_path / "interrupted"
-    stopped = triaxial(*BASE, *KINDS[kind], "--out", str(run), "--stop-after", "237",
-                       check=False)
-    assert stopped.returncode == 130, stopped.stderr
+    status, err = in_process(capsys, *BASE, *KINDS[kind], "--out", run, "--stop-after", "237")
+    assert status == 130, err
     assert (run / "checkpoint.h5").exists()
     partial = json.loads((run / "summary.json").read_text())     # what was sheared is kept
     assert partial["completed"] is False
     with h5py.File(run / "history.h5") as handle:
         assert 0 < len(handle["history"]["step"]) < 500       # fewer rows than the full run
-    triaxial("--resume", str(run), "--quiet")
+    status, err = in_process(capsys, "--resume", run, "--quiet")
+    assert status == 0, err
     with h5py.File(out / "history.h5") as whole, h5py.File(run / "history.h5") as resumed:
         expected, got = whole["history"], resumed["history"]
         assert set(got) == set(expected)
@@ -131,15 +138,17 @@ def test_resume_refuses_new_arguments_and_runs_without_checkpoint(tmp_path):
     assert missing.returncode != 0 and "sample.h5" in missing.stderr
 
 
-def test_a_run_at_a_water_content_resumes_with_its_liquid_account(tmp_path):
+def test_a_run_at_a_water_content_resumes_with_its_liquid_account(tmp_path, capsys):
     """The closed liquid (--water-content, shared at rupture) comes back from the checkpoint:
     the resumed history has the uninterrupted one's liquid columns, to the bit."""
     argv = [*BASE, "--water-content", "1", "--rupture-liquid", "shared"]
     whole, run = tmp_path / "whole", tmp_path / "interrupted"
-    triaxial(*argv, "--out", str(whole))
-    stopped = triaxial(*argv, "--out", str(run), "--stop-after", "237", check=False)
-    assert stopped.returncode == 130, stopped.stderr
-    triaxial("--resume", str(run), "--quiet")
+    status, err = in_process(capsys, *argv, "--out", whole)
+    assert status == 0, err
+    status, err = in_process(capsys, *argv, "--out", run, "--stop-after", "237")
+    assert status == 130, err
+    status, err = in_process(capsys, "--resume", run, "--quiet")
+    assert status == 0, err
     with h5py.File(whole / "history.h5") as full, h5py.File(run / "history.h5") as resumed:
         expected, got = full["history"], resumed["history"]
         assert {"liquid_bridges", "liquid_film", "liquid_lost"} <= set(got) == set(expected)

@@ -10,6 +10,7 @@ import os
 import numpy as np
 import pytest
 
+from pendular.cli import run_command
 from pendular.homogenize.invariants import deviator_stress, mean_stress
 from pendular.io.schema import undeclared_keys
 
@@ -20,12 +21,18 @@ SMALL = ["--particles", "60", "--confining", "750", "--seed", "1", "--quiet", "-
 SHEAR = ["--drainage", "undrained", "--max-strain", "0.01", "--inertial-number", "2e-3"]
 
 
-@pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])
-def test_an_undrained_triaxial_holds_its_volume_and_gives_the_excess_pore_pressure(
-        wet, tmp_path, capsys):
-    out = tmp_path / "undrained"
-    status, err = run_in_process("triaxial", [*SMALL, *SHEAR, *wet, "--out", out], capsys)
-    assert status == 0, err
+@pytest.fixture(scope="module", params=[[], ["--suction", "30000"]], ids=["dry", "wet"])
+def undrained(request, tmp_path_factory):
+    """(wetting options, all options, folder) of an undrained shear with checkpoints: the
+    uninterrupted run the resume test stops and resumes."""
+    options = [*SMALL, *SHEAR, *request.param, "--checkpoint-every", "200"]
+    out = tmp_path_factory.mktemp("undrained") / "whole"
+    assert run_command("triaxial", [*options, "--out", str(out)]) == 0
+    return request.param, options, out
+
+
+def test_an_undrained_triaxial_holds_its_volume_and_gives_the_excess_pore_pressure(undrained):
+    wet, _, out = undrained
     history, summary = history_of(out), summary_of(out)
     assert np.abs(history["volumetric_strain"]).max() < 1e-6
     assert summary["max_volume_change"] < 1e-6 and summary["drainage"] == "undrained"
@@ -149,12 +156,10 @@ def test_the_shipped_collapse_table_runs_and_gives_the_strain_of_its_wetting(tmp
     assert axial == pytest.approx([10000.0] * 3, rel=0.01)
 
 
-@pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])
-def test_an_interrupted_undrained_shear_resumes_to_the_same_history(wet, tmp_path, capsys):
-    options = [*SMALL, *SHEAR, *wet, "--checkpoint-every", "200"]
-    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
-    status, err = run_in_process("triaxial", [*options, "--out", whole], capsys)
-    assert status == 0, err
+def test_an_interrupted_undrained_shear_resumes_to_the_same_history(undrained, tmp_path,
+                                                                     capsys):
+    _, options, whole = undrained
+    stopped = tmp_path / "stopped"
     steps = summary_of(whole)["steps"]
     status, _ = run_in_process("triaxial", [*options, "--out", stopped,
                                             "--stop-after", str(steps // 2)], capsys)
