@@ -237,5 +237,6 @@ def verify(path, expected_identity=None, kind="sample"):
         if differences:
             what = "; ".join(differences)
             raise ValueError(f"path = {path!r}: identity mismatch: {what}: this {kind} was made "
-                             "by another run or configuration")
+                             "by another run or configuration (or by a pendular whose "
+                             "configurations had other fields)")
     return identity
