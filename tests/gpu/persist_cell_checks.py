@@ -10,10 +10,12 @@ from persist_checks import bridge_events, compare, snapshot as persist_snapshot
 from shear_checks import scene as shear_scene
 from simulator import relative, run_checks
 
-#: Steps of each comparison; (suction [Pa], steps) of the suction path's later stages
-#: ("suction": a higher suction in the same device run, a lower one, which reaches farther,
-#: in a new one).
-STEPS = 300
+#: Steps of each control's comparison (the volume-controlled bridges' third rupture across a
+#: gap comes after 260 steps, the sheared cell's shear strain passes 0.4 after 260; the
+#: suction path's later stages add their own events); (suction [Pa], steps) of the suction
+#: path's later stages ("suction": a higher suction in the same device run, a lower one,
+#: which reaches farther, in a new one).
+STEPS = {"suction": 100, "volume": 300, "sheared": 300}
 PATH = ((90000.0, 100), (10000.0, 80))
 #: The periodic tension's water content [-] (its bridges' reach fits the 64 spheres' cell)
 #: and steps of its wetting's settling (the tension's WET_STEPS, a bound on its run).
@@ -55,17 +57,18 @@ def snapshot(sim, bridges):
 
 
 def agreement(control):
-    """STEPS steps of the scene with bridges of ``control`` on the CPU (one at a time, counting
-    the bridges' events) and on the GPU, compared, then ("suction") each stage of PATH; the
-    CPU's and the GPU's rebuilds, the particles wrapped through the faces (per axis), the
-    axial and shear strains and the bridges held through a face, at the end of each stage."""
+    """STEPS[control] steps of the scene with bridges of ``control`` on the CPU (one at a
+    time, counting the bridges' events) and on the GPU, compared, then ("suction") each stage
+    of PATH; the CPU's and the GPU's rebuilds, the particles wrapped through the faces (per
+    axis), the axial and shear strains and the bridges held through a face, at the end of
+    each stage."""
     from pendular.gpu import GpuSimulation
 
     cpu, cpu_bridges = scene(control)
     gpu_sim, gpu_bridges = scene(control)
     gpu = GpuSimulation(gpu_sim)
     out = {"stages": [], "events": [0, 0, 0]}
-    stages = ((None, STEPS), *(PATH if control == "suction" else ()))
+    stages = ((None, STEPS[control]), *(PATH if control == "suction" else ()))
     for stage, (suction, steps) in enumerate(stages):
         if suction is not None:
             cpu_bridges.set_suction(suction)
