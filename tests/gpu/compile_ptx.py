@@ -72,8 +72,19 @@ def signature(arguments):
 
 def compile_step_kernels(cuda, capability):
     """{kernel (and " wet"): PTX lines} of every kernel of a dry and a wet step, and of the
-    homogenisation at a record step (pendular.gpu.homogenize)."""
+    homogenisation at a record step (pendular.gpu.homogenize). A kernel reached again with
+    the same argument types (a dry and a wet step's leapfrog) is compiled once."""
     import numba.cuda.dispatcher as dispatcher
+
+    lines = {}
+
+    def ptx_lines(kernel, args):
+        """The lines of ``kernel``'s PTX for the types of ``args``."""
+        key = (kernel.py_func, signature(args))
+        if key not in lines:
+            ptx, _ = cuda.compile_ptx(kernel.py_func, key[1], cc=capability)
+            lines[key] = ptx.count("\n")
+        return lines[key]
 
     dispatcher.get_current_device = lambda: types.SimpleNamespace(
         compute_capability=capability)
@@ -90,8 +101,8 @@ def compile_step_kernels(cuda, capability):
         # wet, the bridges' refresh at a new suction (a suction path, between runs)
         refresh = (gpu.bridges.refresh_step(gpu.state),) if wet else ()
         for kernel, _, args in (*gpu.steps, *reduction, *refresh):
-            ptx, _ = cuda.compile_ptx(kernel.py_func, signature(args), cc=capability)
-            compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx.count("\n")
+            compiled[f"{kernel.py_func.__name__}{' wet' if wet else ''}"] = ptx_lines(kernel,
+                                                                                  args)
     # the kernels a radius growth adds to a dry step (growth_checks.py's scene), those of a
     # dry and a wet step in a periodic cell (periodic_checks.py's), of a simple shear
     # (shear_checks.py's), the grips' (grips_checks.py's), volume-controlled bridges'
@@ -118,8 +129,7 @@ def compile_step_kernels(cuda, capability):
         for kernel, _, args in gpu.steps:
             name = kernel.py_func.__name__
             if name not in compiled and f"{name}{label}" not in compiled:
-                ptx, _ = cuda.compile_ptx(kernel.py_func, signature(args), cc=capability)
-                compiled[f"{name}{label}"] = ptx.count("\n")
+                compiled[f"{name}{label}"] = ptx_lines(kernel, args)
     return compiled
 
 

@@ -55,7 +55,8 @@ def widen_menisci(gpu, filling_angle):
 
 
 def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
-    """{quantity: relative difference device vs CPU}, {quantity: equal bit for bit}, the
+    """After ``steps`` steps of the scene (all but the last on the CPU, the last on the device):
+    {quantity: relative difference device vs CPU}, {quantity: equal bit for bit}, the
     device's counts, the copies back during the device's homogenisation (device_homogenization,
     then GpuSimulation.homogenized, which must repeat it bit for bit: the same result for the
     same step, a new one a step later), whether the state was still held by the device after
@@ -86,8 +87,10 @@ def measure(wet, chunk, filling_angle=None, cell=None, steps=STEPS):
 
     cells = {"periodic": periodic_scene, "sheared": sheared_scene,
              "persist": lambda wet: persist_scene()[0], "volume": lambda wet: volume_scene()[0]}
-    gpu = GpuSimulation(cells[cell](wet) if cell else scene(wet=wet, side=SIDE))
-    gpu.run(steps)
+    sim = cells[cell](wet) if cell else scene(wet=wet, side=SIDE)
+    sim.run(steps - 1)          # the scene's motion on the CPU (the simulator is slow) ...
+    gpu = GpuSimulation(sim)
+    gpu.run(1)                  # ... its last step on the device, which holds the state
     if filling_angle is not None:
         widen_menisci(gpu, filling_angle)
     GpuSimulation.copy_back = counted

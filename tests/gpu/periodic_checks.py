@@ -19,9 +19,10 @@ RADIUS = 1e-3
 YOUNG = 1e7
 SIDE = 4
 SPACING = 1.95 * RADIUS
-#: Steps of the dry and the wet comparison, and of the GPU part of a run the CPU continues.
-STEPS = {"dry": 300, "wet": 200}
-HANDOVER = 150
+#: Steps of the dry and the wet comparison (seven rebuilds, particles wrapped through each
+#: face), and of the GPU part of a run the CPU continues (several rebuilds on the device).
+STEPS = {"dry": 100, "wet": 100}
+HANDOVER = 50
 CONTINUED = 100
 
 

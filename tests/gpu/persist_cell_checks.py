@@ -10,15 +10,20 @@ from persist_checks import bridge_events, compare, snapshot as persist_snapshot
 from shear_checks import scene as shear_scene
 from simulator import relative, run_checks
 
-#: Steps of each comparison; (suction [Pa], steps) of the suction path's later stages
-#: ("suction": a higher suction in the same device run, a lower one, which reaches farther,
-#: in a new one).
-STEPS = 300
+#: Steps of each control's comparison (the volume-controlled bridges' third rupture across a
+#: gap comes after 260 steps, the sheared cell's shear strain passes 0.4 after 260; the
+#: suction path's later stages add their own events); (suction [Pa], steps) of the suction
+#: path's later stages ("suction": a higher suction in the same device run, a lower one,
+#: which reaches farther, in a new one).
+STEPS = {"suction": 100, "volume": 300, "sheared": 300}
 PATH = ((90000.0, 100), (10000.0, 80))
-#: The periodic tension's water content [-] (its bridges' reach fits the 64 spheres' cell)
-#: and steps of its wetting's settling (the tension's WET_STEPS, a bound on its run).
+#: The periodic tension's water content [-] (its bridges' reach fits the 64 spheres' cell),
+#: steps of its wetting's settling (the tension's WET_STEPS, a bound on its run: each of the
+#: wetting's two tries reaches it) and its pull's extension [-] (bridges rupture from about
+#: a third of it on).
 WATER_CONTENT = 0.005
-WET_STEPS = 200
+WET_STEPS = 100
+PULL_STRAIN = 0.005
 
 
 def pulled_apart(length):
@@ -55,17 +60,18 @@ def snapshot(sim, bridges):
 
 
 def agreement(control):
-    """STEPS steps of the scene with bridges of ``control`` on the CPU (one at a time, counting
-    the bridges' events) and on the GPU, compared, then ("suction") each stage of PATH; the
-    CPU's and the GPU's rebuilds, the particles wrapped through the faces (per axis), the
-    axial and shear strains and the bridges held through a face, at the end of each stage."""
+    """STEPS[control] steps of the scene with bridges of ``control`` on the CPU (one at a
+    time, counting the bridges' events) and on the GPU, compared, then ("suction") each stage
+    of PATH; the CPU's and the GPU's rebuilds, the particles wrapped through the faces (per
+    axis), the axial and shear strains and the bridges held through a face, at the end of
+    each stage."""
     from pendular.gpu import GpuSimulation
 
     cpu, cpu_bridges = scene(control)
     gpu_sim, gpu_bridges = scene(control)
     gpu = GpuSimulation(gpu_sim)
     out = {"stages": [], "events": [0, 0, 0]}
-    stages = ((None, STEPS), *(PATH if control == "suction" else ()))
+    stages = ((None, STEPS[control]), *(PATH if control == "suction" else ()))
     for stage, (suction, steps) in enumerate(stages):
         if suction is not None:
             cpu_bridges.set_suction(suction)
@@ -98,7 +104,8 @@ def wetted_and_pulled(device, folder):
     """(wetting report, wetted positions unwrapped, pull steps, history) of the periodic
     tension's phases on ``device``: the scene dry under a stress servo at 10 kPa, wetted to a
     water content of 0.5 % (volume-controlled bridges at contacts and across gaps, WET_STEPS
-    steps of settling), then pulled along z (the cell stretched, x and y servoed at zero) 1 %."""
+    steps of settling), then pulled along z (the cell stretched, x and y servoed at zero) by
+    PULL_STRAIN."""
     from dataclasses import replace
 
     from pendular.dem.walls import StressServo
@@ -114,7 +121,7 @@ def wetted_and_pulled(device, folder):
     sample = replace(tension_sample(), radius=RADIUS, density=2650.0, confining=1e4,
                      periodic=True)
     config = TensionConfig(sample=sample, cases=[(0.7, WATER_CONTENT)], inertial_number=1e-2,
-                           max_strain=0.01, vtk_frames=0)
+                           max_strain=PULL_STRAIN, vtk_frames=0)
     sim, bridges, report = tension_pull.wet(dry, config, WATER_CONTENT, progress=False)
     position = sim.walls.unwrapped(sim.particles)
     steps, history = tension_pull.Pull(sim, bridges, config, folder, progress=False).run(None)

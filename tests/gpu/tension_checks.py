@@ -7,8 +7,11 @@ import numpy as np
 
 from simulator import counted_copies, relative, run_checks
 
-#: Steps of the wetting's settling (the tension's WET_STEPS, a bound on its run).
-WET_STEPS = 200
+#: Steps of the wetting's settling (the tension's WET_STEPS, a bound on its run: the wetting
+#: takes one try at the CPU's formation suction within it), and the pull's extension [-]
+#: (contacts opening all along it).
+WET_STEPS = 100
+PULL_STRAIN = 0.005
 
 
 def wetted_and_pulled(device, folder):
@@ -29,7 +32,7 @@ def wetted_and_pulled(device, folder):
     dry.device = device
     sample = replace(tension_sample(), radius=RADIUS, density=2650.0, confining=1e4)
     config = TensionConfig(sample=sample, cases=[(0.7, 0.01)], inertial_number=1e-2,
-                           max_strain=0.01, grip_depth=0.1, vtk_frames=0)
+                           max_strain=PULL_STRAIN, grip_depth=0.1, vtk_frames=0)
     sim, bridges, report = tension_pull.wet(dry, config, 0.01, progress=False)
     position = sim.particles.position.copy()
     with counted_copies() as copies:

@@ -3,7 +3,8 @@ same state, under Numba's CUDA simulator: the 64-sphere walled scene of tests/gp
 the 64-sphere periodic cell of tests/gpu/periodic_checks.py (pairs through the faces:
 branch vectors with their images, the cell's volume, no walls), dry and wet
 at 30 kPa (exact bridges at contact), and wet the sheared cell of tests/gpu/shear_checks.py
-(Lees–Edwards: the images through the z faces offset along x), after 30 steps on the device.
+(Lees–Edwards: the images through the z faces offset along x), after 30 steps, the last on the
+device (the others on the CPU: the simulator runs a step slowly).
 The device's quantities are computed from the state it holds, which then comes back for the
 CPU's (pendular.homogenize.contact_stress, pendular.dem.measure,
 pendular.homogenize.on_the_fly, pendular.dem.measure.largest_overlap).

@@ -8,7 +8,7 @@ Checked under Numba's CUDA simulator in a process of its own (tests/gpu/tension_
 from tests/gpu/simulated.py's 27 spheres (dry, slightly
 overlapping, servoed at 10 kPa) standing for a prepared sample (a whole preparation is out of
 the simulator's reach): ``wet`` at w = 1 % (WET_STEPS steps of settling), then ``Pull`` (one
-grip layer at each z wall, 1 % of extension, a record every step).
+grip layer at each z wall, PULL_STRAIN of extension, a record every step).
 
 The wetting's formation suction, water content and saturation equal the CPU's, the pull's
 rows and counts too, its columns within round-off (docs/gpu.md). Each record brings back the
