@@ -351,7 +351,7 @@ def test_periodic_direct_tension_pulls_the_cell(tmp_path):
     from pendular.cli import main
 
     out = tmp_path / "tension"
-    assert main(["tension", "--periodic", "--particles", "300", "--void-ratio", "0.58",
+    assert main(["tension", "--periodic", "--particles", "150", "--void-ratio", "0.58",
                  "--water-content", "1.04", "--vtk-frames", "0", "--quiet",
                  "--out", str(out)]) == 0
     case = json.loads((out / "tension.json").read_text())["cases"][0]
