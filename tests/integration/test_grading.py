@@ -151,12 +151,20 @@ def test_a_graded_wet_triaxial_reports_its_grading(tmp_path):
     assert summary["saturation_at_peak"] > 0.0
 
 
-def test_a_sample_of_another_spread_is_refused_naming_the_sizes(tmp_path, capsys):
-    out = tmp_path / "graded"
+@pytest.fixture(scope="module")
+def graded_run(tmp_path_factory):
+    """Output folder of a short triaxial of 120 spheres of radius spread 0.3 (seed 3), whose
+    sample.h5 the tests below load; made once for the module, read only."""
+    out = tmp_path_factory.mktemp("graded") / "graded"
     assert run_command("triaxial", ["--particles", "120", "--radius-spread", "0.3",
-                                    "--max-strain", "0.002", "--inertial-number", "2e-3",
-                                    "--vtk-frames", "0", "--quiet", "--out", str(out)]) == 0
-    sample = str(out / "sample.h5")
+                                    "--seed", "3", "--max-strain", "0.002",
+                                    "--inertial-number", "2e-3", "--vtk-frames", "0",
+                                    "--quiet", "--out", str(out)]) == 0
+    return out
+
+
+def test_a_sample_of_another_spread_is_refused_naming_the_sizes(graded_run, tmp_path, capsys):
+    sample = str(graded_run / "sample.h5")
     again = ["--particles", "120", "--max-strain", "0.002", "--inertial-number", "2e-3",
              "--vtk-frames", "0", "--quiet", "--sample", sample]
     assert run_command("triaxial", again + ["--radius-spread", "0.3",
@@ -166,15 +174,11 @@ def test_a_sample_of_another_spread_is_refused_naming_the_sizes(tmp_path, capsys
             "radius_spread = 0.2", sample.rsplit("/", 1)[0])
 
 
-def test_a_sample_gives_its_count_and_sizes_and_refuses_only_a_contradiction(tmp_path,
-                                                                             capsys):
+def test_a_sample_gives_its_count_and_sizes_and_refuses_only_a_contradiction(graded_run,
+                                                                             tmp_path, capsys):
     """--sample takes the particle count and the radii from the sample (no --particles
     repeated, on the command line or in the API); a count that contradicts it is refused."""
-    out = tmp_path / "graded"
-    assert run_command("triaxial", ["--particles", "120", "--radius-spread", "0.3",
-                                    "--seed", "3", "--max-strain", "0.002",
-                                    "--inertial-number", "2e-3", "--vtk-frames", "0",
-                                    "--quiet", "--out", str(out)]) == 0
+    out = graded_run
     sample = str(out / "sample.h5")
     loaded = tmp_path / "loaded"
     assert run_command("triaxial", ["--sample", sample, "--max-strain", "0.002",

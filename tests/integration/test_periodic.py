@@ -201,15 +201,22 @@ def _periodic_prep(threads):
     numba.set_num_threads(threads)
     sim, report = prepare_sample(config, progress=False, threads=threads)
     sim.run(500)
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     return sim, report
 
 
+@pytest.fixture(scope="module")
+def periodic_prep():
+    """The periodic 150-sphere preparation on one thread (its simulation and report), made
+    once for the module; a test that changes the simulation takes a deep copy."""
+    return _periodic_prep(1)
+
+
 @requires("threads")
-def test_a_periodic_preparation_is_deterministic_and_thread_independent():
-    one, report = _periodic_prep(1)
+def test_a_periodic_preparation_is_deterministic_and_thread_independent(periodic_prep):
+    one, report = periodic_prep
     two, _ = _periodic_prep(2)
     again, _ = _periodic_prep(1)
-    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     for other in (two, again):
         np.testing.assert_array_equal(other.particles.position, one.particles.position)
         np.testing.assert_array_equal(other.walls.position, one.walls.position)
@@ -218,13 +225,14 @@ def test_a_periodic_preparation_is_deterministic_and_thread_independent():
 
 
 @pytest.mark.parametrize("persist", [False, True])
-def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persist):
+def test_the_cell_stress_gathered_with_the_forces_is_the_pair_by_pair_sum(persist,
+                                                                         periodic_prep):
     """The Love–Weber sum that the contact and bridge gathers add up (each particle's position
     times its resultant, plus the pairs through a face, pendular.dem.virial) is the sum of pair_virial
     (every pair's branch vector times its force) on a static packing and on one whose
     particles are off balance, with bridges at contacts and across gaps, on 1 and 2 threads
     alike."""
-    sim, _ = _periodic_prep(1)
+    sim = copy.deepcopy(periodic_prep[0])
     bridges = CapillaryBridges(3000.0, persist=persist)
     sim.forces.append(bridges)
     for shaken in (False, True):
@@ -264,10 +272,10 @@ class _NoForce:
         pass
 
 
-def test_a_force_that_is_not_a_pair_force_sends_the_cell_stress_pair_by_pair():
+def test_a_force_that_is_not_a_pair_force_sends_the_cell_stress_pair_by_pair(periodic_prep):
     """With a force that has no pair_forces among the scene's (its gather adds no virial), the
     cell sums pair by pair, and gets the same stress here as from the gathers."""
-    sim, _ = _periodic_prep(1)
+    sim = copy.deepcopy(periodic_prep[0])
     gathered = copy.deepcopy(sim)       # the same state each time (the shear springs move on)
     gathered.evaluate_forces()
     sim.forces.append(_NoForce())
@@ -276,8 +284,8 @@ def test_a_force_that_is_not_a_pair_force_sends_the_cell_stress_pair_by_pair():
                                atol=1e-9 * np.abs(gathered.walls.stress_tensor).max())
 
 
-def test_a_periodic_sample_round_trips_and_is_refused_for_walls(tmp_path):
-    sim, _ = _periodic_prep(1)
+def test_a_periodic_sample_round_trips_and_is_refused_for_walls(tmp_path, periodic_prep):
+    sim, _ = periodic_prep
     path = tmp_path / "sample.h5"
     save_sample(path, sim)
     particles, cell, _, _ = load_sample(path, expected={"periodic": True})
@@ -343,7 +351,7 @@ def test_periodic_direct_tension_pulls_the_cell(tmp_path):
     from pendular.cli import main
 
     out = tmp_path / "tension"
-    assert main(["tension", "--periodic", "--particles", "300", "--void-ratio", "0.58",
+    assert main(["tension", "--periodic", "--particles", "150", "--void-ratio", "0.58",
                  "--water-content", "1.04", "--vtk-frames", "0", "--quiet",
                  "--out", str(out)]) == 0
     case = json.loads((out / "tension.json").read_text())["cases"][0]

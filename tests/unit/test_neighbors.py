@@ -201,11 +201,11 @@ def test_spatial_order_walks_the_cells_along_the_z_curve():
     assert spatial_order(twice, RADIUS).tolist()[:4] == [7, 15, 6, 14]
 
 
-def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory():
+def test_a_prepared_sample_is_numbered_near_neighbours_near_in_memory(small_sample):
     """The preparation numbers particles along the curve: the pairs' mean index distance is
-    under 40 % of the same packing's numbered at random."""
-    config = PrepareConfig(particles=1000, confining=750.0)
-    sim, _ = prepare_sample(config, progress=False)
+    under 40 % of the same packing's numbered at random (the 300-sphere sample shared with
+    other tests)."""
+    _, sim, _ = small_sample
     i, j = sim.contacts.pair_i, sim.contacts.pair_j
     shuffled = np.random.default_rng(0).permutation(len(sim.particles))
     assert np.mean(np.abs(j - i)) < 0.4 * np.mean(np.abs(shuffled[j] - shuffled[i]))
@@ -237,12 +237,11 @@ def test_a_contact_lost_on_a_rebuild_step_forgets_its_shear_spring():
 
 
 @pytest.mark.parametrize("suction", [0.0, 30000.0])
-def test_a_shear_does_not_depend_on_the_skin(suction):
+def test_a_shear_does_not_depend_on_the_skin(suction, small_sample):
     """The skin only decides when the list is rebuilt: contacts open and close (and bridges
     form and break) on rebuild steps as on any other, so a shear with a thin and a thick skin
-    is the same to the bit, dry or wet."""
-    config = PrepareConfig(particles=300, confining=750.0)
-    sample, _ = prepare_sample(config, progress=False)
+    is the same to the bit, dry or wet (of the 300-sphere sample shared with other tests)."""
+    config, sample, _ = small_sample
     runs = []
     for skin_factor in (0.05, 0.6):
         sim = servoed_simulation(copy.deepcopy(sample.particles), copy.deepcopy(sample.walls),

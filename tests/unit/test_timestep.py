@@ -45,12 +45,11 @@ def exact_critical_step(sim, young=YOUNG, shear_ratio=SHEAR_RATIO):
         n = branch / distance
         kn = normal_stiffness(young, p.radius[i], p.radius[j])
         spring = kn * np.outer(n, n) + shear_ratio * kn * (np.eye(3) - np.outer(n, n))
-        arm = np.zeros((3, 6 * count))
-        arm[:, 6 * i:6 * i + 3] = -np.eye(3)
-        arm[:, 6 * i + 3:6 * i + 6] = p.radius[i] * _skew(n)
-        arm[:, 6 * j:6 * j + 3] = np.eye(3)
-        arm[:, 6 * j + 3:6 * j + 6] = p.radius[j] * _skew(n)
-        stiffness += arm.T @ spring @ arm
+        # the arm's columns of particles i and j (its only nonzero ones): the pair adds its
+        # 12 x 12 block arm^T spring arm there
+        arm = np.hstack([-np.eye(3), p.radius[i] * _skew(n), np.eye(3), p.radius[j] * _skew(n)])
+        block = np.r_[6 * i:6 * i + 6, 6 * j:6 * j + 6]
+        stiffness[np.ix_(block, block)] += arm.T @ spring @ arm
     if not sim.walls.periodic:
         faces = sim.walls.position
         for q in range(count):
@@ -60,7 +59,8 @@ def exact_critical_step(sim, young=YOUNG, shear_ratio=SHEAR_RATIO):
                 stiffness[6 * q + a, 6 * q + a] += touching * young * p.radius[q]
     scale = 1.0 / np.sqrt(np.repeat(np.stack([p.mass] * 3 + [p.inertia] * 3, axis=1), 1))
     scale = scale.ravel()
-    largest = scipy.linalg.eigvalsh(scale[:, None] * stiffness * scale[None, :])[-1]
+    largest = scipy.linalg.eigvalsh(scale[:, None] * stiffness * scale[None, :],
+                                    subset_by_index=[6 * count - 1, 6 * count - 1])[0]
     return 2.0 / np.sqrt(largest)
 
 
