@@ -12,6 +12,13 @@ import shutil
 import subprocess
 import sys
 
+# Before numpy and Numba load: idle OpenMP threads (Numba's threading layer) sleep instead of
+# spinning, and BLAS runs on one thread; otherwise the parallel workers' waiting threads take
+# the cores from one another. The results are the same bit for bit; the tests' processes
+# inherit both.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import h5py
 import numba
 import numpy as np
