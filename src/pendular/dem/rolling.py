@@ -53,6 +53,18 @@ FIELDS = (
 
 
 @numba.njit(cache=True, inline="always")
+def capped_moment(m0, m1, m2, limit):
+    """The rolling spring (m0, m1, m2) [N m] held to its limit moment ``limit`` [N m] (Ai et
+    al. 2011, type C: scaled back onto the limit, keeping its direction), and whether it was
+    (the contact rolls plastically, its dashpot off)."""
+    size = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    if size > limit:
+        scale = limit / size
+        return m0 * scale, m1 * scale, m2 * scale, True
+    return m0, m1, m2, False
+
+
+@numba.njit(cache=True, inline="always")
 def _turned(m0, m1, m2, a0, a1, a2):
     """m - m x a: the vector m turned by the small rotation a [rad] (as the shear force,
     pendular.dem.contact_law._evaluate_pair)."""
@@ -103,15 +115,9 @@ def _pair_moment(k, i, j, radius, mass, inertia, angular_velocity, normal, overl
     m0 -= along * n0 + stiffness * w0 * dt
     m1 -= along * n1 + stiffness * w1 * dt
     m2 -= along * n2 + stiffness * w2 * dt
-    limit = rolling * reduced * fn
-    size = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    m0, m1, m2, sliding = capped_moment(m0, m1, m2, rolling * reduced * fn)
     viscous = 0.0
-    if size > limit:
-        scale = limit / size
-        m0 *= scale
-        m1 *= scale
-        m2 *= scale
-    elif damping_ratio > 0.0:
+    if not sliding and damping_ratio > 0.0:
         equivalent = 1.0 / (1.0 / (inertia[i] + mass[i] * ri * ri)
                             + 1.0 / (inertia[j] + mass[j] * rj * rj))
         viscous = damping_ratio * 2.0 * math.sqrt(equivalent * stiffness)

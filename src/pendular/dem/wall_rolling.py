@@ -38,7 +38,7 @@ from pendular.dem.contact_law import wall_contact_stiffness
 from pendular.dem.hertz_mindlin import _stiffnesses
 from pendular.dem.material import effective_modulus
 from pendular.dem.protocols import state_array
-from pendular.dem.rolling import MAX_RESISTANCE
+from pendular.dem.rolling import MAX_RESISTANCE, capped_moment
 from pendular.utils.validate import check_range
 
 
@@ -79,15 +79,9 @@ def _sphere_wall_moments(p, position, angular_velocity, radius, mass, inertia, w
         m0 = rolling_moment[p, w, 0] - stiffness * w0 * dt
         m1 = rolling_moment[p, w, 1] - stiffness * w1 * dt
         m2 = rolling_moment[p, w, 2] - stiffness * w2 * dt
-        limit = rolling * r * fn
-        size = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+        m0, m1, m2, sliding = capped_moment(m0, m1, m2, rolling * r * fn)
         viscous = 0.0
-        if size > limit:
-            scale = limit / size
-            m0 *= scale
-            m1 *= scale
-            m2 *= scale
-        elif damping_ratio > 0.0:
+        if not sliding and damping_ratio > 0.0:
             viscous = damping_ratio * 2.0 * math.sqrt((inertia[p] + mass[p] * r * r)
                                                       * stiffness)
         rolling_moment[p, w, 0] = m0
