@@ -2,7 +2,7 @@
 
 Build (from the repository root, after ``pip install -e '.[docs]'``):
 
-    python -m sphinx -W --keep-going -b html docs docs/_build/html
+    python -m sphinx -j auto -W --keep-going -b html docs docs/_build/html
 
 Pages are Markdown (MyST); the tutorials (docs/tutorials/) and the examples (examples/) are
 Python scripts that sphinx-gallery runs at every build, so their figures and printed numbers
@@ -58,6 +58,10 @@ for _name in sorted(os.listdir(os.path.join(HERE, "figures"))):
 autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 autodoc_default_options = {"undoc-members": False}
+# the API's functions and classes stay out of the tables of contents (the API pages list each
+# module's section there): the theme draws the whole site's tree into every page, and with an
+# entry per object that tree took half of each build; the search and the index still hold them
+toc_object_entries = False
 
 # sphinx-gallery: every script of docs/tutorials and examples/ runs at each build, at the
 # small sizes they set (a few seconds to half a minute each on the 2-core machine), one per
