@@ -14,6 +14,7 @@ from pendular.capillary import (BridgeState, CapillaryBridges, SuctionBridges, V
 from pendular.capillary.bridge_state import ACROSS_GAP, AT_CONTACT, FIELDS, NO_BRIDGE
 from pendular.capillary.volume_table import lookup_volume_interface
 from pendular.dem.neighbors import build_contacts
+from pendular.dem.state import period_layout
 
 GAMMA = capillary.SURFACE_TENSION
 RADIUS = 1e-3
@@ -75,7 +76,7 @@ def three_pairs(gap_star):
     branch = position[pair_j] - position[pair_i]
     distance = np.linalg.norm(branch, axis=1)
     return (position, np.full(6, RADIUS), pair_i, pair_j, np.zeros((3, 3), np.int8),
-            np.zeros(3), 2 * RADIUS - distance, branch / distance[:, None])
+            period_layout(np.zeros(3)), 2 * RADIUS - distance, branch / distance[:, None])
 
 
 def no_bridges():

@@ -11,7 +11,7 @@ from pendular.dem.contact_law import (add_face_terms, gather_contact_forces,
     scattered_pair_forces)
 from pendular.dem.neighbors import build_contacts
 from pendular.dem.prefetch import PREFETCH_AHEAD, PREFETCH_MIN_PAIRS, prefetch_distance
-from pendular.dem.state import Walls
+from pendular.dem.state import Walls, period_layout
 from pendular.dem.virial import SUM_BLOCKS
 
 
@@ -150,7 +150,7 @@ def jammed_cloud(count=2000, seed=7):
     radius = RADIUS * rng.uniform(0.95, 1.05, count)
     velocity = rng.normal(0, 1e-3, (count, 3))
     spin = rng.normal(0, 1.0, (count, 3))
-    return position, radius, velocity, spin, np.full(3, side * 1.9 * RADIUS)
+    return position, radius, velocity, spin, period_layout(np.full(3, side * 1.9 * RADIUS))
 
 
 def evaluate(kernel, position, velocity, spin, radius, contacts, period, *extra):
@@ -194,7 +194,7 @@ def test_one_thread_kernels_give_the_gathers_sums_bit_for_bit(periodic):
     jammed cloud of 2,000 spheres, in walls and in a periodic cell whose faces it presses
     through; each kernel prefetching (1 ahead) or not."""
     position, radius, velocity, spin, lattice = jammed_cloud()
-    period = lattice if periodic else np.zeros(3)
+    period = lattice if periodic else period_layout(np.zeros(3))
     count = len(radius)
 
     def contacts():

@@ -39,7 +39,7 @@ import numba
 import numpy as np
 
 from pendular.dem.neighbors import branch_vector
-from pendular.dem.state import Box, _box_position, _check_box
+from pendular.dem.state import Box, _box_position, _check_box, period_layout
 from pendular.utils.validate import check_array, check_range
 from pendular.dem.virial import (SUM_BLOCKS, ZERO9, add_outer, add_to_block, block_bounds,
     sum_blocks)
@@ -223,10 +223,7 @@ class PeriodicCell(Box):
         (one compiled version of each kernel)."""
         if not self.sheared:
             return self.position[1::2]
-        lattice = np.zeros(8)
-        lattice[1:6:2] = self.position[1::2]
-        lattice[7] = self.shear_offset
-        return lattice[1::2]
+        return period_layout([*self.position[1::2], self.shear_offset])
 
     def volume(self):
         """Volume of the cell [m^3]."""

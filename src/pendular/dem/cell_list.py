@@ -142,9 +142,9 @@ def build_pairs(position, radius, skin):
     dims, cell_of, cell_start, cell_particles = _cell_grid(position, cell_size)
     kept = np.empty((count, ROW_CAPACITY), np.int64)
     row_count = np.empty(count, np.int64)
-    for p in numba.prange(count):
-        row_count[p] = _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start,
-                                     cell_particles, kept[p])
+    for p in numba.prange(count):     # p as int64 in both loops: one compiled _neighbors_of
+        row_count[p] = _neighbors_of(np.int64(p), position, radius, skin, dims, cell_of,
+                                     cell_start, cell_particles, kept[p])
     row_start = _row_starts(row_count)
     pair_j = np.empty(row_start[count], np.int64)
     for p in numba.prange(count):
@@ -152,8 +152,8 @@ def build_pairs(position, radius, skin):
         if stop - start <= ROW_CAPACITY:
             pair_j[start:stop] = kept[p, :stop - start]
         else:
-            _neighbors_of(p, position, radius, skin, dims, cell_of, cell_start, cell_particles,
-                          pair_j[start:stop])
+            _neighbors_of(np.int64(p), position, radius, skin, dims, cell_of, cell_start,
+                          cell_particles, pair_j[start:stop])
     return row_start, pair_j
 
 
@@ -257,10 +257,10 @@ def build_periodic_pairs(position, radius, skin, period):
     kept = np.empty((count, ROW_CAPACITY), np.int64)
     kept_image = np.empty((count, ROW_CAPACITY, 3), np.int8)
     row_count = np.empty(count, np.int64)
-    for p in numba.prange(count):
-        row_count[p] = _periodic_neighbors_of(p, position, radius, skin, period, shear, dims,
-                                              cell_of, cell_start, cell_particles, kept[p],
-                                              kept_image[p])
+    for p in numba.prange(count):     # p as int64 in both loops (build_pairs)
+        row_count[p] = _periodic_neighbors_of(np.int64(p), position, radius, skin, period,
+                                              shear, dims, cell_of, cell_start, cell_particles,
+                                              kept[p], kept_image[p])
     row_start = _row_starts(row_count)
     pair_j = np.empty(row_start[count], np.int64)
     image = np.empty((row_start[count], 3), np.int8)
@@ -270,8 +270,8 @@ def build_periodic_pairs(position, radius, skin, period):
             pair_j[start:stop] = kept[p, :stop - start]
             image[start:stop] = kept_image[p, :stop - start]
         else:
-            _periodic_neighbors_of(p, position, radius, skin, period, shear, dims, cell_of,
-                                   cell_start, cell_particles, pair_j[start:stop],
+            _periodic_neighbors_of(np.int64(p), position, radius, skin, period, shear, dims,
+                                   cell_of, cell_start, cell_particles, pair_j[start:stop],
                                    image[start:stop])
     return row_start, pair_j, image
 

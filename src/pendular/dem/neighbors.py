@@ -19,6 +19,7 @@ import numpy as np
 
 from pendular.dem.cell_list import build_pairs, build_periodic_pairs, group_members
 from pendular.dem.protocols import state_array
+from pendular.dem.state import period_layout
 from pendular.utils.validate import check_int, check_positive, check_range
 from pendular.dem.virial import SUM_BLOCKS, add_face_block, block_bounds, face_block_starts
 
@@ -319,7 +320,7 @@ def build_contacts(position, radius, skin, previous=None, period=None, walls=Non
                 f"{narrowest:g} m (3 times the largest diameter plus the neighbour reach "
                 f"{skin:g} m); use more particles")
         row_start, pair_j, image = build_periodic_pairs(position, radius, skin,
-                                                        np.asarray(period, dtype=np.float64))
+                                                        period_layout(period))
     pair_i = np.repeat(np.arange(count, dtype=np.int64), np.diff(row_start))
     second_start, second_pair = second_index(row_start, pair_j, count)
     size = len(pair_j)

@@ -120,11 +120,20 @@ def _box_position(lo, hi):
     return np.array([lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]], dtype=np.float64)
 
 
+def period_layout(values):
+    """``values`` [m] (a cell's (3,) period, or a sheared cell's (4,)) as a new array laid out
+    as a periodic cell's ``period``: a strided view of every other element. Walled and
+    periodic scenes, and any caller of the kernels that take a period, then pass one array
+    type and share one compiled version of each kernel (another layout compiles each again)."""
+    values = np.asarray(values, dtype=np.float64)
+    laid_out = np.zeros(2 * len(values))[1::2]
+    laid_out[:] = values
+    return laid_out
+
+
 _NO_STRETCHING = np.zeros(3)
-#: Zeros (3,) laid out as a periodic cell's ``period`` (a strided view of its (6,) faces), so
-#: that walled and periodic scenes call the kernels that take a period with one array type
-#: and share one compiled version of each (a second layout would compile each kernel again).
-_NO_PERIOD = np.zeros(6)[1::2]
+#: Zeros (3,) laid out as a periodic cell's ``period`` (period_layout).
+_NO_PERIOD = period_layout(np.zeros(3))
 _NO_VIRIAL = np.zeros((0, 9))
 
 
