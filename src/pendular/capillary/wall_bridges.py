@@ -27,6 +27,7 @@ import numba
 import numpy as np
 
 from pendular.capillary.wall_bridge import WallBridgeTable, lookup_wall
+from pendular.dem.contact_law import wall_gap
 from pendular.dem.protocols import state_array
 
 #: Table range of u = s R / gamma of the wall bridges: 0.01 (s = 30 Pa for R = 24 um, gamma =
@@ -48,9 +49,7 @@ def _sphere_on_walls(p, position, radius, wall_position, suction, surface_tensio
     u = suction * r / surface_tension
     for w in range(6):
         moment[w] = 0.0
-        axis = w // 2
-        side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box
-        gap = side * (position[p, axis] - wall_position[w]) - r
+        axis, side, gap = wall_gap(p, w, position, radius, wall_position)
         found = gap <= 0.0 or (persist and exists[p, w] != 0)
         if found:
             found, force_star, volume_star, delta1, _ = lookup_wall(

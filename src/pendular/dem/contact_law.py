@@ -52,6 +52,15 @@ def wall_contact_stiffness(young, radius):
 
 
 @numba.njit(cache=True, inline="always")
+def wall_gap(p, w, position, radius, wall_position):
+    """(axis, side, gap [m]) of sphere p and wall w (0-5: the low and high walls of x, y, z):
+    the wall's normal into the box is side e_axis; gap < 0 where they overlap."""
+    axis = w // 2
+    side = 1.0 if w % 2 == 0 else -1.0
+    return axis, side, side * (position[p, axis] - wall_position[w]) - radius[p]
+
+
+@numba.njit(cache=True, inline="always")
 def _first_member(i, position, velocity, angular_velocity, radius):
     """Particle i's position, velocity, angular velocity and radius as one tuple of ten
     scalars (_evaluate_pair's ``first``): the row loops read it once for all of i's pairs."""

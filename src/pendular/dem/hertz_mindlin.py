@@ -54,7 +54,7 @@ import numpy as np
 from pendular.dem import HOT_KERNEL_FASTMATH
 from pendular.dem.contact_law import (MAX_SHEAR_RATIO, ContactForces, _contact_gap,
     _first_member, _prefetch_second, _row_sums, _scatter_to_both, _store_row_sums, _stretched,
-    _turned_contact, normal_stiffness, wall_contact_stiffness)
+    _turned_contact, normal_stiffness, wall_contact_stiffness, wall_gap)
 from pendular.dem.material import (check_poisson, check_restitution, effective_modulus,
     effective_shear_modulus, rigid_wall, wall_contact)
 from pendular.dem.prefetch import prefetch_distance
@@ -240,9 +240,8 @@ def _sphere_on_walls(p, position, velocity, angular_velocity, radius, mass, wall
     (6,); arguments as viscoelastic_wall_forces'."""
     r = radius[p]
     for w in range(6):
-        axis = w // 2
-        side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box: side e_axis
-        overlap = r - side * (position[p, axis] - wall_position[w])
+        axis, side, gap = wall_gap(p, w, position, radius, wall_position)
+        overlap = -gap
         if overlap <= 0.0:
             wall_shear[p, w, 0] = 0.0
             wall_shear[p, w, 1] = 0.0

@@ -34,7 +34,7 @@ import math
 import numba
 import numpy as np
 
-from pendular.dem.contact_law import wall_contact_stiffness
+from pendular.dem.contact_law import wall_contact_stiffness, wall_gap
 from pendular.dem.hertz_mindlin import _stiffnesses
 from pendular.dem.material import effective_modulus
 from pendular.dem.protocols import state_array
@@ -52,9 +52,8 @@ def _sphere_wall_moments(p, position, angular_velocity, radius, mass, inertia, w
     arguments as wall_moments'."""
     r = radius[p]
     for w in range(6):
-        axis = w // 2
-        side = 1.0 if w % 2 == 0 else -1.0      # the wall's normal into the box: side e_axis
-        overlap = r - side * (position[p, axis] - wall_position[w])
+        axis, side, gap = wall_gap(p, w, position, radius, wall_position)
+        overlap = -gap
         if overlap <= 0.0:
             rolling_moment[p, w, 0] = 0.0
             rolling_moment[p, w, 1] = 0.0
