@@ -173,6 +173,21 @@ class LiquidClusters:
             gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, particles.force)
 
+    def grain_forces(self, sim):
+        """(N, 3) [N] the forces ``apply`` adds to the grains at ``sim``'s state: the
+        clusters' own, less the shares of the bridges' forces they absorb."""
+        force = np.zeros_like(sim.particles.position)
+        if self._force is None or not (self.filled.any() or self._front_held()):
+            return force
+        force += self._force
+        contacts = sim.contacts
+        pair_force = self.bridges.pair_force
+        share = self.pair_share(contacts)
+        if len(pair_force) == len(share):
+            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
+                               contacts.second_start, contacts.second_pair, force)
+        return force
+
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
         liquid's front, in its fraction)."""

@@ -100,6 +100,15 @@ def contact_angle_parameter(help="wetting angle", **changes):
                      flag="--contact-angle", help=help, **changes)
 
 
+def liquid_parameter(where):
+    """The field of a test's liquid regime (``--liquid``, LIQUID_REGIMES): pendular bridges
+    alone (default), or liquid clusters of filled pore units beside them
+    (docs/liquid_clusters.md); ``where``: how the test's clusters start, in words."""
+    return parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                     help="liquid regime: pendular bridges alone, or clusters of filled pore "
+                          f"units beside them ({where}; docs/liquid_clusters.md)")
+
+
 def strain_rate_parameter():
     """The field of a loading's strain rate [1/s], None for the inertial number's."""
     return parameter(None, unit="1/s", low=0.0, high=MAX_STRAIN_RATE, low_inclusive=False,
@@ -359,6 +368,9 @@ class LaboratoryConfig:
                                   "and re-equilibrated (isotropic), switched on at the first "
                                   "loading step (at-shear), or added with the walls fixed, then "
                                   "servoed (constant-volume)")
+    liquid: str = liquid_parameter("with --suction: the sample wetted from dry, the pore "
+                                   "units filled at their filling suction and updated as the "
+                                   "packing deforms")
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
@@ -395,6 +407,39 @@ class LaboratoryConfig:
                                             or self.bridges.water_content is not None):
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
+        if self.liquid == "clusters":
+            self._check_clusters()
+
+    def _check_clusters(self):
+        """ParameterError naming --liquid and the option it cannot run with; the bridges made
+        to persist (LiquidClusters holds persisting suction-controlled bridges)."""
+        bridges = self.bridges
+        refused = None
+        if bridges is None:
+            refused = ("--liquid clusters needs a wet test at a suction: give --suction > 0 "
+                       "(--suction 0 is dry)")
+        elif bridges.water_content is not None:
+            refused = ("--liquid clusters with --water-content is not built for the laboratory "
+                       "tests (pendular tension --liquid clusters holds a water content): give "
+                       "--suction instead")
+        elif self.undrained:
+            refused = ("--liquid clusters holds the liquid at the suction: not with --drainage "
+                       "undrained (volume-controlled bridges)")
+        elif bridges.model != "exact":
+            refused = (f"--liquid clusters needs the exact bridges, not --bridges "
+                       f"{bridges.model}")
+        elif self.sample.periodic:
+            refused = ("--liquid clusters runs between walls, not in a periodic cell "
+                       "(--periodic, a simple shear): its cluster forces would need their face "
+                       "terms in the cell's stress")
+        elif self.checkpoint_every:
+            refused = (f"--liquid clusters runs without checkpoints (its pore units are the "
+                       f"host's and not checkpointed): --checkpoint-every "
+                       f"{self.checkpoint_every} does not apply")
+        if refused is not None:
+            raise fail(self, "liquid", refused)
+        if not bridges.persist:
+            self.bridges = dataclasses.replace(bridges, persist=True)
 
     def stage_rates(self):
         """[(where, strain rate [1/s], steps or None)] of the loading's stages that name their
