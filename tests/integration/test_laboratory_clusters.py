@@ -2,7 +2,8 @@
 pendular.procedures.loading_clusters): above every pore unit's filling suction they are the
 pendular run bit for bit; where units fill, the history and summary hold the clusters' figures,
 the wall stress balances the contacts', bridges' and clusters' stresses, and pores/ holds the
-units; what is not built is refused by one error line naming the options."""
+units; at a water content the closed liquid is held; what is not built is refused by one error
+line naming the options."""
 
 import json
 
@@ -64,9 +65,26 @@ def test_a_triaxial_where_pores_fill_records_its_clusters(tmp_path, capsys):
     assert len(frames) == 5 and (out / "pores" / "pores.pvd").exists()   # wetted + 4 updates
 
 
+def test_a_triaxial_at_a_water_content_holds_its_water_in_bridges_and_clusters(tmp_path):
+    """The closed liquid (LiquidClusters.hold_volume) at the wetting and at every update;
+    between updates the bridges follow their gaps at the suction found."""
+    config = TriaxialConfig(sample=SAMPLE, shear=SHEAR, vtk_frames=0, liquid="clusters",
+                            bridges=BridgeConfig(water_content=0.02, control="volume"))
+    summary = TriaxialTest(config).run(tmp_path, progress=False, plots=False)
+    history = read_history(tmp_path / "history.h5")
+    assert summary["clusters_wet"]["clusters"] > 0
+    assert summary["cluster_updates"] == 2
+    water = history["water_content"].values
+    assert water[0] == pytest.approx(0.02, rel=1e-9)           # the wetting's solution
+    assert np.abs(water / 0.02 - 1.0).max() < 1e-2      # bridges formed at new contacts
+    suction = history["suction"].values
+    assert len(np.unique(suction)) == 3                     # the wetting's, then two updates
+    assert summary["formation_suction_pa"] == suction[0]
+    assert undeclared_keys(summary, "triaxial") == []
+
+
 @pytest.mark.parametrize("options, words", [
     ({}, ["--liquid", "--suction"]),
-    ({"water_content": 1.0}, ["--liquid", "--water-content"]),
     ({"suction": 20000.0, "periodic": True}, ["--liquid", "--periodic"]),
     ({"suction": 20000.0, "checkpoint_every": 100}, ["--liquid", "--checkpoint-every"]),
     ({"suction": 20000.0, "drainage": "undrained"}, ["--liquid", "--drainage"]),

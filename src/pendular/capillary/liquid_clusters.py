@@ -136,20 +136,35 @@ class LiquidClusters:
     def _set_state(self, sim, units, filled, suction, edges=None):
         """Take ``filled`` at ``suction`` [Pa] (and the closed liquid's front, ``liquid``):
         clusters, forces."""
-        particles = sim.particles
         self.units, self.filled, self.suction = units, filled, float(suction)
-        self._unit_forces = UnitForces(units.vertices, particles.radius[units.grains])
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
-        self._force = cluster_forces(units, self._unit_forces, filled, self.suction,
+        self._set_forces(sim.particles, units.vertices)
+        self._contacts = None
+        self._carried = None
+
+    def _set_forces(self, particles, vertices):
+        """The clusters' forces of the filled units (and the closed liquid's front) with their
+        grains at ``vertices`` (M, 4, 3) [m]."""
+        units = self.units
+        self._unit_forces = UnitForces(vertices, particles.radius[units.grains])
+        self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
                                      len(particles))
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
             self._force += partial_forces(units, self._unit_forces,
                                           np.flatnonzero(self.liquid.front),
                                           self.liquid.front_fraction, self.suction,
                                           len(particles))
-        self._contacts = None
-        self._carried = None
+
+    def follow_packing(self, sim):
+        """The forces of the filled units with their grains where they are now, the filled
+        units, the suction and the liquid as they are (no decomposition, filling or drainage:
+        between two steps of the model, the forces follow the grains as the packing moves)."""
+        if self.units is None:
+            return
+        sim.fetch("particles")
+        particles = sim.particles
+        self._set_forces(particles, particles.position[self.units.grains])
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""

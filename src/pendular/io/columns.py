@@ -69,7 +69,7 @@ HISTORY_WRITERS = {
                      "liquid_in_largest_cluster", "largest_cluster_percolates",
                      "saturation_pore_units", "chi_with_clusters", "sigma_clusters"),
                     (*LABORATORY, "swcc", "tension")),
-    "water_content": ("tension", "path"),
+    "water_content": (*LABORATORY, "swcc", "tension"),
     "liquid_total": ("path",),
     "excess_pore_pressure": ("triaxial",),
     "void_ratio": ("oedometer", "isotropic", "cyclic", "path"),

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from pendular.dem.measure import porosity
+from pendular.procedures.config import WATER_DENSITY
 from pendular.homogenize.invariants import lateral_stress
 from pendular.homogenize.on_the_fly import homogenized
 
@@ -34,10 +35,12 @@ def cluster_operation(sim):
 
 def cluster_columns(clusters):
     """History columns of the liquid clusters (pendular.io.columns.HISTORY_COLUMNS), their
-    figures measured once per state; ``saturation``: of the bridges and clusters together;
+    figures measured once per state; ``saturation`` and ``water_content``: of the bridges and
+    clusters together;
     ``chi_with_clusters``: chi of the bridges' shares outside the filled units and of the
     clusters, ``sigma_clusters`` the Love–Weber stress of the clusters' forces
     (pendular.homogenize.clusters)."""
+    from pendular.capillary.wetting import gravimetric_water_content
     from pendular.homogenize.clusters import chi_with_clusters, cluster_force_stress
 
     last = {}
@@ -55,6 +58,9 @@ def cluster_columns(clusters):
         "saturation_pore_units", "saturation")}
     percolates = figure("largest_cluster_percolates")
     columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
+    columns["water_content"] = lambda sim: gravimetric_water_content(
+        clusters.account(sim).total, sim.particles.solid_volume(),
+        sim.particles.density / WATER_DENSITY)
     columns["chi_with_clusters"] = lambda sim: chi_with_clusters(sim, clusters)
     columns["sigma_clusters"] = lambda sim: cluster_force_stress(sim, clusters)
     return columns

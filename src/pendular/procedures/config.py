@@ -368,9 +368,9 @@ class LaboratoryConfig:
                                   "and re-equilibrated (isotropic), switched on at the first "
                                   "loading step (at-shear), or added with the walls fixed, then "
                                   "servoed (constant-volume)")
-    liquid: str = liquid_parameter("with --suction: the sample wetted from dry, the pore "
-                                   "units filled at their filling suction and updated as the "
-                                   "packing deforms")
+    liquid: str = liquid_parameter("the sample wetted from dry at --suction or "
+                                   "--water-content, the pore units updated as the packing "
+                                   "deforms")
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
@@ -416,15 +416,11 @@ class LaboratoryConfig:
         bridges = self.bridges
         refused = None
         if bridges is None:
-            refused = ("--liquid clusters needs a wet test at a suction: give --suction > 0 "
-                       "(--suction 0 is dry)")
-        elif bridges.water_content is not None:
-            refused = ("--liquid clusters with --water-content is not built for the laboratory "
-                       "tests (pendular tension --liquid clusters holds a water content): give "
-                       "--suction instead")
+            refused = ("--liquid clusters needs a wet test: give --suction > 0 or "
+                       "--water-content (--suction 0 is dry)")
         elif self.undrained:
-            refused = ("--liquid clusters holds the liquid at the suction: not with --drainage "
-                       "undrained (volume-controlled bridges)")
+            refused = ("--liquid clusters holds the liquid in suction-controlled bridges and "
+                       "clusters: not with --drainage undrained (volume-controlled bridges)")
         elif bridges.model != "exact":
             refused = (f"--liquid clusters needs the exact bridges, not --bridges "
                        f"{bridges.model}")
@@ -438,7 +434,7 @@ class LaboratoryConfig:
                        f"{self.checkpoint_every} does not apply")
         if refused is not None:
             raise fail(self, "liquid", refused)
-        if not bridges.persist:
+        if not bridges.persist and bridges.water_content is None:
             self.bridges = dataclasses.replace(bridges, persist=True)
 
     def stage_rates(self):

@@ -25,7 +25,8 @@ from pendular.dem.walls import StressServo
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.config import WATER_DENSITY
 from pendular.procedures.loading import run_stage
-from pendular.procedures.loading_clusters import join_clusters, wetted_clusters
+from pendular.procedures.loading_clusters import (join_clusters, wet_clusters_at_water_content,
+    wetted_clusters)
 from pendular.procedures.preparation import static
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.water_content import wet_to_water_volume
@@ -132,7 +133,9 @@ def wet_sample(sim, config, *, progress=None):
     With config.liquid 'clusters' (at a suction), liquid clusters join the persisting
     suction-controlled bridges (pendular.procedures.loading_clusters), the pore units filled
     at their filling suction before the equilibria and again at the packing they reach (then
-    run until static once more); the report adds ``clusters_wet``.
+    run until static once more); the report adds ``clusters_wet``. At a water content with
+    clusters, the liquid is a closed volume held by persisting suction-controlled bridges and
+    the clusters at the suction that holds it (loading_clusters.wet_clusters_at_water_content).
 
     The equilibria run on ``sim``'s device (Simulation.device; the wettings at a water content
     from copies of ``sim``, which keep it); the bridges of 'at-shear' form on the host."""
@@ -140,6 +143,8 @@ def wet_sample(sim, config, *, progress=None):
     thresholds = {"unbalanced": sample.equilibrium_unbalanced,
                   "tolerance": sample.stress_tolerance, "max_steps": config.wet_steps}
     if config.bridges.water_content is not None:
+        if config.liquid == "clusters":
+            return _wet_clusters_at_water_content(sim, config, thresholds, progress)
         return _wet_at_water_content(sim, config, thresholds, progress)
     bridges = config.bridges.build()
     clusters = config.liquid == "clusters"
@@ -216,6 +221,27 @@ def _wet_at_water_content(dry, config, thresholds, progress):
         sim, bridges, sum(t["steps"] for t in tries), started,
         formation_suction_pa=tries[-1]["formation_suction_pa"], water_content=water_content,
         wetting_attempts=tries, liquid_initial=bridges.liquid_initial)}
+
+
+def _wet_clusters_at_water_content(sim, config, thresholds, progress):
+    """wet_sample at config.bridges.water_content with liquid clusters
+    (pendular.procedures.loading_clusters.wet_clusters_at_water_content)."""
+    from pendular.capillary import gravimetric_water_content
+
+    particles = sim.particles
+    specific_gravity = particles.density / WATER_DENSITY
+    target = config.bridges.water_content * specific_gravity * particles.solid_volume()
+    started = time.perf_counter()
+    bridges, clusters, details = wet_clusters_at_water_content(
+        sim, config.bridges, target,
+        lambda s: equilibrate(s, progress=progress, phase="equilibrium after wetting",
+                              **thresholds))
+    steps = details.pop("wetting_steps")
+    water_content = gravimetric_water_content(clusters.account(sim).total,
+                                              particles.solid_volume(), specific_gravity)
+    return sim, bridges, {"wetting": "water-content", **wetting_report(
+        sim, bridges, steps, started, clusters=clusters, water_content=water_content,
+        **details)}
 
 
 @contextlib.contextmanager

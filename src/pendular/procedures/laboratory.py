@@ -124,8 +124,8 @@ def parameters(config):
                      "persist_bridges": bridges.persist, "control": bridges.control,
                      "water_content_percent": (None if bridges.water_content is None
                                                else 100.0 * bridges.water_content),
-                     "liquid": (bridges.liquid if bridges.water_content is not None else
-                                None if config.liquid == "pendular" else config.liquid),
+                     "liquid": (config.liquid if config.liquid != "pendular" else None
+                                if bridges.water_content is None else bridges.liquid),
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
     return flat
@@ -423,10 +423,12 @@ class _PathRun:
         clusters = cluster_operation(sim)
         if clusters is not None:            # after the recorder: its rows show the update
             recorder = self.path.recorder
+            closed = config.bridges.water_content is not None     # the liquid held: a volume
             self.cluster_updates = ClusterUpdates(
-                sim, clusters, CLUSTER_RECORDS * recorder.period, recorder.origin,
+                sim, clusters, recorder.period, CLUSTER_RECORDS, recorder.origin,
                 None if self.vtk is None else PoreFrames(os.path.join(out, "pores"),
-                                                         time_axis), field_data)
+                                                         time_axis), field_data,
+                before_shear["wetting"]["liquid_initial"] if closed else None)
             sim.writers.append(self.cluster_updates)
         self.checkpoint = None
         if config.checkpoint_every > 0:

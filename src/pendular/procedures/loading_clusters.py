@@ -1,16 +1,18 @@
-"""Liquid clusters in a laboratory test at a suction (``--liquid clusters``;
-docs/liquid_clusters.md 'In the DEM and the commands').
+"""Liquid clusters in a laboratory test (``--liquid clusters``; docs/liquid_clusters.md 'In
+the DEM and the commands').
 
-The sample is wetted from dry: persisting suction-controlled bridges and
+At a suction the sample is wetted from dry: persisting suction-controlled bridges and
 pendular.capillary.liquid_clusters.LiquidClusters(bridges, saturated=False) join its forces
 (``join_clusters``), the units whose filling suction is at least the suction fill
 (LiquidClusters.set_suction) before the wetting's equilibrium, and again at the packing it
-settles to. During the loading ``ClusterUpdates`` imposes the bridges' suction on the clusters
-again every CLUSTER_RECORDS history records, at the packing as it stands (decomposed again,
-the filled units carried over, pore filling, then Haines jumps where pores opened), writing a
-frame of pores/ each time; between updates the clusters' forces are held, as in a stage of
-the SWCC. ``cluster_summary``: the clusters' figures of a history row, with the effective
-stress of bridges and clusters.
+settles to. At a water content the suction is the one that holds the closed liquid
+(``wet_clusters_at_water_content``, LiquidClusters.hold_volume). During the loading
+``ClusterUpdates`` steps the model again every CLUSTER_RECORDS history records, at the packing
+as it stands (decomposed again, the filled units carried over, pore filling, then Haines jumps
+where pores opened), writing a frame of pores/ each time; at every history record in between,
+the filled units' forces follow their grains (LiquidClusters.follow_packing: the same units,
+filled state and suction, the forces at the grains' positions then). ``cluster_summary``: the
+clusters' figures of a history row, with the effective stress of bridges and clusters.
 """
 
 from __future__ import annotations
@@ -23,8 +25,8 @@ from pendular.homogenize.invariants import mean_stress
 
 #: History records between two updates of the clusters during a loading (the ParaView frames'
 #: default spacing, pendular.procedures.loading.VTK_RECORDS): about 50 over a triaxial of 500
-#: records, 0.2 % of axial strain apart at 10 %; each costs about one decomposition of the
-#: packing (docs/liquid_clusters.md 'Cost').
+#: records; each costs about one decomposition of the packing (docs/liquid_clusters.md
+#: 'Cost'). At every record in between, the clusters' forces follow the grains.
 CLUSTER_RECORDS = 10
 
 #: The clusters' figures of a history row kept in a summary (``cluster_summary``).
@@ -58,25 +60,86 @@ def wetted_clusters(sim, clusters):
     return figures
 
 
+def wet_clusters_at_water_content(dry, bridges_config, target, settle):
+    """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
+    liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
+    bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
+    contact angle), the pore units empty at first (liquid added to dry grains): the suction
+    found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
+    sample run until static (``settle(sim)``, the steps), the suction found again at the
+    packing reached and, where units are filled, the sample run until static once more.
+    Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
+    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot hold
+    it within the pendular limit."""
+    from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
+                                    sample_radius_ratios)
+    from pendular.capillary.liquid_clusters import LiquidClusters
+    from pendular.capillary.validation import NotPendular
+
+    sim, particles = dry, dry.particles
+    if sim.contacts is None:
+        sim.evaluate_forces()
+    touching = sim.contacts.overlap > 0.0
+    table = BridgeTable.cached(bridges_config.contact_angle,
+                               radius_ratios=sample_radius_ratios(particles.radius))
+    # the bridges' alone: the clusters hold more at a suction, so theirs is higher
+    start = formation_suction(table, particles.radius[sim.contacts.pair_i[touching]],
+                              particles.radius[sim.contacts.pair_j[touching]], target,
+                              bridges_config.surface_tension)
+    bridges = CapillaryBridges(start, bridges_config.surface_tension,
+                               bridges_config.contact_angle, persist=True)
+    clusters = LiquidClusters(bridges, saturated=False)
+    sim.forces += [bridges, clusters]
+    try:
+        sim.evaluate_forces()
+        clusters.hold_volume(sim, target)
+        steps = settle(sim)
+        found = clusters.hold_volume(sim, target)
+        if clusters.filled.any():
+            steps += settle(sim)
+    except NotPendular as error:
+        raise ValueError(
+            f"--water-content = {100.0 * bridges_config.water_content:g} % is more than this "
+            f"sample holds with --liquid clusters: its liquid is held at {error.suction:.4g} "
+            f"Pa, below the {error.lowest:.4g} Pa where bridges at contact pass the pendular "
+            "limit; lower --water-content") from None
+    return bridges, clusters, {"wetting_steps": steps, "formation_suction_pa": found.suction,
+                               "liquid_initial": target}
+
+
 class ClusterUpdates:
-    """Writer: every ``period`` steps from step ``origin``, ``clusters`` take their bridges'
-    suction again at the packing as it stands (LiquidClusters.set_suction), and ``frames``
+    """Writer: every ``follow`` steps from step ``origin`` the clusters' forces follow the
+    grains (LiquidClusters.follow_packing), and every ``updates_every``-th time instead
+    ``clusters`` take their bridges' suction again at the packing as it stands
+    (LiquidClusters.set_suction), or with a closed liquid ``volume`` [m^3] the suction that
+    holds it there (LiquidClusters.hold_volume), and ``frames``
     (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
     ``field_data(sim)`` (the loading's frame fields) and the suction; the first frame, the
-    state of ``sim`` the loading starts from, at once. ``updates`` and ``time_s``: how many
-    updates ran and their wall time [s]."""
+    state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
+    ``time_s``: the wall time of the updates and of the forces following the grains [s]."""
 
-    def __init__(self, sim, clusters, period, origin, frames=None, field_data=None):
+    def __init__(self, sim, clusters, follow, updates_every, origin, frames=None,
+                 field_data=None, volume=None):
         self.clusters, self.frames, self.field_data = clusters, frames, field_data
-        self.period, self.origin = max(1, int(period)), int(origin)
+        self.volume = volume
+        self.follow = max(1, int(follow))
+        self.period, self.origin = self.follow * max(1, int(updates_every)), int(origin)
         self.updates, self.time_s = 0, 0.0
         self._frame(sim)
 
     def apply(self, sim):
-        if sim.step == self.origin or (sim.step - self.origin) % self.period:
+        taken = sim.step - self.origin
+        if taken == 0 or taken % self.follow:
             return
         started = time.perf_counter()
-        self.clusters.set_suction(sim, self.clusters.bridges.suction)
+        if taken % self.period:
+            self.clusters.follow_packing(sim)
+            self.time_s += time.perf_counter() - started
+            return
+        if self.volume is None:
+            self.clusters.set_suction(sim, self.clusters.bridges.suction)
+        else:
+            self.clusters.hold_volume(sim, self.volume)
         self.updates += 1
         self.time_s += time.perf_counter() - started
         self._frame(sim)
