@@ -428,7 +428,8 @@ SUMMARY_KEYS = {
     "clusters_final": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the clusters' figures "
                           "at the history's last row (their number, the liquid's fractions, "
                           "percolation, saturations, chi with clusters and of the bridges, "
-                          "p' = p + chi_with_clusters s)", ("oedometer", "isotropic", "cyclic")),
+                          "p' = p + chi_with_clusters s)",
+                          ("oedometer", "isotropic", "cyclic", "path")),
     "clusters_wet": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the suction that holds "
                         "(tension) or is imposed on (a laboratory test) the water once wetted "
                         "and the clusters then (their number, the liquid's fractions in "

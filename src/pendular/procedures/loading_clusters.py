@@ -112,7 +112,9 @@ class ClusterUpdates:
     grains (LiquidClusters.follow_packing), and every ``updates_every``-th time instead
     ``clusters`` take their bridges' suction again at the packing as it stands
     (LiquidClusters.set_suction), or with a closed liquid ``volume`` [m^3] the suction that
-    holds it there (LiquidClusters.hold_volume), and ``frames``
+    holds it there (LiquidClusters.hold_volume); at the step the bridges' suction changes (a
+    path's suction stage) too, at most once every ``follow`` steps while it changes; and
+    ``frames``
     (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
     ``field_data(sim)`` (the loading's frame fields) and the suction; the first frame, the
     state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
@@ -125,17 +127,21 @@ class ClusterUpdates:
         self.follow = max(1, int(follow))
         self.period, self.origin = self.follow * max(1, int(updates_every)), int(origin)
         self.updates, self.time_s = 0, 0.0
+        self._updated = self.origin
         self._frame(sim)
 
     def apply(self, sim):
         taken = sim.step - self.origin
-        if taken == 0 or taken % self.follow:
+        changed = (self.volume is None and self.clusters.bridges.suction != self.clusters.suction
+                   and sim.step - self._updated >= self.follow)
+        if taken == 0 or (taken % self.follow and not changed):
             return
         started = time.perf_counter()
-        if taken % self.period:
+        if taken % self.period and not changed:
             self.clusters.follow_packing(sim)
             self.time_s += time.perf_counter() - started
             return
+        self._updated = sim.step
         if self.volume is None:
             self.clusters.set_suction(sim, self.clusters.bridges.suction)
         else:
