@@ -143,11 +143,11 @@ class LiquidClusters:
         self._contacts = None
         self._carried = None
 
-    def _set_forces(self, particles, vertices):
+    def _set_forces(self, particles, vertices, sides=None):
         """The clusters' forces of the filled units (and the closed liquid's front) with their
-        grains at ``vertices`` (M, 4, 3) [m]."""
+        grains at ``vertices`` (M, 4, 3) [m] (``sides``: UnitForces's)."""
         units = self.units
-        self._unit_forces = UnitForces(vertices, particles.radius[units.grains])
+        self._unit_forces = UnitForces(vertices, particles.radius[units.grains], sides)
         self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
                                      len(particles))
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
@@ -159,12 +159,15 @@ class LiquidClusters:
     def follow_packing(self, sim):
         """The forces of the filled units with their grains where they are now, the filled
         units, the suction and the liquid as they are (no decomposition, filling or drainage:
-        between two steps of the model, the forces follow the grains as the packing moves)."""
+        between two steps of the model, the forces follow the grains as the packing moves);
+        each face keeps the side its normal had at the decomposition, so that the forces still
+        sum to zero where a flat unit has turned inside out."""
         if self.units is None:
             return
         sim.fetch("particles")
         particles = sim.particles
-        self._set_forces(particles, particles.position[self.units.grains])
+        self._set_forces(particles, particles.position[self.units.grains],
+                         self._unit_forces.sides)
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
