@@ -2,8 +2,8 @@
 liquid clusters (after Richefeu, El Youssoufi & Radjaï 2006, who found in direct shear that
 the cohesion of wet glass beads rises with the water content, then levels off).
 
-    python benchmarks/bench_cohesion.py [--particles 1000] [--confining 750,3000]
-        [--suctions 300000,60000,30000,20000,15000,10000] [--max-strain 0.1] [--workers 2]
+    python benchmarks/bench_cohesion.py [--particles 1000] [--confining 750,1500,3000]
+        [--suctions 300000,60000,30000,20000,15000,10000] [--max-strain 0.15] [--workers 2]
         [--out runs/cohesion]
 
 One sample per confining stress (thesis Ch. 5.2.2 defaults, R = 24 µm, the same seed), saved
@@ -14,12 +14,15 @@ same bridges, plus the pore units filled on wetting from dry). A run whose summa
 complete is not run again, nor one the guard stopped
 (pendular.procedures.guards.SampleCrushed: an overlap of a quarter radius, where the capillary
 forces of the soft default spheres, E = 1 MPa, meet the highest stresses), whose history up
-to there, and peak if reached, is kept. From the peaks (q, p) at the confining stresses of each case, the
-Mohr–Coulomb line q = M p + q0 of triaxial compression gives the friction angle, sin phi = 3 M
-/ (6 + M), and the cohesion c = q0 (3 - sin phi) / (6 cos phi), in net stress and in the
-effective stress p' = p + chi s (Eq. 3.43's form, u_a = 0; chi = tr chi / 3 at the peak: the
-bridges' Eq. 3.44, or chi with clusters, pendular.homogenize.clusters). The water content is
-the wetted sample's, w = Sr e / Gs. Writes ``out``/cohesion.json and cohesion.png.
+to there, and peak if reached, is kept. From the peaks (q, p) at the confining stresses of
+each case, the Mohr–Coulomb line q = M p + q0 of triaxial compression gives the friction
+angle, sin phi = 3 M / (6 + M), and the cohesion c = q0 (3 - sin phi) / (6 cos phi), in net
+stress and in the effective stress p' = p + chi s (Eq. 3.43's form, u_a = 0; chi = tr chi / 3
+at the peak: the bridges' Eq. 3.44, or chi with clusters, pendular.homogenize.clusters); and
+each peak's distance to the dry envelope at its p'. Above ``--clusters-below`` no pore unit
+fills, and the pendular run stands for the clusters' (continuity). The water content is the
+wetted sample's, w = Sr e / Gs. Writes ``out``/cohesion.json and cohesion.png
+(docs/liquid_clusters.md 'Shear').
 """
 
 import argparse
@@ -178,12 +181,13 @@ def plot(table, rows, path):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--particles", type=int, default=1000)
-    parser.add_argument("--confining", default="750,3000")
-    parser.add_argument("--suctions", default="300000,60000,30000,20000,15000,10000")
+    parser.add_argument("--confining", default="750,1500,3000")
+    parser.add_argument("--suctions",
+                        default="300000,60000,30000,25000,20000,15000,12000,10000")
     parser.add_argument("--clusters-below", type=float, default=60000.0,
                         help="run --liquid clusters at the suctions up to this one [Pa] (above, "
                              "no pore unit fills: the pendular run, bit for bit)")
-    parser.add_argument("--max-strain", type=float, default=0.1)
+    parser.add_argument("--max-strain", type=float, default=0.15)
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--out", default="runs/cohesion")
     args = parser.parse_args(argv)

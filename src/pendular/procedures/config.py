@@ -21,6 +21,7 @@ import numpy as np
 from pendular.capillary import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_CONTACT_ANGLE,
     MAX_ROUGHNESS, SURFACE_TENSION)
 from pendular.dem.sample import load_sample
+from pendular.procedures.loading_clusters import refuse_clusters
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
@@ -408,34 +409,11 @@ class LaboratoryConfig:
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
         if self.liquid == "clusters":
-            self._check_clusters()
-
-    def _check_clusters(self):
-        """ParameterError naming --liquid and the option it cannot run with; the bridges made
-        to persist (LiquidClusters holds persisting suction-controlled bridges)."""
-        bridges = self.bridges
-        refused = None
-        if bridges is None:
-            refused = ("--liquid clusters needs a wet test: give --suction > 0 or "
-                       "--water-content (--suction 0 is dry)")
-        elif self.undrained:
-            refused = ("--liquid clusters holds the liquid in suction-controlled bridges and "
-                       "clusters: not with --drainage undrained (volume-controlled bridges)")
-        elif bridges.model != "exact":
-            refused = (f"--liquid clusters needs the exact bridges, not --bridges "
-                       f"{bridges.model}")
-        elif self.sample.periodic:
-            refused = ("--liquid clusters runs between walls, not in a periodic cell "
-                       "(--periodic, a simple shear): its cluster forces would need their face "
-                       "terms in the cell's stress")
-        elif self.checkpoint_every:
-            refused = (f"--liquid clusters runs without checkpoints (its pore units are the "
-                       f"host's and not checkpointed): --checkpoint-every "
-                       f"{self.checkpoint_every} does not apply")
-        if refused is not None:
-            raise fail(self, "liquid", refused)
-        if not bridges.persist and bridges.water_content is None:
-            self.bridges = dataclasses.replace(bridges, persist=True)
+            refused = refuse_clusters(self)
+            if refused is not None:
+                raise fail(self, "liquid", refused)
+            if not self.bridges.persist and self.bridges.water_content is None:
+                self.bridges = dataclasses.replace(self.bridges, persist=True)
 
     def stage_rates(self):
         """[(where, strain rate [1/s], steps or None)] of the loading's stages that name their

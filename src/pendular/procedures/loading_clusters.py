@@ -12,7 +12,8 @@ as it stands (decomposed again, the filled units carried over, pore filling, the
 where pores opened), writing a frame of pores/ each time; at every history record in between,
 the filled units' forces follow their grains (LiquidClusters.follow_packing: the same units,
 filled state and suction, the forces at the grains' positions then). ``cluster_summary``: the
-clusters' figures of a history row, with the effective stress of bridges and clusters.
+clusters' figures of a history row, with the effective stress of bridges and clusters;
+``refuse_clusters``: what a configuration with clusters cannot run with.
 """
 
 from __future__ import annotations
@@ -33,6 +34,29 @@ CLUSTER_RECORDS = 10
 CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
                    "liquid_in_largest_cluster", "largest_cluster_percolates",
                    "saturation_pore_units", "saturation")
+
+
+def refuse_clusters(config) -> str | None:
+    """Why the LaboratoryConfig ``config`` with liquid clusters cannot run (naming --liquid
+    and the option it cannot run with), or None."""
+    bridges = config.bridges
+    if bridges is None:
+        return ("--liquid clusters needs a wet test: give --suction > 0 or --water-content "
+                "(--suction 0 is dry)")
+    if config.undrained:
+        return ("--liquid clusters holds the liquid in suction-controlled bridges and "
+                "clusters: not with --drainage undrained (volume-controlled bridges)")
+    if bridges.model != "exact":
+        return f"--liquid clusters needs the exact bridges, not --bridges {bridges.model}"
+    if config.sample.periodic:
+        return ("--liquid clusters runs between walls, not in a periodic cell (--periodic, a "
+                "simple shear): its cluster forces would need their face terms in the cell's "
+                "stress")
+    if config.checkpoint_every:
+        return (f"--liquid clusters runs without checkpoints (its pore units are the host's "
+                f"and not checkpointed): --checkpoint-every {config.checkpoint_every} does not "
+                "apply")
+    return None
 
 
 def join_clusters(sim, bridges):
@@ -69,8 +93,8 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle):
     sample run until static (``settle(sim)``, the steps), the suction found again at the
     packing reached and, where units are filled, the sample run until static once more.
     Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
-    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot hold
-    it within the pendular limit."""
+    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at
+    contact cannot hold it within the pendular limit."""
     from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
                                     sample_radius_ratios)
     from pendular.capillary.liquid_clusters import LiquidClusters
