@@ -77,3 +77,17 @@ def test_a_saturated_sample_drains_and_its_cluster_forces_balance(small_sample):
     assert np.count_nonzero(clusters.filled) < filled
     state = clusters.state_dict()
     assert state["filled_units"].shape == (np.count_nonzero(clusters.filled), 4)
+
+
+def test_the_clusters_forces_follow_their_grains(small_sample):
+    """LiquidClusters.follow_packing: at the decomposition's positions the same forces bit for
+    bit; as the grains move, the forces of the same filled units, still summing to zero."""
+    sim, _, clusters = wetted(small_sample, 3000.0, "clusters", saturated=True)
+    held = clusters._force.copy()
+    clusters.follow_packing(sim)
+    assert np.array_equal(clusters._force, held)
+    filled = clusters.filled.copy()
+    sim.run(100)
+    clusters.follow_packing(sim)
+    assert np.array_equal(clusters.filled, filled) and not np.array_equal(clusters._force, held)
+    assert np.abs(clusters._force.sum(axis=0)).max() < 1e-10 * np.abs(clusters._force).max()

@@ -45,13 +45,19 @@ def cap_force(suction, surface_tension, contact_angle, radius, filling_angle):
             * np.sin(filling_angle + contact_angle))
 
 
-def face_normals(vertices):
-    """(M, 4, 3) unit outward normal of the face opposite each vertex."""
+def face_normals(vertices, sides=None):
+    """(M, 4, 3) unit outward normal of the face opposite each vertex, and (M, 4) its side: the
+    sign that turns the face's cross product outward. ``sides`` given (those of an earlier
+    position of the same units), those signs instead: the normals then move continuously with
+    the grains, and stay opposite across a face two units share, even where a flat unit turns
+    inside out."""
     corners = vertices[:, FACES]                           # (M, 4, 3, 3)
     normal = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
     normal /= np.linalg.norm(normal, axis=2, keepdims=True)
-    inward = np.sum((vertices - corners[:, :, 0]) * normal, axis=2)
-    return normal * -np.sign(inward)[..., None]
+    if sides is None:
+        inward = np.sum((vertices - corners[:, :, 0]) * normal, axis=2)
+        sides = -np.sign(inward)
+    return normal * sides[..., None], sides
 
 
 class UnitForces:
@@ -59,10 +65,11 @@ class UnitForces:
     ``cone`` (M, 4, 3) the pressure on each grain's wetted cone, and ``meniscus`` (M, 4, 3, 3)
     the pull of the meniscus across each face (opposite vertex f) on its three grains
     (``FACES[f]`` order), should that face meet gas. ``vertices`` (M, 4, 3) [m] and ``radii``
-    (M, 4) [m] of the units' grains."""
+    (M, 4) [m] of the units' grains; ``sides``: face_normals's, of an earlier position of the
+    same units (None: outward at these vertices), kept as ``sides``."""
 
-    def __init__(self, vertices, radii):
-        normal = face_normals(vertices)                    # (M, 4, 3)
+    def __init__(self, vertices, radii, sides=None):
+        normal, self.sides = face_normals(vertices, sides)          # (M, 4, 3), (M, 4)
         angle = face_angles(vertices)                      # (M, 4, 3)
         face_radii = radii[:, FACES]                       # (M, 4, 3)
         sector = 0.5 * angle * face_radii ** 2             # alpha R^2 / 2

@@ -136,20 +136,38 @@ class LiquidClusters:
     def _set_state(self, sim, units, filled, suction, edges=None):
         """Take ``filled`` at ``suction`` [Pa] (and the closed liquid's front, ``liquid``):
         clusters, forces."""
-        particles = sim.particles
         self.units, self.filled, self.suction = units, filled, float(suction)
-        self._unit_forces = UnitForces(units.vertices, particles.radius[units.grains])
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
-        self._force = cluster_forces(units, self._unit_forces, filled, self.suction,
+        self._set_forces(sim.particles, units.vertices)
+        self._contacts = None
+        self._carried = None
+
+    def _set_forces(self, particles, vertices, sides=None):
+        """The clusters' forces of the filled units (and the closed liquid's front) with their
+        grains at ``vertices`` (M, 4, 3) [m] (``sides``: UnitForces's)."""
+        units = self.units
+        self._unit_forces = UnitForces(vertices, particles.radius[units.grains], sides)
+        self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
                                      len(particles))
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
             self._force += partial_forces(units, self._unit_forces,
                                           np.flatnonzero(self.liquid.front),
                                           self.liquid.front_fraction, self.suction,
                                           len(particles))
-        self._contacts = None
-        self._carried = None
+
+    def follow_packing(self, sim):
+        """The forces of the filled units with their grains where they are now, the filled
+        units, the suction and the liquid as they are (no decomposition, filling or drainage:
+        between two steps of the model, the forces follow the grains as the packing moves);
+        each face keeps the side its normal had at the decomposition, so that the forces still
+        sum to zero where a flat unit has turned inside out."""
+        if self.units is None:
+            return
+        sim.fetch("particles")
+        particles = sim.particles
+        self._set_forces(particles, particles.position[self.units.grains],
+                         self._unit_forces.sides)
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
@@ -172,6 +190,21 @@ class LiquidClusters:
         if len(pair_force) == len(self._share):
             gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, particles.force)
+
+    def grain_forces(self, sim):
+        """(N, 3) [N] the forces ``apply`` adds to the grains at ``sim``'s state: the
+        clusters' own, less the shares of the bridges' forces they absorb."""
+        force = np.zeros_like(sim.particles.position)
+        if self._force is None or not (self.filled.any() or self._front_held()):
+            return force
+        force += self._force
+        contacts = sim.contacts
+        pair_force = self.bridges.pair_force
+        share = self.pair_share(contacts)
+        if len(pair_force) == len(share):
+            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
+                               contacts.second_start, contacts.second_pair, force)
+        return force
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed

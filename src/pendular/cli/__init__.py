@@ -269,9 +269,10 @@ RUPTURE_LIQUIDS = ("shared", "lost")
 
 def deprecated_liquid(parser, argv):
     """``argv`` with ``--liquid shared|lost`` (the old name of ``--rupture-liquid``) renamed,
-    one warning line on stderr, for a command that has --rupture-liquid and no --liquid."""
+    one warning line on stderr, for a command that has --rupture-liquid (its --liquid, if
+    any, is the regime: pendular|clusters)."""
     flags = {flag for action in parser._actions for flag in action.option_strings}
-    if "--rupture-liquid" not in flags or "--liquid" in flags:
+    if "--rupture-liquid" not in flags:
         return argv
     renamed = list(argv)
     for k, word in enumerate(renamed):

@@ -33,3 +33,13 @@ def chi_with_clusters(sim, clusters):
                            state.filling_j[index], weight=weight)
     bridges = (float(np.sum(weight * state.volume[index])) * np.eye(3) + caps) / volume
     return bridges + clusters.stress(sim) / clusters.suction
+
+
+def cluster_force_stress(sim, clusters):
+    """(3, 3) [Pa] Love–Weber stress of the forces ``clusters`` add to the grains of ``sim``
+    (LiquidClusters.grain_forces: theirs, less the bridges' shares they absorb), (1/V) sum
+    x (x) F over the grains (the forces sum to zero), with the sign of the bridges'
+    sigma_capillary (tension negative): in static equilibrium sigma_wall = sigma_contact +
+    sigma_capillary + this."""
+    force = clusters.grain_forces(sim)
+    return np.einsum("ki,kj->ij", sim.particles.position, force) / sim.walls.volume()

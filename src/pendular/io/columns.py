@@ -67,8 +67,9 @@ HISTORY_WRITERS = {
     **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
     **dict.fromkeys(("clusters", "liquid_in_bridges", "liquid_in_clusters",
                      "liquid_in_largest_cluster", "largest_cluster_percolates",
-                     "saturation_pore_units"), ("swcc", "tension")),
-    "water_content": ("tension", "path"),
+                     "saturation_pore_units", "chi_with_clusters", "sigma_clusters"),
+                    (*LABORATORY, "swcc", "tension")),
+    "water_content": (*LABORATORY, "swcc", "tension"),
     "liquid_total": ("path",),
     "excess_pore_pressure": ("triaxial",),
     "void_ratio": ("oedometer", "isotropic", "cyclic", "path"),
@@ -146,6 +147,14 @@ HISTORY_COLUMNS = {
     "saturation_pore_units": Column("1", "liquid in the pore units over their pore volume "
                                          "(--liquid clusters; the strip along the walls "
                                          "left out)"),
+    "chi_with_clusters": Column("1", "effective stress parameter of the bridges' shares "
+                                     "outside the filled pore units and of the clusters, "
+                                     "chi_b + psi_c / s (--liquid clusters)", _TENSOR,
+                                equation="Eq. 3.44 with clusters"),
+    "sigma_clusters": Column("Pa", "Love-Weber stress of the liquid clusters' forces, less "
+                                   "the bridges' shares they absorb (tension negative); "
+                                   "sigma_wall = sigma_contact + sigma_capillary + "
+                                   "sigma_clusters in equilibrium (--liquid clusters)", _TENSOR),
     "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
                                     "water content)"),
     "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "

@@ -81,6 +81,12 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
 TENSION_CLUSTER_UNITS = {"suction": "Pa", "clusters": "1", "liquid_in_bridges": "1",
                          "liquid_in_clusters": "1", "liquid_in_largest_cluster": "1",
                          "largest_cluster_percolates": "1", "saturation_pore_units": "1"}
+#: The clusters' figures of a laboratory test at a suction (--liquid clusters,
+#: pendular.procedures.loading_clusters): the tension's, the saturation of bridges and
+#: clusters, chi (tr / 3) with clusters and of the bridges alone, and p' with clusters.
+LABORATORY_CLUSTER_UNITS = {**TENSION_CLUSTER_UNITS, "saturation": "1",
+                            "chi_with_clusters": "1", "chi": "1",
+                            "p_effective_with_clusters": "Pa"}
 
 #: Units of the run options in campaign rows (pendular.procedures.laboratory.parameters, TensionConfig) and
 #: of the columns a Chapter 5 campaign.json adds.
@@ -415,12 +421,25 @@ SUMMARY_KEYS = {
     "pull_time_s": Key("s", "wall-clock time of the pull", _TEN),
     "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
     "case": Key("1", "the case's name: e<void ratio>_w<water content %>", _TEN),
-    "clusters_wet": Key(TENSION_CLUSTER_UNITS, "--liquid clusters: the suction that holds the "
-                        "water once wetted and the clusters then (their number, the liquid's "
-                        "fractions in bridges, clusters and the largest, its percolation along "
-                        "x, y, z, the saturation of the pore units)", _TEN),
-    "clusters_at_peak": Key(TENSION_CLUSTER_UNITS, "--liquid clusters: the same at the peak "
-                            "(the history's row)", _TEN),
+    "cluster_updates": Key("1", "--liquid clusters: updates of the clusters during the "
+                                "loading (one every 10 history rows)", LABORATORY),
+    "cluster_update_time_s": Key("s", "--liquid clusters: wall-clock time of those updates",
+                                 LABORATORY),
+    "clusters_final": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the clusters' figures "
+                          "at the history's last row (their number, the liquid's fractions, "
+                          "percolation, saturations, chi with clusters and of the bridges, "
+                          "p' = p + chi_with_clusters s)",
+                          ("oedometer", "isotropic", "cyclic", "path")),
+    "clusters_wet": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the suction that holds "
+                        "(tension) or is imposed on (a laboratory test) the water once wetted "
+                        "and the clusters then (their number, the liquid's fractions in "
+                        "bridges, clusters and the largest, its percolation along x, y, z, the "
+                        "saturation of the pore units; a laboratory test adds the saturation, "
+                        "chi with clusters and p' = p + chi_with_clusters s)",
+                        (*_TEN, *LABORATORY)),
+    "clusters_at_peak": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the same at the peak "
+                            "(the history's row; a triaxial or path adds the bridges' chi)",
+                            (*_TEN, *SHEARS)),
     # -- the soil-water characteristic curve, swcc.json (pendular.procedures.swcc)
     "drying": Key(SWCC_STAGE_UNITS, "one row per suction of the drying branch, each stage's "
                                "equilibrium: suction, Sr, bridges (and across gaps), "

@@ -269,6 +269,28 @@ def pore_mesh(pore_units, label):
     return meshio.Mesh(points, [("tetra", cells)], cell_data=data)
 
 
+class PoreFrames:
+    """The ParaView series ``folder``/pores.pvd of a run with liquid clusters: one
+    pores_NNNN.vtu a frame (``pore_mesh``: the pore units, cell data ``cluster`` and
+    ``pore_volume``), ParaView's time axis ``time_axis`` (a VTK_FIELDS name)."""
+
+    def __init__(self, folder, time_axis):
+        self.folder, self.time_axis = folder, time_axis
+        self.frames = []
+
+    def write(self, number, pore_units, label, field_data):
+        """Frame ``number`` of the pore units ``pore_units`` labelled by cluster ``label``
+        (-1 empty), ``field_data`` (name -> number, the time axis among them); the .pvd
+        rewritten with the frames so far."""
+        os.makedirs(self.folder, exist_ok=True)
+        name = f"pores_{number:04d}.vtu"
+        write_vtu(os.path.join(self.folder, name), pore_mesh(pore_units, label),
+                  field_data=field_data)
+        self.frames.append((field_data[self.time_axis], name))
+        write_pvd(os.path.join(self.folder, "pores.pvd"), self.frames,
+                  time_axis=self.time_axis)
+
+
 def contact_mesh(sim):
     """The contact network: one line per touching sphere pair (centre to centre) with cell data
     normal_force [N] (spring, compressive), shear_force [N] (magnitude of the elastic shear

@@ -2,9 +2,9 @@
 
 ``history_columns``: the columns every laboratory history has (step, time, strains, wall and
 Love–Weber stresses, porosity, coordination; wet, the bridges' and the effective stresses;
-pendular.io.schema.HISTORY_COLUMNS); ``void_ratio``, ``k0`` and ``COMPRESSION_COLUMNS``, the
-compression tests' own; ``friction_angle`` of principal stresses. Stresses compression
-positive [Pa].
+with liquid clusters, theirs: ``cluster_columns``; pendular.io.columns.HISTORY_COLUMNS);
+``void_ratio``, ``k0`` and ``COMPRESSION_COLUMNS``, the compression tests' own;
+``friction_angle`` of principal stresses. Stresses compression positive [Pa].
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from pendular.dem.measure import porosity
+from pendular.procedures.config import WATER_DENSITY
 from pendular.homogenize.invariants import lateral_stress
 from pendular.homogenize.on_the_fly import homogenized
 
@@ -22,6 +23,47 @@ def capillary_operation(sim):
     """The scene's capillary bridge operation, or None for a dry scene."""
     found = [op for op in sim.forces if hasattr(op, "water_volume")]
     return found[0] if found else None
+
+
+def cluster_operation(sim):
+    """The scene's liquid clusters (pendular.capillary.liquid_clusters.LiquidClusters), or None
+    (--liquid pendular, or dry)."""
+    from pendular.capillary.liquid_clusters import LiquidClusters   # a dry run never needs it
+
+    return next((op for op in sim.forces if isinstance(op, LiquidClusters)), None)
+
+
+def cluster_columns(clusters):
+    """History columns of the liquid clusters (pendular.io.columns.HISTORY_COLUMNS), their
+    figures measured once per state; ``saturation`` and ``water_content``: of the bridges and
+    clusters together;
+    ``chi_with_clusters``: chi of the bridges' shares outside the filled units and of the
+    clusters, ``sigma_clusters`` the Love–Weber stress of the clusters' forces
+    (pendular.homogenize.clusters)."""
+    from pendular.capillary.wetting import gravimetric_water_content
+    from pendular.homogenize.clusters import chi_with_clusters, cluster_force_stress
+
+    last = {}
+
+    def figure(name):
+        def column(sim):
+            key = (sim.step, id(clusters.found))      # a stage's start changes the state
+            if last.get("key") != key:
+                last.update(clusters.statistics(sim), key=key)
+            return last[name]
+        return column
+
+    columns = {name: figure(name) for name in (
+        "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
+        "saturation_pore_units", "saturation")}
+    percolates = figure("largest_cluster_percolates")
+    columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
+    columns["water_content"] = lambda sim: gravimetric_water_content(
+        clusters.account(sim).total, sim.particles.solid_volume(),
+        sim.particles.density / WATER_DENSITY)
+    columns["chi_with_clusters"] = lambda sim: chi_with_clusters(sim, clusters)
+    columns["sigma_clusters"] = lambda sim: cluster_force_stress(sim, clusters)
+    return columns
 
 
 def measured(name):
@@ -44,7 +86,8 @@ def history_columns(sim, axial, reference_volume, bridges=None):
     """Recorded columns of a loading path's history (name -> function of sim); ``axial``
     measures the axial strain (``strain(walls)``); pendular.io.schema declares their units. A
     wet scene adds the capillary and homogenised columns of
-    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)."""
+    pendular.homogenize.on_the_fly.CapillaryHomogenization (Eqs. 3.43-3.46, 3.53-3.54, 4.5)
+    and, with liquid clusters among the scene's forces, ``cluster_columns``."""
 
     columns = {
         "step": lambda s: s.step,
@@ -67,6 +110,9 @@ def history_columns(sim, axial, reference_volume, bridges=None):
             columns.update({"liquid_bridges": lambda s: bridges.liquid_balance(s)[0],
                             "liquid_film": lambda s: bridges.liquid_balance(s)[1],
                             "liquid_lost": lambda s: bridges.liquid_balance(s)[2]})
+        clusters = cluster_operation(sim)
+        if clusters is not None:
+            columns.update(cluster_columns(clusters))
     return columns
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from pendular.capillary import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_CONTACT_ANGLE,
     MAX_ROUGHNESS, SURFACE_TENSION)
 from pendular.dem.sample import load_sample
+from pendular.procedures.loading_clusters import refuse_clusters
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
@@ -98,6 +99,15 @@ def contact_angle_parameter(help="wetting angle", **changes):
     ``changes``: e.g. ``unset``)."""
     return parameter(0.0, unit="deg", low=0.0, high=MAX_CONTACT_ANGLE, high_inclusive=False,
                      flag="--contact-angle", help=help, **changes)
+
+
+def liquid_parameter(where):
+    """The field of a test's liquid regime (``--liquid``, LIQUID_REGIMES): pendular bridges
+    alone (default), or liquid clusters of filled pore units beside them
+    (docs/liquid_clusters.md); ``where``: how the test's clusters start, in words."""
+    return parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                     help="liquid regime: pendular bridges alone, or clusters of filled pore "
+                          f"units beside them ({where}; docs/liquid_clusters.md)")
 
 
 def strain_rate_parameter():
@@ -359,6 +369,9 @@ class LaboratoryConfig:
                                   "and re-equilibrated (isotropic), switched on at the first "
                                   "loading step (at-shear), or added with the walls fixed, then "
                                   "servoed (constant-volume)")
+    liquid: str = liquid_parameter("the sample wetted from dry at --suction or "
+                                   "--water-content, the pore units updated as the packing "
+                                   "deforms")
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
@@ -395,6 +408,12 @@ class LaboratoryConfig:
                                             or self.bridges.water_content is not None):
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
+        if self.liquid == "clusters":
+            refused = refuse_clusters(self)
+            if refused is not None:
+                raise fail(self, "liquid", refused)
+            if not self.bridges.persist and self.bridges.water_content is None:
+                self.bridges = dataclasses.replace(self.bridges, persist=True)
 
     def stage_rates(self):
         """[(where, strain rate [1/s], steps or None)] of the loading's stages that name their

@@ -25,6 +25,8 @@ from pendular.dem.walls import StressServo
 from pendular.io.vtk import VtkWriter
 from pendular.procedures.config import WATER_DENSITY
 from pendular.procedures.loading import run_stage
+from pendular.procedures.loading_clusters import (join_clusters, wet_clusters_at_water_content,
+    wetted_clusters)
 from pendular.procedures.preparation import static
 from pendular.procedures.progress import equilibrium_bar
 from pendular.procedures.water_content import wet_to_water_volume
@@ -73,24 +75,40 @@ def equilibrium_status(unbalanced):
     return status
 
 
-def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None):
+def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None,
+        clusters=False):
     """Add the capillary operation ``bridges`` to the forces of a static sample and run until
-    static again; returns the wetting report (steps, time, Sr, bridges, porosity)."""
+    static again; returns the wetting report (steps, time, Sr, bridges, porosity). With
+    ``clusters``, liquid clusters join the bridges (pendular.procedures.loading_clusters
+    .join_clusters: set before the equilibrium, then again at the packing it reaches, which
+    is run until static once more where units are filled)."""
     sim.forces.append(bridges)
     started = time.perf_counter()
+    joined = join_clusters(sim, bridges) if clusters else None
     steps = equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
                         progress=progress, phase="equilibrium after wetting")
-    return wetting_report(sim, bridges, steps, started)
+    if joined is not None:          # the units of the packing reached, in equilibrium again
+        joined.set_suction(sim, bridges.suction)
+    if joined is not None and joined.filled.any():
+        steps += equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance,
+                             max_steps=max_steps, progress=progress,
+                             phase="equilibrium after wetting with liquid clusters")
+    return wetting_report(sim, bridges, steps, started, clusters=joined)
 
 
-def wetting_report(sim, bridges, steps, started, **details):
+def wetting_report(sim, bridges, steps, started, clusters=None, **details):
     """The report of a wetting that took ``steps`` steps from ``started`` (time.perf_counter,
     [s]): steps and time, ``details`` (what the protocol adds), then the wet state: Sr, the
-    bridges of the operation ``bridges`` and the porosity."""
-    return {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
-            **details, "initial_saturation": bridges.saturation(sim),
-            "initial_bridges": bridges.count(sim),
-            "wet_porosity": porosity(sim.particles, sim.walls)}
+    bridges of the operation ``bridges`` and the porosity; with liquid ``clusters``, their
+    figures (``clusters_wet``; Sr of bridges and clusters together)."""
+    report = {"wetting_steps": steps, "wetting_time_s": time.perf_counter() - started,
+              **details, "initial_saturation": bridges.saturation(sim),
+              "initial_bridges": bridges.count(sim),
+              "wet_porosity": porosity(sim.particles, sim.walls)}
+    if clusters is not None:
+        report["clusters_wet"] = wetted_clusters(sim, clusters)
+        report["initial_saturation"] = report["clusters_wet"]["saturation"]
+    return report
 
 
 def wet_sample(sim, config, *, progress=None):
@@ -112,28 +130,40 @@ def wet_sample(sim, config, *, progress=None):
     pendular.procedures.water_content), the sample re-equilibrated; the liquid is then closed
     (CapillaryBridges.close_liquid), so the shear conserves it.
 
+    With config.liquid 'clusters' (at a suction), liquid clusters join the persisting
+    suction-controlled bridges (pendular.procedures.loading_clusters), the pore units filled
+    at their filling suction before the equilibria and again at the packing they reach (then
+    run until static once more); the report adds ``clusters_wet``. At a water content with
+    clusters, the liquid is a closed volume held by persisting suction-controlled bridges and
+    the clusters at the suction that holds it (loading_clusters.wet_clusters_at_water_content).
+
     The equilibria run on ``sim``'s device (Simulation.device; the wettings at a water content
     from copies of ``sim``, which keep it); the bridges of 'at-shear' form on the host."""
     sample = config.sample
     thresholds = {"unbalanced": sample.equilibrium_unbalanced,
                   "tolerance": sample.stress_tolerance, "max_steps": config.wet_steps}
     if config.bridges.water_content is not None:
+        if config.liquid == "clusters":
+            return _wet_clusters_at_water_content(sim, config, thresholds, progress)
         return _wet_at_water_content(sim, config, thresholds, progress)
     bridges = config.bridges.build()
+    clusters = config.liquid == "clusters"
     if config.wetting == "isotropic":
-        report = wet(sim, bridges, progress=progress, **thresholds)
+        report = wet(sim, bridges, progress=progress, clusters=clusters, **thresholds)
     else:
-        report = _wet_by_protocol(sim, config, bridges, thresholds, progress)
+        report = _wet_by_protocol(sim, config, bridges, thresholds, progress, clusters)
     if config.undrained:                # the water cannot leave during the shear
         bridges.close_liquid(sim, config.bridges.liquid)
         report["liquid_initial"] = bridges.liquid_initial
     return sim, bridges, report
 
 
-def _wet_by_protocol(sim, config, bridges, thresholds, progress):
-    """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols."""
+def _wet_by_protocol(sim, config, bridges, thresholds, progress, clusters=False):
+    """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols (with
+    ``clusters``, liquid clusters beside the bridges, as ``wet``)."""
     started = time.perf_counter()
     sim.forces.append(bridges)
+    joined = join_clusters(sim, bridges) if clusters else None
     steps = 0
     if config.wetting == "at-shear":
         sim.evaluate_forces()               # the bridges form at the sample's contacts
@@ -146,7 +176,13 @@ def _wet_by_protocol(sim, config, bridges, thresholds, progress):
         sim.controls = servo
         steps += equilibrate(sim, phase="equilibrium after wetting at constant volume",
                              progress=progress, **thresholds)
-    report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started)}
+        if joined is not None:
+            joined.set_suction(sim, bridges.suction)
+            if joined.filled.any():
+                steps += equilibrate(sim, progress=progress, **thresholds,
+                                     phase="equilibrium after wetting with liquid clusters")
+    report = {"wetting": config.wetting, **wetting_report(sim, bridges, steps, started,
+                                                          clusters=joined)}
     if config.wetting == "constant-volume":
         report["sigma_wall_at_constant_volume"] = fixed_stress
     return report
@@ -185,6 +221,27 @@ def _wet_at_water_content(dry, config, thresholds, progress):
         sim, bridges, sum(t["steps"] for t in tries), started,
         formation_suction_pa=tries[-1]["formation_suction_pa"], water_content=water_content,
         wetting_attempts=tries, liquid_initial=bridges.liquid_initial)}
+
+
+def _wet_clusters_at_water_content(sim, config, thresholds, progress):
+    """wet_sample at config.bridges.water_content with liquid clusters
+    (pendular.procedures.loading_clusters.wet_clusters_at_water_content)."""
+    from pendular.capillary import gravimetric_water_content
+
+    particles = sim.particles
+    specific_gravity = particles.density / WATER_DENSITY
+    target = config.bridges.water_content * specific_gravity * particles.solid_volume()
+    started = time.perf_counter()
+    bridges, clusters, details = wet_clusters_at_water_content(
+        sim, config.bridges, target,
+        lambda s: equilibrate(s, progress=progress, phase="equilibrium after wetting",
+                              **thresholds))
+    steps = details.pop("wetting_steps")
+    water_content = gravimetric_water_content(clusters.account(sim).total,
+                                              particles.solid_volume(), specific_gravity)
+    return sim, bridges, {"wetting": "water-content", **wetting_report(
+        sim, bridges, steps, started, clusters=clusters, water_content=water_content,
+        **details)}
 
 
 @contextlib.contextmanager

@@ -38,13 +38,15 @@ from pendular.io.history import write_history
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import run_label
 from pendular.io.schema import SUMMARY_UNITS
-from pendular.io.vtk import VtkWriter, axial_strain_fields
+from pendular.io.vtk import PoreFrames, VtkWriter, axial_strain_fields
 from pendular.procedures.config import (LaboratoryConfig, config_from_dict, config_to_dict,
     inertial_number, sized_as_sample)
 from pendular.procedures.equilibrium import (equilibrate, frame_period, frames_writer,
     prep_vtk_period, watched, wet_sample)
+from pendular.procedures.columns import cluster_operation
 from pendular.procedures.guards import AxialContactLost, SampleCrushed
 from pendular.procedures.loading import VTK_RECORDS, check_stages_device
+from pendular.procedures.loading_clusters import CLUSTER_RECORDS, ClusterUpdates, cluster_summary
 from pendular.procedures.feasibility import check_feasible
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
     servoed_simulation, timestep, timestep_description)
@@ -89,12 +91,14 @@ def stress_balance(history):
 
 
 def stress_balance_error(history):
-    """Per record, max over the axes of |sigma_wall - diag(sigma_contact + sigma_capillary)| / p
-    (p the mean wall stress): how far the wall stress and the Love–Weber stress (Eq. 3.41) of
-    the contacts and bridges inside are from the balance that holds in equilibrium."""
+    """Per record, max over the axes of |sigma_wall - diag(sigma_contact + sigma_capillary +
+    sigma_clusters)| / p (p the mean wall stress): how far the wall stress and the Love–Weber
+    stress (Eq. 3.41) of the contacts, bridges and liquid clusters inside are from the balance
+    that holds in equilibrium."""
     inside = history["sigma_contact"]
-    if "sigma_capillary" in history:
-        inside = inside + history["sigma_capillary"]
+    for name in ("sigma_capillary", "sigma_clusters"):
+        if name in history:
+            inside = inside + history[name]
     wall = history["sigma_wall"]
     return (np.abs(np.diagonal(inside, axis1=1, axis2=2) - wall).max(axis=1)
             / np.abs(mean_stress(wall)))
@@ -120,7 +124,8 @@ def parameters(config):
                      "persist_bridges": bridges.persist, "control": bridges.control,
                      "water_content_percent": (None if bridges.water_content is None
                                                else 100.0 * bridges.water_content),
-                     "liquid": None if bridges.water_content is None else bridges.liquid,
+                     "liquid": (config.liquid if config.liquid != "pendular" else None
+                                if bridges.water_content is None else bridges.liquid),
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
     return flat
@@ -231,6 +236,9 @@ class LaboratoryTest:
         ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
         the wetting, the loading), "cpu" or "gpu" (``check_device``)."""
         options = RunOptions.of(options, **settings)
+        if self.config.liquid == "clusters" and options.device != "cpu":
+            raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the "
+                             f"host's): --device {options.device} does not apply")
         check_device(options.device)
         check_stages_device(self.stages(), options.device)
         vtk_prep = options.vtk_prep
@@ -349,7 +357,8 @@ class LaboratoryTest:
     def outputs(self):
         """Files and folders the test owns in its output folder (pendular.io.outputs)."""
         return ("history.h5", "summary.json", self.FIGURE, "plots", "vtk", "sample.h5",
-                "checkpoint.h5", "vtk_prep")
+                "checkpoint.h5", "vtk_prep") + (("pores",) if self.config.liquid == "clusters"
+                                                else ())
 
     def loading(self, sim):
         """The LoadingPath of the test attached to the static sample ``sim`` (time step set)."""
@@ -410,6 +419,17 @@ class _PathRun:
         field_data, time_axis = test.frame_fields(self.path)
         self.vtk = frames_writer(sim, out, self.vtk_period, field_data=field_data,
                                  time_axis=time_axis)
+        self.cluster_updates = None
+        clusters = cluster_operation(sim)
+        if clusters is not None:            # after the recorder: its rows show the update
+            recorder = self.path.recorder
+            closed = config.bridges.water_content is not None     # the liquid held: a volume
+            self.cluster_updates = ClusterUpdates(
+                sim, clusters, recorder.period, CLUSTER_RECORDS, recorder.origin,
+                None if self.vtk is None else PoreFrames(os.path.join(out, "pores"),
+                                                         time_axis), field_data,
+                before_shear["wetting"]["liquid_initial"] if closed else None)
+            sim.writers.append(self.cluster_updates)
         self.checkpoint = None
         if config.checkpoint_every > 0:
             self.checkpoint = CheckpointWriter(os.path.join(out, "checkpoint.h5"),
@@ -520,6 +540,12 @@ class _PathRun:
             "grading": grading(sim.particles.radius),
             **self.before_shear["wetting"],
         })
+        if "clusters" in history:
+            summary.update(cluster_summary(
+                history, summary.get("peak_index", -1),
+                "clusters_at_peak" if "peak_index" in summary else "clusters_final"))
+            summary.update({"cluster_updates": self.cluster_updates.updates,
+                            "cluster_update_time_s": self.cluster_updates.time_s})
         wetting = self.before_shear["wetting"]
         if "wet_porosity" in wetting:
             before, after = preparation["porosity"], wetting["wet_porosity"]

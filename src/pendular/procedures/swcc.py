@@ -64,15 +64,15 @@ from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.homogenize.regular_packing import KINDS
 from pendular.io.history import write_history
-from pendular.io.vtk import pore_mesh, write_pvd, write_vtu
+from pendular.io.vtk import PoreFrames
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_swcc
 from pendular.io.schema import SWCC_STAGE_UNITS
 from pendular.procedures.columns import history_columns
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import (AVERAGES, LIQUID_REGIMES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
+from pendular.procedures.config import (AVERAGES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
     check_loaded_confining, check_particles, config_from_dict, config_to_dict,
-    contact_angle_parameter, registered, stage_steps_parameter)
+    contact_angle_parameter, liquid_parameter, registered, stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
@@ -122,10 +122,7 @@ class SwccConfig:
     stage_steps: int = stage_steps_parameter(200000, "most steps per stage to reach equilibrium")
     record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
                                   help="steps between history records")
-    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
-                            help="liquid regime: pendular bridges alone, or clusters of filled "
-                                 "pore units beside them (drying from saturation; "
-                                 "docs/liquid_clusters.md)")
+    liquid: str = liquid_parameter("drying from saturation")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -317,9 +314,7 @@ class SwccPath:
             self.clusters = LiquidClusters(bridges, saturated=True)
             sim.forces.append(self.clusters)
         axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
-        columns = history_columns(sim, axial, self.dry_volume, bridges)
-        if self.clusters is not None:
-            columns.update(cluster_columns(self.clusters))
+        columns = history_columns(sim, axial, self.dry_volume, bridges)   # clusters' too
         self.recorder = HistoryRecorder(config.record_every, columns, origin=sim.step)
         self.homogenization = CapillaryHomogenization(bridges)
         suctions = list(config.suctions)
@@ -327,7 +322,7 @@ class SwccPath:
         self.index, self.stage_start = 0, None
         self.stages = {"drying": [], "wetting": []}
         self.formed = 0
-        self.pore_frames = []
+        self.pore_frames = PoreFrames(os.path.join(out, "pores"), "stage")
         self.path_time = 0.0         # seconds spent on the path by earlier (interrupted) runs
         self._static = static(config.sample.equilibrium_unbalanced,
                               config.sample.stress_tolerance)
@@ -438,15 +433,9 @@ class SwccPath:
 
     def write_pores(self, suction):
         """pores/pores_NNNN.vtu of the stage just ended (its index NNNN) and pores/pores.pvd
-        of the stages so far (pendular.io.vtk.pore_mesh)."""
-        folder = os.path.join(self.out, "pores")
-        os.makedirs(folder, exist_ok=True)
-        name = f"pores_{self.index:04d}.vtu"
-        write_vtu(os.path.join(folder, name),
-                  pore_mesh(self.clusters.units, self.clusters.found.label),
-                  field_data={"stage": self.index, "suction": suction})
-        self.pore_frames.append((self.index, name))
-        write_pvd(os.path.join(folder, "pores.pvd"), self.pore_frames, time_axis="stage")
+        of the stages so far (pendular.io.vtk.PoreFrames)."""
+        self.pore_frames.write(self.index, self.clusters.units, self.clusters.found.label,
+                               {"stage": self.index, "suction": suction})
 
     def write_outputs(self):
         """history.h5, swcc.json and swcc.png; returns the swcc.json content."""
@@ -470,27 +459,6 @@ class SwccPath:
         write_json(os.path.join(out, "swcc.json"), result)
         plot_swcc(os.path.join(out, "swcc.png"), result)
         return result
-
-
-def cluster_columns(clusters):
-    """History columns of the liquid clusters (pendular.io.schema.HISTORY_COLUMNS), their
-    figures measured once per state; ``saturation``: of the bridges and clusters together."""
-    last = {}
-
-    def figure(name):
-        def column(sim):
-            key = (sim.step, id(clusters.found))      # a stage's start changes the state
-            if last.get("key") != key:
-                last.update(clusters.statistics(sim), key=key)
-            return last[name]
-        return column
-
-    columns = {name: figure(name) for name in (
-        "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
-        "saturation_pore_units", "saturation")}
-    percolates = figure("largest_cluster_percolates")
-    columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
-    return columns
 
 
 def hysteresis(stages):

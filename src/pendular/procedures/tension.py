@@ -71,9 +71,9 @@ from pendular.homogenize import packing_state, regular_packing
 from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
-from pendular.procedures.config import (LIQUID_REGIMES, MAX_SURFACE_TENSION, WATER_DENSITY,
-    check_particles, check_steps_count, config_from_dict, config_to_dict,
-    contact_angle_parameter, inertial_number, registered)
+from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
+    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
+    inertial_number, liquid_parameter, registered)
 from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
@@ -247,10 +247,7 @@ class TensionConfig:
     vtk_every: int | None = parameter(None, kind=int, low=0, flag="--vtk-every",
                                       help="steps between ParaView frames of the pull, instead "
                                            "of --vtk-frames (0: none)")
-    liquid: str = parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
-                            help="liquid regime: pendular bridges alone, or clusters of filled "
-                                 "pore units beside them at the suction that holds the water "
-                                 "(--roughness 0; docs/liquid_clusters.md)")
+    liquid: str = liquid_parameter("at the suction that holds the water; --roughness 0")
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):

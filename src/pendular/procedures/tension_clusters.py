@@ -31,7 +31,7 @@ from pendular.capillary.table import BridgeTable
 from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import formation_suction, gravimetric_water_content
 from pendular.dem.measure import coordination, unbalanced_force
-from pendular.procedures.swcc import cluster_columns as cluster_figures
+from pendular.procedures.columns import cluster_columns as cluster_figures
 from pendular.utils.parameters import ParameterError
 
 #: Closed-liquid solutions of a pull (LiquidClusters.hold_volume) over --max-strain.
@@ -132,7 +132,7 @@ class ClosedLiquidUpdates:
 
 def cluster_columns(clusters, solid_volume, specific_gravity):
     """The pull's history columns of the clusters: the SWCC's
-    (pendular.procedures.swcc.cluster_columns: their number, the liquid's fractions,
+    (pendular.procedures.columns.cluster_columns: their number, the liquid's fractions,
     percolation, the saturations of bridges and clusters together), the suction, and the
     water content of the liquid held, bridges and clusters together (``solid_volume``
     [m^3], ``specific_gravity`` Gs)."""

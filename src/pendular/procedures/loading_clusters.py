@@ -1,0 +1,199 @@
+"""Liquid clusters in a laboratory test (``--liquid clusters``; docs/liquid_clusters.md 'In
+the DEM and the commands').
+
+At a suction the sample is wetted from dry: persisting suction-controlled bridges and
+pendular.capillary.liquid_clusters.LiquidClusters(bridges, saturated=False) join its forces
+(``join_clusters``), the units whose filling suction is at least the suction fill
+(LiquidClusters.set_suction) before the wetting's equilibrium, and again at the packing it
+settles to. At a water content the suction is the one that holds the closed liquid
+(``wet_clusters_at_water_content``, LiquidClusters.hold_volume). During the loading
+``ClusterUpdates`` steps the model again every CLUSTER_RECORDS history records, at the packing
+as it stands (decomposed again, the filled units carried over, pore filling, then Haines jumps
+where pores opened), writing a frame of pores/ each time; at every history record in between,
+the filled units' forces follow their grains (LiquidClusters.follow_packing: the same units,
+filled state and suction, the forces at the grains' positions then). ``cluster_summary``: the
+clusters' figures of a history row, with the effective stress of bridges and clusters;
+``refuse_clusters``: what a configuration with clusters cannot run with.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from pendular.homogenize.invariants import mean_stress
+
+#: History records between two updates of the clusters during a loading (the ParaView frames'
+#: default spacing, pendular.procedures.loading.VTK_RECORDS): about 50 over a triaxial of 500
+#: records; each costs about one decomposition of the packing (docs/liquid_clusters.md
+#: 'Cost'). At every record in between, the clusters' forces follow the grains.
+CLUSTER_RECORDS = 10
+
+#: The clusters' figures of a history row kept in a summary (``cluster_summary``).
+CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
+                   "liquid_in_largest_cluster", "largest_cluster_percolates",
+                   "saturation_pore_units", "saturation")
+
+
+def refuse_clusters(config) -> str | None:
+    """Why the LaboratoryConfig ``config`` with liquid clusters cannot run (naming --liquid
+    and the option it cannot run with), or None."""
+    bridges = config.bridges
+    if bridges is None:
+        return ("--liquid clusters needs a wet test: give --suction > 0 or --water-content "
+                "(--suction 0 is dry)")
+    if config.undrained:
+        return ("--liquid clusters holds the liquid in suction-controlled bridges and "
+                "clusters: not with --drainage undrained (volume-controlled bridges)")
+    if bridges.model != "exact":
+        return f"--liquid clusters needs the exact bridges, not --bridges {bridges.model}"
+    if config.sample.periodic:
+        return ("--liquid clusters runs between walls, not in a periodic cell (--periodic, a "
+                "simple shear): its cluster forces would need their face terms in the cell's "
+                "stress")
+    if config.checkpoint_every:
+        return (f"--liquid clusters runs without checkpoints (its pore units are the host's "
+                f"and not checkpointed): --checkpoint-every {config.checkpoint_every} does not "
+                "apply")
+    return None
+
+
+def join_clusters(sim, bridges):
+    """LiquidClusters of the persisting suction-controlled ``bridges`` (already among
+    ``sim``'s forces), the pore units empty (a sample wetted from dry), appended to the forces
+    and set at the bridges' suction at ``sim``'s packing now."""
+    from pendular.capillary.liquid_clusters import LiquidClusters   # a dry run never needs it
+
+    clusters = LiquidClusters(bridges, saturated=False)
+    sim.forces.append(clusters)
+    clusters.set_suction(sim, bridges.suction)
+    return clusters
+
+
+def wetted_clusters(sim, clusters):
+    """The clusters' figures once wetted (a wetting report's ``clusters_wet``)."""
+    from pendular.homogenize.clusters import chi_with_clusters
+
+    statistics = clusters.statistics(sim)
+    figures = {"suction": clusters.suction,
+               **{name: statistics[name] for name in CLUSTER_FIGURES[1:]},
+               "chi_with_clusters": float(np.trace(chi_with_clusters(sim, clusters)) / 3.0)}
+    figures["p_effective_with_clusters"] = float(
+        mean_stress(sim.walls.stress()) + figures["chi_with_clusters"] * clusters.suction)
+    return figures
+
+
+def wet_clusters_at_water_content(dry, bridges_config, target, settle):
+    """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
+    liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
+    bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
+    contact angle), the pore units empty at first (liquid added to dry grains): the suction
+    found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
+    sample run until static (``settle(sim)``, the steps), the suction found again at the
+    packing reached and, where units are filled, the sample run until static once more.
+    Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
+    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at
+    contact cannot hold it within the pendular limit."""
+    from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
+                                    sample_radius_ratios)
+    from pendular.capillary.liquid_clusters import LiquidClusters
+    from pendular.capillary.validation import NotPendular
+
+    sim, particles = dry, dry.particles
+    if sim.contacts is None:
+        sim.evaluate_forces()
+    touching = sim.contacts.overlap > 0.0
+    table = BridgeTable.cached(bridges_config.contact_angle,
+                               radius_ratios=sample_radius_ratios(particles.radius))
+    # the bridges' alone: the clusters hold more at a suction, so theirs is higher
+    start = formation_suction(table, particles.radius[sim.contacts.pair_i[touching]],
+                              particles.radius[sim.contacts.pair_j[touching]], target,
+                              bridges_config.surface_tension)
+    bridges = CapillaryBridges(start, bridges_config.surface_tension,
+                               bridges_config.contact_angle, persist=True)
+    clusters = LiquidClusters(bridges, saturated=False)
+    sim.forces += [bridges, clusters]
+    try:
+        sim.evaluate_forces()
+        clusters.hold_volume(sim, target)
+        steps = settle(sim)
+        found = clusters.hold_volume(sim, target)
+        if clusters.filled.any():
+            steps += settle(sim)
+    except NotPendular as error:
+        raise ValueError(
+            f"--water-content = {100.0 * bridges_config.water_content:g} % is more than this "
+            f"sample holds with --liquid clusters: its liquid is held at {error.suction:.4g} "
+            f"Pa, below the {error.lowest:.4g} Pa where bridges at contact pass the pendular "
+            "limit; lower --water-content") from None
+    return bridges, clusters, {"wetting_steps": steps, "formation_suction_pa": found.suction,
+                               "liquid_initial": target}
+
+
+class ClusterUpdates:
+    """Writer: every ``follow`` steps from step ``origin`` the clusters' forces follow the
+    grains (LiquidClusters.follow_packing), and every ``updates_every``-th time instead
+    ``clusters`` take their bridges' suction again at the packing as it stands
+    (LiquidClusters.set_suction), or with a closed liquid ``volume`` [m^3] the suction that
+    holds it there (LiquidClusters.hold_volume); at the step the bridges' suction changes (a
+    path's suction stage) too, at most once every ``follow`` steps while it changes; and
+    ``frames``
+    (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
+    ``field_data(sim)`` (the loading's frame fields) and the suction; the first frame, the
+    state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
+    ``time_s``: the wall time of the updates and of the forces following the grains [s]."""
+
+    def __init__(self, sim, clusters, follow, updates_every, origin, frames=None,
+                 field_data=None, volume=None):
+        self.clusters, self.frames, self.field_data = clusters, frames, field_data
+        self.volume = volume
+        self.follow = max(1, int(follow))
+        self.period, self.origin = self.follow * max(1, int(updates_every)), int(origin)
+        self.updates, self.time_s = 0, 0.0
+        self._updated = self.origin
+        self._frame(sim)
+
+    def apply(self, sim):
+        taken = sim.step - self.origin
+        changed = (self.volume is None and self.clusters.bridges.suction != self.clusters.suction
+                   and sim.step - self._updated >= self.follow)
+        if taken == 0 or (taken % self.follow and not changed):
+            return
+        started = time.perf_counter()
+        if taken % self.period and not changed:
+            self.clusters.follow_packing(sim)
+            self.time_s += time.perf_counter() - started
+            return
+        self._updated = sim.step
+        if self.volume is None:
+            self.clusters.set_suction(sim, self.clusters.bridges.suction)
+        else:
+            self.clusters.hold_volume(sim, self.volume)
+        self.updates += 1
+        self.time_s += time.perf_counter() - started
+        self._frame(sim)
+
+    def _frame(self, sim):
+        if self.frames is not None:
+            self.frames.write(len(self.frames.frames), self.clusters.units,
+                              self.clusters.found.label,
+                              {**self.field_data(sim), "suction": self.clusters.suction})
+
+
+def cluster_summary(history, row: int, key: str) -> dict:
+    """{``key``: the clusters' figures of ``history`` row ``row``}: CLUSTER_FIGURES,
+    ``chi_with_clusters`` and the bridges' ``chi`` (each tr chi / 3), and
+    ``p_effective_with_clusters`` = p + chi_with_clusters s (Eq. 3.43's form, u_a = 0; p the
+    mean wall stress) [Pa]."""
+    figures = {}
+    for name in CLUSTER_FIGURES:
+        value = np.asarray(history[name][row])
+        figures[name] = (value.astype(bool).tolist() if name == "largest_cluster_percolates"
+                         else int(value) if name == "clusters" else float(value))
+    chi = float(np.trace(history["chi_with_clusters"][row]) / 3.0)
+    figures.update({"chi_with_clusters": chi,
+                    "chi": float(np.trace(history["chi"][row]) / 3.0),
+                    "p_effective_with_clusters": float(
+                        mean_stress(history["sigma_wall"][row]) + chi * figures["suction"])})
+    return {key: figures}
