@@ -8,11 +8,13 @@ concurrent runs on one folder, a run into a used folder, SIGINT during a shear. 
 identities and the physical checks of samples at the library level, and tampered table caches,
 are in tests/unit/test_integrity.py (not repeated here).
 
-Option cases, and runs whose ending the test reads from their exit status and stderr, run
-in-process through pendular.cli.run_command; the runs a signal stops, and the runs those leave
-behind, are subprocesses; all of 60 spheres.
+Option cases, the runs the tests damage or run over, and runs whose ending the test reads from
+their exit status and stderr, run in-process through pendular.cli.run_command; the runs a
+signal stops are subprocesses; all of 60 spheres.
 """
 
+import contextlib
+import io
 import json
 import os
 import shutil
@@ -44,12 +46,16 @@ def command(argv, capsys):
     return run_in_process("triaxial", argv, capsys, prog="triaxial.py")
 
 
-def script(argv, cwd, timeout=900, **options):
-    """``triaxial.py ARGV`` run in a process of its own (``timeout`` [s]: a bound on a hung
-    run, far beyond a run's time in a fresh clone, whose first runs compile the kernels, on a
-    loaded machine)."""
-    return subprocess.run([sys.executable, SCRIPT, *argv], cwd=cwd, capture_output=True,
-                          text=True, timeout=timeout, **options)
+def quietly(argv):
+    """(exit status, stderr) of ``triaxial.py ARGV`` run in-process, its output kept from the
+    test's (for the module's fixtures, which have no capsys)."""
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            status = run_command("triaxial", [str(a) for a in argv], prog="triaxial.py")
+        except SystemExit as stop:
+            status = stop.code
+    return status, err.getvalue()
 
 
 # ---------------------------------------------------------------- extreme settings
@@ -123,9 +129,9 @@ def test_an_out_that_is_a_file_is_refused(tmp_path, capsys):
 def interrupted(tmp_path_factory):
     """An interrupted run of 60 spheres with a checkpoint (folder), as --stop-after leaves it."""
     out = tmp_path_factory.mktemp("faults") / "run"
-    done = script(TINY + ["--checkpoint-every", "50", "--stop-after", "120", "--out", str(out)],
-                  cwd=out.parent)
-    assert done.returncode == 130, done.stderr
+    status, err = quietly(TINY + ["--checkpoint-every", "50", "--stop-after", "120",
+                                  "--out", out])
+    assert status == 130, err
     assert json.loads((out / "summary.json").read_text())["completed"] is False
     return out
 
@@ -241,8 +247,8 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 def finished(tmp_path_factory):
     """A finished run of 60 spheres (folder) with a checkpoint."""
     out = tmp_path_factory.mktemp("finished") / "run"
-    done = script(TINY + ["--checkpoint-every", "100", "--out", str(out)], cwd=out.parent)
-    assert done.returncode == 0, done.stderr
+    status, err = quietly(TINY + ["--checkpoint-every", "100", "--out", out])
+    assert status == 0, err
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     return out
 
@@ -369,10 +375,11 @@ def test_a_bad_sample_into_a_used_folder_touches_nothing(finished, tmp_path, cap
     assert {path: path.read_bytes() for path in out.rglob("*") if path.is_file()} == before
 
 
-def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_path):
+def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_path, capsys):
     """kill -9 during the shear leaves the earlier results aside and the new run's checkpoint
     in place: --resume finishes the new run (the earlier results go then); a new run instead
-    first puts the earlier results back, and keeps them if it fails."""
+    first puts the earlier results back, and keeps them if it fails (the killed runs are
+    processes; the runs after them, in-process)."""
     argv = TINY + ["--seed", "1", "--checkpoint-every", "100"]
     for then in ("resume", "replace"):
         out = tmp_path / then
@@ -381,14 +388,14 @@ def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_
         status, _ = interrupt_at("shear", argv + ["--out", str(out)], tmp_path, signal.SIGKILL)
         assert status == -signal.SIGKILL and (out / ".pendular-earlier").is_dir()
         if then == "resume":
-            done = script(["--resume", str(out), "--quiet"], cwd=tmp_path)
-            assert done.returncode == 0, done.stderr
-            assert "holds the results of an earlier run" in done.stderr
+            status, err = command(["--resume", out, "--quiet"], capsys)
+            assert status == 0, err
+            assert "holds the results of an earlier run" in err
             assert json.loads((out / "summary.json").read_text())["completed"] is True
             assert outputs(out)["summary.json"] != before["summary.json"]
         else:
-            done = script(TINY + WET + ["--wet-steps", "1", "--out", str(out)], cwd=tmp_path)
-            assert done.returncode == 2, done.stderr
+            status, err = command(TINY + WET + ["--wet-steps", "1", "--out", out], capsys)
+            assert status == 2, err
             assert outputs(out) == before
         assert not (out / ".pendular-earlier").exists()
 
