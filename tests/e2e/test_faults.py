@@ -242,7 +242,8 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 
 # ---------------------------------------------------------------- signals
 # Each run waits at a known phase (pendular.utils.interrupt.pause_point, PENDULAR_TEST_PAUSE_AT)
-# until the test's signal arrives there: nothing races the machine's speed.
+# until the test's signal arrives there: nothing races the machine's speed. The runs stopped
+# in the shear or after it start from the finished run's sample (--sample).
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """A finished run of 60 spheres (folder) with a checkpoint."""
@@ -307,9 +308,10 @@ def test_ctrl_c_before_the_shear_exits_in_one_line_leaving_the_phase_reached(pha
     assert not (out / "sample.h5").exists() and not (out / ".pendular-earlier").exists()
 
 
-def test_ctrl_c_during_the_shear_keeps_the_history_so_far(tmp_path):
+def test_ctrl_c_during_the_shear_keeps_the_history_so_far(finished, tmp_path):
     out = tmp_path / "out"
-    status, err = interrupt_at("shear", TINY + ["--out", str(out)], tmp_path)
+    sample = ["--sample", str(finished / "sample.h5")]
+    status, err = interrupt_at("shear", TINY + sample + ["--out", str(out)], tmp_path)
     assert status == 130 and "interrupted at step" in last_line(err), err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is False and summary["phase"] == "shear"
@@ -318,10 +320,11 @@ def test_ctrl_c_during_the_shear_keeps_the_history_so_far(tmp_path):
     assert len(steps) >= 2 and steps[-1] - steps[0] < summary["steps"]
 
 
-def test_ctrl_c_while_the_results_are_written_leaves_them_whole(tmp_path):
+def test_ctrl_c_while_the_results_are_written_leaves_them_whole(finished, tmp_path):
     """Between history.h5 and summary.json: both are written, then the run ends (130)."""
     out = tmp_path / "out"
-    status, err = interrupt_at("write", TINY + ["--out", str(out)], tmp_path)
+    sample = ["--sample", str(finished / "sample.h5")]
+    status, err = interrupt_at("write", TINY + sample + ["--out", str(out)], tmp_path)
     assert status == 130 and last_line(err) == "triaxial.py: interrupted", err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True and "phase" not in summary
@@ -380,7 +383,8 @@ def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_
     in place: --resume finishes the new run (the earlier results go then); a new run instead
     first puts the earlier results back, and keeps them if it fails (the killed runs are
     processes; the runs after them, in-process)."""
-    argv = TINY + ["--seed", "1", "--checkpoint-every", "100"]
+    argv = TINY + ["--seed", "1", "--checkpoint-every", "100",
+                   "--sample", str(finished / "sample.h5")]
     for then in ("resume", "replace"):
         out = tmp_path / then
         shutil.copytree(finished, out)

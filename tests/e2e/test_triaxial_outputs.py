@@ -140,9 +140,10 @@ def test_resume_refuses_new_arguments_and_runs_without_checkpoint(tmp_path, caps
 
 def test_a_run_at_a_water_content_resumes_with_its_liquid_account(tmp_path, capsys):
     """The closed liquid (--water-content, shared at rupture) comes back from the checkpoint:
-    the resumed history has the uninterrupted one's liquid columns, to the bit (no ParaView
-    frames: their series across a resume is checked above)."""
-    argv = [*BASE, "--water-content", "1", "--rupture-liquid", "shared", "--vtk-frames", "0"]
+    the resumed history has the uninterrupted one's liquid columns, to the bit (60 spheres, no
+    ParaView frames: their series across a resume is checked above)."""
+    argv = [*BASE[2:], "--particles", "60", "--water-content", "1", "--rupture-liquid", "shared",
+            "--vtk-frames", "0"]
     whole, run = tmp_path / "whole", tmp_path / "interrupted"
     status, err = in_process(capsys, *argv, "--out", whole)
     assert status == 0, err
