@@ -31,8 +31,8 @@ from pendular.studies.run_kinds import PROCEDURES
 TABLE = """
 command = "triaxial"
 [fixed]
-particles = 150
-max_strain = 0.01
+particles = 100
+max_strain = 0.005
 inertial_number = 3e-3
 vtk_every = 0
 [sweep]
@@ -62,7 +62,7 @@ def test_two_by_two_sweep_runs_writes_its_table_and_reuses_its_runs(tmp_path, ca
         (0, 250), (0, 750), (30000, 250), (30000, 750)]
     peak = {}
     for row in rows:
-        assert row["status"] == "run" and row["particles"] == "150"
+        assert row["status"] == "run" and row["particles"] == "100"
         folder = out / "runs" / row["run"]
         assert float(row["peak_q"]) == pytest.approx(summary_of(folder)["peak_q"], rel=1e-6)
         peak[float(row["suction"]), float(row["confining"])] = float(row["peak_q"])

@@ -28,7 +28,7 @@ KEYS = ("suction", "confining", "peak_axial_stress", "peak_q", "p_at_peak",
 ARGUMENTS = ["particles", "suctions", "confining", "jobs", "out", "seed", "max_strain",
              "inertial_number", "prep_friction", "scheduler"]
 SMALL = ["--particles", "120", "--suctions", "0,30000", "--confining", "500,1000",
-         "--max-strain", "0.03", "--inertial-number", "3e-3", "--jobs", "2"]
+         "--max-strain", "0.015", "--inertial-number", "3e-3", "--jobs", "2"]
 
 
 # ---------------------------------------------------------------- library, no runs

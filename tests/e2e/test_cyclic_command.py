@@ -17,8 +17,10 @@ CYCLE_KEYS = {"cycle", "secant_modulus", "damping_ratio", "axial_strain_max", "a
 
 @pytest.fixture(scope="module")
 def cyclic_run(tmp_path_factory):
+    """A run with checkpoints: the uninterrupted run the resume test stops and resumes."""
     out = tmp_path_factory.mktemp("cyclic") / "run"
-    subprocess.run([sys.executable, "-m", "pendular.cli", "cyclic", *SMALL, "--out", str(out)],
+    subprocess.run([sys.executable, "-m", "pendular.cli", "cyclic", *SMALL,
+                    "--checkpoint-every", "500", "--out", str(out)],
                    check=True, capture_output=True, text=True, timeout=600)
     return out
 
@@ -49,11 +51,12 @@ def test_a_stress_controlled_run_gives_its_loops_modulus_and_damping(cyclic_run)
     assert_drawn(cyclic_run / "plots" / "stress_path.png")
 
 
-def test_a_resumed_cyclic_run_has_the_history_of_an_uninterrupted_one(tmp_path, capsys):
-    whole, out = tmp_path / "whole", tmp_path / "stopped"
+def test_a_resumed_cyclic_run_has_the_history_of_an_uninterrupted_one(cyclic_run, tmp_path,
+                                                                      capsys):
+    """Stopped and resumed, the run of the module's cyclic run (the same options and
+    checkpoints) gives its history."""
+    whole, out = cyclic_run, tmp_path / "stopped"
     argv = [*SMALL, "--checkpoint-every", "500"]
-    status, err = run_in_process("cyclic", [*argv, "--out", whole], capsys)
-    assert status == 0, err
     steps = summary_of(whole)["steps"]
     status, _ = run_in_process("cyclic", [*argv, "--out", out,
                                           "--stop-after", str(int(0.6 * steps))], capsys)

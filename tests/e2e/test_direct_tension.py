@@ -211,10 +211,10 @@ def test_unreachable_void_ratio_is_refused_with_the_reachable_range(args):
 def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     out = tmp_path / "tension"
     done = subprocess.run([sys.executable, os.path.join(ROOT, "scenarios", "direct_tension.py"),
-                           "--particles", "200", "--void-ratio", "0.65", "--water-content", "1",
+                           "--particles", "100", "--void-ratio", "0.72", "--water-content", "1",
                            "--max-strain", "0.01", "--vtk-every", "2000", "--quiet", "--out",
                            str(out)], check=True, capture_output=True, text=True)
-    assert json.loads(done.stdout)["cases"][0]["case"] == "e0.65_w1.00"   # --quiet: JSON alone
+    assert json.loads(done.stdout)["cases"][0]["case"] == "e0.72_w1.00"   # --quiet: JSON alone
     result = json.loads((out / "tension.json").read_text())
     (case,) = result["cases"]
     assert not undeclared_keys(case, "tension")
@@ -224,9 +224,9 @@ def test_command_runs_one_case_and_writes_its_outputs(tmp_path):
     assert (out / "report.md").exists() and (folder / "history.h5").exists()
     assert list((folder / "vtk").glob("*.pvd"))
     # the command line as given, and the configuration it built
-    assert result["arguments"]["void_ratio"] == "0.65" and result["arguments"]["quiet"] is True
+    assert result["arguments"]["void_ratio"] == "0.72" and result["arguments"]["quiet"] is True
     config = config_from_dict(result["config"])
-    assert config.vtk_every == 2000 and config.sample.particles == 200
+    assert config.vtk_every == 2000 and config.sample.particles == 100
 
 
 def test_prediction_is_chapter4s_kim_comparison(args):

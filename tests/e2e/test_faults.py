@@ -8,11 +8,13 @@ concurrent runs on one folder, a run into a used folder, SIGINT during a shear. 
 identities and the physical checks of samples at the library level, and tampered table caches,
 are in tests/unit/test_integrity.py (not repeated here).
 
-Option cases, and runs whose ending the test reads from their exit status and stderr, run
-in-process through pendular.cli.run_command; the runs a signal stops, and the runs those leave
-behind, are subprocesses; all of 60 spheres.
+Option cases, the runs the tests damage or run over, and runs whose ending the test reads from
+their exit status and stderr, run in-process through pendular.cli.run_command; the runs a
+signal stops are subprocesses; all of 60 spheres.
 """
 
+import contextlib
+import io
 import json
 import os
 import shutil
@@ -44,12 +46,16 @@ def command(argv, capsys):
     return run_in_process("triaxial", argv, capsys, prog="triaxial.py")
 
 
-def script(argv, cwd, timeout=900, **options):
-    """``triaxial.py ARGV`` run in a process of its own (``timeout`` [s]: a bound on a hung
-    run, far beyond a run's time in a fresh clone, whose first runs compile the kernels, on a
-    loaded machine)."""
-    return subprocess.run([sys.executable, SCRIPT, *argv], cwd=cwd, capture_output=True,
-                          text=True, timeout=timeout, **options)
+def quietly(argv):
+    """(exit status, stderr) of ``triaxial.py ARGV`` run in-process, its output kept from the
+    test's (for the module's fixtures, which have no capsys)."""
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        try:
+            status = run_command("triaxial", [str(a) for a in argv], prog="triaxial.py")
+        except SystemExit as stop:
+            status = stop.code
+    return status, err.getvalue()
 
 
 # ---------------------------------------------------------------- extreme settings
@@ -123,9 +129,9 @@ def test_an_out_that_is_a_file_is_refused(tmp_path, capsys):
 def interrupted(tmp_path_factory):
     """An interrupted run of 60 spheres with a checkpoint (folder), as --stop-after leaves it."""
     out = tmp_path_factory.mktemp("faults") / "run"
-    done = script(TINY + ["--checkpoint-every", "50", "--stop-after", "120", "--out", str(out)],
-                  cwd=out.parent)
-    assert done.returncode == 130, done.stderr
+    status, err = quietly(TINY + ["--checkpoint-every", "50", "--stop-after", "120",
+                                  "--out", out])
+    assert status == 130, err
     assert json.loads((out / "summary.json").read_text())["completed"] is False
     return out
 
@@ -236,13 +242,14 @@ def test_a_run_into_a_used_folder_clears_what_the_old_run_owned(interrupted, tmp
 
 # ---------------------------------------------------------------- signals
 # Each run waits at a known phase (pendular.utils.interrupt.pause_point, PENDULAR_TEST_PAUSE_AT)
-# until the test's signal arrives there: nothing races the machine's speed.
+# until the test's signal arrives there: nothing races the machine's speed. The runs stopped
+# in the shear or after it start from the finished run's sample (--sample).
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """A finished run of 60 spheres (folder) with a checkpoint."""
     out = tmp_path_factory.mktemp("finished") / "run"
-    done = script(TINY + ["--checkpoint-every", "100", "--out", str(out)], cwd=out.parent)
-    assert done.returncode == 0, done.stderr
+    status, err = quietly(TINY + ["--checkpoint-every", "100", "--out", out])
+    assert status == 0, err
     assert json.loads((out / "summary.json").read_text())["completed"] is True
     return out
 
@@ -301,9 +308,10 @@ def test_ctrl_c_before_the_shear_exits_in_one_line_leaving_the_phase_reached(pha
     assert not (out / "sample.h5").exists() and not (out / ".pendular-earlier").exists()
 
 
-def test_ctrl_c_during_the_shear_keeps_the_history_so_far(tmp_path):
+def test_ctrl_c_during_the_shear_keeps_the_history_so_far(finished, tmp_path):
     out = tmp_path / "out"
-    status, err = interrupt_at("shear", TINY + ["--out", str(out)], tmp_path)
+    sample = ["--sample", str(finished / "sample.h5")]
+    status, err = interrupt_at("shear", TINY + sample + ["--out", str(out)], tmp_path)
     assert status == 130 and "interrupted at step" in last_line(err), err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is False and summary["phase"] == "shear"
@@ -312,10 +320,11 @@ def test_ctrl_c_during_the_shear_keeps_the_history_so_far(tmp_path):
     assert len(steps) >= 2 and steps[-1] - steps[0] < summary["steps"]
 
 
-def test_ctrl_c_while_the_results_are_written_leaves_them_whole(tmp_path):
+def test_ctrl_c_while_the_results_are_written_leaves_them_whole(finished, tmp_path):
     """Between history.h5 and summary.json: both are written, then the run ends (130)."""
     out = tmp_path / "out"
-    status, err = interrupt_at("write", TINY + ["--out", str(out)], tmp_path)
+    sample = ["--sample", str(finished / "sample.h5")]
+    status, err = interrupt_at("write", TINY + sample + ["--out", str(out)], tmp_path)
     assert status == 130 and last_line(err) == "triaxial.py: interrupted", err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["completed"] is True and "phase" not in summary
@@ -369,11 +378,13 @@ def test_a_bad_sample_into_a_used_folder_touches_nothing(finished, tmp_path, cap
     assert {path: path.read_bytes() for path in out.rglob("*") if path.is_file()} == before
 
 
-def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_path):
+def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_path, capsys):
     """kill -9 during the shear leaves the earlier results aside and the new run's checkpoint
     in place: --resume finishes the new run (the earlier results go then); a new run instead
-    first puts the earlier results back, and keeps them if it fails."""
-    argv = TINY + ["--seed", "1", "--checkpoint-every", "100"]
+    first puts the earlier results back, and keeps them if it fails (the killed runs are
+    processes; the runs after them, in-process)."""
+    argv = TINY + ["--seed", "1", "--checkpoint-every", "100",
+                   "--sample", str(finished / "sample.h5")]
     for then in ("resume", "replace"):
         out = tmp_path / then
         shutil.copytree(finished, out)
@@ -381,14 +392,14 @@ def test_a_run_killed_in_a_used_folder_can_be_resumed_or_replaced(finished, tmp_
         status, _ = interrupt_at("shear", argv + ["--out", str(out)], tmp_path, signal.SIGKILL)
         assert status == -signal.SIGKILL and (out / ".pendular-earlier").is_dir()
         if then == "resume":
-            done = script(["--resume", str(out), "--quiet"], cwd=tmp_path)
-            assert done.returncode == 0, done.stderr
-            assert "holds the results of an earlier run" in done.stderr
+            status, err = command(["--resume", out, "--quiet"], capsys)
+            assert status == 0, err
+            assert "holds the results of an earlier run" in err
             assert json.loads((out / "summary.json").read_text())["completed"] is True
             assert outputs(out)["summary.json"] != before["summary.json"]
         else:
-            done = script(TINY + WET + ["--wet-steps", "1", "--out", str(out)], cwd=tmp_path)
-            assert done.returncode == 2, done.stderr
+            status, err = command(TINY + WET + ["--wet-steps", "1", "--out", out], capsys)
+            assert status == 2, err
             assert outputs(out) == before
         assert not (out / ".pendular-earlier").exists()
 

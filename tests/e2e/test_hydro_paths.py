@@ -1,8 +1,13 @@
 """Hydro-mechanical paths (issue 14): the SWCC of a sample (drying then wetting), the triaxial at
 constant water content (liquid conserved, suction an output) and the wetting protocols, run as
-a user runs them (scenarios/*.py; the runs beside the first of each scenario run its command
-in-process, pendular.cli.run_command), and their bad input refused in one line."""
+a user runs them (scenarios/swcc.py in a process of its own; the other runs in-process,
+pendular.cli.run_command, as the scenarios run it: scenarios/triaxial.py's own process is
+tested in test_triaxial.py and test_faults.py), and their bad input refused in one line. The
+triaxials whose test is not about the preparation start from the SWCC's sample
+(--sample)."""
 
+import contextlib
+import io
 import json
 import os
 import subprocess
@@ -19,7 +24,7 @@ from conftest import ROOT, assert_drawn, run_in_process
 
 SMALL = ["--particles", "150", "--quiet"]
 RATE = ["--inertial-number", "2e-3", "--vtk-frames", "0"]
-SHEAR = ["--max-strain", "0.03", *RATE]
+SHEAR = ["--max-strain", "0.01", *RATE]
 
 
 def scenario(name, *argv):
@@ -71,7 +76,7 @@ def test_swcc_at_contacts_only_has_no_broken_gap_bridges(tmp_path, capsys):
     """--form-gap 0: every bridge formed at a contact, so the wetting branch differs from the
     drying one only by the contacts the path opened."""
     in_process(capsys, "swcc.py", *SMALL, "--suctions", "10000,100000", "--form-gap", "0",
-             "--out", str(tmp_path))
+               "--out", str(tmp_path))
     result = json.loads((tmp_path / "swcc.json").read_text())
     assert result["bridges_formed_across_gaps"] == 0
     first = result["hysteresis"][0]
@@ -81,7 +86,11 @@ def test_swcc_at_contacts_only_has_no_broken_gap_bridges(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def water_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("water") / "w"
-    scenario("triaxial.py", *SMALL, *SHEAR, "--water-content", "0.5", "--out", str(out))
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        status = run_command("triaxial", [*SMALL, *SHEAR, "--water-content", "0.5",
+                                          "--out", str(out)], prog="triaxial.py")
+    assert status == 0, err.getvalue()
     return out, json.loads((out / "summary.json").read_text())
 
 
@@ -100,12 +109,13 @@ def test_constant_water_content_conserves_the_liquid(water_run):
     assert np.all(np.isfinite(history["suction"].values)) and history["suction"].values.std() > 0
 
 
-def test_wetting_protocols_run_and_report(tmp_path, capsys):
+def test_wetting_protocols_run_and_report(swcc_run, tmp_path, capsys):
     """The wetting before the shear, its steps and wall stresses: a shear to 0.5 %."""
     summaries = {}
     for protocol in ("at-shear", "constant-volume"):
         in_process(capsys, "triaxial.py", *SMALL, "--max-strain", "0.005", *RATE, "--suction",
-                   "30000", "--wetting", protocol, "--out", str(tmp_path / protocol))
+                   "30000", "--wetting", protocol, "--sample", swcc_run[0] / "sample.h5",
+                   "--out", str(tmp_path / protocol))
         summaries[protocol] = json.loads((tmp_path / protocol / "summary.json").read_text())
     assert summaries["at-shear"]["wetting_steps"] == 0
     assert summaries["at-shear"]["initial_bridges"] > 0

@@ -1,6 +1,7 @@
 """The loading paths as a user runs them: pendular oedometer, pendular isotropic and pendular
 triaxial --direction extension / --b / --constant-p (pendular.cli), their outputs, a resumed
-path, and their bad input refused in one line."""
+path, and their bad input refused in one line. The runs whose test is not about the
+preparation start from the sample the module's oedometer prepared (--sample)."""
 
 import os
 import subprocess
@@ -50,11 +51,12 @@ def test_oedometer_gives_k0_along_the_path_and_at_the_axial_stress(oedometer_run
         assert_drawn(oedometer_run / name)
 
 
-def test_isotropic_path_gives_e_log_p_and_its_indices(tmp_path, capsys):
+def test_isotropic_path_gives_e_log_p_and_its_indices(oedometer_run, tmp_path, capsys):
     out = tmp_path / "iso"
     stresses = [500.0, 1000.0, 2000.0, 1000.0, 500.0]
     status, err = run_in_process("isotropic", [*SMALL, "--stresses",
                                                ",".join(f"{s:g}" for s in stresses),
+                                               "--sample", oedometer_run / "sample.h5",
                                                "--out", out], capsys)
     assert status == 0, err
     summary, history = summary_of(out), history_of(out)
@@ -76,12 +78,14 @@ def test_extension_and_compression_of_the_same_dry_sample_fail_at_close_friction
     25.7 and 28.8 degrees at 200 spheres; 26.4 and 23.5 at 300, seed 1: the order changes
     with the sample, Mohr-Coulomb and Matsuoka-Nakai give them equal)."""
     found = {}
-    for direction in ("compression", "extension"):
-        out = tmp_path / direction
+    for direction in ("compression", "extension"):      # the extension from the sample saved
+        out = tmp_path / direction                         # by the compression (--sample)
+        sample = ["--sample", tmp_path / "compression" / "sample.h5"] * (
+            direction == "extension")
         status, err = run_in_process("triaxial", [
             "--particles", "200", "--seed", "3", "--quiet", "--max-strain", "0.10",
             "--inertial-number", "1e-3", "--vtk-frames", "0", "--periodic",
-            "--direction", direction, "--out", out], capsys)
+            "--direction", direction, *sample, "--out", out], capsys)
         assert status == 0, err
         found[direction] = summary_of(out)
     extension = found["extension"]
@@ -152,10 +156,11 @@ def test_bad_paths_are_refused_in_one_line(command, arguments, words, tmp_path, 
     assert not (tmp_path / "x").exists()
 
 
-def test_a_non_monotonic_stress_list_is_a_path(tmp_path, capsys):
+def test_a_non_monotonic_stress_list_is_a_path(oedometer_run, tmp_path, capsys):
     """Stresses in any order make a path (load, unload, reload); a run of three stages."""
     out = tmp_path / "iso"
     status, err = run_in_process("isotropic", [*SMALL, "--stresses", "1000,500,2000",
+                                               "--sample", oedometer_run / "sample.h5",
                                                "--out", out], capsys)
     assert status == 0, err
     summary = summary_of(out)
@@ -170,8 +175,9 @@ def test_a_wet_oedometer_gives_the_effective_k0_of_the_dry_sample(oedometer_run,
     to 10 kPa)."""
     out = tmp_path / "wet"
     status, err = run_in_process("oedometer", [*SMALL, "--axial-stress", "5000", "--suction",
-                                               "30000", "--vtk-every", "0", "--out", out],
-                                 capsys)
+                                               "30000", "--vtk-every", "0",
+                                               "--sample", oedometer_run / "sample.h5",
+                                               "--out", out], capsys)
     assert status == 0, err
     wet, dry = summary_of(out), summary_of(oedometer_run)
     assert wet["k0"] < dry["k0"]

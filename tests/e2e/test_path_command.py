@@ -1,7 +1,9 @@
 """``pendular path PATH.toml`` as a user runs it: the Chapter 5 triaxial as a table gives, bit
 for bit, the history of ``pendular triaxial``; each shipped table of examples/paths/ runs at a
 small size; a multi-stage path resumes without its table; bad input is refused in one line;
-and the Python API example of a hydro-mechanical path (examples/loading_path_api.py) runs."""
+and the Python API example of a hydro-mechanical path (examples/loading_path_api.py) runs. The
+runs whose test is not about the preparation start from one sample prepared for the module
+(--sample); the dry triaxial and its table prepare their own."""
 
 import os
 import runpy
@@ -10,17 +12,30 @@ import numpy as np
 import pytest
 
 from conftest import ROOT, assert_drawn, history_of, refused, run_in_process, summary_of
+from pendular.dem.sample import save_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 
 PATHS = os.path.join(ROOT, "examples", "paths")
 SMALL = ["--particles", "150", "--confining", "750", "--seed", "2", "--quiet"]
 
 
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    """["--sample", PATH] of the sample SMALL prepares, saved once for the module."""
+    config = PrepareConfig(particles=150, confining=750.0, seed=2)
+    sim, report = prepare_sample(config, progress=False)
+    path = tmp_path_factory.mktemp("sample") / "sample.h5"
+    save_sample(str(path), sim, report, identity={"seed": config.seed})
+    return ["--sample", path]
+
+
 @pytest.mark.parametrize("wet", [[], ["--suction", "30000"]], ids=["dry", "wet"])
-def test_the_triaxial_as_a_table_is_the_triaxial_bit_for_bit(wet, tmp_path, capsys):
+def test_the_triaxial_as_a_table_is_the_triaxial_bit_for_bit(wet, sample, tmp_path, capsys):
     """The shipped triaxial.toml (to 25 % strain) with --records as the triaxial's: the same
-    rows, every column of the triaxial's history equal to the last bit."""
+    rows, every column of the triaxial's history equal to the last bit (dry: both prepare
+    their sample; wet: both start from the module's)."""
     options = [*SMALL, *wet, "--inertial-number", "1e-2", "--records", "60",
-               "--vtk-every", "0"]
+               "--vtk-every", "0", *(sample if wet else [])]
     status, err = run_in_process("triaxial", [*options, "--max-strain", "0.25",
                                               "--out", tmp_path / "triaxial"], capsys)
     assert status == 0, err
@@ -44,10 +59,10 @@ def test_the_triaxial_as_a_table_is_the_triaxial_bit_for_bit(wet, tmp_path, caps
         assert "q_effective" in end and "sigma_effective" in got
 
 
-def test_the_oedometer_table_loads_unloads_and_reloads(tmp_path, capsys):
+def test_the_oedometer_table_loads_unloads_and_reloads(sample, tmp_path, capsys):
     out = tmp_path / "oedometer"
     status, err = run_in_process("path", [os.path.join(PATHS, "oedometer_unload.toml"),
-                                          *SMALL, "--out", out], capsys)
+                                          *SMALL, *sample, "--out", out], capsys)
     assert status == 0, err
     history, summary = history_of(out), summary_of(out)
     sigma, stage = history["sigma_wall"], history["stage"]
@@ -69,9 +84,9 @@ def test_the_oedometer_table_loads_unloads_and_reloads(tmp_path, capsys):
     assert_drawn(out / "path.png")
 
 
-def test_the_cyclic_table_cycles_between_its_axial_stresses(tmp_path, capsys):
+def test_the_cyclic_table_cycles_between_its_axial_stresses(sample, tmp_path, capsys):
     out = tmp_path / "cyclic"
-    status, err = run_in_process("path", [os.path.join(PATHS, "cyclic.toml"), *SMALL,
+    status, err = run_in_process("path", [os.path.join(PATHS, "cyclic.toml"), *SMALL, *sample,
                                           "--vtk-every", "0", "--out", out], capsys)
     assert status == 0, err
     history, summary = history_of(out), summary_of(out)
@@ -86,11 +101,12 @@ def test_the_cyclic_table_cycles_between_its_axial_stresses(tmp_path, capsys):
     assert strain[-1] > strain[0] > 0.0
 
 
-def test_an_interrupted_path_resumes_to_the_same_history_without_its_table(tmp_path, capsys):
+def test_an_interrupted_path_resumes_to_the_same_history_without_its_table(sample, tmp_path,
+                                                                          capsys):
     table = tmp_path / "cycles.toml"
     with open(os.path.join(PATHS, "cyclic.toml")) as shipped:
         table.write_text(shipped.read().replace("repeat = 5", "repeat = 2"))
-    options = [*SMALL, "--vtk-every", "0", "--checkpoint-every", "2000"]
+    options = [*SMALL, *sample, "--vtk-every", "0", "--checkpoint-every", "2000"]
     whole, stopped = tmp_path / "whole", tmp_path / "stopped"
     status, err = run_in_process("path", [table, *options, "--out", whole], capsys)
     assert status == 0, err

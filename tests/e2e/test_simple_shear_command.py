@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from conftest import assert_drawn, history_of, refused, run_in_process, summary_of
+from pendular.dem.sample import save_sample
+from pendular.procedures.preparation import PrepareConfig, prepare_sample
 
 SMALL = ["--particles", "200", "--seed", "4", "--max-strain", "0.02", "--quiet"]
 
@@ -132,8 +134,12 @@ def test_bad_input_is_refused_in_one_line(arguments, words, tmp_path, capsys):
     assert not (tmp_path / "bad").exists()
 
 
-def test_a_sample_in_walls_is_refused_in_one_line(wet_triaxial_run, tmp_path, capsys):
-    status, err = run_in_process("simple-shear", ["--particles", "200", "--sample",
-                                                  wet_triaxial_run / "sample.h5",
+def test_a_sample_in_walls_is_refused_in_one_line(tmp_path, capsys):
+    """A sample prepared in six walls (the smallest a simple shear takes, 60 spheres)."""
+    config = PrepareConfig(particles=60, seed=1)
+    sim, report = prepare_sample(config, progress=False)
+    save_sample(str(tmp_path / "walls.h5"), sim, report)
+    status, err = run_in_process("simple-shear", ["--particles", "60", "--sample",
+                                                  tmp_path / "walls.h5",
                                                   "--out", tmp_path / "walls"], capsys)
     refused(status, err, "six walls", "periodic")
