@@ -1,7 +1,7 @@
 """What the GPU tests share: a script or a command run under Numba's CUDA simulator in a
-process of its own (``simulated``, ``simulated_command``, ``histories_on_both``), the relative
-difference they judge (``relative``) and a count of the state's copies back from the device
-(``counted_copies``). The simulator runs there with the serial block runner of
+process of its own (``simulated``, ``simulated_command``, ``histories_on_both``), the samples
+the command tests load (``prepared_sample``), the relative difference they judge
+(``relative``) and a count of the state's copies back from the device (``counted_copies``). The simulator runs there with the serial block runner of
 serial_simulator/sitecustomize.py (the same results, sooner).
 
 Nothing here imports pendular.gpu when the module loads: the tests are collected where the
@@ -89,15 +89,37 @@ def assert_same_records(cpu, gpu, rows, counts=("coordination",)):
         assert cpu["bridges"].min() > 20
 
 
-def histories_on_both(command, prepare, argv, folder):
-    """(CPU history, GPU history): a sample prepared on the CPU by ``pendular command
-    *prepare``, then ``pendular command *argv --sample S`` run on the CPU in this process and
-    with ``--device gpu`` under the simulator, in ``folder``'s prep/, cpu/ and gpu/."""
+#: The options of the samples that the command tests load, each prepared on the CPU by
+#: ``pendular triaxial`` (prepared_sample): 60 spheres in six walls, in a periodic cell (the
+#: simple shear's too: its own preparation gives the same sample).
+WALLED_SAMPLE = ("--particles", "60", "--max-strain", "1e-4", "--quiet")
+PERIODIC_SAMPLE = (*WALLED_SAMPLE, "--periodic")
+
+#: options -> the sample.h5 that prepared_sample made in this process.
+_SAMPLES = {}
+
+
+def prepared_sample(folders, options):
+    """The sample.h5 of ``pendular triaxial *options`` run on the CPU in this process, once
+    for every test module of the process that asks (``folders``: pytest's
+    tmp_path_factory)."""
+    if options not in _SAMPLES:
+        from pendular.cli import run_command
+
+        out = folders.mktemp("sample") / "prep"
+        assert run_command("triaxial", [*options, "--out", str(out)]) == 0
+        _SAMPLES[options] = out / "sample.h5"
+    return _SAMPLES[options]
+
+
+def histories_on_both(command, sample, argv, folder):
+    """(CPU history, GPU history): ``pendular command *argv --sample sample`` run on the CPU
+    in this process and with ``--device gpu`` under the simulator, in ``folder``'s cpu/ and
+    gpu/."""
     from pendular.cli import run_command
 
     folder = str(folder)
-    assert run_command(command, [*map(str, prepare), "--out", f"{folder}/prep"]) == 0
-    run = [*map(str, argv), "--sample", f"{folder}/prep/sample.h5"]
+    run = [*map(str, argv), "--sample", str(sample)]
     assert run_command(command, [*run, "--out", f"{folder}/cpu"]) == 0
     simulated_command(command, [*run, "--device", "gpu", "--out", f"{folder}/gpu"])
     return history(f"{folder}/cpu"), history(f"{folder}/gpu")

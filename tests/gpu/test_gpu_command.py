@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from conftest import refused, requires, run_in_process
-from simulator import history, simulated_command
+from simulator import WALLED_SAMPLE, history, prepared_sample, simulated_command
 
 #: Whether the gpu extra is installed (what the refusal of a GPU run says depends on it).
 HAVE_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
@@ -112,11 +112,10 @@ def sensitivity(runs):
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """Folders of the sample, the CPU run and the GPU run."""
+    """Folders of the CPU run, the GPU run and the one-ulp CPU run, of the sample prepared
+    on the CPU (simulator.prepared_sample)."""
     root = tmp_path_factory.mktemp("gpu_command")
-    pendular(["--particles", 60, "--max-strain", 1e-4, "--quiet", "--out", root / "prep"],
-             simulated=False)
-    sample = root / "prep" / "sample.h5"
+    sample = prepared_sample(tmp_path_factory, WALLED_SAMPLE)
     for device in ("cpu", "gpu"):
         pendular([*TRIAXIAL, "--sample", sample, "--device", device, "--out", root / device],
                  simulated=device == "gpu")

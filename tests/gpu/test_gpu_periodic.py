@@ -11,7 +11,8 @@ import pytest
 
 from conftest import requires
 from periodic_checks import scene
-from simulator import assert_same_records, histories_on_both, simulated
+from simulator import (PERIODIC_SAMPLE, assert_same_records, histories_on_both,
+                       prepared_sample, simulated)
 
 pytestmark = requires("numba_cuda")
 
@@ -71,18 +72,23 @@ def test_a_gpu_run_continued_on_the_cpu_equals_the_cpu_run(dry, wet):
     assert_agrees(wet["continued"])
 
 
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    """The sample the command loads, prepared on the CPU (simulator.prepared_sample)."""
+    return prepared_sample(tmp_path_factory, PERIODIC_SAMPLE)
+
+
 #: The periodic triaxial command on both devices (its sample, prepared on the CPU, added).
 COMMAND = ["--particles", "60", "--periodic", "--max-strain", "0.002", "--inertial-number",
            "1e-3", "--quiet"]
 
 
-def test_the_periodic_triaxial_command_records_the_cpu_history(tmp_path):
+def test_the_periodic_triaxial_command_records_the_cpu_history(sample, tmp_path):
     """``pendular triaxial --periodic --sample S --device gpu`` (S a periodic sample prepared on
     the CPU) runs the sample's equilibrium and the shear on the device and records the CPU's
     history: the same rows and contact counts, the other columns to round-off grown over the
     steps (the unbalanced force, a residual ratio, looser)."""
-    cpu, gpu = histories_on_both("triaxial", ["--particles", 60, "--periodic", "--max-strain",
-                                              1e-4, "--quiet"], COMMAND, tmp_path)
+    cpu, gpu = histories_on_both("triaxial", sample, COMMAND, tmp_path)
     assert_same_records(cpu, gpu, 100)
     for name, values in cpu.items():
         if values.dtype == object:

@@ -12,7 +12,7 @@ import pytest
 
 from conftest import requires
 from shear_checks import GROWTH_TARGET, MIXED_STEPS, START_OFFSET
-from simulator import histories_on_both, simulated
+from simulator import PERIODIC_SAMPLE, histories_on_both, prepared_sample, simulated
 
 pytestmark = requires("numba_cuda")
 
@@ -119,6 +119,12 @@ def test_a_periodic_preparation_runs_its_growth_on_the_gpu(growth):
     assert "radius growth not reached" in prepared["gpu"]
 
 
+@pytest.fixture(scope="module")
+def sample(tmp_path_factory):
+    """The sample the command loads, prepared on the CPU (simulator.prepared_sample)."""
+    return prepared_sample(tmp_path_factory, PERIODIC_SAMPLE)
+
+
 #: The simple shear command on both devices (its sample, prepared on the CPU, added).
 COMMAND = ["--particles", "60", "--max-strain", "0.002", "--inertial-number", "1e-3",
            "--quiet"]
@@ -128,12 +134,11 @@ TOLERANCE = 2e-9
 UNBALANCED_TOLERANCE = 1e-7
 
 
-def test_the_simple_shear_command_records_the_cpu_history(tmp_path):
-    """``pendular simple-shear --sample S --device gpu`` (S a sample prepared by the command on
-    the CPU) shears on the device and records the CPU's history: the same rows, contact
+def test_the_simple_shear_command_records_the_cpu_history(sample, tmp_path):
+    """``pendular simple-shear --sample S --device gpu`` (S a periodic sample prepared on the
+    CPU) shears on the device and records the CPU's history: the same rows, contact
     counts and shear strains, the other columns to round-off grown over the steps."""
-    cpu, gpu = histories_on_both("simple-shear", ["--particles", 60, "--max-strain", 1e-3,
-                                                  "--quiet"], COMMAND, tmp_path)
+    cpu, gpu = histories_on_both("simple-shear", sample, COMMAND, tmp_path)
     assert cpu.keys() == gpu.keys() and len(cpu["step"]) > 5
     for name in ("step", "coordination", "shear_strain"):
         assert np.array_equal(cpu[name], gpu[name]), name

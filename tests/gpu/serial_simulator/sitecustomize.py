@@ -8,12 +8,11 @@ no block synchronisation (no syncthreads, no shared memory: each thread reads an
 global memory alone, integer atomics aside), so a block's threads run here one after the
 other in the process's own thread on the NumPy arrays the device arrays wrap, and a device
 function that uses no CUDA API (no ``cuda`` in its code) is called as the plain Python
-function it is: a kernel runs as a copy of its function whose globals (and closure) name,
-instead of each such device function, that function's own plain copy, made the same way
-once (as pendular.gpu.cuda.device_twin makes a twin), so that a call costs what a Python call
-costs. Results are the same bit for bit, several times sooner. A kernel that did
-synchronise its block would fail at once (the main thread has no ``syncthreads``), not run
-wrong.
+function it is: a kernel runs as a copy of its function whose globals name, instead of each
+such device function, that function's own copy made the same way (as
+pendular.gpu.cuda.device_twin makes a twin), so that a call costs what a Python call costs.
+Results are the same bit for bit, several times sooner. A kernel that did synchronise its
+block would fail at once (the main thread has no ``syncthreads``), not run wrong.
 """
 
 import os
@@ -26,7 +25,7 @@ if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
     from numba.cuda.simulator import kernel as _kernel
     from numba.cuda.simulator.cudadrv.devicearray import (FakeCUDAArray,
                                                           FakeWithinKernelCUDAArray)
-    from numba.cuda.simulator.kernelapi import Dim3, FakeCUDAModule
+    from numba.cuda.simulator.kernelapi import Dim3
 
     def _plain(argument):
         """A kernel's argument with the simulator's device arrays as the NumPy arrays they
@@ -54,62 +53,65 @@ if os.environ.get("NUMBA_ENABLE_CUDASIM") == "1":
         return (isinstance(value, _kernel.FakeCUDAKernel) and value._device
                 and "cuda" not in _names(value.fn.__code__))
 
-    #: function -> its copy calling plain copies of the device functions it names (_flat).
-    _FLAT = {}
+    class _PlainCalls:
+        """A kernel's function as a copy whose globals name, instead of each device function
+        without CUDA calls, that function's own copy, made the same way down the call tree;
+        each copy's other globals read from the original's at each launch (``current``), as
+        the simulator's kernel reads its module's."""
 
-    def _flat(function):
-        """``function`` with each device function without CUDA calls that its globals or its
-        closure name replaced by that function's own plain copy (made once; ``function``
-        itself when it names none)."""
-        flat = _FLAT.get(function)
-        if flat is not None:
-            return flat
-        _FLAT[function] = function          # a call cycle ends here
-        names = function.__globals__
-        plain = {name: _flat(names[name].fn) for name in _names(function.__code__)
-                 if _plain_device(names.get(name))}
-        closure = function.__closure__
-        if closure is not None and any(_plain_device(_content(cell)) for cell in closure):
-            closure = tuple(types.CellType(_flat(_content(cell).fn))
-                            if _plain_device(_content(cell)) else cell for cell in closure)
-        if plain or closure is not function.__closure__:
-            flat = types.FunctionType(function.__code__, {**names, **plain},
-                                      function.__name__, function.__defaults__, closure)
-            flat.__kwdefaults__ = function.__kwdefaults__
-            _FLAT[function] = flat
-        return _FLAT[function]
+        def __init__(self, kernel):
+            #: (a copy's globals, the original's, the names read from them, the device
+            #: functions replaced in them by name).
+            self.links = []
+            self.kernel = self._copy(kernel, {})
 
-    def _content(cell):
-        """What a closure's cell holds (None when empty)."""
-        try:
-            return cell.cell_contents
-        except ValueError:
-            return None
+        def _copy(self, function, made):
+            if function in made:
+                return made[function]
+            made[function] = function       # a call cycle ends here
+            original = function.__globals__
+            read = _names(function.__code__)
+            devices = {name: original[name] for name in read
+                       if _plain_device(original.get(name))}
+            if not devices:
+                return function
+            scope = dict(original)
+            scope.update({name: self._copy(device.fn, made) for name, device in devices.items()})
+            made[function] = types.FunctionType(function.__code__, scope, function.__name__,
+                                                function.__defaults__, function.__closure__)
+            made[function].__kwdefaults__ = function.__kwdefaults__
+            self.links.append((scope, original, sorted(read - devices.keys()), devices))
+            return made[function]
 
-    #: kernel -> the names of its globals that a launch sets to the simulated CUDA module.
-    _CUDA_NAMES = {}
+        def current(self):
+            """Whether the device functions replaced are still those the originals' globals
+            name; if so, each copy's other globals read again from the original's."""
+            for scope, original, names, devices in self.links:
+                if any(original.get(name) is not device for name, device in devices.items()):
+                    return False
+                for name in names:
+                    if name in original:
+                        scope[name] = original[name]
+                    else:
+                        scope.pop(name, None)
+            return True
+
+    #: kernel function -> its _PlainCalls.
+    _PLAIN_CALLS = {}
 
     def _run_block_serially(self, grid_point, *args):
         """BlockManager.run: the block's threads one after the other in this thread, reading
-        and writing the device arrays as plain NumPy arrays, the kernel's plain copy
-        (_flat) given the simulated CUDA module that the launch put in the kernel's
-        globals."""
+        and writing the device arrays as plain NumPy arrays, the kernel's device functions
+        called plainly (_PlainCalls)."""
         thread = threading.current_thread()
         thread.blockIdx = Dim3(*grid_point)
         args = [_plain(argument) for argument in args]
-        kernel = _flat(self._f)
-        if kernel is not self._f:
-            launched = self._f.__globals__
-            names = _CUDA_NAMES.get(self._f)
-            if names is None:
-                names = _CUDA_NAMES[self._f] = [
-                    name for name in _names(self._f.__code__)
-                    if isinstance(launched.get(name), FakeCUDAModule)]
-            for name in names:
-                kernel.__globals__[name] = launched[name]
+        plain = _PLAIN_CALLS.get(self._f)
+        if plain is None or not plain.current():
+            plain = _PLAIN_CALLS[self._f] = _PlainCalls(self._f)
         for block_point in np.ndindex(*self._block_dim):
             thread.threadIdx = Dim3(*block_point)
-            kernel(*args)
+            plain.kernel(*args)
 
     _call = _kernel.FakeCUDAKernel.__call__
 
