@@ -17,7 +17,9 @@ null), "kernels": {kernel: PTX lines}}.
 
 Arrays stay on the host (the kernels' argument types are those of the device arrays), and
 device functions are compiled for the compute capability asked where numba-cuda would ask a
-driver.
+driver. NVVM compiles without its optimisation passes (``opt=False``, NVVM's -opt=0): code
+that Numba's CUDA target or NVVM rejects is rejected at every level, and the passes, which a
+GPU's own run applies to code that compiles, are most of NVVM's time.
 """
 
 import json
@@ -82,7 +84,7 @@ def compile_step_kernels(cuda, capability):
         """The lines of ``kernel``'s PTX for the types of ``args``."""
         key = (kernel.py_func, signature(args))
         if key not in lines:
-            ptx, _ = cuda.compile_ptx(kernel.py_func, key[1], cc=capability)
+            ptx, _ = cuda.compile_ptx(kernel.py_func, key[1], cc=capability, opt=False)
             lines[key] = ptx.count("\n")
         return lines[key]
 

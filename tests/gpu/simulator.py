@@ -1,8 +1,10 @@
-"""What the GPU tests share: a script or a command run under Numba's CUDA simulator in a
-process of its own (``simulated``, ``simulated_command``, ``histories_on_both``), the relative
-difference they judge (``relative``) and a count of the state's copies back from the device
-(``counted_copies``). The simulator runs there with the serial block runner of
-serial_simulator/sitecustomize.py (the same results, sooner).
+"""What the GPU tests share: scripts and commands run under Numba's CUDA simulator in a
+process of their own (``simulated``, ``simulated_commands``, ``histories_on_both``), the
+samples the command tests load (``prepared_sample``), the relative difference they judge
+(``relative``) and a count of the state's copies back from the device (``counted_copies``).
+The simulator runs there with the serial block runner of serial_simulator/sitecustomize.py
+(the same results, sooner). Run as a script, this module runs the commands it is given
+(``simulated_commands``).
 
 Nothing here imports pendular.gpu when the module loads: the tests are collected where the
 gpu extra (numba-cuda) is not installed, and skip there.
@@ -44,30 +46,49 @@ def _run(argv, timeout):
     return done.stdout
 
 
-def simulated(script, *arguments, timeout=None):
+#: The argument of a script of checks after which come, in JSON, the commands it runs first.
+COMMANDS = "--commands"
+
+
+def simulated(script, *arguments, commands=(), timeout=None):
     """The JSON object that ``script`` (a file of tests/gpu, or a path) prints last, run with
     ``arguments`` under the simulator in a process of its own. A script of checks
-    (``run_checks``) given several names runs them all in that one process (``timeout``
-    [s]: by default CHECK_TIMEOUT per check)."""
+    (``run_checks``) given several names runs them all in that one process, after the
+    ``commands``, (command, argv) pairs each run as ``pendular command *argv`` (``timeout``
+    [s]: by default CHECK_TIMEOUT per check and command)."""
     if timeout is None:
-        timeout = CHECK_TIMEOUT * max(1, len(arguments))
+        timeout = CHECK_TIMEOUT * max(1, len(arguments) + len(commands))
+    if commands:
+        arguments = (*arguments, COMMANDS, json.dumps([[command, [str(a) for a in argv]]
+                                                       for command, argv in commands]))
     stdout = _run([sys.executable, os.path.join(HERE, script), *arguments], timeout)
     return json.loads(stdout.strip().splitlines()[-1])
 
 
 def run_checks(checks):
     """The main of a script of checks run under the simulator: print one JSON object, each
-    check named on the command line -> its measurements (``checks``: name -> function)."""
-    names = sys.argv[1:]
+    check named on the command line -> its measurements (``checks``: name -> function), after
+    running the commands given after COMMANDS (simulated's ``commands``; the script fails
+    with the first that fails)."""
+    names, commands = sys.argv[1:], []
+    if COMMANDS in names:
+        names, commands = names[:names.index(COMMANDS)], json.loads(names[-1])
     unknown = [name for name in names if name not in checks]
-    if unknown or not names:
+    if unknown or not (names or commands):
         raise SystemExit(f"checks: {', '.join(checks)} (unknown or none: {unknown})")
+    if commands:
+        from pendular.cli import run_command
+
+        for command, argv in commands:
+            if run_command(command, argv) != 0:
+                raise SystemExit(f"pendular {command} {' '.join(argv)} failed")
     print(json.dumps({name: checks[name]() for name in names}, default=float))
 
 
-def simulated_command(command, argv, timeout=600):
-    """Run ``pendular command argv`` under the simulator in a process of its own."""
-    _run([sys.executable, "-m", "pendular", command, *[str(a) for a in argv]], timeout)
+def simulated_commands(*commands, timeout=600):
+    """Run each (command, argv) of ``commands`` as ``pendular command *argv`` under the
+    simulator, all in one process of their own (this script's, with no checks)."""
+    simulated("simulator.py", commands=commands, timeout=timeout)
 
 
 def history(folder):
@@ -89,17 +110,44 @@ def assert_same_records(cpu, gpu, rows, counts=("coordination",)):
         assert cpu["bridges"].min() > 20
 
 
-def histories_on_both(command, prepare, argv, folder):
-    """(CPU history, GPU history): a sample prepared on the CPU by ``pendular command
-    *prepare``, then ``pendular command *argv --sample S`` run on the CPU in this process and
-    with ``--device gpu`` under the simulator, in ``folder``'s prep/, cpu/ and gpu/."""
+#: The options of the samples that the command tests load, each prepared on the CPU by
+#: ``pendular triaxial`` (prepared_sample): 60 spheres in six walls, in a periodic cell (the
+#: simple shear's too: its own preparation gives the same sample).
+WALLED_SAMPLE = ("--particles", "60", "--max-strain", "1e-4", "--quiet")
+PERIODIC_SAMPLE = (*WALLED_SAMPLE, "--periodic")
+
+#: options -> the sample.h5 that prepared_sample made in this process.
+_SAMPLES = {}
+
+
+def prepared_sample(folders, options):
+    """The sample.h5 of ``pendular triaxial *options`` run on the CPU in this process, once
+    for every test module of the process that asks (``folders``: pytest's
+    tmp_path_factory)."""
+    if options not in _SAMPLES:
+        from pendular.cli import run_command
+
+        out = folders.mktemp("sample") / "prep"
+        assert run_command("triaxial", [*options, "--out", str(out)]) == 0
+        _SAMPLES[options] = out / "sample.h5"
+    return _SAMPLES[options]
+
+
+def on_the_gpu(command, sample, argv, folder):
+    """The (command, argv) of ``pendular command *argv --sample sample --device gpu`` writing
+    into ``folder``/gpu, for simulated's ``commands`` (histories_on_both reads its run)."""
+    return command, [*map(str, argv), "--sample", str(sample), "--device", "gpu", "--out",
+                     f"{folder}/gpu"]
+
+
+def histories_on_both(command, sample, argv, folder):
+    """(CPU history, GPU history): ``pendular command *argv --sample sample`` run on the CPU
+    in this process, in ``folder``/cpu, and the run of ``on_the_gpu(command, sample, argv,
+    folder)``, which a simulated process has made."""
     from pendular.cli import run_command
 
-    folder = str(folder)
-    assert run_command(command, [*map(str, prepare), "--out", f"{folder}/prep"]) == 0
-    run = [*map(str, argv), "--sample", f"{folder}/prep/sample.h5"]
-    assert run_command(command, [*run, "--out", f"{folder}/cpu"]) == 0
-    simulated_command(command, [*run, "--device", "gpu", "--out", f"{folder}/gpu"])
+    run = [*map(str, argv), "--sample", str(sample), "--out", f"{folder}/cpu"]
+    assert run_command(command, run) == 0
     return history(f"{folder}/cpu"), history(f"{folder}/gpu")
 
 
@@ -128,3 +176,7 @@ def counted_copies():
         yield copies
     finally:
         GpuSimulation.copy_back = copy_back
+
+
+if __name__ == "__main__":
+    run_checks({})

@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from conftest import refused, requires, run_in_process
-from simulator import history, simulated_command
+from simulator import WALLED_SAMPLE, history, prepared_sample, simulated_commands
 
 #: Whether the gpu extra is installed (what the refusal of a GPU run says depends on it).
 HAVE_NUMBA_CUDA = importlib.util.find_spec("numba_cuda") is not None
@@ -49,16 +49,12 @@ TRIAXIAL = ["--particles", "60", "--suction", "30000", "--max-strain", "0.002",
             "--inertial-number", "1e-3", "--checkpoint-every", "45", "--quiet"]
 
 
-def pendular(argv, simulated):
-    """Run ``pendular triaxial argv``: in this process on the CPU, in one of its own under
-    Numba's CUDA simulator when ``simulated`` (so that no other test meets the simulator)."""
-    argv = [str(a) for a in argv]
-    if not simulated:
-        from pendular.cli import run_command
+def on_the_cpu(argv):
+    """Run ``pendular triaxial argv`` in this process on the CPU (the GPU's runs are in one
+    process of their own under Numba's CUDA simulator, so that no other test meets it)."""
+    from pendular.cli import run_command
 
-        assert run_command("triaxial", argv) == 0
-        return
-    simulated_command("triaxial", argv)
+    assert run_command("triaxial", [str(a) for a in argv]) == 0
 
 
 def differences(cpu, other):
@@ -112,16 +108,21 @@ def sensitivity(runs):
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """Folders of the sample, the CPU run and the GPU run."""
+    """Folders of the CPU run, the GPU run and the one-ulp CPU run of the sample prepared on
+    the CPU (simulator.prepared_sample), and of a copy of each device's run resumed from its
+    checkpoint on the other device (W_on_R: written on W, resumed on R); the GPU's run and
+    resume in one process."""
     root = tmp_path_factory.mktemp("gpu_command")
-    pendular(["--particles", 60, "--max-strain", 1e-4, "--quiet", "--out", root / "prep"],
-             simulated=False)
-    sample = root / "prep" / "sample.h5"
-    for device in ("cpu", "gpu"):
-        pendular([*TRIAXIAL, "--sample", sample, "--device", device, "--out", root / device],
-                 simulated=device == "gpu")
+    sample = prepared_sample(tmp_path_factory, WALLED_SAMPLE)
+    on_the_cpu([*TRIAXIAL, "--sample", sample, "--device", "cpu", "--out", root / "cpu"])
+    shutil.copytree(root / "cpu", root / "cpu_on_gpu")
+    simulated_commands(
+        ("triaxial", [*TRIAXIAL, "--sample", sample, "--device", "gpu", "--out", root / "gpu"]),
+        ("triaxial", ["--resume", root / "cpu_on_gpu", "--device", "gpu", "--quiet"]))
+    shutil.copytree(root / "gpu", root / "gpu_on_cpu")
+    on_the_cpu(["--resume", root / "gpu_on_cpu", "--device", "cpu", "--quiet"])
     with one_ulp_off(sample):
-        pendular([*TRIAXIAL, "--sample", sample, "--out", root / "cpu_ulp"], simulated=False)
+        on_the_cpu([*TRIAXIAL, "--sample", sample, "--out", root / "cpu_ulp"])
     return root
 
 
@@ -148,13 +149,11 @@ def test_the_gpu_command_records_the_cpu_history(runs):
 @requires("numba_cuda")
 @pytest.mark.parametrize("written, resumed", [("gpu", "cpu"), ("cpu", "gpu")])
 def test_a_checkpoint_resumes_on_the_other_device(runs, written, resumed):
-    copy = runs / f"{written}_on_{resumed}"
-    shutil.copytree(runs / written, copy)
-    step = checkpoint_step(copy)
-    steps = history(copy)["step"]
-    assert steps[0] < step < steps[-1]              # written by the loading, partway
-    pendular(["--resume", copy, "--device", resumed, "--quiet"], simulated=resumed == "gpu")
-    again = history(copy)
+    """The copy of the run on ``written`` resumed on ``resumed`` (runs) from the checkpoint
+    that the run wrote partway records the run's steps, the CPU's history within bounds."""
+    steps = history(runs / written)["step"]
+    assert steps[0] < checkpoint_step(runs / written) < steps[-1]  # written by the loading
+    again = history(runs / f"{written}_on_{resumed}")
     assert np.array_equal(again["step"], steps)
     assert_agrees(history(runs / "cpu"), again, sensitivity(runs))
 

@@ -11,14 +11,25 @@ import pytest
 
 from conftest import requires
 from periodic_checks import scene
-from simulator import assert_same_records, histories_on_both, simulated
+from simulator import (PERIODIC_SAMPLE, assert_same_records, histories_on_both,
+                       on_the_gpu, prepared_sample, simulated)
 
 pytestmark = requires("numba_cuda")
 
 
 @pytest.fixture(scope="module")
-def measured():
-    return simulated("periodic_checks.py", "dry", "wet", "hertz")
+def command_runs(tmp_path_factory):
+    """The sample that the command test loads (prepared on the CPU,
+    simulator.prepared_sample), and the folder of its runs."""
+    return prepared_sample(tmp_path_factory, PERIODIC_SAMPLE), tmp_path_factory.mktemp("command")
+
+
+@pytest.fixture(scope="module")
+def measured(command_runs):
+    """The checks' measurements, in one process, after the command test's GPU run there."""
+    sample, folder = command_runs
+    return simulated("periodic_checks.py", "dry", "wet", "hertz",
+                     commands=[on_the_gpu("triaxial", sample, COMMAND, folder)])
 
 
 @pytest.fixture(scope="module")
@@ -76,13 +87,13 @@ COMMAND = ["--particles", "60", "--periodic", "--max-strain", "0.002", "--inerti
            "1e-3", "--quiet"]
 
 
-def test_the_periodic_triaxial_command_records_the_cpu_history(tmp_path):
+def test_the_periodic_triaxial_command_records_the_cpu_history(command_runs, measured):
     """``pendular triaxial --periodic --sample S --device gpu`` (S a periodic sample prepared on
     the CPU) runs the sample's equilibrium and the shear on the device and records the CPU's
     history: the same rows and contact counts, the other columns to round-off grown over the
     steps (the unbalanced force, a residual ratio, looser)."""
-    cpu, gpu = histories_on_both("triaxial", ["--particles", 60, "--periodic", "--max-strain",
-                                              1e-4, "--quiet"], COMMAND, tmp_path)
+    sample, folder = command_runs
+    cpu, gpu = histories_on_both("triaxial", sample, COMMAND, folder)
     assert_same_records(cpu, gpu, 100)
     for name, values in cpu.items():
         if values.dtype == object:

@@ -12,11 +12,22 @@ import numpy as np
 import pytest
 
 from conftest import requires
-from simulator import assert_same_records, histories_on_both, simulated
+from simulator import (WALLED_SAMPLE, assert_same_records, histories_on_both,
+                       on_the_gpu, prepared_sample, simulated)
 
 @pytest.fixture(scope="module")
-def measured():
-    return simulated("persist_checks.py", "path")["path"]
+def command_runs(tmp_path_factory):
+    """The sample that the command test loads (prepared on the CPU,
+    simulator.prepared_sample), and the folder of its runs."""
+    return prepared_sample(tmp_path_factory, WALLED_SAMPLE), tmp_path_factory.mktemp("command")
+
+
+@pytest.fixture(scope="module")
+def measured(command_runs):
+    """The checks' measurements, in one process, after the command test's GPU run there."""
+    sample, folder = command_runs
+    return simulated("persist_checks.py", "path",
+                     commands=[on_the_gpu("triaxial", sample, TRIAXIAL, folder)])["path"]
 
 
 @requires("numba_cuda")
@@ -45,13 +56,14 @@ TRIAXIAL = ["--particles", "60", "--suction", "30000", "--persist-bridges", "--m
 
 
 @requires("numba_cuda")
-def test_the_triaxial_command_with_persisting_bridges_records_the_cpu_history(tmp_path):
+def test_the_triaxial_command_with_persisting_bridges_records_the_cpu_history(command_runs,
+                                                                             measured):
     """``pendular triaxial --sample S --suction 30000 --persist-bridges --device gpu`` (S
     prepared on the CPU; the wetting on the CPU, the loading on the device) records the CPU's
     history: the same rows, bridge and contact counts, the other columns to round-off grown
     over the steps (module docstring)."""
-    cpu, gpu = histories_on_both("triaxial", ["--particles", 60, "--max-strain", 1e-4,
-                                              "--quiet"], TRIAXIAL, tmp_path)
+    sample, folder = command_runs
+    cpu, gpu = histories_on_both("triaxial", sample, TRIAXIAL, folder)
     assert_same_records(cpu, gpu, 100, ("bridges", "coordination"))
     worst = {}
     for name, values in cpu.items():

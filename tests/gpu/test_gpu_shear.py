@@ -12,14 +12,25 @@ import pytest
 
 from conftest import requires
 from shear_checks import GROWTH_TARGET, MIXED_STEPS, START_OFFSET
-from simulator import histories_on_both, simulated
+from simulator import (PERIODIC_SAMPLE, histories_on_both, on_the_gpu, prepared_sample,
+                       simulated)
 
 pytestmark = requires("numba_cuda")
 
 
 @pytest.fixture(scope="module")
-def measured():
-    return simulated("shear_checks.py", "dry", "wet", "mixed", "growth")
+def command_runs(tmp_path_factory):
+    """The sample that the command test loads (prepared on the CPU,
+    simulator.prepared_sample), and the folder of its runs."""
+    return prepared_sample(tmp_path_factory, PERIODIC_SAMPLE), tmp_path_factory.mktemp("command")
+
+
+@pytest.fixture(scope="module")
+def measured(command_runs):
+    """The checks' measurements, in one process, after the command test's GPU run there."""
+    sample, folder = command_runs
+    return simulated("shear_checks.py", "dry", "wet", "mixed", "growth",
+                     commands=[on_the_gpu("simple-shear", sample, COMMAND, folder)])
 
 
 @pytest.fixture(scope="module")
@@ -128,12 +139,12 @@ TOLERANCE = 2e-9
 UNBALANCED_TOLERANCE = 1e-7
 
 
-def test_the_simple_shear_command_records_the_cpu_history(tmp_path):
-    """``pendular simple-shear --sample S --device gpu`` (S a sample prepared by the command on
-    the CPU) shears on the device and records the CPU's history: the same rows, contact
+def test_the_simple_shear_command_records_the_cpu_history(command_runs, measured):
+    """``pendular simple-shear --sample S --device gpu`` (S a periodic sample prepared on the
+    CPU) shears on the device and records the CPU's history: the same rows, contact
     counts and shear strains, the other columns to round-off grown over the steps."""
-    cpu, gpu = histories_on_both("simple-shear", ["--particles", 60, "--max-strain", 1e-3,
-                                                  "--quiet"], COMMAND, tmp_path)
+    sample, folder = command_runs
+    cpu, gpu = histories_on_both("simple-shear", sample, COMMAND, folder)
     assert cpu.keys() == gpu.keys() and len(cpu["step"]) > 5
     for name in ("step", "coordination", "shear_strain"):
         assert np.array_equal(cpu[name], gpu[name]), name

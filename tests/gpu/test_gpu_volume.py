@@ -14,14 +14,25 @@ import numpy as np
 import pytest
 
 from conftest import requires
-from simulator import assert_same_records, histories_on_both, simulated
+from simulator import (WALLED_SAMPLE, assert_same_records, histories_on_both,
+                       on_the_gpu, prepared_sample, simulated)
 
 pytestmark = requires("numba_cuda")
 
 
 @pytest.fixture(scope="module")
-def measured():
-    return simulated("volume_checks.py", "shared", "lost")
+def command_runs(tmp_path_factory):
+    """The sample that the command test loads (prepared on the CPU,
+    simulator.prepared_sample), and the folder of its runs."""
+    return prepared_sample(tmp_path_factory, WALLED_SAMPLE), tmp_path_factory.mktemp("command")
+
+
+@pytest.fixture(scope="module")
+def measured(command_runs):
+    """The checks' measurements, in one process, after the command test's GPU run there."""
+    sample, folder = command_runs
+    return simulated("volume_checks.py", "shared", "lost",
+                     commands=[on_the_gpu("triaxial", sample, TRIAXIAL, folder)])
 
 
 def assert_agrees(stage):
@@ -52,12 +63,12 @@ TRIAXIAL = ["--particles", "60", "--water-content", "5", "--max-strain", "0.002"
             "--inertial-number", "1e-3", "--quiet"]
 
 
-def test_the_triaxial_command_at_a_water_content_records_the_cpu_history(tmp_path):
+def test_the_triaxial_command_at_a_water_content_records_the_cpu_history(command_runs, measured):
     """``pendular triaxial --sample S --water-content 5 --device gpu`` (S prepared on the CPU)
     records the CPU's rows, bridge and contact counts, and columns within the sensitivity of
     that wetting (module docstring)."""
-    cpu, gpu = histories_on_both("triaxial", ["--particles", 60, "--max-strain", 1e-4,
-                                              "--quiet"], TRIAXIAL, tmp_path)
+    sample, folder = command_runs
+    cpu, gpu = histories_on_both("triaxial", sample, TRIAXIAL, folder)
     assert_same_records(cpu, gpu, 100, ("bridges", "coordination"))
     for name, values in cpu.items():
         if values.dtype == object:
