@@ -1,23 +1,24 @@
 """Drained triaxial test of thesis Chapter 5 (Table 5.2 defaults): prepare, wet, shear, write.
 
 Writes into --out: history.h5 (one row per record), summary.json, triaxial.png, plots/,
-``vtk/*.pvd`` (ParaView), sample.h5 (the sample the shear starts from), with
---checkpoint-every N checkpoint.h5 and, with --vtk-prep, ``vtk_prep/*.pvd`` (ParaView frames
-of the preparation and wetting); --resume DIR continues an interrupted run. Stresses
-compression positive [Pa]. Wet test (--suction > 0): bridges at every contact at the confining
-stress, re-equilibrated, then sheared (pendular.procedures.triaxial); --wetting chooses when the
-bridges appear. Constant water content (--water-content W): volume-controlled bridges holding
-W % of the grains' mass, the liquid then conserved during the shear (--rupture-liquid) and the
-suction an output. --direction extension pulls the axial walls apart (--max-strain the
-magnitude of the extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
+``vtk/*.pvd`` (ParaView), sample.h5 (the sample the shear starts from), with --checkpoint-every
+N checkpoint.h5 and, with --vtk-prep, ``vtk_prep/*.pvd`` (ParaView frames of the preparation
+and wetting); --resume DIR continues an interrupted run. Stresses compression positive [Pa].
+Wet test (--suction > 0): bridges at every contact at the confining stress, re-equilibrated,
+then sheared (pendular.procedures.triaxial); --wetting chooses when the bridges appear.
+Constant water content (--water-content W): volume-controlled bridges holding W % of the
+grains' mass, the liquid then conserved during the shear (--rupture-liquid) and the suction an
+output. --direction extension pulls the axial walls apart (--max-strain the magnitude of the
+extension); --b B holds b = (sigma_2 - sigma_3) / (sigma_1 - sigma_3) (true triaxial, sigma_1
 axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress as q rises
 (pendular.procedures.triaxial.shear_stage). --drainage undrained holds the volume (the lateral
 walls follow the axial ones): summary excess_pore_pressure_at_peak [Pa] of a saturated sample
 and effective_stress_path; wet, the water content is held too (volume-controlled bridges,
-closed liquid) and the suction and Sr change. --liquid clusters (with --suction, between walls,
-on the CPU, without checkpoints): liquid clusters of filled pore units beside persisting
-bridges, updated as the packing deforms (pendular.procedures.loading_clusters); ``pores/*.pvd``
-holds the pore units coloured by cluster.
+closed liquid) and the suction and Sr change. --liquid clusters (at a suction or a water
+content, between walls, on the CPU, without checkpoints): liquid clusters of filled pore units
+beside persisting bridges, updated as the packing deforms
+(pendular.procedures.loading_clusters); ``pores/*.pvd`` holds the pore units coloured by
+cluster.
 
 The sample, wetting and output options are shared with every laboratory command (``pendular
 oedometer``, ``isotropic``, ``simple-shear``, ``cyclic``, ``path``): pendular.procedures.options
