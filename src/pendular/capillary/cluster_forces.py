@@ -51,13 +51,20 @@ def face_normals(vertices, sides=None):
     position of the same units), those signs instead: the normals then move continuously with
     the grains, and stay opposite across a face two units share, even where a flat unit turns
     inside out."""
+    normal, sides, _ = _face_normals_areas(vertices, sides)
+    return normal, sides
+
+
+def _face_normals_areas(vertices, sides=None):
+    """face_normals's (normal, sides) and (M, 4) [m^2] the area of each face."""
     corners = vertices[:, FACES]                           # (M, 4, 3, 3)
     normal = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
-    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+    length = np.linalg.norm(normal, axis=2, keepdims=True)
+    normal /= length
     if sides is None:
         inward = np.sum((vertices - corners[:, :, 0]) * normal, axis=2)
         sides = -np.sign(inward)
-    return normal * sides[..., None], sides
+    return normal * sides[..., None], sides, 0.5 * length[..., 0]
 
 
 class UnitForces:
@@ -69,13 +76,10 @@ class UnitForces:
     same units (None: outward at these vertices), kept as ``sides``."""
 
     def __init__(self, vertices, radii, sides=None):
-        normal, self.sides = face_normals(vertices, sides)          # (M, 4, 3), (M, 4)
+        normal, self.sides, area = _face_normals_areas(vertices, sides)  # (M, 4, 3), (M, 4)
         angle = face_angles(vertices)                      # (M, 4, 3)
         face_radii = radii[:, FACES]                       # (M, 4, 3)
         sector = 0.5 * angle * face_radii ** 2             # alpha R^2 / 2
-        corners = vertices[:, FACES]
-        area = 0.5 * np.linalg.norm(np.cross(corners[:, :, 1] - corners[:, :, 0],
-                                             corners[:, :, 2] - corners[:, :, 0]), axis=2)
         self.open_area = area - sector.sum(axis=2)         # (M, 4) A_f [m^2]
         self.cone = np.zeros(vertices.shape)
         for f in range(4):

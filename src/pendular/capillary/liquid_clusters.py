@@ -52,7 +52,8 @@ class LiquidClusters:
         self._unit_forces = None
         self._edges = None
         self._force = None
-        self._contacts = None
+        self._contacts = None         # the neighbour list _pair_edge and _share are of
+        self._pair_edge = None
         self._share = None
         self._carried = None          # filled units of a checkpoint, until set_suction
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
@@ -183,12 +184,10 @@ class LiquidClusters:
             return
         particles, contacts = sim.particles, sim.contacts
         particles.force += self._force
-        if contacts is not self._contacts:
-            self._share = self.pair_share(contacts)
-            self._contacts = contacts
+        share = self.pair_share(contacts)
         pair_force = self.bridges.pair_force
-        if len(pair_force) == len(self._share):
-            gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
+        if len(pair_force) == len(share):
+            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, particles.force)
 
     def grain_forces(self, sim):
@@ -208,13 +207,25 @@ class LiquidClusters:
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
-        liquid's front, in its fraction)."""
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
-        if self._front_held():
-            share = self._edges.share(self.liquid.weight)
-        else:
-            share = self._edges.filled_share(self.filled)
-        return np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+        liquid's front, in its fraction); kept until the neighbour list or the filled units
+        change (read only)."""
+        edge = self.pair_edge(contacts)
+        if self._share is None:
+            if self._front_held():
+                share = self._edges.share(self.liquid.weight)
+            else:
+                share = self._edges.filled_share(self.filled)
+            self._share = np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+        return self._share
+
+    def pair_edge(self, contacts):
+        """(K,) the edge of the pore units each pair of the neighbour list ``contacts`` is
+        (UnitEdges.of_pairs, -1: none); kept until the neighbour list or the units change."""
+        if contacts is not self._contacts:
+            self._pair_edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+            self._share = None
+            self._contacts = contacts
+        return self._pair_edge
 
     def _front_held(self):
         """Whether the closed liquid's front holds liquid."""
@@ -226,7 +237,7 @@ class LiquidClusters:
         sim.fetch("contacts")
         contacts = sim.contacts
         volume = BridgeState.of(contacts).volume
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        edge = self.pair_edge(contacts)
         if self.liquid is None:
             return liquid_account(self.units, self._edges, self.found, volume, edge)
         return liquid_account(self.units, self._edges, self.found, volume, edge,
@@ -238,7 +249,7 @@ class LiquidClusters:
         share no unit, across a gap, all)."""
         contacts = sim.contacts
         volume = BridgeState.of(contacts).volume
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        edge = self.pair_edge(contacts)
         inside = self._edges.filled_share(np.ones(self.units.count, bool))
         inside = np.where(edge >= 0, inside[np.maximum(edge, 0)], 1.0)
         return account.clusters + float(np.sum(volume * inside)) - account.absorbed
@@ -258,12 +269,13 @@ class LiquidClusters:
         return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
                               sim.walls.volume())
 
-    def statistics(self, sim):
+    def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
         the liquid fractions in bridges, in clusters and in the largest cluster, whether the
         largest percolates along x, y, z, the saturation (over the voids of the box, and over
-        the pore units' void alone) and the clusters' stress."""
-        account = self.account(sim)
+        the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
+        if already measured)."""
+        account = self.account(sim) if account is None else account
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
         in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))
