@@ -90,6 +90,18 @@ class UnitForces:
         self.meniscus = (-(self.open_area[..., None] * share)[..., None]
                          * normal[:, :, None, :])          # (M, 4, 3, 3)
 
+    def moved(self, units, vertices, radii):
+        """UnitForces of the same pore units with ``units`` (U,) moved to ``vertices`` (U, 4,
+        3) [m] (grain radii ``radii`` (U, 4) [m]), each face keeping its side; the other
+        units' coefficients as they were."""
+        moved = UnitForces(vertices, radii, self.sides[units])
+        result = object.__new__(UnitForces)
+        for name in ("sides", "open_area", "cone", "meniscus"):
+            coefficients = getattr(self, name).copy()
+            coefficients[units] = getattr(moved, name)
+            setattr(result, name, coefficients)
+        return result
+
 
 def boundary_faces(pore_units, filled):
     """(M, 4) bool: the faces of filled units that meet gas (an empty unit or the hull)."""

@@ -140,15 +140,16 @@ class LiquidClusters:
         self.units, self.filled, self.suction = units, filled, float(suction)
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
-        self._set_forces(sim.particles, units.vertices)
+        self._set_forces(sim.particles,
+                         UnitForces(units.vertices, sim.particles.radius[units.grains]))
         self._contacts = None
         self._carried = None
 
-    def _set_forces(self, particles, vertices, sides=None):
-        """The clusters' forces of the filled units (and the closed liquid's front) with their
-        grains at ``vertices`` (M, 4, 3) [m] (``sides``: UnitForces's)."""
+    def _set_forces(self, particles, unit_forces):
+        """The clusters' forces of the filled units (and the closed liquid's front) with the
+        coefficients ``unit_forces`` (UnitForces)."""
         units = self.units
-        self._unit_forces = UnitForces(vertices, particles.radius[units.grains], sides)
+        self._unit_forces = unit_forces
         self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
                                      len(particles))
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
@@ -162,13 +163,16 @@ class LiquidClusters:
         units, the suction and the liquid as they are (no decomposition, filling or drainage:
         between two steps of the model, the forces follow the grains as the packing moves);
         each face keeps the side its normal had at the decomposition, so that the forces still
-        sum to zero where a flat unit has turned inside out."""
+        sum to zero where a flat unit has turned inside out. Only the units that hold liquid
+        move: an empty unit's coefficients stay those of the decomposition, unused."""
         if self.units is None:
             return
         sim.fetch("particles")
         particles = sim.particles
-        self._set_forces(particles, particles.position[self.units.grains],
-                         self._unit_forces.sides)
+        held = self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
+        grains = self.units.grains[held]
+        self._set_forces(particles, self._unit_forces.moved(
+            np.flatnonzero(held), particles.position[grains], particles.radius[grains]))
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
