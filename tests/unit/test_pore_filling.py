@@ -150,6 +150,8 @@ def test_bridge_shares_and_the_liquid_account(packing):
     pair_edge = edges.of_pairs(edges.pair[:, 0], edges.pair[:, 1])
     assert (pair_edge == np.arange(len(edges.pair))).all()
     assert edges.of_pairs(np.array([0]), np.array([0]))[0] == -1
+    beyond = int(edges.pair.max()) + 1               # a grain on no edge: none found
+    assert (edges.of_pairs(np.array([0, 1]), np.array([beyond, beyond + 5])) == -1).all()
     volume = np.full(len(edges.pair), 1e-15)
     half = np.zeros(units.count, bool)
     half[::2] = True
@@ -190,6 +192,25 @@ def test_cone_area_vector_against_a_quadrature(packing):
             error = np.linalg.norm(forces.cone[u, k] - expected)
             noise = 4 * math.pi / math.sqrt(len(direction)) * radius.max() ** 2
             assert error < 5 * noise
+
+
+def test_moved_unit_forces_are_those_of_the_units_at_their_new_positions(packing):
+    """UnitForces.moved (the forces following the grains) recomputes the units given, their
+    faces keeping their sides, exactly as the coefficients of all units at the new
+    positions; the other units keep theirs."""
+    _, radius, units, _ = packing
+    radii = radius[units.grains]
+    forces = cluster_forces.UnitForces(units.vertices, radii)
+    shifted = units.vertices + np.random.default_rng(3).normal(0.0, 0.02 * RADIUS,
+                                                               units.vertices.shape)
+    every = cluster_forces.UnitForces(shifted, radii, forces.sides)
+    moved_units = np.flatnonzero(np.arange(units.count) % 3 == 0)
+    moved = forces.moved(moved_units, shifted[moved_units], radii[moved_units])
+    kept = np.setdiff1d(np.arange(units.count), moved_units)
+    for name in ("sides", "open_area", "cone", "meniscus"):
+        assert np.array_equal(getattr(moved, name)[moved_units],
+                              getattr(every, name)[moved_units]), name
+        assert np.array_equal(getattr(moved, name)[kept], getattr(forces, name)[kept]), name
 
 
 def test_a_filled_regular_tetrahedron_pulls_each_grain_to_its_centre():
