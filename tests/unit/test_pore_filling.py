@@ -245,6 +245,15 @@ def test_cluster_forces_balance_and_vanish_inside(packing):
     assert np.abs(everything[inner]).max() < 1e-12 * scale
     stress = cluster_forces.cluster_stress(units, forces, filled, 1e3, 1e-9)
     assert np.isfinite(stress).all()
+    # with the grains moved, the stress of the forces there is -(1/V) sum x (x) F over the
+    # grains at their new positions (the forces balance, so the origin does not matter)
+    moved = centres + np.random.default_rng(2).normal(0.0, 0.02 * RADIUS, centres.shape)
+    at = moved[units.grains]
+    followed = forces.moved(np.arange(units.count), at, radius[units.grains])
+    grain_force = cluster_forces.cluster_forces(units, followed, filled, 1e3, len(radius))
+    expected = -np.einsum("ki,kj->ij", moved, grain_force) / 1e-9
+    found = cluster_forces.cluster_stress(units, followed, filled, 1e3, 1e-9, vertices=at)
+    assert np.allclose(found, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
 
 
 def test_pore_units_coloured_by_cluster_for_paraview(packing, tmp_path):

@@ -154,18 +154,21 @@ def partial_forces(pore_units, unit_forces, units, fraction, suction, grain_coun
     return fraction * suction * force
 
 
-def cluster_stress(pore_units, unit_forces, filled, suction, volume, weight=None):
+def cluster_stress(pore_units, unit_forces, filled, suction, volume, weight=None,
+                   vertices=None):
     """(3, 3) [Pa] the stress of the clusters' forces, compression positive, over ``volume``
     [m^3]: -(1/V) sum x (x) F, taken unit by unit over each filled unit's self-equilibrated
     set (equilibrated_sets; the menisci of faces shared by two filled units cancel in the
     grains' forces), at the positions the unit sees (a periodic image's, unwrapped); with
     ``weight`` (M,) [-], each unit's set in that share (a partly filled unit), ``filled`` then
-    the units with a share. It is the clusters' share of the complete capillary stress
-    psi + I (docs/capillary.md), as -(1/V) sum x (x) F of the bridges' forces is theirs."""
+    the units with a share; ``vertices`` (M, 4, 3) [m]: the grains' positions where the
+    forces act (those ``unit_forces`` were computed at; None: the decomposition's). It is the
+    clusters' share of the complete capillary stress psi + I (docs/capillary.md), as -(1/V)
+    sum x (x) F of the bridges' forces is theirs."""
     units = np.flatnonzero(filled)
     force = equilibrated_sets(unit_forces, units)
     if weight is not None:
         force *= np.asarray(weight, float)[units, None, None]
-    centred = pore_units.vertices[units] - pore_units.vertices[units].mean(axis=1,
-                                                                           keepdims=True)
+    at = (pore_units.vertices if vertices is None else vertices)[units]
+    centred = at - at.mean(axis=1, keepdims=True)
     return -suction / volume * np.einsum("uki,ukj->ij", centred, force)

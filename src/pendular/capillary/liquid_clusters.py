@@ -50,6 +50,7 @@ class LiquidClusters:
         self.filled = None
         self.found = None
         self._unit_forces = None
+        self._vertices = None         # (M, 4, 3) [m] where the units' forces act
         self._edges = None
         self._force = None
         self._contacts = None         # the neighbour list _pair_edge and _share are of
@@ -140,6 +141,7 @@ class LiquidClusters:
         self.units, self.filled, self.suction = units, filled, float(suction)
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
+        self._vertices = units.vertices
         self._set_forces(sim.particles,
                          UnitForces(units.vertices, sim.particles.radius[units.grains]))
         self._contacts = None
@@ -171,8 +173,11 @@ class LiquidClusters:
         particles = sim.particles
         held = self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
         grains = self.units.grains[held]
+        vertices = self._vertices.copy()
+        vertices[held] = particles.position[grains]
+        self._vertices = vertices
         self._set_forces(particles, self._unit_forces.moved(
-            np.flatnonzero(held), particles.position[grains], particles.radius[grains]))
+            np.flatnonzero(held), vertices[held], particles.radius[grains]))
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
@@ -265,13 +270,13 @@ class LiquidClusters:
 
     def stress(self, sim):
         """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box
-        (cluster_forces.cluster_stress)."""
+        (cluster_forces.cluster_stress), with the grains where their forces act."""
         if self._front_held():
             weight = self.liquid.weight
             return cluster_stress(self.units, self._unit_forces, weight > 0.0, self.suction,
-                                  sim.walls.volume(), weight)
+                                  sim.walls.volume(), weight, self._vertices)
         return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
-                              sim.walls.volume())
+                              sim.walls.volume(), vertices=self._vertices)
 
     def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
