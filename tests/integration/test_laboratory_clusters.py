@@ -14,6 +14,7 @@ from conftest import refused, run_in_process
 from pendular import BridgeConfig, PrepareConfig, ShearConfig, TriaxialConfig, TriaxialTest
 from pendular import read_history
 from pendular.io.schema import undeclared_keys
+from pendular.procedures import laboratory
 from pendular.procedures.registry import config_from_options
 from pendular.utils.parameters import ParameterError
 
@@ -38,7 +39,8 @@ def test_clusters_above_every_filling_suction_are_the_pendular_run(tmp_path):
         assert np.array_equal(pendular[name].values, clusters[name].values), name
 
 
-def test_a_triaxial_where_pores_fill_records_its_clusters(tmp_path, capsys):
+def test_a_triaxial_where_pores_fill_records_its_clusters(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(laboratory, "CLUSTER_RECORDS", 10)     # updates within 40 records
     out = tmp_path / "clusters"
     status, err = run_in_process("triaxial", [
         "--particles", "200", "--suction", "20000", "--liquid", "clusters", "--max-strain",
@@ -65,9 +67,11 @@ def test_a_triaxial_where_pores_fill_records_its_clusters(tmp_path, capsys):
     assert len(frames) == 5 and (out / "pores" / "pores.pvd").exists()   # wetted + 4 updates
 
 
-def test_a_triaxial_at_a_water_content_holds_its_water_in_bridges_and_clusters(tmp_path):
+def test_a_triaxial_at_a_water_content_holds_its_water_in_bridges_and_clusters(tmp_path,
+                                                                             monkeypatch):
     """The closed liquid (LiquidClusters.hold_volume) at the wetting and at every update;
     between updates the bridges follow their gaps at the suction found."""
+    monkeypatch.setattr(laboratory, "CLUSTER_RECORDS", 10)     # updates within 20 records
     config = TriaxialConfig(sample=SAMPLE, shear=SHEAR, vtk_frames=0, liquid="clusters",
                             bridges=BridgeConfig(water_content=0.02, control="volume"))
     summary = TriaxialTest(config).run(tmp_path, progress=False, plots=False)

@@ -150,6 +150,8 @@ def test_bridge_shares_and_the_liquid_account(packing):
     pair_edge = edges.of_pairs(edges.pair[:, 0], edges.pair[:, 1])
     assert (pair_edge == np.arange(len(edges.pair))).all()
     assert edges.of_pairs(np.array([0]), np.array([0]))[0] == -1
+    beyond = int(edges.pair.max()) + 1               # a grain on no edge: none found
+    assert (edges.of_pairs(np.array([0, 1]), np.array([beyond, beyond + 5])) == -1).all()
     volume = np.full(len(edges.pair), 1e-15)
     half = np.zeros(units.count, bool)
     half[::2] = True
@@ -192,6 +194,25 @@ def test_cone_area_vector_against_a_quadrature(packing):
             assert error < 5 * noise
 
 
+def test_moved_unit_forces_are_those_of_the_units_at_their_new_positions(packing):
+    """UnitForces.moved (the forces following the grains) recomputes the units given, their
+    faces keeping their sides, exactly as the coefficients of all units at the new
+    positions; the other units keep theirs."""
+    _, radius, units, _ = packing
+    radii = radius[units.grains]
+    forces = cluster_forces.UnitForces(units.vertices, radii)
+    shifted = units.vertices + np.random.default_rng(3).normal(0.0, 0.02 * RADIUS,
+                                                               units.vertices.shape)
+    every = cluster_forces.UnitForces(shifted, radii, forces.sides)
+    moved_units = np.flatnonzero(np.arange(units.count) % 3 == 0)
+    moved = forces.moved(moved_units, shifted[moved_units], radii[moved_units])
+    kept = np.setdiff1d(np.arange(units.count), moved_units)
+    for name in ("sides", "open_area", "cone", "meniscus"):
+        assert np.array_equal(getattr(moved, name)[moved_units],
+                              getattr(every, name)[moved_units]), name
+        assert np.array_equal(getattr(moved, name)[kept], getattr(forces, name)[kept]), name
+
+
 def test_a_filled_regular_tetrahedron_pulls_each_grain_to_its_centre():
     vertices = touching_tetrahedron(np.full(4, RADIUS))
     units = pores.decompose(vertices, np.full(4, RADIUS))
@@ -224,6 +245,15 @@ def test_cluster_forces_balance_and_vanish_inside(packing):
     assert np.abs(everything[inner]).max() < 1e-12 * scale
     stress = cluster_forces.cluster_stress(units, forces, filled, 1e3, 1e-9)
     assert np.isfinite(stress).all()
+    # with the grains moved, the stress of the forces there is -(1/V) sum x (x) F over the
+    # grains at their new positions (the forces balance, so the origin does not matter)
+    moved = centres + np.random.default_rng(2).normal(0.0, 0.02 * RADIUS, centres.shape)
+    at = moved[units.grains]
+    followed = forces.moved(np.arange(units.count), at, radius[units.grains])
+    grain_force = cluster_forces.cluster_forces(units, followed, filled, 1e3, len(radius))
+    expected = -np.einsum("ki,kj->ij", moved, grain_force) / 1e-9
+    found = cluster_forces.cluster_stress(units, followed, filled, 1e3, 1e-9, vertices=at)
+    assert np.allclose(found, expected, rtol=0, atol=1e-9 * np.abs(expected).max())
 
 
 def test_pore_units_coloured_by_cluster_for_paraview(packing, tmp_path):

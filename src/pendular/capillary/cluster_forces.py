@@ -51,13 +51,20 @@ def face_normals(vertices, sides=None):
     position of the same units), those signs instead: the normals then move continuously with
     the grains, and stay opposite across a face two units share, even where a flat unit turns
     inside out."""
+    normal, sides, _ = _face_normals_areas(vertices, sides)
+    return normal, sides
+
+
+def _face_normals_areas(vertices, sides=None):
+    """face_normals's (normal, sides) and (M, 4) [m^2] the area of each face."""
     corners = vertices[:, FACES]                           # (M, 4, 3, 3)
     normal = np.cross(corners[:, :, 1] - corners[:, :, 0], corners[:, :, 2] - corners[:, :, 0])
-    normal /= np.linalg.norm(normal, axis=2, keepdims=True)
+    length = np.linalg.norm(normal, axis=2, keepdims=True)
+    normal /= length
     if sides is None:
         inward = np.sum((vertices - corners[:, :, 0]) * normal, axis=2)
         sides = -np.sign(inward)
-    return normal * sides[..., None], sides
+    return normal * sides[..., None], sides, 0.5 * length[..., 0]
 
 
 class UnitForces:
@@ -69,13 +76,10 @@ class UnitForces:
     same units (None: outward at these vertices), kept as ``sides``."""
 
     def __init__(self, vertices, radii, sides=None):
-        normal, self.sides = face_normals(vertices, sides)          # (M, 4, 3), (M, 4)
+        normal, self.sides, area = _face_normals_areas(vertices, sides)  # (M, 4, 3), (M, 4)
         angle = face_angles(vertices)                      # (M, 4, 3)
         face_radii = radii[:, FACES]                       # (M, 4, 3)
         sector = 0.5 * angle * face_radii ** 2             # alpha R^2 / 2
-        corners = vertices[:, FACES]
-        area = 0.5 * np.linalg.norm(np.cross(corners[:, :, 1] - corners[:, :, 0],
-                                             corners[:, :, 2] - corners[:, :, 0]), axis=2)
         self.open_area = area - sector.sum(axis=2)         # (M, 4) A_f [m^2]
         self.cone = np.zeros(vertices.shape)
         for f in range(4):
@@ -85,6 +89,18 @@ class UnitForces:
         share = arc / arc.sum(axis=2, keepdims=True)
         self.meniscus = (-(self.open_area[..., None] * share)[..., None]
                          * normal[:, :, None, :])          # (M, 4, 3, 3)
+
+    def moved(self, units, vertices, radii):
+        """UnitForces of the same pore units with ``units`` (U,) moved to ``vertices`` (U, 4,
+        3) [m] (grain radii ``radii`` (U, 4) [m]), each face keeping its side; the other
+        units' coefficients as they were."""
+        moved = UnitForces(vertices, radii, self.sides[units])
+        result = object.__new__(UnitForces)
+        for name in ("sides", "open_area", "cone", "meniscus"):
+            coefficients = getattr(self, name).copy()
+            coefficients[units] = getattr(moved, name)
+            setattr(result, name, coefficients)
+        return result
 
 
 def boundary_faces(pore_units, filled):
@@ -138,18 +154,21 @@ def partial_forces(pore_units, unit_forces, units, fraction, suction, grain_coun
     return fraction * suction * force
 
 
-def cluster_stress(pore_units, unit_forces, filled, suction, volume, weight=None):
+def cluster_stress(pore_units, unit_forces, filled, suction, volume, weight=None,
+                   vertices=None):
     """(3, 3) [Pa] the stress of the clusters' forces, compression positive, over ``volume``
     [m^3]: -(1/V) sum x (x) F, taken unit by unit over each filled unit's self-equilibrated
     set (equilibrated_sets; the menisci of faces shared by two filled units cancel in the
     grains' forces), at the positions the unit sees (a periodic image's, unwrapped); with
     ``weight`` (M,) [-], each unit's set in that share (a partly filled unit), ``filled`` then
-    the units with a share. It is the clusters' share of the complete capillary stress
-    psi + I (docs/capillary.md), as -(1/V) sum x (x) F of the bridges' forces is theirs."""
+    the units with a share; ``vertices`` (M, 4, 3) [m]: the grains' positions where the
+    forces act (those ``unit_forces`` were computed at; None: the decomposition's). It is the
+    clusters' share of the complete capillary stress psi + I (docs/capillary.md), as -(1/V)
+    sum x (x) F of the bridges' forces is theirs."""
     units = np.flatnonzero(filled)
     force = equilibrated_sets(unit_forces, units)
     if weight is not None:
         force *= np.asarray(weight, float)[units, None, None]
-    centred = pore_units.vertices[units] - pore_units.vertices[units].mean(axis=1,
-                                                                           keepdims=True)
+    at = (pore_units.vertices if vertices is None else vertices)[units]
+    centred = at - at.mean(axis=1, keepdims=True)
     return -suction / volume * np.einsum("uki,ukj->ij", centred, force)

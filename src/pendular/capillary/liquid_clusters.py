@@ -50,9 +50,11 @@ class LiquidClusters:
         self.filled = None
         self.found = None
         self._unit_forces = None
+        self._vertices = None         # (M, 4, 3) [m] where the units' forces act
         self._edges = None
         self._force = None
-        self._contacts = None
+        self._contacts = None         # the neighbour list _pair_edge and _share are of
+        self._pair_edge = None
         self._share = None
         self._carried = None          # filled units of a checkpoint, until set_suction
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
@@ -139,15 +141,17 @@ class LiquidClusters:
         self.units, self.filled, self.suction = units, filled, float(suction)
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
-        self._set_forces(sim.particles, units.vertices)
+        self._vertices = units.vertices
+        self._set_forces(sim.particles,
+                         UnitForces(units.vertices, sim.particles.radius[units.grains]))
         self._contacts = None
         self._carried = None
 
-    def _set_forces(self, particles, vertices, sides=None):
-        """The clusters' forces of the filled units (and the closed liquid's front) with their
-        grains at ``vertices`` (M, 4, 3) [m] (``sides``: UnitForces's)."""
+    def _set_forces(self, particles, unit_forces):
+        """The clusters' forces of the filled units (and the closed liquid's front) with the
+        coefficients ``unit_forces`` (UnitForces)."""
         units = self.units
-        self._unit_forces = UnitForces(vertices, particles.radius[units.grains], sides)
+        self._unit_forces = unit_forces
         self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
                                      len(particles))
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
@@ -161,13 +165,19 @@ class LiquidClusters:
         units, the suction and the liquid as they are (no decomposition, filling or drainage:
         between two steps of the model, the forces follow the grains as the packing moves);
         each face keeps the side its normal had at the decomposition, so that the forces still
-        sum to zero where a flat unit has turned inside out."""
+        sum to zero where a flat unit has turned inside out. Only the units that hold liquid
+        move: an empty unit's coefficients stay those of the decomposition, unused."""
         if self.units is None:
             return
         sim.fetch("particles")
         particles = sim.particles
-        self._set_forces(particles, particles.position[self.units.grains],
-                         self._unit_forces.sides)
+        held = self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
+        grains = self.units.grains[held]
+        vertices = self._vertices.copy()
+        vertices[held] = particles.position[grains]
+        self._vertices = vertices
+        self._set_forces(particles, self._unit_forces.moved(
+            np.flatnonzero(held), vertices[held], particles.radius[grains]))
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
@@ -183,12 +193,10 @@ class LiquidClusters:
             return
         particles, contacts = sim.particles, sim.contacts
         particles.force += self._force
-        if contacts is not self._contacts:
-            self._share = self.pair_share(contacts)
-            self._contacts = contacts
+        share = self.pair_share(contacts)
         pair_force = self.bridges.pair_force
-        if len(pair_force) == len(self._share):
-            gather_pair_forces(-self._share[:, None] * pair_force, contacts.row_start,
+        if len(pair_force) == len(share):
+            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, particles.force)
 
     def grain_forces(self, sim):
@@ -208,13 +216,25 @@ class LiquidClusters:
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
-        liquid's front, in its fraction)."""
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
-        if self._front_held():
-            share = self._edges.share(self.liquid.weight)
-        else:
-            share = self._edges.filled_share(self.filled)
-        return np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+        liquid's front, in its fraction); kept until the neighbour list or the filled units
+        change (read only)."""
+        edge = self.pair_edge(contacts)
+        if self._share is None:
+            if self._front_held():
+                share = self._edges.share(self.liquid.weight)
+            else:
+                share = self._edges.filled_share(self.filled)
+            self._share = np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
+        return self._share
+
+    def pair_edge(self, contacts):
+        """(K,) the edge of the pore units each pair of the neighbour list ``contacts`` is
+        (UnitEdges.of_pairs, -1: none); kept until the neighbour list or the units change."""
+        if contacts is not self._contacts:
+            self._pair_edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+            self._share = None
+            self._contacts = contacts
+        return self._pair_edge
 
     def _front_held(self):
         """Whether the closed liquid's front holds liquid."""
@@ -226,7 +246,7 @@ class LiquidClusters:
         sim.fetch("contacts")
         contacts = sim.contacts
         volume = BridgeState.of(contacts).volume
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        edge = self.pair_edge(contacts)
         if self.liquid is None:
             return liquid_account(self.units, self._edges, self.found, volume, edge)
         return liquid_account(self.units, self._edges, self.found, volume, edge,
@@ -238,7 +258,7 @@ class LiquidClusters:
         share no unit, across a gap, all)."""
         contacts = sim.contacts
         volume = BridgeState.of(contacts).volume
-        edge = self._edges.of_pairs(contacts.pair_i, contacts.pair_j)
+        edge = self.pair_edge(contacts)
         inside = self._edges.filled_share(np.ones(self.units.count, bool))
         inside = np.where(edge >= 0, inside[np.maximum(edge, 0)], 1.0)
         return account.clusters + float(np.sum(volume * inside)) - account.absorbed
@@ -250,20 +270,21 @@ class LiquidClusters:
 
     def stress(self, sim):
         """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box
-        (cluster_forces.cluster_stress)."""
+        (cluster_forces.cluster_stress), with the grains where their forces act."""
         if self._front_held():
             weight = self.liquid.weight
             return cluster_stress(self.units, self._unit_forces, weight > 0.0, self.suction,
-                                  sim.walls.volume(), weight)
+                                  sim.walls.volume(), weight, self._vertices)
         return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
-                              sim.walls.volume())
+                              sim.walls.volume(), vertices=self._vertices)
 
-    def statistics(self, sim):
+    def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
         the liquid fractions in bridges, in clusters and in the largest cluster, whether the
         largest percolates along x, y, z, the saturation (over the voids of the box, and over
-        the pore units' void alone) and the clusters' stress."""
-        account = self.account(sim)
+        the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
+        if already measured)."""
+        account = self.account(sim) if account is None else account
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
         in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))

@@ -27,6 +27,7 @@ units around an edge fill 2 pi; the rest, on the hull, is the strip outside the 
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -168,13 +169,22 @@ class UnitEdges:
     def of_pairs(self, pair_i, pair_j):
         """(K,) the edge of each pair of grains (pair_i < pair_j), -1 for a pair that is not
         an edge."""
-        count = int(max(self.pair.max(initial=0), np.max(pair_j, initial=0))) + 1
+        count, keys, order = self._lookup
+        pair_i, pair_j = np.asarray(pair_i, np.int64), np.asarray(pair_j, np.int64)
+        known = pair_j < count                  # a grain beyond the edges' is on none
+        wanted = np.where(known, pair_i * count + pair_j, -1)
+        where = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
+        found = known & (len(keys) > 0) & (keys[where] == wanted)
+        return np.where(found, order[where], -1)
+
+    @cached_property
+    def _lookup(self):
+        """(count, the edges' keys first * count + second sorted, their edges) for of_pairs,
+        sorted once per set of edges."""
+        count = int(self.pair.max(initial=0)) + 1
         keys = self.pair[:, 0] * count + self.pair[:, 1]
         order = np.argsort(keys)
-        wanted = np.asarray(pair_i, np.int64) * count + np.asarray(pair_j, np.int64)
-        where = np.minimum(np.searchsorted(keys[order], wanted), max(len(keys) - 1, 0))
-        found = (len(keys) > 0) & (keys[order][where] == wanted)
-        return np.where(found, order[where], -1)
+        return count, keys[order], order
 
 
 def unit_edges(pore_units):

@@ -17,10 +17,10 @@ from pendular.dem.neighbors import branch_vectors
 from pendular.homogenize.bridge_tensors import wetted_caps_sum
 
 
-def chi_with_clusters(sim, clusters):
+def chi_with_clusters(sim, clusters, psi_clusters=None):
     """(3, 3) chi of the bridges' shares outside the filled units and of the clusters of
     ``clusters`` (pendular.capillary.liquid_clusters.LiquidClusters) of ``sim``, over the box
-    (module docstring)."""
+    (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if already measured."""
     contacts, particles = sim.contacts, sim.particles
     state = BridgeState.of(contacts)
     index = np.flatnonzero(state.mask())
@@ -32,7 +32,9 @@ def chi_with_clusters(sim, clusters):
                            particles.radius[contacts.pair_j[index]], state.filling_i[index],
                            state.filling_j[index], weight=weight)
     bridges = (float(np.sum(weight * state.volume[index])) * np.eye(3) + caps) / volume
-    return bridges + clusters.stress(sim) / clusters.suction
+    if psi_clusters is None:
+        psi_clusters = clusters.stress(sim)
+    return bridges + psi_clusters / clusters.suction
 
 
 def cluster_force_stress(sim, clusters):

@@ -422,7 +422,7 @@ SUMMARY_KEYS = {
     "grip_particles": Key("1", "particles held by each grip (z-, z+)", _TEN),
     "case": Key("1", "the case's name: e<void ratio>_w<water content %>", _TEN),
     "cluster_updates": Key("1", "--liquid clusters: updates of the clusters during the "
-                                "loading (one every 10 history rows)", LABORATORY),
+                                "loading (one every 50 history rows)", LABORATORY),
     "cluster_update_time_s": Key("s", "--liquid clusters: wall-clock time of those updates",
                                  LABORATORY),
     "clusters_final": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the clusters' figures "

@@ -45,13 +45,16 @@ def cluster_columns(clusters):
 
     last = {}
 
+    def measures(sim):
+        """The clusters' figures of ``sim``'s state, its liquid's account, measured once."""
+        key = (sim.step, id(clusters.found))          # a stage's start changes the state
+        if last.get("key") != key:
+            account = clusters.account(sim)
+            last.update(clusters.statistics(sim, account), key=key, account=account)
+        return last
+
     def figure(name):
-        def column(sim):
-            key = (sim.step, id(clusters.found))      # a stage's start changes the state
-            if last.get("key") != key:
-                last.update(clusters.statistics(sim), key=key)
-            return last[name]
-        return column
+        return lambda sim: measures(sim)[name]
 
     columns = {name: figure(name) for name in (
         "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
@@ -59,9 +62,10 @@ def cluster_columns(clusters):
     percolates = figure("largest_cluster_percolates")
     columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
     columns["water_content"] = lambda sim: gravimetric_water_content(
-        clusters.account(sim).total, sim.particles.solid_volume(),
+        measures(sim)["account"].total, sim.particles.solid_volume(),
         sim.particles.density / WATER_DENSITY)
-    columns["chi_with_clusters"] = lambda sim: chi_with_clusters(sim, clusters)
+    columns["chi_with_clusters"] = lambda sim: chi_with_clusters(
+        sim, clusters, np.array(measures(sim)["psi_clusters"]))
     columns["sigma_clusters"] = lambda sim: cluster_force_stress(sim, clusters)
     return columns
 

@@ -24,11 +24,11 @@ import numpy as np
 
 from pendular.homogenize.invariants import mean_stress
 
-#: History records between two updates of the clusters during a loading (the ParaView frames'
-#: default spacing, pendular.procedures.loading.VTK_RECORDS): about 50 over a triaxial of 500
-#: records; each costs about one decomposition of the packing (docs/liquid_clusters.md
-#: 'Cost'). At every record in between, the clusters' forces follow the grains.
-CLUSTER_RECORDS = 10
+#: History records between two updates of the clusters during a loading (10 over a triaxial
+#: of 500 records), each about one decomposition of the packing: the period that keeps a wet
+#: triaxial with clusters within twice its pendular cost (docs/liquid_clusters.md 'Cost',
+#: against its accuracy). At every record in between, the clusters' forces follow the grains.
+CLUSTER_RECORDS = 50
 
 #: The clusters' figures of a history row kept in a summary (``cluster_summary``).
 CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
