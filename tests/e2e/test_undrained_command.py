@@ -17,7 +17,7 @@ from pendular.io.schema import undeclared_keys
 from conftest import ROOT, history_of, refused, run_in_process, summary_of
 
 SMALL = ["--particles", "60", "--confining", "750", "--seed", "1", "--quiet", "--vtk-every",
-         "0"]
+         "0", "--no-plots"]
 SHEAR = ["--drainage", "undrained", "--max-strain", "0.01", "--inertial-number", "2e-3"]
 
 

@@ -113,7 +113,7 @@ def assert_same_records(cpu, gpu, rows, counts=("coordination",)):
 #: The options of the samples that the command tests load, each prepared on the CPU by
 #: ``pendular triaxial`` (prepared_sample): 60 spheres in six walls, in a periodic cell (the
 #: simple shear's too: its own preparation gives the same sample).
-WALLED_SAMPLE = ("--particles", "60", "--max-strain", "1e-4", "--quiet")
+WALLED_SAMPLE = ("--particles", "60", "--max-strain", "1e-4", "--quiet", "--no-plots")
 PERIODIC_SAMPLE = (*WALLED_SAMPLE, "--periodic")
 
 #: options -> the sample.h5 that prepared_sample made in this process.
@@ -135,18 +135,19 @@ def prepared_sample(folders, options):
 
 def on_the_gpu(command, sample, argv, folder):
     """The (command, argv) of ``pendular command *argv --sample sample --device gpu`` writing
-    into ``folder``/gpu, for simulated's ``commands`` (histories_on_both reads its run)."""
-    return command, [*map(str, argv), "--sample", str(sample), "--device", "gpu", "--out",
-                     f"{folder}/gpu"]
+    into ``folder``/gpu, without figures, for simulated's ``commands`` (histories_on_both reads
+    its run)."""
+    return command, [*map(str, argv), "--sample", str(sample), "--device", "gpu", "--no-plots",
+                     "--out", f"{folder}/gpu"]
 
 
 def histories_on_both(command, sample, argv, folder):
     """(CPU history, GPU history): ``pendular command *argv --sample sample`` run on the CPU
-    in this process, in ``folder``/cpu, and the run of ``on_the_gpu(command, sample, argv,
+    without figures in this process, in ``folder``/cpu, and the run of ``on_the_gpu(command, sample, argv,
     folder)``, which a simulated process has made."""
     from pendular.cli import run_command
 
-    run = [*map(str, argv), "--sample", str(sample), "--out", f"{folder}/cpu"]
+    run = [*map(str, argv), "--sample", str(sample), "--no-plots", "--out", f"{folder}/cpu"]
     assert run_command(command, run) == 0
     return history(f"{folder}/cpu"), history(f"{folder}/gpu")
 

@@ -141,7 +141,7 @@ def test_a_graded_wet_triaxial_reports_its_grading(tmp_path):
     status = run_command("triaxial", ["--particles", "300", "--radius-spread", "0.3",
                                       "--suction", "30000", "--max-strain", "0.01",
                                       "--inertial-number", "1e-3", "--vtk-frames", "0",
-                                      "--quiet", "--out", str(out)])
+                                      "--no-plots", "--quiet", "--out", str(out)])
     assert status == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["grading"]["radius_mean"] == pytest.approx(2.4e-5, rel=1e-9)
@@ -159,14 +159,14 @@ def graded_run(tmp_path_factory):
     assert run_command("triaxial", ["--particles", "120", "--radius-spread", "0.3",
                                     "--seed", "3", "--max-strain", "0.002",
                                     "--inertial-number", "2e-3", "--vtk-frames", "0",
-                                    "--quiet", "--out", str(out)]) == 0
+                                    "--no-plots", "--quiet", "--out", str(out)]) == 0
     return out
 
 
 def test_a_sample_of_another_spread_is_refused_naming_the_sizes(graded_run, tmp_path, capsys):
     sample = str(graded_run / "sample.h5")
     again = ["--particles", "120", "--max-strain", "0.002", "--inertial-number", "2e-3",
-             "--vtk-frames", "0", "--quiet", "--sample", sample]
+             "--vtk-frames", "0", "--no-plots", "--quiet", "--sample", sample]
     assert run_command("triaxial", again + ["--radius-spread", "0.3",
                                             "--out", str(tmp_path / "same")]) == 0
     capsys.readouterr()
@@ -183,7 +183,7 @@ def test_a_sample_gives_its_count_and_sizes_and_refuses_only_a_contradiction(gra
     loaded = tmp_path / "loaded"
     assert run_command("triaxial", ["--sample", sample, "--max-strain", "0.002",
                                     "--inertial-number", "2e-3", "--vtk-frames", "0",
-                                    "--quiet", "--out", str(loaded)]) == 0
+                                    "--no-plots", "--quiet", "--out", str(loaded)]) == 0
     config = config_from_dict(json.loads(read_history(loaded).attrs["config"]))
     assert (config.sample.particles, config.sample.radius_spread, config.sample.seed) == \
         (120, 0.3, 3)

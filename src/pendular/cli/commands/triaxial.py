@@ -39,7 +39,7 @@ from pendular.procedures.registry import COMMANDS
 from pendular.procedures.run_options import RunOptions
 
 #: Options a resumed run takes from its own command line, not from the stored run.
-RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force")
+RESUME_OPTIONS = ("resume", "quiet", "threads", "device", "stop_after", "force", "no_plots")
 def loading_command(name):
     """(add_arguments, config_from, run, EXAMPLE) of the laboratory command ``name`` (a key
     of pendular.procedures.registry.COMMANDS): its declared options, its test, the summary
@@ -75,6 +75,10 @@ def add_output_options(parser, out):
                              "DIR/vtk_prep/ (field data 'phase': 0 growth, 1 friction, 2 "
                              "unload, 3 equilibrate, 4 sample, 5 wetting), every N steps "
                              "(default: unload_steps / 20 = 500, a few tens of frames)")
+    parser.add_argument("--no-plots", action="store_true",
+                        help="write no figures (the test's figure and plots/); the history, "
+                             "summary, sample and ParaView series are written as always "
+                             "(sweeps and scripts that read the data)")
     add_resume_options(parser)
 
 
@@ -83,8 +87,8 @@ def add_resume_options(parser):
     interruption would, exit status 130)."""
     parser.add_argument("--resume", metavar="DIR", default=None,
                         help="continue the interrupted run of DIR from its checkpoint, with the "
-                             "configuration stored there (only --quiet, --threads and --device "
-                             "may be added)")
+                             "configuration stored there (only --quiet, --threads, --device "
+                             "and, on a laboratory test, --no-plots may be added)")
     parser.add_argument("--stop-after", type=positive_int("--stop-after", low=1), default=None,
                         help=argparse.SUPPRESS)
 
@@ -99,8 +103,8 @@ def check_resume_options(args, add_arguments):
     if given:
         raise UsageError(f"--resume takes the run's configuration from {args.resume}; "
                          f"{', '.join('--' + n.replace('_', '-') for n in given)} "
-                         "cannot be changed (only --quiet, --threads and --device may be "
-                         "added)")
+                         "cannot be changed (only --quiet, --threads, --device and, on a "
+                         "laboratory test, --no-plots may be added)")
 
 
 add_arguments, config_from, run, EXAMPLE = loading_command("triaxial")
@@ -115,12 +119,13 @@ def run_test(args, test, config_from, shown, add_arguments):
     try:
         if args.resume is not None:
             check_resume_options(args, add_arguments)
-            summary = test.resume(args.resume, run_options(args))
+            summary = test.resume(args.resume, run_options(args, plots=not args.no_plots))
             out = args.resume
         else:
             config = config_from(args)
             check_device(args.device)               # before the test loads its tables
-            options = run_options(args, force=args.force, vtk_prep=args.vtk_prep)
+            options = run_options(args, force=args.force, vtk_prep=args.vtk_prep,
+                                  plots=not args.no_plots)
             summary = test(config, force=options.force).run(args.out, options)
             out = args.out
     except Interrupted as stop:
