@@ -603,9 +603,10 @@ class Calibration:
 
     def campaign_curves(self, runs, out, log, options):
         """{run name: its curve (simulated)} of ``runs`` run as one campaign into ``out`` as
-        the RunOptions ``options`` say (Campaign.run); a run that failed or whose history does
-        not span the data is left out, and said so through ``log``."""
-        result = Campaign(runs).run(out, options)
+        the RunOptions ``options`` say (Campaign.run), without figures of their own (the
+        calibration draws its own); a run that failed or whose history does not span the data
+        is left out, and said so through ``log``."""
+        result = Campaign(runs).run(out, RunOptions.of(options, plots=False))
         curves = {}
         for run in runs:
             if run.name not in result.summaries:

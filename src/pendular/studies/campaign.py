@@ -359,7 +359,8 @@ class Campaign:
         ``scheduler`` (its workers must see ``out`` at the same path), the preparations and
         the runs on ``device`` ("cpu" or "gpu"; a run option: not part of a run's identity,
         so a finished run is reused whichever device ran it), the campaign's progress bar
-        unless ``progress`` is False (each run's bars go to its log.txt). Every
+        unless ``progress`` is False (each run's bars go to its log.txt), each run's figures
+        unless ``plots`` is False. Every
         configuration still to run is checked here first (its test: quasi-static, duration,
         bridge tables), and the device, so a bad one is refused before anything runs. The
         caller holds ``out`` (an OutputFolder, module docstring)."""
@@ -368,7 +369,8 @@ class Campaign:
         threads = check_int("threads", 1 if options.threads is None else options.threads,
                             low=1)
         quiet = not options.progress
-        each = RunOptions(device=device, threads=threads)      # a run's, bars into its log
+        # a run's, bars into its log
+        each = RunOptions(device=device, threads=threads, plots=options.plots)
         out = os.path.abspath(os.fspath(out))       # workers elsewhere see the same paths
         result = CampaignResult(self.runs)
         todo = []
