@@ -124,8 +124,10 @@ def parameters(config):
                      "persist_bridges": bridges.persist, "control": bridges.control,
                      "water_content_percent": (None if bridges.water_content is None
                                                else 100.0 * bridges.water_content),
-                     "liquid": (config.liquid if config.liquid != "pendular" else None
-                                if bridges.water_content is None else bridges.liquid),
+                     # the regime with clusters; otherwise, at a water content, where a
+                     # ruptured bridge's liquid goes (the old --liquid shared|lost)
+                     "liquid": (config.liquid if config.liquid != "pendular" else
+                                (None if bridges.water_content is None else bridges.liquid)),
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
     return flat
