@@ -138,10 +138,9 @@ class ClusterUpdates:
     (LiquidClusters.set_suction), or with a closed liquid ``volume`` [m^3] the suction that
     holds it there (LiquidClusters.hold_volume); at the step the bridges' suction changes (a
     path's suction stage) too, at most once every ``follow`` steps while it changes; and
-    ``frames``
-    (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
-    ``field_data(sim)`` (the loading's frame fields) and the suction; the first frame, the
-    state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
+    ``frames`` (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
+    ``field_data(sim)`` (the loading's frame fields) and the suction at each update; the
+    first frame, the state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
     ``time_s``: the wall time of the updates and of the forces following the grains [s]."""
 
     def __init__(self, sim, clusters, follow, updates_every, origin, frames=None,
