@@ -189,30 +189,27 @@ class LiquidClusters:
 
     # ---------------------------------------------------------------- every step
     def apply(self, sim):
-        if self._force is None or not (self.filled.any() or self._front_held()):
-            return
-        particles, contacts = sim.particles, sim.contacts
-        particles.force += self._force
-        share = self.pair_share(contacts)
-        pair_force = self.bridges.pair_force
-        if len(pair_force) == len(share):
-            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
-                               contacts.second_start, contacts.second_pair, particles.force)
+        self._add_forces(sim, sim.particles.force)
 
     def grain_forces(self, sim):
         """(N, 3) [N] the forces ``apply`` adds to the grains at ``sim``'s state: the
         clusters' own, less the shares of the bridges' forces they absorb."""
         force = np.zeros_like(sim.particles.position)
+        self._add_forces(sim, force)
+        return force
+
+    def _add_forces(self, sim, force):
+        """Add to ``force`` (N, 3) [N] the clusters' forces and take off the shares of the
+        bridges' forces they absorb (nothing while no unit holds liquid)."""
         if self._force is None or not (self.filled.any() or self._front_held()):
-            return force
+            return
         force += self._force
         contacts = sim.contacts
-        pair_force = self.bridges.pair_force
         share = self.pair_share(contacts)
+        pair_force = self.bridges.pair_force
         if len(pair_force) == len(share):
             gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, force)
-        return force
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed

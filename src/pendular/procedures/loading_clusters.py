@@ -140,8 +140,9 @@ class ClusterUpdates:
     path's suction stage) too, at most once every ``follow`` steps while it changes; and
     ``frames`` (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
     ``field_data(sim)`` (the loading's frame fields) and the suction at each update; the
-    first frame, the state of ``sim`` the loading starts from, at once. ``updates``: how many updates ran;
-    ``time_s``: the wall time of the updates and of the forces following the grains [s]."""
+    first frame, the state of ``sim`` the loading starts from, at once. ``updates``: how many
+    updates ran; ``time_s``: the wall time of the updates and of the forces following the
+    grains [s]."""
 
     def __init__(self, sim, clusters, follow, updates_every, origin, frames=None,
                  field_data=None, volume=None):
@@ -180,16 +181,24 @@ class ClusterUpdates:
                               {**self.field_data(sim), "suction": self.clusters.suction})
 
 
+def cluster_row(history, row: int, names) -> dict:
+    """The clusters' figures ``names`` of ``history`` row ``row``
+    (pendular.procedures.columns.cluster_columns) as plain JSON values: ``clusters`` an int,
+    ``largest_cluster_percolates`` three bools, the rest floats."""
+    figures = {}
+    for name in names:
+        value = np.asarray(history[name][row])
+        figures[name] = (value.astype(bool).tolist() if name == "largest_cluster_percolates"
+                         else int(value) if name == "clusters" else float(value))
+    return figures
+
+
 def cluster_summary(history, row: int, key: str) -> dict:
     """{``key``: the clusters' figures of ``history`` row ``row``}: CLUSTER_FIGURES,
     ``chi_with_clusters`` and the bridges' ``chi`` (each tr chi / 3), and
     ``p_effective_with_clusters`` = p + chi_with_clusters s (Eq. 3.43's form, u_a = 0; p the
     mean wall stress) [Pa]."""
-    figures = {}
-    for name in CLUSTER_FIGURES:
-        value = np.asarray(history[name][row])
-        figures[name] = (value.astype(bool).tolist() if name == "largest_cluster_percolates"
-                         else int(value) if name == "clusters" else float(value))
+    figures = cluster_row(history, row, CLUSTER_FIGURES)
     chi = float(np.trace(history["chi_with_clusters"][row]) / 3.0)
     figures.update({"chi_with_clusters": chi,
                     "chi": float(np.trace(history["chi"][row]) / 3.0),

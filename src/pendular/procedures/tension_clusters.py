@@ -22,8 +22,6 @@ from __future__ import annotations
 import copy
 import math
 
-import numpy as np
-
 from pendular.capillary.bridges import CapillaryBridges
 from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.capillary.radius_ratios import sample_radius_ratios
@@ -32,6 +30,7 @@ from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import formation_suction, gravimetric_water_content
 from pendular.dem.measure import coordination, unbalanced_force
 from pendular.procedures.columns import cluster_columns as cluster_figures
+from pendular.procedures.loading_clusters import cluster_row
 from pendular.utils.parameters import ParameterError
 
 #: Closed-liquid solutions of a pull (LiquidClusters.hold_volume) over --max-strain.
@@ -145,11 +144,7 @@ def cluster_columns(clusters, solid_volume, specific_gravity):
 
 def cluster_summary(history, peak: int) -> dict:
     """The clusters' figures of the pull's ``history`` row ``peak`` (CLUSTER_FIGURES)."""
-    return {"clusters_at_peak": {
-        name: (np.asarray(history[name][peak]).astype(bool).tolist()
-               if name == "largest_cluster_percolates" else
-               (int(history[name][peak]) if name == "clusters" else float(history[name][peak])))
-        for name in CLUSTER_FIGURES}}
+    return {"clusters_at_peak": cluster_row(history, peak, CLUSTER_FIGURES)}
 
 
 def update_period(pull_steps: int) -> int:
