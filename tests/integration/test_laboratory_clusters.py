@@ -90,7 +90,6 @@ def test_a_triaxial_at_a_water_content_holds_its_water_in_bridges_and_clusters(t
 @pytest.mark.parametrize("options, words", [
     ({}, ["--liquid", "--suction"]),
     ({"suction": 20000.0, "periodic": True}, ["--liquid", "--periodic"]),
-    ({"suction": 20000.0, "checkpoint_every": 100}, ["--liquid", "--checkpoint-every"]),
     ({"suction": 20000.0, "drainage": "undrained"}, ["--liquid", "--drainage"]),
     ({"suction": 20000.0, "bridges": "toroidal"}, ["--liquid", "--bridges"]),
 ])
