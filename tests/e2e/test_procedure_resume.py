@@ -1,5 +1,5 @@
-"""An SWCC run stopped mid-path, a direct tension stopped mid-pull and, with liquid clusters, a
-triaxial test stopped mid-loading and a direct tension stopped mid-pull (deterministically,
+"""An SWCC run stopped mid-path and a direct tension stopped mid-pull, pendular and with liquid
+clusters, and a triaxial test with liquid clusters stopped mid-loading (deterministically,
 --stop-after) and continued with --resume write the uninterrupted run's files bit for bit
 (timings aside); a damaged or forged checkpoint, and a resume that would change the run's
 configuration, are refused in one line naming the file or the option."""
@@ -109,6 +109,24 @@ def test_a_stopped_swcc_resumes_bit_for_bit(runs, tmp_path, capsys):
     assert status == 130 and f"--resume {again}" in err, err
     assert swcc(["--resume", str(again), "--quiet"], capsys)[0] == 0
     assert_same_files(whole, again)
+
+
+def test_a_stopped_swcc_with_clusters_resumes_bit_for_bit(tmp_path, capsys):
+    """Stopped in its second stage: the clusters' state of that stage and the first stage's
+    pores/ frame come from the checkpoint."""
+    argv = RUN + ["--liquid", "clusters"]
+    whole, run = tmp_path / "whole", tmp_path / "run"
+    assert swcc(argv + ["--out", whole], capsys)[0] == 0
+    assert swcc(argv + STOP + ["--out", run], capsys)[0] == 130
+    with h5py.File(run / "checkpoint.h5") as handle:
+        assert json.loads(handle.attrs["extra_state"])["stage"] == 1
+    status, err = swcc(["--resume", run, "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole, run)
+    frames = sorted(path.name for path in (whole / "pores").glob("*"))
+    assert frames == sorted(path.name for path in (run / "pores").glob("*"))
+    for name in frames:
+        assert (whole / "pores" / name).read_bytes() == (run / "pores" / name).read_bytes()
 
 
 def forge(path, change):

@@ -45,7 +45,6 @@ def test_swcc_with_clusters_dries_from_saturation_and_wets_back(tmp_path):
 
 @pytest.mark.parametrize("argv, words", [
     (["--liquid", "drops"], ["--liquid", "pendular", "clusters"]),
-    (["--liquid", "clusters", "--checkpoint-every", "100"], ["clusters", "checkpoint"]),
 ])
 def test_bad_cluster_settings_are_refused(argv, words, tmp_path, capsys):
     with pytest.raises(SystemExit) as stop:
