@@ -18,6 +18,10 @@ the suction is the one at which the bridges and the filled units hold V
 (pendular.capillary.closed_liquid), imposed on the bridges; the units at the front of a jump
 hold a fraction of their pore volume (their forces and absorbed shares in that fraction), and
 what a bridge broken at that suction leaves stays on the grains as film.
+
+``state_dict``/``load_state`` keep all of this (the pore units of the last step of the model,
+the filled state, the closed liquid, where the forces act), so that a checkpointed run
+resumes bit for bit.
 """
 
 import math
