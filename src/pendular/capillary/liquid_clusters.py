@@ -404,9 +404,10 @@ def _liquid_of(state, filled):
     numbers = {}
     for name in ("suction", "front_fraction", "bridges", "clusters", "film"):
         value = state[name]
-        if not isinstance(value, float) or not math.isfinite(value):
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value):
             raise ValueError(f"liquid/{name} = {value!r}; valid: a finite number")
-        numbers[name] = value
+        numbers[name] = float(value)
     if not (0.0 <= numbers["front_fraction"] <= 1.0 and (weight >= 0.0).all()
             and (weight <= 1.0).all()):
         raise ValueError("liquid/front_fraction and liquid/weight: valid shares in [0, 1]")

@@ -11,7 +11,9 @@ settles to. At a water content the suction is the one that holds the closed liqu
 as it stands (decomposed again, the filled units carried over, pore filling, then Haines jumps
 where pores opened), writing a frame of pores/ each time; at every history record in between,
 the filled units' forces follow their grains (LiquidClusters.follow_packing: the same units,
-filled state and suction, the forces at the grains' positions then). ``cluster_summary``: the
+filled state and suction, the forces at the grains' positions then). A checkpoint holds the
+clusters' state (LiquidClusters.state_dict) and ClusterUpdates' progress; a resumed loading
+builds the same scene (``rejoin_clusters``) and takes both back. ``cluster_summary``: the
 clusters' figures of a history row, with the effective stress of bridges and clusters;
 ``refuse_clusters``: what a configuration with clusters cannot run with.
 """
