@@ -294,8 +294,10 @@ class PoreFrames:
     def load_state(self, state):
         numbers = state_array(state, "numbers", np.int64, (None,))
         values = state_array(state, "values", np.float64, (len(numbers),))
-        if (numbers < 0).any() or (numbers > 9999).any():
-            raise ValueError(f"numbers = {numbers.tolist()}: frame numbers in [0, 9999] expected")
+        outside = (numbers < 0) | (numbers > 9999)
+        if outside.any():
+            k = int(np.argmax(outside))
+            raise ValueError(f"numbers[{k}] = {numbers[k]} is outside the valid range [0, 9999]")
         self.numbers = [int(number) for number in numbers]
         self.frames = [(float(value), self.file_name(number))
                        for number, value in zip(self.numbers, values)]
