@@ -26,7 +26,8 @@ the code of before, bit for bit.
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
 each step from the particles' forces and the face terms that the forces' gathers add to
-``virial_blocks`` (pendular.dem.virial). The
+``virial_blocks`` (pendular.dem.virial); forces that are not pair forces (liquid clusters)
+give their own sum of x (x) F (``virial``). The
 stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
 unit strain] as a wall servo reads the stiffness of the wall's contacts; the servo refreshes it
 (``update_stiffness``) when it refreshes its own.
@@ -301,10 +302,13 @@ class PeriodicCell(Box):
             self.shear_strain += self.shear_rate * dt
 
     def after_forces(self, sim):
-        """The stress of this step's pair forces: from the particles' forces and the face terms
+        """The stress of this step's forces: from the particles' forces and the face terms
         the gathers left in ``virial_blocks`` (store_cell_stress) when every force operation
         is a pair force (has ``pair_forces(sim)``); otherwise pair by pair over the operations
-        that are. The stretching and shear rates return to zero until a control sets them."""
+        that are, and the sum of x (x) F [N m] that each other operation declaring
+        ``virial(sim)`` gives of its forces (liquid clusters,
+        pendular.capillary.liquid_clusters). The stretching and shear rates return to zero
+        until a control sets them."""
         contacts = sim.contacts
         if all(hasattr(op, "pair_forces") for op in sim.forces):
             store_cell_stress(self.virial_blocks, sim.particles.position, sim.particles.force,
@@ -316,6 +320,8 @@ class PeriodicCell(Box):
                     total += pair_virial(sim.particles.position, contacts.row_start,
                                          contacts.pair_j, contacts.image, self.period,
                                          op.pair_forces(sim))
+                elif hasattr(op, "virial"):
+                    total += np.ravel(op.virial(sim))
             self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
         self.rate.fill(0.0)
         self.shear_rate = 0.0
