@@ -87,6 +87,8 @@ def test_percolation_in_a_sheared_cell_counts_its_images_shifted_along_x():
             found = clusters.find_clusters(units, filled)
             assert found.count == 1
             assert found.percolates.tolist() == expected, offset
+        one = clusters.find_clusters(units, np.arange(units.count) == 0)
+        assert one.count == 1 and not one.percolates.any()
 
 
 def test_filled_must_be_one_bool_per_unit():

@@ -62,18 +62,18 @@ def lattice_vectors(shift, period):
     return vector
 
 
-def image_shifts(vector, period, round_=np.rint):
+def image_shifts(vector, period, rounding=np.rint):
     """(..., 3) int64 the image shifts whose translation (``lattice_vectors``) is nearest to
     ``vector`` (..., 3) [m] (z, then y and x; exact for a lattice vector, or one off it by less
-    than half the cell); ``round_`` np.floor: those of the copy of the box [0, L)^3 that holds
+    than half the cell); ``rounding`` np.floor: those of the copy of the box [0, L)^3 that holds
     the point ``vector``."""
     period = np.asarray(period)
     vector = np.asarray(vector, dtype=float)
     shift = np.empty(vector.shape, np.int64)
-    shift[..., 2] = round_(vector[..., 2] / period[2])
-    shift[..., 1] = round_(vector[..., 1] / period[1])
+    shift[..., 2] = rounding(vector[..., 2] / period[2])
+    shift[..., 1] = rounding(vector[..., 1] / period[1])
     along = vector[..., 0] - (shift[..., 2] * period[3] if len(period) > 3 else 0.0)
-    shift[..., 0] = round_(along / period[0])
+    shift[..., 0] = rounding(along / period[0])
     return shift
 
 

@@ -20,7 +20,8 @@ from pendular.homogenize.bridge_tensors import wetted_caps_sum
 def chi_with_clusters(sim, clusters, psi_clusters=None):
     """(3, 3) chi of the bridges' shares outside the filled units and of the clusters of
     ``clusters`` (pendular.capillary.liquid_clusters.LiquidClusters) of ``sim``, over the box
-    (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if already measured."""
+    or the periodic cell (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if
+    already measured."""
     contacts, particles = sim.contacts, sim.particles
     state = BridgeState.of(contacts)
     index = np.flatnonzero(state.mask())
