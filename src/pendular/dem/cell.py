@@ -172,7 +172,8 @@ class PeriodicCell(Box):
     position: (6,) faces as Walls.position, low faces at 0 [m];
     rate: (3,) stretching rate L' / L of the current step, extension positive [1/s];
     stress_tensor: (3, 3) Love–Weber stress of every force at the last evaluation (the pair
-    forces', and the sums the other forces give, ``after_forces``), compression positive [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
+    forces', and the sums the other forces give, ``after_forces``), compression positive
+    [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
     wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face);
     virial_blocks: (SUM_BLOCKS, 9) the face terms of the pair forces' sum of l (x) f [N m]
     gathered since the step began (pendular.dem.virial; zeroed with the forces);
