@@ -23,12 +23,15 @@ SAMPLE = PrepareConfig(particles=60, seed=3)
 SHEAR = ShearConfig(max_strain=0.01, inertial_number=2e-3, records=20)
 
 
-def test_clusters_above_every_filling_suction_are_the_pendular_run(tmp_path):
+@pytest.mark.parametrize("periodic", [False, True])
+def test_clusters_above_every_filling_suction_are_the_pendular_run(periodic, tmp_path):
     """At 300 kPa no pore unit fills (their filling suctions are some 20-50 kPa for R =
-    24 µm): the clusters' history is the persisting bridges' bit for bit."""
+    24 µm): the clusters' history is the persisting bridges' bit for bit, between walls and
+    in a periodic cell (whose stress is then the gathered one of the pair forces)."""
     histories = []
     for liquid in ("pendular", "clusters"):
-        config = TriaxialConfig(sample=SAMPLE, shear=SHEAR, vtk_frames=0, liquid=liquid,
+        sample = PrepareConfig(particles=SAMPLE.particles, seed=SAMPLE.seed, periodic=periodic)
+        config = TriaxialConfig(sample=sample, shear=SHEAR, vtk_frames=0, liquid=liquid,
                                 bridges=BridgeConfig(300000.0, persist=True))
         summary = TriaxialTest(config).run(tmp_path / liquid, progress=False, plots=False)
         histories.append(read_history(tmp_path / liquid / "history.h5"))

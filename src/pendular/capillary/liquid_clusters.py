@@ -218,7 +218,7 @@ class LiquidClusters:
     def _add_forces(self, sim, force):
         """Add to ``force`` (N, 3) [N] the clusters' forces and take off the shares of the
         bridges' forces they absorb (nothing while no unit holds liquid)."""
-        if self._force is None or not (self.filled.any() or self._front_held()):
+        if not self.adds_forces(sim):
             return
         force += self._force
         contacts = sim.contacts
@@ -227,6 +227,12 @@ class LiquidClusters:
         if len(pair_force) == len(share):
             gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, force)
+
+    def adds_forces(self, sim):
+        """Whether ``apply`` adds any force to ``sim``'s grains now: whether a unit holds
+        liquid (without, a periodic cell's stress stays the gathered sum of the pair forces,
+        pendular.dem.cell.PeriodicCell.after_forces)."""
+        return self._force is not None and bool(self.filled.any() or self._front_held())
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
@@ -307,7 +313,7 @@ class LiquidClusters:
         cell), and the shares of the bridges' forces they take off, over their pairs' branch
         vectors (pendular.dem.neighbors.branch_vector)."""
         total = np.zeros((3, 3))
-        if self._force is None or not (self.filled.any() or self._front_held()):
+        if not self.adds_forces(sim):
             return total
         if self._own_virial is None or self._own_virial[0] is not self._force:
             self._own_virial = (self._force, -self._stress_over(1.0))

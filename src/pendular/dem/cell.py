@@ -165,6 +165,15 @@ def servo_cell(position, rate, stress_tensor, cell_stiffness, stiffness, previou
         rate[axis] = previous[slot] / (length * dt)
 
 
+def _gathered(op, sim):
+    """Whether the force operation ``op`` leaves the gathered stress of ``sim``'s cell exact
+    (PeriodicCell.after_forces): a pair force, or one that adds no force this step."""
+    if hasattr(op, "pair_forces"):
+        return True
+    adds_forces = getattr(op, "adds_forces", None)
+    return adds_forces is not None and not adds_forces(sim)
+
+
 @dataclass
 class PeriodicCell(Box):
     """A periodic box [0, L] (module docstring), the counterpart of pendular.dem.state.Walls.
@@ -305,13 +314,14 @@ class PeriodicCell(Box):
     def after_forces(self, sim):
         """The stress of this step's forces: from the particles' forces and the face terms
         the gathers left in ``virial_blocks`` (store_cell_stress) when every force operation
-        is a pair force (has ``pair_forces(sim)``); otherwise pair by pair over the operations
-        that are, and the sum of x (x) F [N m] that each other operation declaring
+        is a pair force (has ``pair_forces(sim)``) or adds no force this step (declares
+        ``adds_forces(sim)``, false now); otherwise pair by pair over the operations that are
+        pair forces, and the sum of x (x) F [N m] that each other operation declaring
         ``virial(sim)`` gives of its forces (liquid clusters,
         pendular.capillary.liquid_clusters). The stretching and shear rates return to zero
         until a control sets them."""
         contacts = sim.contacts
-        if all(hasattr(op, "pair_forces") for op in sim.forces):
+        if all(_gathered(op, sim) for op in sim.forces):
             store_cell_stress(self.virial_blocks, sim.particles.position, sim.particles.force,
                               self.position, self.stress_tensor)
         else:       # a force that is not a pair force: its gather adds no virial
