@@ -119,6 +119,47 @@ def test_a_wet_shear_at_constant_volume_keeps_its_volume(tmp_path, capsys):
     assert_drawn(out / "simple_shear.png")
 
 
+@pytest.mark.parametrize("liquid", [["--suction", "20000"], ["--water-content", "4"]])
+def test_a_shear_with_liquid_clusters_records_them_in_the_sheared_cell(liquid, tmp_path, capsys,
+                                                                      monkeypatch):
+    """--liquid clusters: the pore units cut from the sheared cell's images, updated during
+    the shear, their history columns, and the cell's stress (the normal stress its servo
+    holds, the shear stress) the contacts', bridges' and clusters' Love–Weber sums."""
+    from pendular.io.schema import undeclared_keys
+    from pendular.procedures import laboratory
+
+    monkeypatch.setattr(laboratory, "CLUSTER_RECORDS", 5)      # updates within 20 records
+    out = tmp_path / "clusters"
+    status, err = run_in_process("simple-shear", [
+        "--particles", "60", "--seed", "3", "--max-strain", "0.02", "--record-strain", "0.001",
+        *liquid, "--liquid", "clusters", "--quiet", "--out", out], capsys)
+    assert status == 0, err
+    summary, history = summary_of(out), history_of(out)
+    rows = len(history["step"])
+    for name in ("clusters", "liquid_in_bridges", "liquid_in_clusters",
+                 "liquid_in_largest_cluster", "saturation", "saturation_pore_units",
+                 "water_content"):
+        assert history[name].shape == (rows,), name
+    assert history["largest_cluster_percolates"].shape == (rows, 3)
+    assert history["sigma_clusters"].shape == history["chi_with_clusters"].shape == (rows, 3, 3)
+    assert (history["clusters"] > 0).all()
+    np.testing.assert_allclose(history["liquid_in_bridges"] + history["liquid_in_clusters"],
+                               1.0, rtol=0, atol=1e-12)
+    if liquid[0] == "--water-content":
+        np.testing.assert_allclose(history["water_content"], 0.04, rtol=1e-2)
+    updates = summary["cluster_updates"]
+    assert updates >= 3 and summary["clusters_final"]["clusters"] > 0
+    assert len(list((out / "pores").glob("pores_*.vtu"))) == updates + 1
+    inside = history["sigma_contact"] + history["sigma_capillary"] + history["sigma_clusters"]
+    scale = np.abs(history["sigma_wall"]).max()
+    np.testing.assert_allclose(np.diagonal(inside, axis1=1, axis2=2), history["sigma_wall"],
+                               rtol=0, atol=1e-3 * scale)
+    np.testing.assert_allclose(-0.5 * (inside[:, 0, 2] + inside[:, 2, 0]),
+                               history["shear_stress"], rtol=0, atol=1e-3 * scale)
+    assert summary["stress_balance_flagged"] == []
+    assert undeclared_keys(summary, "simple-shear") == []
+
+
 @pytest.mark.parametrize("arguments, words", [
     (["--max-strain", "-0.1"], ("--max-strain = -0.1", "[1e-06, 10]")),
     (["--max-strain", "20"], ("--max-strain = 20", "[1e-06, 10]")),

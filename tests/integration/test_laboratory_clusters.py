@@ -23,12 +23,15 @@ SAMPLE = PrepareConfig(particles=60, seed=3)
 SHEAR = ShearConfig(max_strain=0.01, inertial_number=2e-3, records=20)
 
 
-def test_clusters_above_every_filling_suction_are_the_pendular_run(tmp_path):
+@pytest.mark.parametrize("periodic", [False, True])
+def test_clusters_above_every_filling_suction_are_the_pendular_run(periodic, tmp_path):
     """At 300 kPa no pore unit fills (their filling suctions are some 20-50 kPa for R =
-    24 µm): the clusters' history is the persisting bridges' bit for bit."""
+    24 µm): the clusters' history is the persisting bridges' bit for bit, between walls and
+    in a periodic cell (whose stress is then the gathered one of the pair forces)."""
     histories = []
     for liquid in ("pendular", "clusters"):
-        config = TriaxialConfig(sample=SAMPLE, shear=SHEAR, vtk_frames=0, liquid=liquid,
+        sample = PrepareConfig(particles=SAMPLE.particles, seed=SAMPLE.seed, periodic=periodic)
+        config = TriaxialConfig(sample=sample, shear=SHEAR, vtk_frames=0, liquid=liquid,
                                 bridges=BridgeConfig(300000.0, persist=True))
         summary = TriaxialTest(config).run(tmp_path / liquid, progress=False, plots=False)
         histories.append(read_history(tmp_path / liquid / "history.h5"))
@@ -87,9 +90,28 @@ def test_a_triaxial_at_a_water_content_holds_its_water_in_bridges_and_clusters(t
     assert undeclared_keys(summary, "triaxial") == []
 
 
+def test_a_periodic_triaxial_counts_its_clusters_in_the_cells_stress(tmp_path, monkeypatch):
+    """--periodic: the pore units cut from the grains' images, the cell's stress (the stress
+    its servo holds) the contacts', bridges' and clusters' Love–Weber sums."""
+    monkeypatch.setattr(laboratory, "CLUSTER_RECORDS", 10)     # updates within 20 records
+    config = TriaxialConfig(sample=PrepareConfig(particles=60, seed=3, periodic=True),
+                            shear=SHEAR, vtk_frames=0, liquid="clusters",
+                            bridges=BridgeConfig(20000.0))
+    summary = TriaxialTest(config).run(tmp_path, progress=False, plots=False)
+    history = read_history(tmp_path / "history.h5")
+    assert summary["clusters_wet"]["clusters"] > 0 and summary["cluster_updates"] == 2
+    assert (history["clusters"].values > 0).all()
+    inside = history["sigma_contact"].values + history["sigma_capillary"].values
+    clusters = history["sigma_clusters"].values
+    assert np.abs(clusters).max() > 0.1 * np.abs(inside).max()
+    wall = history["sigma_wall"].values
+    np.testing.assert_allclose(np.diagonal(inside + clusters, axis1=1, axis2=2), wall,
+                               rtol=0, atol=1e-3 * np.abs(wall).max())
+    assert undeclared_keys(summary, "triaxial") == []
+
+
 @pytest.mark.parametrize("options, words", [
     ({}, ["--liquid", "--suction"]),
-    ({"suction": 20000.0, "periodic": True}, ["--liquid", "--periodic"]),
     ({"suction": 20000.0, "drainage": "undrained"}, ["--liquid", "--drainage"]),
     ({"suction": 20000.0, "bridges": "toroidal"}, ["--liquid", "--bridges"]),
 ])
@@ -102,7 +124,7 @@ def test_what_clusters_do_not_support_is_refused(options, words):
 
 @pytest.mark.parametrize("command, argv, words", [
     ("oedometer", [], ["--liquid", "--suction"]),
-    ("simple-shear", ["--suction", "20000"], ["--liquid", "periodic"]),
+    ("simple-shear", ["--suction", "20000", "--bridges", "toroidal"], ["--liquid", "--bridges"]),
 ])
 def test_the_command_line_refuses_them_in_one_line(command, argv, words, capsys, tmp_path):
     status, err = run_in_process(command, ["--liquid", "clusters", "--particles", "60", *argv,

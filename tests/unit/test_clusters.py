@@ -70,6 +70,27 @@ def test_percolation_in_a_periodic_cell_is_wrapping():
     assert clusters.find_clusters(units, split).count == 1
 
 
+def test_percolation_in_a_sheared_cell_counts_its_images_shifted_along_x():
+    """Lees–Edwards images (the image above in z shifted by delta along x): a slab of half the
+    cell across x climbs through the z faces as a staircase (it wraps along y and z, not x),
+    whatever the offset."""
+    cells = 4
+    centres = cubic_lattice(cells)
+    for offset in (0.5, 1.3, -1.7):
+        period = np.array([*[cells * SPACING] * 3, offset * SPACING])
+        units = pores.decompose(centres, np.full(len(centres), RADIUS), period=period)
+        centroid = pores.into_cell(units.vertices.mean(axis=1), period) / SPACING
+        for filled, expected in ((centroid[:, 2] < 1.0, [True, True, False]),
+                                 (centroid[:, 0] < 2.0, [False, True, True]),
+                                 (centroid[:, 1] < 2.0, [True, False, True]),
+                                 (np.ones(units.count, bool), [True, True, True])):
+            found = clusters.find_clusters(units, filled)
+            assert found.count == 1
+            assert found.percolates.tolist() == expected, offset
+        one = clusters.find_clusters(units, np.arange(units.count) == 0)
+        assert one.count == 1 and not one.percolates.any()
+
+
 def test_filled_must_be_one_bool_per_unit():
     centres = cubic_lattice(2)
     units = pores.decompose(centres, np.full(len(centres), RADIUS))

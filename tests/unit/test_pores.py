@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial import ConvexHull, cKDTree
+from scipy.spatial import ConvexHull, Delaunay, cKDTree
 
 from pendular.capillary import pores
 
@@ -294,3 +294,55 @@ def test_periodic_pore_volumes_of_separate_grains_sum_exactly():
     assert units.protrudes.any()
     solid = np.sum(4 / 3 * math.pi * radii ** 3)
     assert units.pore_volume.sum() == pytest.approx(np.prod(box) - solid, rel=1e-12)
+
+
+def sheared_images(centres, period, reach=2):
+    """Every image of ``centres`` with shifts in [-reach, reach]^3 of the sheared cell ``period``
+    (Lx, Ly, Lz, delta): x + (ix Lx + iz delta, iy Ly, iz Lz), and the grain of each."""
+    lx, ly, lz, delta = period
+    images, grain = [], []
+    for ix in range(-reach, reach + 1):
+        for iy in range(-reach, reach + 1):
+            for iz in range(-reach, reach + 1):
+                images.append(centres + [ix * lx + iz * delta, iy * ly, iz * lz])
+                grain.append(np.arange(len(centres)))
+    return np.vstack(images), np.concatenate(grain)
+
+
+def test_a_sheared_cell_is_cut_from_the_triangulation_of_its_images():
+    """Lees–Edwards images (pendular.dem.cell): the units are those of the Delaunay
+    triangulation of the images whose centroid lies in the box, their throats' shifts the
+    sheared lattice's, and without overlaps the pore volumes still sum to the cell less the
+    grains."""
+    box = np.array([11.0, 12.0, 10.0]) * RADIUS
+    period = np.array([*box, 0.37 * box[0]])
+    centres, radii = random_spheres(80, box, (0.8 * RADIUS, 1.2 * RADIUS), 0.0, seed=31)
+    centres = pores.into_cell(centres + 0.5 * box + [0.0, 0.0, 0.2 * box[2]], period)
+    units = pores.decompose(centres, radii, period=period)
+    assert units.volume.sum() == pytest.approx(np.prod(box), rel=1e-12)
+    solid = np.sum(4 / 3 * math.pi * radii ** 3)
+    assert units.pore_volume.sum() == pytest.approx(np.prod(box) - solid, rel=1e-12)
+    check_throats(units)
+    # the images' triangulation, cut by the box
+    images, grain = sheared_images(centres, period)
+    triangulation = Delaunay(images)
+    centroid = images[triangulation.simplices].mean(axis=1)
+    inside = np.all((centroid >= 0) & (centroid < box), axis=1)
+    expected = {tuple(np.round(np.sort(images[s].ravel()) / RADIUS, 9))
+                for s in triangulation.simplices[inside]}
+    found = {tuple(np.round(np.sort(v.ravel()) / RADIUS, 9)) for v in units.vertices}
+    assert found == expected and units.count == len(expected)
+    assert (sorted(map(tuple, np.sort(grain[triangulation.simplices[inside]], axis=1)))
+            == sorted(map(tuple, np.sort(units.grains, axis=1))))
+    # across each throat the second unit's face is the first's moved by its shift
+    inner = np.flatnonzero(units.throat_units[:, 1] >= 0)
+
+    def face_centre(side):
+        unit = units.throat_units[inner, side]
+        face = np.argmax(units.throat_of[unit] == inner[:, None], axis=1)
+        return units.vertices[unit[:, None], pores.FACES[face]].mean(axis=1)
+
+    move = pores.lattice_vectors(units.throat_shift[inner], period)
+    assert np.abs(units.throat_shift[inner]).max() == 1
+    np.testing.assert_allclose(face_centre(1), face_centre(0) + move, rtol=0,
+                               atol=1e-9 * RADIUS)

@@ -7,7 +7,10 @@ bridges and menisci around a cluster's edge are not in it yet). The largest clus
 percolates along an axis when it spans the sample along it: between walls, when it holds units
 on both the low and the high face of the hull of the centres; in a periodic cell, when it wraps
 around the cell, i.e. a closed path of its throats crosses the cell's faces a net non-zero number
-of times along that axis.
+of times along that axis: it joins its own image across those faces, an infinite cluster of
+the periodic packing (PoreUnits.throat_shift). In a sheared cell the images are the sheared
+lattice's (pendular.capillary.pores.lattice_vectors): a path through the z faces lands on the
+image shifted by delta along x, which counts as a crossing of the z faces alone.
 """
 
 from dataclasses import dataclass
@@ -100,6 +103,8 @@ def _wraps(pore_units, graph, inner, label, cluster):
     order, predecessor = breadth_first_order(graph, root, directed=False,
                                              return_predecessors=True)
     child = order[1:]
+    if len(child) == 0:         # one unit: no throat of its own to wrap through
+        return np.zeros(3, bool)
     parent = predecessor[child]
     edge = np.asarray(graph[parent, child]).ravel() + np.asarray(graph[child, parent]).ravel() - 1
     first = pore_units.throat_units[edge, 0]

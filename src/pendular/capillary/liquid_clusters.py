@@ -11,7 +11,10 @@ Until the next ``set_suction`` (a stage of a path run to equilibrium) the cluste
 those of the packing at that moment (pendular.capillary.cluster_forces), added to the grains
 each step, and a bridge on an edge of filled units keeps only the share of its force and
 liquid that lies in empty units (its force is taken off in the share the filled units hold:
-the cluster's pressure and menisci replace it there). Between walls only; on the CPU.
+the cluster's pressure and menisci replace it there). Between walls, or in a periodic cell
+(sheared too): there the units are cut from the grains' images (pendular.capillary.pores), a
+unit's forces act at the images it sees, and ``virial`` hands the cell's stress their sum of
+x (x) F (pendular.dem.cell.PeriodicCell.after_forces). On the CPU.
 
 With the liquid closed (a water content), ``hold_volume(sim, V)`` is the model's step instead:
 the suction is the one at which the bridges and the filled units hold V
@@ -35,8 +38,10 @@ from pendular.capillary.cluster_forces import (UnitForces, cluster_forces, clust
 from pendular.capillary.clusters import find_clusters
 from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
     liquid_account, unit_edges)
-from pendular.capillary.pores import PoreUnits, decompose, search_rows
-from pendular.dem.neighbors import gather_pair_forces
+from pendular.capillary.pores import (PoreUnits, decompose, into_cell, nearest_images,
+    search_rows)
+from pendular.dem.cell import pair_virial
+from pendular.dem.neighbors import branch_vectors, gather_pair_forces
 from pendular.dem.protocols import state_array
 
 
@@ -64,6 +69,7 @@ class LiquidClusters:
         self._pair_edge = None
         self._share = None
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
+        self._own_virial = None       # (the forces, their sum of x (x) F [N m]) (virial)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
@@ -138,8 +144,9 @@ class LiquidClusters:
         after a step (or sim.evaluate_forces()), whose neighbour list and bridges it reads."""
         units, thresholds, carried = self._decompose(sim)
         contacts, radius = sim.contacts, sim.particles.radius
-        position = sim.particles.position     # the gaps the next step's bridges will see
-        gap = (np.linalg.norm(position[contacts.pair_j] - position[contacts.pair_i], axis=1)
+        # the gaps the next step's bridges will see (through the cell's images)
+        gap = (np.linalg.norm(branch_vectors(sim.particles.position, contacts, sim.walls.period),
+                              axis=1)
                - radius[contacts.pair_i] - radius[contacts.pair_j])
         held = self.bridges.state(sim).mask() | (gap < 0.0)
         if max_gap > 0.0:
@@ -160,14 +167,16 @@ class LiquidClusters:
         return liquid
 
     def _decompose(self, sim):
-        """(pore units, thresholds, the filled state carried over) of ``sim``'s packing."""
-        if sim.walls.periodic:
-            raise ValueError("liquid = 'clusters' runs between walls (a periodic cell's "
-                             "cluster forces would need their face terms in the cell's stress)")
+        """(pore units, thresholds, the filled state carried over) of ``sim``'s packing (in a
+        periodic cell, its grains brought into the cell and cut with their images)."""
         sim.fetch("particles")
         particles = sim.particles
         previous = self._filled_grains()
-        units = decompose(particles.position, particles.radius)
+        if sim.walls.periodic:
+            period = np.array(sim.walls.period)
+            units = decompose(into_cell(particles.position, period), particles.radius, period)
+        else:
+            units = decompose(particles.position, particles.radius)
         if previous is None:
             carried = np.full(units.count, self.saturated)
         else:
@@ -215,7 +224,7 @@ class LiquidClusters:
         held = self._held()
         grains = self.units.grains[held]
         vertices = self._vertices.copy()
-        vertices[held] = particles.position[grains]
+        vertices[held] = self._grain_images(sim, grains, vertices[held])
         self._vertices = vertices
         self._set_forces(len(particles), self._unit_forces.moved(
             np.flatnonzero(held), vertices[held], particles.radius[grains]))
@@ -223,6 +232,15 @@ class LiquidClusters:
     def _held(self):
         """(M,) bool: the units that hold liquid, filled or at the closed liquid's front."""
         return self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
+
+    def _grain_images(self, sim, grains, near):
+        """(..., 3) [m] where ``grains`` are now as the units see them: their positions, or in
+        a periodic cell their images nearest ``near`` (..., 3) [m], the units' vertices of
+        before (the grains and the cell move little between two updates)."""
+        position = sim.particles.position[grains]
+        if not sim.walls.periodic:
+            return position
+        return nearest_images(position, near, np.array(sim.walls.period))
 
     def _filled_grains(self):
         """(F, 4) the grains of the filled units so far (None before the first step of the
@@ -245,7 +263,7 @@ class LiquidClusters:
     def _add_forces(self, sim, force):
         """Add to ``force`` (N, 3) [N] the clusters' forces and take off the shares of the
         bridges' forces they absorb (nothing while no unit holds liquid)."""
-        if self._force is None or not (self.filled.any() or self._front_held()):
+        if not self.adds_forces(sim):
             return
         force += self._force
         contacts = sim.contacts
@@ -254,6 +272,12 @@ class LiquidClusters:
         if len(pair_force) == len(share):
             gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
                                contacts.second_start, contacts.second_pair, force)
+
+    def adds_forces(self, sim):
+        """Whether ``apply`` adds any force to ``sim``'s grains now: whether a unit holds
+        liquid (without, a periodic cell's stress stays the gathered sum of the pair forces,
+        pendular.dem.cell.PeriodicCell.after_forces)."""
+        return self._force is not None and bool(self.filled.any() or self._front_held())
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
@@ -305,24 +329,54 @@ class LiquidClusters:
         return account.clusters + float(np.sum(volume * inside)) - account.absorbed
 
     def saturation(self, sim):
-        """Degree of saturation: the liquid held over the voids (the box less the solid)."""
+        """Degree of saturation: the liquid held over the voids (the box, or the periodic cell,
+        less the solid: a cell holds each grain once, whole)."""
         voids = sim.walls.volume() - sim.particles.solid_volume()
         return self.account(sim).total / voids
 
     def stress(self, sim):
-        """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box
-        (cluster_forces.cluster_stress), with the grains where their forces act."""
+        """(3, 3) [Pa] the clusters' share of the complete capillary stress over the box or the
+        cell (cluster_forces.cluster_stress), with the grains where their forces act (in a
+        periodic cell, the images each unit sees)."""
+        return self._stress_over(sim.walls.volume())
+
+    def _stress_over(self, volume):
+        """``stress`` over ``volume`` [m^3]."""
         if self._front_held():
             weight = self.liquid.weight
             return cluster_stress(self.units, self._unit_forces, weight > 0.0, self.suction,
-                                  sim.walls.volume(), weight, self._vertices)
+                                  volume, weight, self._vertices)
         return cluster_stress(self.units, self._unit_forces, self.filled, self.suction,
-                              sim.walls.volume(), vertices=self._vertices)
+                              volume, vertices=self._vertices)
+
+    def virial(self, sim):
+        """(3, 3) [N m] sum x (x) F of the forces ``apply`` adds to the grains of ``sim``, the
+        Love–Weber sum of the cell's stress (pendular.dem.cell.PeriodicCell.after_forces,
+        compression positive): the clusters' own, unit by unit over each unit's
+        self-equilibrated set at the images it sees where its forces were last computed
+        (-V ``stress``: translation-invariant, a unit across a face counts as one inside the
+        cell), and the shares of the bridges' forces they take off, over their pairs' branch
+        vectors (pendular.dem.neighbors.branch_vector)."""
+        total = np.zeros((3, 3))
+        if not self.adds_forces(sim):
+            return total
+        if self._own_virial is None or self._own_virial[0] is not self._force:
+            self._own_virial = (self._force, -self._stress_over(1.0))
+        total += self._own_virial[1]
+        contacts = sim.contacts
+        share = self.pair_share(contacts)
+        pair_force = self.bridges.pair_force
+        if len(share) and len(pair_force) == len(share):
+            total += pair_virial(sim.particles.position, contacts.row_start, contacts.pair_j,
+                                 contacts.image, sim.walls.period,
+                                 -share[:, None] * pair_force).reshape(3, 3)
+        return total
 
     def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
         the liquid fractions in bridges, in clusters and in the largest cluster, whether the
-        largest percolates along x, y, z, the saturation (over the voids of the box, and over
+        largest percolates along x, y, z (in a periodic cell: wraps around it,
+        pendular.capillary.clusters), the saturation (over the voids of the box or cell, and over
         the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
         if already measured)."""
         account = self.account(sim) if account is None else account
@@ -351,7 +405,7 @@ def _carry(grains, previous):
 
 
 #: The arrays of the pore units (pendular.capillary.pores.PoreUnits) a checkpoint keeps, with
-#: their dtype and shape (M: units, T: throats; ``period`` apart: None or (3,) [m]).
+#: their dtype and shape (M: units, T: throats; ``period`` apart: None, (3,) or (4,) [m]).
 _UNIT_ARRAYS = {
     "grains": (np.int64, ("M", 4)), "vertices": (np.float64, ("M", 4, 3)),
     "neighbours": (np.int64, ("M", 4)), "volume": (np.float64, ("M",)),
@@ -359,7 +413,7 @@ _UNIT_ARRAYS = {
     "grain_area": (np.float64, ("M", 4)), "protrudes": (bool, ("M",)),
     "throat_radius": (np.float64, ("M", 4)), "throat_units": (np.int64, ("T", 2)),
     "throat_of": (np.int64, ("M", 4)), "throat_shift": (np.int64, ("T", 3)),
-    "period": (np.float64, (3,))}
+    "period": (np.float64, (None,))}
 
 #: What a checkpoint keeps of a ClosedLiquid (its ``filled`` is the clusters').
 _LIQUID_STATE = ("suction", "front", "front_fraction", "weight", "bridges", "clusters", "film")
@@ -382,6 +436,10 @@ def _units_of(state, grain_count):
                                                                  for n in shape))
     except ValueError as error:
         raise ValueError(f"units/{error}") from None
+    period = arrays["period"]
+    if period is not None and (len(period) not in (3, 4) or (period[:3] <= 0.0).any()):
+        raise ValueError(f"units/period = {period.tolist()} m; valid: None, or the cell's "
+                         "lengths (3,) > 0 (and a sheared cell's offset, (4,))")
     for name, low, high in (("grains", 0, grain_count), ("neighbours", -1, sizes["M"]),
                             ("throat_units", -1, sizes["M"]), ("throat_of", 0, sizes["T"])):
         outside = (arrays[name] < low) | (arrays[name] >= high)

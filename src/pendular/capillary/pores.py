@@ -25,7 +25,11 @@ it. Per unit, in SI units (positions and radii in m):
 
 The decomposition covers the convex hull of the centres; with walls, the strip between that
 hull and the walls belongs to no unit yet. In a periodic cell [0, L)^3 it covers the cell
-exactly, through the images of the grains (``period``).
+exactly, through the images of the grains (``period``). A sheared cell (Lees–Edwards,
+pendular.dem.cell) has ``period`` (Lx, Ly, Lz, delta): the image (ix, iy, iz) of a grain is
+shifted by (ix Lx + iz delta, iy Ly, iz Lz) (``lattice_vectors``). The box [0, L)^3 still tiles
+space with those images, so the triangulation of the grains' images is cut as the plain cell's:
+each unit once, the one whose centroid lies in the box.
 """
 
 import math
@@ -48,6 +52,49 @@ _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(16)
 FACES = np.array([[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]])
 
 
+def lattice_vectors(shift, period):
+    """(..., 3) [m] the translations of the periodic images ``shift`` (..., 3) int of a cell of
+    ``period`` (3,) [m], or a sheared cell's (4,) (Lx, Ly, Lz, delta): (ix Lx + iz delta, iy Ly,
+    iz Lz) (pendular.dem.cell)."""
+    vector = np.asarray(shift) * np.asarray(period)[:3]
+    if len(period) > 3:
+        vector[..., 0] += np.asarray(shift)[..., 2] * period[3]
+    return vector
+
+
+def image_shifts(vector, period, rounding=np.rint):
+    """(..., 3) int64 the image shifts whose translation (``lattice_vectors``) is nearest to
+    ``vector`` (..., 3) [m] (z, then y and x; exact for a lattice vector, or one off it by less
+    than half the cell); ``rounding`` np.floor: those of the copy of the box [0, L)^3 that holds
+    the point ``vector``."""
+    period = np.asarray(period)
+    vector = np.asarray(vector, dtype=float)
+    shift = np.empty(vector.shape, np.int64)
+    shift[..., 2] = rounding(vector[..., 2] / period[2])
+    shift[..., 1] = rounding(vector[..., 1] / period[1])
+    along = vector[..., 0] - (shift[..., 2] * period[3] if len(period) > 3 else 0.0)
+    shift[..., 0] = rounding(along / period[0])
+    return shift
+
+
+def into_cell(position, period):
+    """(N, 3) [m] copies of ``position`` (N, 3) [m] brought into the periodic cell [0, L)^3 of
+    ``period`` (lattice_vectors; a sheared cell's images above in z are shifted by delta)."""
+    lengths = np.asarray(period)[:3]
+    wrapped = position - lattice_vectors(image_shifts(position, period, np.floor), period)
+    return np.clip(wrapped, 0.0, np.nextafter(lengths, 0.0))
+
+
+def nearest_images(position, reference, period):
+    """(..., 3) [m] the periodic images of ``position`` (..., 3) [m] nearest to ``reference``
+    (..., 3) [m] (each less than half the cell away from one); ``position`` itself without a
+    ``period`` (None)."""
+    if period is None:
+        return position
+    offset = position - reference
+    return position - lattice_vectors(image_shifts(offset, period), period)
+
+
 @dataclass(frozen=True)
 class PoreUnits:
     """The pore units of a packing (SI units). M units, T throats.
@@ -61,9 +108,10 @@ class PoreUnits:
     throat_radius: (M, 4) [m] of the face opposite each vertex.
     throat_units: (T, 2) the two units of each throat (the second -1 on the hull), first < second.
     throat_of: (M, 4) the throat across the face opposite each vertex.
-    throat_shift: (T, 3) int, the periods between the throat's face as the second unit sees it
-    and as the first does (zero without a period; zero on the hull).
-    period: (3,) [m] the periodic cell's lengths, or None (walls: the hull of the centres).
+    throat_shift: (T, 3) int, the image shifts (lattice_vectors) between the throat's face as
+    the second unit sees it and as the first does (zero without a period; zero on the hull).
+    period: (3,) [m] the periodic cell's lengths, (4,) a sheared cell's (Lx, Ly, Lz, delta), or
+    None (walls: the hull of the centres).
     """
 
     grains: np.ndarray
@@ -271,36 +319,36 @@ def ball_tetrahedron_volume(centre, radius, vertices):
 
 def _intruding_volume(vertices, grains, position, radius, period):
     """(M,) [m^3] the volume of the balls of other grains than a unit's four inside it (in a
-    periodic cell, of their images nearest the unit). Candidates: the grains within their radius
+    periodic cell, of their images near the unit). Candidates: the grains within their radius
     of the unit's bounding sphere (about its centroid) and of each face's plane on its side."""
     centroid = vertices.mean(axis=1)
     reach = np.linalg.norm(vertices - centroid[:, None], axis=2).max(axis=1)
     if period is None:
-        grains_tree = cKDTree(position)
+        points, grain_of, cell = position, np.arange(len(position)), None
     else:
-        centroid_in_cell = np.mod(centroid, period)
-        centroid_in_cell = np.where(centroid_in_cell < period, centroid_in_cell, 0.0)
-        grains_tree = cKDTree(position, boxsize=period)
+        points, grain_of, _ = _images_near_cell(position, period,
+                                                reach.max() + radius.max())
+        cell = lattice_vectors(image_shifts(centroid, period, np.floor), period)
+    grains_tree = cKDTree(points)
     # the few flat units with a long reach are searched apart, so that the bulk's search stays short
     long_reach = reach > 2.0 * np.median(reach)
     found = []
     for group in (np.flatnonzero(~long_reach), np.flatnonzero(long_reach)):
         if len(group) == 0:
             continue
-        points = centroid[group] if period is None else centroid_in_cell[group]
-        tree = cKDTree(points) if period is None else cKDTree(points, boxsize=period)
-        pairs = tree.sparse_distance_matrix(grains_tree, reach[group].max() + radius.max(),
-                                            output_type="ndarray")
-        unit, grain = group[pairs["i"]], pairs["j"].astype(np.int64)
-        near = pairs["v"] < reach[unit] + radius[grain]
-        found.append((unit[near], grain[near]))
+        at = centroid[group] if period is None else centroid[group] - cell[group]
+        pairs = cKDTree(at).sparse_distance_matrix(grains_tree, reach[group].max()
+                                                   + radius.max(), output_type="ndarray")
+        unit, point = group[pairs["i"]], pairs["j"].astype(np.int64)
+        near = pairs["v"] < reach[unit] + radius[grain_of[point]]
+        found.append((unit[near], point[near]))
     unit = np.concatenate([f[0] for f in found])
-    grain = np.concatenate([f[1] for f in found])
+    point = np.concatenate([f[1] for f in found])
+    grain = grain_of[point]
     other = np.all(grains[unit] != grain[:, None], axis=1)
-    unit, grain = unit[other], grain[other]
-    centre = position[grain]
+    unit, grain, centre = unit[other], grain[other], points[point[other]]
     if period is not None:
-        centre = centre + period * np.rint((centroid[unit] - centre) / period)
+        centre = centre + cell[unit]
     for k in range(4):
         face = vertices[unit[:, None], FACES[k]]
         normal = np.cross(face[:, 1] - face[:, 0], face[:, 2] - face[:, 0])
@@ -310,6 +358,22 @@ def _intruding_volume(vertices, grains, position, radius, period):
         unit, grain, centre = unit[keep], grain[keep], centre[keep]
     inside = ball_tetrahedron_volume(centre, radius[grain], vertices[unit])
     return np.bincount(unit, inside, minlength=len(vertices))
+
+
+def _images_near_cell(position, period, margin):
+    """(points (P, 3) [m], grain_of (P,), shift_of (P, 3) int): the grains at ``position`` (in
+    the cell [0, L)^3) and their images (lattice_vectors) within ``margin`` [m] of the cell,
+    image by image (shifts in lexicographic order)."""
+    lengths = np.asarray(period)[:3]
+    reach = np.ceil(margin / lengths).astype(np.int64)
+    if len(period) > 3:     # an image above in z is shifted by delta along x
+        reach[0] = np.ceil((margin + reach[2] * abs(period[3])) / lengths[0])
+    shifts = np.stack(np.meshgrid(*[np.arange(-n, n + 1) for n in reach], indexing="ij"),
+                      axis=-1).reshape(-1, 3)
+    images = position[None, :, :] + lattice_vectors(shifts, period)[:, None, :]
+    keep = np.all((images >= -margin) & (images < lengths + margin), axis=2)
+    shift_of, grain_of = np.nonzero(keep)
+    return images[shift_of, grain_of], grain_of, shifts[shift_of]
 
 
 def _heights(vertices):
@@ -360,7 +424,8 @@ def _throats(neighbours):
 
 
 def _throat_shift(vertices, throat_units, throat_of, period):
-    """(T, 3) int periods from the first unit's copy of each throat's face to the second's."""
+    """(T, 3) int image shifts from the first unit's copy of each throat's face to the
+    second's."""
     shift = np.zeros((len(throat_units), 3), np.int64)
     if period is None:
         return shift
@@ -370,8 +435,8 @@ def _throat_shift(vertices, throat_units, throat_of, period):
     second = throat_units[throat, 1] == unit
     first_centre = np.empty((len(throat_units), 3))
     first_centre[throat[~second]] = face_centre[unit[~second], face[~second]]
-    shift[throat[second]] = np.rint((face_centre[unit[second], face[second]]
-                                     - first_centre[throat[second]]) / period).astype(np.int64)
+    shift[throat[second]] = image_shifts(face_centre[unit[second], face[second]]
+                                         - first_centre[throat[second]], period)
     return shift
 
 
@@ -380,7 +445,9 @@ def decompose(position, radius, period=None):
 
     Without ``period`` the units fill the convex hull of the centres (a sample between walls).
     With ``period`` (3,) [m] the positions lie in the periodic cell [0, L)^3 and the units fill
-    it exactly: each unit once, its vertices the images nearest its centroid in the cell."""
+    it exactly: each unit once, its vertices the images nearest its centroid in the cell; a
+    sheared cell's ``period`` (4,) adds its offset delta [m] (module docstring; |delta| <= Lx,
+    as the cell keeps it, pendular.dem.cell)."""
     position = check_array("position", position, (3,))
     radius = check_array("radius", radius, positive=True, length=len(position))
     if len(position) < 4:
@@ -392,8 +459,8 @@ def decompose(position, radius, period=None):
         neighbours = triangulation.neighbors.astype(np.int64)
         period_array = None
     else:
-        period_array = check_array("period", period, positive=True, length=3)
-        outside = (position < 0) | (position >= period_array)
+        period_array = _check_period(period)
+        outside = (position < 0) | (position >= period_array[:3])
         if outside.any():
             i, axis = (int(x) for x in np.argwhere(outside)[0])
             raise ValueError(f"position[{i}, {axis}] = {position[i, axis]:g} m is outside the "
@@ -408,6 +475,19 @@ def decompose(position, radius, period=None):
                      pore_volume=pore, solid_angle=omega, grain_area=area, protrudes=protrudes,
                      throat_radius=throat, throat_units=throat_units, throat_of=throat_of,
                      throat_shift=shift, period=period_array)
+
+
+def _check_period(period):
+    """``period`` as a float array: (3,) positive lengths [m], or a sheared cell's (4,) whose
+    offset is at most Lx in size."""
+    period = np.asarray(period, dtype=float)
+    if period.shape not in ((3,), (4,)):
+        raise ValueError(f"period has shape {period.shape}; expected (3,), the cell's lengths "
+                         "[m], or (4,), a sheared cell's lengths and offset")
+    check_array("period", period[:3], positive=True, length=3)
+    if len(period) > 3:
+        check_range("period[3] (the shear offset)", period[3], -period[0], period[0], unit="m")
+    return period
 
 
 def _delaunay(points):
@@ -427,41 +507,39 @@ def _periodic_units(position, radius, period):
     outside it can then be in the circumsphere); the margin doubles until every unit whose
     centroid is in the cell, and its four neighbours, are such units."""
     count = len(position)
-    spacing = (np.prod(period) / count) ** (1.0 / 3.0)
+    lengths = period[:3]
+    spacing = (np.prod(lengths) / count) ** (1.0 / 3.0)
     margin = 2.0 * spacing + 2.0 * radius.max()
     # A fixed perturbation, the same for a grain and its images, settles ties between
     # cospherical points (a lattice) the same way in every period; the geometry is the grains'.
     tie_break = PERTURBATION * spacing * np.random.default_rng(0).uniform(-1, 1, (count, 3))
-    shifts = np.array([[i, j, k] for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)])
     while True:
-        margin = min(margin, period.min())
-        images = position[None, :, :] + shifts[:, None, :] * period
-        keep = np.all((images >= -margin) & (images < period + margin), axis=2)
-        shift_of, grain_of = np.nonzero(keep)
-        points = images[shift_of, grain_of]
+        margin = min(margin, lengths.min())
+        points, grain_of, shift_of = _images_near_cell(position, period, margin)
         triangulation = _delaunay(points + tie_break[grain_of])
         simplices = triangulation.simplices
         corners = points[simplices]
         centroid = (points + tie_break[grain_of])[simplices].mean(axis=1)
-        cell = np.floor(centroid / period).astype(np.int64)
+        cell = image_shifts(centroid, period, np.floor)
         inside = np.flatnonzero(np.all(cell == 0, axis=1))
         neighbours_ext = triangulation.neighbors[inside]
         needed = np.concatenate([inside, neighbours_ext[neighbours_ext >= 0]])
         centre, circumradius = _circumspheres(corners[needed])
         fits = np.all((centre - circumradius[:, None] >= -margin)
-                      & (centre + circumradius[:, None] <= period + margin), axis=1)
+                      & (centre + circumradius[:, None] <= lengths + margin), axis=1)
         if (neighbours_ext >= 0).all() and fits.all():
             break
-        if margin >= period.min():
+        if margin >= lengths.min():
             raise ValueError(f"the periodic cell {period.tolist()} m is too small for its "
                              f"{count} spheres to be decomposed into pore units")
         margin *= 2.0
     # each point as (grain, image) coded in one integer; a unit as its four sorted codes
-    code = grain_of[simplices] * 125 + _image_code(shifts[shift_of][simplices])
+    translated = shift_of[simplices[neighbours_ext]] - cell[neighbours_ext][:, :, None, :]
+    base = 2 * int(max(np.abs(shift_of).max(), np.abs(translated).max())) + 1
+    code = grain_of[simplices] * base ** 3 + _image_code(shift_of[simplices], base)
     key = np.sort(code[inside], axis=1)
-    translated = (grain_of[simplices[neighbours_ext]] * 125
-                  + _image_code(shifts[shift_of][simplices[neighbours_ext]]
-                                - cell[neighbours_ext][:, :, None, :]))
+    translated = (grain_of[simplices[neighbours_ext]] * base ** 3
+                  + _image_code(translated, base))
     wanted = np.sort(translated.reshape(-1, 4), axis=1)
     order = np.lexsort(key.T[::-1])
     sorted_keys = key[order]
@@ -473,9 +551,10 @@ def _periodic_units(position, radius, period):
     return grains, corners[inside], neighbours
 
 
-def _image_code(shift):
-    """Integer code of image shifts in {-2, ..., 2}^3."""
-    return (shift[..., 0] + 2) * 25 + (shift[..., 1] + 2) * 5 + (shift[..., 2] + 2)
+def _image_code(shift, base):
+    """Integer code of image shifts in {-(base - 1) / 2, ..., (base - 1) / 2}^3."""
+    half = base // 2
+    return ((shift[..., 0] + half) * base + (shift[..., 1] + half)) * base + (shift[..., 2] + half)
 
 
 def search_rows(sorted_rows, rows):

@@ -26,7 +26,8 @@ the code of before, bit for bit.
 With no walls, the stress of the cell is the Love–Weber average of every pair force over the
 cell volume (Eq. 3.41 over contacts and, in a wet scene, bridges): ``after_forces`` computes it
 each step from the particles' forces and the face terms that the forces' gathers add to
-``virial_blocks`` (pendular.dem.virial). The
+``virial_blocks`` (pendular.dem.virial); forces that are not pair forces (liquid clusters)
+give their own sum of x (x) F (``virial``). The
 stress servo reads the cell's stiffness S_a = (1/V) sum kn (l_a n_a)^2 [Pa per
 unit strain] as a wall servo reads the stiffness of the wall's contacts; the servo refreshes it
 (``update_stiffness``) when it refreshes its own.
@@ -164,14 +165,24 @@ def servo_cell(position, rate, stress_tensor, cell_stiffness, stiffness, previou
         rate[axis] = previous[slot] / (length * dt)
 
 
+def _gathered(op, sim):
+    """Whether the force operation ``op`` leaves the gathered stress of ``sim``'s cell exact
+    (PeriodicCell.after_forces): a pair force, or one that adds no force this step."""
+    if hasattr(op, "pair_forces"):
+        return True
+    adds_forces = getattr(op, "adds_forces", None)
+    return adds_forces is not None and not adds_forces(sim)
+
+
 @dataclass
 class PeriodicCell(Box):
     """A periodic box [0, L] (module docstring), the counterpart of pendular.dem.state.Walls.
 
     position: (6,) faces as Walls.position, low faces at 0 [m];
     rate: (3,) stretching rate L' / L of the current step, extension positive [1/s];
-    stress_tensor: (3, 3) Love–Weber stress of every pair force at the last evaluation,
-    compression positive [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
+    stress_tensor: (3, 3) Love–Weber stress of every force at the last evaluation (the pair
+    forces', and the sums the other forces give, ``after_forces``), compression positive
+    [Pa]; stiffness: (3,) S_a [Pa] (module docstring);
     wraps: (N, 3) int64 periods crossed by each particle (+1 through a high face);
     virial_blocks: (SUM_BLOCKS, 9) the face terms of the pair forces' sum of l (x) f [N m]
     gathered since the step began (pendular.dem.virial; zeroed with the forces);
@@ -301,12 +312,16 @@ class PeriodicCell(Box):
             self.shear_strain += self.shear_rate * dt
 
     def after_forces(self, sim):
-        """The stress of this step's pair forces: from the particles' forces and the face terms
+        """The stress of this step's forces: from the particles' forces and the face terms
         the gathers left in ``virial_blocks`` (store_cell_stress) when every force operation
-        is a pair force (has ``pair_forces(sim)``); otherwise pair by pair over the operations
-        that are. The stretching and shear rates return to zero until a control sets them."""
+        is a pair force (has ``pair_forces(sim)``) or adds no force this step (declares
+        ``adds_forces(sim)``, false now); otherwise pair by pair over the operations that are
+        pair forces, and the sum of x (x) F [N m] that each other operation declaring
+        ``virial(sim)`` gives of its forces (liquid clusters,
+        pendular.capillary.liquid_clusters). The stretching and shear rates return to zero
+        until a control sets them."""
         contacts = sim.contacts
-        if all(hasattr(op, "pair_forces") for op in sim.forces):
+        if all(_gathered(op, sim) for op in sim.forces):
             store_cell_stress(self.virial_blocks, sim.particles.position, sim.particles.force,
                               self.position, self.stress_tensor)
         else:       # a force that is not a pair force: its gather adds no virial
@@ -316,6 +331,8 @@ class PeriodicCell(Box):
                     total += pair_virial(sim.particles.position, contacts.row_start,
                                          contacts.pair_j, contacts.image, self.period,
                                          op.pair_forces(sim))
+                elif hasattr(op, "virial"):
+                    total += np.ravel(op.virial(sim))
             self.stress_tensor[:] = total.reshape(3, 3) / self.volume()
         self.rate.fill(0.0)
         self.shear_rate = 0.0

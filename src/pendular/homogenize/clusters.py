@@ -20,13 +20,14 @@ from pendular.homogenize.bridge_tensors import wetted_caps_sum
 def chi_with_clusters(sim, clusters, psi_clusters=None):
     """(3, 3) chi of the bridges' shares outside the filled units and of the clusters of
     ``clusters`` (pendular.capillary.liquid_clusters.LiquidClusters) of ``sim``, over the box
-    (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if already measured."""
+    or the periodic cell (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if
+    already measured."""
     contacts, particles = sim.contacts, sim.particles
     state = BridgeState.of(contacts)
     index = np.flatnonzero(state.mask())
     volume = sim.walls.volume()
     weight = 1.0 - clusters.pair_share(contacts)[index]
-    branch = branch_vectors(particles.position, contacts, np.zeros(3), index)
+    branch = branch_vectors(particles.position, contacts, sim.walls.period, index)
     normal = branch / np.linalg.norm(branch, axis=1, keepdims=True)
     caps = wetted_caps_sum(normal, particles.radius[contacts.pair_i[index]],
                            particles.radius[contacts.pair_j[index]], state.filling_i[index],
@@ -40,8 +41,9 @@ def chi_with_clusters(sim, clusters, psi_clusters=None):
 def cluster_force_stress(sim, clusters):
     """(3, 3) [Pa] Love–Weber stress of the forces ``clusters`` add to the grains of ``sim``
     (LiquidClusters.grain_forces: theirs, less the bridges' shares they absorb), (1/V) sum
-    x (x) F over the grains (the forces sum to zero), with the sign of the bridges'
-    sigma_capillary (tension negative): in static equilibrium sigma_wall = sigma_contact +
-    sigma_capillary + this."""
-    force = clusters.grain_forces(sim)
-    return np.einsum("ki,kj->ij", sim.particles.position, force) / sim.walls.volume()
+    x (x) F (LiquidClusters.virial: each unit's forces at the positions, or the periodic
+    images, where they were last computed; the shares over their pairs' branch vectors), with
+    the sign of the bridges' sigma_capillary (tension negative): in static equilibrium
+    sigma_wall = sigma_contact + sigma_capillary + this; in a periodic cell, this is the
+    clusters' part of the cell's stress."""
+    return clusters.virial(sim) / sim.walls.volume()

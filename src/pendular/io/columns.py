@@ -154,7 +154,9 @@ HISTORY_COLUMNS = {
     "sigma_clusters": Column("Pa", "Love-Weber stress of the liquid clusters' forces, less "
                                    "the bridges' shares they absorb (tension negative); "
                                    "sigma_wall = sigma_contact + sigma_capillary + "
-                                   "sigma_clusters in equilibrium (--liquid clusters)", _TENSOR),
+                                   "sigma_clusters in equilibrium, and the clusters' "
+                                   "part of a periodic cell's stress (--liquid clusters)",
+                                   _TENSOR),
     "liquid_bridges": Column("m^3", "liquid held by the bridges (closed liquid: constant "
                                     "water content)"),
     "liquid_film": Column("m^3", "liquid held on grains without a bridge, from ruptured bridges "

@@ -429,7 +429,7 @@ SUMMARY_KEYS = {
                           "at the history's last row (their number, the liquid's fractions, "
                           "percolation, saturations, chi with clusters and of the bridges, "
                           "p' = p + chi_with_clusters s)",
-                          ("oedometer", "isotropic", "cyclic", "path")),
+                          ("oedometer", "isotropic", "cyclic", "path", "simple-shear")),
     "clusters_wet": Key(LABORATORY_CLUSTER_UNITS, "--liquid clusters: the suction that holds "
                         "(tension) or is imposed on (a laboratory test) the water once wetted "
                         "and the clusters then (their number, the liquid's fractions in "

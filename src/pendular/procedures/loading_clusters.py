@@ -51,10 +51,6 @@ def refuse_clusters(config) -> str | None:
                 "clusters: not with --drainage undrained (volume-controlled bridges)")
     if bridges.model != "exact":
         return f"--liquid clusters needs the exact bridges, not --bridges {bridges.model}"
-    if config.sample.periodic:
-        return ("--liquid clusters runs between walls, not in a periodic cell (--periodic, a "
-                "simple shear): its cluster forces would need their face terms in the cell's "
-                "stress")
     return None
 
 
