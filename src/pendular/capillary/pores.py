@@ -202,6 +202,182 @@ def entry_suction(throat_radius, surface_tension, contact_angle=0.0):
         return np.where(r > 0, 2.0 * gamma * math.cos(math.radians(theta)) / r, np.inf)
 
 
+#: Throat entry estimates (``filling_thresholds``'s ``entry``): the inscribed circle's
+#: 2 gamma cos(theta) / r_t, or the Mayer–Stowe–Princen balance over the throat's section.
+ENTRY_ESTIMATES = ("inscribed", "mayer-stowe-princen")
+#: The radii of curvature a Mayer–Stowe–Princen entry is looked for among, scanned from the
+#: largest: log-spaced from _MSP_LOWEST r_t to _MSP_HIGHEST r_t / cos(theta), r_t the
+#: inscribed radius; then bisected between the two nodes that bracket the entry.
+_MSP_LOWEST, _MSP_HIGHEST, _MSP_NODES, _MSP_BISECTIONS = 1e-6, 1e3, 96, 48
+#: The three sides (i, j) of a throat's triangle, counter-clockwise; the third grain is k.
+_SIDES = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
+
+
+def mayer_stowe_princen_entry(centres, radii, surface_tension, contact_angle=0.0):
+    """(T,) [Pa] Mayer–Stowe–Princen entry suction of throats between three spheres with
+    centres ``centres`` (T, 3, 3) [m] and radii ``radii`` (T, 3) [m] (any radii, gaps or
+    overlaps; ``surface_tension`` gamma [N/m], ``contact_angle`` theta [deg]); inf for a
+    throat its grains close, 0 where the inscribed estimate is 0 (no inscribed circle).
+
+    In the plane of the centres the gas that enters the throat is bounded by the grains' great
+    circles and by arcs of radius r = gamma / s meeting two grains at the angle theta (the
+    liquid left in the corners; a side whose gap is too wide for such an arc, whose neck
+    would close, has none, and the gas meets the neighbouring throat across it). The entry is
+    the balance of the work of the gas pressure with the surface energy of a meniscus that
+    advances through the throat as through a prism (Mayer & Stowe 1965; Princen 1969; Mason &
+    Mellor 1995):
+
+        s A_gas = gamma (L_gas-liquid + cos(theta) L_gas-solid),
+
+    at the largest r (the lowest suction) where it holds, the corner arcs not crossing (a
+    circular throat of radius a gives 2 gamma / a). Where the triangle of the centres does not
+    hold the throat's opening (the inscribed circle's centre outside it, or a grain across
+    the side opposite it: flat and obtuse faces, whose opening lies across a side) the
+    inscribed estimate ``entry_suction`` stands (docs/liquid_clusters.md)."""
+    gamma = check_range("surface_tension", surface_tension, 0.0, math.inf, low_inclusive=False,
+                        unit="N/m")
+    cosine = math.cos(math.radians(check_contact_angle(contact_angle)))
+    centres = np.asarray(centres, dtype=float).reshape(-1, 3, 3)
+    radii = np.asarray(radii, dtype=float).reshape(-1, 3)
+    inscribed = throat_radius(centres, radii)
+    suction = entry_suction(inscribed, gamma, contact_angle)
+    open_ = np.flatnonzero((inscribed > 0) & np.isfinite(inscribed))
+    throat = _ThroatSection(centres[open_], radii[open_], cosine)
+    posed = throat.holds_its_opening(inscribed[open_])
+    open_, throat = open_[posed], _ThroatSection(centres[open_[posed]], radii[open_[posed]],
+                                                 cosine)
+    if len(open_) == 0 or cosine <= 0.0:
+        return suction
+    scale = np.log(inscribed[open_])
+    nodes = np.linspace(math.log(_MSP_HIGHEST / cosine), math.log(_MSP_LOWEST), _MSP_NODES)
+    low = np.full(len(open_), np.nan)         # the largest node where the gas enters
+    for node in nodes:
+        free = np.isnan(low)
+        if not free.any():
+            break
+        enters = throat.enters(np.exp(scale + node))
+        low[free & enters] = node
+    high = low + (nodes[0] - nodes[1])
+    found = np.isfinite(low)
+    first = found & (low == nodes[0])       # enters at the widest radius looked at: ~0
+    low, high = np.where(found, low, nodes[-1]), np.where(found, high, nodes[-1])
+    for _ in range(_MSP_BISECTIONS):
+        middle = 0.5 * (low + high)
+        enters = throat.enters(np.exp(scale + middle))
+        low, high = np.where(enters, middle, low), np.where(enters, high, middle)
+    suction[open_] = np.where(found & ~first, gamma / np.exp(scale + 0.5 * (low + high)),
+                              np.where(found, 0.0, np.inf))
+    return suction
+
+
+class _ThroatSection:
+    """The section of T throats in the plane of their centres, for mayer_stowe_princen_entry:
+    each triangle in its own frame, counter-clockwise, centred on its centroid."""
+
+    def __init__(self, centres, radii, cosine):
+        u = centres[:, 1] - centres[:, 0]
+        length = np.linalg.norm(u, axis=1)
+        ex = u / length[:, None]
+        w = centres[:, 2] - centres[:, 0]
+        x3 = np.sum(w * ex, axis=1)
+        y3 = np.linalg.norm(w - x3[:, None] * ex, axis=1)
+        corner = np.zeros((len(centres), 3, 2))
+        corner[:, 1, 0] = length
+        corner[:, 2, 0], corner[:, 2, 1] = x3, y3
+        self.corner = corner - corner.mean(axis=1, keepdims=True)
+        self.radii = radii
+        self.cosine = cosine
+
+    def holds_its_opening(self, inscribed):
+        """(T,) whether the triangle holds the circle of radius ``inscribed`` (T,) [m] tangent
+        to the three grains (its centre inside) and no grain crosses the side opposite it."""
+        corner, radii = self.corner, self.radii
+        reach = radii + inscribed[:, None]
+        rows = 2.0 * (corner[:, 1:] - corner[:, :1])             # |p - c_i| = R_i + r
+        rhs = (np.sum(corner[:, 1:] ** 2, axis=2) - np.sum(corner[:, :1] ** 2, axis=2)
+               - reach[:, 1:] ** 2 + reach[:, :1] ** 2)
+        centre = np.linalg.solve(rows, rhs[..., None])[..., 0]
+        holds = np.ones(len(corner), bool)
+        for i, j, k in _SIDES:
+            side = corner[:, j] - corner[:, i]
+            length = np.linalg.norm(side, axis=1)
+            holds &= _cross(side, centre - corner[:, i]) >= 0.0
+            holds &= _cross(side, corner[:, k] - corner[:, i]) >= radii[:, k] * length
+        return holds
+
+    def enters(self, r):
+        """(T,) whether the gas enters at the radius of curvature ``r`` (T,) [m]: the corner
+        arcs leave it a section, and s A_gas >= gamma (L_gl + cos(theta) L_gs) there."""
+        corner, radii, cosine = self.corner, self.radii, self.cosine
+        count = len(r)
+        # the arc of each side: its centre, contact angles on both grains, or none
+        start = np.empty((count, 3))          # where each grain's gas boundary starts [rad]
+        end = np.empty((count, 3))            # and where it ends (clockwise about the grain)
+        area = np.zeros(count)                # 2 A_gas by Green's theorem
+        liquid_length = np.zeros(count)
+        for i, j, _ in _SIDES:
+            ci, cj, ri, rj = corner[:, i], corner[:, j], radii[:, i], radii[:, j]
+            side = cj - ci
+            distance = np.linalg.norm(side, axis=1)
+            along = side / distance[:, None]
+            inward = np.stack([-along[:, 1], along[:, 0]], axis=1)
+            rho_i = np.sqrt(ri * ri + r * r + 2.0 * ri * r * cosine)
+            rho_j = np.sqrt(rj * rj + r * r + 2.0 * rj * r * cosine)
+            foot = (distance ** 2 + rho_i ** 2 - rho_j ** 2) / (2.0 * distance)
+            height = np.sqrt(np.maximum(rho_i ** 2 - foot ** 2, 0.0))
+            centre = ci + foot[:, None] * along + height[:, None] * inward
+            # the arc meets grain i at beta_i from the line c_i -> centre, towards the side
+            beta_i = np.arccos(np.clip((ri * ri + rho_i ** 2 - r * r) / (2 * ri * rho_i), -1, 1))
+            beta_j = np.arccos(np.clip((rj * rj + rho_j ** 2 - r * r) / (2 * rj * rho_j), -1, 1))
+            to_i, to_j = centre - ci, centre - cj
+            angle_i = np.arctan2(to_i[:, 1], to_i[:, 0]) - beta_i
+            angle_j = np.arctan2(to_j[:, 1], to_j[:, 0]) + beta_j
+            side_angle = np.arctan2(along[:, 1], along[:, 0])
+            above_i = _wrap(angle_i - side_angle) >= 0.0
+            above_j = _wrap(side_angle + math.pi - angle_j) >= 0.0
+            arc = (rho_i ** 2 - foot ** 2 >= r * r) & above_i & above_j
+            end[:, i] = np.where(arc, angle_i, side_angle)
+            start[:, j] = np.where(arc, angle_j, side_angle + math.pi)
+            point_i = ci + ri[:, None] * _unit(end[:, i])
+            point_j = cj + rj[:, None] * _unit(start[:, j])
+            from_, to = (np.arctan2(p[:, 1] - centre[:, 1], p[:, 0] - centre[:, 0])
+                         for p in (point_i, point_j))
+            sweep = np.mod(to - from_, 2.0 * math.pi)
+            area += np.where(arc, _arc_area(centre, r, from_, sweep),
+                             point_i[:, 0] * point_j[:, 1] - point_j[:, 0] * point_i[:, 1])
+            liquid_length += np.where(arc, r * sweep, 0.0)
+        span = _wrap(start - end)             # each grain's arc in contact with the gas
+        solid_length = np.sum(radii * span, axis=1)
+        for k in range(3):
+            area += _arc_area(corner[:, k], radii[:, k], start[:, k], -span[:, k])
+        valid = np.all(span >= 0.0, axis=1) & (area > 0.0)
+        return valid & (0.5 * area >= r * (liquid_length + cosine * solid_length))
+
+
+def _cross(u, v):
+    """(T,) the z component of the cross products of the plane vectors ``u``, ``v`` (T, 2)."""
+    return u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]
+
+
+def _wrap(angle):
+    """``angle`` [rad] in (-pi, pi]."""
+    return math.pi - np.mod(math.pi - angle, 2.0 * math.pi)
+
+
+def _unit(angle):
+    """(T, 2) the unit vectors at ``angle`` (T,) [rad]."""
+    return np.stack([np.cos(angle), np.sin(angle)], axis=1)
+
+
+def _arc_area(centre, radius, start, sweep):
+    """(T,) twice the Green's-theorem area (the integral of x dy - y dx) of arcs of circles
+    ``centre`` (T, 2), ``radius`` from the angle ``start`` through ``sweep`` [rad]."""
+    stop = start + sweep
+    return (radius * radius * sweep
+            + radius * centre[:, 0] * (np.sin(stop) - np.sin(start))
+            - radius * centre[:, 1] * (np.cos(stop) - np.cos(start)))
+
+
 def beyond_face_volume(apex, radius, triangle):
     """(P,) [m^3] volume of the ball of ``radius`` (P,) [m] about ``apex`` (P, 3) [m] that lies
     beyond the plane of ``triangle`` (P, 3, 3) [m] inside the cone from the apex through the
