@@ -32,7 +32,7 @@ from functools import cached_property
 
 import numpy as np
 
-from pendular.capillary.pores import (EDGES, ENTRY_ESTIMATES, FACES, dihedral_angles,
+from pendular.capillary.pores import (EDGES, FACES, check_entry_estimate, dihedral_angles,
     entry_suction, mayer_stowe_princen_entry)
 
 
@@ -100,9 +100,7 @@ def filling_thresholds(pore_units, radius, surface_tension, contact_angle=0.0,
     ENTRY_ESTIMATES: the throats' entry suctions through their inscribed circles
     (``entry_suction``) or by the Mayer–Stowe–Princen balance over their sections
     (``mayer_stowe_princen_entry``, taken on the first unit's side of each throat)."""
-    if entry not in ENTRY_ESTIMATES:
-        raise ValueError(f"entry = {entry!r} is not a throat entry estimate; valid: "
-                         f"{', '.join(ENTRY_ESTIMATES)}")
+    check_entry_estimate(entry)
     radii = radius[pore_units.grains]
     throat = np.full(len(pore_units.throat_units), -np.inf)
     np.maximum.at(throat, pore_units.throat_of.ravel(), pore_units.throat_radius.ravel())

@@ -206,18 +206,27 @@ def entry_suction(throat_radius, surface_tension, contact_angle=0.0):
 #: 2 gamma cos(theta) / r_t, or the Mayer–Stowe–Princen balance over the throat's section.
 ENTRY_ESTIMATES = ("inscribed", "mayer-stowe-princen")
 #: The radii of curvature a Mayer–Stowe–Princen entry is looked for among, scanned from the
-#: largest: log-spaced from _MSP_LOWEST r_t to _MSP_HIGHEST r_t / cos(theta), r_t the
-#: inscribed radius; then bisected between the two nodes that bracket the entry.
-_MSP_LOWEST, _MSP_HIGHEST, _MSP_NODES, _MSP_BISECTIONS = 1e-6, 1e3, 96, 48
+#: largest: _MSP_NODES log-spaced from _MSP_HIGHEST r_t / cos(theta) down to _MSP_LOWEST r_t,
+#: r_t the inscribed radius; then bisected _MSP_BISECTIONS times between the two nodes that
+#: bracket the entry.
+_MSP_HIGHEST, _MSP_LOWEST, _MSP_NODES, _MSP_BISECTIONS = 10.0, 1e-3, 41, 40
 #: The three sides (i, j) of a throat's triangle, counter-clockwise; the third grain is k.
 _SIDES = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
+
+
+def check_entry_estimate(entry):
+    """``entry`` if it is one of ENTRY_ESTIMATES, else ValueError naming them."""
+    if entry not in ENTRY_ESTIMATES:
+        raise ValueError(f"entry = {entry!r} is not a throat entry estimate; valid: "
+                         f"{', '.join(ENTRY_ESTIMATES)}")
+    return entry
 
 
 def mayer_stowe_princen_entry(centres, radii, surface_tension, contact_angle=0.0):
     """(T,) [Pa] Mayer–Stowe–Princen entry suction of throats between three spheres with
     centres ``centres`` (T, 3, 3) [m] and radii ``radii`` (T, 3) [m] (any radii, gaps or
     overlaps; ``surface_tension`` gamma [N/m], ``contact_angle`` theta [deg]); inf for a
-    throat its grains close, 0 where the inscribed estimate is 0 (no inscribed circle).
+    throat its grains close.
 
     In the plane of the centres the gas that enters the throat is bounded by the grains' great
     circles and by arcs of radius r = gamma / s meeting two grains at the angle theta (the
@@ -232,8 +241,10 @@ def mayer_stowe_princen_entry(centres, radii, surface_tension, contact_angle=0.0
     at the largest r (the lowest suction) where it holds, the corner arcs not crossing (a
     circular throat of radius a gives 2 gamma / a). Where the triangle of the centres does not
     hold the throat's opening (the inscribed circle's centre outside it, or a grain across
-    the side opposite it: flat and obtuse faces, whose opening lies across a side) the
-    inscribed estimate ``entry_suction`` stands (docs/liquid_clusters.md)."""
+    the side opposite it: flat and obtuse faces, whose opening lies across a side), or no
+    balance is found among the radii looked at, the inscribed estimate ``entry_suction``
+    stands; a throat the gas enters at the widest radius looked at gets the suction there, an
+    upper bound (docs/liquid_clusters.md)."""
     gamma = check_range("surface_tension", surface_tension, 0.0, math.inf, low_inclusive=False,
                         unit="N/m")
     cosine = math.cos(math.radians(check_contact_angle(contact_angle)))
@@ -242,73 +253,78 @@ def mayer_stowe_princen_entry(centres, radii, surface_tension, contact_angle=0.0
     inscribed = throat_radius(centres, radii)
     suction = entry_suction(inscribed, gamma, contact_angle)
     open_ = np.flatnonzero((inscribed > 0) & np.isfinite(inscribed))
-    throat = _ThroatSection(centres[open_], radii[open_], cosine)
-    posed = throat.holds_its_opening(inscribed[open_])
-    open_, throat = open_[posed], _ThroatSection(centres[open_[posed]], radii[open_[posed]],
-                                                 cosine)
-    if len(open_) == 0 or cosine <= 0.0:
+    corner = _plane_triangles(centres[open_])
+    posed = _holds_its_opening(corner, radii[open_], inscribed[open_])
+    open_ = open_[posed]
+    if len(open_) == 0:
         return suction
+    throat = _ThroatSection(corner[posed], radii[open_], cosine)
     scale = np.log(inscribed[open_])
     nodes = np.linspace(math.log(_MSP_HIGHEST / cosine), math.log(_MSP_LOWEST), _MSP_NODES)
     low = np.full(len(open_), np.nan)         # the largest node where the gas enters
     for node in nodes:
-        free = np.isnan(low)
-        if not free.any():
+        free = np.flatnonzero(np.isnan(low))
+        if len(free) == 0:
             break
-        enters = throat.enters(np.exp(scale + node))
-        low[free & enters] = node
-    high = low + (nodes[0] - nodes[1])
-    found = np.isfinite(low)
-    first = found & (low == nodes[0])       # enters at the widest radius looked at: ~0
-    low, high = np.where(found, low, nodes[-1]), np.where(found, high, nodes[-1])
+        enters = throat.enters(np.exp(scale[free] + node), free)
+        low[free[enters]] = node
+    found = np.flatnonzero(np.isfinite(low))
+    low = low[found]
+    high = np.where(low == nodes[0], low, low + (nodes[0] - nodes[1]))   # at most the widest
     for _ in range(_MSP_BISECTIONS):
         middle = 0.5 * (low + high)
-        enters = throat.enters(np.exp(scale + middle))
+        enters = throat.enters(np.exp(scale[found] + middle), found)
         low, high = np.where(enters, middle, low), np.where(enters, high, middle)
-    suction[open_] = np.where(found & ~first, gamma / np.exp(scale + 0.5 * (low + high)),
-                              np.where(found, 0.0, np.inf))
+    suction[open_[found]] = gamma / np.exp(scale[found] + 0.5 * (low + high))
     return suction
 
 
+def _plane_triangles(centres):
+    """(T, 3, 2) [m] the triangles of ``centres`` (T, 3, 3) in their planes, counter-clockwise,
+    centred on their centroids."""
+    u = centres[:, 1] - centres[:, 0]
+    length = np.linalg.norm(u, axis=1)
+    ex = u / length[:, None]
+    w = centres[:, 2] - centres[:, 0]
+    x3 = np.sum(w * ex, axis=1)
+    y3 = np.linalg.norm(w - x3[:, None] * ex, axis=1)
+    corner = np.zeros((len(centres), 3, 2))
+    corner[:, 1, 0] = length
+    corner[:, 2, 0], corner[:, 2, 1] = x3, y3
+    return corner - corner.mean(axis=1, keepdims=True)
+
+
+def _holds_its_opening(corner, radii, inscribed):
+    """(T,) whether the triangles ``corner`` (T, 3, 2) [m] hold the circle of radius
+    ``inscribed`` (T,) [m] tangent to their grains of ``radii`` (T, 3) [m] (its centre inside)
+    and no grain crosses the side opposite it."""
+    reach = radii + inscribed[:, None]
+    rows = 2.0 * (corner[:, 1:] - corner[:, :1])                 # |p - c_i| = R_i + r
+    rhs = (np.sum(corner[:, 1:] ** 2, axis=2) - np.sum(corner[:, :1] ** 2, axis=2)
+           - reach[:, 1:] ** 2 + reach[:, :1] ** 2)
+    centre = np.linalg.solve(rows, rhs[..., None])[..., 0]
+    holds = np.ones(len(corner), bool)
+    for i, j, k in _SIDES:
+        side = corner[:, j] - corner[:, i]
+        length = np.linalg.norm(side, axis=1)
+        holds &= _cross(side, centre - corner[:, i]) >= 0.0
+        holds &= _cross(side, corner[:, k] - corner[:, i]) >= radii[:, k] * length
+    return holds
+
+
 class _ThroatSection:
-    """The section of T throats in the plane of their centres, for mayer_stowe_princen_entry:
-    each triangle in its own frame, counter-clockwise, centred on its centroid."""
+    """The sections of T throats in the planes of their centres (``corner`` (T, 3, 2) [m],
+    _plane_triangles; ``radii`` (T, 3) [m]; ``cosine`` of the contact angle), for
+    mayer_stowe_princen_entry."""
 
-    def __init__(self, centres, radii, cosine):
-        u = centres[:, 1] - centres[:, 0]
-        length = np.linalg.norm(u, axis=1)
-        ex = u / length[:, None]
-        w = centres[:, 2] - centres[:, 0]
-        x3 = np.sum(w * ex, axis=1)
-        y3 = np.linalg.norm(w - x3[:, None] * ex, axis=1)
-        corner = np.zeros((len(centres), 3, 2))
-        corner[:, 1, 0] = length
-        corner[:, 2, 0], corner[:, 2, 1] = x3, y3
-        self.corner = corner - corner.mean(axis=1, keepdims=True)
-        self.radii = radii
-        self.cosine = cosine
+    def __init__(self, corner, radii, cosine):
+        self.corner, self.radii, self.cosine = corner, radii, cosine
 
-    def holds_its_opening(self, inscribed):
-        """(T,) whether the triangle holds the circle of radius ``inscribed`` (T,) [m] tangent
-        to the three grains (its centre inside) and no grain crosses the side opposite it."""
-        corner, radii = self.corner, self.radii
-        reach = radii + inscribed[:, None]
-        rows = 2.0 * (corner[:, 1:] - corner[:, :1])             # |p - c_i| = R_i + r
-        rhs = (np.sum(corner[:, 1:] ** 2, axis=2) - np.sum(corner[:, :1] ** 2, axis=2)
-               - reach[:, 1:] ** 2 + reach[:, :1] ** 2)
-        centre = np.linalg.solve(rows, rhs[..., None])[..., 0]
-        holds = np.ones(len(corner), bool)
-        for i, j, k in _SIDES:
-            side = corner[:, j] - corner[:, i]
-            length = np.linalg.norm(side, axis=1)
-            holds &= _cross(side, centre - corner[:, i]) >= 0.0
-            holds &= _cross(side, corner[:, k] - corner[:, i]) >= radii[:, k] * length
-        return holds
-
-    def enters(self, r):
-        """(T,) whether the gas enters at the radius of curvature ``r`` (T,) [m]: the corner
-        arcs leave it a section, and s A_gas >= gamma (L_gl + cos(theta) L_gs) there."""
-        corner, radii, cosine = self.corner, self.radii, self.cosine
+    def enters(self, r, which):
+        """(W,) whether the gas enters the throats ``which`` (W,) at the radii of curvature
+        ``r`` (W,) [m]: the corner arcs leave it a section, and s A_gas >= gamma (L_gl +
+        cos(theta) L_gs) there."""
+        corner, radii, cosine = self.corner[which], self.radii[which], self.cosine
         count = len(r)
         # the arc of each side: its centre, contact angles on both grains, or none
         start = np.empty((count, 3))          # where each grain's gas boundary starts [rad]

@@ -101,7 +101,7 @@ OPTION_UNITS = {
     "skin_factor": "1", "max_strain": "1", "inertial_number": "1", "strain_rate": "1/s",
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
     "checkpoint_every": "1", "contact_angle": "deg", "surface_tension": "N/m",
-    "roughness": "1", "liquid": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
+    "roughness": "1", "liquid": "1", "entry_suction": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
     "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",

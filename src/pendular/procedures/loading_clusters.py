@@ -59,13 +59,14 @@ def refuse_clusters(config) -> str | None:
     return None
 
 
-def join_clusters(sim, bridges):
+def join_clusters(sim, bridges, entry):
     """LiquidClusters of the persisting suction-controlled ``bridges`` (already among
-    ``sim``'s forces), the pore units empty (a sample wetted from dry), appended to the forces
-    and set at the bridges' suction at ``sim``'s packing now."""
+    ``sim``'s forces), the pore units empty (a sample wetted from dry), their throats' entry
+    estimate ``entry`` (--entry-suction), appended to the forces and set at the bridges'
+    suction at ``sim``'s packing now."""
     from pendular.capillary.liquid_clusters import LiquidClusters   # a dry run never needs it
 
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces.append(clusters)
     clusters.set_suction(sim, bridges.suction)
     return clusters
@@ -84,11 +85,11 @@ def wetted_clusters(sim, clusters):
     return figures
 
 
-def wet_clusters_at_water_content(dry, bridges_config, target, settle):
+def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
     liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
     bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
-    contact angle), the pore units empty at first (liquid added to dry grains): the suction
+    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first (liquid added to dry grains): the suction
     found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
     sample run until static (``settle(sim)``, the steps), the suction found again at the
     packing reached and, where units are filled, the sample run until static once more.
@@ -112,7 +113,7 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle):
                               bridges_config.surface_tension)
     bridges = CapillaryBridges(start, bridges_config.surface_tension,
                                bridges_config.contact_angle, persist=True)
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces += [bridges, clusters]
     try:
         sim.evaluate_forces()
