@@ -89,13 +89,14 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
     liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
     bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
-    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first (liquid added to dry grains): the suction
-    found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
-    sample run until static (``settle(sim)``, the steps), the suction found again at the
-    packing reached and, where units are filled, the sample run until static once more.
-    Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
-    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at
-    contact cannot hold it within the pendular limit."""
+    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
+    (liquid added to dry grains): the suction found at the dry packing
+    (LiquidClusters.hold_volume; bridges at every contact), the sample run until static
+    (``settle(sim)``, the steps), the suction found again at the packing reached and, where
+    units are filled, the sample run until static once more. Report: the steps, the suction
+    found at the packing reached (``formation_suction_pa``) and the volume
+    (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot
+    hold it within the pendular limit."""
     from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
                                     sample_radius_ratios)
     from pendular.capillary.liquid_clusters import LiquidClusters
