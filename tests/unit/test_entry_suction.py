@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from pendular.capillary import pore_filling, pores
+from pendular.capillary import CapillaryBridges, pore_filling, pores
+from pendular.capillary.liquid_clusters import LiquidClusters
 
 RADIUS = 1.0e-4            # m
 GAMMA = 0.073              # N/m
@@ -186,3 +187,7 @@ def test_entry_estimates_in_the_filling_thresholds():
     assert (msp.filling <= msp.throat_entry[units.throat_of].min(axis=1)).all()
     with pytest.raises(ValueError, match="entry"):
         pore_filling.filling_thresholds(units, radius, GAMMA, entry="circle")
+    bridges = CapillaryBridges(2e4, GAMMA, 0.0, persist=True)
+    assert LiquidClusters(bridges, entry="mayer-stowe-princen").entry == "mayer-stowe-princen"
+    with pytest.raises(ValueError, match="inscribed, mayer-stowe-princen"):
+        LiquidClusters(bridges, entry="circle")
