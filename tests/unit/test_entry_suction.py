@@ -85,7 +85,7 @@ def test_closed_and_vectorised():
         entry(centres[1], radii[1], 90.0)
 
 
-def grid_balance(centres, radii, r, angle, pixels=1600, points=20000):
+def grid_balance(centres, radii, r, angle, pixels=1200, points=12000):
     """A_gas - r (L_gl + cos(theta) L_gs) counted on a grid: the gas is the triangle less the
     grains and the corners; a corner (c_i, t_i, t_j, c_j) holds what lies outside the grains
     and the arc of radius r meeting both grains at theta, where that arc has a neck."""
