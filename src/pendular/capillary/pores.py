@@ -23,6 +23,10 @@ it. Per unit, in SI units (positions and radii in m):
   face's plane tangent to the three grains' great circles (Apollonius' problem; the throat's
   inscribed circle), negative where the three grains close the throat.
 
+A throat's entry suction, the suction at which gas passes it: ``entry_suction`` through its
+inscribed circle, or ``mayer_stowe_princen_entry`` by the Mayer–Stowe–Princen balance over
+its section (ENTRY_ESTIMATES).
+
 The decomposition covers the convex hull of the centres; with walls, the strip between that
 hull and the walls belongs to no unit yet. In a periodic cell [0, L)^3 it covers the cell
 exactly, through the images of the grains (``period``).
