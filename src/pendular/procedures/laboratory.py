@@ -130,6 +130,8 @@ def parameters(config):
                                 (None if bridges.water_content is None else bridges.liquid)),
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
+        if config.liquid == "clusters":
+            flat["entry_suction"] = config.entry_suction
     return flat
 
 

@@ -55,13 +55,14 @@ def refuse_clusters(config) -> str | None:
     return None
 
 
-def join_clusters(sim, bridges):
+def join_clusters(sim, bridges, entry):
     """LiquidClusters of the persisting suction-controlled ``bridges`` (already among
-    ``sim``'s forces), the pore units empty (a sample wetted from dry), appended to the forces
-    and set at the bridges' suction at ``sim``'s packing now."""
+    ``sim``'s forces), the pore units empty (a sample wetted from dry), their throats' entry
+    estimate ``entry`` (--entry-suction), appended to the forces and set at the bridges'
+    suction at ``sim``'s packing now."""
     from pendular.capillary.liquid_clusters import LiquidClusters   # a dry run never needs it
 
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces.append(clusters)
     clusters.set_suction(sim, bridges.suction)
     return clusters
@@ -80,17 +81,18 @@ def wetted_clusters(sim, clusters):
     return figures
 
 
-def wet_clusters_at_water_content(dry, bridges_config, target, settle):
+def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
     liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
     bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
-    contact angle), the pore units empty at first (liquid added to dry grains): the suction
-    found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
-    sample run until static (``settle(sim)``, the steps), the suction found again at the
-    packing reached and, where units are filled, the sample run until static once more.
-    Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
-    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at
-    contact cannot hold it within the pendular limit."""
+    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
+    (liquid added to dry grains): the suction found at the dry packing
+    (LiquidClusters.hold_volume; bridges at every contact), the sample run until static
+    (``settle(sim)``, the steps), the suction found again at the packing reached and, where
+    units are filled, the sample run until static once more. Report: the steps, the suction
+    found at the packing reached (``formation_suction_pa``) and the volume
+    (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot
+    hold it within the pendular limit."""
     from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
                                     sample_radius_ratios)
     from pendular.capillary.liquid_clusters import LiquidClusters
@@ -108,7 +110,7 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle):
                               bridges_config.surface_tension)
     bridges = CapillaryBridges(start, bridges_config.surface_tension,
                                bridges_config.contact_angle, persist=True)
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces += [bridges, clusters]
     try:
         sim.evaluate_forces()
