@@ -1,8 +1,9 @@
 """An SWCC run stopped mid-path and a direct tension stopped mid-pull, pendular and with liquid
 clusters, and laboratory tests with liquid clusters (triaxial, simple shear) stopped
 mid-loading (deterministically, --stop-after) and continued with --resume write the
-uninterrupted run's files bit for bit (timings aside); a damaged or forged checkpoint, and a resume that would change the run's
-configuration, are refused in one line naming the file or the option."""
+uninterrupted run's files bit for bit (timings aside); a damaged or forged checkpoint, and a
+resume that would change the run's configuration, are refused in one line naming the file or
+the option."""
 
 import copy
 import json

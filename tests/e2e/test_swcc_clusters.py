@@ -43,8 +43,26 @@ def test_swcc_with_clusters_dries_from_saturation_and_wets_back(tmp_path):
     assert len(list((out / "pores").glob("pores_*.vtu"))) == 5       # the turning point apart
 
 
+def test_the_mayer_stowe_princen_entry_drains_sooner(tmp_path):
+    """Its throats' entry suctions lie below the inscribed ones (water, theta = 0), so the
+    drying from saturation holds fewer units at 20 kPa; the choice is in the configuration."""
+    filled = {}
+    for entry in ("inscribed", "mayer-stowe-princen"):
+        out = tmp_path / entry
+        assert run_command("swcc", [*SMALL, "--suctions", "3000,20000,300000", "--liquid",
+                                    "clusters", "--entry-suction", entry, "--out", str(out)],
+                           prog="swcc.py") == 0
+        result = json.loads((out / "swcc.json").read_text())
+        assert result["config"]["fields"]["entry_suction"] == entry
+        filled[entry] = result["drying"][1]["filled_units"]
+    assert filled["mayer-stowe-princen"] < filled["inscribed"]
+
+
 @pytest.mark.parametrize("argv, words", [
     (["--liquid", "drops"], ["--liquid", "pendular", "clusters"]),
+    (["--liquid", "clusters", "--entry-suction", "circle"],
+     ["--entry-suction", "inscribed", "mayer-stowe-princen"]),
+    (["--entry-suction", "mayer-stowe-princen"], ["--entry-suction", "--liquid clusters"]),
 ])
 def test_bad_cluster_settings_are_refused(argv, words, tmp_path, capsys):
     with pytest.raises(SystemExit) as stop:

@@ -46,7 +46,7 @@ GENERATED = {"particles", "confining", "seed", "periodic", "radius", "radius_spr
              "timestep_safety",
              "timestep_rule", "skin_factor", "sample", "contact_angle", "bridges",
              "surface_tension", "rupture_liquid", "wall_bridges", "wetting", "liquid",
-             "persist_bridges",
+             "entry_suction", "persist_bridges",
              "wet_steps",
              "table_resolution", "max_strain", "direction", "b", "constant_p", "drainage",
              "inertial_number", "strain_rate", "records", "vtk_every", "vtk_frames",
@@ -70,10 +70,10 @@ OWN_GENERATED = {
     "tension": {"roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
                 "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "vtk_frames",
                 "vtk_every", "checkpoint_every", "particles", "confining", "friction",
-                "young", "seed", "periodic", "liquid"} | SIZES,
+                "young", "seed", "periodic", "liquid", "entry_suction"} | SIZES,
     "swcc": {"particles", "confining", "suctions", "contact_angle", "surface_tension",
              "form_gap", "stage_steps", "record_every", "friction", "prep_friction",
-             "seed", "checkpoint_every", "liquid"} | SIZES,
+             "seed", "checkpoint_every", "liquid", "entry_suction"} | SIZES,
 }
 #: Options whose default is the command's own, not its field's (the field's otherwise).
 COMMAND_DEFAULTS = {("tension", "particles"), ("tension", "confining"), ("swcc", "particles"),

@@ -89,43 +89,6 @@ def test_lens_volume_closed_forms():
     assert pores.lens_volume(0.5 * r, r, 3 * r) == pytest.approx(4 / 3 * math.pi * r ** 3)
 
 
-@pytest.mark.parametrize("radii", [(1.0, 1.0, 1.0), (1.0, 2.0, 3.0), (0.5, 1.0, 2.5)])
-def test_throat_radius_of_touching_spheres_follows_descartes(radii):
-    """Three mutually touching circles: Descartes, k4 = k1 + k2 + k3 + 2 sqrt(k1 k2 + k2 k3 +
-    k3 k1)."""
-    r1, r2, r3 = (RADIUS * x for x in radii)
-    # triangle of the centres from its sides r1 + r2, r1 + r3, r2 + r3
-    a, b = r1 + r2, r1 + r3
-    c = r2 + r3
-    x3 = (a * a + b * b - c * c) / (2 * a)
-    centres = np.array([[0, 0, 0], [a, 0, 0], [x3, math.sqrt(b * b - x3 * x3), 0]])
-    k = [1 / r1, 1 / r2, 1 / r3]
-    descartes = 1 / (sum(k) + 2 * math.sqrt(k[0] * k[1] + k[1] * k[2] + k[2] * k[0]))
-    radius = pores.throat_radius(centres[None], np.array([[r1, r2, r3]]))[0]
-    assert radius == pytest.approx(descartes, rel=1e-12)
-
-
-def test_throat_radius_of_a_gap_and_a_closed_throat():
-    # equilateral triangle of side d: the circle through the centre, radius d / sqrt 3 - R
-    for side, expected in ((2.4 * RADIUS, 2.4 * RADIUS / math.sqrt(3) - RADIUS),
-                           (1.6 * RADIUS, 1.6 * RADIUS / math.sqrt(3) - RADIUS)):
-        centres = np.array([[0, 0, 0], [side, 0, 0], [side / 2, side * math.sqrt(3) / 2, 0]])
-        radius = pores.throat_radius(centres[None], np.full((1, 3), RADIUS))[0]
-        assert radius == pytest.approx(expected, rel=1e-12)
-    assert expected < 0  # three overlapping grains close the throat
-    assert pores.entry_suction(expected, 0.072) == math.inf
-
-
-def test_entry_suction_is_young_laplace_through_the_inscribed_circle():
-    r = RADIUS * (2 / math.sqrt(3) - 1)
-    assert pores.entry_suction(r, 0.072) == pytest.approx(2 * 0.072 / r, rel=1e-14)
-    assert pores.entry_suction(r, 0.072, 60.0) == pytest.approx(0.072 / r, rel=1e-12)
-    with pytest.raises(ValueError, match=r"contact_angle = 95.0 deg is outside the valid range"):
-        pores.entry_suction(r, 0.072, 95.0)
-    with pytest.raises(ValueError, match="surface_tension"):
-        pores.entry_suction(r, -1.0)
-
-
 def lattice(kind, cells, spacing):
     """Centres of a simple cubic or face-centred cubic lattice of ``cells``^3 cubes of side
     ``spacing``, shifted off the cell's faces."""

@@ -25,7 +25,8 @@ from pendular.capillary.clusters import Clusters, find_clusters
 from pendular.capillary.bridges import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_ROUGHNESS,
     SURFACE_TENSION, CapillaryBridges, SuctionBridges, VolumeBridges)
 from pendular.capillary.meniscus import Bridge, solve_bridge
-from pendular.capillary.pores import PoreUnits, decompose, entry_suction
+from pendular.capillary.pores import PoreUnits, decompose
+from pendular.capillary.throats import entry_suction
 from pendular.capillary.radius_ratios import sample_radius_ratios, table_radius_ratios
 from pendular.capillary.suction_control import (bridge_at_distance, lowest_distance,
     rupture_distance)

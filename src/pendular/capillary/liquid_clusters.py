@@ -40,6 +40,7 @@ from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
     liquid_account, unit_edges)
 from pendular.capillary.pores import (PoreUnits, decompose, into_cell, nearest_images,
     search_rows)
+from pendular.capillary.throats import check_entry_estimate
 from pendular.dem.cell import pair_virial
 from pendular.dem.neighbors import branch_vectors, gather_pair_forces
 from pendular.dem.protocols import state_array
@@ -48,14 +49,16 @@ from pendular.dem.protocols import state_array
 class LiquidClusters:
     """Liquid clusters beside persisting suction-controlled ``bridges`` (module docstring).
     ``saturated``: the pore units start filled (a sample drying from saturation) or empty
-    (bridges alone, a sample wetted from dry)."""
+    (bridges alone, a sample wetted from dry). ``entry``: the throats' entry estimate, one of
+    pendular.capillary.throats.ENTRY_ESTIMATES (pore_filling.filling_thresholds)."""
 
-    def __init__(self, bridges, saturated=True):
+    def __init__(self, bridges, saturated=True, entry="inscribed"):
         if bridges.control != "suction" or not bridges.persist:
             raise ValueError("liquid = 'clusters' needs suction-controlled bridges that persist "
                              "across gaps (control = 'suction', persist = True)")
         self.bridges = bridges
         self.saturated = bool(saturated)
+        self.entry = check_entry_estimate(entry)
         self.suction = None
         self.units = None
         self.filled = None
@@ -102,7 +105,7 @@ class LiquidClusters:
             raise ValueError(f"suction = {suction!r}: a suction > 0 [Pa] or None expected")
         saturated = bool(state["saturated"])
         if state["units"] is None:
-            self.__init__(self.bridges, saturated)
+            self.__init__(self.bridges, saturated, self.entry)     # the scene's entry kept
             self.suction = suction
             return
         if suction is None:
@@ -115,7 +118,7 @@ class LiquidClusters:
         filled = state_array(state, "filled", bool, (units.count,))
         vertices = state_array(state, "vertices", np.float64, (units.count, 4, 3))
         liquid = None if state["liquid"] is None else _liquid_of(state["liquid"], filled)
-        self.__init__(self.bridges, saturated)
+        self.__init__(self.bridges, saturated, self.entry)
         self.units, self.filled, self.suction, self.liquid = units, filled, suction, liquid
         self._radius, self._vertices = radius, vertices
         self._edges = unit_edges(units)
@@ -182,7 +185,7 @@ class LiquidClusters:
         else:
             carried = _carry(units.grains, previous)
         thresholds = filling_thresholds(units, particles.radius, self.bridges.surface_tension,
-                                        self.bridges.contact_angle)
+                                        self.bridges.contact_angle, self.entry)
         return units, thresholds, carried
 
     def _set_state(self, sim, units, filled, suction, edges=None):

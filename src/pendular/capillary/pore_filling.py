@@ -11,8 +11,9 @@ Lenormand, Zarcone & Sarr 1983):
   at the one suction s [Pa] (imposed, or found from the liquid volume);
 - **drainage** (Haines jump): a filled unit empties when one of its throats opens onto gas (an
   empty unit, or the hull of the centres where the gas outside enters) and s exceeds that
-  throat's entry suction 2 gamma cos(theta) / r_t (r_t its inscribed circle, ``entry_suction``
-  of pendular.capillary.pores). Invasion goes on from the units it empties;
+  throat's entry suction: 2 gamma cos(theta) / r_t (r_t its inscribed circle, ``entry_suction``
+  of pendular.capillary.pores), or the Mayer–Stowe–Princen balance over the throat's section
+  (``mayer_stowe_princen_entry``). Invasion goes on from the units it empties;
 - **imbibition** (pore filling): an empty unit fills when s falls to its filling suction
   2 gamma cos(theta) / r_b, r_b the radius of the pore body: the sphere tangent to its four
   grains where that sphere's centre lies inside the unit, and never less than its largest
@@ -31,7 +32,9 @@ from functools import cached_property
 
 import numpy as np
 
-from pendular.capillary.pores import EDGES, dihedral_angles, entry_suction
+from pendular.capillary.pores import EDGES, FACES, dihedral_angles
+from pendular.capillary.throats import (check_entry_estimate, entry_suction,
+    mayer_stowe_princen_entry)
 
 
 def pore_body_radius(vertices, radii):
@@ -91,16 +94,28 @@ class FillingThresholds:
     filling: np.ndarray
 
 
-def filling_thresholds(pore_units, radius, surface_tension, contact_angle=0.0):
+def filling_thresholds(pore_units, radius, surface_tension, contact_angle=0.0,
+                       entry="inscribed"):
     """FillingThresholds of ``pore_units`` with grains of ``radius`` (N,) [m]
-    (``surface_tension`` [N/m], ``contact_angle`` [deg]; module docstring)."""
+    (``surface_tension`` [N/m], ``contact_angle`` [deg]; module docstring). ``entry``, one of
+    ENTRY_ESTIMATES: the throats' entry suctions through their inscribed circles
+    (``entry_suction``) or by the Mayer–Stowe–Princen balance over their sections
+    (``mayer_stowe_princen_entry``, taken on the first unit's side of each throat)."""
+    check_entry_estimate(entry)
     radii = radius[pore_units.grains]
     throat = np.full(len(pore_units.throat_units), -np.inf)
     np.maximum.at(throat, pore_units.throat_of.ravel(), pore_units.throat_radius.ravel())
     body = pore_body_radius(pore_units.vertices, radii)
     finite = np.where(np.isfinite(pore_units.throat_radius), pore_units.throat_radius, np.nan)
     body = np.fmax(body, np.nanmax(finite, axis=1))
-    entry = entry_suction(throat, surface_tension, contact_angle)
+    if entry == "inscribed":
+        entry = entry_suction(throat, surface_tension, contact_angle)
+    else:
+        _, side = np.unique(pore_units.throat_of.ravel(), return_index=True)
+        unit, face = np.divmod(side, 4)
+        entry = mayer_stowe_princen_entry(pore_units.vertices[unit[:, None], FACES[face]],
+                                          radii[unit[:, None], FACES[face]], surface_tension,
+                                          contact_angle)
     filling = np.minimum(entry_suction(body, surface_tension, contact_angle),
                          entry[pore_units.throat_of].min(axis=1))
     return FillingThresholds(throat_entry=entry, filling=filling)

@@ -23,6 +23,9 @@ it. Per unit, in SI units (positions and radii in m):
   face's plane tangent to the three grains' great circles (Apollonius' problem; the throat's
   inscribed circle), negative where the three grains close the throat.
 
+A throat's radius and entry suction, the suction at which gas passes it, are
+pendular.capillary.throats's.
+
 The decomposition covers the convex hull of the centres; with walls, the strip between that
 hull and the walls belongs to no unit yet. In a periodic cell [0, L)^3 it covers the cell
 exactly, through the images of the grains (``period``). A sheared cell (Lees–Edwards,
@@ -32,13 +35,12 @@ space with those images, so the triangulation of the grains' images is cut as th
 each unit once, the one whose centroid lies in the box.
 """
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import Delaunay, cKDTree
 
-from pendular.capillary.validation import check_contact_angle
+from pendular.capillary.throats import throat_radius
 from pendular.utils.validate import check_array, check_range
 
 #: The six edges of a tetrahedron as vertex pairs (a, b), and the other two vertices (c, d).
@@ -202,52 +204,6 @@ def lens_volume(distance, radius1, radius2):
     inside = d <= np.abs(r1 - r2)
     smaller = 4.0 / 3.0 * np.pi * np.minimum(r1, r2) ** 3
     return np.where(d >= r1 + r2, 0.0, np.where(inside, smaller, lens))
-
-
-def throat_radius(centres, radii):
-    """(..., ) [m] radius of the circle in the plane of three sphere centres ``centres`` (..., 3,
-    3) [m] tangent to the three great circles of radii ``radii`` (..., 3) [m] from outside
-    (Apollonius' problem): the inscribed circle of the throat between three grains, R (2/sqrt 3
-    - 1) for three touching equal spheres. Negative where the three grains close the throat.
-
-    With p the circle's centre and r its radius, |p - c_i| = R_i + r; differences of two of
-    these are linear in p, which leaves a quadratic in r. Of its roots with R_i + r >= 0 for
-    all i (a circle outside every grain) the smaller is the throat."""
-    c1, c2, c3 = centres[..., 0, :], centres[..., 1, :], centres[..., 2, :]
-    r1, r2, r3 = radii[..., 0], radii[..., 1], radii[..., 2]
-    u = c2 - c1
-    d12 = np.linalg.norm(u, axis=-1)
-    e1 = u / d12[..., None]
-    w = c3 - c1
-    x3 = np.sum(w * e1, axis=-1)
-    y3 = np.linalg.norm(w - x3[..., None] * e1, axis=-1)
-    # x = ax + bx r, y = ay + by r in the face's frame (c1 at the origin, c2 on the x axis)
-    ax = (d12 ** 2 - r2 ** 2 + r1 ** 2) / (2 * d12)
-    bx = -(r2 - r1) / d12
-    ay = (x3 ** 2 + y3 ** 2 - r3 ** 2 + r1 ** 2 - 2 * x3 * ax) / (2 * y3)
-    by = (-(r3 - r1) - x3 * bx) / y3
-    qa = bx ** 2 + by ** 2 - 1.0
-    qb = ax * bx + ay * by - r1
-    qc = ax ** 2 + ay ** 2 - r1 ** 2
-    root = np.sqrt(np.maximum(qb * qb - qa * qc, 0.0))
-    q = -(qb + np.copysign(root, qb))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        roots = np.stack([q / qa, qc / q])
-    lowest = -np.minimum(np.minimum(r1, r2), r3)
-    valid = np.isfinite(roots) & (roots >= lowest - 1e-12 * np.abs(lowest))
-    return np.where(valid, roots, np.inf).min(axis=0)
-
-
-def entry_suction(throat_radius, surface_tension, contact_angle=0.0):
-    """[Pa] suction at which a meniscus passes a throat of inscribed radius ``throat_radius``
-    [m]: Young–Laplace for a spherical cap through the inscribed circle, 2 gamma cos(theta) / r
-    (``surface_tension`` gamma [N/m], ``contact_angle`` theta [deg]); inf for a closed throat."""
-    gamma = check_range("surface_tension", surface_tension, 0.0, math.inf, low_inclusive=False,
-                        unit="N/m")
-    theta = check_contact_angle(contact_angle)
-    r = np.asarray(throat_radius, dtype=float)
-    with np.errstate(divide="ignore"):
-        return np.where(r > 0, 2.0 * gamma * math.cos(math.radians(theta)) / r, np.inf)
 
 
 def beyond_face_volume(apex, radius, triangle):

@@ -102,6 +102,7 @@ OPTION_UNITS = {
     "records": "1", "suction": "Pa", "wet_steps": "1", "vtk_every": "1",
     "checkpoint_every": "1", "contact_angle": "deg", "surface_tension": "N/m",
     "roughness": "1", "liquid": "1", "specific_gravity": "1", "residual": "1", "grip_depth": "1",
+    "entry_suction": "1",
     "void_ratio_tolerance": "1", "vtk_frames": "1", "timestep": "s",
     "saturation_at_20_percent": "1", "water_content_percent": "%",
     "b": "1", "axial_stress": "Pa", "stresses": "Pa", "stage_steps": "1",

@@ -20,6 +20,7 @@ import numpy as np
 
 from pendular.capillary import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_CONTACT_ANGLE,
     MAX_ROUGHNESS, SURFACE_TENSION)
+from pendular.capillary.throats import ENTRY_ESTIMATES
 from pendular.dem.sample import load_sample
 from pendular.procedures.loading_clusters import refuse_clusters
 from pendular.dem.walls import ConstantStrainRate
@@ -108,6 +109,25 @@ def liquid_parameter(where):
     return parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
                      help="liquid regime: pendular bridges alone, or clusters of filled pore "
                           f"units beside them ({where}; docs/liquid_clusters.md)")
+
+
+def entry_suction_parameter():
+    """The field of the liquid clusters' throat entry estimate (``--entry-suction``,
+    pendular.capillary.throats.ENTRY_ESTIMATES): the inscribed circle's (default) or the
+    Mayer–Stowe–Princen balance over the throat's section (docs/liquid_clusters.md)."""
+    return parameter("inscribed", kind=str, choices=ENTRY_ESTIMATES, flag="--entry-suction",
+                     help="with --liquid clusters, the suction at which gas enters a throat: "
+                          "through its inscribed circle, or by the Mayer-Stowe-Princen "
+                          "balance over its section (lower for wetting liquids; "
+                          "docs/liquid_clusters.md)")
+
+
+def refuse_entry_suction(config):
+    """ParameterError naming --entry-suction where ``config`` sets it without liquid
+    clusters (a configuration with ``liquid`` and ``entry_suction`` fields)."""
+    if config.entry_suction != "inscribed" and config.liquid != "clusters":
+        raise fail(config, "entry_suction", f"entry_suction = {config.entry_suction!r} needs "
+                   "liquid clusters (--liquid clusters): the pendular bridges have no throats")
 
 
 def strain_rate_parameter():
@@ -372,6 +392,7 @@ class LaboratoryConfig:
     liquid: str = liquid_parameter("the sample wetted from dry at --suction or "
                                    "--water-content, the pore units updated as the packing "
                                    "deforms")
+    entry_suction: str = entry_suction_parameter()
 
     #: The test in words, for errors ("a triaxial test").
     TEST = "a laboratory test"
@@ -408,6 +429,7 @@ class LaboratoryConfig:
                                             or self.bridges.water_content is not None):
             raise fail(self, "wetting", f"wetting = {self.wetting!r} needs a wet test at a "
                        "suction (--suction > 0)")
+        refuse_entry_suction(self)
         if self.liquid == "clusters":
             refused = refuse_clusters(self)
             if refused is not None:

@@ -76,15 +76,16 @@ def equilibrium_status(unbalanced):
 
 
 def wet(sim, bridges, *, unbalanced=0.01, tolerance=0.01, max_steps=200000, progress=None,
-        clusters=False):
+        cluster_entry=None):
     """Add the capillary operation ``bridges`` to the forces of a static sample and run until
     static again; returns the wetting report (steps, time, Sr, bridges, porosity). With
-    ``clusters``, liquid clusters join the bridges (pendular.procedures.loading_clusters
-    .join_clusters: set before the equilibrium, then again at the packing it reaches, which
-    is run until static once more where units are filled)."""
+    ``cluster_entry``, a throat entry estimate (--entry-suction), liquid clusters join the
+    bridges (pendular.procedures.loading_clusters.join_clusters: set before the
+    equilibrium, then again at the packing it reaches, which is run until static once more
+    where units are filled)."""
     sim.forces.append(bridges)
     started = time.perf_counter()
-    joined = join_clusters(sim, bridges) if clusters else None
+    joined = join_clusters(sim, bridges, cluster_entry) if cluster_entry else None
     steps = equilibrate(sim, unbalanced=unbalanced, tolerance=tolerance, max_steps=max_steps,
                         progress=progress, phase="equilibrium after wetting")
     if joined is not None:          # the units of the packing reached, in equilibrium again
@@ -147,23 +148,23 @@ def wet_sample(sim, config, *, progress=None):
             return _wet_clusters_at_water_content(sim, config, thresholds, progress)
         return _wet_at_water_content(sim, config, thresholds, progress)
     bridges = config.bridges.build()
-    clusters = config.liquid == "clusters"
+    cluster_entry = config.entry_suction if config.liquid == "clusters" else None
     if config.wetting == "isotropic":
-        report = wet(sim, bridges, progress=progress, clusters=clusters, **thresholds)
+        report = wet(sim, bridges, progress=progress, cluster_entry=cluster_entry, **thresholds)
     else:
-        report = _wet_by_protocol(sim, config, bridges, thresholds, progress, clusters)
+        report = _wet_by_protocol(sim, config, bridges, thresholds, progress, cluster_entry)
     if config.undrained:                # the water cannot leave during the shear
         bridges.close_liquid(sim, config.bridges.liquid)
         report["liquid_initial"] = bridges.liquid_initial
     return sim, bridges, report
 
 
-def _wet_by_protocol(sim, config, bridges, thresholds, progress, clusters=False):
+def _wet_by_protocol(sim, config, bridges, thresholds, progress, cluster_entry=None):
     """The wetting report of wet_sample's 'at-shear' and 'constant-volume' protocols (with
-    ``clusters``, liquid clusters beside the bridges, as ``wet``)."""
+    ``cluster_entry``, liquid clusters beside the bridges, as ``wet``)."""
     started = time.perf_counter()
     sim.forces.append(bridges)
-    joined = join_clusters(sim, bridges) if clusters else None
+    joined = join_clusters(sim, bridges, cluster_entry) if cluster_entry else None
     steps = 0
     if config.wetting == "at-shear":
         sim.evaluate_forces()               # the bridges form at the sample's contacts
@@ -235,7 +236,7 @@ def _wet_clusters_at_water_content(sim, config, thresholds, progress):
     bridges, clusters, details = wet_clusters_at_water_content(
         sim, config.bridges, target,
         lambda s: equilibrate(s, progress=progress, phase="equilibrium after wetting",
-                              **thresholds))
+                              **thresholds), config.entry_suction)
     steps = details.pop("wetting_steps")
     water_content = gravimetric_water_content(clusters.account(sim).total,
                                               particles.solid_volume(), specific_gravity)

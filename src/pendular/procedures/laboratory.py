@@ -131,6 +131,8 @@ def parameters(config):
                                 (None if bridges.water_content is None else bridges.liquid)),
                      "table_resolution": (None if bridges.table_resolution is None else
                                           ",".join(map(str, bridges.table_resolution)))})
+        if config.liquid == "clusters":
+            flat["entry_suction"] = config.entry_suction
     return flat
 
 
@@ -327,7 +329,7 @@ class LaboratoryTest:
             suction = (before_shear["wetting"].get("formation_suction_pa")
                        if config.bridges is not None else None)
             if config.liquid == "clusters":
-                rejoin_clusters(sim, config.bridges, suction)
+                rejoin_clusters(sim, config.bridges, suction, config.entry_suction)
             elif config.bridges is not None:
                 sim.forces.append(config.bridges.build(suction, closed=True))
             identity = run_identity(config, sample_file)

@@ -62,13 +62,14 @@ def refuse_clusters_device(config, device: str) -> None:
                          f"--device {device} does not apply")
 
 
-def join_clusters(sim, bridges):
+def join_clusters(sim, bridges, entry):
     """LiquidClusters of the persisting suction-controlled ``bridges`` (already among
-    ``sim``'s forces), the pore units empty (a sample wetted from dry), appended to the forces
-    and set at the bridges' suction at ``sim``'s packing now."""
+    ``sim``'s forces), the pore units empty (a sample wetted from dry), their throats' entry
+    estimate ``entry`` (--entry-suction), appended to the forces and set at the bridges'
+    suction at ``sim``'s packing now."""
     from pendular.capillary.liquid_clusters import LiquidClusters   # a dry run never needs it
 
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces.append(clusters)
     clusters.set_suction(sim, bridges.suction)
     return clusters
@@ -87,17 +88,17 @@ def cluster_bridges(bridges_config, suction=None):
                             bridges_config.contact_angle, persist=True)
 
 
-def rejoin_clusters(sim, bridges_config, suction):
-    """The LiquidClusters of a resumed loading, appended to ``sim``'s forces after their
-    bridges (``cluster_bridges`` of ``bridges_config`` at the wetting's formation ``suction``
-    [Pa], None at a suction) as the wetting appended them; the checkpoint then gives both
-    their state. Until then the clusters stand at the bridges' suction at ``sim``'s packing
-    (the sample's), which the loading path's first record reads before the checkpoint
-    replaces it and that record."""
+def rejoin_clusters(sim, bridges_config, suction, entry):
+    """The LiquidClusters of a resumed loading (their throats' entry estimate ``entry``),
+    appended to ``sim``'s forces after their bridges (``cluster_bridges`` of
+    ``bridges_config`` at the wetting's formation ``suction`` [Pa], None at a suction) as the
+    wetting appended them; the checkpoint then gives both their state. Until then the
+    clusters stand at the bridges' suction at ``sim``'s packing (the sample's), which the
+    loading path's first record reads before the checkpoint replaces it and that record."""
     from pendular.capillary.liquid_clusters import LiquidClusters
 
     bridges = cluster_bridges(bridges_config, suction)
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces += [bridges, clusters]
     clusters.set_suction(sim, bridges.suction)
     return clusters
@@ -116,17 +117,18 @@ def wetted_clusters(sim, clusters):
     return figures
 
 
-def wet_clusters_at_water_content(dry, bridges_config, target, settle):
+def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
     liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
     bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
-    contact angle), the pore units empty at first (liquid added to dry grains): the suction
-    found at the dry packing (LiquidClusters.hold_volume; bridges at every contact), the
-    sample run until static (``settle(sim)``, the steps), the suction found again at the
-    packing reached and, where units are filled, the sample run until static once more.
-    Report: the steps, the suction found at the packing reached (``formation_suction_pa``)
-    and the volume (``liquid_initial``). ValueError naming --water-content where bridges at
-    contact cannot hold it within the pendular limit."""
+    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
+    (liquid added to dry grains): the suction found at the dry packing
+    (LiquidClusters.hold_volume; bridges at every contact), the sample run until static
+    (``settle(sim)``, the steps), the suction found again at the packing reached and, where
+    units are filled, the sample run until static once more. Report: the steps, the suction
+    found at the packing reached (``formation_suction_pa``) and the volume
+    (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot
+    hold it within the pendular limit."""
     from pendular.capillary import BridgeTable, formation_suction, sample_radius_ratios
     from pendular.capillary.liquid_clusters import LiquidClusters
     from pendular.capillary.validation import NotPendular
@@ -142,7 +144,7 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle):
                               particles.radius[sim.contacts.pair_j[touching]], target,
                               bridges_config.surface_tension)
     bridges = cluster_bridges(bridges_config, start)
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces += [bridges, clusters]
     try:
         sim.evaluate_forces()

@@ -95,6 +95,7 @@ BRIDGES = options_named(BridgeConfig, ("contact_angle", "model", "surface_tensio
 WETTING = ((option_from(SUCTION, 0.0, checked=True),) + BRIDGES[:3]
            + (option_from(WATER_CONTENT, None, checked=True), *BRIDGES[3:],
               option_of(LaboratoryConfig, "wetting"), option_of(LaboratoryConfig, "liquid"),
+              option_of(LaboratoryConfig, "entry_suction"),
               option_of(BridgeConfig, "persist"),
               option_of(LaboratoryConfig, "wet_steps"),
               option_of(BridgeConfig, "table_resolution", metavar="NS,ND",
@@ -226,7 +227,7 @@ def laboratory_fields(values, given, path):
     return {"sample": sample, "bridges": bridges, "sample_path": values["sample"],
             "wet_steps": values["wet_steps"], "vtk_every": values["vtk_every"],
             "checkpoint_every": values["checkpoint_every"], "wetting": values["wetting"],
-            "liquid": values["liquid"],
+            "liquid": values["liquid"], "entry_suction": values["entry_suction"],
             **own}
 
 

@@ -72,7 +72,8 @@ from pendular.procedures.columns import history_columns
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (AVERAGES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
     check_loaded_confining, check_particles, config_from_dict, config_to_dict,
-    contact_angle_parameter, liquid_parameter, registered, stage_steps_parameter)
+    contact_angle_parameter, entry_suction_parameter, liquid_parameter, refuse_entry_suction,
+    registered, stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
@@ -104,7 +105,9 @@ class SwccConfig:
     form_gap: at wetting, bridges also form across gaps up to form_gap mean radii (0: at
     contacts only); stage_steps: most steps per stage to reach equilibrium; record_every: steps
     between history records; liquid: the liquid regime, "pendular" (bridges alone) or
-    "clusters" (filled pore units beside them: pendular.capillary.liquid_clusters).
+    "clusters" (filled pore units beside them: pendular.capillary.liquid_clusters);
+    entry_suction: the clusters' throat entry estimate, "inscribed" or "mayer-stowe-princen"
+    (pendular.capillary.throats.ENTRY_ESTIMATES).
     """
 
     sample: PrepareConfig = field(default_factory=PrepareConfig)
@@ -124,6 +127,7 @@ class SwccConfig:
     record_every: int = parameter(1000, kind=int, low=1, flag="--record-every",
                                   help="steps between history records")
     liquid: str = liquid_parameter("drying from saturation")
+    entry_suction: str = entry_suction_parameter()
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -131,6 +135,7 @@ class SwccConfig:
         check_particles(self.sample.particles, MIN_SAMPLE_PARTICLES, MAX_PARTICLES, "an SWCC",
                         AVERAGES)
         validate(self)
+        refuse_entry_suction(self)
         if len(self.suctions) < 2 or any(b <= a for a, b in zip(self.suctions,
                                                                    self.suctions[1:])):
             raise fail(self, "suctions", f"suctions = "
@@ -310,7 +315,7 @@ class SwccPath:
         sim.forces.append(bridges)
         self.clusters = None
         if config.liquid == "clusters":          # the pore space starts full: main drying
-            self.clusters = LiquidClusters(bridges, saturated=True)
+            self.clusters = LiquidClusters(bridges, saturated=True, entry=config.entry_suction)
             sim.forces.append(self.clusters)
         axial = ConstantStrainRate("z", 0.0, sim.walls.lengths()[2])   # measures the strain
         columns = history_columns(sim, axial, self.dry_volume, bridges)   # clusters' too
@@ -505,7 +510,8 @@ SWCC_SAMPLE = (option_of(PrepareConfig, "particles", default=1000, low=MIN_SAMPL
                option_of(PrepareConfig, "confining"))
 
 SWCC_OWN = options_named(SwccConfig, ("suctions", "contact_angle", "surface_tension",
-                                       "form_gap", "stage_steps", "record_every", "liquid"))
+                                       "form_gap", "stage_steps", "record_every", "liquid",
+                                       "entry_suction"))
 
 SWCC_MATERIAL = options_named(PrepareConfig, ("friction_deg", "prep_friction_deg", "seed"))
 

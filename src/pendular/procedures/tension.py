@@ -73,7 +73,8 @@ from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
     check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
-    inertial_number, liquid_parameter, registered)
+    entry_suction_parameter, inertial_number, liquid_parameter, refuse_entry_suction,
+    registered)
 from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
@@ -248,6 +249,7 @@ class TensionConfig:
                                       help="steps between ParaView frames of the pull, instead "
                                            "of --vtk-frames (0: none)")
     liquid: str = liquid_parameter("at the suction that holds the water; --roughness 0")
+    entry_suction: str = entry_suction_parameter()
 
     def __post_init__(self):
         if not isinstance(self.sample, PrepareConfig):
@@ -274,6 +276,7 @@ class TensionConfig:
                        "to --periodic: a periodic cell has no walls, so no grips")
         if refuse_clusters(self) is not None:
             raise fail(self, "liquid", refuse_clusters(self))
+        refuse_entry_suction(self)
         steps = self.pull_steps()
         for name in ("vtk_frames", "vtk_every"):
             if getattr(self, name) is not None:
@@ -310,7 +313,8 @@ class TensionConfig:
                 "residual": self.residual, "grip_depth": self.grip_depth,
                 "void_ratio_tolerance": self.void_ratio_tolerance,
                 "vtk_frames": self.vtk_frames, "vtk_every": self.vtk_every,
-                "seed": sample.seed, "periodic": sample.periodic, "liquid": self.liquid}
+                "seed": sample.seed, "periodic": sample.periodic, "liquid": self.liquid,
+                **({"entry_suction": self.entry_suction} if self.liquid == "clusters" else {})}
 
     def pull_steps(self):
         """Steps of a pull to max_strain estimated before anything runs [-]: max_strain over
@@ -628,7 +632,7 @@ TENSION_WATER_CONTENT = option_from(dataclasses.replace(
 #: A direct tension's own fields set by their options as they are.
 TENSION_OWN = {name: option_of(TensionConfig, name) for name in (
     "roughness", "form_gap", "contact_angle", "surface_tension", "inertial_number",
-    "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "liquid")}
+    "max_strain", "residual", "grip_depth", "void_ratio_tolerance", "liquid", "entry_suction")}
 
 
 TENSION_FRAMES = (dataclasses.replace(option_of(TensionConfig, "vtk_frames"), group="frames"),
@@ -645,7 +649,7 @@ TENSION = ((TENSION_VOID_RATIO, TENSION_OWN["roughness"], TENSION_WATER_CONTENT,
               TENSION_SAMPLE_OPTIONS["young"])
            + tuple(TENSION_OWN[name] for name in ("inertial_number", "max_strain", "residual",
                                                   "grip_depth", "void_ratio_tolerance",
-                                                  "liquid"))
+                                                  "liquid", "entry_suction"))
            + TENSION_FRAMES + (CHECKPOINT_EVERY, TENSION_SAMPLE_OPTIONS["seed"],
                                TENSION_SAMPLE_OPTIONS["periodic"]))
 

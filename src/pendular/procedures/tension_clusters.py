@@ -84,7 +84,7 @@ def wet_clusters(dry, config, water_content: float, pairs, settle):
     sim = copy.deepcopy(dry)
     bridges = CapillaryBridges(start, config.surface_tension, config.contact_angle,
                                persist=True)
-    clusters = LiquidClusters(bridges, saturated=False)
+    clusters = LiquidClusters(bridges, saturated=False, entry=config.entry_suction)
     sim.forces += [bridges, clusters]
     try:
         sim.evaluate_forces()
