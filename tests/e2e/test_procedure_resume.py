@@ -1,8 +1,11 @@
-"""An SWCC run stopped mid-path and a direct tension stopped mid-pull (deterministically,
---stop-after) and continued with --resume write the uninterrupted run's files bit for bit
-(timings aside); a damaged or forged checkpoint, and a resume that would change the run's
-configuration, are refused in one line naming the file or the option."""
+"""An SWCC run stopped mid-path and a direct tension stopped mid-pull, pendular and with liquid
+clusters, and laboratory tests with liquid clusters (triaxial, simple shear) stopped
+mid-loading (deterministically, --stop-after) and continued with --resume write the
+uninterrupted run's files bit for bit (timings aside); a damaged or forged checkpoint, and a
+resume that would change the run's configuration, are refused in one line naming the file or
+the option."""
 
+import copy
 import json
 import os
 import shutil
@@ -13,6 +16,8 @@ import pytest
 
 from conftest import refused, run_in_process, zero_bytes
 from pendular.cli import run_command
+from pendular.procedures import laboratory, tension as tension_module
+from pendular.procedures.tension_clusters import update_period
 from pendular.utils.integrity import stamp, verify
 
 pytestmark = pytest.mark.slow
@@ -24,7 +29,8 @@ RUN = ["--particles", "50", "--confining", "750", "--suctions", "3000,30000", "-
 #: inside a stage, away from its equilibrium checks (every 200 steps of the stage).
 STOP = ["--checkpoint-every", "70", "--stop-after", "350"]
 #: Timings, which differ between runs (summaries, a tension's cases, history attributes).
-TIMINGS = {"wall_time_s", "wetting_time_s", "pull_time_s"}
+TIMINGS = {"wall_time_s", "wetting_time_s", "pull_time_s", "preparation_time_s",
+           "pre_shear_time_s", "shear_time_s", "cluster_update_time_s", "particle_steps_per_s"}
 #: HDF5 attributes that hold object references (dimension scales), compared by their targets.
 REFERENCES = {"DIMENSION_LIST", "REFERENCE_LIST"}
 
@@ -66,6 +72,14 @@ def without_timings(data):
     return data
 
 
+def same(value, other):
+    """Whether two attribute values are equal, NaN equal to NaN (the suction of a test at a
+    water content)."""
+    value, other = np.asarray(value), np.asarray(other)
+    numbers = value.dtype.kind in "fc" and other.dtype.kind in "fc"
+    return np.array_equal(value, other, equal_nan=numbers)
+
+
 def assert_same_files(first, second, files=("history.h5", "sample.h5"), summary="swcc.json"):
     for name in files:
         a, b = contents(first / name), contents(second / name)
@@ -76,7 +90,7 @@ def assert_same_files(first, second, files=("history.h5", "sample.h5"), summary=
                 assert data.dtype == other.dtype and np.array_equal(data, other), (name, key)
             assert attributes.keys() == other_attributes.keys(), (name, key)
             for attribute, value in attributes.items():
-                assert np.array_equal(value, other_attributes[attribute]), (name, key, attribute)
+                assert same(value, other_attributes[attribute]), (name, key, attribute)
     a, b = (json.loads((folder / summary).read_text()) for folder in (first, second))
     assert without_timings(a) == without_timings(b)
 
@@ -96,6 +110,24 @@ def test_a_stopped_swcc_resumes_bit_for_bit(runs, tmp_path, capsys):
     assert status == 130 and f"--resume {again}" in err, err
     assert swcc(["--resume", str(again), "--quiet"], capsys)[0] == 0
     assert_same_files(whole, again)
+
+
+def test_a_stopped_swcc_with_clusters_resumes_bit_for_bit(tmp_path, capsys):
+    """Stopped in its second stage: the clusters' state of that stage and the first stage's
+    pores/ frame come from the checkpoint."""
+    argv = RUN + ["--liquid", "clusters"]
+    whole, run = tmp_path / "whole", tmp_path / "run"
+    assert swcc(argv + ["--out", whole], capsys)[0] == 0
+    assert swcc(argv + STOP + ["--out", run], capsys)[0] == 130
+    with h5py.File(run / "checkpoint.h5") as handle:
+        assert json.loads(handle.attrs["extra_state"])["stage"] == 1
+    status, err = swcc(["--resume", run, "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole, run)
+    frames = sorted(path.name for path in (whole / "pores").glob("*"))
+    assert frames == sorted(path.name for path in (run / "pores").glob("*"))
+    for name in frames:
+        assert (whole / "pores" / name).read_bytes() == (run / "pores" / name).read_bytes()
 
 
 def forge(path, change):
@@ -209,3 +241,109 @@ def test_a_tension_resume_that_changes_the_configuration_is_refused(tension_runs
     shutil.copytree(tension_runs[1] / "run", run)
     refused(*tension(["--resume", str(run), "--water-content", "3", "--quiet"], capsys),
             "--water-content", "cannot be changed")
+
+
+# ---------------------------------------------------------------- liquid clusters
+
+#: Laboratory tests with liquid clusters, updated every 10 records (CLUSTER_RECORDS patched),
+#: their forces following the grains at every record between.
+CLUSTERS = ["--particles", "60", "--liquid", "clusters", "--checkpoint-every", "100",
+            "--threads", "1", "--quiet"]
+#: (command, its options, --stop-after): a triaxial at a suction with pores/ frames, one at a
+#: water content (the closed liquid) without, a simple shear (a sheared periodic cell).
+CLUSTER_CASES = {
+    "suction": ("triaxial", ["--suction", "20000", "--max-strain", "0.01", "--records", "40",
+                             "--vtk-frames", "5"], 1500),
+    "water content": ("triaxial", ["--water-content", "3", "--max-strain", "0.01",
+                                   "--records", "20", "--vtk-frames", "0"], 1500),
+    "sheared cell": ("simple-shear", ["--suction", "20000", "--seed", "3", "--max-strain",
+                                      "0.02", "--record-strain", "0.001", "--vtk-frames", "5"],
+                     3000)}
+
+
+def saved_state(checkpoint, kind, name):
+    """(step, {key: value} of the state of the operation ``name`` among ``kind``) of a
+    checkpoint, its groups as dicts."""
+    def read(group):
+        return {**dict(group.attrs), **{key: read(item) if isinstance(item, h5py.Group)
+                                        else item[()] for key, item in group.items()}}
+
+    with h5py.File(checkpoint) as handle:
+        for group in handle["operations"][kind].values():
+            if group.attrs["type"].endswith(name):
+                return int(handle.attrs["step"]), read(group["state"])
+    raise KeyError(name)
+
+
+def assert_between_updates(checkpoint):
+    """The checkpoint holds clusters updated at least once, whose forces have followed the
+    grains since their last update."""
+    step, updates = saved_state(checkpoint, "writers", "ClusterUpdates")
+    assert updates["updates"] >= 1 and updates["updated"] < step, (step, updates)
+    return saved_state(checkpoint, "forces", "LiquidClusters")[1]
+
+
+@pytest.mark.parametrize("case", sorted(CLUSTER_CASES))
+def test_a_stopped_laboratory_test_with_clusters_resumes_bit_for_bit(case, tmp_path, capsys,
+                                                                     monkeypatch):
+    monkeypatch.setattr(laboratory, "CLUSTER_RECORDS", 10)
+    command, options, stop = CLUSTER_CASES[case]
+    argv = CLUSTERS + options
+    whole, run = tmp_path / "whole", tmp_path / "run"
+    assert run_in_process(command, argv + ["--out", whole], capsys)[0] == 0
+    status, err = run_in_process(command, argv + ["--stop-after", stop, "--out", run], capsys)
+    assert status == 130 and f"--resume {run}" in err, err
+    clusters = assert_between_updates(run / "checkpoint.h5")
+    if case == "water content":          # the closed liquid's front partly filled
+        assert 0.0 < clusters["liquid"]["front_fraction"] < 1.0
+    if case == "sheared cell":           # the units of a sheared cell: (Lx, Ly, Lz, offset)
+        assert len(clusters["units"]["period"]) == 4 and clusters["units"]["period"][3] != 0
+    status, err = run_in_process(command, ["--resume", run, "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(whole, run, files=("history.h5",), summary="summary.json")
+    frames = sorted(path.name for path in (whole / "pores").glob("*")) \
+        if (whole / "pores").exists() else []
+    assert frames == sorted(path.name for path in (run / "pores").glob("*"))
+    for name in frames:
+        assert (whole / "pores" / name).read_bytes() == (run / "pores" / name).read_bytes()
+
+
+#: A direct tension with liquid clusters: its closed liquid solved again 40 times over the
+#: pull (about 770 steps), checkpoints every 150 steps, stopped after 400.
+CLUSTER_TENSION = ["--particles", "100", "--void-ratio", "0.72", "--water-content", "2",
+                   "--max-strain", "0.004", "--roughness", "0", "--liquid", "clusters",
+                   "--vtk-frames", "0", "--threads", "1", "--quiet"]
+
+
+def test_a_stopped_tension_with_clusters_resumes_bit_for_bit(tmp_path, capsys, monkeypatch):
+    """(The three runs prepare one sample: the preparation, deterministic, is the first
+    run's, which the existing tension resume test proves the same when prepared again.)"""
+    prepared = {}
+    prepare = tension_module.prepare_void_ratio
+
+    def once(*arguments):
+        key = repr(arguments)
+        if key not in prepared:
+            prepared[key] = prepare(*arguments)
+        return copy.deepcopy(prepared[key])
+
+    monkeypatch.setattr(tension_module, "prepare_void_ratio", once)
+    for name in ("whole", "stopped"):
+        (tmp_path / name).mkdir()
+    monkeypatch.chdir(tmp_path / "whole")
+    assert tension(CLUSTER_TENSION + ["--out", "run"], capsys)[0] == 0
+    monkeypatch.chdir(tmp_path / "stopped")
+    status, err = tension(CLUSTER_TENSION + ["--checkpoint-every", "150", "--stop-after", "400",
+                                             "--out", "run"], capsys)
+    assert status == 130, err
+    step, _ = saved_state("run/checkpoint.h5", "forces", "LiquidClusters")
+    with h5py.File("run/checkpoint.h5") as handle:
+        start = json.loads(handle.attrs["extra_state"])["pull_start"]
+    case = json.loads((tmp_path / "whole" / "run" / "tension.json").read_text())["cases"][0]
+    assert not case["ruptured"]          # pulled to --max-strain: its pull_steps as planned
+    period = update_period(case["pull_steps"])
+    assert step - start > period and (step - start) % period, (step, start)   # between updates
+    status, err = tension(["--resume", "run", "--quiet"], capsys)
+    assert status == 0, err
+    assert_same_files(tmp_path / "whole" / "run", tmp_path / "stopped" / "run",
+                      files=["cases/e0.72_w2.00/history.h5"], summary="tension.json")

@@ -60,7 +60,6 @@ def test_the_mayer_stowe_princen_entry_drains_sooner(tmp_path):
 
 @pytest.mark.parametrize("argv, words", [
     (["--liquid", "drops"], ["--liquid", "pendular", "clusters"]),
-    (["--liquid", "clusters", "--checkpoint-every", "100"], ["clusters", "checkpoint"]),
     (["--liquid", "clusters", "--entry-suction", "circle"],
      ["--entry-suction", "inscribed", "mayer-stowe-princen"]),
     (["--entry-suction", "mayer-stowe-princen"], ["--entry-suction", "--liquid clusters"]),

@@ -112,7 +112,6 @@ def test_a_periodic_triaxial_counts_its_clusters_in_the_cells_stress(tmp_path, m
 
 @pytest.mark.parametrize("options, words", [
     ({}, ["--liquid", "--suction"]),
-    ({"suction": 20000.0, "checkpoint_every": 100}, ["--liquid", "--checkpoint-every"]),
     ({"suction": 20000.0, "drainage": "undrained"}, ["--liquid", "--drainage"]),
     ({"suction": 20000.0, "bridges": "toroidal"}, ["--liquid", "--bridges"]),
 ])

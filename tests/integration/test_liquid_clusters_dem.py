@@ -1,6 +1,7 @@
 """Liquid clusters in the DEM (pendular.capillary.liquid_clusters): below the filling suction of
 every pore unit they are the pendular bridges bit for bit; a saturated sample's clusters pull
-on its grains with forces that balance, and hand over their bridges' liquid."""
+on its grains with forces that balance, and hand over their bridges' liquid; their state, taken
+back, gives the same forces and stress bit for bit, then and as the grains move on."""
 
 import copy
 
@@ -9,6 +10,7 @@ import pytest
 
 from pendular.capillary import CapillaryBridges
 from pendular.capillary.liquid_clusters import LiquidClusters
+from pendular.dem.checkpoint import load_checkpoint, save_checkpoint
 from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 
@@ -75,8 +77,6 @@ def test_a_saturated_sample_drains_and_its_cluster_forces_balance(small_sample):
     bridges.set_suction(30000.0)
     clusters.set_suction(sim, 30000.0)
     assert np.count_nonzero(clusters.filled) < filled
-    state = clusters.state_dict()
-    assert state["filled_units"].shape == (np.count_nonzero(clusters.filled), 4)
 
 
 def test_the_clusters_forces_follow_their_grains(small_sample):
@@ -91,3 +91,70 @@ def test_the_clusters_forces_follow_their_grains(small_sample):
     clusters.follow_packing(sim)
     assert np.array_equal(clusters.filled, filled) and not np.array_equal(clusters._force, held)
     assert np.abs(clusters._force.sum(axis=0)).max() < 1e-10 * np.abs(clusters._force).max()
+
+
+def restored(sim, path):
+    """A copy of ``sim`` whose clusters are built afresh, then given ``sim``'s checkpoint
+    ``path`` (pendular.dem.checkpoint): (copy, its clusters)."""
+    save_checkpoint(path, sim)
+    copied = copy.deepcopy(sim)
+    index = copied.forces.index(copied.operation(LiquidClusters))
+    copied.forces[index] = LiquidClusters(copied.operation(CapillaryBridges))
+    load_checkpoint(path, copied)
+    return copied, copied.forces[index]
+
+
+def assert_same(sim, clusters, other_sim, other):
+    assert np.array_equal(clusters._force, other._force)
+    assert np.array_equal(clusters.stress(sim), other.stress(other_sim))
+    assert np.array_equal(clusters.grain_forces(sim), other.grain_forces(other_sim))
+    assert clusters.statistics(sim) == other.statistics(other_sim)
+
+
+@pytest.mark.parametrize("closed", [False, True])
+def test_the_clusters_resume_from_a_checkpoint_bit_for_bit(small_sample, closed, tmp_path):
+    """At an imposed suction and with a closed liquid (its front partly filled), saved right
+    after a step of the model and after their forces followed the grains: the restored
+    clusters pull as the saved ones, and the run goes on the same, the forces following the
+    grains."""
+    sim, bridges, clusters = wetted(small_sample, 3000.0, "clusters", saturated=True)
+    if closed:
+        clusters.hold_volume(sim, 0.9 * clusters.account(sim).total)
+        assert 0.0 < clusters.liquid.front_fraction < 1.0
+    assert_same(sim, clusters, *restored(sim, tmp_path / "updated.h5"))
+    sim.run(50)
+    clusters.follow_packing(sim)
+    other_sim, other = restored(sim, tmp_path / "followed.h5")
+    assert_same(sim, clusters, other_sim, other)
+    for each, its in ((sim, clusters), (other_sim, other)):
+        each.run(50)
+        its.follow_packing(each)
+    assert np.array_equal(sim.particles.position, other_sim.particles.position)
+    assert_same(sim, clusters, other_sim, other)
+
+
+def test_an_empty_clusters_state_is_taken_back_empty(small_sample):
+    _, _, clusters = wetted(small_sample, 3000.0, "clusters")
+    fresh = LiquidClusters(clusters.bridges)
+    fresh.load_state(LiquidClusters(clusters.bridges).state_dict())
+    assert fresh.units is None and fresh.suction is None
+
+
+@pytest.mark.parametrize("change, words", [
+    (lambda s: s["units"].update(grains=s["units"]["grains"] + len(s["radius"])),
+     ["units/grains", "valid range [0, 300)"]),
+    (lambda s: s["units"].update(vertices=s["units"]["vertices"][:-1]), ["units/vertices"]),
+    (lambda s: s.update(filled=s["filled"][:-1]), ["filled", "shape"]),
+    (lambda s: s.update(suction=None), ["suction"]),
+])
+def test_a_clusters_state_that_does_not_fit_is_refused_naming_it(small_sample, change, words):
+    sim, _, clusters = wetted(small_sample, 3000.0, "clusters", saturated=True)
+    state = clusters.state_dict()
+    state["units"] = dict(state["units"])
+    change(state)
+    fresh = LiquidClusters(clusters.bridges)
+    with pytest.raises(ValueError) as error:
+        fresh.load_state(state)
+    for word in words:
+        assert word in str(error.value), (word, str(error.value))
+    assert fresh.units is None

@@ -82,7 +82,6 @@ def test_every_update_of_the_pull_holds_the_water_to_round_off(wetted, config, t
 @pytest.mark.parametrize("extra, words", [
     ([], ["--liquid", "--roughness"]),
     (["--roughness", "0", "--periodic"], ["--liquid", "--periodic"]),
-    (["--roughness", "0", "--checkpoint-every", "100"], ["--liquid", "--checkpoint-every"]),
 ])
 def test_what_clusters_do_not_support_is_refused(extra, words, capsys, tmp_path):
     status, err = run_in_process("tension", ["--liquid", "clusters", "--particles", "200",

@@ -21,18 +21,25 @@ the suction is the one at which the bridges and the filled units hold V
 (pendular.capillary.closed_liquid), imposed on the bridges; the units at the front of a jump
 hold a fraction of their pore volume (their forces and absorbed shares in that fraction), and
 what a bridge broken at that suction leaves stays on the grains as film.
+
+``state_dict``/``load_state`` keep all of this (the pore units of the last step of the model,
+the filled state, the closed liquid, where the forces act), so that a checkpointed run
+resumes bit for bit.
 """
+
+import math
 
 import numpy as np
 
 from pendular.capillary.bridge_state import BridgeState
-from pendular.capillary.closed_liquid import HeldLiquid, solve_closed_liquid
+from pendular.capillary.closed_liquid import ClosedLiquid, HeldLiquid, solve_closed_liquid
 from pendular.capillary.cluster_forces import (UnitForces, cluster_forces, cluster_stress,
     partial_forces)
 from pendular.capillary.clusters import find_clusters
 from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
     liquid_account, unit_edges)
-from pendular.capillary.pores import decompose, into_cell, nearest_images, search_rows
+from pendular.capillary.pores import (PoreUnits, decompose, into_cell, nearest_images,
+    search_rows)
 from pendular.capillary.throats import check_entry_estimate
 from pendular.dem.cell import pair_virial
 from pendular.dem.neighbors import branch_vectors, gather_pair_forces
@@ -57,35 +64,70 @@ class LiquidClusters:
         self.filled = None
         self.found = None
         self._unit_forces = None
+        self._radius = None           # (N,) [m] the grains' radii
         self._vertices = None         # (M, 4, 3) [m] where the units' forces act
         self._edges = None
         self._force = None
         self._contacts = None         # the neighbour list _pair_edge and _share are of
         self._pair_edge = None
         self._share = None
-        self._carried = None          # filled units of a checkpoint, until set_suction
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
         self._own_virial = None       # (the forces, their sum of x (x) F [N m]) (virial)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
-        """The filled units, each as its four grains, and the suction of the last step of the
-        model (None before the first)."""
+        """The clusters as the last step of the model left them, their forces following the
+        grains (follow_packing), so that the next steps are those of a run never stopped:
+        ``suction`` [Pa] (None before the first step of the model), ``saturated``; then (None
+        before the first step) ``units`` the pore units (pendular.capillary.pores.PoreUnits:
+        positions [m], volumes [m^3], solid angles [sr], areas [m^2], indices), ``radius``
+        (N,) [m] the grains', ``filled`` (M,) bool, ``vertices`` (M, 4, 3) [m] where the
+        units' forces act, and ``liquid`` the closed liquid (ClosedLiquid less its
+        ``filled``: ``suction`` [Pa], ``front`` (M,) bool, ``front_fraction``, ``weight``
+        (M,), ``bridges``, ``clusters``, ``film`` [m^3]; None at an imposed suction)."""
+        state = {"suction": self.suction, "saturated": self.saturated, "units": None,
+                 "radius": None, "filled": None, "vertices": None, "liquid": None}
         if self.units is None:
-            return {"suction": None, "saturated": self.saturated,
-                    "filled_units": np.zeros((0, 4), np.int64)}
-        return {"suction": self.suction, "saturated": self.saturated,
-                "filled_units": self.units.grains[self.filled].copy()}
+            return state
+        state.update(units={name: getattr(self.units, name) for name in _UNIT_ARRAYS},
+                     radius=self._radius, filled=self.filled, vertices=self._vertices)
+        if self.liquid is not None:
+            state["liquid"] = {name: getattr(self.liquid, name) for name in _LIQUID_STATE}
+        return state
 
     def load_state(self, state):
-        """Take back a ``state_dict``: the filled units are carried into the next
-        ``set_suction``, which the loading scene calls before the clusters pull again."""
-        filled = state_array(state, "filled_units", np.int64, (None, 4))
+        """Take back a ``state_dict``: the units, filled state, suction and closed liquid as
+        saved, their forces computed again where the saved ``vertices`` put the grains
+        (follow_packing's, bit for bit). ValueError naming the key of a value that does not
+        fit, nothing changed then."""
         suction = state["suction"]
         if suction is not None and not (isinstance(suction, float) and suction > 0):
             raise ValueError(f"suction = {suction!r}: a suction > 0 [Pa] or None expected")
-        self.saturated = bool(state["saturated"])
-        self._carried, self.suction = filled, suction
+        saturated = bool(state["saturated"])
+        if state["units"] is None:
+            self.__init__(self.bridges, saturated, self.entry)     # the scene's entry kept
+            self.suction = suction
+            return
+        if suction is None:
+            raise ValueError("suction = None: the saved pore units need the suction they hold")
+        radius = state_array(state, "radius", np.float64, (None,))
+        if (radius <= 0.0).any():
+            raise ValueError(f"radius[{int(np.argmax(radius <= 0.0))}] = "
+                             f"{radius[radius <= 0.0][0]} m; valid: > 0")
+        units = _units_of(state["units"], len(radius))
+        filled = state_array(state, "filled", bool, (units.count,))
+        vertices = state_array(state, "vertices", np.float64, (units.count, 4, 3))
+        liquid = None if state["liquid"] is None else _liquid_of(state["liquid"], filled)
+        self.__init__(self.bridges, saturated, self.entry)
+        self.units, self.filled, self.suction, self.liquid = units, filled, suction, liquid
+        self._radius, self._vertices = radius, vertices
+        self._edges = unit_edges(units)
+        self.found = find_clusters(units, filled)
+        unit_forces = UnitForces(units.vertices, radius[units.grains])
+        held = np.flatnonzero(self._held())
+        if len(held):
+            unit_forces = unit_forces.moved(held, vertices[held], radius[units.grains[held]])
+        self._set_forces(len(radius), unit_forces)
 
     # ---------------------------------------------------------------- the model's step
     def set_suction(self, sim, suction):
@@ -153,23 +195,23 @@ class LiquidClusters:
         self._edges = unit_edges(units) if edges is None else edges
         self.found = find_clusters(units, filled)
         self._vertices = units.vertices
-        self._set_forces(sim.particles,
+        self._radius = sim.particles.radius.copy()
+        self._set_forces(len(sim.particles),
                          UnitForces(units.vertices, sim.particles.radius[units.grains]))
         self._contacts = None
-        self._carried = None
 
-    def _set_forces(self, particles, unit_forces):
-        """The clusters' forces of the filled units (and the closed liquid's front) with the
-        coefficients ``unit_forces`` (UnitForces)."""
+    def _set_forces(self, grain_count, unit_forces):
+        """The clusters' forces on ``grain_count`` grains of the filled units (and the closed
+        liquid's front) with the coefficients ``unit_forces`` (UnitForces)."""
         units = self.units
         self._unit_forces = unit_forces
         self._force = cluster_forces(units, self._unit_forces, self.filled, self.suction,
-                                     len(particles))
+                                     grain_count)
         if self.liquid is not None and self.liquid.front_fraction > 0.0:
             self._force += partial_forces(units, self._unit_forces,
                                           np.flatnonzero(self.liquid.front),
                                           self.liquid.front_fraction, self.suction,
-                                          len(particles))
+                                          grain_count)
 
     def follow_packing(self, sim):
         """The forces of the filled units with their grains where they are now, the filled
@@ -182,13 +224,17 @@ class LiquidClusters:
             return
         sim.fetch("particles")
         particles = sim.particles
-        held = self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
+        held = self._held()
         grains = self.units.grains[held]
         vertices = self._vertices.copy()
         vertices[held] = self._grain_images(sim, grains, vertices[held])
         self._vertices = vertices
-        self._set_forces(particles, self._unit_forces.moved(
+        self._set_forces(len(particles), self._unit_forces.moved(
             np.flatnonzero(held), vertices[held], particles.radius[grains]))
+
+    def _held(self):
+        """(M,) bool: the units that hold liquid, filled or at the closed liquid's front."""
+        return self.filled if self.liquid is None else self.filled | (self.liquid.weight > 0.0)
 
     def _grain_images(self, sim, grains, near):
         """(..., 3) [m] where ``grains`` are now as the units see them: their positions, or in
@@ -200,9 +246,8 @@ class LiquidClusters:
         return nearest_images(position, near, np.array(sim.walls.period))
 
     def _filled_grains(self):
-        """(F, 4) the grains of the filled units so far (a checkpoint's, or this run's)."""
-        if self._carried is not None:
-            return self._carried
+        """(F, 4) the grains of the filled units so far (None before the first step of the
+        model)."""
         if self.units is None:
             return None
         return self.units.grains[self.filled]
@@ -360,3 +405,71 @@ def _carry(grains, previous):
         return np.zeros(len(grains), bool)
     table = np.unique(np.sort(np.asarray(previous, np.int64), axis=1), axis=0)
     return search_rows(table, np.sort(grains, axis=1)) >= 0
+
+
+#: The arrays of the pore units (pendular.capillary.pores.PoreUnits) a checkpoint keeps, with
+#: their dtype and shape (M: units, T: throats; ``period`` apart: None, (3,) or (4,) [m]).
+_UNIT_ARRAYS = {
+    "grains": (np.int64, ("M", 4)), "vertices": (np.float64, ("M", 4, 3)),
+    "neighbours": (np.int64, ("M", 4)), "volume": (np.float64, ("M",)),
+    "pore_volume": (np.float64, ("M",)), "solid_angle": (np.float64, ("M", 4)),
+    "grain_area": (np.float64, ("M", 4)), "protrudes": (bool, ("M",)),
+    "throat_radius": (np.float64, ("M", 4)), "throat_units": (np.int64, ("T", 2)),
+    "throat_of": (np.int64, ("M", 4)), "throat_shift": (np.int64, ("T", 3)),
+    "period": (np.float64, (None,))}
+
+#: What a checkpoint keeps of a ClosedLiquid (its ``filled`` is the clusters').
+_LIQUID_STATE = ("suction", "front", "front_fraction", "weight", "bridges", "clusters", "film")
+
+
+def _units_of(state, grain_count):
+    """PoreUnits of a LiquidClusters.state_dict's ``units`` over ``grain_count`` grains;
+    ValueError naming the array (units/<name>) that does not fit."""
+    sizes = {}
+    for name, length in (("grains", "M"), ("throat_units", "T")):
+        value = state[name]
+        sizes[length] = len(value) if isinstance(value, np.ndarray) and value.ndim else -1
+    arrays = {}
+    try:
+        for name, (dtype, shape) in _UNIT_ARRAYS.items():
+            if name == "period" and state[name] is None:
+                arrays[name] = None
+                continue
+            arrays[name] = state_array(state, name, dtype, tuple(sizes.get(n, n)
+                                                                 for n in shape))
+    except ValueError as error:
+        raise ValueError(f"units/{error}") from None
+    period = arrays["period"]
+    if period is not None and (len(period) not in (3, 4) or (period[:3] <= 0.0).any()):
+        raise ValueError(f"units/period = {period.tolist()} m; valid: None, or the cell's "
+                         "lengths (3,) > 0 (and a sheared cell's offset, (4,))")
+    for name, low, high in (("grains", 0, grain_count), ("neighbours", -1, sizes["M"]),
+                            ("throat_units", -1, sizes["M"]), ("throat_of", 0, sizes["T"])):
+        outside = (arrays[name] < low) | (arrays[name] >= high)
+        if outside.any():
+            index = [int(i) for i in np.argwhere(outside)[0]]
+            raise ValueError(f"units/{name}{index} = {arrays[name][tuple(index)]} is outside "
+                             f"the valid range [{low}, {high})")
+    return PoreUnits(**arrays)
+
+
+def _liquid_of(state, filled):
+    """ClosedLiquid of a LiquidClusters.state_dict's ``liquid`` with the units ``filled``
+    (M,); ValueError naming the value (liquid/<name>) that does not fit."""
+    count = len(filled)
+    try:
+        front = state_array(state, "front", bool, (count,))
+        weight = state_array(state, "weight", np.float64, (count,))
+    except ValueError as error:
+        raise ValueError(f"liquid/{error}") from None
+    numbers = {}
+    for name in ("suction", "front_fraction", "bridges", "clusters", "film"):
+        value = state[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not math.isfinite(value):
+            raise ValueError(f"liquid/{name} = {value!r}; valid: a finite number")
+        numbers[name] = float(value)
+    if not (0.0 <= numbers["front_fraction"] <= 1.0 and (weight >= 0.0).all()
+            and (weight <= 1.0).all()):
+        raise ValueError("liquid/front_fraction and liquid/weight: valid shares in [0, 1]")
+    return ClosedLiquid(filled=filled, front=front, weight=weight, **numbers)

@@ -277,16 +277,41 @@ class PoreFrames:
     def __init__(self, folder, time_axis):
         self.folder, self.time_axis = folder, time_axis
         self.frames = []
+        self.numbers = []            # the frames' numbers, in the order written
+
+    @staticmethod
+    def file_name(number):
+        """The file of frame ``number``."""
+        return f"pores_{number:04d}.vtu"
+
+    def state_dict(self):
+        """The frames written so far (the .pvd of a resumed run lists them): ``numbers`` (F,)
+        and ``values`` (F,), their time-axis values. A resumed run writes into its own
+        folder."""
+        return {"numbers": np.array(self.numbers, np.int64),
+                "values": np.array([value for value, _ in self.frames], np.float64)}
+
+    def load_state(self, state):
+        numbers = state_array(state, "numbers", np.int64, (None,))
+        values = state_array(state, "values", np.float64, (len(numbers),))
+        outside = (numbers < 0) | (numbers > 9999)
+        if outside.any():
+            k = int(np.argmax(outside))
+            raise ValueError(f"numbers[{k}] = {numbers[k]} is outside the valid range [0, 9999]")
+        self.numbers = [int(number) for number in numbers]
+        self.frames = [(float(value), self.file_name(number))
+                       for number, value in zip(self.numbers, values)]
 
     def write(self, number, pore_units, label, field_data):
         """Frame ``number`` of the pore units ``pore_units`` labelled by cluster ``label``
         (-1 empty), ``field_data`` (name -> number, the time axis among them); the .pvd
         rewritten with the frames so far."""
         os.makedirs(self.folder, exist_ok=True)
-        name = f"pores_{number:04d}.vtu"
+        name = self.file_name(number)
         write_vtu(os.path.join(self.folder, name), pore_mesh(pore_units, label),
                   field_data=field_data)
         self.frames.append((field_data[self.time_axis], name))
+        self.numbers.append(number)
         write_pvd(os.path.join(self.folder, "pores.pvd"), self.frames,
                   time_axis=self.time_axis)
 

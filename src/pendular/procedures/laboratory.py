@@ -46,7 +46,8 @@ from pendular.procedures.equilibrium import (equilibrate, frame_period, frames_w
 from pendular.procedures.columns import cluster_operation
 from pendular.procedures.guards import AxialContactLost, SampleCrushed
 from pendular.procedures.loading import VTK_RECORDS, check_stages_device
-from pendular.procedures.loading_clusters import CLUSTER_RECORDS, ClusterUpdates, cluster_summary
+from pendular.procedures.loading_clusters import (CLUSTER_RECORDS, ClusterUpdates,
+    cluster_summary, refuse_clusters_device, rejoin_clusters)
 from pendular.procedures.feasibility import check_feasible
 from pendular.procedures.preparation import (PREPARATION_PHASES, prepare_sample,
     servoed_simulation, timestep, timestep_description)
@@ -240,9 +241,7 @@ class LaboratoryTest:
         ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
         the wetting, the loading), "cpu" or "gpu" (``check_device``)."""
         options = RunOptions.of(options, **settings)
-        if self.config.liquid == "clusters" and options.device != "cpu":
-            raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the "
-                             f"host's): --device {options.device} does not apply")
+        refuse_clusters_device(self.config, options.device)
         check_device(options.device)
         check_stages_device(self.stages(), options.device)
         vtk_prep = options.vtk_prep
@@ -296,6 +295,8 @@ class LaboratoryTest:
         save_sample(sample_file, sim, preparation, before_shear,
                     identity={"seed": config.sample.seed})
         run = _PathRun(sim, self, folder, before_shear, run_identity(config, sample_file))
+        if run.cluster_updates is not None:
+            run.cluster_updates.start(sim)
         if run.checkpoint is not None:
             run.checkpoint.write(sim)
         return run.finish(progress, options.stop_after, options.plots)
@@ -321,11 +322,16 @@ class LaboratoryTest:
             particles, walls, _, before_shear = load_sample(sample_file)
             config = stored_run(config_from_dict(before_shear.get("config"), sample_file), out,
                                 cls, cls.NAME, device)
+            refuse_clusters_device(config, device)
             sim = servoed_simulation(particles, walls, config.sample, config.confining,
                                      threads=options.threads)
-            if config.bridges is not None:   # its state (liquid, films) comes from the checkpoint
-                sim.forces.append(config.bridges.build(
-                    before_shear["wetting"].get("formation_suction_pa"), closed=True))
+            # the bridges' state (liquid, films) and the clusters' come from the checkpoint
+            suction = (before_shear["wetting"].get("formation_suction_pa")
+                       if config.bridges is not None else None)
+            if config.liquid == "clusters":
+                rejoin_clusters(sim, config.bridges, suction, config.entry_suction)
+            elif config.bridges is not None:
+                sim.forces.append(config.bridges.build(suction, closed=True))
             identity = run_identity(config, sample_file)
             test = cls.__new__(cls)          # the stored run, checked when it started
             test.config = config
@@ -429,7 +435,7 @@ class _PathRun:
             recorder = self.path.recorder
             closed = config.bridges.water_content is not None     # the liquid held: a volume
             self.cluster_updates = ClusterUpdates(
-                sim, clusters, recorder.period, CLUSTER_RECORDS, recorder.origin,
+                clusters, recorder.period, CLUSTER_RECORDS, recorder.origin,
                 None if self.vtk is None else PoreFrames(os.path.join(out, "pores"),
                                                          time_axis), field_data,
                 before_shear["wetting"]["liquid_initial"] if closed else None)

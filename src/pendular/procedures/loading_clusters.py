@@ -11,7 +11,9 @@ settles to. At a water content the suction is the one that holds the closed liqu
 as it stands (decomposed again, the filled units carried over, pore filling, then Haines jumps
 where pores opened), writing a frame of pores/ each time; at every history record in between,
 the filled units' forces follow their grains (LiquidClusters.follow_packing: the same units,
-filled state and suction, the forces at the grains' positions then). ``cluster_summary``: the
+filled state and suction, the forces at the grains' positions then). A checkpoint holds the
+clusters' state (LiquidClusters.state_dict) and ClusterUpdates' progress; a resumed loading
+builds the same scene (``rejoin_clusters``) and takes both back. ``cluster_summary``: the
 clusters' figures of a history row, with the effective stress of bridges and clusters;
 ``refuse_clusters``: what a configuration with clusters cannot run with.
 """
@@ -23,6 +25,7 @@ import time
 import numpy as np
 
 from pendular.homogenize.invariants import mean_stress
+from pendular.utils.validate import check_int, check_range
 
 #: History records between two updates of the clusters during a loading (10 over a triaxial
 #: of 500 records), each about one decomposition of the packing: the period that keeps a wet
@@ -48,11 +51,15 @@ def refuse_clusters(config) -> str | None:
                 "clusters: not with --drainage undrained (volume-controlled bridges)")
     if bridges.model != "exact":
         return f"--liquid clusters needs the exact bridges, not --bridges {bridges.model}"
-    if config.checkpoint_every:
-        return (f"--liquid clusters runs without checkpoints (its pore units are the host's "
-                f"and not checkpointed): --checkpoint-every {config.checkpoint_every} does not "
-                "apply")
     return None
+
+
+def refuse_clusters_device(config, device: str) -> None:
+    """ValueError naming --device when the LaboratoryConfig ``config`` with liquid clusters
+    would run (or resume) on the GPU."""
+    if config.liquid == "clusters" and device != "cpu":
+        raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the host's): "
+                         f"--device {device} does not apply")
 
 
 def join_clusters(sim, bridges, entry):
@@ -64,6 +71,35 @@ def join_clusters(sim, bridges, entry):
 
     clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces.append(clusters)
+    clusters.set_suction(sim, bridges.suction)
+    return clusters
+
+
+def cluster_bridges(bridges_config, suction=None):
+    """The persisting suction-controlled bridges (pendular.capillary.CapillaryBridges) that
+    liquid clusters join: at a suction the configuration's (``bridges_config``: BridgeConfig,
+    persist set), at a water content the exact ones at ``suction`` [Pa] with its surface
+    tension and contact angle."""
+    from pendular.capillary import CapillaryBridges
+
+    if bridges_config.water_content is None:
+        return bridges_config.build()
+    return CapillaryBridges(suction, bridges_config.surface_tension,
+                            bridges_config.contact_angle, persist=True)
+
+
+def rejoin_clusters(sim, bridges_config, suction, entry):
+    """The LiquidClusters of a resumed loading (their throats' entry estimate ``entry``),
+    appended to ``sim``'s forces after their bridges (``cluster_bridges`` of
+    ``bridges_config`` at the wetting's formation ``suction`` [Pa], None at a suction) as the
+    wetting appended them; the checkpoint then gives both their state. Until then the
+    clusters stand at the bridges' suction at ``sim``'s packing (the sample's), which the
+    loading path's first record reads before the checkpoint replaces it and that record."""
+    from pendular.capillary.liquid_clusters import LiquidClusters
+
+    bridges = cluster_bridges(bridges_config, suction)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
+    sim.forces += [bridges, clusters]
     clusters.set_suction(sim, bridges.suction)
     return clusters
 
@@ -93,8 +129,7 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     found at the packing reached (``formation_suction_pa``) and the volume
     (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot
     hold it within the pendular limit."""
-    from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
-                                    sample_radius_ratios)
+    from pendular.capillary import BridgeTable, formation_suction, sample_radius_ratios
     from pendular.capillary.liquid_clusters import LiquidClusters
     from pendular.capillary.validation import NotPendular
 
@@ -108,8 +143,7 @@ def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     start = formation_suction(table, particles.radius[sim.contacts.pair_i[touching]],
                               particles.radius[sim.contacts.pair_j[touching]], target,
                               bridges_config.surface_tension)
-    bridges = CapillaryBridges(start, bridges_config.surface_tension,
-                               bridges_config.contact_angle, persist=True)
+    bridges = cluster_bridges(bridges_config, start)
     clusters = LiquidClusters(bridges, saturated=False, entry=entry)
     sim.forces += [bridges, clusters]
     try:
@@ -138,18 +172,42 @@ class ClusterUpdates:
     path's suction stage) too, at most once every ``follow`` steps while it changes; and
     ``frames`` (pendular.io.vtk.PoreFrames, or None) gets a frame of the pore units with
     ``field_data(sim)`` (the loading's frame fields) and the suction at each update; the
-    first frame, the state of ``sim`` the loading starts from, at once. ``updates``: how many
-    updates ran; ``time_s``: the wall time of the updates and of the forces following the
-    grains [s]."""
+    first frame, the state of ``sim`` the loading starts from, by ``start`` (a resumed
+    loading has it already). ``updates``: how many updates ran; ``time_s``: the wall time of
+    the updates and of the forces following the grains [s]."""
 
-    def __init__(self, sim, clusters, follow, updates_every, origin, frames=None,
-                 field_data=None, volume=None):
+    def __init__(self, clusters, follow, updates_every, origin, frames=None, field_data=None,
+                 volume=None):
         self.clusters, self.frames, self.field_data = clusters, frames, field_data
         self.volume = volume
         self.follow = max(1, int(follow))
         self.period, self.origin = self.follow * max(1, int(updates_every)), int(origin)
         self.updates, self.time_s = 0, 0.0
         self._updated = self.origin
+
+    def state_dict(self):
+        """``origin`` (the step the updates count from: a resumed run builds its writer at
+        another step), ``updates`` (the updates so far), ``updated`` (the step of the last,
+        or the origin), ``time_s`` [s] their wall time and ``frames`` the pores/ frames
+        written (PoreFrames.state_dict; None without frames)."""
+        return {"origin": self.origin, "updates": self.updates, "updated": self._updated,
+                "time_s": self.time_s,
+                "frames": None if self.frames is None else self.frames.state_dict()}
+
+    def load_state(self, state):
+        origin = check_int("origin", state["origin"], low=0)
+        updates = check_int("updates", state["updates"], low=0)
+        updated = check_int("updated", state["updated"], low=origin)
+        time_s = check_range("time_s", state["time_s"], 0.0, unit="s")
+        if (self.frames is None) != (state["frames"] is None):
+            raise ValueError("frames: the checkpoint's loading and this one differ in their "
+                             "pores/ frames (--vtk-frames, --vtk-every)")
+        if self.frames is not None:
+            self.frames.load_state(state["frames"])
+        self.origin, self.updates, self._updated, self.time_s = origin, updates, updated, time_s
+
+    def start(self, sim):
+        """The first frame of pores/: the state of ``sim`` the loading starts from."""
         self._frame(sim)
 
     def apply(self, sim):

@@ -34,7 +34,7 @@ liquid clusters of filled pore units join the bridges (pendular.capillary.liquid
 drying empties units by Haines jumps from the hull, wetting fills them at their filling
 suction, so that the path gives the main drying and wetting curves; each row adds the
 clusters' figures, and pores/ holds the pore units coloured by cluster, one ParaView frame per
-stage (CPU only, without checkpoints).
+stage (CPU only; a checkpoint holds the clusters' state and the frames written).
 
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
@@ -78,6 +78,7 @@ from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
 from pendular.procedures.loading import run_stage
+from pendular.procedures.loading_clusters import refuse_clusters_device
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
     sample_sizes, size_options)
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,
@@ -200,10 +201,7 @@ class SwccTest:
         check_device(device)
         checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
         stop_after = options.stop_after
-        if self.config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
-            raise ValueError(f"liquid = 'clusters' runs on the CPU without checkpoints (its pore "
-                             f"units are the host's and not yet checkpointed); got device = "
-                             f"{device!r}, checkpoint_every = {checkpoint_every}")
+        refuse_clusters_device(self.config, device)
         with OutputFolder(out, "swcc") as folder:
             for name in OUTPUTS:
                 folder.claim(name)
@@ -245,6 +243,7 @@ class SwccTest:
             particles, walls, preparation, stored = load_sample(sample_file)
             config = stored_run(config_from_dict(stored.get("config"), sample_file), out, cls,
                                 "swcc", device)
+            refuse_clusters_device(config, device)
             sim = servoed_simulation(particles, walls, config.sample, config.sample.confining,
                                      threads=threads)
             test = cls.__new__(cls)          # the stored run, checked when it started
@@ -341,11 +340,15 @@ class SwccPath:
 
     def extra_state(self, sim):
         """What a resumed run needs besides the simulation (CheckpointWriter extra_state)."""
-        return {"phase": "path", "stage": self.index, "stage_start": self.stage_start,
-                "stages": plain(self.stages), "formed": self.formed,
-                "checkpoint_every": self.checkpoint.period,
-                "preparation_time_s": self.preparation_time,
-                "path_time_s": self.path_time + time.perf_counter() - self._clock}
+        state = {"phase": "path", "stage": self.index, "stage_start": self.stage_start,
+                 "stages": plain(self.stages), "formed": self.formed,
+                 "checkpoint_every": self.checkpoint.period,
+                 "preparation_time_s": self.preparation_time,
+                 "path_time_s": self.path_time + time.perf_counter() - self._clock}
+        if self.clusters is not None:        # the pores/ frames so far
+            state["pore_frames"] = {key: value.tolist()
+                                    for key, value in self.pore_frames.state_dict().items()}
+        return state
 
     def load(self, path):
         """Load the checkpoint ``path`` into the simulation; its extra state (ValueError naming
@@ -366,6 +369,10 @@ class SwccPath:
                                                low=1)
             self.formed = check_int("formed", state["formed"], low=0)
             times = (float(state["preparation_time_s"]), float(state["path_time_s"]))
+            if self.clusters is not None:
+                frames = state["pore_frames"]
+                self.pore_frames.load_state({"numbers": np.array(frames["numbers"], np.int64),
+                                             "values": np.array(frames["values"], np.float64)})
         except (KeyError, TypeError, ValueError):
             raise ValueError(f"{path} does not belong to this run's suction path") from None
         if done != index or not all(isinstance(row, dict) for rows in stages.values()

@@ -425,7 +425,7 @@ class TensionTest:
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
         checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
-        refuse_clusters_run(self.config, device, checkpoint_every)
+        refuse_clusters_run(self.config, device)
         check_device(device)
         arguments = (self.config.options() if options.arguments is None
                      else dict(options.arguments))
@@ -453,6 +453,7 @@ class TensionTest:
             state = checkpoint_extra_state(path)
             config = stored_run(config_from_dict(state.get("config") if isinstance(state, dict)
                                                  else None, path), out, cls, "tension", device)
+            refuse_clusters_run(config, device)
             run = TensionRun(out, config, state.get("arguments"), 1, stop_after, state)
             return cls(config)._run(out, progress, device, run)
 

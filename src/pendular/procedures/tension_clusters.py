@@ -12,9 +12,9 @@ the packing as it stands CLUSTER_UPDATES times over --max-strain (``ClosedLiquid
 filled units carried over, so the liquid is V at every update; between updates the suction
 is held, the bridges following their gaps at it.
 
-Between walls, smooth spheres (suction-controlled bridges have no roughness), on the CPU,
-without checkpoints: ``refuse_clusters`` and ``refuse_clusters_run`` name the options
-otherwise.
+Between walls, smooth spheres (suction-controlled bridges have no roughness), on the CPU:
+``refuse_clusters`` and ``refuse_clusters_run`` name the options otherwise. A checkpoint holds
+the clusters' state (LiquidClusters.state_dict), so a pull resumes bit for bit.
 """
 
 from __future__ import annotations
@@ -57,13 +57,12 @@ def refuse_clusters(config) -> str | None:
     return None
 
 
-def refuse_clusters_run(config, device: str, checkpoint_every: int) -> None:
-    """ValueError naming --device and --checkpoint-every when a run of ``config`` with liquid
-    clusters asks for the GPU or checkpoints."""
-    if config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
-        raise ValueError(f"--liquid clusters runs on the CPU without checkpoints (its pore units "
-                         f"are the host's and not checkpointed); got --device {device}, "
-                         f"--checkpoint-every {checkpoint_every}")
+def refuse_clusters_run(config, device: str) -> None:
+    """ValueError naming --device when a run of ``config`` with liquid clusters asks for the
+    GPU."""
+    if config.liquid == "clusters" and device != "cpu":
+        raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the host's); "
+                         f"got --device {device}")
 
 
 def wet_clusters(dry, config, water_content: float, pairs, settle):
@@ -118,7 +117,10 @@ def wet_clusters(dry, config, water_content: float, pairs, settle):
 
 class ClosedLiquidUpdates:
     """Writer: every ``period`` steps from step ``origin``, ``clusters`` hold ``volume`` [m^3]
-    again at the packing as it stands (LiquidClusters.hold_volume)."""
+    again at the packing as it stands (LiquidClusters.hold_volume). Its volume, period and
+    origin are the pull's (a resumed pull builds it the same way)."""
+
+    stateless = True
 
     def __init__(self, clusters, volume, period, origin):
         self.clusters, self.volume = clusters, float(volume)
