@@ -122,6 +122,32 @@ def test_an_interrupted_path_resumes_to_the_same_history_without_its_table(sampl
         assert np.array_equal(got[name], expected[name], equal_nan=True), name
 
 
+def test_a_path_stopped_in_a_stage_of_other_controls_resumes_bit_for_bit(sample, tmp_path,
+                                                                        capsys):
+    """A suction ramp, then a compression at a strain rate: a checkpoint of the second stage
+    loads into that stage's controls (LoadingPath.enter_stage), not the first's."""
+    table = tmp_path / "dry_then_load.toml"
+    table.write_text("[[stage]]\nstress = {x = 750, y = 750, z = 750}\nsuction = 20000\n"
+                     "suction_rate = 2e6\n[[stage]]\nstrain_rate = {z = 'quasi-static'}\n"
+                     "stress = {x = 750, y = 750}\nuntil = {strain = 0.003, axis = 'z'}\n")
+    options = [*SMALL, *sample, "--suction", "30000", "--vtk-every", "0", "--no-plots",
+               "--checkpoint-every", "100"]
+    whole, stopped = tmp_path / "whole", tmp_path / "stopped"
+    status, err = run_in_process("path", [table, *options, "--out", whole], capsys)
+    assert status == 0, err
+    stages = summary_of(whole)["stages"]
+    steps = summary_of(whole)["steps"]
+    second = stages[1]["step"] - stages[0]["step"]      # the second stage's steps
+    status, _ = run_in_process("path", [table, *options, "--out", stopped, "--stop-after",
+                                        str(steps - second // 2)], capsys)
+    assert status == 130 and 1 in history_of(stopped)["stage"]    # stopped in the second
+    status, err = run_in_process("path", ["--resume", stopped, "--quiet"], capsys)
+    assert status == 0, err
+    expected, got = history_of(whole), history_of(stopped)
+    for name in expected:
+        assert np.array_equal(got[name], expected[name], equal_nan=True), name
+
+
 @pytest.mark.parametrize("table, arguments, words", [
     ("[[stage]]\nstress = {x = 750, y = 750, z = 750}\n[[stage]]\nstres = {x = 5}\n", [],
      ("path.toml: stage 2: unknown key 'stres'; valid: stress, strain_rate",)),

@@ -27,7 +27,7 @@ import time
 import numba
 import numpy as np
 
-from pendular.dem.checkpoint import CheckpointWriter, load_checkpoint
+from pendular.dem.checkpoint import CheckpointWriter, checkpoint_extra_state, load_checkpoint
 from pendular.dem.grading import grading
 from pendular.dem.measure import coordination, porosity
 from pendular.dem.mixed_stress import StageFailed
@@ -337,6 +337,13 @@ class LaboratoryTest:
             test.config = config
             run = _PathRun(sim, test, folder, before_shear, identity)
             dt = sim.dt                      # the loading's time step, set from its sample
+            extra = checkpoint_extra_state(checkpoint, identity)
+            where = extra.get("path") if isinstance(extra, dict) else None
+            if isinstance(where, dict) and "stage" in where:   # that stage's controls
+                try:
+                    run.path.enter_stage(sim, where["stage"])
+                except (TypeError, ValueError) as error:
+                    raise ValueError(f"{checkpoint}: {error} (an edited checkpoint)") from None
             state = load_checkpoint(checkpoint, sim, expected_identity=identity)
             if sim.dt != dt:                 # a checksum can be forged
                 raise ValueError(f"{checkpoint}: dt = {sim.dt:g} s is not this run's time step, "

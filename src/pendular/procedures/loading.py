@@ -578,11 +578,22 @@ class LoadingPath:
         return {"stage": self.stage, "stage_start": self.stage_start,
                 "stage_steps": self.stage_steps}
 
+    def enter_stage(self, sim, stage):
+        """Make the controls of stage number ``stage`` (from 0) ``sim``'s, built as a run
+        reaches them (each stage's from the one before, its servos carried): the pipeline
+        that a checkpoint taken in that stage loads into, whose ``load_state`` then sets them
+        as they were (``resume``)."""
+        stage = check_int("stage", stage, high=len(self.stages) - 1)
+        controls = self._controls(sim, self.stages[0], ())
+        for number in range(1, stage + 1):
+            controls = self._controls(sim, self.stages[number], controls)
+        self.controls = controls
+        sim.controls = list(controls)
+
     def resume(self, sim, state):
         """Take the stage of ``state`` (``state()`` of the run a checkpoint was written by),
-        once that checkpoint is loaded into ``sim``: the path's controls are then the loaded
-        ones (a checkpoint loads into a pipeline of the same operation types, so every stage
-        of a resumable path has those of the first)."""
+        once that checkpoint is loaded into ``sim`` (its controls those of ``enter_stage``):
+        the path's controls are then the loaded ones."""
         try:
             self.stage = check_int("stage", state["stage"], high=len(self.stages) - 1)
             self.stage_start = check_int("stage_start", state["stage_start"], high=sim.step)
