@@ -102,18 +102,13 @@ def test_the_forces_and_the_stress_follow_the_grains_through_a_face():
     sim.particles.position += np.array([0.0, 0.0, 0.6]) * RADIUS
     sim.walls.wrap(sim.particles)
     assert sim.walls.wraps[:4, 2].any()          # through the z face, the unit still across x
-    clusters.follow_packing(sim)
-    sim.evaluate_forces()
-    assert np.count_nonzero(clusters.filled) == 1
-    np.testing.assert_allclose(clusters.grain_forces(sim), force, rtol=0,
-                               atol=1e-10 * np.abs(force).max())
-    np.testing.assert_allclose(sim.walls.stress_tensor, stress, rtol=0,
-                               atol=1e-10 * np.abs(stress).max())
-    # decomposed again where the grains now are: the same unit, filled, the same forces
-    clusters.set_suction(sim, clusters.suction)
-    sim.evaluate_forces()
-    assert np.count_nonzero(clusters.filled) == 1
-    np.testing.assert_allclose(clusters.grain_forces(sim), force, rtol=0,
-                               atol=1e-10 * np.abs(force).max())
-    np.testing.assert_allclose(sim.walls.stress_tensor, stress, rtol=0,
-                               atol=1e-10 * np.abs(stress).max())
+    # followed, then decomposed again where the grains now are: the same unit, filled, the
+    # same forces and stress
+    for update in (clusters.follow_packing, lambda s: clusters.set_suction(s, clusters.suction)):
+        update(sim)
+        sim.evaluate_forces()
+        assert np.count_nonzero(clusters.filled) == 1
+        np.testing.assert_allclose(clusters.grain_forces(sim), force, rtol=0,
+                                   atol=1e-10 * np.abs(force).max())
+        np.testing.assert_allclose(sim.walls.stress_tensor, stress, rtol=0,
+                                   atol=1e-10 * np.abs(stress).max())
