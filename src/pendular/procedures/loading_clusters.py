@@ -117,42 +117,61 @@ def wetted_clusters(sim, clusters):
     return figures
 
 
+def hold_water(sim, bridges_config, pairs, target, settle, entry, *, max_gap=0.0,
+               settle_filled=True):
+    """(bridges, clusters, first, found, steps): the static sample ``sim`` wetted in place to
+    the closed liquid volume ``target`` [m^3] (a water content) held by persisting
+    suction-controlled bridges and liquid clusters (``bridges_config``: a configuration with its surface
+    tension and contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
+    (liquid added to dry grains). The suction is found at the dry packing (``first``,
+    LiquidClusters.hold_volume; bridges on ``pairs``, (pair_i, pair_j, gap [m] or None: at
+    contact), and with ``max_gap`` [m] > 0 across every gap of the neighbour list up to
+    it), the sample run until static (``settle(sim)``, the steps), the suction found again
+    at the packing reached (``found``) and, with ``settle_filled`` where units are filled,
+    the sample run until static once more; ``steps`` in all. NotPendular where bridges at
+    contact cannot hold ``target`` within the pendular limit."""
+    from pendular.capillary import (BridgeTable, CapillaryBridges, formation_suction,
+                                    sample_radius_ratios)
+    from pendular.capillary.liquid_clusters import LiquidClusters
+
+    pair_i, pair_j, gap = pairs
+    radius = sim.particles.radius
+    table = BridgeTable.cached(bridges_config.contact_angle,
+                               radius_ratios=sample_radius_ratios(radius))
+    # the bridges' alone: the clusters hold more at a suction, so theirs is higher (and the
+    # neighbour list at this one's reach holds every pair that can take liquid)
+    start = formation_suction(table, radius[pair_i], radius[pair_j], target,
+                              bridges_config.surface_tension, gap=gap)
+    bridges = CapillaryBridges(start, bridges_config.surface_tension,
+                               bridges_config.contact_angle, persist=True)
+    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
+    sim.forces += [bridges, clusters]
+    sim.evaluate_forces()
+    first = clusters.hold_volume(sim, target, max_gap)
+    steps = settle(sim)
+    found = clusters.hold_volume(sim, target)
+    if settle_filled and clusters.filled.any():
+        steps += settle(sim)
+    return bridges, clusters, first, found, steps
+
+
 def wet_clusters_at_water_content(dry, bridges_config, target, settle, entry):
     """(bridges, clusters, report) of the static sample ``dry`` wetted in place to the closed
-    liquid volume ``target`` [m^3] (a water content) held by persisting suction-controlled
-    bridges and liquid clusters (``bridges_config``: BridgeConfig, its surface tension and
-    contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
-    (liquid added to dry grains): the suction found at the dry packing
-    (LiquidClusters.hold_volume; bridges at every contact), the sample run until static
-    (``settle(sim)``, the steps), the suction found again at the packing reached and, where
-    units are filled, the sample run until static once more. Report: the steps, the suction
-    found at the packing reached (``formation_suction_pa``) and the volume
-    (``liquid_initial``). ValueError naming --water-content where bridges at contact cannot
-    hold it within the pendular limit."""
-    from pendular.capillary import BridgeTable, formation_suction, sample_radius_ratios
-    from pendular.capillary.liquid_clusters import LiquidClusters
+    liquid volume ``target`` [m^3] (``hold_water``, bridges at every contact; the sample run
+    until static once more where units are filled). Report: the steps, the suction found at
+    the packing reached (``formation_suction_pa``) and the volume (``liquid_initial``).
+    ValueError naming --water-content where bridges at contact cannot hold it within the
+    pendular limit."""
     from pendular.capillary.validation import NotPendular
 
-    sim, particles = dry, dry.particles
+    sim = dry
     if sim.contacts is None:
         sim.evaluate_forces()
     touching = sim.contacts.overlap > 0.0
-    table = BridgeTable.cached(bridges_config.contact_angle,
-                               radius_ratios=sample_radius_ratios(particles.radius))
-    # the bridges' alone: the clusters hold more at a suction, so theirs is higher
-    start = formation_suction(table, particles.radius[sim.contacts.pair_i[touching]],
-                              particles.radius[sim.contacts.pair_j[touching]], target,
-                              bridges_config.surface_tension)
-    bridges = cluster_bridges(bridges_config, start)
-    clusters = LiquidClusters(bridges, saturated=False, entry=entry)
-    sim.forces += [bridges, clusters]
+    pairs = (sim.contacts.pair_i[touching], sim.contacts.pair_j[touching], None)
     try:
-        sim.evaluate_forces()
-        clusters.hold_volume(sim, target)
-        steps = settle(sim)
-        found = clusters.hold_volume(sim, target)
-        if clusters.filled.any():
-            steps += settle(sim)
+        bridges, clusters, _, found, steps = hold_water(sim, bridges_config, pairs, target,
+                                                        settle, entry)
     except NotPendular as error:
         raise ValueError(
             f"--water-content = {100.0 * bridges_config.water_content:g} % is more than this "

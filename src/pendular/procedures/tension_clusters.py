@@ -22,15 +22,11 @@ from __future__ import annotations
 import copy
 import math
 
-from pendular.capillary.bridges import CapillaryBridges
-from pendular.capillary.liquid_clusters import LiquidClusters
-from pendular.capillary.radius_ratios import sample_radius_ratios
-from pendular.capillary.table import BridgeTable
 from pendular.capillary.validation import NotPendular
-from pendular.capillary.wetting import formation_suction, gravimetric_water_content
+from pendular.capillary.wetting import gravimetric_water_content
 from pendular.dem.measure import coordination, unbalanced_force
 from pendular.procedures.columns import cluster_columns as cluster_figures
-from pendular.procedures.loading_clusters import cluster_row
+from pendular.procedures.loading_clusters import cluster_row, hold_water
 from pendular.utils.parameters import ParameterError
 
 #: Closed-liquid solutions of a pull (LiquidClusters.hold_volume) over --max-strain.
@@ -72,25 +68,12 @@ def wet_clusters(dry, config, water_content: float, pairs, settle):
     (tension_pull.wetted_pairs); ``settle(sim)``: runs it to equilibrium, returns the steps.
     The report is tension_pull.wet's, its void ratio aside, and ``clusters_wet``."""
     particles = dry.particles
-    radius = particles.radius
     target = water_content * config.specific_gravity * particles.solid_volume()
-    max_gap = config.form_gap * config.sample.radius
-    pair_i, pair_j, gap = pairs
-    table = BridgeTable.cached(config.contact_angle, radius_ratios=sample_radius_ratios(radius))
-    # the bridges' alone: the clusters hold more at a suction, so theirs is higher and the
-    # neighbour list at this one's reach holds every pair that can take liquid
-    start = formation_suction(table, radius[pair_i], radius[pair_j], target,
-                              config.surface_tension, gap=gap)
     sim = copy.deepcopy(dry)
-    bridges = CapillaryBridges(start, config.surface_tension, config.contact_angle,
-                               persist=True)
-    clusters = LiquidClusters(bridges, saturated=False, entry=config.entry_suction)
-    sim.forces += [bridges, clusters]
     try:
-        sim.evaluate_forces()
-        first = clusters.hold_volume(sim, target, max_gap)
-        steps = settle(sim)
-        liquid = clusters.hold_volume(sim, target)
+        bridges, clusters, first, liquid, steps = hold_water(
+            sim, config, pairs, target, settle, config.entry_suction,
+            max_gap=config.form_gap * config.sample.radius, settle_filled=False)
     except NotPendular as error:
         raise ParameterError("water_content", (
             f"water_content = {100.0 * water_content:g} % is more than this sample holds with "
