@@ -247,8 +247,8 @@ def test_a_tension_resume_that_changes_the_configuration_is_refused(tension_runs
 
 #: Laboratory tests with liquid clusters, updated every 10 records (CLUSTER_RECORDS patched),
 #: their forces following the grains at every record between.
-CLUSTERS = ["--particles", "60", "--liquid", "clusters", "--checkpoint-every", "100",
-            "--threads", "1", "--quiet"]
+CLUSTERS = ["--particles", "60", "--liquid", "clusters", "--checkpoint-every", "300",
+            "--threads", "1", "--quiet", "--no-plots"]
 #: (command, its options, --stop-after): a triaxial at a suction with pores/ frames, one at a
 #: water content (the closed liquid) without, a simple shear (a sheared periodic cell).
 CLUSTER_CASES = {
@@ -257,8 +257,8 @@ CLUSTER_CASES = {
     "water content": ("triaxial", ["--water-content", "3", "--max-strain", "0.01",
                                    "--records", "20", "--vtk-frames", "0"], 1500),
     "sheared cell": ("simple-shear", ["--suction", "20000", "--seed", "3", "--max-strain",
-                                      "0.02", "--record-strain", "0.001", "--vtk-frames", "5"],
-                     3000)}
+                                      "0.01", "--record-strain", "0.0005", "--vtk-frames", "5"],
+                     1500)}
 
 
 def saved_state(checkpoint, kind, name):
