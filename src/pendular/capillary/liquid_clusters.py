@@ -66,6 +66,7 @@ class LiquidClusters:
         self._carried = None          # filled units of a checkpoint, until set_suction
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
         self._own_virial = None       # (the forces, their sum of x (x) F [N m]) (virial)
+        self.version = 0              # counts the changes of the forces apply adds (_set_forces)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
@@ -170,6 +171,7 @@ class LiquidClusters:
                                           np.flatnonzero(self.liquid.front),
                                           self.liquid.front_fraction, self.suction,
                                           len(particles))
+        self.version += 1
 
     def follow_packing(self, sim):
         """The forces of the filled units with their grains where they are now, the filled
@@ -214,6 +216,7 @@ class LiquidClusters:
     def grain_forces(self, sim):
         """(N, 3) [N] the forces ``apply`` adds to the grains at ``sim``'s state: the
         clusters' own, less the shares of the bridges' forces they absorb."""
+        sim.fetch("contacts")           # all of a device run's state (Simulation.fetch)
         force = np.zeros_like(sim.particles.position)
         self._add_forces(sim, force)
         return force
@@ -235,7 +238,18 @@ class LiquidClusters:
         """Whether ``apply`` adds any force to ``sim``'s grains now: whether a unit holds
         liquid (without, a periodic cell's stress stays the gathered sum of the pair forces,
         pendular.dem.cell.PeriodicCell.after_forces)."""
+        return self.holds_liquid
+
+    @property
+    def holds_liquid(self):
+        """Whether a unit holds liquid now (``apply`` adds forces)."""
         return self._force is not None and bool(self.filled.any() or self._front_held())
+
+    @property
+    def cluster_force(self):
+        """(N, 3) [N] the clusters' own forces on the grains that ``apply`` adds each step
+        (None before the model's first step; read only: it changes with ``version``)."""
+        return self._force
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
@@ -243,12 +257,29 @@ class LiquidClusters:
         change (read only)."""
         edge = self.pair_edge(contacts)
         if self._share is None:
-            if self._front_held():
-                share = self._edges.share(self.liquid.weight)
-            else:
-                share = self._edges.filled_share(self.filled)
+            share = self._edge_share()
             self._share = np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
         return self._share
+
+    def absorbed_shares(self, count):
+        """(keys, shares): the units' edges of which the filled units hold a share, each as
+        the key i * ``count`` + j of its grains i < j (of ``count`` grains), sorted (E,)
+        int64, and that share (E,) [-], ``pair_share``'s by grain pair rather than by a
+        neighbour list's pair (a device matches its own pairs to it: pendular.gpu.clusters);
+        it changes with ``version``."""
+        share = self._edge_share()
+        held = share > 0.0
+        pair = self._edges.pair[held].astype(np.int64)
+        keys = pair[:, 0] * count + pair[:, 1]
+        order = np.argsort(keys, kind="stable")
+        return keys[order], share[held][order]
+
+    def _edge_share(self):
+        """(E,) the share of each edge of the units that the filled units hold (and the
+        closed liquid's front, in its fraction)."""
+        if self._front_held():
+            return self._edges.share(self.liquid.weight)
+        return self._edges.filled_share(self.filled)
 
     def pair_edge(self, contacts):
         """(K,) the edge of the pore units each pair of the neighbour list ``contacts`` is
@@ -318,6 +349,7 @@ class LiquidClusters:
         total = np.zeros((3, 3))
         if not self.adds_forces(sim):
             return total
+        sim.fetch("contacts")           # all of a device run's state (Simulation.fetch)
         if self._own_virial is None or self._own_virial[0] is not self._force:
             self._own_virial = (self._force, -self._stress_over(1.0))
         total += self._own_virial[1]
@@ -338,6 +370,7 @@ class LiquidClusters:
         the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
         if already measured)."""
         account = self.account(sim) if account is None else account
+        sim.fetch("particles")          # all of a device run's state (Simulation.fetch)
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
         in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))

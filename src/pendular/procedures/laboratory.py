@@ -240,9 +240,11 @@ class LaboratoryTest:
         ``device``: where every phase runs (the preparation or a loaded sample's equilibrium,
         the wetting, the loading), "cpu" or "gpu" (``check_device``)."""
         options = RunOptions.of(options, **settings)
-        if self.config.liquid == "clusters" and options.device != "cpu":
-            raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the "
-                             f"host's): --device {options.device} does not apply")
+        if (self.config.liquid == "clusters" and options.device != "cpu"
+                and self.config.sample.periodic):
+            raise ValueError(f"--liquid clusters runs on the GPU between walls only: --device "
+                             f"{options.device} does not apply with --periodic (the cell's "
+                             "stress would need the clusters' virial on the device)")
         check_device(options.device)
         check_stages_device(self.stages(), options.device)
         vtk_prep = options.vtk_prep

@@ -12,8 +12,8 @@ the packing as it stands CLUSTER_UPDATES times over --max-strain (``ClosedLiquid
 filled units carried over, so the liquid is V at every update; between updates the suction
 is held, the bridges following their gaps at it.
 
-Between walls, smooth spheres (suction-controlled bridges have no roughness), on the CPU,
-without checkpoints: ``refuse_clusters`` and ``refuse_clusters_run`` name the options
+Between walls, smooth spheres (suction-controlled bridges have no roughness), on either
+device, without checkpoints: ``refuse_clusters`` and ``refuse_clusters_run`` name the options
 otherwise.
 """
 
@@ -58,11 +58,11 @@ def refuse_clusters(config) -> str | None:
 
 
 def refuse_clusters_run(config, device: str, checkpoint_every: int) -> None:
-    """ValueError naming --device and --checkpoint-every when a run of ``config`` with liquid
-    clusters asks for the GPU or checkpoints."""
-    if config.liquid == "clusters" and (device != "cpu" or checkpoint_every):
-        raise ValueError(f"--liquid clusters runs on the CPU without checkpoints (its pore units "
-                         f"are the host's and not checkpointed); got --device {device}, "
+    """ValueError naming --checkpoint-every when a run of ``config`` with liquid clusters asks
+    for checkpoints (``device``: either runs them)."""
+    if config.liquid == "clusters" and checkpoint_every:
+        raise ValueError(f"--liquid clusters runs without checkpoints (its pore units "
+                         f"are the host's and not checkpointed); got "
                          f"--checkpoint-every {checkpoint_every}")
 
 
