@@ -12,6 +12,9 @@ measurements, simulator.run_checks):
   the positions and the clusters' forces against the CPU's, the filled units of each, and
   the largest of the clusters' own forces and of the bridges' forces they absorb (the
   comparison's sensitivity to them);
+- "wetter": the same scene, its model stepped by a writer at a lower suction WETTER halfway
+  through a run of STEPS steps (the bridges' reach grows: the device's state uploaded again
+  from the host), against the CPU's;
 - "refusal": clusters listed before their bridges, and in a periodic cell.
 """
 
@@ -21,6 +24,7 @@ from simulator import relative, run_checks
 #: the second (drier: fewer filled units).
 SUCTION = 350.0
 DRIER = 360.0
+WETTER = 300.0
 STEPS = 40
 FOLLOW = 10
 UPDATES = 2
@@ -97,6 +101,41 @@ def clusters():
             "absorbed_force": [value / size for value, size in zip(largest, scale)]}
 
 
+class Wetting:
+    """Writer: at step ``at`` the bridges and the clusters of ``sim`` at WETTER (the state
+    fetched first, as the model's steps do)."""
+
+    def __init__(self, bridges, clusters, at):
+        self.bridges, self.clusters, self.at = bridges, clusters, at
+
+    def apply(self, sim):
+        if sim.step == self.at:
+            self.bridges.set_suction(WETTER)
+            self.clusters.set_suction(sim, WETTER)
+
+
+def wetter():
+    """The module docstring's "wetter"."""
+    import numpy as np
+
+    from pendular.gpu import GpuSimulation
+
+    runs = {}
+    for device in ("cpu", "gpu"):
+        sim, bridges, held = scene()
+        reach = bridges.required_range
+        sim.writers.append(Wetting(bridges, held, sim.step + STEPS // 2))
+        runner = sim if device == "cpu" else GpuSimulation(sim)
+        uploaded = None if device == "cpu" else runner.state
+        runner.run(STEPS)
+        runs[device] = snapshot(sim, held)
+        if device == "gpu":
+            replaced = runner.state is not uploaded
+        filled = int(np.count_nonzero(held.filled))
+    return {"agreement": compare(runs["cpu"], runs["gpu"]), "replaced": replaced,
+            "reach": [reach, bridges.required_range], "filled": filled}
+
+
 def refusal():
     """The messages of the scenes the device refuses: clusters before their bridges, and in
     a periodic cell."""
@@ -119,4 +158,4 @@ def refusal():
 
 
 if __name__ == "__main__":
-    run_checks({"clusters": clusters, "refusal": refusal})
+    run_checks({"clusters": clusters, "wetter": wetter, "refusal": refusal})

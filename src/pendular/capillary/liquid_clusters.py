@@ -14,7 +14,9 @@ liquid that lies in empty units (its force is taken off in the share the filled 
 the cluster's pressure and menisci replace it there). Between walls, or in a periodic cell
 (sheared too): there the units are cut from the grains' images (pendular.capillary.pores), a
 unit's forces act at the images it sees, and ``virial`` hands the cell's stress their sum of
-x (x) F (pendular.dem.cell.PeriodicCell.after_forces). On the CPU.
+x (x) F (pendular.dem.cell.PeriodicCell.after_forces). The model runs on the host; between
+walls a device adds the forces each step from what it reads here (``cluster_force``,
+``absorbed_shares``, new at each ``version``: pendular.gpu.clusters).
 
 With the liquid closed (a water content), ``hold_volume(sim, V)`` is the model's step instead:
 the suction is the one at which the bridges and the filled units hold V

@@ -195,6 +195,11 @@ class VolumeBridgesOnDevice(SuctionBridgesOnDevice):
         """Volume-controlled bridges always persist across gaps."""
         return True
 
+    def changed_on_host(self):
+        """Never during a run: the formation suction changes between runs (a wetting's try),
+        which a run's set-up reads."""
+        return False
+
     @property
     def roughness(self):
         """The liquid model's roughness now."""

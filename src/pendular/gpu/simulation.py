@@ -7,6 +7,7 @@ CPU pipeline (pendular.dem.simulation) on the device::
     pair_forces                                 contact law (+ bridges, wet)
     gather                                      forces and torques per particle (+ walls)
     pair_moments, gather_moments                rolling resistance (its moments on torques)
+    absorbed_forces, add_clusters               liquid clusters (their forces, absorbed shares)
     add_weight                                  gravity
     wall_partials, wall_sums, wall_controls     walls' force, stiffness, moment; controls
     grip_partials, grip_hold                    grips: their pulls, members on their walls
@@ -39,7 +40,8 @@ and Hertz–Mindlin laws of pendular.dem.hertz_mindlin), WallForces or a wall la
 (ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance
 (pendular.gpu.rolling), WallRollingResistance (pendular.gpu.wall_rolling), Gravity
 (pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps (``persist``; a
-new suction between runs, as the CPU: pendular.gpu.bridges); controls StressServo,
+new suction between runs, as the CPU: pendular.gpu.bridges), LiquidClusters beside bridges
+across gaps (their model on the host: pendular.gpu.clusters); controls StressServo,
 ConstantStrainRate, MixedStress (its servos among the controls), RadiusGrowth and
 GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
 damped or Hertz–Mindlin law), RollingResistance and, wet, SuctionBridges at contact or across
