@@ -1,6 +1,6 @@
 """Compile every kernel of a dry and a wet step (and a radius growth's, a periodic cell's
 dry and wet, a simple shear's, the grips', the rolling resistance's and gravity's, the walls'
-springs and rolling resistance) for a real GPU (PTX,
+springs and rolling resistance, the liquid clusters') for a real GPU (PTX,
 by default for compute capability 9.0, an H100) without one, as a script in its own process:
 the simulator runs kernels as Python and would not see code that the CUDA target cannot
 compile (a NumPy ufunc, a global it cannot type).
@@ -110,7 +110,9 @@ def compile_step_kernels(cuda, capability):
     # (shear_checks.py's), the grips' (grips_checks.py's), volume-controlled bridges'
     # liquid exchange (volume_checks.py's), the rolling resistance and gravity
     # (rolling_checks.py's), the sphere-wall bridges (wall_bridges_checks.py's), the walls'
-    # springs and rolling resistance (wall_friction_checks.py's)
+    # springs and rolling resistance (wall_friction_checks.py's), the liquid clusters'
+    # (clusters_checks.py's)
+    from clusters_checks import scene as clusters_scene
     from grips_checks import scene as grips_scene
     from growth_checks import scene as growth_scene
     from periodic_checks import scene as periodic_scene
@@ -125,7 +127,7 @@ def compile_step_kernels(cuda, capability):
                        (shear_scene(), " sheared"),
                        (grips_scene(wet=False)[0], ""), (volume_scene()[0], " volume"),
                        (rolling_scene(), ""), (wall_bridges_scene(), ""),
-                       (wall_friction_scene(rolling=True), "")):
+                       (wall_friction_scene(rolling=True), ""), (clusters_scene()[0], "")):
         gpu = GpuSimulation(sim)
         gpu.configure()
         for kernel, _, args in gpu.steps:

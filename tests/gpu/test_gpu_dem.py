@@ -120,7 +120,7 @@ def compile_ptx(*arguments):
 def test_every_kernel_compiles_for_a_gpu():
     """PTX for an H100 of every kernel of a dry and a wet step, walled and periodic, with
     the rolling resistance, gravity, the sphere-wall bridges, the walls' springs and rolling
-    resistance (tests/gpu/compile_ptx.py),
+    resistance, the liquid clusters (tests/gpu/compile_ptx.py),
     where the gpu extra's CUDA compiler is installed: the simulator would run code that the
     CUDA target rejects."""
     done = compile_ptx()
@@ -134,10 +134,12 @@ def test_every_kernel_compiles_for_a_gpu():
     resisting = ("pair_moments", "gather_moments", "add_weight")
     wall_bridges = ("wall_bridges", "wall_bridge_partials", "wall_bridge_sums")
     wall_springs = ("wall_contacts", "wall_moments")
+    clusters = ("absorbed_forces", "add_clusters")
     periodic = ("bin_periodic", "find_periodic_pairs", "cell_partials", "cell_controls",
                 "cell_leapfrog")
     assert set(compiled["kernels"]) == {*kernels, *(f"{name} wet" for name in kernels), *growth,
                                         *grips, *resisting, *wall_bridges, *wall_springs,
+                                        *clusters,
                                         *(f"{name} periodic" for name in periodic),
                                         *(f"{name} periodic wet" for name in periodic),
                                         *(f"{name} sheared" for name in (*periodic,

@@ -132,9 +132,11 @@ def test_the_command_line_refuses_them_in_one_line(command, argv, words, capsys,
     refused(status, err, *words)
 
 
-def test_clusters_on_the_gpu_are_refused_before_anything_runs(tmp_path):
-    config = TriaxialConfig(sample=SAMPLE, shear=SHEAR, vtk_frames=0, liquid="clusters",
+def test_clusters_in_a_periodic_cell_on_the_gpu_are_refused_before_anything_runs(tmp_path):
+    config = TriaxialConfig(sample=PrepareConfig(particles=60, seed=3, periodic=True),
+                            shear=SHEAR, vtk_frames=0, liquid="clusters",
                             bridges=BridgeConfig(20000.0))
-    with pytest.raises(ValueError, match="--liquid clusters runs on the CPU.*--device gpu"):
+    with pytest.raises(ValueError, match="--liquid clusters runs on the GPU between walls "
+                                         "only: --device gpu .*--periodic"):
         TriaxialTest(config).run(tmp_path / "out", device="gpu", progress=False)
     assert not (tmp_path / "out").exists()

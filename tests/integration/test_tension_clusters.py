@@ -13,7 +13,7 @@ from pendular.capillary.liquid_clusters import LiquidClusters
 from pendular.io.schema import undeclared_keys
 from pendular.procedures import tension_pull
 from pendular.procedures.preparation import prepare_sample
-from pendular.procedures.tension import TensionConfig, TensionTest, tension_sample
+from pendular.procedures.tension import TensionConfig, tension_sample
 from pendular.procedures.tension_clusters import (CLUSTER_FIGURES, ClosedLiquidUpdates,
                                                   cluster_summary)
 
@@ -88,9 +88,3 @@ def test_what_clusters_do_not_support_is_refused(extra, words, capsys, tmp_path)
                                              "--vtk-frames", "0", "--out", tmp_path / "out",
                                              *extra], capsys)
     refused(status, err, *words)
-
-
-def test_clusters_on_the_gpu_are_refused_before_anything_runs(config, tmp_path):
-    """(The command line refuses --device gpu first where no GPU is visible.)"""
-    with pytest.raises(ValueError, match="--liquid clusters runs on the CPU.*--device gpu"):
-        TensionTest(config).run(str(tmp_path / "out"), device="gpu", progress=False)

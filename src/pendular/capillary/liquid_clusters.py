@@ -14,7 +14,9 @@ liquid that lies in empty units (its force is taken off in the share the filled 
 the cluster's pressure and menisci replace it there). Between walls, or in a periodic cell
 (sheared too): there the units are cut from the grains' images (pendular.capillary.pores), a
 unit's forces act at the images it sees, and ``virial`` hands the cell's stress their sum of
-x (x) F (pendular.dem.cell.PeriodicCell.after_forces). On the CPU.
+x (x) F (pendular.dem.cell.PeriodicCell.after_forces). The model runs on the host; between
+walls a device adds the forces each step from what it reads here (``cluster_force``,
+``absorbed_shares``, new at each ``version``: pendular.gpu.clusters).
 
 With the liquid closed (a water content), ``hold_volume(sim, V)`` is the model's step instead:
 the suction is the one at which the bridges and the filled units hold V
@@ -73,6 +75,7 @@ class LiquidClusters:
         self._share = None
         self.liquid = None            # ClosedLiquid of the last hold_volume (None: imposed)
         self._own_virial = None       # (the forces, their sum of x (x) F [N m]) (virial)
+        self.version = 0              # counts the changes of the forces apply adds (_set_forces)
 
     # ---------------------------------------------------------------- checkpoints
     def state_dict(self):
@@ -212,6 +215,7 @@ class LiquidClusters:
                                           np.flatnonzero(self.liquid.front),
                                           self.liquid.front_fraction, self.suction,
                                           grain_count)
+        self.version += 1
 
     def follow_packing(self, sim):
         """The forces of the filled units with their grains where they are now, the filled
@@ -259,6 +263,7 @@ class LiquidClusters:
     def grain_forces(self, sim):
         """(N, 3) [N] the forces ``apply`` adds to the grains at ``sim``'s state: the
         clusters' own, less the shares of the bridges' forces they absorb."""
+        sim.fetch("contacts")           # all of a device run's state (Simulation.fetch)
         force = np.zeros_like(sim.particles.position)
         self._add_forces(sim, force)
         return force
@@ -280,7 +285,18 @@ class LiquidClusters:
         """Whether ``apply`` adds any force to ``sim``'s grains now: whether a unit holds
         liquid (without, a periodic cell's stress stays the gathered sum of the pair forces,
         pendular.dem.cell.PeriodicCell.after_forces)."""
+        return self.holds_liquid
+
+    @property
+    def holds_liquid(self):
+        """Whether a unit holds liquid now (``apply`` adds forces)."""
         return self._force is not None and bool(self.filled.any() or self._front_held())
+
+    @property
+    def cluster_force(self):
+        """(N, 3) [N] the clusters' own forces on the grains that ``apply`` adds each step
+        (None before the model's first step; read only: it changes with ``version``)."""
+        return self._force
 
     def pair_share(self, contacts):
         """(K,) the share of each pair's bridge that the filled units hold (and the closed
@@ -288,12 +304,29 @@ class LiquidClusters:
         change (read only)."""
         edge = self.pair_edge(contacts)
         if self._share is None:
-            if self._front_held():
-                share = self._edges.share(self.liquid.weight)
-            else:
-                share = self._edges.filled_share(self.filled)
+            share = self._edge_share()
             self._share = np.where(edge >= 0, share[np.maximum(edge, 0)], 0.0)
         return self._share
+
+    def absorbed_shares(self, count):
+        """(keys, shares): the units' edges of which the filled units hold a share, each as
+        the key i * ``count`` + j of its grains i < j (of ``count`` grains), sorted (E,)
+        int64, and that share (E,) [-], ``pair_share``'s by grain pair rather than by a
+        neighbour list's pair (a device matches its own pairs to it: pendular.gpu.clusters);
+        it changes with ``version``."""
+        share = self._edge_share()
+        held = share > 0.0
+        pair = self._edges.pair[held].astype(np.int64)
+        keys = pair[:, 0] * count + pair[:, 1]
+        order = np.argsort(keys, kind="stable")
+        return keys[order], share[held][order]
+
+    def _edge_share(self):
+        """(E,) the share of each edge of the units that the filled units hold (and the
+        closed liquid's front, in its fraction)."""
+        if self._front_held():
+            return self._edges.share(self.liquid.weight)
+        return self._edges.filled_share(self.filled)
 
     def pair_edge(self, contacts):
         """(K,) the edge of the pore units each pair of the neighbour list ``contacts`` is
@@ -363,6 +396,7 @@ class LiquidClusters:
         total = np.zeros((3, 3))
         if not self.adds_forces(sim):
             return total
+        sim.fetch("contacts")           # all of a device run's state (Simulation.fetch)
         if self._own_virial is None or self._own_virial[0] is not self._force:
             self._own_virial = (self._force, -self._stress_over(1.0))
         total += self._own_virial[1]
@@ -383,6 +417,7 @@ class LiquidClusters:
         the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
         if already measured)."""
         account = self.account(sim) if account is None else account
+        sim.fetch("particles")          # all of a device run's state (Simulation.fetch)
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
         in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))

@@ -53,6 +53,10 @@ class NoBridges:
     def pairs_to_host(self, sim, state, index):
         """Nothing to bring back."""
 
+    def reach_changed(self, state):
+        """Whether the bridges' reach differs from the one ``state`` was sized for: never."""
+        return False
+
 
 @device_side(SuctionBridges)
 class SuctionBridgesOnDevice(DeviceSide, NoBridges):
@@ -98,7 +102,8 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
         if not self.persist:
             return
         what = f"bridges across gaps ({self.name} with persist = True)"
-        if scene.forces[-1] is not self:
+        after = scene.forces[scene.index(self) + 1:]
+        if any(side.role in ("contact law", "walls") for side in after):
             raise ValueError(f"device='gpu' runs {what} listed after the contact law and the "
                              "wall forces only")
         if any(side.grows_radii for side in scene.controls):
@@ -138,8 +143,18 @@ class SuctionBridgesOnDevice(DeviceSide, NoBridges):
         """The sphere–wall bridges' pulls on the walls, after the walls' own sums."""
         return [] if self.walls is None else self.walls.wall_launches(state)
 
+    def changed_on_host(self):
+        """Whether the host imposed a new suction during a run (LiquidClusters.hold_volume
+        between two steps)."""
+        return self.op.suction != self.suction
+
+    def reach_changed(self, state):
+        """Whether the bridges' reach (the rupture range, which grows as the suction falls)
+        differs from the one ``state`` (a DeviceState) was sized for."""
+        return self.op.required_range != state.reach
+
     def _check_reach(self, state):
-        if self.op.required_range != state.reach:
+        if self.reach_changed(state):
             raise ValueError(f"the bridges' reach {self.op.required_range:g} m changed since "
                              f"the GPU copy was made ({state.reach:g} m; a lower suction "
                              "of persisting bridges): call to_host() and build a new "
@@ -179,6 +194,11 @@ class VolumeBridgesOnDevice(SuctionBridgesOnDevice):
     def persist(self):
         """Volume-controlled bridges always persist across gaps."""
         return True
+
+    def changed_on_host(self):
+        """Never during a run: the formation suction changes between runs (a wetting's try),
+        which a run's set-up reads."""
+        return False
 
     @property
     def roughness(self):

@@ -23,10 +23,12 @@ operation's parameters at every run. It declares:
 - ``check(scene)``: ValueError naming what of ``scene`` (a Scene: the simulation and every
   side) it does not run, called before anything is uploaded and at every run;
 - a box (BoxSide): its step's launches, its own state up and back; a force: what its role's
-  launches read (pendular.gpu.simulation); a control (ControlSide): ``upload(row, program,
-  scene)``, its row of the controls' program and memory; ``parameters(values)``, its row of
-  parameters now; ``to_host(row, program)``, the memory it keeps back into the operation;
-  ``driven(scene)``, the rows of the servos whose targets it sets.
+  launches read (pendular.gpu.simulation), and ``changed_on_host()``, whether the host changed
+  its operation during a run (the launches laid again); a control (ControlSide):
+  ``upload(row, program, scene)``, its row of the controls' program and memory;
+  ``parameters(values)``, its row of parameters now; ``to_host(row, program)``, the memory it
+  keeps back into the operation; ``driven(scene)``, the rows of the servos whose targets it
+  sets.
 """
 
 from dataclasses import dataclass
@@ -75,6 +77,13 @@ class DeviceSide:
         controls, its own share of the walls' sums (``state`` a DeviceState, inside walls);
         none by default."""
         return []
+
+    def changed_on_host(self):
+        """A force's: whether the host changed what the step's launches read of its operation
+        since they were laid (a model stepped on the host between two of the device's steps,
+        the state fetched: a new suction, new cluster forces), so that they are laid again
+        before the next step (GpuSimulation.advance); False by default."""
+        return False
 
     def pairs_to_host(self, sim, state, index):
         """A force's own state from ``state`` (a DeviceState) into its operation when the

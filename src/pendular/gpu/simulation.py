@@ -7,6 +7,7 @@ CPU pipeline (pendular.dem.simulation) on the device::
     pair_forces                                 contact law (+ bridges, wet)
     gather                                      forces and torques per particle (+ walls)
     pair_moments, gather_moments                rolling resistance (its moments on torques)
+    absorbed_forces, add_clusters               liquid clusters (their forces, absorbed shares)
     add_weight                                  gravity
     wall_partials, wall_sums, wall_controls     walls' force, stiffness, moment; controls
     grip_partials, grip_hold                    grips: their pulls, members on their walls
@@ -39,7 +40,8 @@ and Hertz–Mindlin laws of pendular.dem.hertz_mindlin), WallForces or a wall la
 (ViscoelasticWallForces, FrictionalWallForces: pendular.gpu.wall_friction), RollingResistance
 (pendular.gpu.rolling), WallRollingResistance (pendular.gpu.wall_rolling), Gravity
 (pendular.gpu.gravity) and, wet, SuctionBridges at contact or across gaps (``persist``; a
-new suction between runs, as the CPU: pendular.gpu.bridges); controls StressServo,
+new suction between runs, as the CPU: pendular.gpu.bridges), LiquidClusters beside bridges
+across gaps (their model on the host: pendular.gpu.clusters); controls StressServo,
 ConstantStrainRate, MixedStress (its servos among the controls), RadiusGrowth and
 GrowthTimeStep (pendular.gpu.growth), Grip after them (pendular.gpu.grips); the Integrator. A periodic cell (``PeriodicCell``, sheared or not) with ContactForces (or a
 damped or Hertz–Mindlin law), RollingResistance and, wet, SuctionBridges at contact or across
@@ -57,7 +59,7 @@ import numpy as np
 
 from pendular.dem.neighbors import carry_pair_array, previous_pair_index
 # the modules that declare the operations' device sides (pendular.gpu.operations)
-from pendular.gpu import (cell, gravity, grips, integrate, rolling,  # noqa: F401
+from pendular.gpu import (cell, clusters, gravity, grips, integrate, rolling,  # noqa: F401
     wall_friction, wall_rolling)
 from pendular.gpu import bridges as device_bridges, forces, neighbors, walls as device_walls
 from pendular.gpu.cuda import configured, cuda, simulated
@@ -106,6 +108,15 @@ class GpuSimulation:
         self.sim = sim
         self.scene = scene
         self.bridges = scene.force("bridges") or device_bridges.NoBridges()
+        self._upload()
+        self.steps = []
+        self.launches = []
+
+    # ---------------------------------------------------------------- set-up
+    def _upload(self):
+        """The host's state onto the device: particles, the neighbour list with its per-pair
+        state (sized for the bridges' reach now), the controls' program and memory."""
+        sim, scene = self.sim, self.scene
         reach, film = self.bridges.upload(sim)
         self._growth = DeviceGrowth.of(scene)
         resisting = scene.force("rolling") is not None
@@ -120,10 +131,7 @@ class GpuSimulation:
                                      for row in side.driven(scene)}))
         self._holding = False
         self._upload_controls()
-        self.steps = []
-        self.launches = []
 
-    # ---------------------------------------------------------------- set-up
     def _upload_controls(self):
         """The controls' program and memory (pendular.gpu.walls), each row from its control's
         side, and the box's own state."""
@@ -223,7 +231,14 @@ class GpuSimulation:
     # ---------------------------------------------------------------- running
     def advance(self):
         """One step on the device (launches only); sim.step and sim.time advance, the rest of
-        sim's state is held by the device (Simulation.hold) until read."""
+        sim's state is held by the device (Simulation.hold) until read. When the host changed
+        an operation since the last step (a model stepped by a writer on the state it fetched:
+        a force side's ``changed_on_host``), the launches are laid again first, and the state
+        uploaded again from the host if the bridges' reach grew (the host holds it then)."""
+        if any(side.changed_on_host() for side in self.scene.forces):
+            if not self._holding and self.bridges.reach_changed(self.state):
+                self._upload()
+            self.configure()
         idle = simulated() and self.state.flags[0] == 0
         launches = self.launches[REBUILD_LAUNCHES if idle else 0:]
         if self._growth is not None:        # sets dt mid-step at a rebuild

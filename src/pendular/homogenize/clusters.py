@@ -22,6 +22,7 @@ def chi_with_clusters(sim, clusters, psi_clusters=None):
     ``clusters`` (pendular.capillary.liquid_clusters.LiquidClusters) of ``sim``, over the box
     or the periodic cell (module docstring); ``psi_clusters``: ``clusters.stress(sim)`` if
     already measured."""
+    sim.fetch("contacts")           # all of a device run's state (Simulation.fetch)
     contacts, particles = sim.contacts, sim.particles
     state = BridgeState.of(contacts)
     index = np.flatnonzero(state.mask())

@@ -55,11 +55,15 @@ def refuse_clusters(config) -> str | None:
 
 
 def refuse_clusters_device(config, device: str) -> None:
-    """ValueError naming --device when the LaboratoryConfig ``config`` with liquid clusters
-    would run (or resume) on the GPU."""
-    if config.liquid == "clusters" and device != "cpu":
-        raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the host's): "
-                         f"--device {device} does not apply")
+    """ValueError naming --device when ``config`` (a LaboratoryConfig or SwccConfig) with
+    liquid clusters in a periodic cell would run (or resume) on the GPU: the device's cell
+    stress holds no clusters' virial (pendular.gpu.clusters; between walls the GPU runs
+    them)."""
+    if config.liquid == "clusters" and device != "cpu" and config.sample.periodic:
+        raise ValueError(f"--liquid clusters runs on the GPU between walls only: --device "
+                         f"{device} does not apply in a periodic cell (--periodic, "
+                         "simple-shear), whose stress would need the clusters' virial on the "
+                         "device")
 
 
 def join_clusters(sim, bridges, entry):

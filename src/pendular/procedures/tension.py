@@ -85,7 +85,7 @@ from pendular.procedures.reference import (CHAPTER4_SURFACE_TENSION, KIM_2001, K
     KIM_SEPARATION, SPECIFIC_GRAVITY, comparison_packing)
 from pendular.procedures.resume import resume_files, stored_run
 from pendular.procedures.run_options import RunOptions
-from pendular.procedures.tension_clusters import refuse_clusters, refuse_clusters_run
+from pendular.procedures.tension_clusters import refuse_clusters
 from pendular.procedures.tension_pull import case_name, prepare_void_ratio, run_case
 from pendular.procedures.tension_report import case_line, strength_predictions, write_report
 from pendular.utils.atomic import write_json
@@ -425,7 +425,6 @@ class TensionTest:
         options = RunOptions.of(options, **settings)
         progress, device, stop_after = options.progress, options.device, options.stop_after
         checkpoint_every = check_int("checkpoint_every", options.checkpoint_every, low=0)
-        refuse_clusters_run(self.config, device)
         check_device(device)
         arguments = (self.config.options() if options.arguments is None
                      else dict(options.arguments))
@@ -453,7 +452,6 @@ class TensionTest:
             state = checkpoint_extra_state(path)
             config = stored_run(config_from_dict(state.get("config") if isinstance(state, dict)
                                                  else None, path), out, cls, "tension", device)
-            refuse_clusters_run(config, device)
             run = TensionRun(out, config, state.get("arguments"), 1, stop_after, state)
             return cls(config)._run(out, progress, device, run)
 

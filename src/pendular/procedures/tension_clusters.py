@@ -12,9 +12,9 @@ the packing as it stands CLUSTER_UPDATES times over --max-strain (``ClosedLiquid
 filled units carried over, so the liquid is V at every update; between updates the suction
 is held, the bridges following their gaps at it.
 
-Between walls, smooth spheres (suction-controlled bridges have no roughness), on the CPU:
-``refuse_clusters`` and ``refuse_clusters_run`` name the options otherwise. A checkpoint holds
-the clusters' state (LiquidClusters.state_dict), so a pull resumes bit for bit.
+Between walls, smooth spheres (suction-controlled bridges have no roughness), on either
+device: ``refuse_clusters`` names the options otherwise. A checkpoint holds the clusters'
+state (LiquidClusters.state_dict), so a pull resumes bit for bit.
 """
 
 from __future__ import annotations
@@ -44,8 +44,8 @@ def refuse_clusters(config) -> str | None:
     if config.liquid != "clusters":
         return None
     if config.sample.periodic:
-        return ("--liquid clusters runs between walls, not with --periodic (a periodic cell's "
-                "cluster forces would need their face terms in the cell's stress)")
+        return ("--liquid clusters runs the direct tension between walls, not with --periodic "
+                "(its closed liquid is held in the walled sample's pore units)")
     if config.roughness > 0.0:
         return (f"--liquid clusters needs --roughness 0, got {config.roughness:g}: its "
                 "suction-controlled bridges are between smooth spheres (roughness is modelled "
@@ -53,12 +53,6 @@ def refuse_clusters(config) -> str | None:
     return None
 
 
-def refuse_clusters_run(config, device: str) -> None:
-    """ValueError naming --device when a run of ``config`` with liquid clusters asks for the
-    GPU."""
-    if config.liquid == "clusters" and device != "cpu":
-        raise ValueError(f"--liquid clusters runs on the CPU (its pore units are the host's); "
-                         f"got --device {device}")
 
 
 def wet_clusters(dry, config, water_content: float, pairs, settle):
