@@ -34,7 +34,7 @@ liquid clusters of filled pore units join the bridges (pendular.capillary.liquid
 drying empties units by Haines jumps from the hull, wetting fills them at their filling
 suction, so that the path gives the main drying and wetting curves; each row adds the
 clusters' figures, and pores/ holds the pore units coloured by cluster, one ParaView frame per
-stage (CPU only; a checkpoint holds the clusters' state and the frames written).
+stage (on either device; a checkpoint holds the clusters' state and the frames written).
 
 ``run(out, device="gpu")`` runs the preparation and every stage of the path on the GPU
 (docs/gpu.md: the persisting bridges and the suction changes between stages run there); the
@@ -185,9 +185,9 @@ class SwccTest:
                 "--stage-steps)")
         path_bridges(config, sample.radii())       # refuse a bad path before preparing
         if config.liquid == "clusters" and sample.periodic:
-            raise ValueError("liquid = 'clusters' runs between walls, not in a periodic cell "
-                             "(the clusters' forces would need their face terms in the cell's "
-                             "stress)")
+            raise ValueError("liquid = 'clusters' runs the SWCC between walls, not in a periodic "
+                             "cell (its drying starts at the hull of the centres, where the gas "
+                             "enters)")
 
     def run(self, out, options=None, **settings):
         """Run the path into ``out`` as ``options`` say (pendular.procedures.run_options

@@ -11,7 +11,8 @@ angles, the dilatancy, or at constant volume the volume change), simple_shear.pn
 sigma_n and the volumetric strain against gamma), vtk/, sample.h5, with --checkpoint-every
 checkpoint.h5; --resume DIR continues an interrupted run. The sample, wetting and output
 options are those of ``pendular triaxial``. Stresses compression positive [Pa]. --liquid
-clusters (at a suction or a water content, on the CPU): liquid clusters of filled pore units
+clusters (at a suction or a water content; on the CPU, the GPU's cell stress holding no
+clusters): liquid clusters of filled pore units
 cut from the sheared cell's images, their stress in the cell's (docs/liquid_clusters.md).
 
 --device gpu prepares and shears on the GPU (docs/gpu.md, "The periodic cell on the GPU").

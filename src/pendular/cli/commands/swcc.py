@@ -11,7 +11,7 @@ history.h5 and sample.h5, with --checkpoint-every N checkpoint.h5; --resume DIR 
 interrupted run bit for bit. --device gpu runs the preparation and the path on the GPU
 (docs/gpu.md). --liquid clusters adds liquid clusters of filled pore units to the bridges,
 the sample starting saturated: the main drying and wetting curves, with the clusters' figures
-in the rows and pores/ for ParaView (docs/liquid_clusters.md; on the CPU).
+in the rows and pores/ for ParaView (docs/liquid_clusters.md; on either device).
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ axial, sigma_3 on x); --constant-p holds the mean stress at the confining stress
 walls follow the axial ones): summary excess_pore_pressure_at_peak [Pa] of a saturated sample
 and effective_stress_path; wet, the water content is held too (volume-controlled bridges,
 closed liquid) and the suction and Sr change. --liquid clusters (at a suction or a water
-content, between walls or in a periodic cell, on the CPU): liquid clusters of filled pore
+content, between walls or in a periodic cell; on the GPU between walls): liquid clusters of filled pore
 units beside persisting bridges, updated as the packing deforms
 (pendular.procedures.loading_clusters); ``pores/*.pvd`` holds the pore units coloured by
 cluster.
