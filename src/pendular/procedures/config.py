@@ -20,9 +20,9 @@ import numpy as np
 
 from pendular.capillary import (BRIDGE_MODELS, CONTROLS, LIQUID_MODELS, MAX_CONTACT_ANGLE,
     MAX_ROUGHNESS, SURFACE_TENSION)
-from pendular.capillary.throats import ENTRY_ESTIMATES
 from pendular.dem.sample import load_sample
-from pendular.procedures.loading_clusters import refuse_clusters
+from pendular.procedures.loading_clusters import (entry_suction_parameter, liquid_parameter,
+    refuse_clusters, refuse_entry_suction)
 from pendular.dem.walls import ConstantStrainRate
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, check_soft_contacts,
     pwave_step)
@@ -36,9 +36,6 @@ MAX_TABLE_NODES = 200_000
 #: Fewest nodes of a bridge table along each of its axes (suction, distance).
 MIN_TABLE_NODES = 4
 
-#: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them
-#: (pendular.capillary.liquid_clusters).
-LIQUID_REGIMES = ("pendular", "clusters")
 #: Largest surface tension of a wetting liquid [N/m] (water 0.0728, mercury 0.485).
 MAX_SURFACE_TENSION = 1.0
 
@@ -100,34 +97,6 @@ def contact_angle_parameter(help="wetting angle", **changes):
     ``changes``: e.g. ``unset``)."""
     return parameter(0.0, unit="deg", low=0.0, high=MAX_CONTACT_ANGLE, high_inclusive=False,
                      flag="--contact-angle", help=help, **changes)
-
-
-def liquid_parameter(where):
-    """The field of a test's liquid regime (``--liquid``, LIQUID_REGIMES): pendular bridges
-    alone (default), or liquid clusters of filled pore units beside them
-    (docs/liquid_clusters.md); ``where``: how the test's clusters start, in words."""
-    return parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
-                     help="liquid regime: pendular bridges alone, or clusters of filled pore "
-                          f"units beside them ({where}; docs/liquid_clusters.md)")
-
-
-def entry_suction_parameter():
-    """The field of the liquid clusters' throat entry estimate (``--entry-suction``,
-    pendular.capillary.throats.ENTRY_ESTIMATES): the inscribed circle's (default) or the
-    Mayer–Stowe–Princen balance over the throat's section (docs/liquid_clusters.md)."""
-    return parameter("inscribed", kind=str, choices=ENTRY_ESTIMATES, flag="--entry-suction",
-                     help="with --liquid clusters, the suction at which gas enters a throat: "
-                          "through its inscribed circle, or by the Mayer-Stowe-Princen "
-                          "balance over its section (lower for wetting liquids; "
-                          "docs/liquid_clusters.md)")
-
-
-def refuse_entry_suction(config):
-    """ParameterError naming --entry-suction where ``config`` sets it without liquid
-    clusters (a configuration with ``liquid`` and ``entry_suction`` fields)."""
-    if config.entry_suction != "inscribed" and config.liquid != "clusters":
-        raise fail(config, "entry_suction", f"entry_suction = {config.entry_suction!r} needs "
-                   "liquid clusters (--liquid clusters): the pendular bridges have no throats")
 
 
 def strain_rate_parameter():

@@ -1,5 +1,6 @@
 """Liquid clusters in a laboratory test (``--liquid clusters``; docs/liquid_clusters.md 'In
-the DEM and the commands').
+the DEM and the commands'), and the clusters' options of every command, declared once
+(``liquid_parameter``, ``entry_suction_parameter``).
 
 At a suction the sample is wetted from dry: persisting suction-controlled bridges and
 pendular.capillary.liquid_clusters.LiquidClusters(bridges, saturated=False) join its forces
@@ -24,7 +25,9 @@ import time
 
 import numpy as np
 
+from pendular.capillary.throats import ENTRY_ESTIMATES
 from pendular.homogenize.invariants import mean_stress
+from pendular.utils.parameters import fail, parameter
 from pendular.utils.validate import check_int, check_range
 
 #: History records between two updates of the clusters during a loading (10 over a triaxial
@@ -37,6 +40,39 @@ CLUSTER_RECORDS = 50
 CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
                    "liquid_in_largest_cluster", "largest_cluster_percolates",
                    "saturation_pore_units", "saturation")
+
+
+#: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them
+#: (pendular.capillary.liquid_clusters).
+LIQUID_REGIMES = ("pendular", "clusters")
+
+
+def liquid_parameter(where):
+    """The field of a test's liquid regime (``--liquid``, LIQUID_REGIMES): pendular bridges
+    alone (default), or liquid clusters of filled pore units beside them
+    (docs/liquid_clusters.md); ``where``: how the test's clusters start, in words."""
+    return parameter("pendular", kind=str, choices=LIQUID_REGIMES, flag="--liquid",
+                     help="liquid regime: pendular bridges alone, or clusters of filled pore "
+                          f"units beside them ({where}; docs/liquid_clusters.md)")
+
+
+def entry_suction_parameter():
+    """The field of the liquid clusters' throat entry estimate (``--entry-suction``,
+    pendular.capillary.throats.ENTRY_ESTIMATES): the inscribed circle's (default) or the
+    Mayer–Stowe–Princen balance over the throat's section (docs/liquid_clusters.md)."""
+    return parameter("inscribed", kind=str, choices=ENTRY_ESTIMATES, flag="--entry-suction",
+                     help="with --liquid clusters, the suction at which gas enters a throat: "
+                          "through its inscribed circle, or by the Mayer-Stowe-Princen "
+                          "balance over its section (lower for wetting liquids; "
+                          "docs/liquid_clusters.md)")
+
+
+def refuse_entry_suction(config):
+    """ParameterError naming --entry-suction where ``config`` sets it without liquid
+    clusters (a configuration with ``liquid`` and ``entry_suction`` fields)."""
+    if config.entry_suction != "inscribed" and config.liquid != "clusters":
+        raise fail(config, "entry_suction", f"entry_suction = {config.entry_suction!r} needs "
+                   "liquid clusters (--liquid clusters): the pendular bridges have no throats")
 
 
 def refuse_clusters(config) -> str | None:
@@ -125,9 +161,9 @@ def hold_water(sim, bridges_config, pairs, target, settle, entry, *, max_gap=0.0
                settle_filled=True):
     """(bridges, clusters, first, found, steps): the static sample ``sim`` wetted in place to
     the closed liquid volume ``target`` [m^3] (a water content) held by persisting
-    suction-controlled bridges and liquid clusters (``bridges_config``: a configuration with its surface
-    tension and contact angle; ``entry``: the throats' entry estimate), the pore units empty at first
-    (liquid added to dry grains). The suction is found at the dry packing (``first``,
+    suction-controlled bridges and liquid clusters (``bridges_config``: a configuration with
+    its surface tension and contact angle; ``entry``: the throats' entry estimate), the pore
+    units empty at first (liquid added to dry grains). The suction is found at the dry packing (``first``,
     LiquidClusters.hold_volume; bridges on ``pairs``, (pair_i, pair_j, gap [m] or None: at
     contact), and with ``max_gap`` [m] > 0 across every gap of the neighbour list up to
     it), the sample run until static (``settle(sim)``, the steps), the suction found again

@@ -72,13 +72,13 @@ from pendular.procedures.columns import history_columns
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (AVERAGES, MAX_SURFACE_TENSION, MIN_SAMPLE_PARTICLES,
     check_loaded_confining, check_particles, config_from_dict, config_to_dict,
-    contact_angle_parameter, entry_suction_parameter, liquid_parameter, refuse_entry_suction,
-    registered, stage_steps_parameter)
+    contact_angle_parameter, registered, stage_steps_parameter)
 from pendular.procedures.equilibrium import NotStatic, equilibrium_status
 from pendular.procedures.feasibility import MIN_CONFINING_OVER_YOUNG, check_hertz_equilibria
 from pendular.procedures.laboratory import Interrupted, plain, run_identity
 from pendular.procedures.loading import run_stage
-from pendular.procedures.loading_clusters import refuse_clusters_device
+from pendular.procedures.loading_clusters import (entry_suction_parameter, liquid_parameter,
+    refuse_clusters_device, refuse_entry_suction)
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, options_named,
     sample_sizes, size_options)
 from pendular.procedures.preparation import (MAX_PARTICLES, PrepareConfig, prepare_sample,

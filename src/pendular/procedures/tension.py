@@ -72,9 +72,10 @@ from pendular.io.outputs import OutputFolder
 from pendular.io.plots import plot_curves, plot_strength
 from pendular.procedures.command import LaboratoryCommand
 from pendular.procedures.config import (MAX_SURFACE_TENSION, WATER_DENSITY, check_particles,
-    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter,
-    entry_suction_parameter, inertial_number, liquid_parameter, refuse_entry_suction,
+    check_steps_count, config_from_dict, config_to_dict, contact_angle_parameter, inertial_number,
     registered)
+from pendular.procedures.loading_clusters import (entry_suction_parameter, liquid_parameter,
+    refuse_entry_suction)
 from pendular.procedures.feasibility import MAX_INERTIAL_NUMBER
 from pendular.procedures.laboratory import Interrupted
 from pendular.procedures.options import (CHECKPOINT_EVERY, CommandOptions, WATER_CONTENT,
