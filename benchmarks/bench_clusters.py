@@ -14,7 +14,8 @@ over the volume between the walls (Scheel et al.'s liquid content), with the fra
 bridges, in clusters and in the largest cluster, the number of clusters and the percolation of
 the largest, the number of trimers (pendular.capillary.trimers) and the fraction of the liquid in
 their bridges, and ``merged_throats``: the throats whose three bridges' menisci meet, the filled
-units' included (the trimers the bridges alone would hold). For Kim (2001)'s direct-tension cases, the mean capillary stress chi s at each
+units' included (the trimers the bridges alone would hold), and the bridges' largest filling
+angle. For Kim (2001)'s direct-tension cases, the mean capillary stress chi s at each
 case's saturation on the wetting branch, bridges alone and with clusters (an estimate of how
 much the clusters raise the tensile strength, not a pull). Timed: ``set_suction`` (decomposition, thresholds, filling, forces) and one DEM
 step of the wet scene without and with the clusters.
@@ -77,8 +78,15 @@ def branch(sim, suctions, saturated, gap):
                                               "filled_units", "pore_units",
                                               "largest_cluster_percolates")},
                      "merged_throats": merged_throats(sim, clusters),
+                     "largest_filling_angle": largest_filling_angle(sim),
                      "bridges": bridges.count(sim)})
     return rows, times, sim
+
+
+def largest_filling_angle(sim):
+    """[deg] the largest filling angle of the bridges (at contact, on a packing of one size)."""
+    state = BridgeState.of(sim.contacts)
+    return float(max(state.filling_i.max(initial=0.0), state.filling_j.max(initial=0.0)))
 
 
 def merged_throats(sim, clusters):

@@ -421,9 +421,9 @@ class LiquidClusters:
     def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
         the liquid fractions in bridges, in clusters and in the largest cluster, the number of
-        trimers and the fraction of the liquid in their bridges (outside filled units: a part
-        of the bridges' fraction; ``trimers``), whether the
-        largest percolates along x, y, z (in a periodic cell: wraps around it,
+        trimers and the fraction of the liquid in their bridges (``trimers``; their shares
+        outside filled units, a part of the bridges' fraction), whether the largest cluster
+        percolates along x, y, z (in a periodic cell: wraps around it,
         pendular.capillary.clusters), the saturation (over the voids of the box or cell, and over
         the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
         if already measured)."""
