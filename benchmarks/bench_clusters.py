@@ -12,7 +12,10 @@ ascending from a saturated pore space (drying: Haines jumps from the hull),
 pendular.capillary.liquid_clusters.LiquidClusters gives the liquid account; W is the liquid
 over the volume between the walls (Scheel et al.'s liquid content), with the fractions in
 bridges, in clusters and in the largest cluster, the number of clusters and the percolation of
-the largest. For Kim (2001)'s direct-tension cases, the mean capillary stress chi s at each
+the largest, the number of trimers (pendular.capillary.trimers) and the fraction of the liquid in
+their bridges, and ``merged_throats``: the throats whose three bridges' menisci meet, the filled
+units' included (the trimers the bridges alone would hold), and the bridges' largest filling
+angle. For Kim (2001)'s direct-tension cases, the mean capillary stress chi s at each
 case's saturation on the wetting branch, bridges alone and with clusters (an estimate of how
 much the clusters raise the tensile strength, not a pull). Timed: ``set_suction`` (decomposition, thresholds, filling, forces) and one DEM
 step of the wet scene without and with the clusters.
@@ -26,7 +29,10 @@ import time
 import numpy as np
 
 from pendular.capillary import CapillaryBridges
+from pendular.capillary.bridge_state import BridgeState
 from pendular.capillary.liquid_clusters import LiquidClusters
+from pendular.capillary.pore_filling import unit_edges
+from pendular.capillary.trimers import find_trimers
 from pendular.homogenize.clusters import chi_with_clusters
 from pendular.homogenize.on_the_fly import CapillaryHomogenization
 from pendular.interop.yade.runner import cached_sample
@@ -68,10 +74,28 @@ def branch(sim, suctions, saturated, gap):
                      **{k: stats[k] for k in ("saturation", "saturation_pore_units",
                                               "liquid_in_bridges", "liquid_in_clusters",
                                               "liquid_in_largest_cluster", "clusters",
+                                              "trimers", "liquid_in_trimers",
                                               "filled_units", "pore_units",
                                               "largest_cluster_percolates")},
+                     "merged_throats": merged_throats(sim, clusters),
+                     "largest_filling_angle": largest_filling_angle(sim),
                      "bridges": bridges.count(sim)})
     return rows, times, sim
+
+
+def largest_filling_angle(sim):
+    """[deg] the largest filling angle of the bridges (at contact, on a packing of one size)."""
+    state = BridgeState.of(sim.contacts)
+    return float(max(state.filling_i.max(initial=0.0), state.filling_j.max(initial=0.0)))
+
+
+def merged_throats(sim, clusters):
+    """Number of throats whose three bridges' menisci meet, whether or not their units are
+    filled (pendular.capillary.trimers.find_trimers with no unit holding liquid)."""
+    contacts = sim.contacts
+    return find_trimers(clusters.units, unit_edges(clusters.units),
+                        np.zeros(clusters.units.count, bool), BridgeState.of(contacts),
+                        contacts.pair_i, contacts.pair_j, clusters.pair_edge(contacts)).count
 
 
 def kim_estimate(rows):

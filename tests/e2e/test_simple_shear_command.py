@@ -137,8 +137,8 @@ def test_a_shear_with_liquid_clusters_records_them_in_the_sheared_cell(liquid, t
     summary, history = summary_of(out), history_of(out)
     rows = len(history["step"])
     for name in ("clusters", "liquid_in_bridges", "liquid_in_clusters",
-                 "liquid_in_largest_cluster", "saturation", "saturation_pore_units",
-                 "water_content"):
+                 "liquid_in_largest_cluster", "trimers", "liquid_in_trimers", "saturation",
+                 "saturation_pore_units", "water_content"):
         assert history[name].shape == (rows,), name
     assert history["largest_cluster_percolates"].shape == (rows, 3)
     assert history["sigma_clusters"].shape == history["chi_with_clusters"].shape == (rows, 3, 3)

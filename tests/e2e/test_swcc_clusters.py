@@ -26,6 +26,7 @@ def test_swcc_with_clusters_dries_from_saturation_and_wets_back(tmp_path):
     assert drying[-1]["clusters"] == 0 and drying[-1]["liquid_in_bridges"] == 1.0
     for row in drying + wetting:
         assert row["liquid_in_bridges"] + row["liquid_in_clusters"] == pytest.approx(1.0)
+        assert 0.0 <= row["liquid_in_trimers"] <= row["liquid_in_bridges"]
         assert row["saturation"] <= row["saturation_pore_units"]
         assert np.isfinite(row["chi_with_clusters"])
     # at 20 kPa drying holds pore units that wetting has not filled again
@@ -34,7 +35,7 @@ def test_swcc_with_clusters_dries_from_saturation_and_wets_back(tmp_path):
     history = read_history(out / "history.h5")
     for column in ("clusters", "liquid_in_bridges", "liquid_in_clusters",
                    "liquid_in_largest_cluster", "largest_cluster_percolates",
-                   "saturation_pore_units"):
+                   "trimers", "liquid_in_trimers", "saturation_pore_units"):
         assert np.isfinite(history[column].values).all(), column
     assert history["clusters"].values.max() >= 1
     assert history["saturation"].values.max() == pytest.approx(

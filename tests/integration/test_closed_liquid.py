@@ -100,6 +100,7 @@ def test_hold_volume_conserves_the_liquid_in_the_dem_account(small_sample):
         stats = clusters.statistics(sim)
         assert stats["saturation"] == pytest.approx(saturation, rel=1e-9)
         assert stats["liquid_in_bridges"] + stats["liquid_in_clusters"] <= 1.0 + 1e-12
+        assert 0.0 <= stats["liquid_in_trimers"] <= stats["liquid_in_bridges"]
     assert clusters.filled.any()
     force = clusters._force
     assert np.abs(force.sum(axis=0)).max() < 1e-10 * np.abs(force).max()

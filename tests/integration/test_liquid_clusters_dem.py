@@ -58,6 +58,11 @@ def test_a_saturated_sample_drains_and_its_cluster_forces_balance(small_sample):
     assert stats["clusters"] >= 1 and stats["filled_units"] == filled
     assert stats["liquid_in_bridges"] + stats["liquid_in_clusters"] == pytest.approx(1.0)
     assert 0 < stats["liquid_in_largest_cluster"] <= stats["liquid_in_clusters"]
+    # trimers: around throats of empty units only, their liquid a part of the bridges'
+    trimers = clusters.trimers(sim)
+    assert stats["trimers"] == trimers.count
+    assert 0.0 <= stats["liquid_in_trimers"] <= stats["liquid_in_bridges"]
+    assert not clusters.filled[clusters.units.throat_units[trimers.throats]].any()
     assert 0 < stats["saturation"] < stats["saturation_pore_units"]
     # the clusters' share of chi: positive, below the saturated sample's
     chi = np.trace(chi_with_clusters(sim, clusters)) / 3

@@ -27,8 +27,8 @@ PATHS = ["void_ratio", "k0", "stage", "cycle", "shear_strain", "shear_stress", "
          "excess_pore_pressure"]
 #: Columns of a run with liquid clusters (--liquid clusters), besides WET.
 CLUSTERS = ["clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
-            "largest_cluster_percolates", "saturation_pore_units", "chi_with_clusters",
-            "sigma_clusters"]
+            "largest_cluster_percolates", "trimers", "liquid_in_trimers", "saturation_pore_units",
+            "chi_with_clusters", "sigma_clusters"]
 #: Columns of an impact (pendular.procedures.impact), besides time.
 IMPACT = ["overlap", "normal_force", "tangential_force", "angular_velocity"]
 CONFIG = {"type": "TriaxialConfig", "fields": {"suction": 30000.0, "particles": 200}}

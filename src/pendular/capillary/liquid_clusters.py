@@ -43,6 +43,7 @@ from pendular.capillary.pore_filling import (drain, filling_thresholds, imbibe,
 from pendular.capillary.pores import (PoreUnits, decompose, into_cell, nearest_images,
     search_rows)
 from pendular.capillary.throats import check_entry_estimate
+from pendular.capillary.trimers import find_trimers
 from pendular.dem.cell import pair_virial
 from pendular.dem.neighbors import branch_vectors, gather_pair_forces
 from pendular.dem.protocols import state_array
@@ -353,6 +354,14 @@ class LiquidClusters:
         return liquid_account(self.units, self._edges, self.found, volume, edge,
                               weight=self.liquid.weight, film=self.liquid.film)
 
+    def trimers(self, sim):
+        """Trimers (pendular.capillary.trimers) of the bridges now around the throats of the
+        units that hold no liquid."""
+        sim.fetch("contacts")
+        contacts = sim.contacts
+        return find_trimers(self.units, self._edges, self._held(), BridgeState.of(contacts),
+                            contacts.pair_i, contacts.pair_j, self.pair_edge(contacts))
+
     def _units_liquid(self, sim, account):
         """[m^3] the liquid inside the pore units: the filled units, and the bridges' shares in
         the empty ones (their dihedral angles there over 2 pi; a bridge between grains that
@@ -411,8 +420,10 @@ class LiquidClusters:
 
     def statistics(self, sim, account=None):
         """The clusters' figures of a stage row: their number, the filled and all pore units,
-        the liquid fractions in bridges, in clusters and in the largest cluster, whether the
-        largest percolates along x, y, z (in a periodic cell: wraps around it,
+        the liquid fractions in bridges, in clusters and in the largest cluster, the number of
+        trimers and the fraction of the liquid in their bridges (``trimers``; their shares
+        outside filled units, a part of the bridges' fraction), whether the largest cluster
+        percolates along x, y, z (in a periodic cell: wraps around it,
         pendular.capillary.clusters), the saturation (over the voids of the box or cell, and over
         the pore units' void alone) and the clusters' stress (``account``: ``account(sim)``
         if already measured)."""
@@ -421,12 +432,17 @@ class LiquidClusters:
         fractions = account.fractions()
         voids = sim.walls.volume() - sim.particles.solid_volume()
         in_units = self._units_liquid(sim, account) / float(np.sum(self.units.pore_volume))
+        trimers = self.trimers(sim)
+        in_trimers = trimers.liquid(BridgeState.of(sim.contacts).volume,
+                                    self.pair_share(sim.contacts))
         return {"clusters": int(self.found.count),
                 "filled_units": int(np.count_nonzero(self.filled)),
                 "pore_units": int(self.units.count),
                 "liquid_in_bridges": fractions["bridges"],
                 "liquid_in_clusters": fractions["clusters"],
                 "liquid_in_largest_cluster": fractions["largest"],
+                "trimers": trimers.count,
+                "liquid_in_trimers": in_trimers / account.total if account.total > 0 else 0.0,
                 "largest_cluster_percolates": [bool(v) for v in self.found.percolates],
                 "saturation": account.total / voids,
                 "saturation_pore_units": in_units,

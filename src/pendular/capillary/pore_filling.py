@@ -32,7 +32,7 @@ from functools import cached_property
 
 import numpy as np
 
-from pendular.capillary.pores import EDGES, FACES, dihedral_angles
+from pendular.capillary.pores import EDGES, FACES, dihedral_angles, throat_sides
 from pendular.capillary.throats import (check_entry_estimate, entry_suction,
     mayer_stowe_princen_entry)
 
@@ -111,8 +111,7 @@ def filling_thresholds(pore_units, radius, surface_tension, contact_angle=0.0,
     if entry == "inscribed":
         entry = entry_suction(throat, surface_tension, contact_angle)
     else:
-        _, side = np.unique(pore_units.throat_of.ravel(), return_index=True)
-        unit, face = np.divmod(side, 4)
+        unit, face = throat_sides(pore_units)
         entry = mayer_stowe_princen_entry(pore_units.vertices[unit[:, None], FACES[face]],
                                           radii[unit[:, None], FACES[face]], surface_tension,
                                           contact_angle)

@@ -140,6 +140,13 @@ class PoreUnits:
         return np.bincount(self.grains.ravel(), self.solid_angle.ravel(), minlength=grain_count)
 
 
+def throat_sides(pore_units):
+    """(unit, face) (T,) each: the first unit of each throat and the face (``FACES``) across
+    which it sees it (each throat once)."""
+    _, side = np.unique(pore_units.throat_of.ravel(), return_index=True)
+    return np.divmod(side, 4)
+
+
 def tetrahedron_volume(vertices):
     """(M,) [m^3] volumes of tetrahedra with ``vertices`` (M, 4, 3) [m]."""
     a = vertices[:, 1] - vertices[:, 0]

@@ -67,7 +67,8 @@ HISTORY_WRITERS = {
     **dict.fromkeys(("tensile_stress", "grip_pull"), ("tension",)),
     **dict.fromkeys(("clusters", "liquid_in_bridges", "liquid_in_clusters",
                      "liquid_in_largest_cluster", "largest_cluster_percolates",
-                     "saturation_pore_units", "chi_with_clusters", "sigma_clusters"),
+                     "trimers", "liquid_in_trimers", "saturation_pore_units",
+                     "chi_with_clusters", "sigma_clusters"),
                     (*LABORATORY, "swcc", "tension")),
     "water_content": (*LABORATORY, "swcc", "tension"),
     "liquid_total": ("path",),
@@ -141,6 +142,12 @@ HISTORY_COLUMNS = {
                                       "(--liquid clusters)"),
     "liquid_in_largest_cluster": Column("1", "fraction of the liquid held in the largest "
                                              "cluster (--liquid clusters)"),
+    "trimers": Column("1", "number of trimers: throats of empty pore units whose three "
+                           "bridges' menisci have merged (Scheel et al. 2008; --liquid "
+                           "clusters)", dtype="int64"),
+    "liquid_in_trimers": Column("1", "fraction of the liquid held in the trimers' bridges, "
+                                     "outside filled pore units (a part of liquid_in_bridges; "
+                                     "--liquid clusters)"),
     "largest_cluster_percolates": Column("1", "1 where the largest cluster spans the sample "
                                               "along the axis, else 0 (--liquid clusters)",
                                          _VECTOR),

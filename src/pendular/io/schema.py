@@ -73,7 +73,7 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "clusters": "1", "filled_units": "1", "pore_units": "1",
                     "liquid_in_bridges": "1", "liquid_in_clusters": "1",
                     "liquid_in_largest_cluster": "1", "largest_cluster_percolates": "1",
-                    "psi_clusters": "Pa", "saturation_pore_units": "1",
+                    "trimers": "1", "liquid_in_trimers": "1", "psi_clusters": "Pa", "saturation_pore_units": "1",
                     "chi_with_clusters": "1"}
 
 #: The clusters' figures of a direct tension's case (--liquid clusters,

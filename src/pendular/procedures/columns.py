@@ -58,7 +58,7 @@ def cluster_columns(clusters):
 
     columns = {name: figure(name) for name in (
         "clusters", "liquid_in_bridges", "liquid_in_clusters", "liquid_in_largest_cluster",
-        "saturation_pore_units", "saturation")}
+        "trimers", "liquid_in_trimers", "saturation_pore_units", "saturation")}
     percolates = figure("largest_cluster_percolates")
     columns["largest_cluster_percolates"] = lambda sim: np.array(percolates(sim), float)
     columns["water_content"] = lambda sim: gravimetric_water_content(
