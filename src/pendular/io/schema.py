@@ -73,14 +73,16 @@ SWCC_STAGE_UNITS = {"suction": "Pa", "saturation": "1", "bridges": "1",
                     "clusters": "1", "filled_units": "1", "pore_units": "1",
                     "liquid_in_bridges": "1", "liquid_in_clusters": "1",
                     "liquid_in_largest_cluster": "1", "largest_cluster_percolates": "1",
-                    "trimers": "1", "liquid_in_trimers": "1", "psi_clusters": "Pa", "saturation_pore_units": "1",
+                    "trimers": "1", "liquid_in_trimers": "1", "psi_clusters": "Pa",
+                    "saturation_pore_units": "1",
                     "chi_with_clusters": "1"}
 
 #: The clusters' figures of a direct tension's case (--liquid clusters,
 #: pendular.procedures.tension_clusters).
 TENSION_CLUSTER_UNITS = {"suction": "Pa", "clusters": "1", "liquid_in_bridges": "1",
                          "liquid_in_clusters": "1", "liquid_in_largest_cluster": "1",
-                         "largest_cluster_percolates": "1", "saturation_pore_units": "1"}
+                         "largest_cluster_percolates": "1", "trimers": "1",
+                         "liquid_in_trimers": "1", "saturation_pore_units": "1"}
 #: The clusters' figures of a laboratory test at a suction (--liquid clusters,
 #: pendular.procedures.loading_clusters): the tension's, the saturation of bridges and
 #: clusters, chi (tr / 3) with clusters and of the bridges alone, and p' with clusters.

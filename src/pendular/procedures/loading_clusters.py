@@ -38,8 +38,8 @@ CLUSTER_RECORDS = 50
 
 #: The clusters' figures of a history row kept in a summary (``cluster_summary``).
 CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
-                   "liquid_in_largest_cluster", "largest_cluster_percolates",
-                   "saturation_pore_units", "saturation")
+                   "liquid_in_largest_cluster", "largest_cluster_percolates", "trimers",
+                   "liquid_in_trimers", "saturation_pore_units", "saturation")
 
 
 #: Liquid regimes (``--liquid``): pendular bridges alone, or liquid clusters beside them

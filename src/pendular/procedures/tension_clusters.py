@@ -26,16 +26,16 @@ from pendular.capillary.validation import NotPendular
 from pendular.capillary.wetting import gravimetric_water_content
 from pendular.dem.measure import coordination, unbalanced_force
 from pendular.procedures.columns import cluster_columns as cluster_figures
-from pendular.procedures.loading_clusters import cluster_row, hold_water
+from pendular.procedures.loading_clusters import (CLUSTER_FIGURES as LABORATORY_FIGURES,
+    cluster_row, hold_water)
 from pendular.utils.parameters import ParameterError
 
 #: Closed-liquid solutions of a pull (LiquidClusters.hold_volume) over --max-strain.
 CLUSTER_UPDATES = 40
 
-#: The clusters' figures of a history row, kept in a case's summary (wetted and at the peak).
-CLUSTER_FIGURES = ("suction", "clusters", "liquid_in_bridges", "liquid_in_clusters",
-                   "liquid_in_largest_cluster", "largest_cluster_percolates",
-                   "saturation_pore_units")
+#: The clusters' figures of a history row, kept in a case's summary (wetted and at the peak):
+#: a laboratory test's, less the saturation, which the case reports itself.
+CLUSTER_FIGURES = tuple(name for name in LABORATORY_FIGURES if name != "saturation")
 
 
 def refuse_clusters(config) -> str | None:
