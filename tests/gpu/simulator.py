@@ -133,6 +133,18 @@ def prepared_sample(folders, options):
     return _SAMPLES[options]
 
 
+def command_runs_fixture(options):
+    """A test module's fixture ``command_runs``: (the sample.h5 of ``options``, prepared once
+    on the CPU by prepared_sample; a folder for the module's command runs)."""
+    import pytest
+
+    @pytest.fixture(scope="module")
+    def command_runs(tmp_path_factory):
+        return prepared_sample(tmp_path_factory, options), tmp_path_factory.mktemp("command")
+
+    return command_runs
+
+
 def on_the_gpu(command, sample, argv, folder):
     """The (command, argv) of ``pendular command *argv --sample sample --device gpu`` writing
     into ``folder``/gpu, without figures, for simulated's ``commands`` (histories_on_both reads

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from conftest import requires
-from simulator import (WALLED_SAMPLE, assert_same_records, histories_on_both, on_the_gpu,
-                       prepared_sample, simulated)
+from simulator import (WALLED_SAMPLE, assert_same_records, command_runs_fixture, histories_on_both,
+                       on_the_gpu, simulated)
 
 pytestmark = requires("numba_cuda")
 
@@ -24,11 +24,8 @@ TRIAXIAL = ["--particles", "60", "--suction", "20000", "--liquid", "clusters", "
             "0.002", "--inertial-number", "1e-3", "--quiet"]
 
 
-@pytest.fixture(scope="module")
-def command_runs(tmp_path_factory):
-    """The sample that the command test loads (prepared on the CPU,
-    simulator.prepared_sample), and the folder of its runs."""
-    return prepared_sample(tmp_path_factory, WALLED_SAMPLE), tmp_path_factory.mktemp("command")
+#: The sample that the command test loads, and the folder of its runs.
+command_runs = command_runs_fixture(WALLED_SAMPLE)
 
 
 @pytest.fixture(scope="module")
