@@ -275,12 +275,21 @@ class LiquidClusters:
         if not self.adds_forces(sim):
             return
         force += self._force
-        contacts = sim.contacts
-        share = self.pair_share(contacts)
+        absorbed = self._absorbed(sim)
+        if absorbed is not None:
+            contacts = sim.contacts
+            gather_pair_forces(absorbed, contacts.row_start, contacts.second_start,
+                               contacts.second_pair, force)
+
+    def _absorbed(self, sim):
+        """(K, 3) [N] minus the shares of the bridges' pair forces (on j from i) that the
+        filled units absorb, over ``sim``'s neighbour list; None where there is none, or where
+        the bridges' forces are not yet of this list."""
+        share = self.pair_share(sim.contacts)
         pair_force = self.bridges.pair_force
-        if len(pair_force) == len(share):
-            gather_pair_forces(-share[:, None] * pair_force, contacts.row_start,
-                               contacts.second_start, contacts.second_pair, force)
+        if len(share) and len(pair_force) == len(share):
+            return -share[:, None] * pair_force
+        return None
 
     def adds_forces(self, sim):
         """Whether ``apply`` adds any force to ``sim``'s grains now: whether a unit holds
@@ -409,13 +418,11 @@ class LiquidClusters:
         if self._own_virial is None or self._own_virial[0] is not self._force:
             self._own_virial = (self._force, -self._stress_over(1.0))
         total += self._own_virial[1]
-        contacts = sim.contacts
-        share = self.pair_share(contacts)
-        pair_force = self.bridges.pair_force
-        if len(share) and len(pair_force) == len(share):
+        absorbed = self._absorbed(sim)
+        if absorbed is not None:
+            contacts = sim.contacts
             total += pair_virial(sim.particles.position, contacts.row_start, contacts.pair_j,
-                                 contacts.image, sim.walls.period,
-                                 -share[:, None] * pair_force).reshape(3, 3)
+                                 contacts.image, sim.walls.period, absorbed).reshape(3, 3)
         return total
 
     def statistics(self, sim, account=None):
