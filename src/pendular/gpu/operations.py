@@ -189,6 +189,12 @@ class Scene:
             raise ValueError(f"device='gpu' needs one {role} among the forces; found none")
         return found[0] if found else None
 
+    def changeable_on_host(self):
+        """The force sides whose operation the host may change during a run: those whose
+        class has a ``changed_on_host`` of its own (GpuSimulation.advance asks only them)."""
+        return [side for side in self.forces
+                if type(side).changed_on_host is not DeviceSide.changed_on_host]
+
     def index(self, side):
         """The place of ``side`` among the forces' sides."""
         return next(i for i, other in enumerate(self.forces) if other is side)

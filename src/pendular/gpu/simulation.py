@@ -108,6 +108,7 @@ class GpuSimulation:
         self.sim = sim
         self.scene = scene
         self.bridges = scene.force("bridges") or device_bridges.NoBridges()
+        self._host_changes = scene.changeable_on_host()
         self._upload()
         self.steps = []
         self.launches = []
@@ -235,7 +236,7 @@ class GpuSimulation:
         an operation since the last step (a model stepped by a writer on the state it fetched:
         a force side's ``changed_on_host``), the launches are laid again first, and the state
         uploaded again from the host if the bridges' reach grew (the host holds it then)."""
-        if any(side.changed_on_host() for side in self.scene.forces):
+        if self._host_changes and any(side.changed_on_host() for side in self._host_changes):
             if not self._holding and self.bridges.reach_changed(self.state):
                 self._upload()
             self.configure()
